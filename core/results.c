@@ -1,0 +1,2 @@
+/* placeholder: being written */
+typedef int bvhlab_placeholder_results;

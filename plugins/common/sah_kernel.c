@@ -1,0 +1,2 @@
+/* placeholder */
+typedef int bvhlab_placeholder_kernel;
