@@ -1,4 +1,51 @@
-int main(void)
+/* bvhlab: build, check and compare BVH construction strategies. */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+static const char usage[] =
+	"usage: bvhlab COMMAND [ARGS]\n"
+	"\n"
+	"Build, check and compare BVH construction strategies (builder plugins).\n"
+	"\n"
+	"commands:\n"
+	"  run CONFIG.json [--out DIR] [--threads LIST] [--repeat N]\n"
+	"                        run an experiment: every scene x builder x thread count\n"
+	"  list                  the plugins on the search path, with their options\n"
+	"  info SCENE [--json]   triangle count and bounds of a mesh file or generator\n"
+	"  build PLUGIN SCENE [--threads N] [-o KEY=VALUE]...\n"
+	"                        one build, validated and measured\n"
+	"  help                  this text; `bvhlab COMMAND --help` for a command's\n"
+	"  version               the version\n"
+	"\n"
+	"Plugins are found by name on $BVHLAB_PLUGIN_PATH, the build tree and the\n"
+	"install folder, or given as a path to a .so file.\n";
+
+int main(int argc, char **argv)
 {
-	return 0;
+	if (argc < 2) {
+		fputs(usage, stderr);
+		return EXIT_USAGE;
+	}
+	const char *cmd = argv[1];
+	if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
+		fputs(usage, stdout);
+		return 0;
+	}
+	if (!strcmp(cmd, "version") || !strcmp(cmd, "--version")) {
+		printf("bvhlab %s (plugin ABI %d.%d)\n", bvhlab_version(), BVHLAB_ABI_MAJOR,
+		       BVHLAB_ABI_MINOR);
+		return 0;
+	}
+	if (!strcmp(cmd, "run"))
+		return cmd_run(argc - 1, argv + 1);
+	if (!strcmp(cmd, "list"))
+		return cmd_list(argc - 1, argv + 1);
+	if (!strcmp(cmd, "info"))
+		return cmd_info(argc - 1, argv + 1);
+	if (!strcmp(cmd, "build"))
+		return cmd_build(argc - 1, argv + 1);
+	fprintf(stderr, "bvhlab: unknown command '%s'\n\n%s", cmd, usage);
+	return EXIT_USAGE;
 }

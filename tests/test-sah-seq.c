@@ -1,5 +1,280 @@
+/*
+ * sah_seq: both methods on every generator and on degenerate scenes build
+ * valid trees that trace like brute force, respect max_leaf, repeat
+ * exactly, and the exact sweep is at least as good as binning. Its options
+ * are declared with their ranges.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <bvhlab/bvhlab.h>
+
 #include "testutil.h"
+
+#define RAYS 512
+#define RAY_SEED 12345
+
+static const char *const methods[] = { "sweep", "binned" };
+static const uint32_t leaf_sizes[] = { 1, 4, 8, 16 };
+#define LEAF_SIZES (sizeof(leaf_sizes) / sizeof(leaf_sizes[0]))
+
+static bvhlab_scene *generate(const char *generator, uint32_t count, uint32_t frequency,
+                              uint32_t size)
+{
+	bvhlab_gen_params params;
+	bvhlab_scene *scene = NULL;
+	bvhlab_error err = { { 0 } };
+
+	bvhlab_gen_params_init(&params);
+	params.seed = 7;
+	if (count)
+		params.count = count;
+	if (frequency)
+		params.frequency = frequency;
+	if (size)
+		params.size = size;
+	if (bvhlab_scene_generate(generator, &params, &scene, &err) < 0)
+		fprintf(stderr, "%s: %s\n", generator, err.message);
+	CHECK(scene != NULL);
+	return scene;
+}
+
+/* n copies of one triangle: no split separates any centroids. */
+static bvhlab_scene *identical_scene(uint32_t n)
+{
+	static const float tri[9] = { 0, 0, 0, 1, 0.5f, 0, 0.25f, 1, 0.75f };
+	bvhlab_scene *scene = calloc(1, sizeof(*scene));
+
+	CHECK(scene != NULL);
+	if (!scene)
+		return NULL;
+	scene->vertices = malloc(sizeof(tri));
+	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
+	CHECK(scene->vertices && scene->indices);
+	memcpy(scene->vertices, tri, sizeof(tri));
+	for (uint32_t i = 0; i < 3 * n; i++)
+		scene->indices[i] = i % 3;
+	scene->vertex_count = 3;
+	scene->triangle_count = n;
+	bvhlab_scene_update(scene);
+	return scene;
+}
+
+/* A leaf over max_leaf is allowed only when all its centroids coincide. */
+static void check_leaves(const bvhlab_tree *tree, const bvhlab_build_input *in,
+                         uint32_t max_leaf)
+{
+	for (uint32_t i = 0; i < tree->node_count; i++) {
+		const bvhlab_node *node = &tree->nodes[i];
+		if (node->count <= max_leaf)
+			continue;
+		const float *c0 = &in->centroids[3 * (size_t)tree->prim_index[node->first]];
+		for (uint32_t j = 1; j < node->count; j++) {
+			const float *c = &in->centroids[3 * (size_t)tree->prim_index[node->first + j]];
+			CHECK(c[0] == c0[0] && c[1] == c0[1] && c[2] == c0[2]);
+		}
+	}
+}
+
+static int build(const bvhlab_plugin *plugin, const bvhlab_build_input *in, const char *method,
+                 uint32_t max_leaf, bvhlab_tree *tree)
+{
+	bvhlab_options opts;
+	bvhlab_error err = { { 0 } };
+	int rc;
+
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin)), 0);
+	CHECK_INT(bvhlab_options_set_string(&opts, "method", method, &err), 0);
+	CHECK_INT(bvhlab_options_set_int(&opts, "max_leaf", max_leaf, &err), 0);
+	rc = bvhlab_build(plugin, &opts, in, 1, tree, &err);
+	if (rc < 0)
+		fprintf(stderr, "build %s max_leaf=%u: %s\n", method, max_leaf, err.message);
+	bvhlab_options_finish(&opts);
+	return rc;
+}
+
+/* Builds, checks everything about the tree and returns its SAH cost. */
+static double build_checked(const bvhlab_plugin *plugin, const char *name,
+                            const bvhlab_scene *scene, const bvhlab_build_input *in,
+                            const char *method, uint32_t max_leaf)
+{
+	bvhlab_tree tree = { 0 }, again = { 0 };
+	bvhlab_tree_stats stats;
+	bvhlab_error err = { { 0 } };
+	uint64_t mismatches = 1;
+	double cost = -1;
+
+	CHECK_INT(build(plugin, in, method, max_leaf, &tree), 0);
+	if (bvhlab_validate_tree(&tree, in, false, &err) != 0) {
+		fprintf(stderr, "%s %s max_leaf=%u: %s\n", name, method, max_leaf, err.message);
+		CHECK(!"valid tree");
+		goto out;
+	}
+	CHECK_INT(tree.index_count, in->prim_count);
+	CHECK(tree.node_count <= 2 * in->prim_count - 1);
+	CHECK_INT(bvhlab_validate_rays(&tree, scene, RAYS, RAY_SEED, &mismatches, &err), 0);
+	CHECK_INT(mismatches, 0);
+	check_leaves(&tree, in, max_leaf);
+	bvhlab_tree_stats_compute(&tree, &stats);
+	cost = stats.sah_cost;
+	/* Twice the same input: the same tree. */
+	CHECK_INT(build(plugin, in, method, max_leaf, &again), 0);
+	CHECK_INT(again.node_count, tree.node_count);
+	if (bvhlab_tree_compare(&tree, &again, &err) != 0) {
+		fprintf(stderr, "%s %s max_leaf=%u rebuilt: %s\n", name, method, max_leaf,
+		        err.message);
+		CHECK(!"repeatable");
+	}
+out:
+	bvhlab_tree_finish(&tree);
+	bvhlab_tree_finish(&again);
+	return cost;
+}
+
+static void test_scene(const bvhlab_plugin *plugin, const char *name, bvhlab_scene *scene)
+{
+	bvhlab_prims prims;
+	bvhlab_error err = { { 0 } };
+
+	if (!scene)
+		return;
+	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
+	for (size_t l = 0; l < LEAF_SIZES; l++) {
+		double cost[2];
+		for (int m = 0; m < 2; m++)
+			cost[m] = build_checked(plugin, name, scene, &prims.input, methods[m],
+			                        leaf_sizes[l]);
+		printf("%-10s %7u triangles  max_leaf %2u  SAH sweep %10.4f  binned %10.4f\n",
+		       name, scene->triangle_count, leaf_sizes[l], cost[0], cost[1]);
+		CHECK(cost[0] <= cost[1]);
+	}
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+static void test_descriptor(const bvhlab_plugin *plugin)
+{
+	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
+	static const char *const names[] = { "method", "bins", "max_leaf", "c_trav", "c_isect" };
+
+	CHECK(strcmp(b->name, "sah_seq") == 0);
+	CHECK(b->summary && *b->summary);
+	CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
+	CHECK(!(b->flags & BVHLAB_BUILDER_PARALLEL));
+	CHECK_INT(b->option_count, 5);
+	for (uint32_t i = 0; i < b->option_count && i < 5; i++) {
+		CHECK(strcmp(b->options[i].name, names[i]) == 0);
+		CHECK(b->options[i].help && *b->options[i].help);
+	}
+	CHECK(strcmp(b->options[0].def_string, "sweep") == 0);
+	CHECK_INT(b->options[1].def_int, 32);
+	CHECK_INT(b->options[2].def_int, 8);
+	CHECK(b->options[3].def_float == 1.0 && b->options[4].def_float == 1.0);
+}
+
+static void test_options(const bvhlab_plugin *plugin)
+{
+	bvhlab_options opts;
+	bvhlab_error err = { { 0 } };
+
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin)), 0);
+	CHECK_INT(bvhlab_options_set_int(&opts, "bins", 1, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "bins");
+	CHECK_INT(bvhlab_options_set_int(&opts, "bins", 257, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "bins");
+	CHECK_INT(bvhlab_options_set_int(&opts, "max_leaf", 0, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "max_leaf");
+	CHECK_INT(bvhlab_options_set_float(&opts, "c_trav", 0, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "c_trav");
+	CHECK_INT(bvhlab_options_set_string(&opts, "method", "median", &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "method");
+	CHECK_INT(bvhlab_options_set_int(&opts, "bins", 2, &err), 0);
+	CHECK_INT(bvhlab_options_set_int(&opts, "bins", 256, &err), 0);
+	bvhlab_options_finish(&opts);
+}
+
+/* With traversal made expensive the SAH wants big leaves: max_leaf caps them. */
+static void test_max_leaf_binds(const bvhlab_plugin *plugin, const bvhlab_prims *prims)
+{
+	const char *const settings[] = { "method=sweep", "method=binned" };
+	bvhlab_tree tree = { 0 };
+	bvhlab_tree_stats stats;
+	bvhlab_error err = { { 0 } };
+	bvhlab_options opts;
+
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin)), 0);
+	CHECK_INT(bvhlab_options_parse(&opts, "c_trav=1000", &err), 0);
+	for (uint32_t max_leaf = 2; max_leaf <= 16; max_leaf *= 2) {
+		CHECK_INT(bvhlab_options_set_int(&opts, "max_leaf", max_leaf, &err), 0);
+		for (size_t i = 0; i < 2; i++) {
+			CHECK_INT(bvhlab_options_parse(&opts, settings[i], &err), 0);
+			CHECK_INT(bvhlab_build(plugin, &opts, &prims->input, 1, &tree, &err), 0);
+			CHECK_INT(bvhlab_validate_tree(&tree, &prims->input, false, &err), 0);
+			check_leaves(&tree, &prims->input, max_leaf);
+			bvhlab_tree_stats_compute(&tree, &stats);
+			CHECK(stats.leaf_histogram[max_leaf - 1] > 0);
+		}
+	}
+	bvhlab_options_finish(&opts);
+	bvhlab_tree_finish(&tree);
+}
+
+/* Other bins and costs still give valid trees; bins does not affect sweep. */
+static void test_option_values(const bvhlab_plugin *plugin)
+{
+	bvhlab_scene *scene = generate("icosphere", 0, 12, 0);
+	bvhlab_prims prims;
+	bvhlab_options opts;
+	bvhlab_tree a = { 0 }, b = { 0 };
+	bvhlab_error err = { { 0 } };
+
+	if (!scene || bvhlab_prims_init(&prims, scene, &err) < 0) {
+		CHECK(!"icosphere input");
+		bvhlab_scene_destroy(scene);
+		return;
+	}
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin)), 0);
+	CHECK_INT(bvhlab_build(plugin, &opts, &prims.input, 1, &a, &err), 0);
+	CHECK_INT(bvhlab_options_set_int(&opts, "bins", 2, &err), 0);
+	CHECK_INT(bvhlab_build(plugin, &opts, &prims.input, 1, &b, &err), 0);
+	CHECK_INT(bvhlab_tree_compare(&a, &b, &err), 0);
+	const char *const settings[] = { "method=binned", "bins=256", "bins=2", "c_trav=0.25",
+	                                 "c_isect=4", "max_leaf=64" };
+	for (size_t i = 0; i < sizeof(settings) / sizeof(settings[0]); i++) {
+		CHECK_INT(bvhlab_options_parse(&opts, settings[i], &err), 0);
+		CHECK_INT(bvhlab_build(plugin, &opts, &prims.input, 2, &b, &err), 0);
+		CHECK_INT(bvhlab_validate_tree(&b, &prims.input, false, &err), 0);
+	}
+	bvhlab_options_finish(&opts);
+	test_max_leaf_binds(plugin, &prims);
+	bvhlab_tree_finish(&a);
+	bvhlab_tree_finish(&b);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
 int main(void)
 {
-	return TEST_SKIP;
+	bvhlab_plugin *plugin = NULL;
+	bvhlab_error err = { { 0 } };
+
+	if (bvhlab_plugin_open("sah_seq", &plugin, &err) < 0) {
+		fprintf(stderr, "%s\n", err.message);
+		CHECK(!"sah_seq loads");
+		return test_finish();
+	}
+	test_descriptor(plugin);
+	test_options(plugin);
+	test_option_values(plugin);
+	test_scene(plugin, "soup", generate("soup", 20000, 0, 0));
+	test_scene(plugin, "icosphere", generate("icosphere", 0, 24, 0));
+	test_scene(plugin, "stadium", generate("stadium", 10000, 0, 0));
+	test_scene(plugin, "terrain", generate("terrain", 0, 0, 48));
+	test_scene(plugin, "identical", identical_scene(1000));
+	test_scene(plugin, "one", generate("soup", 1, 0, 0));
+	test_scene(plugin, "two", generate("soup", 2, 0, 0));
+	bvhlab_plugin_close(plugin);
+	return test_finish();
 }

@@ -84,15 +84,20 @@ typedef struct bvhlab_trace_stats {
 	uint64_t tris_tested;
 } bvhlab_trace_stats;
 
-/* Watertight ray/triangle test; on a hit nearer than hit->t updates hit. */
+/*
+ * Watertight ray/triangle test (Woop, Benthin, Wald 2013), two-sided. Uses
+ * the caller's hit->t as the upper bound (initialise it to ray->tmax) and
+ * reports hits with tmin < t < hit->t; u and v weight vertices 1 and 2.
+ */
 bool bvhlab_intersect_triangle(const bvhlab_ray *ray, const bvhlab_scene *scene,
                                uint32_t prim, bvhlab_hit *hit);
 
-/* Closest hit through the tree (stack-based, near child first). */
+/* Closest hit through the tree (stack-based, near child first). Initialises
+ * *hit (t = tmax, prim = BVHLAB_NO_HIT); nodes_visited counts nodes entered. */
 void bvhlab_trace_closest(const bvhlab_tree *tree, const bvhlab_scene *scene,
                           const bvhlab_ray *ray, bvhlab_hit *hit, bvhlab_trace_stats *stats);
 
-/* Closest hit by testing every triangle. */
+/* Closest hit by testing every triangle; initialises *hit like the above. */
 void bvhlab_trace_brute(const bvhlab_scene *scene, const bvhlab_ray *ray, bvhlab_hit *hit);
 
 /* ---- canonical comparison ------------------------------------------------ */
@@ -100,7 +105,8 @@ void bvhlab_trace_brute(const bvhlab_scene *scene, const bvhlab_ray *ray, bvhlab
 /*
  * Compares two trees regardless of node order: same shape, same boxes (bit
  * for bit), same primitive set in each leaf. 0 when equal; 1 with the first
- * difference described in err; a negative errno on allocation failure.
+ * difference described in err; -EINVAL for a malformed tree (cycle, index
+ * out of range: validate first); -ENOMEM on allocation failure.
  */
 int bvhlab_tree_compare(const bvhlab_tree *a, const bvhlab_tree *b, bvhlab_error *err);
 

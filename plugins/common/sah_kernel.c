@@ -1,2 +1,278 @@
-/* placeholder */
-typedef int bvhlab_placeholder_kernel;
+/*
+ * The SAH kernel's shared part: options, builder setup, node writing, the
+ * leaf rule and the sequential subtree builder. The split searches are in
+ * sah_sweep.c and sah_binned.c.
+ */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sah_internal.h"
+
+static int read_int(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *name,
+                    int64_t lo, int64_t hi, uint32_t *out)
+{
+	int64_t v;
+	int rc = host->option_int(ctx, name, &v);
+
+	if (rc < 0) {
+		host->set_error(ctx, "option \"%s\" is not available (%d)", name, rc);
+		return rc;
+	}
+	if (v < lo || v > hi) {
+		host->set_error(ctx, "option \"%s\" = %lld is outside %lld..%lld", name,
+		                (long long)v, (long long)lo, (long long)hi);
+		return -EINVAL;
+	}
+	*out = (uint32_t)v;
+	return 0;
+}
+
+static int read_cost(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *name,
+                     float *out)
+{
+	double v;
+	int rc = host->option_float(ctx, name, &v);
+
+	if (rc < 0) {
+		host->set_error(ctx, "option \"%s\" is not available (%d)", name, rc);
+		return rc;
+	}
+	/* Written as a negation so that NaN is rejected too. */
+	if (!(v > 0 && v <= 1e30)) {
+		host->set_error(ctx, "option \"%s\" = %g must be positive and finite", name, v);
+		return -EINVAL;
+	}
+	*out = (float)v;
+	return 0;
+}
+
+static int read_method(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
+{
+	const char *s;
+	int rc = host->option_string(ctx, "method", &s);
+
+	if (rc < 0) {
+		host->set_error(ctx, "option \"method\" is not available (%d)", rc);
+		return rc;
+	}
+	if (s && strcmp(s, "sweep") == 0) {
+		*out = SAH_SWEEP;
+	} else if (s && strcmp(s, "binned") == 0) {
+		*out = SAH_BINNED;
+	} else {
+		host->set_error(ctx, "option \"method\" = \"%s\" is not sweep or binned",
+		                s ? s : "(null)");
+		return -EINVAL;
+	}
+	return 0;
+}
+
+int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt)
+{
+	int rc;
+
+	if ((rc = read_method(host, ctx, &opt->method)) < 0 ||
+	    (rc = read_int(host, ctx, "bins", 2, SAH_MAX_BINS, &opt->bins)) < 0 ||
+	    (rc = read_int(host, ctx, "max_leaf", 1, 64, &opt->max_leaf)) < 0 ||
+	    (rc = read_cost(host, ctx, "c_trav", &opt->c_trav)) < 0 ||
+	    (rc = read_cost(host, ctx, "c_isect", &opt->c_isect)) < 0)
+		return rc;
+	return 0;
+}
+
+static bool input_ok(const sah_options *opt, const bvhlab_build_input *in,
+                     const bvhlab_build_output *out)
+{
+	uint64_t n = in->prim_count;
+
+	if (n == 0 || n > UINT32_MAX / 2 || !in->prim_bounds || !out->nodes || !out->prim_index)
+		return false;
+	if (opt->bins < 2 || opt->bins > SAH_MAX_BINS || opt->max_leaf < 1)
+		return false;
+	return out->node_capacity >= 2 * n - 1 && out->index_capacity >= n;
+}
+
+/* Copies the input boxes into dst in id order, and gathers the centroid
+ * bounds on the way (the kernel's centroids, see sah_prim). */
+static void copy_prims(sah_builder *b, const bvhlab_build_input *input, sah_prim *dst)
+{
+	box_empty(&b->root_cbox);
+	for (uint32_t i = 0; i < b->prim_count; i++) {
+		const bvhlab_aabb *src = &input->prim_bounds[i];
+		sah_prim *p = &dst[i];
+		for (int k = 0; k < 3; k++) {
+			p->lo[k] = src->lo[k];
+			p->hi[k] = src->hi[k];
+		}
+		p->id = i;
+		p->pad = 0;
+		box_grow_centroid(&b->root_cbox, p);
+	}
+}
+
+static int alloc_sweep(sah_builder *b, const bvhlab_build_input *input)
+{
+	size_t n = b->prim_count;
+
+	for (int a = 0; a < 3; a++)
+		b->prims[a] = malloc(n * sizeof(sah_prim));
+	b->temp = malloc(n * sizeof(sah_prim));
+	b->area = malloc(n * sizeof(float));
+	b->side = malloc(n);
+	if (!b->prims[0] || !b->prims[1] || !b->prims[2] || !b->temp || !b->area || !b->side)
+		return -ENOMEM;
+	copy_prims(b, input, b->temp);
+	return sah_presort(b);
+}
+
+int sah_builder_init(sah_builder *b, const sah_options *opt,
+                     const bvhlab_build_input *input, bvhlab_build_output *output)
+{
+	int rc = -ENOMEM;
+
+	memset(b, 0, sizeof(*b));
+	if (!input_ok(opt, input, output))
+		return -EINVAL;
+	b->opt = *opt;
+	b->prim_count = input->prim_count;
+	b->root_box = input->bounds;
+	b->nodes = output->nodes;
+	b->ids = output->prim_index;
+	atomic_init(&b->node_counter, 1);
+	if (opt->method == SAH_SWEEP) {
+		rc = alloc_sweep(b, input);
+		if (rc < 0)
+			goto fail;
+	} else {
+		b->prims[0] = malloc((size_t)b->prim_count * sizeof(sah_prim));
+		if (!b->prims[0])
+			goto fail;
+		copy_prims(b, input, b->prims[0]);
+	}
+	return 0;
+fail:
+	sah_builder_free(b);
+	return rc;
+}
+
+void sah_builder_free(sah_builder *b)
+{
+	for (int a = 0; a < 3; a++) {
+		free(b->prims[a]);
+		b->prims[a] = NULL;
+	}
+	free(b->temp);
+	free(b->area);
+	free(b->side);
+	b->temp = NULL;
+	b->area = NULL;
+	b->side = NULL;
+}
+
+void sah_builder_root(const sah_builder *b, sah_job *root)
+{
+	root->node = 0;
+	root->begin = 0;
+	root->end = b->prim_count;
+	root->depth = 0;
+	root->box = b->root_box;
+	root->cbox = b->root_cbox;
+}
+
+void sah_builder_finish(sah_builder *b, bvhlab_build_output *output)
+{
+	output->node_count = sah_node_count(b);
+	output->index_count = b->prim_count;
+}
+
+static void write_box(bvhlab_node *node, const bvhlab_aabb *box)
+{
+	for (int k = 0; k < 3; k++) {
+		node->lo[k] = box->lo[k];
+		node->hi[k] = box->hi[k];
+	}
+}
+
+void sah_write_leaf(sah_builder *b, const sah_job *job)
+{
+	bvhlab_node *node = &b->nodes[job->node];
+	const sah_prim *prims = b->prims[0];
+
+	write_box(node, &job->box);
+	node->first = job->begin;
+	node->count = job->end - job->begin;
+	for (uint32_t i = job->begin; i < job->end; i++)
+		b->ids[i] = prims[i].id;
+}
+
+void sah_write_inner(sah_builder *b, const sah_job *job, uint32_t mid, sah_job child[2])
+{
+	bvhlab_node *node = &b->nodes[job->node];
+	/* Relaxed: only uniqueness matters; the scheduler's hand-over of the
+	 * child jobs orders everything else. */
+	uint32_t first = atomic_fetch_add_explicit(&b->node_counter, 2, memory_order_relaxed);
+
+	write_box(node, &job->box);
+	node->first = first;
+	node->count = 0;
+	child[0].node = first;
+	child[0].begin = job->begin;
+	child[0].end = mid;
+	child[1].node = first + 1;
+	child[1].begin = mid;
+	child[1].end = job->end;
+	child[0].depth = child[1].depth = job->depth + 1;
+}
+
+bool sah_prefer_leaf(const sah_builder *b, const sah_job *job, bool found, float best)
+{
+	uint32_t n = job->end - job->begin;
+
+	if (n > b->opt.max_leaf)
+		return false;
+	if (!found)
+		return true;
+	/* Both costs multiplied by A, so a zero-area node (all primitives
+	 * degenerate and coincident) compares without dividing by zero. */
+	float area = box_half_area(&job->box);
+	float leaf = b->opt.c_isect * (float)n * area;
+	float split = b->opt.c_trav * area + b->opt.c_isect * best;
+	return leaf <= split;
+}
+
+unsigned sah_split_job(sah_builder *b, const sah_job *job, sah_job child[2])
+{
+	if (job->end - job->begin == 1) {
+		sah_write_leaf(b, job);
+		return 0;
+	}
+	if (b->opt.method == SAH_SWEEP)
+		return sah_sweep_split(b, job, child);
+	return sah_binned_split(b, job, child);
+}
+
+/* Larger-child-waits keeps the stack within log2(2^32) + 1 entries. */
+#define STACK_SIZE 64
+
+void sah_build_subtree(sah_builder *b, const sah_job *job)
+{
+	sah_job stack[STACK_SIZE];
+	sah_job cur = *job, child[2];
+	unsigned sp = 0;
+
+	for (;;) {
+		if (sah_split_job(b, &cur, child) == 2) {
+			uint32_t n0 = child[0].end - child[0].begin;
+			uint32_t n1 = child[1].end - child[1].begin;
+			unsigned small = n0 <= n1 ? 0 : 1;
+
+			stack[sp++] = child[1 - small];
+			cur = child[small];
+			continue;
+		}
+		if (sp == 0)
+			break;
+		cur = stack[--sp];
+	}
+}

@@ -1,0 +1,100 @@
+/* Argument helpers shared by the subcommands. */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "cli.h"
+#include "harness.h"
+
+int cli_parse_uint(const char *opt, const char *text, unsigned long max, unsigned long *out)
+{
+	char *end = NULL;
+	errno = 0;
+	unsigned long v = strtoul(text, &end, 10);
+	if (!*text || *end || errno || v > max || text[0] == '-') {
+		fprintf(stderr, "bvhlab: %s needs an integer in [0, %lu], not '%s'\n", opt, max, text);
+		return -EINVAL;
+	}
+	*out = v;
+	return 0;
+}
+
+int cli_parse_threads(const char *text, uint32_t *out, size_t max, size_t *count)
+{
+	*count = 0;
+	for (const char *p = text; *p;) {
+		char *end = NULL;
+		errno = 0;
+		unsigned long v = strtoul(p, &end, 10);
+		if (end == p || errno || v > 4096 || (*end && *end != ',') || *count == max ||
+		    *p == '-') {
+			fprintf(stderr, "bvhlab: --threads needs a list like 1,2,0 (0 = all "
+			                "cores, at most %zu entries), not '%s'\n", max, text);
+			return -EINVAL;
+		}
+		out[(*count)++] = (uint32_t)v;
+		p = *end ? end + 1 : end;
+	}
+	if (*count == 0) {
+		fprintf(stderr, "bvhlab: --threads needs at least one thread count\n");
+		return -EINVAL;
+	}
+	return 0;
+}
+
+/* "key=value" of a generator spec into params. */
+static int gen_param(bvhlab_gen_params *g, const char *kv, bvhlab_error *err)
+{
+	static const char *keys[] = {"frequency", "count", "size", "seed"};
+	const char *eq = strchr(kv, '=');
+	char *end = NULL;
+	unsigned long long v = eq ? strtoull(eq + 1, &end, 10) : 0;
+	for (int k = 0; eq && k < 4; k++) {
+		if (strncmp(kv, keys[k], (size_t)(eq - kv)) || strlen(keys[k]) != (size_t)(eq - kv))
+			continue;
+		if (!eq[1] || (end && *end && *end != ',') || (k < 3 && v > UINT32_MAX))
+			break;
+		uint32_t *fields[] = {&g->frequency, &g->count, &g->size};
+		if (k < 3)
+			*fields[k] = (uint32_t)v;
+		else
+			g->seed = v;
+		return 0;
+	}
+	snprintf(err->message, sizeof(err->message),
+	         "bad generator parameter '%.*s' (known: frequency, count, size, seed, as key=N)",
+	         (int)strcspn(kv, ","), kv);
+	return -EINVAL;
+}
+
+static bool is_generator_spec(const char *spec)
+{
+	struct stat st;
+	if (stat(spec, &st) == 0 || strchr(spec, '/'))
+		return false;
+	return !strchr(spec, '.') || strchr(spec, ':');
+}
+
+int cli_load_scene(const char *spec, unsigned subdivide, bvhlab_scene **out, bvhlab_error *err)
+{
+	struct config_scene cs = {.subdivide = subdivide};
+	char name[64];
+	bvhlab_gen_params_init(&cs.gen);
+	if (!is_generator_spec(spec)) {
+		cs.path = (char *)spec;
+		return harness_load_scene(&cs, out, err);
+	}
+	size_t len = strcspn(spec, ":");
+	snprintf(name, sizeof(name), "%.*s", (int)len, spec);
+	for (const char *p = spec[len] ? spec + len + 1 : ""; *p;) {
+		int r = gen_param(&cs.gen, p, err);
+		if (r < 0)
+			return r;
+		p += strcspn(p, ",");
+		p += *p == ',';
+	}
+	cs.generator = name;
+	return harness_load_scene(&cs, out, err);
+}

@@ -1,0 +1,28 @@
+/* The bvhlab command's subcommands. Each returns the process exit status. */
+#ifndef BVHLAB_APP_CLI_H
+#define BVHLAB_APP_CLI_H
+
+#include <bvhlab/bvhlab.h>
+
+/* Exit statuses: 0 success, 1 some run or check failed, 2 usage or input error. */
+enum { EXIT_RUNS_FAILED = 1, EXIT_USAGE = 2 };
+
+int cmd_run(int argc, char **argv);
+int cmd_list(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_build(int argc, char **argv);
+
+/*
+ * A scene named on the command line: a mesh file, or a generator with
+ * optional parameters, "icosphere:frequency=300,seed=2". `subdivide` applies
+ * to either.
+ */
+int cli_load_scene(const char *spec, unsigned subdivide, bvhlab_scene **out, bvhlab_error *err);
+
+/* Parses a comma-separated list of thread counts ("1,2,0"). */
+int cli_parse_threads(const char *text, uint32_t *out, size_t max, size_t *count);
+
+/* Parses a non-negative integer argument of an option, or prints why not. */
+int cli_parse_uint(const char *opt, const char *text, unsigned long max, unsigned long *out);
+
+#endif

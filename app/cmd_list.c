@@ -1,0 +1,88 @@
+/* bvhlab list: the plugins on the search path and their options. */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+static const char usage[] =
+	"usage: bvhlab list [PLUGIN...]\n"
+	"\n"
+	"Lists the builder plugins on the search path (or the named ones, by name or\n"
+	"path) with their summary, flags and options (type, default, range, help).\n"
+	"A plugin that cannot be loaded is listed with the reason.\n"
+	"\n"
+	"search path: $BVHLAB_PLUGIN_PATH, then the build tree, then the install folder.\n";
+
+static void print_flags(uint32_t flags)
+{
+	static const char *names[] = {"parallel", "deterministic", "spatial-splits", "UNFINISHED"};
+	const char *sep = "";
+	printf("  flags:");
+	for (int k = 0; k < 4; k++)
+		if (flags & (1u << k)) {
+			printf("%s %s", sep, names[k]);
+			sep = ",";
+		}
+	printf("%s\n", *sep ? "" : " none");
+}
+
+static void print_option(const bvhlab_option_decl *d)
+{
+	static const char *types[] = {"?", "bool", "int", "float", "string"};
+	bvhlab_option_value v = {.type = d->type, .b = d->def_bool, .i = d->def_int,
+	                         .f = d->def_float, .s = (char *)d->def_string};
+	char def[128];
+	bvhlab_option_format(&v, def, sizeof(def));
+	printf("    %-12s %-6s default %s", d->name, types[d->type <= 4 ? d->type : 0], def);
+	if (d->choices)
+		printf(", one of %s", d->choices);
+	else if (d->min <= d->max)
+		printf(", range [%g, %g]", d->min, d->max);
+	printf("\n      %s\n", d->help ? d->help : "");
+}
+
+static int list_one(const char *name)
+{
+	bvhlab_plugin *p = NULL;
+	bvhlab_error err = {{0}};
+	if (bvhlab_plugin_open(name, &p, &err) < 0) {
+		printf("%s: NOT USABLE: %s\n\n", name, err.message);
+		return 1;
+	}
+	const bvhlab_builder *b = bvhlab_plugin_builder(p);
+	printf("%s — %s%s\n  file: %s\n", b->name, b->summary ? b->summary : "",
+	       b->flags & BVHLAB_BUILDER_UNFINISHED ? " [UNFINISHED]" : "", bvhlab_plugin_path(p));
+	print_flags(b->flags);
+	printf("  options:%s\n", b->option_count ? "" : " none");
+	for (uint32_t k = 0; k < b->option_count; k++)
+		print_option(&b->options[k]);
+	printf("\n");
+	bvhlab_plugin_close(p);
+	return 0;
+}
+
+int cmd_list(int argc, char **argv)
+{
+	if (argc > 1 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
+		fputs(usage, stdout);
+		return 0;
+	}
+	int bad = 0;
+	if (argc > 1) {
+		for (int k = 1; k < argc; k++)
+			bad |= list_one(argv[k]);
+		return bad ? EXIT_RUNS_FAILED : 0;
+	}
+	char **names = NULL;
+	bvhlab_error err = {{0}};
+	if (bvhlab_plugin_names(&names, &err) < 0) {
+		fprintf(stderr, "bvhlab: %s\n", err.message);
+		return EXIT_USAGE;
+	}
+	if (!names[0])
+		printf("no plugins found on the search path %s\n", bvhlab_plugin_search_path());
+	for (char **n = names; *n; n++)
+		bad |= list_one(*n);
+	bvhlab_plugin_names_free(names);
+	return bad ? EXIT_RUNS_FAILED : 0;
+}

@@ -1,0 +1,38 @@
+/* Small helpers private to the core. */
+#ifndef BVHLAB_CORE_UTIL_H
+#define BVHLAB_CORE_UTIL_H
+
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <bvhlab/types.h>
+
+#if defined(__GNUC__)
+#define UTIL_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define UTIL_PRINTF(a, b)
+#endif
+
+/* printf into err->message (truncated with "..." if it must be); NULL err is fine. */
+void error_set(bvhlab_error *err, const char *fmt, ...) UTIL_PRINTF(2, 3);
+void error_setv(bvhlab_error *err, const char *fmt, va_list ap);
+/* Prepends "prefix: " to the message already in err. */
+void error_prefix(bvhlab_error *err, const char *fmt, ...) UTIL_PRINTF(2, 3);
+
+/* A growable string; a failed allocation sticks (failed = true). */
+struct strbuf {
+	char *data;
+	size_t len, cap;
+	bool failed;
+};
+
+void sb_printf(struct strbuf *sb, const char *fmt, ...) UTIL_PRINTF(2, 3);
+/* Returns the text (caller frees), or NULL if any append failed. */
+char *sb_take(struct strbuf *sb);
+
+/* Monotonic clock in seconds. */
+double util_now(void);
+
+#endif

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Sets everything up (Debian packages, meson build) and runs an experiment.
+# Usage: scripts/run.sh [CONFIG.json] [bvhlab run options...]
+# Default config: configs/default.json (generated scenes only, < 1 minute).
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+# shellcheck source=setup.sh
+. "$here/setup.sh"
+
+case "${1:-}" in
+-h|--help)
+	sed -n '2,4p' "$0" | sed 's/^# \{0,1\}//'
+	exit 0
+	;;
+esac
+
+config=${1:-$BVHLAB_ROOT/configs/default.json}
+[ $# -gt 0 ] && shift
+[ -f "$config" ] || { echo "run.sh: no such config: $config" >&2; exit 2; }
+
+setup_build "$BVHLAB_ROOT/build"
+exec "$BVHLAB_ROOT/build/app/bvhlab" run "$config" "$@"

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Sets everything up (Debian packages, meson build) and runs the whole test
+# suite: the release build, then ASan+UBSan, then ThreadSanitizer (threaded
+# code), each in its own build directory. Ends with "N passed, N failed".
+# Usage: scripts/test.sh [--quick]   (--quick: the release build only)
+set -uo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+# shellcheck source=setup.sh
+. "$here/setup.sh"
+
+quick=0
+case "${1:-}" in
+--quick) quick=1 ;;
+-h|--help) sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+esac
+
+passed=0 failed=0 skipped=0
+
+# Runs `meson test` in a build dir and adds its counts to the totals.
+run_suite() {
+	local label=$1 dir=$2
+	shift 2
+	echo "== $label ==" >&2
+	meson test -C "$dir" --print-errorlogs "$@"
+	local log="$dir/meson-logs/testlog.json"
+	local ok fail skip
+	ok=$(grep -c '"result": "OK"' "$log" || true)
+	fail=$(grep -cE '"result": "(FAIL|TIMEOUT|ERROR|UNEXPECTEDPASS)"' "$log" || true)
+	skip=$(grep -c '"result": "SKIP"' "$log" || true)
+	passed=$((passed + ok)); failed=$((failed + fail)); skipped=$((skipped + skip))
+}
+
+build_or_count() {
+	local label=$1 dir=$2
+	shift 2
+	if ! setup_build "$dir" "$@"; then
+		echo "test.sh: $label build failed" >&2
+		failed=$((failed + 1))
+		return 1
+	fi
+}
+
+build_or_count release "$BVHLAB_ROOT/build" && run_suite release "$BVHLAB_ROOT/build"
+
+if [ $quick = 0 ]; then
+	san_opts=(-Dbuildtype=debugoptimized -Db_lundef=false)
+	export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+	build_or_count asan "$BVHLAB_ROOT/build-asan" "${san_opts[@]}" -Db_sanitize=address,undefined &&
+		run_suite "asan+ubsan" "$BVHLAB_ROOT/build-asan" --timeout-multiplier 4
+	export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
+	build_or_count tsan "$BVHLAB_ROOT/build-tsan" "${san_opts[@]}" -Db_sanitize=thread &&
+		run_suite tsan "$BVHLAB_ROOT/build-tsan" --suite plugins --suite core --timeout-multiplier 6
+fi
+
+echo "$passed passed, $failed failed, $skipped skipped"
+[ "$failed" = 0 ]

@@ -1,0 +1,337 @@
+/*
+ * The bvhlab command end to end: runs it as a user would and checks exit
+ * statuses, messages and the files it writes.
+ * Usage: test-cli BVHLAB_EXE basic|errors|shared
+ */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cJSON.h>
+
+#include "../testutil.h"
+
+static const char *exe;
+static char tmpdir[] = "/tmp/bvhlab-cli-XXXXXX";
+static char out_text[1 << 16], err_text[1 << 16];
+
+static void slurp(const char *path, char *buf, size_t size)
+{
+	buf[0] = '\0';
+	FILE *f = fopen(path, "r");
+	if (!f)
+		return;
+	size_t n = fread(buf, 1, size - 1, f);
+	buf[n] = '\0';
+	fclose(f);
+}
+
+static char *read_file(const char *dir, const char *name)
+{
+	char path[512];
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	FILE *f = fopen(path, "r");
+	if (!f)
+		return NULL;
+	fseek(f, 0, SEEK_END);
+	long n = ftell(f);
+	rewind(f);
+	char *text = calloc(1, (size_t)n + 1);
+	if (text && fread(text, 1, (size_t)n, f) != (size_t)n)
+		text[0] = '\0';
+	fclose(f);
+	return text;
+}
+
+/* Runs bvhlab with args (NULL-terminated); stdout/stderr into the buffers. */
+static int run(const char *const *args)
+{
+	char out_path[256], err_path[256];
+	snprintf(out_path, sizeof(out_path), "%s/stdout", tmpdir);
+	snprintf(err_path, sizeof(err_path), "%s/stderr", tmpdir);
+	pid_t pid = fork();
+	if (pid == 0) {
+		int o = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+		int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+		dup2(o, 1);
+		dup2(e, 2);
+		char *argv[32] = {(char *)exe};
+		for (int k = 0; args[k] && k < 30; k++)
+			argv[k + 1] = (char *)args[k];
+		execv(exe, argv);
+		_exit(127);
+	}
+	int status = 0;
+	waitpid(pid, &status, 0);
+	slurp(out_path, out_text, sizeof(out_text));
+	slurp(err_path, err_text, sizeof(err_text));
+	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+static char *write_config(const char *name, const char *text)
+{
+	static char path[512];
+	snprintf(path, sizeof(path), "%s/%s", tmpdir, name);
+	FILE *f = fopen(path, "w");
+	fputs(text, f);
+	fclose(f);
+	return path;
+}
+
+static cJSON *load_results(const char *dir)
+{
+	char *text = read_file(dir, "results.json");
+	CHECK(text != NULL);
+	cJSON *doc = text ? cJSON_Parse(text) : NULL;
+	CHECK(doc != NULL);
+	free(text);
+	return doc;
+}
+
+static const char *run_str(const cJSON *run, const char *key)
+{
+	const cJSON *v = cJSON_GetObjectItem(run, key);
+	return cJSON_IsString(v) ? v->valuestring : "";
+}
+
+static int count_runs(const cJSON *doc, const char *builder, const char *status)
+{
+	int n = 0;
+	const cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
+		n += !strcmp(run_str(run, "builder"), builder) && !strcmp(run_str(run, "status"), status);
+	return n;
+}
+
+#define ARGS(...) ((const char *const[]){__VA_ARGS__, NULL})
+
+static void test_help(void)
+{
+	CHECK_INT(run(ARGS("--help")), 0);
+	CHECK_CONTAINS(out_text, "usage: bvhlab COMMAND");
+	const char *cmds[] = {"run", "list", "info", "build"};
+	for (int k = 0; k < 4; k++) {
+		CHECK_INT(run(ARGS(cmds[k], "--help")), 0);
+		CHECK_CONTAINS(out_text, "usage: bvhlab");
+		CHECK_CONTAINS(out_text, cmds[k]);
+	}
+	CHECK_INT(run(ARGS("frobnicate")), 2);
+	CHECK_CONTAINS(err_text, "unknown command 'frobnicate'");
+	CHECK_INT(run(ARGS("version")), 0);
+	CHECK_CONTAINS(out_text, "plugin ABI 1.");
+}
+
+static const char good_config[] =
+	"{ \"format_version\": 1, \"output\": \"out-good\", \"repeat\": 2, \"warmup\": 1,\n"
+	"  \"threads\": [1, 2],\n"
+	"  \"scenes\": [ { \"name\": \"ico\", \"generator\": \"icosphere\", \"frequency\": 12 },\n"
+	"              { \"generator\": \"soup\", \"count\": 3000, \"seed\": 7 } ],\n"
+	"  \"builders\": [ { \"plugin\": \"sah_seq\", \"name\": \"sweep\", \"threads\": [1] },\n"
+	"                { \"plugin\": \"sah_seq\", \"name\": \"binned\", \"threads\": [1],\n"
+	"                  \"options\": { \"method\": \"binned\", \"bins\": 16 } },\n"
+	"                { \"plugin\": \"fake_good\" } ] }\n";
+
+static void check_good_results(const char *dir)
+{
+	cJSON *doc = load_results(dir);
+	if (!doc)
+		return;
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 8);
+	CHECK_INT(count_runs(doc, "sweep", "ok"), 2);
+	CHECK_INT(count_runs(doc, "binned", "ok"), 2);
+	CHECK_INT(count_runs(doc, "fake_good", "ok"), 4);
+	const cJSON *scenes = cJSON_GetObjectItem(doc, "scenes");
+	CHECK_INT(cJSON_GetArraySize(scenes), 2);
+	const cJSON *ico = cJSON_GetArrayItem(scenes, 0);
+	CHECK_INT(cJSON_GetObjectItem(ico, "triangles")->valueint, 20 * 12 * 12);
+	CHECK(!strcmp(run_str(cJSON_GetArrayItem(scenes, 1), "name"), "soup"));
+	const cJSON *run0 = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
+	CHECK(cJSON_IsTrue(cJSON_GetObjectItem(cJSON_GetObjectItem(run0, "validation"), "valid")));
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(cJSON_GetObjectItem(run0, "build_ms"),
+	                                                 "samples")), 2);
+	CHECK(cJSON_GetObjectItem(cJSON_GetObjectItem(run0, "tree"), "sah_cost")->valuedouble > 1);
+	CHECK(!strcmp(run_str(cJSON_GetObjectItem(run0, "options"), "method"), "sweep"));
+	cJSON_Delete(doc);
+
+	char *csv = read_file(dir, "results.csv");
+	char *md = read_file(dir, "report.md");
+	CHECK_CONTAINS(csv, "scene,builder,plugin,status,threads,build_ms.median");
+	CHECK_CONTAINS(csv, "soup,binned,sah_seq,ok,1,");
+	CHECK_CONTAINS(md, "## ico");
+	CHECK_CONTAINS(md, "## soup");
+	CHECK_CONTAINS(md, "| binned | 1 | ok |");
+	free(csv);
+	free(md);
+}
+
+static void test_run_good(void)
+{
+	const char *cfg = write_config("good.json", good_config);
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 0);
+	char dir[512];
+	snprintf(dir, sizeof(dir), "%s/out-good", tmpdir);
+	check_good_results(dir);
+
+	/* --out and --repeat override the config. */
+	snprintf(dir, sizeof(dir), "%s/out-override", tmpdir);
+	CHECK_INT(run(ARGS("run", cfg, "--out", dir, "--repeat", "1")), 0);
+	CHECK_CONTAINS(err_text, "[8/8");
+	cJSON *doc = load_results(dir);
+	const cJSON *run0 = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(cJSON_GetObjectItem(run0, "build_ms"),
+	                                                 "samples")), 1);
+	cJSON_Delete(doc);
+}
+
+static void test_info_build_list(void)
+{
+	CHECK_INT(run(ARGS("info", "soup:count=1000,seed=3", "--json")), 0);
+	cJSON *o = cJSON_Parse(out_text);
+	CHECK(o && cJSON_GetObjectItem(o, "triangles")->valueint == 1000);
+	cJSON_Delete(o);
+	CHECK_INT(run(ARGS("info", "icosphere:frequency=4", "--subdivide", "1")), 0);
+	CHECK_CONTAINS(out_text, "triangles:  1280");
+	CHECK_INT(run(ARGS("info", "/nonexistent/mesh.obj")), 2);
+	CHECK_CONTAINS(err_text, "/nonexistent/mesh.obj");
+
+	CHECK_INT(run(ARGS("build", "sah_seq", "icosphere:frequency=8", "-o", "method=binned",
+	                   "--repeat", "2")), 0);
+	CHECK_CONTAINS(out_text, "valid:      yes");
+	CHECK_CONTAINS(out_text, "SAH cost:");
+	CHECK_INT(run(ARGS("build", "sah_seq", "soup:count=500", "-o", "bins=1")), 2);
+	CHECK_CONTAINS(err_text, "option 'bins' of builder 'sah_seq' is out of range");
+	CHECK_INT(run(ARGS("build", "no_such_plugin", "soup")), 2);
+	CHECK_CONTAINS(err_text, "plugin 'no_such_plugin' not found");
+
+	CHECK_INT(run(ARGS("list", "sah_seq")), 0);
+	CHECK_CONTAINS(out_text, "sah_seq");
+	CHECK_CONTAINS(out_text, "method");
+	CHECK_CONTAINS(out_text, "sweep|binned");
+	CHECK_INT(run(ARGS("list")), 1); /* the broken fake plugins are on the path */
+	CHECK_CONTAINS(out_text, "fake_abi2: NOT USABLE");
+	CHECK_CONTAINS(out_text, "fake_good");
+}
+
+static void test_config_errors(void)
+{
+	const char *cfg = write_config("typo.json",
+		"{ \"format_version\": 1,\n"
+		"  \"scenes\": [ { \"generator\": \"soup\" } ],\n"
+		"  \"builders\": [ { \"plugin\": \"sah_seq\",\n"
+		"                  \"threds\": [1] } ] }\n");
+	CHECK_INT(run(ARGS("run", cfg)), 2);
+	CHECK_CONTAINS(err_text, "typo.json:4:19: unknown key 'threds'");
+	CHECK_CONTAINS(err_text, "did you mean 'threads'?");
+
+	cfg = write_config("syntax.json", "{ \"format_version\": 1,\n  \"scenes\": [ }\n");
+	CHECK_INT(run(ARGS("run", cfg)), 2);
+	CHECK_CONTAINS(err_text, "syntax.json:2:");
+
+	CHECK_INT(run(ARGS("run", "/nonexistent/config.json")), 2);
+	CHECK_CONTAINS(err_text, "/nonexistent/config.json");
+}
+
+/* Bad builders and scenes are recorded as failed runs; the rest still run. */
+static void test_bad_builders(void)
+{
+	const char *cfg = write_config("bad.json",
+		"{ \"output\": \"out-bad\", \"repeat\": 1,\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 500 },\n"
+		"              { \"name\": \"broken\", \"path\": \"missing.obj\" } ],\n"
+		"  \"builders\": [ { \"plugin\": \"no_such_plugin\" },\n"
+		"                { \"plugin\": \"fake_abi2\" },\n"
+		"                { \"plugin\": \"fake_good\", \"name\": \"fails\",\n"
+		"                  \"options\": { \"fail\": \"error\" } },\n"
+		"                { \"plugin\": \"fake_good\", \"name\": \"typo\",\n"
+		"                  \"options\": { \"alpah\": 2 } },\n"
+		"                { \"plugin\": \"sah_seq\" } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 1);
+	CHECK_CONTAINS(err_text, "bad.json:9:32: builder 'typo': unknown option 'alpah'");
+	char dir[512];
+	snprintf(dir, sizeof(dir), "%s/out-bad", tmpdir);
+	cJSON *doc = load_results(dir);
+	if (!doc)
+		return;
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 10);
+	CHECK_INT(count_runs(doc, "sah_seq", "ok"), 1);
+	CHECK_INT(count_runs(doc, "sah_seq", "failed"), 1); /* the missing scene */
+	CHECK_INT(count_runs(doc, "no_such_plugin", "failed"), 2);
+	CHECK_INT(count_runs(doc, "fake_abi2", "failed"), 2);
+	CHECK_INT(count_runs(doc, "fails", "failed"), 2);
+	char *json = cJSON_PrintUnformatted(doc);
+	CHECK_CONTAINS(json, "plugin 'no_such_plugin' not found");
+	CHECK_CONTAINS(json, "built for ABI 2.0");
+	CHECK_CONTAINS(json, "builder 'fake_good': asked to fail");
+	CHECK_CONTAINS(json, "missing.obj");
+	free(json);
+	cJSON_Delete(doc);
+}
+
+/* All five shared meshes, both sah_seq methods: valid, sweep SAH <= binned SAH. */
+static void test_shared_meshes(void)
+{
+	static const char *meshes[] = {"stanford-bunny.obj", "ogre.obj", "nefertiti.obj",
+	                               "horse.ply", "igea.ply"};
+	char text[4096];
+	int n = snprintf(text, sizeof(text),
+	                 "{ \"output\": \"out-shared\", \"repeat\": 1, \"warmup\": 0,\n"
+	                 "  \"validate_rays\": 64, \"scenes\": [");
+	for (int k = 0; k < 5; k++)
+		n += snprintf(text + n, sizeof(text) - (size_t)n, "%s{ \"path\": \"%s/%s\" }",
+		              k ? ", " : "", BVHLAB_SHARED_SCENES, meshes[k]);
+	snprintf(text + n, sizeof(text) - (size_t)n,
+	         "],\n  \"builders\": [ { \"plugin\": \"sah_seq\", \"name\": \"sweep\" },\n"
+	         "  { \"plugin\": \"sah_seq\", \"name\": \"binned\", "
+	         "\"options\": { \"method\": \"binned\" } } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", write_config("shared.json", text))), 0);
+	char dir[512];
+	snprintf(dir, sizeof(dir), "%s/out-shared", tmpdir);
+	cJSON *doc = load_results(dir);
+	if (!doc)
+		return;
+	const cJSON *runs = cJSON_GetObjectItem(doc, "runs");
+	CHECK_INT(cJSON_GetArraySize(runs), 10);
+	CHECK_INT(count_runs(doc, "sweep", "ok"), 5);
+	CHECK_INT(count_runs(doc, "binned", "ok"), 5);
+	for (int k = 0; k + 1 < cJSON_GetArraySize(runs); k += 2) {
+		const cJSON *sweep = cJSON_GetArrayItem(runs, k), *binned = cJSON_GetArrayItem(runs, k + 1);
+		double s = cJSON_GetObjectItem(cJSON_GetObjectItem(sweep, "tree"), "sah_cost")->valuedouble;
+		double b = cJSON_GetObjectItem(cJSON_GetObjectItem(binned, "tree"), "sah_cost")->valuedouble;
+		printf("%s: sweep SAH %.4f, binned SAH %.4f\n", run_str(sweep, "scene"), s, b);
+		CHECK(!strcmp(run_str(sweep, "scene"), run_str(binned, "scene")));
+		CHECK(s <= b);
+	}
+	cJSON_Delete(doc);
+}
+
+int main(int argc, char **argv)
+{
+	if (argc != 3 || !mkdtemp(tmpdir))
+		return 2;
+	exe = argv[1];
+	if (!strcmp(argv[2], "basic")) {
+		test_help();
+		test_run_good();
+		test_info_build_list();
+	} else if (!strcmp(argv[2], "errors")) {
+		test_config_errors();
+		test_bad_builders();
+	} else if (!strcmp(argv[2], "shared")) {
+		if (access(BVHLAB_SHARED_SCENES "/ogre.obj", R_OK) != 0)
+			return TEST_SKIP;
+		test_shared_meshes();
+	}
+	/* Leaves tmpdir for inspection only when something failed. */
+	if (!test_failures) {
+		char cmd[600];
+		snprintf(cmd, sizeof(cmd), "rm -rf '%s'", tmpdir);
+		CHECK_INT(system(cmd), 0);
+	} else {
+		fprintf(stderr, "files kept in %s\n", tmpdir);
+	}
+	return test_finish();
+}

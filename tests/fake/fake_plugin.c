@@ -1,0 +1,104 @@
+/*
+ * One fake builder plugin, compiled several times with different -D flags
+ * into plugins that are broken in exactly one way each (see meson.build).
+ * The good variant builds a single leaf holding every primitive: a valid,
+ * if useless, tree.
+ */
+#include <errno.h>
+#include <string.h>
+
+#include <bvhlab/builder.h>
+
+#ifndef FAKE_NAME
+#define FAKE_NAME "fake_good"
+#endif
+
+static const bvhlab_option_decl options[] = {
+	{.name = "alpha", .type = BVHLAB_OPTION_INT, .help = "an integer in [1, 10]",
+	 .def_int = 3, .min = 1, .max = 10},
+	{.name = "mode", .type = BVHLAB_OPTION_STRING, .help = "a or b", .def_string = "a",
+	 .choices = "a|b"},
+	{.name = "flag", .type = BVHLAB_OPTION_BOOL, .help = "a switch", .min = 1, .max = 0},
+	{.name = "scale", .type = BVHLAB_OPTION_FLOAT, .help = "a positive number",
+	 .def_float = 0.5, .min = 0.0, .max = 100.0},
+	{.name = "fail", .type = BVHLAB_OPTION_STRING, .help = "how build() fails",
+	 .def_string = "no", .choices = "no|error|silent|positive"},
+#ifdef FAKE_BAD_OPTION
+	{.name = "broken", .type = 0, .help = "an option of no type"},
+#endif
+};
+
+/* Fails as the "fail" option says, to exercise the host's error paths. */
+static int maybe_fail(const bvhlab_host *host, bvhlab_build_ctx *ctx)
+{
+	const char *fail = "no";
+	if (host->option_string(ctx, "fail", &fail) < 0)
+		return -EINVAL;
+	if (strcmp(fail, "error") == 0) {
+		host->set_error(ctx, "asked to fail (alpha was %d)", 3);
+		return -EIO;
+	}
+	if (strcmp(fail, "silent") == 0)
+		return -EIO;
+	if (strcmp(fail, "positive") == 0)
+		return 1;
+	return 0;
+}
+
+/* unused in the variant without a build function */
+__attribute__((unused)) static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	int r = maybe_fail(host, ctx);
+	if (r != 0)
+		return r;
+	bvhlab_node *root = &out->nodes[0];
+	memcpy(root->lo, in->bounds.lo, sizeof(root->lo));
+	memcpy(root->hi, in->bounds.hi, sizeof(root->hi));
+	root->first = 0;
+	root->count = in->prim_count;
+	for (uint32_t k = 0; k < in->prim_count; k++)
+		out->prim_index[k] = k;
+	out->node_count = 1;
+	out->index_count = in->prim_count;
+	return 0;
+}
+
+#ifdef FAKE_ABI_MAJOR
+#define ABI BVHLAB_ABI_VERSION(FAKE_ABI_MAJOR, 0)
+#else
+#define ABI BVHLAB_ABI_CURRENT
+#endif
+
+#ifdef FAKE_STRUCT_SIZE
+#define SIZE FAKE_STRUCT_SIZE
+#else
+#define SIZE sizeof(bvhlab_builder)
+#endif
+
+static const bvhlab_builder desc = {
+	.abi_version = ABI,
+	.struct_size = SIZE,
+	.name = FAKE_NAME,
+	.summary = "test plugin: one leaf with every primitive",
+	.flags = BVHLAB_BUILDER_DETERMINISTIC,
+	.option_count = sizeof(options) / sizeof(options[0]),
+	.options = options,
+#ifndef FAKE_NULL_BUILD
+	.build = build,
+#endif
+};
+
+#ifdef FAKE_NO_ENTRY
+BVHLAB_EXPORT const bvhlab_builder *not_the_entry(uint32_t host_abi_major)
+#else
+BVHLAB_PLUGIN_ENTRY
+#endif
+{
+#ifdef FAKE_NULL_DESCRIPTOR
+	/* Serves no real ABI major (the check keeps desc referenced). */
+	return host_abi_major == 0xffff ? &desc : NULL;
+#else
+	return host_abi_major == BVHLAB_ABI_MAJOR ? &desc : NULL;
+#endif
+}
