@@ -188,7 +188,7 @@ static int parse_face(struct obj_parser *p, const char *s, const char *end)
 {
 	size_t n = 0;
 	int64_t v;
-	uint32_t index;
+	uint32_t index = 0;
 	int ret;
 
 	for (s = skip_space(s, end); s < end && *s != '#'; s = skip_space(s, end), n++) {
