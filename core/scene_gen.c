@@ -12,20 +12,12 @@
 #include <string.h>
 
 #include "scene_private.h"
-
-static uint64_t splitmix64(uint64_t *state)
-{
-	uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
-
-	z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-	z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-	return z ^ (z >> 31);
-}
+#include "util.h"
 
 /* Uniform in [0, 1). */
 static double random01(uint64_t *state)
 {
-	return (double)(splitmix64(state) >> 11) * 0x1.0p-53;
+	return (double)(util_splitmix64(state) >> 11) * 0x1.0p-53;
 }
 
 #define SOURCE_SIZE 96 /* room for a generator's `source` description */

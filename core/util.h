@@ -32,6 +32,16 @@ void sb_printf(struct strbuf *sb, const char *fmt, ...) UTIL_PRINTF(2, 3);
 /* Returns the text (caller frees), or NULL if any append failed. */
 char *sb_take(struct strbuf *sb);
 
+/* splitmix64: the core's one seeded generator, so every random choice
+ * (generators, sampled rays) is reproducible from a seed. */
+static inline uint64_t util_splitmix64(uint64_t *state)
+{
+	uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
+	z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+	z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+	return z ^ (z >> 31);
+}
+
 /* Monotonic clock in seconds. */
 double util_now(void);
 

@@ -19,6 +19,8 @@
 
 #include <bvhlab/tree.h>
 
+#include "util.h"
+
 #define NONE UINT32_MAX
 
 /* Work (rays * triangles) above which the ray check uses threads. */
@@ -265,18 +267,9 @@ typedef struct ray_job {
 	uint64_t mismatches;
 } ray_job;
 
-static uint64_t splitmix64(uint64_t *state)
-{
-	uint64_t z = (*state += 0x9e3779b97f4a7c15u);
-
-	z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-	z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-	return z ^ (z >> 31);
-}
-
 static float uniform(uint64_t *state)
 {
-	return (float)(splitmix64(state) >> 40) * 0x1p-24f;
+	return (float)(util_splitmix64(state) >> 40) * 0x1p-24f;
 }
 
 static void triangle_centroid(const bvhlab_scene *scene, uint32_t tri, float out[3])
@@ -305,7 +298,7 @@ static void make_ray(const ray_job *job, uint32_t i, bvhlab_ray *ray)
 
 	if ((i & 1) && job->scene->triangle_count > 0) {
 		triangle_centroid(job->scene,
-		                  (uint32_t)(splitmix64(&state) % job->scene->triangle_count), target);
+		                  (uint32_t)(util_splitmix64(&state) % job->scene->triangle_count), target);
 	} else {
 		for (k = 0; k < 3; k++)
 			target[k] = job->lo[k] + uniform(&state) * job->size[k];
