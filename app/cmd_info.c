@@ -1,4 +1,4 @@
-/* bvhlab info: what a scene is. */
+/* bvhlab info: what a scene is, or what the machine is. */
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -6,17 +6,24 @@
 #include <cJSON.h>
 
 #include "cli.h"
+#include "machine.h"
 
 static const char usage[] =
 	"usage: bvhlab info SCENE [--subdivide K] [--json]\n"
+	"       bvhlab info --machine [--json]\n"
 	"\n"
 	"Loads a scene and prints its triangle and vertex counts, degenerate\n"
 	"(zero-area) triangles and bounds. SCENE is an .obj or .ply file, or a\n"
 	"generator with parameters: icosphere:frequency=300, soup:count=100000,seed=2,\n"
 	"stadium:count=50000, terrain:size=512.\n"
 	"\n"
+	"With --machine, prints the CPU topology this process may use (hwloc,\n"
+	"narrowed by its affinity mask and cgroup cpuset): packages, physical\n"
+	"cores (what threads 0 means), logical CPUs and L1d/L2/L3 caches.\n"
+	"\n"
 	"options:\n"
 	"  --subdivide K    split every triangle into 4, K times\n"
+	"  --machine        describe the machine instead of a scene\n"
 	"  --json           print one JSON object (key \"triangles\", ...)\n";
 
 static void print_json(const bvhlab_scene *s)
@@ -45,28 +52,95 @@ static void print_text(const bvhlab_scene *s)
 	       s->bounds.lo[2], s->bounds.hi[0], s->bounds.hi[1], s->bounds.hi[2]);
 }
 
+static void print_machine_json(const struct machine_info *m)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "cpu", m->cpu);
+	cJSON_AddNumberToObject(o, "packages", m->topo.packages);
+	cJSON_AddNumberToObject(o, "physical_cores", m->topo.physical_cores);
+	cJSON_AddNumberToObject(o, "logical_cpus", m->topo.logical_cpus);
+	cJSON_AddNumberToObject(o, "threads_available", m->threads_available);
+	cJSON_AddBoolToObject(o, "hwloc", m->topo.from_hwloc);
+	cJSON *caches = cJSON_AddObjectToObject(o, "caches");
+	for (int k = 0; caches && k < MACHINE_CACHE_LEVELS; k++) {
+		if (m->topo.caches[k].size == 0)
+			continue;
+		cJSON *c = cJSON_AddObjectToObject(caches, machine_cache_name(k));
+		cJSON_AddNumberToObject(c, "bytes", (double)m->topo.caches[k].size);
+		cJSON_AddNumberToObject(c, "instances", m->topo.caches[k].instances);
+	}
+	char *text = cJSON_Print(o);
+	if (text)
+		puts(text);
+	free(text);
+	cJSON_Delete(o);
+}
+
+/* 49152 -> "48 KiB", 33554432 -> "32 MiB". */
+static const char *size_text(uint64_t bytes, char *buf, size_t size)
+{
+	if (bytes >= (1u << 20) && bytes % (1u << 20) == 0)
+		snprintf(buf, size, "%llu MiB", (unsigned long long)(bytes >> 20));
+	else
+		snprintf(buf, size, "%llu KiB", (unsigned long long)(bytes >> 10));
+	return buf;
+}
+
+static void print_machine_text(const struct machine_info *m)
+{
+	printf("cpu:        %s\npackages:   %u\ncores:      %u physical (threads 0 = %u)\n"
+	       "logical:    %u CPUs\ncaches:    ",
+	       m->cpu, m->topo.packages, m->topo.physical_cores, m->threads_available,
+	       m->topo.logical_cpus);
+	const char *sep = " ";
+	for (int k = 0; k < MACHINE_CACHE_LEVELS; k++) {
+		char buf[32];
+		if (!m->topo.caches[k].size)
+			continue;
+		printf("%s%s %s x%u", sep, machine_cache_name(k),
+		       size_text(m->topo.caches[k].size, buf, sizeof(buf)),
+		       m->topo.caches[k].instances);
+		sep = ", ";
+	}
+	printf("\nsource:     %s\n", m->topo.from_hwloc ? "hwloc" : "affinity mask (hwloc failed)");
+}
+
+static int info_machine(bool json)
+{
+	struct machine_info m;
+	machine_info_read(&m);
+	if (json)
+		print_machine_json(&m);
+	else
+		print_machine_text(&m);
+	return 0;
+}
+
 int cmd_info(int argc, char **argv)
 {
 	static const struct option longopts[] = {{"subdivide", required_argument, NULL, 's'},
 	                                         {"json", no_argument, NULL, 'j'},
+	                                         {"machine", no_argument, NULL, 'm'},
 	                                         {"help", no_argument, NULL, 'h'},
 	                                         {NULL, 0, NULL, 0}};
 	unsigned long subdivide = 0;
-	bool json = false;
+	bool json = false, machine = false;
 	int c;
 	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
 		if (c == 'h')
 			return fputs(usage, stdout), 0;
 		if (c == 's' && cli_parse_uint("--subdivide", optarg, 8, &subdivide) == 0)
 			continue;
-		if (c == 'j') {
-			json = true;
+		if (c == 'j' || c == 'm') {
+			*(c == 'j' ? &json : &machine) = true;
 			continue;
 		}
 		return EXIT_USAGE;
 	}
-	if (optind != argc - 1) {
-		fprintf(stderr, "bvhlab info: expected one scene\n\n%s", usage);
+	if (machine && optind == argc)
+		return info_machine(json);
+	if (machine || optind != argc - 1) {
+		fprintf(stderr, "bvhlab info: expected one scene, or --machine alone\n\n%s", usage);
 		return EXIT_USAGE;
 	}
 	bvhlab_scene *scene = NULL;

@@ -15,11 +15,21 @@ static const char usage[] =
 	"\n"
 	"Runs every scene x builder x thread count of the config: warm-up builds,\n"
 	"timed builds, validation of the last tree (structure and rays against brute\n"
-	"force), tree metrics. Writes results.json, results.csv and report.md into the\n"
-	"output folder after every run, so an interrupted sweep keeps what finished.\n"
+	"force), tree metrics, rays traced through the tree (primary and diffuse, with\n"
+	"every hardware thread) and, with \"images\": true, images. Writes results.json,\n"
+	"results.csv, report.md and report.html into the output folder after every\n"
+	"run, so an interrupted sweep keeps what finished. Progress goes to stderr: one\n"
+	"line per run, rewritten in place when stderr is a terminal.\n"
+	"\n"
+	"Each run's builds happen in a child process: a plugin that crashes, hangs\n"
+	"past \"timeout_s\" (default 600) or exceeds \"memory_limit_mb\" is recorded as\n"
+	"crashed, timeout or failed and the sweep goes on (\"isolate\": false in the\n"
+	"config runs them in this process instead, for debugging).\n"
 	"\n"
 	"options:\n"
 	"  --out DIR        output folder (overrides the config's \"output\")\n"
+	"  --resume         keep the finished runs of the output folder's results.json\n"
+	"                   and run only the missing ones (a fresh start if there is none)\n"
 	"  --threads LIST   thread counts, e.g. 1,2,0 (0 = all cores; overrides \"threads\")\n"
 	"  --repeat N       timed builds per run (overrides \"repeat\")\n"
 	"  --quiet          no progress lines\n"
@@ -34,7 +44,7 @@ struct run_args {
 	uint32_t threads[MAX_THREAD_COUNTS];
 	size_t thread_count;
 	unsigned long repeat;
-	bool quiet;
+	struct harness_options opts;
 };
 
 static int parse(int argc, char **argv, struct run_args *a)
@@ -42,7 +52,8 @@ static int parse(int argc, char **argv, struct run_args *a)
 	static const struct option longopts[] = {
 		{"out", required_argument, NULL, 'o'},   {"threads", required_argument, NULL, 't'},
 		{"repeat", required_argument, NULL, 'r'}, {"quiet", no_argument, NULL, 'q'},
-		{"help", no_argument, NULL, 'h'},        {NULL, 0, NULL, 0}};
+		{"resume", no_argument, NULL, 'R'},      {"help", no_argument, NULL, 'h'},
+		{NULL, 0, NULL, 0}};
 	int c;
 	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
 		if (c == 'h') {
@@ -57,7 +68,9 @@ static int parse(int argc, char **argv, struct run_args *a)
 			if (cli_parse_uint("--repeat", optarg, 100000, &a->repeat) || a->repeat == 0)
 				return fprintf(stderr, "bvhlab: --repeat must be at least 1\n"), -1;
 		} else if (c == 'q') {
-			a->quiet = true;
+			a->opts.quiet = true;
+		} else if (c == 'R') {
+			a->opts.resume = true;
 		} else {
 			return -1;
 		}
@@ -104,13 +117,13 @@ int cmd_run(int argc, char **argv)
 		fprintf(stderr, "bvhlab: out of memory\n");
 		goto out;
 	}
-	int r = harness_run(&cfg, a.quiet, &err);
+	int r = harness_run(&cfg, &a.opts, &err);
 	if (r < 0) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
-	if (!a.quiet)
-		fprintf(stderr, "bvhlab: results in %s/ (results.json, results.csv, report.md)%s\n",
+	if (!a.opts.quiet)
+		fprintf(stderr, "bvhlab: results in %s/ (results.json, results.csv, report.md, report.html)%s\n",
 		        cfg.output, r ? "; some runs failed or were invalid" : "");
 	status = r ? EXIT_RUNS_FAILED : 0;
 out:

@@ -16,6 +16,10 @@ static const char usage[] =
 	"  info SCENE [--json]   triangle count and bounds of a mesh file or generator\n"
 	"  build PLUGIN SCENE [--threads N] [-o KEY=VALUE]...\n"
 	"                        one build, validated and measured\n"
+	"  render PLUGIN SCENE -o FILE [--heat] [--width W --height H] [-O KEY=VALUE]...\n"
+	"                        one image: the shaded scene or a heat map of nodes visited\n"
+	"  report RESULTS.json [--out DIR]\n"
+	"                        regenerate report.md, report.html and results.csv\n"
 	"  help                  this text; `bvhlab COMMAND --help` for a command's\n"
 	"  version               the version\n"
 	"\n"
@@ -46,6 +50,10 @@ int main(int argc, char **argv)
 		return cmd_info(argc - 1, argv + 1);
 	if (!strcmp(cmd, "build"))
 		return cmd_build(argc - 1, argv + 1);
+	if (!strcmp(cmd, "render"))
+		return cmd_render(argc - 1, argv + 1);
+	if (!strcmp(cmd, "report"))
+		return cmd_report(argc - 1, argv + 1);
 	fprintf(stderr, "bvhlab: unknown command '%s'\n\n%s", cmd, usage);
 	return EXIT_USAGE;
 }

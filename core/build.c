@@ -2,6 +2,8 @@
  * Running one build: the host's function table and the call into a plugin.
  */
 #include <errno.h>
+#include <pthread.h>
+#include <sched.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,6 +11,7 @@
 
 #include <bvhlab/plugin.h>
 
+#include "machine.h"
 #include "util.h"
 
 struct bvhlab_build_ctx {
@@ -17,6 +20,9 @@ struct bvhlab_build_ctx {
 	bvhlab_tree *tree;
 	bvhlab_error *err;
 	bool error_set;
+	bool pinning;          /* plan is set: pin_thread binds */
+	struct pin_plan plan;
+	cpu_set_t caller_mask; /* restored after build(): the caller may be a worker */
 };
 
 /* Messages above this level are dropped; BVHLAB_LOG=error|warn|info|debug. */
@@ -128,8 +134,14 @@ static void host_progress(bvhlab_build_ctx *ctx, double fraction)
 
 static uint32_t host_hardware_threads(bvhlab_build_ctx *ctx)
 {
-	(void)ctx;
-	return bvhlab_hardware_threads();
+	/* A pinned worker's own mask holds one CPU; the plan holds the set the
+	 * build started with, which is what the answer must describe. */
+	return ctx->pinning ? ctx->plan.count : bvhlab_hardware_threads();
+}
+
+static int host_pin_thread(bvhlab_build_ctx *ctx, uint32_t worker)
+{
+	return ctx->pinning ? pin_plan_apply(&ctx->plan, worker) : 0;
 }
 
 static const bvhlab_host host_table = {
@@ -144,6 +156,7 @@ static const bvhlab_host host_table = {
 	.grow_output = host_grow_output,
 	.progress = host_progress,
 	.hardware_threads = host_hardware_threads,
+	.pin_thread = host_pin_thread,
 };
 
 static int prepare_tree(bvhlab_tree *tree, uint32_t prims)
@@ -152,6 +165,51 @@ static int prepare_tree(bvhlab_tree *tree, uint32_t prims)
 	if (tree->nodes)
 		return bvhlab_tree_reserve(tree, nodes, prims);
 	return bvhlab_tree_init(tree, nodes, prims);
+}
+
+/* The plan comes from the caller's mask now, before any worker narrows it. */
+static int pinning_begin(struct bvhlab_build_ctx *ctx)
+{
+	if (!machine_pinning())
+		return 0;
+	int r = -pthread_getaffinity_np(pthread_self(), sizeof(ctx->caller_mask),
+	                                &ctx->caller_mask);
+	if (r == 0)
+		r = pin_plan_init(&ctx->plan);
+	if (r < 0) {
+		pin_plan_finish(&ctx->plan);
+		error_set(ctx->err, "builder '%s': cannot plan thread pinning (%s)",
+		          ctx->builder->name, strerror(-r));
+		return r;
+	}
+	ctx->pinning = true;
+	return 0;
+}
+
+static void pinning_end(struct bvhlab_build_ctx *ctx)
+{
+	if (!ctx->pinning)
+		return;
+	pthread_setaffinity_np(pthread_self(), sizeof(ctx->caller_mask), &ctx->caller_mask);
+	pin_plan_finish(&ctx->plan);
+	ctx->pinning = false;
+}
+
+/* The plugin's status, with a message that names it whatever it said. */
+static int explain(const struct bvhlab_build_ctx *ctx, int r)
+{
+	const char *name = ctx->builder->name;
+	if (r < 0 && !ctx->error_set)
+		error_set(ctx->err, "builder '%s' failed (%s) without saying why", name,
+		          strerror(-r));
+	else if (r < 0)
+		error_prefix(ctx->err, "builder '%s'", name);
+	else if (r > 0) {
+		error_set(ctx->err, "builder '%s' returned %d; the ABI allows 0 or a negative errno",
+		          name, r);
+		r = -EPROTO;
+	}
+	return r;
 }
 
 int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
@@ -174,17 +232,12 @@ int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		.index_capacity = tree->index_capacity,
 	};
 	struct bvhlab_build_ctx ctx = {.builder = b, .opts = opts, .tree = tree, .err = err};
-	int r = b->build(&host_table, &ctx, &in, &out);
+	int r = pinning_begin(&ctx);
+	if (r < 0)
+		return r;
+	r = b->build(&host_table, &ctx, &in, &out);
+	pinning_end(&ctx);
 	tree->node_count = out.node_count;
 	tree->index_count = out.index_count;
-	if (r < 0 && !ctx.error_set)
-		error_set(err, "builder '%s' failed (%s) without saying why", b->name, strerror(-r));
-	else if (r < 0)
-		error_prefix(err, "builder '%s'", b->name);
-	else if (r > 0) {
-		error_set(err, "builder '%s' returned %d; the ABI allows 0 or a negative errno",
-		          b->name, r);
-		r = -EPROTO;
-	}
-	return r;
+	return explain(&ctx, r);
 }

@@ -16,12 +16,15 @@
 #define MAX_RAY_SIDE 16384
 #define MAX_DIFFUSE 1024
 #define READ_CHUNK 65536
+/* Generous: a run that takes longer is stuck rather than slow. */
+#define DEFAULT_TIMEOUT_S 600
 
 static const char *const top_keys[] = {
 	"format_version", "output", "repeat", "warmup", "threads", "validate",
-	"validate_rays", "rays", "images", "scenes", "builders", NULL,
+	"validate_rays", "rays", "images", "isolate", "timeout_s", "memory_limit_mb", "scenes",
+	"builders", NULL,
 };
-static const char *const ray_keys[] = { "width", "height", "diffuse", NULL };
+static const char *const ray_keys[] = { "width", "height", "diffuse", "camera", NULL };
 
 static int out_of_memory(const char *path, bvhlab_error *err)
 {
@@ -40,6 +43,8 @@ static int set_defaults(struct config *cfg)
 	cfg->ray_height = 256;
 	cfg->ray_diffuse = 1;
 	cfg->images = false;
+	cfg->isolate = true;
+	cfg->timeout_s = DEFAULT_TIMEOUT_S;
 	cfg->threads = malloc(sizeof(*cfg->threads));
 	if (!cfg->threads)
 		return -ENOMEM;
@@ -93,7 +98,7 @@ static int parse_rays(struct config *cfg, bvhlab_error *err)
 	if (!cJSON_IsObject(rays)) {
 		char got[48];
 		return config_error(cfg, rays, false, err,
-		                    "'rays' must be an object {width, height, diffuse}, not %s",
+		                    "'rays' must be an object {width, height, diffuse, camera}, not %s",
 		                    config_describe(cfg, rays, got, sizeof(got)));
 	}
 	int rc = config_check_keys(cfg, rays, ray_keys, "in rays", err);
@@ -105,6 +110,8 @@ static int parse_rays(struct config *cfg, bvhlab_error *err)
 	if (!rc)
 		rc = config_get_u32(cfg, rays, "diffuse", "rays.", 0, MAX_DIFFUSE, &cfg->ray_diffuse,
 		                    err);
+	if (!rc)
+		rc = config_parse_camera(cfg, rays, err);
 	return rc;
 }
 
@@ -127,6 +134,18 @@ static int parse_runs(struct config *cfg, bvhlab_error *err)
 	return rc;
 }
 
+static int parse_isolation(struct config *cfg, bvhlab_error *err)
+{
+	const cJSON *root = cfg->root;
+	int rc = config_get_bool(cfg, root, "isolate", "", &cfg->isolate, err);
+	if (!rc)
+		rc = config_get_positive(cfg, root, "timeout_s", "", &cfg->timeout_s, err);
+	if (!rc)
+		rc = config_get_uint(cfg, root, "memory_limit_mb", "", 1, CONFIG_MAX_MEMORY_MB,
+		                     &cfg->memory_limit_mb, err);
+	return rc;
+}
+
 static int parse_top(struct config *cfg, bvhlab_error *err)
 {
 	if (!cJSON_IsObject(cfg->root)) {
@@ -141,6 +160,8 @@ static int parse_top(struct config *cfg, bvhlab_error *err)
 		rc = parse_output(cfg, err);
 	if (!rc)
 		rc = parse_runs(cfg, err);
+	if (!rc)
+		rc = parse_isolation(cfg, err);
 	if (!rc)
 		rc = parse_rays(cfg, err);
 	if (!rc)

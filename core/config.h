@@ -15,6 +15,7 @@
 #include <stdint.h>
 
 #include <bvhlab/plugin.h>
+#include <bvhlab/rays.h>
 #include <bvhlab/scene.h>
 
 struct cJSON;
@@ -34,6 +35,8 @@ struct config_builder {
 	char *name;        /* "name", default: plugin */
 	uint32_t *threads; /* "threads" override, or NULL for the config's list */
 	size_t thread_count;
+	double timeout_s;  /* "timeout_s" override, or 0 for the config's */
+	uint64_t memory_limit_mb; /* "memory_limit_mb" override, or 0 for the config's */
 	const struct cJSON *options; /* "options" object (may be NULL), owned by root */
 	int line, column;  /* where the builder's object starts */
 };
@@ -53,8 +56,14 @@ struct config {
 	size_t thread_count;
 	bool validate;     /* "validate", default true */
 	uint32_t validate_rays; /* "validate_rays", default 256 */
-	uint32_t ray_width, ray_height, ray_diffuse; /* "rays": width/height/diffuse */
+	uint32_t ray_width, ray_height, ray_diffuse; /* "rays": width/height/diffuse,
+	                                              * default 256, 256, 1 */
+	bool has_camera;   /* "rays": {"camera": ...} given; else framed per scene */
+	bvhlab_camera camera;
 	bool images;       /* "images", default false */
+	bool isolate;      /* "isolate", default true: each run's builds in a child process */
+	double timeout_s;  /* "timeout_s", default 600: an isolated run is killed after it */
+	uint64_t memory_limit_mb; /* "memory_limit_mb", default 0 = none: the child's RLIMIT_AS */
 
 	struct config_scene *scenes;
 	size_t scene_count;

@@ -3,6 +3,7 @@
  * did-you-mean suggestions, typed member getters and path resolution.
  */
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -254,6 +255,21 @@ int config_get_bool(const struct config *cfg, const cJSON *obj, const char *key,
 		                    full_name(name, sizeof(name), prefix, key),
 		                    config_describe(cfg, item, got, sizeof(got)));
 	*out = cJSON_IsTrue(item);
+	return 0;
+}
+
+int config_get_positive(const struct config *cfg, const cJSON *obj, const char *key,
+                        const char *prefix, double *out, bvhlab_error *err)
+{
+	const cJSON *item = config_member(obj, key);
+	char name[FULL_NAME_SIZE], got[48];
+	if (!item)
+		return 0;
+	if (!cJSON_IsNumber(item) || !isfinite(item->valuedouble) || !(item->valuedouble > 0))
+		return config_error(cfg, item, false, err, "'%s' must be a number > 0, not %s",
+		                    full_name(name, sizeof(name), prefix, key),
+		                    config_describe(cfg, item, got, sizeof(got)));
+	*out = item->valuedouble;
 	return 0;
 }
 

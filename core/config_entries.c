@@ -18,7 +18,9 @@ static const char *const scene_keys[] = {
 	"name", "path", "generator", "frequency", "count", "size", "seed", "subdivide", NULL,
 };
 static const char *const generator_keys[] = { "frequency", "count", "size", "seed", NULL };
-static const char *const builder_keys[] = { "plugin", "name", "threads", "options", NULL };
+static const char *const builder_keys[] = {
+	"plugin", "name", "threads", "timeout_s", "memory_limit_mb", "options", NULL,
+};
 
 static int out_of_memory(const struct config *cfg, bvhlab_error *err)
 {
@@ -250,6 +252,11 @@ static int parse_builder(struct config *cfg, const cJSON *obj, size_t index,
 	if (!rc)
 		rc = config_get_threads(cfg, obj, "threads", prefix, &b->threads, &b->thread_count,
 		                        err);
+	if (!rc)
+		rc = config_get_positive(cfg, obj, "timeout_s", prefix, &b->timeout_s, err);
+	if (!rc)
+		rc = config_get_uint(cfg, obj, "memory_limit_mb", prefix, 1, CONFIG_MAX_MEMORY_MB,
+		                     &b->memory_limit_mb, err);
 	if (!rc)
 		rc = builder_options(cfg, obj, index, b, err);
 	return rc;

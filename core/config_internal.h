@@ -55,6 +55,9 @@ int config_get_u32(const struct config *cfg, const cJSON *obj, const char *key,
                    bvhlab_error *err);
 int config_get_bool(const struct config *cfg, const cJSON *obj, const char *key,
                     const char *prefix, bool *out, bvhlab_error *err);
+/* A finite number > 0 (a duration, say). */
+int config_get_positive(const struct config *cfg, const cJSON *obj, const char *key,
+                        const char *prefix, double *out, bvhlab_error *err);
 /* A non-empty string, copied into *out (freeing what was there). */
 int config_get_string(const struct config *cfg, const cJSON *obj, const char *key,
                       const char *prefix, char **out, bvhlab_error *err);
@@ -68,6 +71,11 @@ int config_resolve(const struct config *cfg, const char *path, char **out);
 /* The file name without folder and last extension ("a/b/ogre.obj" -> "ogre"). */
 char *config_stem(const char *path);
 
+/* Highest "memory_limit_mb": the limit in bytes must fit in 64 bits. */
+#define CONFIG_MAX_MEMORY_MB (UINT64_MAX >> 20)
+
+/* "rays": {"camera": {position, target, up, fov}}; absent: automatic framing. */
+int config_parse_camera(struct config *cfg, const cJSON *rays, bvhlab_error *err);
 int config_parse_scenes(struct config *cfg, bvhlab_error *err);
 int config_parse_builders(struct config *cfg, bvhlab_error *err);
 

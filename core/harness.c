@@ -8,8 +8,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "harness.h"
+#include "isolate.h"
 #include "results.h"
 #include "util.h"
 
@@ -32,6 +34,37 @@ struct harness {
 	bool all_ok;
 	uint32_t run_index, run_total;
 	double start;
+	bool tty;       /* progress rewritten in place */
+	bool shade_done; /* this scene's shaded render is on its way */
+};
+
+enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };
+
+/*
+ * What one run's build series produces, sent back from its child as plain
+ * bytes: the tree stays behind, only its measurements come back.
+ */
+struct series_report {
+	uint32_t status;       /* enum series_status */
+	uint32_t sample_count; /* repeat, or 0 when the builds failed */
+	bool has_stats, validated, valid;
+	uint64_t rays_checked, mismatches;
+	bvhlab_tree_stats stats;
+	struct ray_metrics rays;
+	bool heat_written, shade_written;
+	char error[sizeof(((bvhlab_error *)0)->message)];
+	double samples[];      /* [repeat] */
+};
+
+/* One run's build series, as handed to the child. */
+struct series_job {
+	const struct harness *h;
+	const bvhlab_scene *scene;
+	const bvhlab_prims *prims;
+	const struct harness_builder *hb;
+	uint32_t threads;
+	const char *heat_path;  /* where the child leaves nodes per pixel, or NULL */
+	const char *shade_path; /* where it leaves the shaded render, or NULL */
 };
 
 int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab_error *err)
@@ -91,23 +124,62 @@ static uint32_t resolve_threads(uint32_t t)
 	return t ? t : bvhlab_hardware_threads();
 }
 
+/* Seconds left, from the mean time of the runs so far; < 0 before the first. */
+static double remaining(const struct harness *h, double elapsed)
+{
+	uint32_t done = h->run_index;
+	return done ? elapsed / done * (h->run_total - done) : -1.0;
+}
+
+static void progress_head(const struct harness *h, const struct run_record *run, uint32_t i)
+{
+	fprintf(stderr, "%s[%u/%u] %s / %s / %u thread%s: ", h->tty ? "\r\033[K" : "", i,
+	        h->run_total, run->scene, run->builder, run->threads, run->threads == 1 ? "" : "s");
+}
+
+static void progress_time(const struct harness *h)
+{
+	double elapsed = util_now() - h->start, left = remaining(h, elapsed);
+	fprintf(stderr, " [%.1fs elapsed", elapsed);
+	if (left >= 0)
+		fprintf(stderr, ", ~%.0fs left", left);
+	fputc(']', stderr);
+}
+
+/* On a terminal, the line of the run in progress (rewritten when it ends). */
+static void progress_start(const struct harness *h, const struct run_record *run)
+{
+	if (h->quiet || !h->tty)
+		return;
+	progress_head(h, run, h->run_index + 1);
+	fputs("running...", stderr);
+	progress_time(h);
+	fflush(stderr);
+}
+
+/* A finished run: one log line, or on a terminal the line rewritten in
+ * place (kept, with a newline, when the run is not ok). */
 static void progress(struct harness *h, const struct run_record *run)
 {
 	h->run_index++;
 	if (h->quiet)
 		return;
-	double elapsed = util_now() - h->start;
-	fprintf(stderr, "[%u/%u %.1fs] %s / %s / %u thread%s: %s", h->run_index, h->run_total,
-	        elapsed, run->scene, run->builder, run->threads, run->threads == 1 ? "" : "s",
-	        run->status);
+	progress_head(h, run, h->run_index);
+	fputs(run->status, stderr);
 	if (run->sample_count && run->stats) {
 		double med, mn, mx;
 		harness_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
 		fprintf(stderr, ", %.2f ms median, SAH %.3f", med, run->stats->sah_cost);
 	}
+	if (run->rays)
+		fprintf(stderr, ", %.1f nodes/ray", run->rays->primary.rays
+		        ? (double)run->rays->primary.nodes_visited / (double)run->rays->primary.rays : 0);
 	if (run->error)
 		fprintf(stderr, " (%s)", run->error);
-	fputc('\n', stderr);
+	progress_time(h);
+	if (!h->tty || strcmp(run->status, "ok") != 0)
+		fputc('\n', stderr);
+	fflush(stderr);
 }
 
 /* Records a run and rewrites the files, so nothing finished is ever lost. */
@@ -142,8 +214,28 @@ static void record_all_failed(struct harness *h, const char *scene, struct harne
 		                         .plugin = hb->cb->plugin, .threads = resolve_threads(threads[k]),
 		                         .opts = hb->opts_ok ? &hb->opts : NULL,
 		                         .status = "failed", .error = error};
-		record(h, &run);
+		if (results_has_run(&h->res, run.scene, run.builder, run.threads))
+			h->run_index++;
+		else
+			record(h, &run);
 	}
+}
+
+/* Resumed runs already hold every run of the scene: no need to load it. */
+static bool scene_done(struct harness *h, const struct config_scene *cs)
+{
+	uint32_t done = 0, total = 0;
+	for (size_t b = 0; b < h->cfg->builder_count; b++) {
+		size_t n;
+		const uint32_t *threads = builder_threads(h, &h->cfg->builders[b], &n);
+		for (size_t t = 0; t < n; t++, total++)
+			done += results_has_run(&h->res, cs->name, h->cfg->builders[b].name,
+			                        resolve_threads(threads[t]));
+	}
+	if (done < total)
+		return false;
+	h->run_index += total;
+	return true;
 }
 
 /*
@@ -151,69 +243,243 @@ static void record_all_failed(struct harness *h, const char *scene, struct harne
  * unsafe to walk) otherwise. The brute-force ray check is what "validate"
  * switches, since it is the expensive part.
  */
-static void validate(struct harness *h, const bvhlab_scene *scene, const bvhlab_prims *prims,
-                     const bvhlab_builder *desc, const bvhlab_tree *tree, struct run_record *run,
-                     bvhlab_error *err)
+static void validate(const struct series_job *job, const bvhlab_tree *tree,
+                     struct series_report *rep, bvhlab_error *err)
 {
+	const struct config *cfg = job->h->cfg;
+	const bvhlab_builder *desc = bvhlab_plugin_builder(job->hb->plugin);
 	bool dup = desc->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
-	run->validated = true;
-	run->valid = bvhlab_validate_tree(tree, &prims->input, dup, err) == 0;
-	if (!run->valid) {
-		run->status = "invalid";
-		run->error = err->message;
+	rep->validated = true;
+	rep->valid = bvhlab_validate_tree(tree, &job->prims->input, dup, err) == 0;
+	if (!rep->valid) {
+		rep->status = SERIES_INVALID;
 		return;
 	}
-	if (!h->cfg->validate)
+	if (!cfg->validate)
 		return;
-	run->rays_checked = h->cfg->validate_rays;
-	if (bvhlab_validate_rays(tree, scene, h->cfg->validate_rays, RAY_SEED, &run->mismatches,
+	rep->rays_checked = cfg->validate_rays;
+	if (bvhlab_validate_rays(tree, job->scene, cfg->validate_rays, RAY_SEED, &rep->mismatches,
 	                         err) < 0) {
-		run->status = "failed";
-		run->error = err->message;
-	} else if (run->mismatches) {
-		run->valid = false;
-		run->status = "invalid";
-		snprintf(err->message, sizeof(err->message),
-		         "%llu of %llu sampled rays disagree with brute force",
-		         (unsigned long long)run->mismatches, (unsigned long long)run->rays_checked);
-		run->error = err->message;
+		rep->status = SERIES_FAILED;
+	} else if (rep->mismatches) {
+		rep->valid = false;
+		rep->status = SERIES_INVALID;
+		error_set(err, "%llu of %llu sampled rays disagree with brute force",
+		          (unsigned long long)rep->mismatches, (unsigned long long)rep->rays_checked);
 	}
 }
 
-static void run_one(struct harness *h, const bvhlab_scene *scene, const bvhlab_prims *prims,
-                    struct harness_builder *hb, uint32_t threads)
+/* Per-pixel buffers of the images this run draws; NULL when it draws none. */
+static int image_buffers(const struct series_job *job, size_t n, uint32_t **nodes,
+                         uint8_t **shade)
 {
-	const bvhlab_builder *desc = bvhlab_plugin_builder(hb->plugin);
-	double samples[h->cfg->repeat];
-	struct build_series s = {.warmup = h->cfg->warmup, .repeat = h->cfg->repeat,
-	                         .threads = threads, .samples_ms = samples};
+	*nodes = job->heat_path ? malloc(n * sizeof(**nodes)) : NULL;
+	*shade = job->shade_path ? malloc(3 * n) : NULL;
+	return (job->heat_path && !*nodes) || (job->shade_path && !*shade) ? -ENOMEM : 0;
+}
+
+/* Traversal statistics on the valid tree, and the raw image data. A
+ * failure here costs the numbers, not the run: the tree itself is fine. */
+static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
+                       struct series_report *rep, bvhlab_error *err)
+{
+	const struct config *cfg = job->h->cfg;
+	size_t n = (size_t)cfg->ray_width * cfg->ray_height;
+	uint32_t *nodes;
+	uint8_t *shade;
+	bvhlab_camera cam;
+	if (n == 0)
+		return;
+	harness_camera(cfg, job->scene, &cam);
+	int r = image_buffers(job, n, &nodes, &shade);
+	if (r == 0)
+		r = harness_trace_rays(tree, job->scene, &cam, cfg->ray_width, cfg->ray_height,
+		                       cfg->ray_diffuse, &rep->rays, nodes, shade);
+	if (r == 0 && nodes)
+		rep->heat_written = harness_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
+	if (r == 0 && shade)
+		rep->shade_written = harness_write_raw(job->shade_path, shade, 3 * n) == 0;
+	if (r < 0)
+		error_set(err, "tracing rays: %s", strerror(-r));
+	free(nodes);
+	free(shade);
+}
+
+/* Warm-up, timed builds, validation and metrics: what runs in the child. */
+static void series_work(void *arg, void *report, size_t size)
+{
+	const struct series_job *job = arg;
+	struct series_report *rep = report;
+	const struct config *cfg = job->h->cfg;
+	struct build_series s = {.warmup = cfg->warmup, .repeat = cfg->repeat,
+	                         .threads = job->threads, .samples_ms = rep->samples};
 	bvhlab_error err = {{0}};
-	bvhlab_tree_stats stats;
-	struct run_record run = {.scene = scene->name, .builder = hb->cb->name,
-	                         .plugin = desc->name, .threads = resolve_threads(threads),
-	                         .opts = &hb->opts, .status = "ok",
-	                         .triangles = scene->triangle_count};
-	if (harness_time_builds(hb->plugin, &hb->opts, &prims->input, &s, &err) < 0) {
-		run.status = "failed";
-		run.error = err.message;
+	(void)size;
+	rep->status = SERIES_OK;
+	if (harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err) < 0) {
+		rep->status = SERIES_FAILED;
 	} else {
-		run.samples_ms = samples;
-		run.sample_count = s.repeat;
-		validate(h, scene, prims, desc, &s.tree, &run, &err);
-		if (run.valid || (run.mismatches && run.rays_checked)) {
-			bvhlab_tree_stats_compute(&s.tree, &stats);
-			run.stats = &stats;
-		}
+		rep->sample_count = s.repeat;
+		validate(job, &s.tree, rep, &err);
+		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
+		if (rep->has_stats)
+			bvhlab_tree_stats_compute(&s.tree, &rep->stats);
+		if (rep->status == SERIES_OK)
+			trace_rays(job, &s.tree, rep, &err);
 	}
-	record(h, &run);
+	if (rep->status != SERIES_OK)
+		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
 	bvhlab_tree_finish(&s.tree);
 }
 
-static void run_scene(struct harness *h, const struct config_scene *cs)
+/* A report from a child is checked before use: the child ran foreign code. */
+static void report_to_run(struct series_report *rep, uint32_t repeat, struct run_record *run)
+{
+	static const char *const names[] = {"ok", "invalid", "failed"};
+	rep->error[sizeof(rep->error) - 1] = '\0';
+	if (rep->status > SERIES_FAILED || rep->sample_count > repeat) {
+		run->status = "crashed";
+		run->error = "sent back a malformed report";
+		return;
+	}
+	run->status = names[rep->status];
+	run->error = rep->status != SERIES_OK ? rep->error : NULL;
+	run->samples_ms = rep->samples;
+	run->sample_count = rep->sample_count;
+	run->stats = rep->has_stats ? &rep->stats : NULL;
+	run->validated = rep->validated;
+	run->valid = rep->valid;
+	run->rays_checked = rep->rays_checked;
+	run->mismatches = rep->mismatches;
+	run->rays = rep->rays.measured ? &rep->rays : NULL;
+}
+
+static struct isolate_limits run_limits(const struct config *cfg, const struct config_builder *cb)
+{
+	uint64_t mb = cb->memory_limit_mb ? cb->memory_limit_mb : cfg->memory_limit_mb;
+	return (struct isolate_limits){.timeout_s = cb->timeout_s > 0 ? cb->timeout_s : cfg->timeout_s,
+	                               .memory_bytes = mb << 20};
+}
+
+/* Runs the series in a child (or here, with "isolate": false) and records it. */
+static void run_series(struct harness *h, struct series_job *job, struct run_record *run,
+                       struct series_report *rep, size_t size)
+{
+	static const char *const outcomes[] = {"ok", "crashed", "timeout"};
+	char why[sizeof(rep->error)] = "";
+	int outcome = ISOLATE_REPORTED;
+	if (h->cfg->isolate) {
+		struct isolate_limits limits = run_limits(h->cfg, job->hb->cb);
+		outcome = isolate_call(series_work, job, rep, size, &limits, why, sizeof(why));
+	} else {
+		series_work(job, rep, size);
+	}
+	if (outcome == ISOLATE_REPORTED) {
+		report_to_run(rep, h->cfg->repeat, run);
+	} else {
+		run->status = outcome < 0 ? "failed" : outcomes[outcome];
+		run->error = why;
+	}
+	record(h, run);
+}
+
+/* Images are drawn in the children: the heat map by each builder's first
+ * thread count, the shaded render by the first run to get that far. */
+static void image_paths(struct harness *h, struct series_job *job, size_t scene_index,
+                        size_t builder_index, bool first, char (*paths)[4096])
+{
+	if (!h->cfg->images || h->cfg->ray_width == 0 || h->cfg->ray_height == 0)
+		return;
+	if (first && harness_temp_path(paths[0], sizeof(paths[0]), h->cfg->output, "heat",
+	                               scene_index, builder_index) == 0)
+		job->heat_path = paths[0];
+	if (!h->shade_done && harness_temp_path(paths[1], sizeof(paths[1]), h->cfg->output,
+	                                        "shade", scene_index, 0) == 0)
+		job->shade_path = paths[1];
+}
+
+static void run_one(struct harness *h, struct series_job *job, size_t scene_index,
+                    size_t builder_index, bool first)
+{
+	const bvhlab_builder *desc = bvhlab_plugin_builder(job->hb->plugin);
+	struct run_record run = {.scene = job->scene->name, .builder = job->hb->cb->name,
+	                         .plugin = desc->name, .threads = resolve_threads(job->threads),
+	                         .opts = &job->hb->opts, .status = "failed",
+	                         .triangles = job->scene->triangle_count};
+	char paths[2][4096];
+	if (results_has_run(&h->res, run.scene, run.builder, run.threads)) {
+		h->run_index++;
+		return;
+	}
+	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double);
+	struct series_report *rep = calloc(1, size);
+	if (!rep) {
+		run.error = "out of memory for the run's samples";
+		record(h, &run);
+		return;
+	}
+	image_paths(h, job, scene_index, builder_index, first, paths);
+	progress_start(h, &run);
+	run_series(h, job, &run, rep, size);
+	h->shade_done = h->shade_done || (job->shade_path && rep->shade_written);
+	free(rep);
+}
+
+/* Every builder's runs on one loaded scene. */
+static void run_builders(struct harness *h, const bvhlab_scene *scene,
+                         const bvhlab_prims *prims, size_t scene_index)
+{
+	for (size_t b = 0; b < h->cfg->builder_count; b++) {
+		struct harness_builder *hb = &h->builders[b];
+		if (!hb->plugin || !hb->opts_ok) {
+			record_all_failed(h, scene->name, hb, hb->error.message);
+			continue;
+		}
+		size_t n;
+		const uint32_t *threads = builder_threads(h, hb->cb, &n);
+		for (size_t t = 0; t < n; t++) {
+			struct series_job job = {.h = h, .scene = scene, .prims = prims, .hb = hb,
+			                         .threads = threads[t]};
+			run_one(h, &job, scene_index, b, t == 0);
+		}
+	}
+}
+
+/* Turns the children's raw files into the scene's PNGs. */
+static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t scene_index)
+{
+	size_t nb = h->cfg->builder_count;
+	const char **names = calloc(nb ? nb : 1, sizeof(*names));
+	uint32_t *threads = calloc(nb ? nb : 1, sizeof(*threads));
+	bvhlab_error err = {{0}};
+	int r = names && threads ? 0 : -ENOMEM;
+	for (size_t b = 0; r == 0 && b < nb; b++) {
+		size_t n;
+		names[b] = h->cfg->builders[b].name;
+		threads[b] = resolve_threads(builder_threads(h, &h->cfg->builders[b], &n)[0]);
+	}
+	struct scene_images si = {.dir = h->cfg->output, .scene_index = scene_index,
+	                          .scene = scene->name, .width = h->cfg->ray_width,
+	                          .height = h->cfg->ray_height, .builders = names,
+	                          .threads = threads, .builder_count = nb};
+	if (r == 0)
+		r = harness_scene_images(&h->res, &si, &err);
+	if (r == 0)
+		r = results_write(&h->res, &err);
+	if (r < 0)
+		fprintf(stderr, "%sbvhlab: images of scene '%s': %s\n", h->tty ? "\n" : "",
+		        scene->name, err.message[0] ? err.message : strerror(-r));
+	free(names);
+	free(threads);
+}
+
+static void run_scene(struct harness *h, const struct config_scene *cs, size_t scene_index)
 {
 	bvhlab_scene *scene = NULL;
 	bvhlab_prims prims = {0};
 	bvhlab_error err = {{0}};
+	if (scene_done(h, cs))
+		return;
 	int r = harness_load_scene(cs, &scene, &err);
 	if (r == 0)
 		r = bvhlab_prims_init(&prims, scene, &err);
@@ -225,17 +491,10 @@ static void run_scene(struct harness *h, const struct config_scene *cs)
 		goto out;
 	}
 	results_add_scene(&h->res, scene->name, scene->source, scene->triangle_count, NULL);
-	for (size_t b = 0; b < h->cfg->builder_count; b++) {
-		struct harness_builder *hb = &h->builders[b];
-		if (!hb->plugin || !hb->opts_ok) {
-			record_all_failed(h, scene->name, hb, hb->error.message);
-			continue;
-		}
-		size_t n;
-		const uint32_t *threads = builder_threads(h, hb->cb, &n);
-		for (size_t t = 0; t < n; t++)
-			run_one(h, scene, &prims, hb, threads[t]);
-	}
+	h->shade_done = false;
+	run_builders(h, scene, &prims, scene_index);
+	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)
+		scene_images(h, scene, scene_index);
 out:
 	bvhlab_prims_finish(&prims);
 	bvhlab_scene_destroy(scene);
@@ -284,18 +543,45 @@ static uint32_t count_runs(const struct harness *h)
 	return total * (uint32_t)h->cfg->scene_count;
 }
 
-int harness_run(const struct config *cfg, bool quiet, bvhlab_error *err)
+/* Takes over the finished runs of the output folder's results.json. */
+static int resume(struct harness *h, bvhlab_error *err)
 {
-	struct harness h = {.cfg = cfg, .quiet = quiet, .all_ok = true, .start = util_now()};
+	size_t kept = 0, not_ok = 0;
+	int r = results_resume(&h->res, &kept, &not_ok, err);
+	if (r == -ENOENT) {
+		if (!h->quiet)
+			fprintf(stderr, "bvhlab: nothing to resume in %s/; starting afresh\n",
+			        h->cfg->output);
+		return 0;
+	}
+	if (r < 0)
+		return r;
+	h->all_ok = not_ok == 0;
+	if (!h->quiet)
+		fprintf(stderr, "bvhlab: resuming %s/: %zu finished run%s kept\n", h->cfg->output,
+		        kept, kept == 1 ? "" : "s");
+	return 0;
+}
+
+int harness_run(const struct config *cfg, const struct harness_options *opts,
+                bvhlab_error *err)
+{
+	struct harness h = {.cfg = cfg, .quiet = opts->quiet, .all_ok = true, .start = util_now(),
+	                    .tty = isatty(STDERR_FILENO)};
 	int r = results_init(&h.res, cfg, cfg->output, err);
 	if (r < 0)
 		return r;
-	r = results_write(&h.res, err);
+	if (opts->resume)
+		r = resume(&h, err);
+	if (r == 0)
+		r = results_write(&h.res, err);
 	if (r == 0 && (r = open_builders(&h)) < 0)
 		error_set(err, "out of memory opening plugins");
 	h.run_total = count_runs(&h);
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
-		run_scene(&h, &cfg->scenes[s]);
+		run_scene(&h, &cfg->scenes[s], s);
+	if (h.tty && !h.quiet && h.run_total)
+		fputc('\n', stderr);
 	close_builders(&h);
 	results_finish(&h.res);
 	return r < 0 ? r : h.all_ok ? 0 : 1;

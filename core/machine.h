@@ -1,15 +1,62 @@
-/* What the results record about the machine a run happened on. */
+/* What the results record about the machine a run happened on, and the CPU
+ * topology (hwloc) behind thread-count resolution and thread pinning. */
 #ifndef BVHLAB_CORE_MACHINE_H
 #define BVHLAB_CORE_MACHINE_H
 
+#include <stdbool.h>
 #include <stdint.h>
+
+enum { MACHINE_L1D, MACHINE_L2, MACHINE_L3, MACHINE_CACHE_LEVELS };
+
+/* One cache level as the allowed CPUs see it. */
+struct machine_cache {
+	uint64_t size;      /* bytes of one instance; 0 when the level is unknown */
+	uint32_t instances; /* instances shared by at least one allowed CPU */
+};
+
+/*
+ * The part of the machine the calling thread may run on: its affinity mask
+ * intersected with the CPUs hwloc reports as allowed (hwloc drops CPUs that
+ * a cgroup cpuset forbids). Every count is >= 1 except caches.
+ */
+struct machine_topology {
+	bool from_hwloc;         /* false: hwloc failed; counts come from the mask */
+	uint32_t packages;       /* sockets with an allowed CPU */
+	uint32_t physical_cores; /* cores with an allowed CPU: what threads = 0 means */
+	uint32_t logical_cpus;   /* allowed hardware threads */
+	struct machine_cache caches[MACHINE_CACHE_LEVELS];
+};
 
 struct machine_info {
 	char cpu[128];        /* model name from /proc/cpuinfo, or "unknown" */
 	uint32_t cores;       /* online logical CPUs of the machine */
-	uint32_t threads_available; /* CPUs this process may run on */
+	uint32_t threads_available; /* what threads = 0 resolves to (physical cores) */
+	struct machine_topology topo;
 };
 
 void machine_info_read(struct machine_info *info);
+
+/* 0, or -ENODEV when hwloc could not load (t is then filled from the mask). */
+int machine_topology_read(struct machine_topology *t);
+
+/* "L1d", "L2", "L3". */
+const char *machine_cache_name(int level);
+
+/*
+ * Pinning plan: one CPU per allowed physical core, in hwloc's logical order
+ * (the cores of one package before the next), captured from the calling
+ * thread's mask before a build so workers that inherit a pinned mask still
+ * spread over the whole set.
+ */
+struct pin_plan {
+	uint32_t count; /* distinct cores, >= 1 */
+	int *cpu;       /* [count] the CPU a worker on that core is bound to */
+};
+
+bool machine_pinning(void);
+int pin_plan_init(struct pin_plan *plan);
+void pin_plan_finish(struct pin_plan *plan);
+/* Binds the calling thread to plan->cpu[worker % count]. 0 or -errno. */
+int pin_plan_apply(const struct pin_plan *plan, uint32_t worker);
 
 #endif

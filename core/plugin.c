@@ -69,6 +69,24 @@ static int find_in_dir(const char *dir, size_t dirlen, const char *name, char *o
 	return -ENOENT;
 }
 
+/* Names what there is to choose from: a typo is then plain to see. */
+static void not_found(const char *name, bvhlab_error *err)
+{
+	char list[300] = "";
+	char **names = NULL;
+	size_t used = 0;
+	if (bvhlab_plugin_names(&names, NULL) == 0) {
+		for (char **p = names; *p && used < sizeof(list); p++)
+			used += (size_t)snprintf(list + used, sizeof(list) - used, "%s%s",
+			                         p == names ? "" : ", ", *p);
+		if (used >= sizeof(list)) /* a long list: say it goes on */
+			memcpy(list + sizeof(list) - 4, "...", 4);
+		bvhlab_plugin_names_free(names);
+	}
+	error_set(err, "plugin '%s' not found on the search path %s (available: %s)", name,
+	          bvhlab_plugin_search_path(), used ? list : "none");
+}
+
 static int resolve(const char *name, char *out, size_t size, bvhlab_error *err)
 {
 	if (looks_like_path(name)) {
@@ -86,7 +104,7 @@ static int resolve(const char *name, char *out, size_t size, bvhlab_error *err)
 			return 0;
 		p += len + (colon ? 1 : 0);
 	}
-	error_set(err, "plugin '%s' not found on the search path %s", name, sp);
+	not_found(name, err);
 	return -ENOENT;
 }
 

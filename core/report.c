@@ -3,12 +3,14 @@
  * report.md (one table per scene). Both read only the document, so a saved
  * results.json can be rendered again later.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <cJSON.h>
 
+#include "report.h"
 #include "results.h"
 #include "util.h"
 
@@ -44,6 +46,51 @@ static const char *num(char *buf, size_t size, const cJSON *o, const char *path,
 	return buf;
 }
 
+const cJSON *report_at(const cJSON *o, const char *path)
+{
+	return at(o, path);
+}
+
+const char *report_str(const cJSON *o, const char *path)
+{
+	return str(o, path);
+}
+
+double report_num(const cJSON *o, const char *path)
+{
+	const cJSON *v = at(o, path);
+	return cJSON_IsNumber(v) ? v->valuedouble : NAN;
+}
+
+double report_speedup(const cJSON *runs, const cJSON *run)
+{
+	const cJSON *base;
+	double t = report_num(run, "build_ms.median");
+	cJSON_ArrayForEach(base, runs) {
+		if (report_num(base, "threads") == 1 &&
+		    strcmp(str(base, "scene"), str(run, "scene")) == 0 &&
+		    strcmp(str(base, "builder"), str(run, "builder")) == 0) {
+			double t1 = report_num(base, "build_ms.median");
+			return t > 0 ? t1 / t : NAN;
+		}
+	}
+	return NAN;
+}
+
+void report_escape(struct strbuf *sb, const char *text)
+{
+	for (const char *p = text; *p; p++) {
+		switch (*p) {
+		case '&': sb_printf(sb, "&amp;"); break;
+		case '<': sb_printf(sb, "&lt;"); break;
+		case '>': sb_printf(sb, "&gt;"); break;
+		case '"': sb_printf(sb, "&quot;"); break;
+		case '\'': sb_printf(sb, "&#39;"); break;
+		default: sb_printf(sb, "%c", *p);
+		}
+	}
+}
+
 /* CSV field: quoted when it holds a separator, quote or newline. */
 static void csv_field(struct strbuf *sb, const char *s, bool last)
 {
@@ -72,6 +119,12 @@ static const char *const csv_numbers[][2] = {
 	{"tree.memory_bytes", "%.0f"},
 	{"validation.rays_checked", "%.0f"},
 	{"validation.mismatches", "%.0f"},
+	{"rays.primary.mrays_per_s", "%.4f"},
+	{"rays.primary.nodes_per_ray", "%.4f"},
+	{"rays.primary.tris_per_ray", "%.4f"},
+	{"rays.diffuse.mrays_per_s", "%.4f"},
+	{"rays.diffuse.nodes_per_ray", "%.4f"},
+	{"rays.diffuse.tris_per_ray", "%.4f"},
 };
 
 static void csv_row(struct strbuf *sb, const cJSON *run)
@@ -110,7 +163,7 @@ static void md_cell(struct strbuf *sb, const char *s)
 	sb_printf(sb, " |");
 }
 
-static void md_run_row(struct strbuf *sb, const cJSON *run)
+static void md_run_row(struct strbuf *sb, const cJSON *doc, const cJSON *run)
 {
 	char buf[64];
 	sb_printf(sb, "|");
@@ -121,7 +174,14 @@ static void md_run_row(struct strbuf *sb, const cJSON *run)
 	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.min", "%.2f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.max", "%.2f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "mtris_per_s", "%.2f"));
+	double speedup = report_speedup(cJSON_GetObjectItem(doc, "runs"), run);
+	snprintf(buf, sizeof(buf), "%.2f", speedup);
+	md_cell(sb, isnan(speedup) ? "" : buf);
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.sah_cost", "%.3f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.mrays_per_s", "%.2f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.nodes_per_ray", "%.1f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "rays.diffuse.mrays_per_s", "%.2f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "rays.diffuse.nodes_per_ray", "%.1f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.nodes", "%.0f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.max_depth", "%.0f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.avg_leaf_size", "%.2f"));
@@ -129,7 +189,20 @@ static void md_run_row(struct strbuf *sb, const cJSON *run)
 	sb_printf(sb, "\n");
 }
 
-static void md_scene(struct strbuf *sb, const cJSON *scene, const cJSON *runs)
+/* The scene's images, when the run drew them (paths relative to the report). */
+static void md_images(struct strbuf *sb, const cJSON *scene)
+{
+	const char *shaded = str(scene, "images.shaded"), *legend = str(scene, "images.legend");
+	if (*shaded)
+		sb_printf(sb, "\n![%s](%s)\n", str(scene, "name"), shaded);
+	if (*legend)
+		sb_printf(sb, "\nHeat maps (nodes visited per primary ray, %.0f to %.0f): "
+		              "![scale](%s) and per builder in report.html.\n",
+		          report_num(scene, "images.heat_min"), report_num(scene, "images.heat_max"),
+		          legend);
+}
+
+static void md_scene(struct strbuf *sb, const cJSON *doc, const cJSON *scene)
 {
 	const char *name = str(scene, "name");
 	char buf[64];
@@ -138,12 +211,15 @@ static void md_scene(struct strbuf *sb, const cJSON *scene, const cJSON *runs)
 	if (*str(scene, "error"))
 		sb_printf(sb, ". **Could not be loaded:** %s", str(scene, "error"));
 	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | Mtris/s "
-	              "| SAH cost | nodes | depth | avg leaf | error |\n"
-	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+	              "| speedup | SAH cost | primary Mrays/s | primary nodes/ray "
+	              "| diffuse Mrays/s | diffuse nodes/ray | nodes | depth | avg leaf | error |\n"
+	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
+	              "|---:|---|\n");
 	const cJSON *run;
-	cJSON_ArrayForEach(run, runs)
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
 		if (strcmp(str(run, "scene"), name) == 0)
-			md_run_row(sb, run);
+			md_run_row(sb, doc, run);
+	md_images(sb, scene);
 }
 
 char *report_markdown(const cJSON *doc)
@@ -157,11 +233,15 @@ char *report_markdown(const cJSON *doc)
 	sb_printf(&sb, "# bvhlab report\n\nbvhlab %s, %s. Machine: %s, %s cores, %s available "
 	               "to this process.\n\n%d runs, %d ok. Times are build times in ms over "
 	               "the timed repeats; SAH cost with c_trav = c_isect = 1, normalised by "
-	               "the root's surface area.\n",
+	               "the root's surface area. Speedup: over the same builder's 1-thread run. "
+	               "Rays (primary from the camera, diffuse bounces from their hits) are "
+	               "traced with every hardware thread for every run, whatever its build "
+	               "thread count, so traversal numbers compare trees.\n",
 	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);
+	report_thesis(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
-		md_scene(&sb, scene, runs);
+		md_scene(&sb, doc, scene);
 	return sb_take(&sb);
 }

@@ -47,6 +47,18 @@ static cJSON *machine_json(void)
 	cJSON_AddStringToObject(o, "cpu", m.cpu);
 	cJSON_AddNumberToObject(o, "cores", m.cores);
 	cJSON_AddNumberToObject(o, "threads_available", m.threads_available);
+	cJSON_AddNumberToObject(o, "packages", m.topo.packages);
+	cJSON_AddNumberToObject(o, "physical_cores", m.topo.physical_cores);
+	cJSON_AddNumberToObject(o, "logical_cpus", m.topo.logical_cpus);
+	/* "caches": { "L1d": { "bytes": 49152, "instances": 2 }, ... }, known levels. */
+	cJSON *caches = cJSON_AddObjectToObject(o, "caches");
+	for (int k = 0; caches && k < MACHINE_CACHE_LEVELS; k++) {
+		if (m.topo.caches[k].size == 0)
+			continue;
+		cJSON *c = cJSON_AddObjectToObject(caches, machine_cache_name(k));
+		cJSON_AddNumberToObject(c, "bytes", (double)m.topo.caches[k].size);
+		cJSON_AddNumberToObject(c, "instances", m.topo.caches[k].instances);
+	}
 	return o;
 }
 
@@ -93,6 +105,18 @@ void results_finish(struct results *res)
 	memset(res, 0, sizeof(*res));
 }
 
+static cJSON *find_scene(const struct results *res, const char *name)
+{
+	cJSON *scene;
+	cJSON_ArrayForEach(scene, res->scenes) {
+		const cJSON *n = cJSON_GetObjectItemCaseSensitive(scene, "name");
+		if (cJSON_IsString(n) && strcmp(n->valuestring, name) == 0)
+			return scene;
+	}
+	return NULL;
+}
+
+/* A scene seen again (a resumed sweep loads it anew) replaces its entry. */
 int results_add_scene(struct results *res, const char *name, const char *source,
                       uint32_t triangles, const char *error)
 {
@@ -104,7 +128,11 @@ int results_add_scene(struct results *res, const char *name, const char *source,
 	cJSON_AddNumberToObject(o, "triangles", triangles);
 	if (error)
 		cJSON_AddStringToObject(o, "error", error);
-	cJSON_AddItemToArray(res->scenes, o);
+	cJSON *old = find_scene(res, name ? name : "");
+	if (old)
+		cJSON_ReplaceItemViaPointer(res->scenes, old, o);
+	else
+		cJSON_AddItemToArray(res->scenes, o);
 	return 0;
 }
 
@@ -188,6 +216,8 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddItemToObject(o, "tree", tree_json(run->stats));
 	if (run->validated)
 		cJSON_AddItemToObject(o, "validation", validation_json(run));
+	if (run->rays)
+		cJSON_AddItemToObject(o, "rays", results_rays_json(run->rays));
 	cJSON_AddItemToArray(res->runs, o);
 	return 0;
 }
@@ -206,6 +236,8 @@ int results_write_file(const char *dir, const char *name, const char *text, bvhl
 	size_t len = strlen(text);
 	bool ok = fwrite(text, 1, len, f) == len;
 	ok = (fflush(f) == 0) && ok;
+	/* On disk before the rename: a crash then leaves the old file or the new, never half. */
+	ok = (fsync(fileno(f)) == 0) && ok;
 	ok = (fclose(f) == 0) && ok;
 	if (ok && rename(tmp, path) == 0)
 		return 0;
@@ -236,5 +268,211 @@ int results_write(const struct results *res, bvhlab_error *err)
 		r = write_rendering(res, "results.csv", results_csv(res->doc), err);
 	if (r == 0)
 		r = write_rendering(res, "report.md", report_markdown(res->doc), err);
+	if (r == 0)
+		r = write_rendering(res, "report.html", report_html(res->doc), err);
+	return r;
+}
+
+/* ---- resuming ---------------------------------------------------------------- */
+
+static bool is_finished(const char *status)
+{
+	static const char *const finished[] = {"ok", "invalid", "failed", "crashed", "timeout"};
+	for (size_t k = 0; k < sizeof(finished) / sizeof(finished[0]); k++)
+		if (strcmp(status, finished[k]) == 0)
+			return true;
+	return false;
+}
+
+static const char *string_of(const cJSON *obj, const char *key)
+{
+	const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+	return cJSON_IsString(v) ? v->valuestring : NULL;
+}
+
+static bool run_matches(const cJSON *run, const char *scene, const char *builder,
+                        uint32_t threads)
+{
+	const char *s = string_of(run, "scene"), *b = string_of(run, "builder");
+	const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
+	return s && b && cJSON_IsNumber(t) && t->valuedouble == threads && strcmp(s, scene) == 0 &&
+	       strcmp(b, builder) == 0;
+}
+
+bool results_has_run(const struct results *res, const char *scene, const char *builder,
+                     uint32_t threads)
+{
+	const cJSON *run;
+	cJSON_ArrayForEach(run, res->runs)
+		if (run_matches(run, scene, builder, threads))
+			return true;
+	return false;
+}
+
+/* The file's text; -ENOENT quietly when there is none. */
+static int read_text(const char *path, char **out, bvhlab_error *err)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		int e = errno;
+		if (e != ENOENT)
+			error_set(err, "cannot resume from %s: %s", path, strerror(e));
+		return -e;
+	}
+	struct strbuf sb = {0};
+	char chunk[65536];
+	size_t n;
+	while ((n = fread(chunk, 1, sizeof(chunk), f)) > 0)
+		sb_printf(&sb, "%.*s", (int)n, chunk);
+	bool failed = ferror(f);
+	fclose(f);
+	*out = sb_take(&sb);
+	if (failed || !*out) {
+		free(*out);
+		error_set(err, "cannot resume from %s: %s", path, failed ? "read error" : "out of memory");
+		return failed ? -EIO : -ENOMEM;
+	}
+	return 0;
+}
+
+/* Each run needs what matching and the reports use; unfinished ones are left to redo. */
+static int check_runs(const cJSON *runs, const char *path, bvhlab_error *err)
+{
+	int k = 0;
+	const cJSON *run;
+	if (!cJSON_IsArray(runs)) {
+		error_set(err, "cannot resume from %s: no \"runs\" array (not a bvhlab results file?)",
+		          path);
+		return -EINVAL;
+	}
+	cJSON_ArrayForEach(run, runs) {
+		const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
+		if (!string_of(run, "scene") || !string_of(run, "builder") || !string_of(run, "status") ||
+		    !cJSON_IsNumber(t)) {
+			error_set(err, "cannot resume from %s: runs[%d] lacks a scene, builder, threads "
+			          "or status", path, k);
+			return -EINVAL;
+		}
+		k++;
+	}
+	return 0;
+}
+
+/* Moves the old document's finished runs and named scenes into ours. */
+static void take_over(struct results *res, cJSON *old, size_t *kept, size_t *not_ok)
+{
+	cJSON *runs = cJSON_GetObjectItemCaseSensitive(old, "runs");
+	cJSON *scenes = cJSON_GetObjectItemCaseSensitive(old, "scenes");
+	while (runs->child) {
+		cJSON *run = cJSON_DetachItemViaPointer(runs, runs->child);
+		const char *status = string_of(run, "status");
+		if (!is_finished(status)) {
+			cJSON_Delete(run);
+			continue;
+		}
+		(*kept)++;
+		*not_ok += strcmp(status, "ok") != 0;
+		cJSON_AddItemToArray(res->runs, run);
+	}
+	while (cJSON_IsArray(scenes) && scenes->child) {
+		cJSON *scene = cJSON_DetachItemViaPointer(scenes, scenes->child);
+		if (string_of(scene, "name") && !find_scene(res, string_of(scene, "name")))
+			cJSON_AddItemToArray(res->scenes, scene);
+		else
+			cJSON_Delete(scene);
+	}
+	/* The sweep began when the first attempt did. */
+	const char *created = string_of(old, "created");
+	if (created) {
+		cJSON_AddStringToObject(res->doc, "resumed", string_of(res->doc, "created"));
+		cJSON_ReplaceItemInObjectCaseSensitive(res->doc, "created", cJSON_CreateString(created));
+	}
+}
+
+int results_resume(struct results *res, size_t *kept, size_t *not_ok, bvhlab_error *err)
+{
+	char path[4096], *text = NULL;
+	*kept = *not_ok = 0;
+	if ((size_t)snprintf(path, sizeof(path), "%s/results.json", res->dir) >= sizeof(path)) {
+		error_set(err, "path too long: %s/results.json", res->dir);
+		return -ENAMETOOLONG;
+	}
+	int r = read_text(path, &text, err);
+	if (r < 0)
+		return r;
+	cJSON *old = cJSON_Parse(text);
+	free(text);
+	if (!cJSON_IsObject(old)) {
+		error_set(err, "cannot resume from %s: not a valid JSON object (damaged? move it away "
+		          "to start afresh)", path);
+		r = -EINVAL;
+	} else {
+		r = check_runs(cJSON_GetObjectItemCaseSensitive(old, "runs"), path, err);
+	}
+	if (r == 0)
+		take_over(res, old, kept, not_ok);
+	cJSON_Delete(old);
+	return r;
+}
+
+/* ---- images and saved documents ----------------------------------------------- */
+
+int results_set_scene_image(struct results *res, const char *scene, const char *kind,
+                            const char *name, uint32_t lo, uint32_t hi)
+{
+	cJSON *s = find_scene(res, scene);
+	if (!s)
+		return -ENOENT;
+	cJSON *images = cJSON_GetObjectItemCaseSensitive(s, "images");
+	if (!images && !(images = cJSON_AddObjectToObject(s, "images")))
+		return -ENOMEM;
+	cJSON_DeleteItemFromObjectCaseSensitive(images, kind);
+	cJSON_AddStringToObject(images, kind, name);
+	if (strcmp(kind, "legend") == 0) {
+		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_min");
+		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_max");
+		cJSON_AddNumberToObject(images, "heat_min", lo);
+		cJSON_AddNumberToObject(images, "heat_max", hi);
+	}
+	return 0;
+}
+
+int results_set_run_image(struct results *res, const char *scene, const char *builder,
+                          uint32_t threads, const char *name)
+{
+	cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
+		if (!run_matches(run, scene, builder, threads))
+			continue;
+		cJSON_DeleteItemFromObjectCaseSensitive(run, "heat_image");
+		return cJSON_AddStringToObject(run, "heat_image", name) ? 0 : -ENOMEM;
+	}
+	return -ENOENT;
+}
+
+int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err)
+{
+	char *text = NULL;
+	int r = read_text(json_path, &text, err);
+	if (r == -ENOENT)
+		error_set(err, "cannot read %s: %s", json_path, strerror(ENOENT));
+	if (r < 0)
+		return r;
+	struct results res = {.doc = cJSON_Parse(text), .dir = (char *)dir};
+	free(text);
+	if (!cJSON_IsObject(res.doc) ||
+	    !cJSON_IsArray(cJSON_GetObjectItemCaseSensitive(res.doc, "runs"))) {
+		error_set(err, "%s is not a bvhlab results document", json_path);
+		r = -EINVAL;
+	}
+	if (r == 0)
+		r = make_dirs(dir, err);
+	if (r == 0)
+		r = write_rendering(&res, "results.csv", results_csv(res.doc), err);
+	if (r == 0)
+		r = write_rendering(&res, "report.md", report_markdown(res.doc), err);
+	if (r == 0)
+		r = write_rendering(&res, "report.html", report_html(res.doc), err);
+	cJSON_Delete(res.doc);
 	return r;
 }

@@ -442,6 +442,23 @@ static bool host_little_endian(void)
 	return first == 1;
 }
 
+/* Data past the last element means the header's counts are wrong: say so
+ * rather than build a scene from part of the file. Trailing blanks are fine. */
+static int check_end(struct ply_reader *r, const struct ply_header *h)
+{
+	size_t pos = r->pos;
+
+	while (pos < r->size && strchr(" \t\r\n", r->data[pos]) && r->data[pos])
+		r->line += r->data[pos++] == '\n';
+	if (pos == r->size)
+		return 0;
+	r->element = &h->elements[h->element_count - 1];
+	r->value_pos = pos;
+	r->value_line = r->line;
+	return body_error(r, "%zu bytes of data after the last element '%s' (wrong element "
+	                     "counts in the header?)", r->size - pos, r->element->name);
+}
+
 static int read_body(struct ply_reader *r, const struct ply_header *h)
 {
 	enum role *roles = calloc(h->element_count + 1, sizeof(*roles));
@@ -461,6 +478,8 @@ static int read_body(struct ply_reader *r, const struct ply_header *h)
 		r->list = lists[i];
 		ret = read_element(r, &h->elements[i], roles[i]);
 	}
+	if (!ret)
+		ret = check_end(r, h);
 	if (!ret && r->mesh.triangle_count == 0)
 		ret = header_error(r, h->end_line, "no faces: the file has no triangles");
 out:

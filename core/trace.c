@@ -61,6 +61,8 @@ typedef struct trace_state {
 	const ray_prep *p;
 	bvhlab_hit *hit;
 	uint64_t nodes, tris;
+	bool any;  /* any-hit: the first hit ends the traversal */
+	bool done;
 } trace_state;
 
 /* False for a zero, infinite or NaN direction: such a ray hits nothing. */
@@ -253,7 +255,10 @@ static void leaf(trace_state *s, const bvhlab_node *n)
 		if (prim >= s->scene->triangle_count)
 			continue;
 		s->tris++;
-		isect_prim(s->p, s->scene, prim, s->hit);
+		if (isect_prim(s->p, s->scene, prim, s->hit) && s->any) {
+			s->done = true;
+			return;
+		}
 	}
 }
 
@@ -349,6 +354,8 @@ static void traverse(trace_state *s)
 			break;
 		if (n->count) {
 			leaf(s, n);
+			if (s->done)
+				break;
 		} else if (descend(s, n, &node, &stack, &sp, &cap, &fail)) {
 			continue;
 		} else if (fail == TRACE_NOMEM) {
@@ -383,10 +390,10 @@ static void hit_init(const bvhlab_ray *ray, bvhlab_hit *hit)
 
 /* Stats: nodes_visited counts the nodes entered (root included, each inner
  * node's two child boxes are tested from it), tris_tested the triangle tests. */
-void bvhlab_trace_closest(const bvhlab_tree *tree, const bvhlab_scene *scene,
-                          const bvhlab_ray *ray, bvhlab_hit *hit, bvhlab_trace_stats *stats)
+static void trace(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhlab_ray *ray,
+                  bvhlab_hit *hit, bvhlab_trace_stats *stats, bool any)
 {
-	trace_state s = { tree, scene, NULL, hit, 0, 0 };
+	trace_state s = { tree, scene, NULL, hit, 0, 0, any, false };
 	ray_prep p;
 
 	hit_init(ray, hit);
@@ -399,6 +406,21 @@ void bvhlab_trace_closest(const bvhlab_tree *tree, const bvhlab_scene *scene,
 		stats->nodes_visited += s.nodes;
 		stats->tris_tested += s.tris;
 	}
+}
+
+void bvhlab_trace_closest(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                          const bvhlab_ray *ray, bvhlab_hit *hit, bvhlab_trace_stats *stats)
+{
+	trace(tree, scene, ray, hit, stats, false);
+}
+
+/* Occlusion rays only need to know that something is in the way, so the
+ * first triangle hit ends the walk (the hit is not the closest one). */
+bool bvhlab_trace_any(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                      const bvhlab_ray *ray, bvhlab_hit *hit, bvhlab_trace_stats *stats)
+{
+	trace(tree, scene, ray, hit, stats, true);
+	return hit->prim != BVHLAB_NO_HIT;
 }
 
 void bvhlab_trace_brute(const bvhlab_scene *scene, const bvhlab_ray *ray, bvhlab_hit *hit)

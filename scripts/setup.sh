@@ -3,7 +3,7 @@
 # Usage: setup_build BUILD_DIR [meson setup options...]
 
 BVHLAB_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-BVHLAB_DEBS="meson ninja-build gcc pkg-config libcjson-dev"
+BVHLAB_DEBS="meson ninja-build gcc g++ pkg-config libcjson-dev libhwloc-dev libopenimageio-dev"
 
 missing_debs() {
 	local missing=""
@@ -14,7 +14,30 @@ missing_debs() {
 	if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists libcjson; then
 		missing="$missing libcjson-dev"
 	fi
+	if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists hwloc; then
+		missing="$missing libhwloc-dev"
+	fi
+	# Images (core/image_oiio.cpp): OpenImageIO and a C++ compiler for that one file.
+	command -v c++ >/dev/null 2>&1 || missing="$missing g++"
+	if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists OpenImageIO; then
+		missing="$missing libopenimageio-dev"
+	fi
 	echo "$missing"
+}
+
+# Optional: Embree 3 for the embree peer plugin. Never fails the set-up.
+install_optional() {
+	[ -f /usr/include/embree3/rtcore.h ] && return 0
+	if [ "$(id -u)" != 0 ] || ! command -v apt-get >/dev/null 2>&1; then
+		echo "setup: optional libembree-dev missing: building without the embree plugin" >&2
+		return 0
+	fi
+	echo "setup: installing libembree-dev (optional: the embree plugin)" >&2
+	export DEBIAN_FRONTEND=noninteractive
+	apt-get install -y -qq --no-install-recommends libembree-dev >&2 ||
+		{ apt-get update -qq >&2 && apt-get install -y -qq --no-install-recommends libembree-dev >&2; } ||
+		echo "setup: could not install libembree-dev: building without the embree plugin" >&2
+	return 0
 }
 
 install_deps() {
@@ -42,6 +65,7 @@ setup_build() {
 	local dir=$1
 	shift
 	install_deps || return 1
+	install_optional
 	if [ ! -f "$dir/build.ninja" ]; then
 		meson setup "$dir" "$BVHLAB_ROOT" "$@" >&2 || return 1
 	fi

@@ -240,8 +240,8 @@ static void test_unknown_keys(void)
 	t = "{ " SCENES ", " BUILDERS ", \"repet\": 3 }";
 	EXPECT_ERROR_AT(t, "\"repet\"", 0,
 	                "unknown key 'repet' at the top level (known: format_version, output, "
-	                "repeat, warmup, threads, validate, validate_rays, rays, images, scenes, "
-	                "builders); did you mean 'repeat'?");
+	                "repeat, warmup, threads, validate, validate_rays, rays, images, isolate, "
+	                "timeout_s, memory_limit_mb, scenes, builders); did you mean 'repeat'?");
 	t = "{ " SCENES ", " BUILDERS ", \"zzzzzz\": 3 }";
 	EXPECT_ERROR_AT(t, "\"zzzzzz\"", 0, "unknown key 'zzzzzz' at the top level");
 	CHECK(load(&cfg, t, &err) < 0 && !strstr(err.message, "did you mean"));
@@ -254,10 +254,10 @@ static void test_unknown_keys(void)
 	             "    { \"plugin\": \"b\", \"threds\": [2] } ] }",
 	             3, 22,
 	             "unknown key 'threds' in builders[1] (known: plugin, name, threads, "
-	             "options); did you mean 'threads'?");
+	             "timeout_s, memory_limit_mb, options); did you mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
-	                "diffuse); did you mean 'width'?");
+	                "diffuse, camera); did you mean 'width'?");
 }
 
 static void test_types(void)
@@ -509,6 +509,47 @@ static void test_locate(void)
 	cJSON_Delete(root);
 }
 
+/* "isolate", "timeout_s" and "memory_limit_mb": defaults, overrides, bad values. */
+static void test_isolation_keys(void)
+{
+	struct config cfg;
+	bvhlab_error err = { "" };
+	const char *t;
+	int rc = load(&cfg, "{ " SCENES ", " BUILDERS " }", &err);
+	CHECK_INT(rc, 0);
+	if (!rc)
+		CHECK(cfg.isolate && cfg.timeout_s == 600 && cfg.memory_limit_mb == 0 &&
+		      cfg.builders[0].timeout_s == 0 && cfg.builders[0].memory_limit_mb == 0);
+	config_finish(&cfg);
+	rc = load(&cfg, "{ \"isolate\": false, \"timeout_s\": 2.5, \"memory_limit_mb\": 512, "
+	          SCENES ", \"builders\": [ { \"plugin\": \"a\", \"timeout_s\": 0.25, "
+	          "\"memory_limit_mb\": 64 } ] }", &err);
+	CHECK_INT(rc, 0);
+	if (!rc)
+		CHECK(!cfg.isolate && cfg.timeout_s == 2.5 && cfg.memory_limit_mb == 512 &&
+		      cfg.builders[0].timeout_s == 0.25 && cfg.builders[0].memory_limit_mb == 64);
+	config_finish(&cfg);
+#define TOP(extra) "{ " SCENES ", " BUILDERS ", " extra " }"
+	t = TOP("\"isolate\": 1");
+	EXPECT_ERROR_AT(t, "1 }", 0, "'isolate' must be true or false, not 1");
+	t = TOP("\"timeout_s\": 0");
+	EXPECT_ERROR_AT(t, "0 }", 0, "'timeout_s' must be a number > 0, not 0");
+	t = TOP("\"timeout_s\": -3");
+	EXPECT_ERROR_AT(t, "-3", 0, "'timeout_s' must be a number > 0, not -3");
+	t = TOP("\"timeout_s\": \"60\"");
+	EXPECT_ERROR_AT(t, "\"60\"", 0, "'timeout_s' must be a number > 0, not a string");
+	t = TOP("\"memory_limit_mb\": 0.5");
+	EXPECT_ERROR_AT(t, "0.5", 0, "'memory_limit_mb' must be a positive integer, not 0.5");
+	t = TOP("\"memory_limit_mb\": 17592186044416");
+	EXPECT_ERROR_AT(t, "1759", 0, "'memory_limit_mb' must be a positive integer up to "
+	                "17592186044415");
+	t = "{ \"builders\": [ { \"plugin\": \"a\", \"timeout_s\": null } ], " SCENES " }";
+	EXPECT_ERROR_AT(t, "null", 0, "'builders[0].timeout_s' must be a number > 0, not null");
+	t = "{ \"builders\": [ { \"plugin\": \"a\", \"memory_limit_mb\": -1 } ], " SCENES " }";
+	EXPECT_ERROR_AT(t, "-1", 0, "'builders[0].memory_limit_mb' must be a positive integer");
+#undef TOP
+}
+
 int main(void)
 {
 	snprintf(tmp_dir, sizeof(tmp_dir), "/tmp/bvhlab-test-config-XXXXXX");
@@ -524,6 +565,7 @@ int main(void)
 	test_types();
 	test_structure();
 	test_options();
+	test_isolation_keys();
 	test_locate();
 	unlink(cfg_path);
 	rmdir(tmp_dir);

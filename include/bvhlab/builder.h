@@ -4,6 +4,8 @@
  * Version history (major.minor; a minor only appends fields, marked "since"):
  *   1.0  first version: bvhlab_builder, bvhlab_host, bvhlab_build_input,
  *        bvhlab_build_output, bvhlab_option_decl.
+ *   1.1  bvhlab_host.pin_thread (check BVHLAB_HOST_HAS(host, pin_thread));
+ *        hardware_threads counts physical cores, not logical CPUs.
  *
  * A plugin is a shared object that exports exactly one symbol,
  *
@@ -29,7 +31,7 @@
 #include "types.h"
 
 #define BVHLAB_ABI_MAJOR 1
-#define BVHLAB_ABI_MINOR 0
+#define BVHLAB_ABI_MINOR 1
 #define BVHLAB_ABI_VERSION(major, minor) (((uint32_t)(major) << 16) | (uint32_t)(minor))
 #define BVHLAB_ABI_VERSION_MAJOR(v) ((uint32_t)(v) >> 16)
 #define BVHLAB_ABI_VERSION_MINOR(v) ((uint32_t)(v) & 0xffffu)
@@ -126,9 +128,25 @@ typedef struct bvhlab_host {
 	/* Optional progress report, fraction in [0, 1]; may be a no-op. */
 	void (*progress)(bvhlab_build_ctx *ctx, double fraction);
 
-	/* Logical CPUs this process may run on (what threads = 0 resolves to). */
+	/* What threads = 0 resolves to: the physical cores the calling thread
+	 * may run on (its affinity mask and cgroup cpuset; SMT siblings count
+	 * once). Logical CPUs before 1.1. */
 	uint32_t (*hardware_threads)(bvhlab_build_ctx *ctx);
+
+	/* since 1.1. Binds the calling thread to the worker-th distinct
+	 * physical core of the set the build started with (wrapping around
+	 * past the last core), when the user enabled pinning; otherwise does
+	 * nothing. Call it first thing in each worker, with distinct workers
+	 * 0 .. input->threads - 1; the host restores the affinity of the
+	 * thread that called build() afterwards. 0, or a negative errno (the
+	 * thread then keeps running unpinned). */
+	int (*pin_thread)(bvhlab_build_ctx *ctx, uint32_t worker);
 } bvhlab_host;
+
+/* True when `host` has `field`: a host older than the plugin lacks fields
+ * that came in later minors, e.g. BVHLAB_HOST_HAS(host, pin_thread). */
+#define BVHLAB_HOST_HAS(host, field) \
+	((host)->struct_size >= offsetof(bvhlab_host, field) + sizeof((host)->field))
 
 /* ---- build input and output ------------------------------------------- */
 

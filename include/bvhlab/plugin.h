@@ -82,12 +82,25 @@ void bvhlab_option_format(const bvhlab_option_value *v, char *buf, size_t size);
 
 /* ---- building ---------------------------------------------------------- */
 
-/* Logical CPUs this process may run on (its affinity mask), >= 1. */
+/*
+ * What threads = 0 means, >= 1: the physical cores the calling thread may
+ * run on, from hwloc's topology intersected with the thread's affinity mask
+ * (taskset, sched_setaffinity; hwloc already drops CPUs a cgroup cpuset
+ * forbids). SMT siblings count once. Without hwloc's topology, the CPUs of
+ * the affinity mask.
+ */
 uint32_t bvhlab_hardware_threads(void);
 
 /*
- * Runs the plugin's build once on `input` with `threads` threads (0: all
- * hardware threads) into `tree`, which is (re)sized to the usual bound first.
+ * Process-wide switch for host->pin_thread (off by default): when on, a
+ * builder worker that calls it is bound to one CPU of a distinct physical
+ * core. Set it between builds, not during one.
+ */
+void bvhlab_set_pinning(bool on);
+
+/*
+ * Runs the plugin's build once on `input` with `threads` threads (0:
+ * bvhlab_hardware_threads()) into `tree`, which is (re)sized to the usual bound first.
  * Returns 0, or the plugin's negative errno with its message (or a generic
  * one naming the plugin) in err. Does not validate.
  */

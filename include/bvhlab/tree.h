@@ -97,6 +97,14 @@ bool bvhlab_intersect_triangle(const bvhlab_ray *ray, const bvhlab_scene *scene,
 void bvhlab_trace_closest(const bvhlab_tree *tree, const bvhlab_scene *scene,
                           const bvhlab_ray *ray, bvhlab_hit *hit, bvhlab_trace_stats *stats);
 
+/*
+ * Any hit (occlusion): true when some triangle is hit with tmin < t < tmax.
+ * Stops at the first hit found, which fills *hit but need not be the
+ * closest; *hit is initialised like bvhlab_trace_closest's. Same counters.
+ */
+bool bvhlab_trace_any(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                      const bvhlab_ray *ray, bvhlab_hit *hit, bvhlab_trace_stats *stats);
+
 /* Closest hit by testing every triangle; initialises *hit like the above. */
 void bvhlab_trace_brute(const bvhlab_scene *scene, const bvhlab_ray *ray, bvhlab_hit *hit);
 

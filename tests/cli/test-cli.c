@@ -4,110 +4,15 @@
  * Usage: test-cli BVHLAB_EXE basic|errors|shared
  */
 #include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cJSON.h>
 
-#include "../testutil.h"
+#include "cliutil.h"
 
-static const char *exe;
-static char tmpdir[] = "/tmp/bvhlab-cli-XXXXXX";
-static char out_text[1 << 16], err_text[1 << 16];
-
-static void slurp(const char *path, char *buf, size_t size)
-{
-	buf[0] = '\0';
-	FILE *f = fopen(path, "r");
-	if (!f)
-		return;
-	size_t n = fread(buf, 1, size - 1, f);
-	buf[n] = '\0';
-	fclose(f);
-}
-
-static char *read_file(const char *dir, const char *name)
-{
-	char path[512];
-	snprintf(path, sizeof(path), "%s/%s", dir, name);
-	FILE *f = fopen(path, "r");
-	if (!f)
-		return NULL;
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	rewind(f);
-	char *text = calloc(1, (size_t)n + 1);
-	if (text && fread(text, 1, (size_t)n, f) != (size_t)n)
-		text[0] = '\0';
-	fclose(f);
-	return text;
-}
-
-/* Runs bvhlab with args (NULL-terminated); stdout/stderr into the buffers. */
-static int run(const char *const *args)
-{
-	char out_path[256], err_path[256];
-	snprintf(out_path, sizeof(out_path), "%s/stdout", tmpdir);
-	snprintf(err_path, sizeof(err_path), "%s/stderr", tmpdir);
-	pid_t pid = fork();
-	if (pid == 0) {
-		int o = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-		int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-		dup2(o, 1);
-		dup2(e, 2);
-		char *argv[32] = {(char *)exe};
-		for (int k = 0; args[k] && k < 30; k++)
-			argv[k + 1] = (char *)args[k];
-		execv(exe, argv);
-		_exit(127);
-	}
-	int status = 0;
-	waitpid(pid, &status, 0);
-	slurp(out_path, out_text, sizeof(out_text));
-	slurp(err_path, err_text, sizeof(err_text));
-	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
-static char *write_config(const char *name, const char *text)
-{
-	static char path[512];
-	snprintf(path, sizeof(path), "%s/%s", tmpdir, name);
-	FILE *f = fopen(path, "w");
-	fputs(text, f);
-	fclose(f);
-	return path;
-}
-
-static cJSON *load_results(const char *dir)
-{
-	char *text = read_file(dir, "results.json");
-	CHECK(text != NULL);
-	cJSON *doc = text ? cJSON_Parse(text) : NULL;
-	CHECK(doc != NULL);
-	free(text);
-	return doc;
-}
-
-static const char *run_str(const cJSON *run, const char *key)
-{
-	const cJSON *v = cJSON_GetObjectItem(run, key);
-	return cJSON_IsString(v) ? v->valuestring : "";
-}
-
-static int count_runs(const cJSON *doc, const char *builder, const char *status)
-{
-	int n = 0;
-	const cJSON *run;
-	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
-		n += !strcmp(run_str(run, "builder"), builder) && !strcmp(run_str(run, "status"), status);
-	return n;
-}
-
-#define ARGS(...) ((const char *const[]){__VA_ARGS__, NULL})
 
 static void test_help(void)
 {
@@ -310,9 +215,8 @@ static void test_shared_meshes(void)
 
 int main(int argc, char **argv)
 {
-	if (argc != 3 || !mkdtemp(tmpdir))
+	if (!cli_begin(argc, argv))
 		return 2;
-	exe = argv[1];
 	if (!strcmp(argv[2], "basic")) {
 		test_help();
 		test_run_good();
@@ -325,13 +229,5 @@ int main(int argc, char **argv)
 			return TEST_SKIP;
 		test_shared_meshes();
 	}
-	/* Leaves tmpdir for inspection only when something failed. */
-	if (!test_failures) {
-		char cmd[600];
-		snprintf(cmd, sizeof(cmd), "rm -rf '%s'", tmpdir);
-		CHECK_INT(system(cmd), 0);
-	} else {
-		fprintf(stderr, "files kept in %s\n", tmpdir);
-	}
-	return test_finish();
+	return cli_end();
 }

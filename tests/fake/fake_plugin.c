@@ -5,7 +5,10 @@
  * if useless, tree.
  */
 #include <errno.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 #include <bvhlab/builder.h>
 
@@ -21,12 +24,73 @@ static const bvhlab_option_decl options[] = {
 	{.name = "flag", .type = BVHLAB_OPTION_BOOL, .help = "a switch", .min = 1, .max = 0},
 	{.name = "scale", .type = BVHLAB_OPTION_FLOAT, .help = "a positive number",
 	 .def_float = 0.5, .min = 0.0, .max = 100.0},
-	{.name = "fail", .type = BVHLAB_OPTION_STRING, .help = "how build() fails",
-	 .def_string = "no", .choices = "no|error|silent|positive"},
+	{.name = "fail", .type = BVHLAB_OPTION_STRING, .help = "how build() fails or misbehaves",
+	 .def_string = "no",
+	 .choices = "no|error|silent|positive|segfault|abort|loop|exit|invalid|alloc"},
 #ifdef FAKE_BAD_OPTION
 	{.name = "broken", .type = 0, .help = "an option of no type"},
 #endif
+	{.name = "wait_for", .type = BVHLAB_OPTION_STRING,
+	 .help = "a file build() waits for first (up to a minute)", .def_string = ""},
 };
+
+#define MB (1024 * 1024)
+#define ALLOC_CHUNK (16 * MB)
+#define ALLOC_CAP ((size_t)4096 * MB) /* stop here should no limit apply */
+
+/* Real crashes, not sanitizer reports: the host is to see the signal. */
+__attribute__((no_sanitize("address", "undefined"))) static void segfault(void)
+{
+	volatile int *volatile p = NULL;
+	*p = 1;
+}
+
+static void spin(void)
+{
+	volatile unsigned long n = 0;
+	for (;;)
+		n++;
+}
+
+/* A runaway allocation: chunks, each touched, until malloc says no. */
+static int allocate(const bvhlab_host *host, bvhlab_build_ctx *ctx)
+{
+	void *head = NULL;
+	size_t total = 0;
+	for (; total < ALLOC_CAP; total += ALLOC_CHUNK) {
+		void **chunk = malloc(ALLOC_CHUNK);
+		if (!chunk)
+			break;
+		memset(chunk, 1, ALLOC_CHUNK);
+		*chunk = head;
+		head = chunk;
+	}
+	while (head) {
+		void *next = *(void **)head;
+		free(head);
+		head = next;
+	}
+	host->set_error(ctx, "%s after %zu MB", total < ALLOC_CAP ? "out of memory" :
+	                "no memory limit", total / MB);
+	return -ENOMEM;
+}
+
+/* Blocks until the file named by "wait_for" exists: tests stop a sweep there. */
+static int wait_for(const bvhlab_host *host, bvhlab_build_ctx *ctx)
+{
+	const char *path = "";
+	const struct timespec pause = {.tv_nsec = 10 * 1000 * 1000};
+	if (host->option_string(ctx, "wait_for", &path) < 0)
+		return -EINVAL;
+	for (int k = 0; *path && k < 6000; k++) {
+		if (access(path, F_OK) == 0)
+			return 0;
+		nanosleep(&pause, NULL);
+	}
+	if (*path)
+		host->set_error(ctx, "%s never appeared", path);
+	return *path ? -ETIMEDOUT : 0;
+}
 
 /* Fails as the "fail" option says, to exercise the host's error paths. */
 static int maybe_fail(const bvhlab_host *host, bvhlab_build_ctx *ctx)
@@ -42,7 +106,23 @@ static int maybe_fail(const bvhlab_host *host, bvhlab_build_ctx *ctx)
 		return -EIO;
 	if (strcmp(fail, "positive") == 0)
 		return 1;
-	return 0;
+	if (strcmp(fail, "segfault") == 0)
+		segfault();
+	if (strcmp(fail, "abort") == 0)
+		abort();
+	if (strcmp(fail, "loop") == 0)
+		spin();
+	if (strcmp(fail, "exit") == 0)
+		exit(3);
+	if (strcmp(fail, "alloc") == 0)
+		return allocate(host, ctx);
+	return wait_for(host, ctx);
+}
+
+static bool fail_is(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *how)
+{
+	const char *fail = "no";
+	return host->option_string(ctx, "fail", &fail) == 0 && strcmp(fail, how) == 0;
 }
 
 /* unused in the variant without a build function */
@@ -55,12 +135,14 @@ __attribute__((unused)) static int build(const bvhlab_host *host, bvhlab_build_c
 	bvhlab_node *root = &out->nodes[0];
 	memcpy(root->lo, in->bounds.lo, sizeof(root->lo));
 	memcpy(root->hi, in->bounds.hi, sizeof(root->hi));
+	/* "invalid": the last primitive goes missing. */
+	uint32_t count = in->prim_count - fail_is(host, ctx, "invalid");
 	root->first = 0;
-	root->count = in->prim_count;
-	for (uint32_t k = 0; k < in->prim_count; k++)
+	root->count = count;
+	for (uint32_t k = 0; k < count; k++)
 		out->prim_index[k] = k;
 	out->node_count = 1;
-	out->index_count = in->prim_count;
+	out->index_count = count;
 	return 0;
 }
 

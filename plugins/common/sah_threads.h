@@ -1,0 +1,67 @@
+/*
+ * What the parallel SAH plugins (sah_even, sah_uneven, sah_queue) share
+ * besides the split kernel: one build frame around a scheduler, and thread
+ * creation with a stack large enough for the kernel.
+ *
+ * The frame does everything sah_seq does (checks, options, output capacity,
+ * kernel setup and teardown) and hands the root job to the scheduler, which
+ * must have processed every job of the tree, with every thread it started
+ * joined, when it returns. Joining is what makes the workers' writes
+ * visible to the host: pthread_join synchronises with the thread's end.
+ */
+#ifndef BVHLAB_SAH_THREADS_H
+#define BVHLAB_SAH_THREADS_H
+
+#include <pthread.h>
+#include <stdint.h>
+
+#include <bvhlab/builder.h>
+
+#include "sah_kernel.h"
+
+/*
+ * Thread stacks: the binned split keeps ~30 KB of bins on the stack and
+ * schedulers may recurse a few levels around it; 8 MiB matches the usual
+ * main-thread stack, so nothing is safe there that would fail here.
+ */
+#define SAH_THREAD_STACK (8u << 20)
+
+/* Builds the tree below root with at most `threads` threads (>= 1), the
+ * calling one included. 0 with every job done, or a negative errno after
+ * host->set_error (called from the calling thread only). */
+typedef int (*sah_scheduler_fn)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                                sah_builder *b, const sah_job *root, uint32_t threads,
+                                void *arg);
+
+/* The whole build() of a parallel SAH plugin around `schedule`: 0, or a
+ * negative errno after host->set_error. */
+int sah_parallel_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                       const bvhlab_build_input *input, bvhlab_build_output *output,
+                       sah_scheduler_fn schedule, void *arg);
+
+/*
+ * pthread_create with a SAH_THREAD_STACK stack. 0, or a negative errno
+ * (the caller then does the work itself: every scheduler stays correct
+ * with fewer threads than it asked for).
+ */
+int sah_thread_start(pthread_t *tid, void *(*fn)(void *), void *arg);
+
+/* A job built whole by sah_build_subtree on a thread of its own. */
+typedef struct sah_subtree_task {
+	sah_builder *b;
+	sah_job job;
+	pthread_t tid;
+	int started; /* 1 once the thread runs: it must be joined */
+} sah_subtree_task;
+
+/* Starts task on a new thread, or, when that fails, builds it right away on
+ * the calling thread. Either way sah_subtree_join finishes it. */
+void sah_subtree_spawn(sah_subtree_task *task);
+void sah_subtree_join(sah_subtree_task *task);
+
+static inline uint32_t sah_job_size(const sah_job *job)
+{
+	return job->end - job->begin;
+}
+
+#endif /* BVHLAB_SAH_THREADS_H */

@@ -1,0 +1,236 @@
+/*
+ * embree: Intel Embree 3's rtcBuildBVH as a peer in the same harness, so a
+ * builder's time and tree quality are measured against the industry
+ * reference in one run.
+ *
+ * quality "low" is Embree's Morton builder, "medium" its binned SAH, "high"
+ * binned SAH with spatial splits (references to one triangle may repeat;
+ * the primitive array gets split_factor times the triangles as capacity).
+ * The descriptor therefore declares BVHLAB_BUILDER_SPATIAL_SPLITS for every
+ * quality: the flag is per descriptor, and the validator still demands at
+ * least one reference per primitive (the tests check "low" and "medium"
+ * reference each exactly once).
+ *
+ * Embree's tasking (TBB on Debian) sizes its thread pool per device, and
+ * creating one costs far more than a small build, so one device is kept
+ * for the last thread count asked for and replaced when it changes. Only
+ * one lives at a time: TBB caps parallelism at the smallest limit of all
+ * live devices. The last device stays until the process exits (reachable,
+ * not leaked): releasing it from an exit handler runs after Embree's own
+ * static destructors and fails. The plugin is linked with -z nodelete so
+ * that dlclose never unmaps Embree under its sleeping worker threads.
+ */
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "embree_internal.h"
+
+/* Embree's recursion depth limit; larger leaves are split before it. */
+#define MAX_DEPTH 64
+
+static const bvhlab_option_decl options[] = {
+	{.name = "quality", .type = BVHLAB_OPTION_STRING,
+	 .help = "low (Morton), medium (binned SAH) or high (SAH with spatial splits)",
+	 .def_string = "medium", .choices = "low|medium|high"},
+	{.name = "max_leaf", .type = BVHLAB_OPTION_INT,
+	 .help = "most primitives in a leaf (Embree allows up to 32)",
+	 .def_int = 8, .min = 1, .max = RTC_BUILD_MAX_PRIMITIVES_PER_LEAF},
+	{.name = "min_leaf", .type = BVHLAB_OPTION_INT,
+	 .help = "always a leaf at this size or below; low (Morton) makes every leaf this small",
+	 .def_int = 1, .min = 1, .max = RTC_BUILD_MAX_PRIMITIVES_PER_LEAF},
+	{.name = "c_trav", .type = BVHLAB_OPTION_FLOAT,
+	 .help = "SAH cost of traversing an inner node (Embree's traversalCost)",
+	 .def_float = 1.0, .min = 1e-6, .max = 1e6},
+	{.name = "c_isect", .type = BVHLAB_OPTION_FLOAT,
+	 .help = "SAH cost of intersecting one primitive (Embree's intersectionCost)",
+	 .def_float = 1.0, .min = 1e-6, .max = 1e6},
+	{.name = "split_factor", .type = BVHLAB_OPTION_FLOAT,
+	 .help = "high: room for references, in triangles (Embree's own default 1.2)",
+	 .def_float = 1.2, .min = 1.0, .max = 4.0},
+};
+#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
+
+/* The cached device; build() holds the lock throughout. */
+static struct {
+	pthread_mutex_t lock;
+	RTCDevice device;
+	uint32_t threads;
+	char error[256]; /* the device's last error message */
+} cache = {.lock = PTHREAD_MUTEX_INITIALIZER};
+
+static void on_error(void *user, enum RTCError code, const char *str)
+{
+	(void)user;
+	snprintf(cache.error, sizeof(cache.error), "Embree error %d: %s", (int)code,
+	         str ? str : "(no message)");
+}
+
+static RTCDevice device_for(uint32_t threads)
+{
+	char config[64];
+	if (cache.device && cache.threads == threads)
+		return cache.device;
+	if (cache.device)
+		rtcReleaseDevice(cache.device);
+	snprintf(config, sizeof(config), "threads=%u,verbose=0", threads);
+	cache.device = rtcNewDevice(config);
+	cache.threads = threads;
+	if (cache.device)
+		rtcSetDeviceErrorFunction(cache.device, on_error, NULL);
+	return cache.device;
+}
+
+typedef struct settings {
+	enum RTCBuildQuality quality;
+	int64_t max_leaf, min_leaf;
+	double c_trav, c_isect, split_factor;
+} settings;
+
+static int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, settings *s)
+{
+	const char *q;
+	int rc;
+	if ((rc = host->option_string(ctx, "quality", &q)) < 0 ||
+	    (rc = host->option_int(ctx, "max_leaf", &s->max_leaf)) < 0 ||
+	    (rc = host->option_int(ctx, "min_leaf", &s->min_leaf)) < 0 ||
+	    (rc = host->option_float(ctx, "c_trav", &s->c_trav)) < 0 ||
+	    (rc = host->option_float(ctx, "c_isect", &s->c_isect)) < 0 ||
+	    (rc = host->option_float(ctx, "split_factor", &s->split_factor)) < 0) {
+		host->set_error(ctx, "cannot read the options (%s)", strerror(-rc));
+		return rc;
+	}
+	if (s->min_leaf > s->max_leaf) {
+		host->set_error(ctx, "min_leaf %lld exceeds max_leaf %lld", (long long)s->min_leaf,
+		                (long long)s->max_leaf);
+		return -EINVAL;
+	}
+	s->quality = strcmp(q, "low") == 0    ? RTC_BUILD_QUALITY_LOW
+	             : strcmp(q, "high") == 0 ? RTC_BUILD_QUALITY_HIGH
+	                                      : RTC_BUILD_QUALITY_MEDIUM;
+	return 0;
+}
+
+/* Embree's input: one 32-byte record per triangle, room for splits after. */
+static struct RTCBuildPrimitive *make_prims(const bvhlab_build_input *in, size_t capacity)
+{
+	size_t bytes = capacity * sizeof(struct RTCBuildPrimitive);
+	struct RTCBuildPrimitive *p = aligned_alloc(32, (bytes + 31) & ~(size_t)31);
+	if (!p)
+		return NULL;
+	for (uint32_t i = 0; i < in->prim_count; i++) {
+		const bvhlab_aabb *b = &in->prim_bounds[i];
+		p[i] = (struct RTCBuildPrimitive){b->lo[0], b->lo[1], b->lo[2], 0,
+		                                  b->hi[0], b->hi[1], b->hi[2], i};
+	}
+	return p;
+}
+
+static void fill_args(struct RTCBuildArguments *a, const settings *s, RTCBVH bvh,
+                      struct RTCBuildPrimitive *prims, size_t count, size_t capacity,
+                      embree_job *job)
+{
+	*a = rtcDefaultBuildArguments();
+	a->buildQuality = s->quality;
+	a->maxBranchingFactor = 2;
+	a->maxDepth = MAX_DEPTH;
+	a->minLeafSize = (unsigned int)s->min_leaf;
+	a->maxLeafSize = (unsigned int)s->max_leaf;
+	a->traversalCost = (float)s->c_trav;
+	a->intersectionCost = (float)s->c_isect;
+	a->bvh = bvh;
+	a->primitives = prims;
+	a->primitiveCount = count;
+	a->primitiveArrayCapacity = capacity;
+	a->userPtr = job;
+	embree_set_callbacks(a, s->quality == RTC_BUILD_QUALITY_HIGH);
+}
+
+static double now_ms(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* Runs Embree and converts its tree; the device lock is held. */
+static int build_locked(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                        const bvhlab_build_input *input, const settings *s,
+                        bvhlab_build_output *output)
+{
+	size_t n = input->prim_count, capacity = n;
+	if (s->quality == RTC_BUILD_QUALITY_HIGH)
+		capacity = (size_t)ceil(s->split_factor * (double)n);
+	double t0 = now_ms();
+	RTCDevice dev = device_for(input->threads);
+	if (!dev) {
+		host->set_error(ctx, "rtcNewDevice(threads=%u) failed", input->threads);
+		return -ENODEV;
+	}
+	double t1 = now_ms();
+	struct RTCBuildPrimitive *prims = make_prims(input, capacity);
+	RTCBVH bvh = prims ? rtcNewBVH(dev) : NULL;
+	int rc = -ENOMEM;
+	if (!bvh) {
+		host->set_error(ctx, "out of memory for %zu build primitives", capacity);
+		goto out;
+	}
+	struct RTCBuildArguments args;
+	embree_job job = {.input = input};
+	fill_args(&args, s, bvh, prims, n, capacity, &job);
+	cache.error[0] = '\0';
+	double t2 = now_ms();
+	const tnode *root = rtcBuildBVH(&args);
+	double t3 = now_ms();
+	if (!root) {
+		host->set_error(ctx, "rtcBuildBVH failed: %s", cache.error[0] ? cache.error : "?");
+		rc = -EIO;
+		goto out;
+	}
+	rc = embree_write_tree(host, ctx, input, root, output);
+	host->log(ctx, BVHLAB_LOG_DEBUG, "ms: device %.2f, primitives %.2f, rtcBuildBVH %.2f, "
+	          "conversion %.2f", t1 - t0, t2 - t1, t3 - t2, now_ms() - t3);
+out:
+	if (bvh)
+		rtcReleaseBVH(bvh);
+	free(prims);
+	return rc;
+}
+
+static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *input, bvhlab_build_output *output)
+{
+	settings s;
+	int rc;
+	if (input->prim_count == 0 || input->prim_count > UINT32_MAX / 8) {
+		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
+		return -EINVAL;
+	}
+	if ((rc = read_settings(host, ctx, &s)) < 0)
+		return rc;
+	pthread_mutex_lock(&cache.lock);
+	rc = build_locked(host, ctx, input, &s, output);
+	pthread_mutex_unlock(&cache.lock);
+	return rc;
+}
+
+static const bvhlab_builder descriptor = {
+	.abi_version = BVHLAB_ABI_CURRENT,
+	.struct_size = sizeof(bvhlab_builder),
+	.name = "embree",
+	.summary = "Intel Embree 3 rtcBuildBVH: low (Morton), medium (binned SAH), "
+	           "high (spatial splits)",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_SPATIAL_SPLITS,
+	.option_count = OPTION_COUNT,
+	.options = options,
+	.build = build,
+};
+
+BVHLAB_PLUGIN_ENTRY
+{
+	return host_abi_major == BVHLAB_ABI_MAJOR ? &descriptor : NULL;
+}

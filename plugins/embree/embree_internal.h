@@ -1,0 +1,52 @@
+/*
+ * embree plugin internals: Embree's rtcBuildBVH builds a temporary binary
+ * tree through callbacks (embree_tree.c), which is then written out in the
+ * standard layout.
+ */
+#ifndef BVHLAB_EMBREE_INTERNAL_H
+#define BVHLAB_EMBREE_INTERNAL_H
+
+#include <embree3/rtcore.h>
+
+#include <bvhlab/builder.h>
+
+/*
+ * A node of the temporary tree, allocated in Embree's thread-local arena
+ * (freed all at once with the RTCBVH). count 0: inner node with `arity`
+ * children (Embree may emit one-child nodes; they are skipped on output);
+ * count > 0: leaf whose primitive ids follow the header.
+ */
+typedef struct tnode {
+	uint32_t count;
+	uint32_t arity;
+} tnode;
+
+typedef struct tinner {
+	tnode head;
+	tnode *child[2];
+} tinner;
+
+typedef struct tleaf {
+	tnode head;
+	uint32_t prim[]; /* [head.count] */
+} tleaf;
+
+/* What the callbacks see through Embree's userPtr. */
+typedef struct embree_job {
+	const bvhlab_build_input *input;
+} embree_job;
+
+/* Sets the callbacks (and splitPrimitive when `spatial`) in args. */
+void embree_set_callbacks(struct RTCBuildArguments *args, bool spatial);
+
+/*
+ * Writes the tree under `root` into `out` (growing it through the host
+ * when spatial splits made more references than primitives) with boxes
+ * recomputed from the input's primitive boxes. 0, or a negative errno
+ * after host->set_error.
+ */
+int embree_write_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                      const bvhlab_build_input *input, const tnode *root,
+                      bvhlab_build_output *out);
+
+#endif

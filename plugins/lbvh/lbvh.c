@@ -1,0 +1,424 @@
+/*
+ * lbvh: a parallel LBVH builder. Primitives are sorted along a Morton curve
+ * of their centroids and the hierarchy is emitted from the sorted codes
+ * (Karras 2012); an SAH pass then collapses small subtrees into leaves.
+ * The phases are described in lbvh.h.
+ *
+ * This file: options, scratch memory, the thread team, build().
+ */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#include "lbvh.h"
+
+static const bvhlab_option_decl options[] = {
+	{ .name = "bits", .type = BVHLAB_OPTION_INT,
+	  .help = "Morton code length: 30 (10 bits per axis) or 63 (21 bits per axis)",
+	  .def_int = 63, .min = 30, .max = 63 },
+	{ .name = "collapse", .type = BVHLAB_OPTION_BOOL,
+	  .help = "turn subtrees of at most max_leaf primitives into leaves where the SAH "
+	          "says a leaf is cheaper (off: one primitive per leaf)",
+	  .def_bool = true },
+	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,
+	  .help = "most primitives in a collapsed leaf (8, as the SAH builders)",
+	  .def_int = 8, .min = 1, .max = 64 },
+	{ .name = "c_trav", .type = BVHLAB_OPTION_FLOAT,
+	  .help = "SAH cost of traversing an inner node (> 0), for collapse",
+	  .def_float = 1.0, .min = 1e-6, .max = 1e6 },
+	{ .name = "c_isect", .type = BVHLAB_OPTION_FLOAT,
+	  .help = "SAH cost of intersecting one primitive (> 0), for collapse",
+	  .def_float = 1.0, .min = 1e-6, .max = 1e6 },
+};
+
+#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
+
+/* Below this many primitives per thread, more threads cost more than they
+ * save (thread start and barriers are tens of microseconds). */
+#define MIN_PRIMS_PER_THREAD 512
+
+static double now_ms(void)
+{
+	struct timespec ts;
+
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b)
+{
+	int64_t bits, max_leaf;
+	double c_trav, c_isect;
+	int rc;
+
+	if ((rc = host->option_int(ctx, "bits", &bits)) < 0 ||
+	    (rc = host->option_bool(ctx, "collapse", &b->collapse)) < 0 ||
+	    (rc = host->option_int(ctx, "max_leaf", &max_leaf)) < 0 ||
+	    (rc = host->option_float(ctx, "c_trav", &c_trav)) < 0 ||
+	    (rc = host->option_float(ctx, "c_isect", &c_isect)) < 0) {
+		host->set_error(ctx, "cannot read the options");
+		return rc;
+	}
+	if (bits != 30 && bits != 63) {
+		host->set_error(ctx, "option bits: %lld, expected 30 or 63", (long long)bits);
+		return -EINVAL;
+	}
+	if (max_leaf < 1 || max_leaf > 64 || !(c_trav > 0) || !(c_isect > 0)) {
+		host->set_error(ctx, "options max_leaf, c_trav or c_isect out of range");
+		return -EINVAL;
+	}
+	b->bits = (unsigned)bits;
+	b->max_leaf = (uint32_t)max_leaf;
+	b->c_trav = (float)c_trav;
+	b->c_isect = (float)c_isect;
+	return 0;
+}
+
+static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                           const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	uint32_t nodes = 2 * in->prim_count - 1;
+
+	if (out->node_capacity >= nodes && out->index_capacity >= in->prim_count)
+		return 0;
+	if (host->grow_output(ctx, out, nodes, in->prim_count) < 0) {
+		host->set_error(ctx, "cannot grow the output to %u nodes", nodes);
+		return -ENOMEM;
+	}
+	return 0;
+}
+
+/* ---- scratch ------------------------------------------------------------ */
+
+#define HUGE_PAGE ((size_t)2 << 20)
+
+struct scratch {
+	void *region;      /* one private mapping */
+	size_t region_size;
+	void *small;       /* hist, span, count */
+};
+
+static size_t align64(size_t x)
+{
+	return (x + 63) & ~(size_t)63;
+}
+
+/*
+ * One private mapping, so that a build gives its memory back whole and,
+ * with transparent huge pages, takes one page fault per 2 MiB instead of
+ * one per 4 KiB: first touches are a large part of a build. The threads
+ * touch the arrays first, each in its own chunk, so the faults are shared
+ * out too.
+ */
+static void *map_region(size_t size)
+{
+	void *p = mmap(NULL, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+
+	if (p == MAP_FAILED)
+		return NULL;
+#ifdef MADV_HUGEPAGE
+	(void)madvise(p, size, MADV_HUGEPAGE); /* a hint; fine if refused */
+#endif
+	return p;
+}
+
+/*
+ * The sort's buffers live in the output node array when it is large enough
+ * (always but for a few primitives): the host keeps that array between
+ * builds, so it is paged in already, and the tree is written into it only
+ * after the sort. Fresh pages cost more than the sort passes themselves.
+ */
+static size_t sort_size(size_t n)
+{
+	return 3 * align64(8 * n) + 2 * align64(4 * n);
+}
+
+static void place_sort(lbvh *b, char *p)
+{
+	size_t n = b->n, k8 = align64(8 * n), k4 = align64(4 * n);
+
+	b->codes = (uint64_t *)(void *)p;
+	b->keys[0] = (uint64_t *)(void *)(p + k8);
+	b->keys[1] = (uint64_t *)(void *)(p + 2 * k8);
+	b->vals[0] = (uint32_t *)(void *)(p + 3 * k8);
+	b->vals[1] = (uint32_t *)(void *)(p + 3 * k8 + k4);
+}
+
+/* The hierarchy's arrays: in the fresh mapping, so zero-filled, which the
+ * arrival counters rely on. node_flags only with collapse. */
+static size_t tree_size(size_t n, bool collapse)
+{
+	return align64(n + 2 * LCP_PAD) + align64(8 * n) + 2 * align64(4 * n) +
+	       (collapse ? align64(n) : 0);
+}
+
+static void place_tree(lbvh *b, char *p)
+{
+	size_t n = b->n;
+
+	b->lcp = (uint8_t *)p + LCP_PAD;
+	p += align64(n + 2 * LCP_PAD);
+	b->parent = (uint32_t *)(void *)p;
+	p += align64(8 * n);
+	b->end = (uint32_t *)(void *)p;
+	p += align64(4 * n);
+	b->visits = (atomic_uint *)(void *)p;
+	p += align64(4 * n);
+	b->node_flags = b->collapse ? (uint8_t *)p : NULL;
+}
+
+static int scratch_alloc(lbvh *b, const bvhlab_build_output *out, struct scratch *s)
+{
+	size_t sort = sort_size(b->n), tree = tree_size(b->n, b->collapse);
+	size_t hist = (size_t)b->threads * RADIX * sizeof(uint32_t);
+	bool in_output = (size_t)out->node_capacity * sizeof(bvhlab_node) >= sort;
+
+	s->region_size = (tree + (in_output ? 0 : sort) + HUGE_PAGE - 1) & ~(HUGE_PAGE - 1);
+	s->region = map_region(s->region_size);
+	s->small = malloc(hist + (size_t)b->threads * (2 * sizeof(uint64_t) + 3 * sizeof(uint32_t)));
+	if (!s->region || !s->small)
+		return -ENOMEM;
+	place_tree(b, s->region);
+	place_sort(b, in_output ? (char *)out->nodes : (char *)s->region + tree);
+	b->hist = s->small;
+	b->span = (uint64_t(*)[2])(void *)((char *)s->small + hist);
+	b->count = (uint32_t *)(void *)(b->span + b->threads);
+	return 0;
+}
+
+static void scratch_free(struct scratch *s)
+{
+	if (s->region)
+		munmap(s->region, s->region_size);
+	free(s->small);
+}
+
+/* ---- the team ------------------------------------------------------------ */
+
+/* Polls of a waiting thread before it sleeps: some tens of microseconds,
+ * more than the usual skew between threads at a phase end, less than the
+ * cost of putting a thread to sleep and waking it again, which in a VM is
+ * itself tens of microseconds, paid at each of some twenty barriers. */
+#define BARRIER_SPINS 1024
+
+static inline void cpu_relax(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+	__builtin_ia32_pause();
+#endif
+}
+
+/*
+ * The last thread to arrive opens the next round. Its acq_rel fetch_add
+ * reads the counter's release sequence, so it has acquired everyone's
+ * writes; its release store of `round` passes them all on to every thread
+ * that sees the new round. The others poll, then sleep on the condition
+ * variable, whose mutex the last thread takes before it bumps the round,
+ * so that no wake-up is lost.
+ */
+void team_sync(lbvh *b)
+{
+	struct team_barrier *tb = &b->barrier;
+	unsigned round = atomic_load_explicit(&tb->round, memory_order_relaxed);
+
+	if (atomic_fetch_add_explicit(&tb->arrived, 1, memory_order_acq_rel) + 1 == b->threads) {
+		atomic_store_explicit(&tb->arrived, 0, memory_order_relaxed);
+		pthread_mutex_lock(&tb->lock);
+		atomic_store_explicit(&tb->round, round + 1, memory_order_release);
+		pthread_cond_broadcast(&tb->wake);
+		pthread_mutex_unlock(&tb->lock);
+		return;
+	}
+	for (unsigned k = 0; k < tb->spins; k++) {
+		if (atomic_load_explicit(&tb->round, memory_order_acquire) != round)
+			return;
+		cpu_relax();
+	}
+	pthread_mutex_lock(&tb->lock);
+	while (atomic_load_explicit(&tb->round, memory_order_acquire) == round)
+		pthread_cond_wait(&tb->wake, &tb->lock);
+	pthread_mutex_unlock(&tb->lock);
+}
+
+/* Holds the started threads until the team size is known. */
+struct gate {
+	pthread_mutex_t lock;
+	pthread_cond_t cond;
+	bool open;
+};
+
+struct member {
+	lbvh *b;
+	struct gate *gate;
+	unsigned t;
+	pthread_t tid;
+};
+
+static void run_phases(lbvh *b, unsigned t)
+{
+	static void (*const phase[])(lbvh *, unsigned) = {
+		lbvh_sort, lbvh_karras, lbvh_bounds, lbvh_compact,
+	};
+
+	for (size_t k = 0; k < sizeof(phase) / sizeof(phase[0]); k++) {
+		phase[k](b, t);
+		if (t == 0)
+			b->phase_ms[k] = now_ms();
+	}
+}
+
+static void *member_main(void *arg)
+{
+	struct member *m = arg;
+
+	pthread_mutex_lock(&m->gate->lock);
+	while (!m->gate->open)
+		pthread_cond_wait(&m->gate->cond, &m->gate->lock);
+	pthread_mutex_unlock(&m->gate->lock);
+	run_phases(m->b, m->t);
+	return NULL;
+}
+
+static void open_gate(struct gate *gate)
+{
+	pthread_mutex_lock(&gate->lock);
+	gate->open = true;
+	pthread_cond_broadcast(&gate->cond);
+	pthread_mutex_unlock(&gate->lock);
+}
+
+/*
+ * Runs every phase with up to `want` threads, the calling one included.
+ * A thread that cannot be started only makes the team smaller: the tree
+ * does not depend on its size. Joining the members is what makes their
+ * writes visible to the caller. 0, or a negative errno.
+ */
+static int run_team(lbvh *b, unsigned want, uint32_t cpus)
+{
+	struct member m[LBVH_MAX_THREADS];
+	struct gate gate = { PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, false };
+	unsigned size = 1;
+	int rc;
+
+	if ((rc = pthread_mutex_init(&b->barrier.lock, NULL)) != 0)
+		return -rc;
+	if ((rc = pthread_cond_init(&b->barrier.wake, NULL)) != 0) {
+		pthread_mutex_destroy(&b->barrier.lock);
+		return -rc;
+	}
+	for (; size < want; size++) {
+		m[size] = (struct member){ .b = b, .gate = &gate, .t = size };
+		if (pthread_create(&m[size].tid, NULL, member_main, &m[size]) != 0)
+			break;
+	}
+	b->threads = size;
+	/* Polling only pays while every thread has a CPU of its own. */
+	b->barrier.spins = size <= cpus ? BARRIER_SPINS : 0;
+	open_gate(&gate);
+	run_phases(b, 0);
+	for (unsigned t = 1; t < size; t++)
+		pthread_join(m[t].tid, NULL);
+	pthread_cond_destroy(&b->barrier.wake);
+	pthread_mutex_destroy(&b->barrier.lock);
+	return 0;
+}
+
+static unsigned team_size(const bvhlab_build_input *in)
+{
+	uint32_t most = in->prim_count / MIN_PRIMS_PER_THREAD;
+	uint32_t want = in->threads < most ? in->threads : most;
+
+	return want < 1 ? 1 : want > LBVH_MAX_THREADS ? LBVH_MAX_THREADS : want;
+}
+
+/* ---- build --------------------------------------------------------------- */
+
+static void single_leaf(const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	bvhlab_node *root = &out->nodes[0];
+
+	for (int k = 0; k < 3; k++) {
+		root->lo[k] = in->prim_bounds[0].lo[k];
+		root->hi[k] = in->prim_bounds[0].hi[k];
+	}
+	root->first = 0;
+	root->count = 1;
+	out->prim_index[0] = 0;
+	out->node_count = 1;
+	out->index_count = 1;
+}
+
+static void log_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx, const lbvh *b,
+                       double start)
+{
+	host->log(ctx, BVHLAB_LOG_DEBUG,
+	          "%u prims, %u threads: setup %.2f, sort %.2f, karras %.2f, "
+	          "bounds %.2f, compact %.2f ms", b->n, b->threads, b->phase_ms[4] - start,
+	          b->phase_ms[0] - b->phase_ms[4], b->phase_ms[1] - b->phase_ms[0],
+	          b->phase_ms[2] - b->phase_ms[1], b->phase_ms[3] - b->phase_ms[2]);
+}
+
+static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b,
+                      bvhlab_build_output *out)
+{
+	struct scratch s = { 0 };
+	double start = now_ms();
+	int rc;
+
+	b->threads = team_size(b->in);
+	if ((rc = scratch_alloc(b, out, &s)) < 0) {
+		host->set_error(ctx, "out of memory for the scratch of %u primitives", b->n);
+		goto out;
+	}
+	b->phase_ms[4] = now_ms();
+	if ((rc = run_team(b, b->threads, host->hardware_threads(ctx))) < 0) {
+		host->set_error(ctx, "cannot set up the thread team");
+		goto out;
+	}
+	out->node_count = b->node_count;
+	out->index_count = b->n;
+	log_phases(host, ctx, b, start);
+out:
+	scratch_free(&s);
+	return rc;
+}
+
+static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *input, bvhlab_build_output *output)
+{
+	lbvh b = { .in = input, .n = input->prim_count };
+	int rc;
+
+	if (input->prim_count == 0 || input->prim_count > UINT32_MAX / 2) {
+		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
+		return -EINVAL;
+	}
+	if ((rc = read_options(host, ctx, &b)) < 0 ||
+	    (rc = ensure_capacity(host, ctx, input, output)) < 0)
+		return rc;
+	if (input->prim_count == 1) {
+		single_leaf(input, output);
+		return 0;
+	}
+	b.nodes = output->nodes;
+	b.prim_index = output->prim_index;
+	return build_team(host, ctx, &b, output);
+}
+
+static const bvhlab_builder descriptor = {
+	.abi_version = BVHLAB_ABI_CURRENT,
+	.struct_size = sizeof(bvhlab_builder),
+	.name = "lbvh",
+	.summary = "parallel LBVH: Morton codes, radix sort, Karras 2012 emission, SAH collapse",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	.option_count = OPTION_COUNT,
+	.options = options,
+	.build = build,
+};
+
+BVHLAB_PLUGIN_ENTRY
+{
+	return host_abi_major == BVHLAB_ABI_MAJOR ? &descriptor : NULL;
+}

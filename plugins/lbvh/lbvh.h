@@ -1,0 +1,187 @@
+/*
+ * lbvh: the parallel LBVH builder's shared state and phases.
+ *
+ * A build is a fixed sequence of phases run by a team of T threads (the
+ * calling one included), separated by barriers, so every phase sees
+ * everything the earlier ones wrote. Each phase splits its index range into
+ * T contiguous chunks (chunk()); nothing a phase computes depends on T, so
+ * the tree, and the order of its nodes, is the same for every thread count.
+ *
+ *   1. sort      Morton codes of the centroids, LSD radix sort of (code,
+ *                primitive) pairs into output->prim_index, and the common
+ *                prefix lengths of neighbours in that order (lbvh_sort.c)
+ *   2. karras    every internal node's range and split (lbvh_emit.c)
+ *   3. bounds    bottom-up boxes and SAH collapse decisions (lbvh_emit.c)
+ *   4. compact   with collapse: drop the nodes inside the new leaves
+ *                (lbvh_collapse.c)
+ *
+ * Karras numbering: n sorted primitives (leaves 0..n-1) and n-1 internal
+ * nodes 0..n-2. Internal node i covers the sorted range between i and
+ * end[i] (either side); its children are split and split + 1, each a
+ * leaf when it is the range's own end, else the internal node of that
+ * index. The root is internal node 0 and covers everything.
+ *
+ * Output layout, built in place: the children of internal node i sit at
+ * output slots 1 + 2i and 2 + 2i (adjacent by construction), the root at
+ * slot 0. A node's own slot is therefore 1 + its parent word (2p + side).
+ * Each node writes its own slot when its box is known: leaves at the start
+ * of the bounds phase, internal nodes when both children are done. With
+ * collapse, the pairs of the nodes that did not stay inner become holes
+ * that the compaction fills (lbvh_collapse.c).
+ */
+#ifndef BVHLAB_LBVH_H
+#define BVHLAB_LBVH_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <bvhlab/builder.h>
+
+#define RADIX_BITS 8
+#define RADIX (1u << RADIX_BITS)
+#define NO_NODE UINT32_MAX
+#define LBVH_MAX_THREADS 256
+/* Zero bytes before and after lcp[], so that 16-byte scans never leave it. */
+#define LCP_PAD 32
+
+typedef struct lbvh {
+	/* parameters */
+	const bvhlab_build_input *in;
+	uint32_t n;          /* primitives, >= 2 when the team runs */
+	uint32_t threads;    /* team size T */
+	unsigned bits;       /* Morton code bits: 30 or 63 */
+	bool collapse;
+	uint32_t max_leaf;
+	float c_trav, c_isect;
+
+	/* output */
+	bvhlab_node *nodes;
+	uint32_t *prim_index;
+	uint32_t node_count;  /* set by the last phase */
+
+	/* sort: in the output node array, which the bounds phase is the first
+	 * to write (see lbvh.c), so the sorted words last through Karras */
+	uint64_t *codes;          /* [n] Morton code of each primitive, by id */
+	uint64_t *keys[2];        /* [n] pass buffers: code words */
+	uint32_t *vals[2];        /* [n] pass buffers: ids, while pairs are wide */
+	uint32_t (*hist)[RADIX];  /* [T][RADIX] digit counts of each chunk */
+	uint64_t (*span)[2];      /* [T] OR and AND of each chunk's codes */
+
+	/* the sorted keys, set at the end of the sort: words[k] holds the code
+	 * of sorted position k from bit `base` up, shifted above `id_bits` of
+	 * primitive id (both 0 when the words are the codes themselves) */
+	struct {
+		const uint64_t *words;
+		unsigned base, id_bits;
+	} sorted;
+
+	/* hierarchy: a fresh mapping, zero-filled */
+	uint8_t *lcp;             /* [n - 1] 1 + common prefix length of sorted
+	                           * keys k and k + 1; 0 at [-1], [n - 1] and in
+	                           * the LCP_PAD bytes around */
+	uint32_t *parent;         /* [2n - 1] parent word, 2 * parent + (1 if
+	                           * right child), of internal node i at [i] and
+	                           * of leaf k at [n - 1 + k]; NO_NODE at the root */
+	uint32_t *end;            /* [n - 1] the other end of node i's range;
+	                           * then the movers of the compaction */
+	atomic_uint *visits;      /* [n - 1] arrivals at nodes shared by threads,
+	                           * zero from the mapping; then the holes */
+	uint8_t *node_flags;      /* [n - 1] see lbvh_collapse.c */
+	uint32_t *count;          /* [3 T] per-chunk counts for the compaction */
+
+	struct team_barrier {
+		atomic_uint arrived;   /* threads at the barrier this round */
+		atomic_uint round;     /* rounds completed */
+		unsigned spins;        /* polls before sleeping; 0 when oversubscribed */
+		pthread_mutex_t lock;  /* guards the sleep on `wake` */
+		pthread_cond_t wake;
+	} barrier;
+	double phase_ms[5];       /* thread 0's phase end times, [4] the start */
+} lbvh;
+
+/* The [lo, hi) share of thread t of `count` items. */
+static inline void chunk(const lbvh *b, unsigned t, uint32_t count, uint32_t *lo,
+                         uint32_t *hi)
+{
+	*lo = (uint32_t)((uint64_t)count * t / b->threads);
+	*hi = (uint32_t)((uint64_t)count * (t + 1) / b->threads);
+}
+
+/* Waits for the whole team: everything written before is visible after
+ * (lbvh.c). */
+void team_sync(lbvh *b);
+
+/*
+ * 1 + the common prefix length of the sorted keys at positions i < j,
+ * extended by the positions where the codes are equal (Karras's k_i ++ i),
+ * so that no two keys are equal. The words hold the codes' upper bits;
+ * only where those agree are the full codes looked up.
+ */
+static inline uint8_t common_prefix(const lbvh *b, uint32_t i, uint32_t j)
+{
+	uint64_t wi = b->sorted.words[i], wj = b->sorted.words[j];
+	uint64_t x = (wi ^ wj) >> b->sorted.id_bits;
+	uint64_t id_mask = (1ull << b->sorted.id_bits) - 1;
+
+	if (x)
+		return (uint8_t)(1 + __builtin_clzll(x) - b->sorted.base);
+	if (b->sorted.id_bits)
+		x = b->codes[wi & id_mask] ^ b->codes[wj & id_mask];
+	if (x)
+		return (uint8_t)(1 + __builtin_clzll(x));
+	return (uint8_t)(1 + 64 + __builtin_clz(i ^ j));
+}
+
+/* The sorted range of internal node i: [range_first, + range_size). */
+static inline uint32_t range_first(const lbvh *b, uint32_t i)
+{
+	return i < b->end[i] ? i : b->end[i];
+}
+
+static inline uint32_t range_size(const lbvh *b, uint32_t i)
+{
+	uint32_t end = b->end[i], first = i < end ? i : end;
+
+	return (i ^ end ^ first) - first + 1;
+}
+
+/* The output slot of the node whose parent word is `word`. */
+static inline bvhlab_node *slot_of(const lbvh *b, uint32_t word)
+{
+	return &b->nodes[word == NO_NODE ? 0 : 1 + (size_t)word];
+}
+
+/* The slots of internal node i's children (before any compaction). */
+static inline bvhlab_node *kids_of(const lbvh *b, uint32_t i)
+{
+	return &b->nodes[1 + 2 * (size_t)i];
+}
+
+/* The index of the internal node whose slot this is, while the slot has
+ * first = 1 + 2i (until the compaction). */
+static inline uint32_t internal_index(const bvhlab_node *node)
+{
+	return (node->first - 1) / 2;
+}
+
+static inline float half_area(const float lo[3], const float hi[3])
+{
+	float dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+
+	return dx * dy + dy * dz + dz * dx;
+}
+
+/* Phases, run by every thread t of the team; each ends with team_sync
+ * except the last, which the caller's join ends. */
+void lbvh_sort(lbvh *b, unsigned t);      /* lbvh_sort.c */
+void lbvh_karras(lbvh *b, unsigned t);    /* lbvh_emit.c */
+void lbvh_bounds(lbvh *b, unsigned t);    /* lbvh_emit.c */
+void lbvh_compact(lbvh *b, unsigned t);   /* lbvh_collapse.c */
+
+/* The SAH decision for internal node i of `size` primitives whose box is
+ * in its slot `out`, during the bounds phase (lbvh_collapse.c). */
+void lbvh_collapse(lbvh *b, uint32_t i, uint32_t size, bvhlab_node *out);
+
+#endif /* BVHLAB_LBVH_H */

@@ -1,0 +1,98 @@
+/*
+ * sah_even: the thesis's "symmetric" scheduling. At every split a new
+ * thread takes one child while the current thread goes on with the other,
+ * and the thread budget left is halved between them (the larger child gets
+ * the extra thread of an odd budget). A subtree whose budget is down to one
+ * thread is built whole by sah_build_subtree. Over the whole tree exactly
+ * threads - 1 threads are started, each joined by the thread that started
+ * it. Splits are the shared kernel's, so the tree is sah_seq's.
+ *
+ * The budget is split by thread count, not by work: a lopsided split (a
+ * dense object in a large sparse scene) leaves half the threads with
+ * little to do. That is the weakness the thesis measured.
+ */
+#include <errno.h>
+
+#include <bvhlab/builder.h>
+
+#include "sah_kernel.h"
+#include "sah_threads.h"
+
+static const bvhlab_option_decl options[] = { SAH_OPTION_DECLS };
+
+_Static_assert(sizeof(options) / sizeof(options[0]) == SAH_OPTION_COUNT,
+               "SAH_OPTION_COUNT matches SAH_OPTION_DECLS");
+
+/* One subtree with its share of the threads; lives in its starter's frame
+ * until the join, so the thread can use it throughout. */
+struct even_task {
+	sah_builder *b;
+	sah_job job;
+	uint32_t budget;
+	pthread_t tid;
+};
+
+static void build_even(sah_builder *b, const sah_job *job, uint32_t budget);
+
+static void *even_main(void *arg)
+{
+	struct even_task *task = arg;
+
+	build_even(task->b, &task->job, task->budget);
+	return NULL;
+}
+
+/* Recursion depth is log2(budget): the budget halves at every level. */
+static void build_even(sah_builder *b, const sah_job *job, uint32_t budget)
+{
+	sah_job child[2];
+
+	if (budget <= 1) {
+		sah_build_subtree(b, job);
+		return;
+	}
+	if (sah_split_job(b, job, child) == 0)
+		return;
+	unsigned big = sah_job_size(&child[1]) > sah_job_size(&child[0]);
+	struct even_task other = { .b = b, .job = child[1 - big], .budget = budget / 2 };
+	/* Without a new thread the work is still done, only later. */
+	int started = sah_thread_start(&other.tid, even_main, &other) == 0;
+
+	build_even(b, &child[big], budget - budget / 2);
+	if (started)
+		pthread_join(other.tid, NULL);
+	else
+		build_even(b, &other.job, other.budget);
+}
+
+static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
+                    const sah_job *root, uint32_t threads, void *arg)
+{
+	(void)host;
+	(void)ctx;
+	(void)arg;
+	build_even(b, root, threads);
+	return 0;
+}
+
+static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *input, bvhlab_build_output *output)
+{
+	return sah_parallel_build(host, ctx, input, output, schedule, NULL);
+}
+
+static const bvhlab_builder descriptor = {
+	.abi_version = BVHLAB_ABI_CURRENT,
+	.struct_size = sizeof(bvhlab_builder),
+	.name = "sah_even",
+	.summary = "parallel SAH, thesis \"symmetric\": a thread per split, budget halved",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	.option_count = SAH_OPTION_COUNT,
+	.options = options,
+	.build = build,
+};
+
+BVHLAB_PLUGIN_ENTRY
+{
+	return host_abi_major == BVHLAB_ABI_MAJOR ? &descriptor : NULL;
+}

@@ -1,0 +1,92 @@
+/*
+ * sah_uneven: the thesis's "asymmetric" scheduling. The calling thread
+ * walks down from the root along the larger child: at each level the
+ * smaller child goes to a new thread, which builds it whole with
+ * sah_build_subtree, and the larger child keeps the right to spawn. When
+ * threads - 1 threads run (or the path reaches a leaf) the calling thread
+ * builds what is left itself, then joins every thread it started. Splits
+ * are the shared kernel's, so the tree is sah_seq's.
+ *
+ * The smaller children shrink level by level while the path keeps the
+ * bulk, so the calling thread carries most of the work on balanced scenes;
+ * on a lopsided split (a small dense object in a large sparse scene) the
+ * larger child is the hard one anyway, and following it is the better bet.
+ */
+#include <errno.h>
+#include <stdlib.h>
+
+#include <bvhlab/builder.h>
+
+#include "sah_kernel.h"
+#include "sah_threads.h"
+
+static const bvhlab_option_decl options[] = { SAH_OPTION_DECLS };
+
+_Static_assert(sizeof(options) / sizeof(options[0]) == SAH_OPTION_COUNT,
+               "SAH_OPTION_COUNT matches SAH_OPTION_DECLS");
+
+/* Splits along the larger child, handing each smaller one to a new thread,
+ * until `spare` threads are started; returns how many tasks it used. */
+static uint32_t spawn_path(sah_builder *b, const sah_job *root, sah_subtree_task *tasks,
+                           uint32_t spare)
+{
+	sah_job cur = *root, child[2];
+	uint32_t used = 0;
+
+	while (used < spare) {
+		if (sah_split_job(b, &cur, child) == 0)
+			return used;
+		unsigned big = sah_job_size(&child[1]) > sah_job_size(&child[0]);
+		tasks[used] = (sah_subtree_task){ .b = b, .job = child[1 - big] };
+		sah_subtree_spawn(&tasks[used++]);
+		cur = child[big];
+	}
+	sah_build_subtree(b, &cur);
+	return used;
+}
+
+static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
+                    const sah_job *root, uint32_t threads, void *arg)
+{
+	sah_subtree_task *tasks;
+	uint32_t used;
+
+	(void)arg;
+	if (threads <= 1) {
+		sah_build_subtree(b, root);
+		return 0;
+	}
+	/* The threads keep pointers into this array until joined. */
+	tasks = calloc(threads - 1, sizeof(*tasks));
+	if (!tasks) {
+		host->set_error(ctx, "out of memory for %u thread records", threads - 1);
+		return -ENOMEM;
+	}
+	used = spawn_path(b, root, tasks, threads - 1);
+	for (uint32_t i = 0; i < used; i++)
+		sah_subtree_join(&tasks[i]);
+	free(tasks);
+	return 0;
+}
+
+static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *input, bvhlab_build_output *output)
+{
+	return sah_parallel_build(host, ctx, input, output, schedule, NULL);
+}
+
+static const bvhlab_builder descriptor = {
+	.abi_version = BVHLAB_ABI_CURRENT,
+	.struct_size = sizeof(bvhlab_builder),
+	.name = "sah_uneven",
+	.summary = "parallel SAH, thesis \"asymmetric\": only the larger child spawns threads",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	.option_count = SAH_OPTION_COUNT,
+	.options = options,
+	.build = build,
+};
+
+BVHLAB_PLUGIN_ENTRY
+{
+	return host_abi_major == BVHLAB_ABI_MAJOR ? &descriptor : NULL;
+}

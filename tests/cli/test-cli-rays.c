@@ -1,0 +1,131 @@
+/*
+ * Rays, images and reports through the bvhlab command: a run with images
+ * writes report.html naming every run, with charts and PNGs of the asked
+ * size that are not blank; `bvhlab report` regenerates it; `bvhlab render`
+ * writes one image; a bad camera is an error with its position.
+ * Usage: test-cli-rays BVHLAB_EXE all
+ */
+#include <stdint.h>
+
+#include "cliutil.h"
+
+static const char config[] =
+	"{ \"format_version\": 1, \"output\": \"out-rays\", \"repeat\": 1, \"threads\": [1, 2],\n"
+	"  \"images\": true, \"rays\": { \"width\": 40, \"height\": 30, \"diffuse\": 2 },\n"
+	"  \"scenes\": [ { \"name\": \"ico<1>\", \"generator\": \"icosphere\", \"frequency\": 10 },\n"
+	"              { \"name\": \"terrain\", \"generator\": \"terrain\", \"size\": 16 } ],\n"
+	"  \"builders\": [ { \"plugin\": \"sah_seq\", \"name\": \"sweep\" },\n"
+	"                { \"plugin\": \"sah_seq\", \"name\": \"binned\",\n"
+	"                  \"options\": { \"method\": \"binned\" } } ] }\n";
+
+/* PNG header: width and height at bytes 16..23, big-endian. */
+static bool png_size(const char *dir, const char *name, uint32_t *w, uint32_t *h)
+{
+	char path[600];
+	unsigned char b[24];
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	FILE *f = fopen(path, "rb");
+	bool ok = f && fread(b, 1, 24, f) == 24 && !memcmp(b + 1, "PNG", 3);
+	if (f)
+		fclose(f);
+	if (ok) {
+		*w = (uint32_t)b[16] << 24 | (uint32_t)b[17] << 16 | (uint32_t)b[18] << 8 | b[19];
+		*h = (uint32_t)b[20] << 24 | (uint32_t)b[21] << 16 | (uint32_t)b[22] << 8 | b[23];
+	}
+	return ok;
+}
+
+static void check_image(const char *dir, const char *name, uint32_t w, uint32_t h)
+{
+	uint32_t gw = 0, gh = 0;
+	if (!png_size(dir, name, &gw, &gh))
+		fprintf(stderr, "missing or not a PNG: %s/%s\n", dir, name);
+	CHECK_INT(gw, w);
+	CHECK_INT(gh, h);
+}
+
+static void check_html(const char *dir)
+{
+	char *html = read_file(dir, "report.html");
+	CHECK_CONTAINS(html, "<svg");
+	CHECK_CONTAINS(html, "ico&lt;1&gt;");
+	CHECK_CONTAINS(html, "terrain");
+	CHECK_CONTAINS(html, ">sweep</td>");
+	CHECK_CONTAINS(html, ">binned</td>");
+	CHECK_CONTAINS(html, "images/ico_1_--sweep--heat.png");
+	CHECK(html && !strstr(html, "ico<1>"));
+	free(html);
+}
+
+static void test_run(void)
+{
+	const char *cfg = write_config("rays.json", config);
+	char dir[512], regen[600], json[600];
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 0);
+	snprintf(dir, sizeof(dir), "%s/out-rays", tmpdir);
+	cJSON *doc = load_results(dir);
+	const cJSON *run0 = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
+	const cJSON *rays = cJSON_GetObjectItem(run0, "rays");
+	const cJSON *prim = cJSON_GetObjectItem(rays, "primary");
+	CHECK(cJSON_GetObjectItem(prim, "mrays_per_s")->valuedouble > 0);
+	CHECK(cJSON_GetObjectItem(prim, "nodes_per_ray")->valuedouble >= 1);
+	CHECK_INT(cJSON_GetObjectItem(prim, "rays")->valueint, 40 * 30);
+	CHECK(cJSON_GetObjectItem(cJSON_GetObjectItem(rays, "diffuse"), "rays")->valueint > 0);
+	CHECK_INT(count_runs(doc, "sweep", "ok"), 4);
+	cJSON_Delete(doc);
+	check_image(dir, "images/ico_1_.png", 40, 30);
+	check_image(dir, "images/ico_1_--sweep--heat.png", 40, 30);
+	check_image(dir, "images/terrain--binned--heat.png", 40, 30);
+	check_image(dir, "images/terrain--legend.png", 256, 16);
+	check_html(dir);
+	char *csv = read_file(dir, "results.csv");
+	CHECK_CONTAINS(csv, "rays.primary.mrays_per_s");
+	free(csv);
+	snprintf(regen, sizeof(regen), "%s/regen", tmpdir);
+	snprintf(json, sizeof(json), "%s/results.json", dir);
+	CHECK_INT(run(ARGS("report", json, "--out", regen)), 0);
+	check_html(regen);
+	char *md = read_file(regen, "report.md");
+	CHECK_CONTAINS(md, "primary Mrays/s");
+	free(md);
+	CHECK_INT(run(ARGS("report", "/nonexistent/results.json")), 2);
+}
+
+static void test_render(void)
+{
+	char out[600];
+	snprintf(out, sizeof(out), "%s/one.png", tmpdir);
+	CHECK_INT(run(ARGS("render", "sah_seq", "icosphere:frequency=6", "-o", out, "--width", "33",
+	                   "--height", "21", "--heat")), 0);
+	check_image(tmpdir, "one.png", 33, 21);
+	CHECK_INT(run(ARGS("render", "--help")), 0);
+	CHECK_CONTAINS(out_text, "usage: bvhlab render");
+	CHECK_INT(run(ARGS("render", "sah_seq")), 2);
+}
+
+static void test_bad_camera(void)
+{
+	const char *cfg = write_config("cam.json",
+		"{ \"rays\": { \"camera\": { \"position\": [0, 0, 1], \"target\": [0, 0, 1] } },\n"
+		"  \"scenes\": [ { \"generator\": \"icosphere\" } ],\n"
+		"  \"builders\": [ { \"plugin\": \"sah_seq\" } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 2);
+	CHECK_CONTAINS(err_text, "cam.json:1:");
+	CHECK_CONTAINS(err_text, "position and target must differ");
+	cfg = write_config("cam2.json",
+		"{ \"rays\": { \"camera\": { \"position\": [0, 0, \"x\"] } },\n"
+		"  \"scenes\": [ { \"generator\": \"icosphere\" } ],\n"
+		"  \"builders\": [ { \"plugin\": \"sah_seq\" } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 2);
+	CHECK_CONTAINS(err_text, "'rays.camera.position' must be an array of 3 finite numbers");
+}
+
+int main(int argc, char **argv)
+{
+	if (!cli_begin(argc, argv))
+		return 2;
+	test_run();
+	test_render();
+	test_bad_camera();
+	return cli_end();
+}

@@ -1,0 +1,313 @@
+/*
+ * The bvhlab command when things go wrong: plugins that crash, hang, exit
+ * or return broken trees, a sweep killed mid-way and resumed, bad input.
+ * Usage: test-cli-robust BVHLAB_EXE all
+ */
+#include <signal.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cJSON.h>
+
+#include "cliutil.h"
+
+static const cJSON *find_run(const cJSON *doc, const char *scene, const char *builder,
+                             int threads)
+{
+	const cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs")) {
+		const cJSON *t = cJSON_GetObjectItem(run, "threads");
+		if (!strcmp(run_str(run, "scene"), scene) && !strcmp(run_str(run, "builder"), builder) &&
+		    cJSON_IsNumber(t) && t->valueint == threads)
+			return run;
+	}
+	return NULL;
+}
+
+static bool run_valid(const cJSON *run)
+{
+	return run && !strcmp(run_str(run, "status"), "ok") &&
+	       cJSON_IsTrue(cJSON_GetObjectItem(cJSON_GetObjectItem(run, "validation"), "valid"));
+}
+
+/*
+ * Sanitizer builds would turn a plugin's segfault into their own report
+ * and check the crashed children for leaks; here the signal is the point.
+ */
+static void append_option(const char *var, const char *more)
+{
+	const char *old = getenv(var);
+	char opts[512];
+	snprintf(opts, sizeof(opts), "%s%s%s", old ? old : "", old && *old ? ":" : "", more);
+	setenv(var, opts, 1);
+}
+
+static void plain_crashes(void)
+{
+	append_option("ASAN_OPTIONS", "handle_segv=0:detect_leaks=0:allocator_may_return_null=1");
+	append_option("TSAN_OPTIONS", "handle_segv=0");
+}
+
+static const char misbehaving_config[] =
+	"{ \"output\": \"out-mis\", \"repeat\": 2, \"threads\": [1, 2],\n"
+	"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 300 } ],\n"
+	"  \"builders\": [\n"
+	"    { \"plugin\": \"fake_good\", \"name\": \"segv\", \"options\": { \"fail\": \"segfault\" } },\n"
+	"    { \"plugin\": \"fake_good\", \"name\": \"abrt\", \"options\": { \"fail\": \"abort\" } },\n"
+	"    { \"plugin\": \"fake_good\", \"name\": \"hang\", \"timeout_s\": 0.5,\n"
+	"      \"options\": { \"fail\": \"loop\" } },\n"
+	"    { \"plugin\": \"fake_good\", \"name\": \"quit\", \"options\": { \"fail\": \"exit\" } },\n"
+	"    { \"plugin\": \"fake_good\", \"name\": \"bad\", \"options\": { \"fail\": \"invalid\" } },\n"
+	"    { \"plugin\": \"fake_good\", \"name\": \"hog\", \"memory_limit_mb\": 256,\n"
+	"      \"options\": { \"fail\": \"alloc\" } },\n"
+	"    { \"plugin\": \"fake_abi2\" },\n"
+	"    { \"plugin\": \"sah_seq\" },\n"
+	"    { \"plugin\": \"fake_good\" } ] }\n";
+
+/* Every misbehaving plugin is reported as such; the others still run, valid. */
+static void test_misbehaving(void)
+{
+	const char *cfg = write_config("mis.json", misbehaving_config);
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 1);
+	char dir[512];
+	snprintf(dir, sizeof(dir), "%s/out-mis", tmpdir);
+	cJSON *doc = load_results(dir);
+	if (!doc)
+		return;
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 18);
+	static const char *const expect[][3] = {
+		{"segv", "crashed", "killed by SIGSEGV"},
+		{"abrt", "crashed", "killed by SIGABRT"},
+		{"hang", "timeout", "no result after 0.5 s (timeout_s); killed"},
+		{"quit", "crashed", "exited with status 3 before reporting"},
+		{"bad", "invalid", "primitive 299 is referenced by no leaf"},
+		{"fake_abi2", "failed", "built for ABI 2.0"},
+	};
+	for (int t = 1; t <= 2; t++) {
+		for (size_t k = 0; k < sizeof(expect) / sizeof(expect[0]); k++) {
+			const cJSON *r = find_run(doc, "soup", expect[k][0], t);
+			CHECK(r && !strcmp(run_str(r, "status"), expect[k][1]));
+			CHECK_CONTAINS(run_str(r, "error"), expect[k][2]);
+		}
+		/* Out of its memory limit: the plugin's allocation fails, or the child dies. */
+		const cJSON *hog = find_run(doc, "soup", "hog", t);
+		const char *status = hog ? run_str(hog, "status") : "";
+		CHECK(!strcmp(status, "failed") || !strcmp(status, "crashed"));
+		CHECK(!strstr(run_str(hog, "error"), "no memory limit"));
+		CHECK(run_valid(find_run(doc, "soup", "sah_seq", t)));
+		CHECK(run_valid(find_run(doc, "soup", "fake_good", t)));
+	}
+	const cJSON *bad = find_run(doc, "soup", "bad", 1);
+	CHECK(bad && cJSON_IsFalse(cJSON_GetObjectItem(cJSON_GetObjectItem(bad, "validation"),
+	                                               "valid")));
+	cJSON_Delete(doc);
+}
+
+/* "isolate": false runs in this process, with the same statuses. */
+static void test_in_process(void)
+{
+	const char *cfg = write_config("inproc.json",
+		"{ \"output\": \"out-inproc\", \"repeat\": 1, \"isolate\": false,\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
+		"    { \"plugin\": \"fake_good\", \"name\": \"bad\", \"options\": { \"fail\": \"invalid\" } },\n"
+		"    { \"plugin\": \"fake_good\", \"name\": \"err\",\n"
+		"      \"options\": { \"fail\": \"error\" } } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 1);
+	char dir[512];
+	snprintf(dir, sizeof(dir), "%s/out-inproc", tmpdir);
+	cJSON *doc = load_results(dir);
+	if (!doc)
+		return;
+	CHECK(run_valid(find_run(doc, "soup", "fake_good", 1)));
+	CHECK_INT(count_runs(doc, "bad", "invalid"), 1);
+	CHECK_INT(count_runs(doc, "err", "failed"), 1);
+	cJSON_Delete(doc);
+}
+
+/* The number of runs in dir/results.json, or -1 while there is none to read. */
+static int runs_written(const char *dir)
+{
+	char *text = read_file(dir, "results.json");
+	cJSON *doc = text ? cJSON_Parse(text) : NULL;
+	int n = doc ? cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")) : -1;
+	cJSON_Delete(doc);
+	free(text);
+	return n;
+}
+
+/* Polls (bounded) until the sweep has written at least one run. */
+static int wait_for_runs(const char *dir)
+{
+	const struct timespec pause = {.tv_nsec = 10 * 1000 * 1000};
+	int n = -1;
+	for (int k = 0; k < 6000 && n < 1; k++) {
+		n = runs_written(dir);
+		if (n < 1)
+			nanosleep(&pause, NULL);
+	}
+	return n;
+}
+
+static bool same_run(const cJSON *a, const cJSON *b)
+{
+	return !strcmp(run_str(a, "scene"), run_str(b, "scene")) &&
+	       !strcmp(run_str(a, "builder"), run_str(b, "builder")) &&
+	       cJSON_GetObjectItem(a, "threads")->valueint ==
+	               cJSON_GetObjectItem(b, "threads")->valueint;
+}
+
+static void check_no_duplicates(const cJSON *doc)
+{
+	const cJSON *a, *b;
+	int dups = 0;
+	cJSON_ArrayForEach(a, cJSON_GetObjectItem(doc, "runs"))
+		for (b = a->next; b; b = b->next)
+			dups += same_run(a, b);
+	CHECK_INT(dups, 0);
+}
+
+/*
+ * A sweep killed mid-way keeps valid results with its finished runs, and
+ * --resume completes it without running those again. The "gated" builder
+ * blocks until a file appears, so the kill surely lands mid-sweep.
+ */
+static void test_kill_and_resume(void)
+{
+	char gate[512], dir[512], text[2048];
+	snprintf(gate, sizeof(gate), "%s/gate", tmpdir);
+	snprintf(dir, sizeof(dir), "%s/out-kill", tmpdir);
+	snprintf(text, sizeof(text),
+	         "{ \"output\": \"out-kill\", \"repeat\": 3, \"threads\": [1, 2],\n"
+	         "  \"scenes\": [ { \"name\": \"a\", \"generator\": \"soup\", \"count\": 200 },\n"
+	         "    { \"name\": \"b\", \"generator\": \"icosphere\", \"frequency\": 4 },\n"
+	         "    { \"name\": \"c\", \"generator\": \"soup\", \"count\": 300, \"seed\": 5 } ],\n"
+	         "  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
+	         "    { \"plugin\": \"fake_good\", \"name\": \"gated\",\n"
+	         "      \"options\": { \"wait_for\": \"%s\" } },\n"
+	         "    { \"plugin\": \"sah_seq\", \"threads\": [1] } ] }\n", gate);
+	const char *cfg = write_config("kill.json", text);
+	pid_t pid = start(ARGS("run", cfg));
+	int before = wait_for_runs(dir);
+	kill(pid, SIGKILL);
+	CHECK_INT(finish(pid), 128 + SIGKILL);
+	CHECK(before >= 1);
+
+	cJSON *doc = load_results(dir);
+	if (!doc)
+		return;
+	int kept = cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs"));
+	CHECK(kept >= 1 && kept <= 2); /* fake_good's two runs of scene a, at most */
+	const cJSON *first = find_run(doc, "a", "fake_good", 1);
+	CHECK(run_valid(first));
+	char *samples = first ? cJSON_PrintUnformatted(cJSON_GetObjectItem(first, "build_ms")) : NULL;
+	char *created = strdup(run_str(doc, "created"));
+	cJSON_Delete(doc);
+
+	FILE *f = fopen(gate, "w");
+	CHECK(f != NULL);
+	if (f)
+		fclose(f);
+	CHECK_INT(run(ARGS("run", cfg, "--resume")), 0);
+	CHECK_CONTAINS(err_text, "bvhlab: resuming");
+	doc = load_results(dir);
+	if (doc) {
+		CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 15);
+		check_no_duplicates(doc);
+		CHECK_INT(count_runs(doc, "gated", "ok"), 6);
+		/* The finished run was kept, not run again. */
+		first = find_run(doc, "a", "fake_good", 1);
+		char *again = first ? cJSON_PrintUnformatted(cJSON_GetObjectItem(first, "build_ms")) : NULL;
+		CHECK(samples && again && !strcmp(samples, again));
+		CHECK(!strcmp(run_str(doc, "created"), created));
+		CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "scenes")), 3);
+		free(again);
+		cJSON_Delete(doc);
+	}
+	free(samples);
+	free(created);
+	/* Nothing left to run: every run is kept. */
+	CHECK_INT(run(ARGS("run", cfg, "--resume")), 0);
+	CHECK_CONTAINS(err_text, "15 finished runs kept");
+	CHECK_INT(runs_written(dir), 15);
+}
+
+static void test_resume_errors(void)
+{
+	const char *cfg = write_config("resume.json",
+		"{ \"output\": \"out-resume\", \"repeat\": 1,\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
+	char dir[512], path[600];
+	snprintf(dir, sizeof(dir), "%s/out-resume", tmpdir);
+	CHECK_INT(run(ARGS("run", cfg, "--resume")), 0); /* no results yet: a fresh start */
+	CHECK_CONTAINS(err_text, "nothing to resume");
+	CHECK_INT(runs_written(dir), 1);
+
+	snprintf(path, sizeof(path), "%s/results.json", dir);
+	FILE *f = fopen(path, "w");
+	fputs("{ \"runs\": [ { \"scene\": \"soup\",", f);
+	fclose(f);
+	CHECK_INT(run(ARGS("run", cfg, "--resume")), 2);
+	CHECK_CONTAINS(err_text, "cannot resume from");
+	CHECK_CONTAINS(err_text, "out-resume/results.json: not a valid JSON object");
+	f = fopen(path, "w");
+	fputs("{ \"runs\": 3 }", f);
+	fclose(f);
+	CHECK_INT(run(ARGS("run", cfg, "--resume")), 2);
+	CHECK_CONTAINS(err_text, "no \"runs\" array");
+	/* Left alone for the user to look at. */
+	char *text = read_file(dir, "results.json");
+	CHECK(text && !strcmp(text, "{ \"runs\": 3 }"));
+	free(text);
+}
+
+/* Bad input through the command: the message reaches the user. */
+static void test_bad_input(void)
+{
+	const char *degen = write_config("degen.obj",
+		"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 1 4\nf 1 2 4\n");
+	CHECK_INT(run(ARGS("info", degen)), 0);
+	CHECK_CONTAINS(out_text, "triangles:  3");
+	CHECK_CONTAINS(out_text, "degenerate: 2");
+	CHECK_INT(run(ARGS("info", degen, "--json")), 0);
+	CHECK_CONTAINS(out_text, "\"degenerate\":\t2");
+
+	char folder[512];
+	snprintf(folder, sizeof(folder), "%s/folder.ply", tmpdir);
+	mkdir(folder, 0755);
+	CHECK_INT(run(ARGS("info", folder)), 2);
+	CHECK_CONTAINS(err_text, "folder.ply: not a regular file");
+	CHECK_INT(run(ARGS("info", write_config("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"))),
+	          2);
+	CHECK_CONTAINS(err_text, "nan.obj:2: coordinate is NaN or infinite");
+	CHECK_INT(run(ARGS("build", "fake_godo", "soup")), 2);
+	CHECK_CONTAINS(err_text, "plugin 'fake_godo' not found");
+	CHECK_CONTAINS(err_text, "(available: ");
+	CHECK_CONTAINS(err_text, "fake_abi2, fake_badopt, fake_good, ");
+	CHECK_INT(run(ARGS("run", write_config("types.json",
+		"{ \"timeout_s\": \"soon\", \"scenes\": [ { \"generator\": \"soup\" } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n"))), 2);
+	CHECK_CONTAINS(err_text, "types.json:1:16: 'timeout_s' must be a number > 0, not a string");
+	CHECK_INT(run(ARGS("build", "fake_good", "soup", "-o", "alpha=11")), 2);
+	CHECK_CONTAINS(err_text, "alpha");
+	CHECK_CONTAINS(err_text, "out of range");
+}
+
+int main(int argc, char **argv)
+{
+	if (!cli_begin(argc, argv))
+		return 2;
+	plain_crashes();
+	test_misbehaving();
+	test_in_process();
+	test_kill_and_resume();
+	test_resume_errors();
+	test_bad_input();
+	return cli_end();
+}

@@ -1,0 +1,175 @@
+/*
+ * The embree peer plugin: every quality at 1 and 2 threads, on generated
+ * scenes and two shared meshes, gives trees the core validator accepts and
+ * whose rays agree with brute force. "low" and "medium" reference each
+ * primitive exactly once; "high" really splits (more references than
+ * triangles on a soup of long triangles). Built only when Embree is found.
+ */
+#include <errno.h>
+#include <unistd.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "testutil.h"
+
+#define RAYS 256
+#define MAX_LEAF 8
+
+static const char *const qualities[] = {"low", "medium", "high"};
+
+static bvhlab_plugin *plugin;
+
+static int build(const bvhlab_prims *prims, const char *quality, uint32_t threads,
+                 bvhlab_tree *tree, bvhlab_error *err)
+{
+	bvhlab_options opts;
+	char q[32];
+	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin));
+	if (rc < 0)
+		return rc;
+	snprintf(q, sizeof(q), "quality=%s", quality);
+	if ((rc = bvhlab_options_parse(&opts, q, err)) == 0)
+		rc = bvhlab_build(plugin, &opts, &prims->input, threads, tree, err);
+	bvhlab_options_finish(&opts);
+	return rc;
+}
+
+static void check_leaves(const bvhlab_tree *t, const char *what)
+{
+	for (uint32_t i = 0; i < t->node_count; i++)
+		if (t->nodes[i].count > MAX_LEAF) {
+			fprintf(stderr, "%s: leaf %u holds %u > %d\n", what, i, t->nodes[i].count,
+			        MAX_LEAF);
+			test_failures++;
+			return;
+		}
+}
+
+/* One build, judged like the harness does; returns its reference count. */
+static uint32_t check_one(const bvhlab_scene *s, const bvhlab_prims *prims, int q,
+                          uint32_t threads)
+{
+	bvhlab_tree tree = {0};
+	bvhlab_error err = {{0}};
+	uint64_t mismatches = 1;
+	uint32_t refs = 0;
+	char what[160];
+	snprintf(what, sizeof(what), "%s, %s, %u thread(s)", s->name, qualities[q], threads);
+	int rc = build(prims, qualities[q], threads, &tree, &err);
+	if (rc == 0)
+		rc = bvhlab_validate_tree(&tree, &prims->input, q == 2, &err);
+	if (rc == 0)
+		rc = bvhlab_validate_rays(&tree, s, RAYS, 0x5eed, &mismatches, &err);
+	if (rc < 0 || mismatches) {
+		fprintf(stderr, "%s: rc %d, %llu mismatches: %s\n", what, rc,
+		        (unsigned long long)mismatches, err.message);
+		test_failures++;
+	} else {
+		check_leaves(&tree, what);
+		refs = tree.index_count;
+		printf("ok: %s, %u nodes, %u references\n", what, tree.node_count, refs);
+	}
+	bvhlab_tree_finish(&tree);
+	return refs;
+}
+
+/* Returns the most references "high" made. */
+static uint32_t check_scene(const bvhlab_scene *s)
+{
+	bvhlab_prims prims = {0};
+	bvhlab_error err = {{0}};
+	uint32_t most = 0;
+	if (bvhlab_prims_init(&prims, s, &err) < 0) {
+		fprintf(stderr, "%s: %s\n", s->name, err.message);
+		test_failures++;
+		return 0;
+	}
+	for (int q = 0; q < 3; q++)
+		for (uint32_t threads = 1; threads <= 2; threads++) {
+			uint32_t refs = check_one(s, &prims, q, threads);
+			if (q == 2 && refs > most)
+				most = refs;
+		}
+	bvhlab_prims_finish(&prims);
+	return most;
+}
+
+static void check_generated(const char *gen, uint32_t count, bool expect_splits)
+{
+	bvhlab_gen_params gp;
+	bvhlab_scene *s = NULL;
+	bvhlab_error err = {{0}};
+	bvhlab_gen_params_init(&gp);
+	gp.frequency = 16;
+	gp.count = count;
+	gp.seed = 3;
+	CHECK_INT(bvhlab_scene_generate(gen, &gp, &s, &err), 0);
+	if (!s)
+		return;
+	uint32_t refs = check_scene(s);
+	if (expect_splits)
+		CHECK(refs > s->triangle_count);
+	bvhlab_scene_destroy(s);
+}
+
+static void check_mesh(const char *file)
+{
+	char path[1024];
+	bvhlab_scene *s = NULL;
+	bvhlab_error err = {{0}};
+	snprintf(path, sizeof(path), "%s/%s", BVHLAB_SHARED_SCENES, file);
+	if (access(path, R_OK) != 0) {
+		printf("skip: %s not found\n", path);
+		return;
+	}
+	CHECK_INT(bvhlab_scene_load(path, &s, &err), 0);
+	if (s)
+		check_scene(s);
+	bvhlab_scene_destroy(s);
+}
+
+/* Duplicates are allowed for this descriptor, a missing primitive is not. */
+static void check_missing_caught(void)
+{
+	bvhlab_gen_params gp;
+	bvhlab_scene *s = NULL;
+	bvhlab_prims prims = {0};
+	bvhlab_tree t = {0};
+	bvhlab_error err = {{0}};
+	bvhlab_gen_params_init(&gp);
+	gp.frequency = 8;
+	CHECK_INT(bvhlab_scene_generate("icosphere", &gp, &s, &err), 0);
+	CHECK_INT(bvhlab_prims_init(&prims, s, &err), 0);
+	CHECK_INT(build(&prims, "medium", 2, &t, &err), 0);
+	uint32_t leaf = 0;
+	while (leaf < t.node_count && t.nodes[leaf].count < 2)
+		leaf++;
+	CHECK(leaf < t.node_count);
+	if (leaf < t.node_count) {
+		uint32_t *slot = &t.prim_index[t.nodes[leaf].first];
+		slot[1] = slot[0]; /* one primitive twice, its neighbour nowhere */
+		CHECK_INT(bvhlab_validate_tree(&t, &prims.input, true, &err), -EINVAL);
+		CHECK_CONTAINS(err.message, "referenced by no leaf");
+	}
+	bvhlab_tree_finish(&t);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(s);
+}
+
+int main(void)
+{
+	bvhlab_error err = {{0}};
+	if (bvhlab_plugin_open("embree", &plugin, &err) < 0) {
+		fprintf(stderr, "%s\n", err.message);
+		return 1;
+	}
+	CHECK(bvhlab_plugin_builder(plugin)->flags & BVHLAB_BUILDER_SPATIAL_SPLITS);
+	check_generated("icosphere", 0, false);
+	check_generated("soup", 4000, true);
+	check_generated("stadium", 4000, false);
+	check_mesh("stanford-bunny.obj");
+	check_mesh("horse.ply");
+	check_missing_caught();
+	bvhlab_plugin_close(plugin);
+	return test_finish();
+}

@@ -1,0 +1,423 @@
+/*
+ * lbvh: on generated scenes (including coincident centroids, duplicate
+ * triangles and 1 to 3 triangles) and on the shared meshes, for 30- and
+ * 63-bit codes, with and without collapse, every build is valid, traces
+ * like brute force, keeps leaves within max_leaf, and is the same tree,
+ * node for node, with 1, 2 and 8 threads and when repeated. Collapse never
+ * raises the SAH cost. Under ThreadSanitizer the scenes shrink.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "testutil.h"
+
+#if defined(__SANITIZE_THREAD__)
+#define UNDER_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define UNDER_TSAN 1
+#endif
+#endif
+#ifndef UNDER_TSAN
+#define UNDER_TSAN 0
+#endif
+
+#define SCALE(full, tsan) (UNDER_TSAN ? (tsan) : (full))
+#define RAYS 256
+#define RAY_SEED 4242
+
+static const unsigned bit_counts[] = { 30, 63 };
+static const uint32_t thread_counts[] = { 1, 2, 8 };
+#define THREAD_COUNTS (sizeof(thread_counts) / sizeof(thread_counts[0]))
+
+static bvhlab_plugin *plugin;
+
+/* One build configuration. */
+struct setup {
+	unsigned bits;
+	bool collapse;
+	uint32_t max_leaf; /* 0: the default */
+	const char *extra; /* one more key=value, or NULL */
+};
+
+static bvhlab_scene *generate(const char *generator, uint32_t count, uint32_t frequency,
+                              uint32_t size)
+{
+	bvhlab_gen_params params;
+	bvhlab_scene *scene = NULL;
+	bvhlab_error err = { { 0 } };
+
+	bvhlab_gen_params_init(&params);
+	params.seed = 5;
+	if (count)
+		params.count = count;
+	if (frequency)
+		params.frequency = frequency;
+	if (size)
+		params.size = size;
+	if (bvhlab_scene_generate(generator, &params, &scene, &err) < 0)
+		fprintf(stderr, "%s: %s\n", generator, err.message);
+	CHECK(scene != NULL);
+	return scene;
+}
+
+/* n copies of one triangle: every centroid, every Morton code equal. */
+static bvhlab_scene *identical_scene(uint32_t n)
+{
+	static const float tri[9] = { 0, 0, 0, 1, 0.5f, 0, 0.25f, 1, 0.75f };
+	bvhlab_scene *scene = calloc(1, sizeof(*scene));
+
+	CHECK(scene != NULL);
+	if (!scene)
+		return NULL;
+	scene->vertices = malloc(sizeof(tri));
+	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
+	CHECK(scene->vertices && scene->indices);
+	memcpy(scene->vertices, tri, sizeof(tri));
+	for (uint32_t i = 0; i < 3 * n; i++)
+		scene->indices[i] = i % 3;
+	scene->vertex_count = 3;
+	scene->triangle_count = n;
+	bvhlab_scene_update(scene);
+	return scene;
+}
+
+/* Every triangle of `scene` twice, the copies interleaved. */
+static bvhlab_scene *doubled(bvhlab_scene *scene)
+{
+	uint32_t n = scene ? scene->triangle_count : 0;
+	uint32_t *indices = scene ? malloc(6 * (size_t)n * sizeof(uint32_t)) : NULL;
+
+	CHECK(indices != NULL);
+	if (!indices)
+		return scene;
+	for (uint32_t t = 0; t < n; t++) {
+		memcpy(indices + 6 * (size_t)t, scene->indices + 3 * (size_t)t, 3 * sizeof(uint32_t));
+		memcpy(indices + 6 * (size_t)t + 3, scene->indices + 3 * (size_t)t,
+		       3 * sizeof(uint32_t));
+	}
+	free(scene->indices);
+	scene->indices = indices;
+	scene->triangle_count = 2 * n;
+	bvhlab_scene_update(scene);
+	return scene;
+}
+
+static int make_options(bvhlab_options *opts, const struct setup *s)
+{
+	bvhlab_error err = { { 0 } };
+	int rc = bvhlab_options_init(opts, bvhlab_plugin_builder(plugin));
+
+	if (rc == 0)
+		rc = bvhlab_options_set_int(opts, "bits", s->bits, &err);
+	if (rc == 0)
+		rc = bvhlab_options_set_bool(opts, "collapse", s->collapse, &err);
+	if (rc == 0 && s->max_leaf)
+		rc = bvhlab_options_set_int(opts, "max_leaf", s->max_leaf, &err);
+	if (rc == 0 && s->extra)
+		rc = bvhlab_options_parse(opts, s->extra, &err);
+	if (rc < 0) {
+		fprintf(stderr, "options: %s\n", err.message);
+		bvhlab_options_finish(opts);
+	}
+	CHECK_INT(rc, 0);
+	return rc;
+}
+
+/* Builds and checks the structure; 0 or the failure (reported). */
+static int build_valid(const char *name, const bvhlab_build_input *in, const struct setup *s,
+                       uint32_t threads, bvhlab_tree *tree)
+{
+	bvhlab_options opts;
+	bvhlab_error err = { { 0 } };
+	int rc = make_options(&opts, s);
+
+	if (rc < 0)
+		return rc;
+	rc = bvhlab_build(plugin, &opts, in, threads, tree, &err);
+	if (rc == 0)
+		rc = bvhlab_validate_tree(tree, in, false, &err);
+	if (rc != 0) {
+		fprintf(stderr, "%s bits=%u collapse=%d threads=%u: %s\n", name, s->bits,
+		        s->collapse, threads, err.message);
+		CHECK(!"valid build");
+	}
+	bvhlab_options_finish(&opts);
+	return rc;
+}
+
+/* Leaves: one primitive without collapse, at most max_leaf with. */
+static void check_leaves(const bvhlab_tree *tree, const struct setup *s)
+{
+	uint32_t most = !s->collapse ? 1 : s->max_leaf ? s->max_leaf : 8;
+
+	for (uint32_t i = 0; i < tree->node_count; i++)
+		if (tree->nodes[i].count > most) {
+			fprintf(stderr, "node %u: leaf of %u > %u\n", i, tree->nodes[i].count, most);
+			CHECK(!"leaf within max_leaf");
+			return;
+		}
+}
+
+/* The same tree, and the same arrays: node order included. */
+static void check_same(const char *name, const bvhlab_tree *ref, const bvhlab_tree *tree,
+                       const char *what)
+{
+	bvhlab_error err = { { 0 } };
+
+	if (bvhlab_tree_compare(ref, tree, &err) != 0) {
+		fprintf(stderr, "%s: %s: %s\n", name, what, err.message);
+		CHECK(!"same tree");
+		return;
+	}
+	CHECK_INT(tree->node_count, ref->node_count);
+	CHECK_INT(tree->index_count, ref->index_count);
+	if (tree->node_count == ref->node_count && tree->index_count == ref->index_count) {
+		CHECK(memcmp(tree->nodes, ref->nodes, ref->node_count * sizeof(bvhlab_node)) == 0);
+		CHECK(memcmp(tree->prim_index, ref->prim_index,
+		             ref->index_count * sizeof(uint32_t)) == 0);
+	}
+}
+
+/*
+ * One setup on one scene: the single-thread tree is checked in full
+ * (structure, rays, leaves), every other thread count and a repeat must
+ * give it again. Returns its SAH cost.
+ */
+static double check_setup(const char *name, const bvhlab_scene *scene,
+                          const bvhlab_build_input *in, const struct setup *s, uint32_t rays)
+{
+	bvhlab_tree ref = { 0 }, tree = { 0 };
+	bvhlab_tree_stats stats = { 0 };
+	bvhlab_error err = { { 0 } };
+	uint64_t mismatches = 1;
+
+	if (build_valid(name, in, s, 1, &ref) != 0)
+		goto out;
+	CHECK_INT(ref.index_count, in->prim_count);
+	if (!s->collapse)
+		CHECK_INT(ref.node_count, 2 * in->prim_count - 1);
+	CHECK_INT(bvhlab_validate_rays(&ref, scene, rays, RAY_SEED, &mismatches, &err), 0);
+	CHECK_INT(mismatches, 0);
+	check_leaves(&ref, s);
+	bvhlab_tree_stats_compute(&ref, &stats);
+	for (size_t t = 0; t < THREAD_COUNTS; t++) {
+		char what[64];
+		snprintf(what, sizeof(what), "threads=%u vs 1", thread_counts[t]);
+		if (build_valid(name, in, s, thread_counts[t], &tree) == 0)
+			check_same(name, &ref, &tree, what);
+	}
+out:
+	bvhlab_tree_finish(&ref);
+	bvhlab_tree_finish(&tree);
+	return stats.sah_cost;
+}
+
+static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
+{
+	bvhlab_prims prims;
+	bvhlab_error err = { { 0 } };
+
+	if (!scene)
+		return;
+	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
+	for (size_t k = 0; k < sizeof(bit_counts) / sizeof(bit_counts[0]); k++) {
+		struct setup on = { .bits = bit_counts[k], .collapse = true };
+		struct setup off = { .bits = bit_counts[k], .collapse = false };
+		double with = check_setup(name, scene, &prims.input, &on, rays);
+		double without = check_setup(name, scene, &prims.input, &off, rays);
+
+		printf("%-18s %8u triangles  bits %2u  SAH collapse %9.4f  single %9.4f\n", name,
+		       scene->triangle_count, bit_counts[k], with, without);
+		CHECK(with <= without * (1 + 1e-6));
+	}
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+static void test_shared(const char *file)
+{
+	char path[1024];
+	bvhlab_scene *scene = NULL;
+	bvhlab_error err = { { 0 } };
+
+	snprintf(path, sizeof(path), "%s/%s", BVHLAB_SHARED_SCENES, file);
+	if (bvhlab_scene_load(path, &scene, &err) < 0) {
+		fprintf(stderr, "%s\n", err.message);
+		CHECK(!"shared mesh loads");
+		return;
+	}
+	/* Brute force costs a pass over every triangle per ray. */
+	test_scene(file, scene, 64);
+}
+
+static void test_descriptor(void)
+{
+	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
+	static const char *const names[] = { "bits", "collapse", "max_leaf", "c_trav", "c_isect" };
+
+	CHECK(strcmp(b->name, "lbvh") == 0);
+	CHECK(b->summary && *b->summary);
+	CHECK(b->flags & BVHLAB_BUILDER_PARALLEL);
+	CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
+	CHECK(!(b->flags & BVHLAB_BUILDER_SPATIAL_SPLITS));
+	CHECK_INT(b->option_count, 5);
+	for (uint32_t i = 0; i < b->option_count && i < 5; i++) {
+		CHECK(strcmp(b->options[i].name, names[i]) == 0);
+		CHECK(b->options[i].help && *b->options[i].help);
+	}
+	if (b->option_count == 5) {
+		CHECK_INT(b->options[0].def_int, 63);
+		CHECK(b->options[1].def_bool);
+		CHECK_INT(b->options[2].def_int, 8);
+		CHECK(b->options[3].def_float == 1.0 && b->options[4].def_float == 1.0);
+	}
+}
+
+/* The host checks ranges; the plugin refuses a bit count it has no codes for. */
+static void test_options(void)
+{
+	bvhlab_scene *scene = generate("soup", 100, 0, 0);
+	bvhlab_options opts;
+	bvhlab_prims prims;
+	bvhlab_tree tree = { 0 };
+	bvhlab_error err = { { 0 } };
+
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin)), 0);
+	CHECK_INT(bvhlab_options_set_int(&opts, "max_leaf", 0, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "max_leaf");
+	CHECK_INT(bvhlab_options_set_int(&opts, "bits", 64, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "bits");
+	CHECK_INT(bvhlab_options_set_float(&opts, "c_trav", 0, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "c_trav");
+	CHECK_INT(bvhlab_options_set_int(&opts, "bits", 31, &err), 0);
+	if (scene && bvhlab_prims_init(&prims, scene, &err) == 0) {
+		CHECK_INT(bvhlab_build(plugin, &opts, &prims.input, 2, &tree, &err), -EINVAL);
+		CHECK_CONTAINS(err.message, "bits");
+		bvhlab_prims_finish(&prims);
+	}
+	bvhlab_options_finish(&opts);
+	bvhlab_tree_finish(&tree);
+	bvhlab_scene_destroy(scene);
+}
+
+/* With traversal made expensive the SAH wants big leaves: max_leaf caps
+ * them, and is reached. */
+static void test_max_leaf_binds(void)
+{
+	bvhlab_scene *scene = generate("icosphere", 0, SCALE(16, 8), 0);
+	bvhlab_prims prims;
+	bvhlab_tree tree = { 0 };
+	bvhlab_tree_stats stats;
+	bvhlab_error err = { { 0 } };
+
+	if (!scene || bvhlab_prims_init(&prims, scene, &err) < 0) {
+		CHECK(!"icosphere input");
+		bvhlab_scene_destroy(scene);
+		return;
+	}
+	for (uint32_t max_leaf = 1; max_leaf <= 16; max_leaf *= 2) {
+		struct setup s = { .bits = 63, .collapse = true, .max_leaf = max_leaf,
+		                   .extra = "c_trav=1000" };
+		if (build_valid("icosphere c_trav=1000", &prims.input, &s, 2, &tree) != 0)
+			continue;
+		check_leaves(&tree, &s);
+		bvhlab_tree_stats_compute(&tree, &stats);
+		CHECK(stats.leaf_histogram[max_leaf - 1] > 0);
+	}
+	bvhlab_tree_finish(&tree);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+/* Equal codes split by position: a balanced tree, not a chain. */
+static void test_ties_balanced(void)
+{
+	uint32_t n = SCALE(5000, 1000);
+	bvhlab_scene *scene = identical_scene(n);
+	bvhlab_prims prims;
+	bvhlab_tree tree = { 0 };
+	bvhlab_tree_stats stats;
+	bvhlab_error err = { { 0 } };
+	struct setup s = { .bits = 63, .collapse = false };
+
+	if (!scene || bvhlab_prims_init(&prims, scene, &err) < 0) {
+		CHECK(!"identical input");
+		bvhlab_scene_destroy(scene);
+		return;
+	}
+	if (build_valid("identical", &prims.input, &s, 2, &tree) == 0) {
+		uint32_t levels = 0;
+		while ((1u << levels) < n)
+			levels++;
+		bvhlab_tree_stats_compute(&tree, &stats);
+		CHECK(stats.max_depth <= levels);
+	}
+	bvhlab_tree_finish(&tree);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+/* threads = 0 means all cores: still the same tree. */
+static void test_all_cores(void)
+{
+	bvhlab_scene *scene = generate("stadium", SCALE(20000, 3000), 0, 0);
+	bvhlab_prims prims;
+	bvhlab_tree ref = { 0 }, tree = { 0 };
+	bvhlab_error err = { { 0 } };
+	struct setup s = { .bits = 63, .collapse = true };
+
+	if (!scene || bvhlab_prims_init(&prims, scene, &err) < 0) {
+		CHECK(!"stadium input");
+		bvhlab_scene_destroy(scene);
+		return;
+	}
+	if (build_valid("stadium", &prims.input, &s, 1, &ref) == 0 &&
+	    build_valid("stadium", &prims.input, &s, 0, &tree) == 0)
+		check_same("stadium", &ref, &tree, "threads=0 vs 1");
+	bvhlab_tree_finish(&ref);
+	bvhlab_tree_finish(&tree);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+int main(void)
+{
+	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "nefertiti.obj",
+	                                      "ogre.obj", "igea.ply" };
+	bvhlab_error err = { { 0 } };
+	struct stat st;
+
+	if (bvhlab_plugin_open("lbvh", &plugin, &err) < 0) {
+		fprintf(stderr, "%s\n", err.message);
+		CHECK(!"lbvh loads");
+		return test_finish();
+	}
+	test_descriptor();
+	test_options();
+	test_max_leaf_binds();
+	test_ties_balanced();
+	test_all_cores();
+	test_scene("soup", generate("soup", SCALE(30000, 4000), 0, 0), RAYS);
+	test_scene("icosphere", generate("icosphere", 0, SCALE(40, 12), 0), RAYS);
+	test_scene("stadium", generate("stadium", SCALE(20000, 3000), 0, 0), RAYS);
+	test_scene("terrain", generate("terrain", 0, 0, SCALE(96, 32)), RAYS);
+	test_scene("identical", identical_scene(SCALE(3000, 600)), RAYS);
+	test_scene("duplicates", doubled(generate("icosphere", 0, SCALE(20, 8), 0)), RAYS);
+	test_scene("one", generate("soup", 1, 0, 0), RAYS);
+	test_scene("two", generate("soup", 2, 0, 0), RAYS);
+	test_scene("three", generate("soup", 3, 0, 0), RAYS);
+	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
+		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
+	} else {
+		for (size_t i = 0; i < (UNDER_TSAN ? 1 : sizeof(shared) / sizeof(shared[0])); i++)
+			test_shared(shared[i]);
+	}
+	bvhlab_plugin_close(plugin);
+	return test_finish();
+}
