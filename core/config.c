@@ -21,8 +21,8 @@
 
 static const char *const top_keys[] = {
 	"format_version", "output", "repeat", "warmup", "threads", "validate",
-	"validate_rays", "rays", "images", "isolate", "timeout_s", "memory_limit_mb", "scenes",
-	"builders", NULL,
+	"validate_rays", "rays", "images", "isolate", "timeout_s", "memory_limit_mb", "pin",
+	"scenes", "builders", NULL,
 };
 static const char *const ray_keys[] = { "width", "height", "diffuse", "camera", NULL };
 
@@ -143,6 +143,8 @@ static int parse_isolation(struct config *cfg, bvhlab_error *err)
 	if (!rc)
 		rc = config_get_uint(cfg, root, "memory_limit_mb", "", 1, CONFIG_MAX_MEMORY_MB,
 		                     &cfg->memory_limit_mb, err);
+	if (!rc)
+		rc = config_get_bool(cfg, root, "pin", "", &cfg->pin, err);
 	return rc;
 }
 

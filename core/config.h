@@ -62,6 +62,8 @@ struct config {
 	bvhlab_camera camera;
 	bool images;       /* "images", default false */
 	bool isolate;      /* "isolate", default true: each run's builds in a child process */
+	bool pin;          /* "pin", default false: host->pin_thread binds builder threads
+	                    * to distinct physical cores */
 	double timeout_s;  /* "timeout_s", default 600: an isolated run is killed after it */
 	uint64_t memory_limit_mb; /* "memory_limit_mb", default 0 = none: the child's RLIMIT_AS */
 

@@ -571,6 +571,7 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 	int r = results_init(&h.res, cfg, cfg->output, err);
 	if (r < 0)
 		return r;
+	bvhlab_set_pinning(cfg->pin);
 	if (opts->resume)
 		r = resume(&h, err);
 	if (r == 0)

@@ -241,7 +241,7 @@ static void test_unknown_keys(void)
 	EXPECT_ERROR_AT(t, "\"repet\"", 0,
 	                "unknown key 'repet' at the top level (known: format_version, output, "
 	                "repeat, warmup, threads, validate, validate_rays, rays, images, isolate, "
-	                "timeout_s, memory_limit_mb, scenes, builders); did you mean 'repeat'?");
+	                "timeout_s, memory_limit_mb, pin, scenes, builders); did you mean 'repeat'?");
 	t = "{ " SCENES ", " BUILDERS ", \"zzzzzz\": 3 }";
 	EXPECT_ERROR_AT(t, "\"zzzzzz\"", 0, "unknown key 'zzzzzz' at the top level");
 	CHECK(load(&cfg, t, &err) < 0 && !strstr(err.message, "did you mean"));

@@ -67,6 +67,9 @@ struct queue {
 	sah_builder *b;
 	int policy;
 	uint32_t depth, low_mark, min_job;
+	const bvhlab_host *host;
+	bvhlab_build_ctx *ctx;
+	atomic_uint next_worker; /* hands out worker numbers for pin_thread */
 };
 
 /* Private pending children of one queue2t worker. Entries shrink from lo
@@ -200,11 +203,20 @@ static void run_queue2t(struct queue *q, const sah_job *job)
 	}
 }
 
+/* With "pin": true each worker gets its own physical core (a no-op otherwise). */
+static void pin(struct queue *q)
+{
+	uint32_t id = atomic_fetch_add_explicit(&q->next_worker, 1, memory_order_relaxed);
+	if (BVHLAB_HOST_HAS(q->host, pin_thread))
+		q->host->pin_thread(q->ctx, id);
+}
+
 static void *worker(void *arg)
 {
 	struct queue *q = arg;
 	sah_job job;
 
+	pin(q);
 	while (queue_take(q, &job)) {
 		if (q->policy == POLICY_DEPTH)
 			run_depth(q, &job);
@@ -231,6 +243,7 @@ static int queue_init(struct queue *q, sah_builder *b, uint32_t threads,
 		return -rc;
 	}
 	atomic_init(&q->waiting, 0);
+	atomic_init(&q->next_worker, 0);
 	q->b = b;
 	q->policy = cfg->policy;
 	q->depth = cfg->depth;
@@ -261,6 +274,8 @@ static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder 
 		free(tids);
 		return rc;
 	}
+	q.host = host;
+	q.ctx = ctx;
 	/* The first push cannot fail: the heap starts with room. */
 	queue_push(&q, root);
 	for (uint32_t i = 1; i < threads; i++)

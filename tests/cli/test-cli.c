@@ -92,6 +92,26 @@ static void test_run_good(void)
 	cJSON_Delete(doc);
 }
 
+/* "pin": true reaches plugins through host->pin_thread; false leaves it a no-op. */
+static void test_pin(void)
+{
+	static const char fmt[] =
+		"{ \"output\": \"out-pin-%s\", \"repeat\": 1, \"pin\": %s, \"threads\": [2],\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 2000 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"%s/pin_probe.so\",\n"
+		"                  \"options\": { \"expect\": \"%s\" } } ] }\n";
+	char text[1024], dir[512];
+	for (int on = 0; on < 2; on++) {
+		snprintf(text, sizeof(text), fmt, on ? "on" : "off", on ? "true" : "false",
+		         BVHLAB_TEST_BUILDDIR, on ? "pinned" : "free");
+		CHECK_INT(run(ARGS("run", "--quiet", write_config("pin.json", text))), 0);
+		snprintf(dir, sizeof(dir), "%s/out-pin-%s", tmpdir, on ? "on" : "off");
+		cJSON *doc = load_results(dir);
+		CHECK_INT(count_runs(doc, "pin_probe", "ok"), 1);
+		cJSON_Delete(doc);
+	}
+}
+
 static void test_info_build_list(void)
 {
 	CHECK_INT(run(ARGS("info", "soup:count=1000,seed=3", "--json")), 0);
@@ -220,6 +240,7 @@ int main(int argc, char **argv)
 	if (!strcmp(argv[2], "basic")) {
 		test_help();
 		test_run_good();
+		test_pin();
 		test_info_build_list();
 	} else if (!strcmp(argv[2], "errors")) {
 		test_config_errors();
