@@ -12,6 +12,7 @@
 
 #include "harness.h"
 #include "isolate.h"
+#include "progress.h"
 #include "results.h"
 #include "util.h"
 
@@ -30,11 +31,8 @@ struct harness {
 	const struct config *cfg;
 	struct results res;
 	struct harness_builder *builders;
-	bool quiet;
+	struct progress progress;
 	bool all_ok;
-	uint32_t run_index, run_total;
-	double start;
-	bool tty;       /* progress rewritten in place */
 	bool shade_done; /* this scene's shaded render is on its way */
 };
 
@@ -67,119 +65,9 @@ struct series_job {
 	const char *shade_path; /* where it leaves the shaded render, or NULL */
 };
 
-int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab_error *err)
-{
-	int r = cs->path ? bvhlab_scene_load(cs->path, out, err)
-	                 : bvhlab_scene_generate(cs->generator, &cs->gen, out, err);
-	if (r < 0)
-		return r;
-	if (cs->subdivide > 0)
-		r = bvhlab_scene_subdivide(*out, cs->subdivide, err);
-	if (r == 0 && cs->name)
-		r = bvhlab_scene_set_name(*out, cs->name);
-	if (r < 0) {
-		if (r == -ENOMEM && err && !err->message[0])
-			error_set(err, "scene '%s': out of memory", cs->name);
-		bvhlab_scene_destroy(*out);
-		*out = NULL;
-	}
-	return r;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return (x > y) - (x < y);
-}
-
-void harness_summarise(const double *samples, uint32_t n, double *median, double *min,
-                       double *max)
-{
-	double sorted[n ? n : 1];
-	memcpy(sorted, samples, n * sizeof(double));
-	qsort(sorted, n, sizeof(double), cmp_double);
-	*min = n ? sorted[0] : 0;
-	*max = n ? sorted[n - 1] : 0;
-	*median = n == 0 ? 0 : n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
-}
-
-int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
-                        const bvhlab_build_input *input, struct build_series *s,
-                        bvhlab_error *err)
-{
-	for (uint32_t k = 0; k < s->warmup + s->repeat; k++) {
-		double t0 = util_now();
-		int r = bvhlab_build(plugin, opts, input, s->threads, &s->tree, err);
-		double t1 = util_now();
-		if (r < 0)
-			return r;
-		if (k >= s->warmup)
-			s->samples_ms[k - s->warmup] = (t1 - t0) * 1e3;
-	}
-	return 0;
-}
-
 static uint32_t resolve_threads(uint32_t t)
 {
 	return t ? t : bvhlab_hardware_threads();
-}
-
-/* Seconds left, from the mean time of the runs so far; < 0 before the first. */
-static double remaining(const struct harness *h, double elapsed)
-{
-	uint32_t done = h->run_index;
-	return done ? elapsed / done * (h->run_total - done) : -1.0;
-}
-
-static void progress_head(const struct harness *h, const struct run_record *run, uint32_t i)
-{
-	fprintf(stderr, "%s[%u/%u] %s / %s / %u thread%s: ", h->tty ? "\r\033[K" : "", i,
-	        h->run_total, run->scene, run->builder, run->threads, run->threads == 1 ? "" : "s");
-}
-
-static void progress_time(const struct harness *h)
-{
-	double elapsed = util_now() - h->start, left = remaining(h, elapsed);
-	fprintf(stderr, " [%.1fs elapsed", elapsed);
-	if (left >= 0)
-		fprintf(stderr, ", ~%.0fs left", left);
-	fputc(']', stderr);
-}
-
-/* On a terminal, the line of the run in progress (rewritten when it ends). */
-static void progress_start(const struct harness *h, const struct run_record *run)
-{
-	if (h->quiet || !h->tty)
-		return;
-	progress_head(h, run, h->run_index + 1);
-	fputs("running...", stderr);
-	progress_time(h);
-	fflush(stderr);
-}
-
-/* A finished run: one log line, or on a terminal the line rewritten in
- * place (kept, with a newline, when the run is not ok). */
-static void progress(struct harness *h, const struct run_record *run)
-{
-	h->run_index++;
-	if (h->quiet)
-		return;
-	progress_head(h, run, h->run_index);
-	fputs(run->status, stderr);
-	if (run->sample_count && run->stats) {
-		double med, mn, mx;
-		harness_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
-		fprintf(stderr, ", %.2f ms median, SAH %.3f", med, run->stats->sah_cost);
-	}
-	if (run->rays)
-		fprintf(stderr, ", %.1f nodes/ray", run->rays->primary.rays
-		        ? (double)run->rays->primary.nodes_visited / (double)run->rays->primary.rays : 0);
-	if (run->error)
-		fprintf(stderr, " (%s)", run->error);
-	progress_time(h);
-	if (!h->tty || strcmp(run->status, "ok") != 0)
-		fputc('\n', stderr);
-	fflush(stderr);
 }
 
 /* Records a run and rewrites the files, so nothing finished is ever lost. */
@@ -188,7 +76,7 @@ static void record(struct harness *h, struct run_record *run)
 	bvhlab_error err = {{0}};
 	if (strcmp(run->status, "ok") != 0)
 		h->all_ok = false;
-	progress(h, run);
+	progress_done(&h->progress, run);
 	if (results_add_run(&h->res, run) < 0 || results_write(&h->res, &err) < 0) {
 		fprintf(stderr, "bvhlab: cannot write results: %s\n",
 		        err.message[0] ? err.message : "out of memory");
@@ -215,7 +103,7 @@ static void record_all_failed(struct harness *h, const char *scene, struct harne
 		                         .opts = hb->opts_ok ? &hb->opts : NULL,
 		                         .status = "failed", .error = error};
 		if (results_has_run(&h->res, run.scene, run.builder, run.threads))
-			h->run_index++;
+			h->progress.index++;
 		else
 			record(h, &run);
 	}
@@ -234,7 +122,7 @@ static bool scene_done(struct harness *h, const struct config_scene *cs)
 	}
 	if (done < total)
 		return false;
-	h->run_index += total;
+	h->progress.index += total;
 	return true;
 }
 
@@ -408,7 +296,7 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 	                         .triangles = job->scene->triangle_count};
 	char paths[2][4096];
 	if (results_has_run(&h->res, run.scene, run.builder, run.threads)) {
-		h->run_index++;
+		h->progress.index++;
 		return;
 	}
 	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double);
@@ -419,7 +307,7 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 		return;
 	}
 	image_paths(h, job, scene_index, builder_index, first, paths);
-	progress_start(h, &run);
+	progress_start(&h->progress, &run);
 	run_series(h, job, &run, rep, size);
 	h->shade_done = h->shade_done || (job->shade_path && rep->shade_written);
 	free(rep);
@@ -467,7 +355,7 @@ static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t sc
 	if (r == 0)
 		r = results_write(&h->res, &err);
 	if (r < 0)
-		fprintf(stderr, "%sbvhlab: images of scene '%s': %s\n", h->tty ? "\n" : "",
+		fprintf(stderr, "%sbvhlab: images of scene '%s': %s\n", h->progress.tty ? "\n" : "",
 		        scene->name, err.message[0] ? err.message : strerror(-r));
 	free(names);
 	free(threads);
@@ -549,7 +437,7 @@ static int resume(struct harness *h, bvhlab_error *err)
 	size_t kept = 0, not_ok = 0;
 	int r = results_resume(&h->res, &kept, &not_ok, err);
 	if (r == -ENOENT) {
-		if (!h->quiet)
+		if (!h->progress.quiet)
 			fprintf(stderr, "bvhlab: nothing to resume in %s/; starting afresh\n",
 			        h->cfg->output);
 		return 0;
@@ -557,7 +445,7 @@ static int resume(struct harness *h, bvhlab_error *err)
 	if (r < 0)
 		return r;
 	h->all_ok = not_ok == 0;
-	if (!h->quiet)
+	if (!h->progress.quiet)
 		fprintf(stderr, "bvhlab: resuming %s/: %zu finished run%s kept\n", h->cfg->output,
 		        kept, kept == 1 ? "" : "s");
 	return 0;
@@ -566,8 +454,8 @@ static int resume(struct harness *h, bvhlab_error *err)
 int harness_run(const struct config *cfg, const struct harness_options *opts,
                 bvhlab_error *err)
 {
-	struct harness h = {.cfg = cfg, .quiet = opts->quiet, .all_ok = true, .start = util_now(),
-	                    .tty = isatty(STDERR_FILENO)};
+	struct harness h = {.cfg = cfg, .all_ok = true};
+	progress_init(&h.progress, opts->quiet);
 	int r = results_init(&h.res, cfg, cfg->output, err);
 	if (r < 0)
 		return r;
@@ -578,11 +466,10 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 		r = results_write(&h.res, err);
 	if (r == 0 && (r = open_builders(&h)) < 0)
 		error_set(err, "out of memory opening plugins");
-	h.run_total = count_runs(&h);
+	h.progress.total = count_runs(&h);
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
 		run_scene(&h, &cfg->scenes[s], s);
-	if (h.tty && !h.quiet && h.run_total)
-		fputc('\n', stderr);
+	progress_finish(&h.progress);
 	close_builders(&h);
 	results_finish(&h.res);
 	return r < 0 ? r : h.all_ok ? 0 : 1;

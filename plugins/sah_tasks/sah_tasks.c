@@ -1,0 +1,331 @@
+/*
+ * sah_tasks: task-parallel binned SAH. Nodes above `parallel_min`
+ * primitives are split one at a time by the whole team (horizontal
+ * parallelism, tasks_split.c): every thread bins and partitions a chunk of
+ * the node. Their smaller children become independent tasks (vertical
+ * parallelism) that the threads then claim largest first from a shared
+ * array and build whole with the kernel's sah_build_subtree.
+ *
+ * Why two phases rather than one queue: the top splits are the serial
+ * part that caps the thesis's speedup; once they are done the tasks are
+ * all known, so an atomic index over them (sorted by size, the classic
+ * longest-first rule) is the whole scheduler. Termination is exact: a
+ * thread leaves once the index passes the last task, and the caller's
+ * barrier returns only when every thread has.
+ *
+ * Determinism: the kernel decides every split of the tasks; the team's
+ * splits are the kernel's binned split (see tasks_split.h) and its stable
+ * partition does not depend on the team's size. The horizontal path runs
+ * with one thread too, so every thread count sees the same order in every
+ * range. Method sweep has no team split: its large nodes are split by the
+ * kernel on the calling thread, then its tasks run in parallel the same way.
+ */
+#include <errno.h>
+#include <stdbool.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <bvhlab/builder.h>
+
+#include "sah_kernel.h"
+#include "sah_threads.h"
+#include "tasks_split.h"
+
+/* SAH_OPTION_DECLS in the same order, but binned by default: the team
+ * split exists for binned only. */
+static const bvhlab_option_decl options[] = {
+	{ .name = "method", .type = BVHLAB_OPTION_STRING,
+	  .help = "split search: binned (team-parallel top splits) or sweep (exact SAH, "
+	          "top splits on one thread)",
+	  .def_string = "binned", .choices = "sweep|binned" },
+	{ .name = "bins", .type = BVHLAB_OPTION_INT, .help = "bins per axis for method binned",
+	  .def_int = 32, .min = 2, .max = SAH_MAX_BINS },
+	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,
+	  .help = "most primitives in a leaf (unless all their centroids coincide)",
+	  .def_int = 8, .min = 1, .max = 64 },
+	{ .name = "c_trav", .type = BVHLAB_OPTION_FLOAT,
+	  .help = "SAH cost of traversing an inner node (> 0)",
+	  .def_float = 1.0, .min = 1e-6, .max = 1e6 },
+	{ .name = "c_isect", .type = BVHLAB_OPTION_FLOAT,
+	  .help = "SAH cost of intersecting one primitive (> 0)",
+	  .def_float = 1.0, .min = 1e-6, .max = 1e6 },
+	{ .name = "parallel_min", .type = BVHLAB_OPTION_INT,
+	  .help = "nodes with more primitives are split by all threads together; "
+	          "smaller ones are tasks built by one thread each",
+	  .def_int = 65536, .min = 128, .max = 1 << 30 },
+};
+
+#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
+
+/* A node larger than 64 (the most max_leaf allows) is never a leaf, which
+ * the team split relies on. */
+_Static_assert(128 > 64, "parallel_min's minimum exceeds max_leaf's maximum");
+
+enum command { CMD_BIN, CMD_COUNT, CMD_SCATTER, CMD_COPY, CMD_TASKS, CMD_EXIT };
+
+struct team {
+	pthread_barrier_t bar;
+	pthread_mutex_t gate; /* held while threads start: size is not final yet */
+	uint32_t size;
+	bool failed;          /* under gate: no barrier, members leave at once */
+	int cmd;              /* set by the caller between barriers */
+	tasks_split split;
+	sah_builder *b;
+	sah_job *tasks;
+	uint32_t task_count, task_cap;
+	atomic_uint next;     /* first unclaimed task */
+};
+
+struct member {
+	struct team *team;
+	uint32_t index;
+	pthread_t tid;
+};
+
+static void run_tasks(struct team *tm)
+{
+	uint32_t i;
+
+	while ((i = atomic_fetch_add_explicit(&tm->next, 1, memory_order_relaxed)) <
+	       tm->task_count)
+		sah_build_subtree(tm->b, &tm->tasks[i]);
+}
+
+static void run_part(struct team *tm, uint32_t part)
+{
+	switch (tm->cmd) {
+	case CMD_BIN: tasks_bin(&tm->split, part); break;
+	case CMD_COUNT: tasks_count(&tm->split, part); break;
+	case CMD_SCATTER: tasks_scatter(&tm->split, part); break;
+	case CMD_COPY: tasks_copy(&tm->split, part); break;
+	case CMD_TASKS: run_tasks(tm); break;
+	default: break;
+	}
+}
+
+static void *member_main(void *arg)
+{
+	struct member *m = arg;
+	struct team *tm = m->team;
+
+	pthread_mutex_lock(&tm->gate);
+	bool failed = tm->failed;
+	pthread_mutex_unlock(&tm->gate);
+	if (failed)
+		return NULL;
+	for (;;) {
+		pthread_barrier_wait(&tm->bar);
+		if (tm->cmd == CMD_EXIT)
+			return NULL;
+		run_part(tm, m->index);
+		pthread_barrier_wait(&tm->bar);
+	}
+}
+
+/* One step by every member; the barriers publish the caller's settings
+ * before it and every member's results after it. */
+static void team_run(struct team *tm, int cmd)
+{
+	tm->cmd = cmd;
+	if (tm->size > 1)
+		pthread_barrier_wait(&tm->bar);
+	run_part(tm, 0);
+	if (tm->size > 1)
+		pthread_barrier_wait(&tm->bar);
+}
+
+static int add_task(struct team *tm, const sah_job *job)
+{
+	if (tm->task_count == tm->task_cap) {
+		uint32_t cap = tm->task_cap ? 2 * tm->task_cap : 64;
+		sah_job *t = realloc(tm->tasks, cap * sizeof(*t));
+		if (!t)
+			return -ENOMEM;
+		tm->tasks = t;
+		tm->task_cap = cap;
+	}
+	tm->tasks[tm->task_count++] = *job;
+	return 0;
+}
+
+/* Splits one large node: by the team for binned, else by the kernel. */
+static unsigned split_large(struct team *tm, const sah_job *job, sah_job child[2])
+{
+	if (tm->b->opt.method != SAH_BINNED)
+		return sah_split_job(tm->b, job, child);
+	tasks_split_begin(&tm->split, job);
+	team_run(tm, CMD_BIN);
+	/* No candidate: every centroid coincides; the kernel's median. */
+	if (!tasks_choose(&tm->split))
+		return sah_split_job(tm->b, job, child);
+	team_run(tm, CMD_COUNT);
+	tasks_counted(&tm->split);
+	team_run(tm, CMD_SCATTER);
+	team_run(tm, CMD_COPY);
+	tasks_split_end(&tm->split, child);
+	return 2;
+}
+
+/*
+ * The horizontal phase, on the calling thread (the members follow its
+ * commands). Larger child pushed first, smaller processed first: the stack
+ * stays within log2(N) + 1 entries.
+ */
+static int split_top(struct team *tm, uint32_t parallel_min, const sah_job *root)
+{
+	sah_job stack[64], child[2];
+	unsigned sp = 0;
+	int rc = 0;
+
+	stack[sp++] = *root;
+	while (sp > 0 && rc == 0) {
+		sah_job job = stack[--sp];
+		if (sah_job_size(&job) <= parallel_min) {
+			rc = add_task(tm, &job);
+			continue;
+		}
+		if (split_large(tm, &job, child) == 0)
+			continue;
+		unsigned big = sah_job_size(&child[1]) > sah_job_size(&child[0]);
+		stack[sp++] = child[big];
+		stack[sp++] = child[1 - big];
+	}
+	return rc;
+}
+
+/* Largest first, ties by position: the order is the same on every run. */
+static int by_size_desc(const void *pa, const void *pb)
+{
+	const sah_job *a = pa, *b = pb;
+	uint32_t na = sah_job_size(a), nb = sah_job_size(b);
+
+	if (na != nb)
+		return na > nb ? -1 : 1;
+	return a->begin < b->begin ? -1 : a->begin > b->begin;
+}
+
+/* Starts up to threads - 1 members; the team is as large as what started
+ * (every step is correct for any size). The number started, or a negative
+ * errno with every started member joined. */
+static int team_start(struct team *tm, struct member *m, uint32_t threads)
+{
+	uint32_t started = 0;
+	int rc;
+
+	pthread_mutex_lock(&tm->gate);
+	for (uint32_t i = 1; i < threads; i++) {
+		m[started].team = tm;
+		m[started].index = started + 1;
+		started += sah_thread_start(&m[started].tid, member_main, &m[started]) == 0;
+	}
+	tm->size = started + 1;
+	tm->split.parts = tm->size;
+	rc = -pthread_barrier_init(&tm->bar, NULL, tm->size);
+	tm->failed = rc < 0;
+	pthread_mutex_unlock(&tm->gate);
+	if (rc == 0)
+		return (int)started;
+	for (uint32_t i = 0; i < started; i++)
+		pthread_join(m[i].tid, NULL);
+	return rc;
+}
+
+static void team_stop(struct team *tm, struct member *m, uint32_t started)
+{
+	/* Members leave after the first barrier: no second one to meet. */
+	tm->cmd = CMD_EXIT;
+	if (tm->size > 1)
+		pthread_barrier_wait(&tm->bar);
+	for (uint32_t i = 0; i < started; i++)
+		pthread_join(m[i].tid, NULL);
+	pthread_barrier_destroy(&tm->bar);
+}
+
+static int team_init(struct team *tm, sah_builder *b, uint32_t threads)
+{
+	int rc;
+
+	memset(tm, 0, sizeof(*tm));
+	tm->b = b;
+	atomic_init(&tm->next, 0);
+	rc = -pthread_mutex_init(&tm->gate, NULL);
+	if (rc < 0)
+		return rc;
+	rc = tasks_split_init(&tm->split, b, threads);
+	if (rc < 0)
+		pthread_mutex_destroy(&tm->gate);
+	return rc;
+}
+
+static void team_destroy(struct team *tm)
+{
+	tasks_split_free(&tm->split);
+	pthread_mutex_destroy(&tm->gate);
+	free(tm->tasks);
+}
+
+/* Top splits, then the tasks, largest first. */
+static int run_build(struct team *tm, uint32_t parallel_min, const sah_job *root)
+{
+	int rc = split_top(tm, parallel_min, root);
+
+	if (rc < 0)
+		return rc;
+	qsort(tm->tasks, tm->task_count, sizeof(*tm->tasks), by_size_desc);
+	team_run(tm, CMD_TASKS);
+	return 0;
+}
+
+static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
+                    const sah_job *root, uint32_t threads, void *arg)
+{
+	const uint32_t *parallel_min = arg;
+	struct member *m = calloc(threads, sizeof(*m));
+	struct team tm;
+	int rc = m ? team_init(&tm, b, threads) : -ENOMEM;
+	int started;
+
+	if (rc < 0)
+		goto out;
+	started = team_start(&tm, m, threads);
+	rc = started < 0 ? started : run_build(&tm, *parallel_min, root);
+	if (started >= 0)
+		team_stop(&tm, m, (uint32_t)started);
+	team_destroy(&tm);
+out:
+	if (rc < 0)
+		host->set_error(ctx, "sah_tasks: cannot set up the build (%d)", rc);
+	free(m);
+	return rc;
+}
+
+static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *input, bvhlab_build_output *output)
+{
+	int64_t v;
+	uint32_t parallel_min;
+
+	if (host->option_int(ctx, "parallel_min", &v) < 0 || v < 128 || v > (1 << 30)) {
+		host->set_error(ctx, "option \"parallel_min\" is not available or out of range");
+		return -EINVAL;
+	}
+	parallel_min = (uint32_t)v;
+	return sah_parallel_build(host, ctx, input, output, schedule, &parallel_min);
+}
+
+static const bvhlab_builder descriptor = {
+	.abi_version = BVHLAB_ABI_CURRENT,
+	.struct_size = sizeof(bvhlab_builder),
+	.name = "sah_tasks",
+	.summary = "parallel binned SAH: large nodes split by all threads, small ones as tasks",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	.option_count = OPTION_COUNT,
+	.options = options,
+	.build = build,
+};
+
+BVHLAB_PLUGIN_ENTRY
+{
+	return host_abi_major == BVHLAB_ABI_MAJOR ? &descriptor : NULL;
+}

@@ -1,0 +1,229 @@
+/*
+ * sah_tasks: valid trees (structure and sampled rays) on generated and
+ * degenerate scenes and two shared meshes, identical (bvhlab_tree_compare)
+ * across 1, 2, 3 and 8 threads and to sah_seq's binned tree, with the same
+ * SAH cost. A low parallel_min makes even the small scenes run the team
+ * split over several levels; the meshes also run with the default. Under
+ * ThreadSanitizer the generated scenes shrink and builds repeat less.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "testutil.h"
+
+#if defined(__SANITIZE_THREAD__)
+#define UNDER_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define UNDER_TSAN 1
+#endif
+#endif
+#ifndef UNDER_TSAN
+#define UNDER_TSAN 0
+#endif
+
+#define SCALE(full, tsan) (UNDER_TSAN ? (tsan) : (full))
+#define RAYS 256
+
+static const uint32_t thread_counts[] = { 1, 2, 3, 8 };
+static bvhlab_plugin *seq, *tasks;
+
+static bvhlab_scene *generate(const char *generator, uint32_t count, uint32_t frequency,
+                              uint32_t size)
+{
+	bvhlab_gen_params params;
+	bvhlab_scene *scene = NULL;
+	bvhlab_error err = { { 0 } };
+
+	bvhlab_gen_params_init(&params);
+	params.seed = 7;
+	if (count)
+		params.count = count;
+	if (frequency)
+		params.frequency = frequency;
+	if (size)
+		params.size = size;
+	if (bvhlab_scene_generate(generator, &params, &scene, &err) < 0)
+		fprintf(stderr, "%s: %s\n", generator, err.message);
+	CHECK(scene != NULL);
+	return scene;
+}
+
+/* n copies of one triangle: only the kernel's median fallback applies. */
+static bvhlab_scene *identical_scene(uint32_t n)
+{
+	static const float tri[9] = { 0, 0, 0, 1, 0.5f, 0, 0.25f, 1, 0.75f };
+	bvhlab_scene *scene = calloc(1, sizeof(*scene));
+
+	if (!scene)
+		return NULL;
+	scene->vertices = malloc(sizeof(tri));
+	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
+	CHECK(scene->vertices && scene->indices);
+	memcpy(scene->vertices, tri, sizeof(tri));
+	for (uint32_t i = 0; i < 3 * n; i++)
+		scene->indices[i] = i % 3;
+	scene->vertex_count = 3;
+	scene->triangle_count = n;
+	bvhlab_scene_update(scene);
+	return scene;
+}
+
+/* Builds with "method=binned" and `extra`, then validates structure and
+ * rays. 0 or the failure (already reported). */
+static int build_valid(bvhlab_plugin *plugin, const char *extra, const bvhlab_scene *scene,
+                       const bvhlab_build_input *in, uint32_t threads, bvhlab_tree *tree)
+{
+	bvhlab_options opts;
+	bvhlab_error err = { { 0 } };
+	uint64_t bad = 0;
+	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin));
+
+	if (rc == 0)
+		rc = bvhlab_options_parse(&opts, "method=binned", &err);
+	if (rc == 0 && extra)
+		rc = bvhlab_options_parse(&opts, extra, &err);
+	if (rc == 0)
+		rc = bvhlab_build(plugin, &opts, in, threads, tree, &err);
+	if (rc == 0)
+		rc = bvhlab_validate_tree(tree, in, false, &err);
+	if (rc == 0)
+		rc = bvhlab_validate_rays(tree, scene, RAYS, 0x5eed, &bad, &err);
+	if (rc != 0 || bad != 0) {
+		fprintf(stderr, "%s %s threads=%u: %s (%llu ray mismatches)\n",
+		        bvhlab_plugin_builder(plugin)->name, extra ? extra : "", threads,
+		        err.message, (unsigned long long)bad);
+		CHECK(!"valid build");
+		rc = rc ? rc : -EINVAL;
+	}
+	bvhlab_options_finish(&opts);
+	return rc;
+}
+
+static void check_same(const char *scene, const char *extra, uint32_t threads,
+                       const bvhlab_tree *ref, const bvhlab_tree *tree, const char *what)
+{
+	bvhlab_error err = { { 0 } };
+	bvhlab_tree_stats a, b;
+
+	if (bvhlab_tree_compare(ref, tree, &err) != 0) {
+		fprintf(stderr, "%s: sah_tasks %s threads=%u differs from %s: %s\n", scene, extra,
+		        threads, what, err.message);
+		CHECK(!"identical tree");
+	}
+	bvhlab_tree_stats_compute(ref, &a);
+	bvhlab_tree_stats_compute(tree, &b);
+	CHECK(fabs(a.sah_cost - b.sah_cost) <= 1e-9 * a.sah_cost);
+}
+
+/* Every thread count against sah_seq binned and sah_tasks on 1 thread. */
+static void check_scene(const char *name, const bvhlab_scene *scene,
+                        const bvhlab_build_input *in, const bvhlab_tree *ref,
+                        const char *extra)
+{
+	bvhlab_tree one = { 0 }, tree = { 0 };
+	int repeats = SCALE(2, 1);
+
+	if (build_valid(tasks, extra, scene, in, 1, &one) == 0) {
+		check_same(name, extra, 1, ref, &one, "sah_seq binned");
+		for (size_t t = 1; t < sizeof(thread_counts) / sizeof(thread_counts[0]); t++) {
+			for (int r = 0; r < repeats; r++) {
+				if (build_valid(tasks, extra, scene, in, thread_counts[t], &tree) != 0)
+					continue;
+				check_same(name, extra, thread_counts[t], &one, &tree,
+				           "its 1-thread tree");
+				check_same(name, extra, thread_counts[t], ref, &tree, "sah_seq binned");
+			}
+		}
+	}
+	bvhlab_tree_finish(&one);
+	bvhlab_tree_finish(&tree);
+}
+
+static void test_scene(const char *name, bvhlab_scene *scene, bool mesh)
+{
+	bvhlab_prims prims;
+	bvhlab_tree ref = { 0 };
+	bvhlab_error err = { { 0 } };
+
+	if (!scene)
+		return;
+	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
+	if (build_valid(seq, NULL, scene, &prims.input, 1, &ref) == 0) {
+		check_scene(name, scene, &prims.input, &ref, "parallel_min=128");
+		if (mesh)
+			check_scene(name, scene, &prims.input, &ref, NULL);
+	}
+	printf("%-18s %8u triangles: done\n", name, scene->triangle_count);
+	bvhlab_tree_finish(&ref);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+static void test_shared(const char *file)
+{
+	char path[1024];
+	bvhlab_scene *scene = NULL;
+	bvhlab_error err = { { 0 } };
+
+	snprintf(path, sizeof(path), "%s/%s", BVHLAB_SHARED_SCENES, file);
+	if (bvhlab_scene_load(path, &scene, &err) < 0) {
+		fprintf(stderr, "%s\n", err.message);
+		CHECK(!"shared mesh loads");
+		return;
+	}
+	test_scene(file, scene, true);
+}
+
+static void test_descriptor(void)
+{
+	const bvhlab_builder *b = bvhlab_plugin_builder(tasks);
+
+	CHECK(strcmp(b->name, "sah_tasks") == 0);
+	CHECK(b->flags & BVHLAB_BUILDER_PARALLEL);
+	CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
+	CHECK_INT(b->option_count, 6);
+	if (b->option_count == 6) {
+		CHECK(strcmp(b->options[0].def_string, "binned") == 0);
+		CHECK(strcmp(b->options[5].name, "parallel_min") == 0);
+	}
+}
+
+int main(void)
+{
+	struct stat st;
+	bvhlab_error err = { { 0 } };
+
+	if (bvhlab_plugin_open("sah_seq", &seq, &err) < 0 ||
+	    bvhlab_plugin_open("sah_tasks", &tasks, &err) < 0) {
+		fprintf(stderr, "%s\n", err.message);
+		CHECK(!"plugins load");
+		goto out;
+	}
+	test_descriptor();
+	test_scene("soup", generate("soup", SCALE(20000, 3000), 0, 0), false);
+	test_scene("icosphere", generate("icosphere", 0, SCALE(24, 10), 0), false);
+	test_scene("stadium", generate("stadium", SCALE(10000, 3000), 0, 0), false);
+	test_scene("terrain", generate("terrain", 0, 0, SCALE(48, 24)), false);
+	test_scene("identical", identical_scene(SCALE(1000, 300)), false);
+	test_scene("one", generate("soup", 1, 0, 0), false);
+	test_scene("two", generate("soup", 2, 0, 0), false);
+	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
+		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
+	} else {
+		test_shared("stanford-bunny.obj");
+		test_shared("horse.ply");
+	}
+out:
+	if (tasks)
+		bvhlab_plugin_close(tasks);
+	if (seq)
+		bvhlab_plugin_close(seq);
+	return test_finish();
+}
