@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "cliutil.h"
+#include "image.h"
 
 static const char config[] =
 	"{ \"format_version\": 1, \"output\": \"out-rays\", \"repeat\": 1, \"threads\": [1, 2],\n"
@@ -35,6 +36,26 @@ static bool png_size(const char *dir, const char *name, uint32_t *w, uint32_t *h
 	return ok;
 }
 
+/* Not blank: decoded through OpenImageIO, more than 1% of the pixels differ
+ * from the first one (a render shows geometry on a background, a heat map
+ * and a legend show a range of colours). */
+static void check_not_blank(const char *dir, const char *name)
+{
+	char path[600];
+	int w = 0, h = 0;
+	uint8_t *rgb = NULL;
+	bvhlab_error err = {{0}};
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	CHECK_INT(image_read_rgb8(path, &w, &h, &rgb, &err), 0);
+	size_t differ = 0, n = (size_t)w * (size_t)h;
+	for (size_t k = 1; rgb && k < n; k++)
+		differ += memcmp(rgb + 3 * k, rgb, 3) != 0;
+	if (differ * 100 <= n)
+		fprintf(stderr, "%s: only %zu of %zu pixels differ from the first\n", path, differ, n);
+	CHECK(differ * 100 > n);
+	free(rgb);
+}
+
 static void check_image(const char *dir, const char *name, uint32_t w, uint32_t h)
 {
 	uint32_t gw = 0, gh = 0;
@@ -42,6 +63,7 @@ static void check_image(const char *dir, const char *name, uint32_t w, uint32_t 
 		fprintf(stderr, "missing or not a PNG: %s/%s\n", dir, name);
 	CHECK_INT(gw, w);
 	CHECK_INT(gh, h);
+	check_not_blank(dir, name);
 }
 
 static void check_html(const char *dir)
