@@ -21,6 +21,9 @@
 #include "results.h"
 #include "testutil.h"
 
+#define FIXTURE_SEED 11
+#include "scene_fixture.h"
+
 #if defined(__SANITIZE_THREAD__)
 #define UNDER_TSAN 1
 #elif defined(__has_feature)
@@ -81,48 +84,6 @@ static double now_ms(void)
 
 	clock_gettime(CLOCK_MONOTONIC, &ts);
 	return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
-}
-
-static bvhlab_scene *generate(const char *generator, uint32_t count, uint32_t frequency,
-                              uint32_t size)
-{
-	bvhlab_gen_params params;
-	bvhlab_scene *scene = NULL;
-	bvhlab_error err = { { 0 } };
-
-	bvhlab_gen_params_init(&params);
-	params.seed = 11;
-	if (count)
-		params.count = count;
-	if (frequency)
-		params.frequency = frequency;
-	if (size)
-		params.size = size;
-	if (bvhlab_scene_generate(generator, &params, &scene, &err) < 0)
-		fprintf(stderr, "%s: %s\n", generator, err.message);
-	CHECK(scene != NULL);
-	return scene;
-}
-
-/* n copies of one triangle: no split separates any centroids. */
-static bvhlab_scene *identical_scene(uint32_t n)
-{
-	static const float tri[9] = { 0, 0, 0, 1, 0.5f, 0, 0.25f, 1, 0.75f };
-	bvhlab_scene *scene = calloc(1, sizeof(*scene));
-
-	CHECK(scene != NULL);
-	if (!scene)
-		return NULL;
-	scene->vertices = malloc(sizeof(tri));
-	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
-	CHECK(scene->vertices && scene->indices);
-	memcpy(scene->vertices, tri, sizeof(tri));
-	for (uint32_t i = 0; i < 3 * n; i++)
-		scene->indices[i] = i % 3;
-	scene->vertex_count = 3;
-	scene->triangle_count = n;
-	bvhlab_scene_update(scene);
-	return scene;
 }
 
 /* Options for one build: the method, then the variant's own settings. */

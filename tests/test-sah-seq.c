@@ -13,54 +13,15 @@
 
 #include "testutil.h"
 
+#define FIXTURE_SEED 7
+#include "scene_fixture.h"
+
 #define RAYS 512
 #define RAY_SEED 12345
 
 static const char *const methods[] = { "sweep", "binned" };
 static const uint32_t leaf_sizes[] = { 1, 4, 8, 16 };
 #define LEAF_SIZES (sizeof(leaf_sizes) / sizeof(leaf_sizes[0]))
-
-static bvhlab_scene *generate(const char *generator, uint32_t count, uint32_t frequency,
-                              uint32_t size)
-{
-	bvhlab_gen_params params;
-	bvhlab_scene *scene = NULL;
-	bvhlab_error err = { { 0 } };
-
-	bvhlab_gen_params_init(&params);
-	params.seed = 7;
-	if (count)
-		params.count = count;
-	if (frequency)
-		params.frequency = frequency;
-	if (size)
-		params.size = size;
-	if (bvhlab_scene_generate(generator, &params, &scene, &err) < 0)
-		fprintf(stderr, "%s: %s\n", generator, err.message);
-	CHECK(scene != NULL);
-	return scene;
-}
-
-/* n copies of one triangle: no split separates any centroids. */
-static bvhlab_scene *identical_scene(uint32_t n)
-{
-	static const float tri[9] = { 0, 0, 0, 1, 0.5f, 0, 0.25f, 1, 0.75f };
-	bvhlab_scene *scene = calloc(1, sizeof(*scene));
-
-	CHECK(scene != NULL);
-	if (!scene)
-		return NULL;
-	scene->vertices = malloc(sizeof(tri));
-	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
-	CHECK(scene->vertices && scene->indices);
-	memcpy(scene->vertices, tri, sizeof(tri));
-	for (uint32_t i = 0; i < 3 * n; i++)
-		scene->indices[i] = i % 3;
-	scene->vertex_count = 3;
-	scene->triangle_count = n;
-	bvhlab_scene_update(scene);
-	return scene;
-}
 
 /* A leaf over max_leaf is allowed only when all its centroids coincide. */
 static void check_leaves(const bvhlab_tree *tree, const bvhlab_build_input *in,

@@ -17,6 +17,9 @@
 
 #include "testutil.h"
 
+#define FIXTURE_SEED 7
+#include "scene_fixture.h"
+
 #if defined(__SANITIZE_THREAD__)
 #define UNDER_TSAN 1
 #elif defined(__has_feature)
@@ -33,47 +36,6 @@
 
 static const uint32_t thread_counts[] = { 1, 2, 3, 8 };
 static bvhlab_plugin *seq, *tasks;
-
-static bvhlab_scene *generate(const char *generator, uint32_t count, uint32_t frequency,
-                              uint32_t size)
-{
-	bvhlab_gen_params params;
-	bvhlab_scene *scene = NULL;
-	bvhlab_error err = { { 0 } };
-
-	bvhlab_gen_params_init(&params);
-	params.seed = 7;
-	if (count)
-		params.count = count;
-	if (frequency)
-		params.frequency = frequency;
-	if (size)
-		params.size = size;
-	if (bvhlab_scene_generate(generator, &params, &scene, &err) < 0)
-		fprintf(stderr, "%s: %s\n", generator, err.message);
-	CHECK(scene != NULL);
-	return scene;
-}
-
-/* n copies of one triangle: only the kernel's median fallback applies. */
-static bvhlab_scene *identical_scene(uint32_t n)
-{
-	static const float tri[9] = { 0, 0, 0, 1, 0.5f, 0, 0.25f, 1, 0.75f };
-	bvhlab_scene *scene = calloc(1, sizeof(*scene));
-
-	if (!scene)
-		return NULL;
-	scene->vertices = malloc(sizeof(tri));
-	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
-	CHECK(scene->vertices && scene->indices);
-	memcpy(scene->vertices, tri, sizeof(tri));
-	for (uint32_t i = 0; i < 3 * n; i++)
-		scene->indices[i] = i % 3;
-	scene->vertex_count = 3;
-	scene->triangle_count = n;
-	bvhlab_scene_update(scene);
-	return scene;
-}
 
 /* Builds with "method=binned" and `extra`, then validates structure and
  * rays. 0 or the failure (already reported). */
