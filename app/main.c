@@ -14,6 +14,7 @@ static const char usage[] =
 	"                        run an experiment: every scene x builder x thread count\n"
 	"  list                  the plugins on the search path, with their options\n"
 	"  info SCENE [--json]   triangle count and bounds of a mesh file or generator\n"
+	"  info --machine        packages, physical cores, logical CPUs, caches (hwloc)\n"
 	"  build PLUGIN SCENE [--threads N] [-o KEY=VALUE]...\n"
 	"                        one build, validated and measured\n"
 	"  render PLUGIN SCENE -o FILE [--heat] [--width W --height H] [-O KEY=VALUE]...\n"
