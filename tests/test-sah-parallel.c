@@ -184,16 +184,10 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool generated)
 
 static void test_shared(const char *file)
 {
-	char path[1024];
-	bvhlab_scene *scene = NULL;
-	bvhlab_error err = { { 0 } };
+	bvhlab_scene *scene = load_shared(file);
 
-	snprintf(path, sizeof(path), "%s/%s", BVHLAB_SHARED_SCENES, file);
-	if (bvhlab_scene_load(path, &scene, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"shared mesh loads");
+	if (!scene)
 		return;
-	}
 	test_scene(file, scene, false);
 }
 
