@@ -23,7 +23,7 @@ static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return 0;
 }
 
-int sah_parallel_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                        const bvhlab_build_input *input, bvhlab_build_output *output,
                        sah_scheduler_fn schedule, void *arg)
 {

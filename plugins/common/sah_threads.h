@@ -1,10 +1,11 @@
 /*
- * What the parallel SAH plugins (sah_even, sah_uneven, sah_queue) share
- * besides the split kernel: one build frame around a scheduler, and thread
- * creation with a stack large enough for the kernel.
+ * What the SAH plugins share besides the split kernel: one build frame
+ * around a scheduler (sah_seq's scheduler is sah_build_subtree on the calling
+ * thread), and thread creation with a stack large enough for the kernel.
  *
- * The frame does everything sah_seq does (checks, options, output capacity,
- * kernel setup and teardown) and hands the root job to the scheduler, which
+ * The frame does the checks, reads the options, ensures the output
+ * capacity, sets the kernel up and tears it down, and hands the root job to
+ * the scheduler, which
  * must have processed every job of the tree, with every thread it started
  * joined, when it returns. Joining is what makes the workers' writes
  * visible to the host: pthread_join synchronises with the thread's end.
@@ -33,9 +34,9 @@ typedef int (*sah_scheduler_fn)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                                 sah_builder *b, const sah_job *root, uint32_t threads,
                                 void *arg);
 
-/* The whole build() of a parallel SAH plugin around `schedule`: 0, or a
- * negative errno after host->set_error. */
-int sah_parallel_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+/* The whole build() of a SAH plugin around `schedule`: 0, or a negative
+ * errno after host->set_error. */
+int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                        const bvhlab_build_input *input, bvhlab_build_output *output,
                        sah_scheduler_fn schedule, void *arg);
 

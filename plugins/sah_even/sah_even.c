@@ -78,7 +78,7 @@ static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder 
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	return sah_parallel_build(host, ctx, input, output, schedule, NULL);
+	return sah_run_build(host, ctx, input, output, schedule, NULL);
 }
 
 static const bvhlab_builder descriptor = {

@@ -328,7 +328,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 
 	if (rc < 0)
 		return rc;
-	return sah_parallel_build(host, ctx, input, output, schedule, &cfg);
+	return sah_run_build(host, ctx, input, output, schedule, &cfg);
 }
 
 static const bvhlab_builder descriptor = {

@@ -4,59 +4,33 @@
  * kernel's (plugins/common/sah_kernel.h); this plugin only runs the whole
  * tree as one subtree on the calling thread.
  */
-#include <errno.h>
 
 #include <bvhlab/builder.h>
 
 #include "sah_kernel.h"
+#include "sah_threads.h"
 
 static const bvhlab_option_decl options[] = { SAH_OPTION_DECLS };
 
 _Static_assert(sizeof(options) / sizeof(options[0]) == SAH_OPTION_COUNT,
                "SAH_OPTION_COUNT matches SAH_OPTION_DECLS");
 
-/* The host preallocates 2N-1 nodes and N indices; ask only if it did not. */
-static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                           const bvhlab_build_input *input, bvhlab_build_output *output)
+/* The reference schedule: the whole tree as one subtree, on this thread. */
+static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
+                    const sah_job *root, uint32_t threads, void *arg)
 {
-	uint64_t nodes = 2 * (uint64_t)input->prim_count - 1;
-
-	if (output->node_capacity >= nodes && output->index_capacity >= input->prim_count)
-		return 0;
-	if (host->grow_output(ctx, output, (uint32_t)nodes, input->prim_count) < 0) {
-		host->set_error(ctx, "cannot grow the output to %llu nodes",
-		                (unsigned long long)nodes);
-		return -ENOMEM;
-	}
+	(void)host;
+	(void)ctx;
+	(void)threads;
+	(void)arg;
+	sah_build_subtree(b, root);
 	return 0;
 }
 
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	sah_options opt;
-	sah_builder b;
-	sah_job root;
-	int rc;
-
-	if (input->prim_count == 0 || input->prim_count > UINT32_MAX / 2) {
-		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
-		return -EINVAL;
-	}
-	if ((rc = sah_options_read(host, ctx, &opt)) < 0 ||
-	    (rc = ensure_capacity(host, ctx, input, output)) < 0)
-		return rc;
-	rc = sah_builder_init(&b, &opt, input, output);
-	if (rc < 0) {
-		host->set_error(ctx, "%s", rc == -ENOMEM ? "out of memory for the SAH scratch"
-		                                         : "invalid build input");
-		return rc;
-	}
-	sah_builder_root(&b, &root);
-	sah_build_subtree(&b, &root);
-	sah_builder_finish(&b, output);
-	sah_builder_free(&b);
-	return 0;
+	return sah_run_build(host, ctx, input, output, schedule, NULL);
 }
 
 static const bvhlab_builder descriptor = {

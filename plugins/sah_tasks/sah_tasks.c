@@ -311,7 +311,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		return -EINVAL;
 	}
 	parallel_min = (uint32_t)v;
-	return sah_parallel_build(host, ctx, input, output, schedule, &parallel_min);
+	return sah_run_build(host, ctx, input, output, schedule, &parallel_min);
 }
 
 static const bvhlab_builder descriptor = {
