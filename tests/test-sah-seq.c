@@ -109,7 +109,17 @@ static void test_scene(const bvhlab_plugin *plugin, const char *name, bvhlab_sce
 			                        leaf_sizes[l]);
 		printf("%-10s %7u triangles  max_leaf %2u  SAH sweep %10.4f  binned %10.4f\n",
 		       name, scene->triangle_count, leaf_sizes[l], cost[0], cost[1]);
-		CHECK(cost[0] <= cost[1]);
+		/* Both methods split nodes of at most 64 primitives exactly
+		 * (the kernel's small subtrees), so over such scenes they build
+		 * the same tree. Above, each sweep split is the best of a
+		 * superset of the binned candidates; over a whole greedy tree
+		 * that holds on meshes (cli-shared checks it strictly) but not
+		 * on a random soup, where a locally worse split higher up can
+		 * come out ahead lower down, by a hair: hence the 0.5 %. */
+		if (scene->triangle_count <= 64)
+			CHECK(cost[0] == cost[1]);
+		else
+			CHECK(cost[0] <= cost[1] * 1.005);
 	}
 	bvhlab_prims_finish(&prims);
 	bvhlab_scene_destroy(scene);
@@ -236,6 +246,7 @@ int main(void)
 	test_scene(plugin, "identical", identical_scene(1000));
 	test_scene(plugin, "one", generate("soup", 1, 0, 0));
 	test_scene(plugin, "two", generate("soup", 2, 0, 0));
+	test_scene(plugin, "soup64", generate("soup", 64, 0, 0));
 	bvhlab_plugin_close(plugin);
 	return test_finish();
 }

@@ -87,35 +87,68 @@ static uint32_t full_bins(const binning *g, int a, uint32_t from, uint32_t to,
  * max(-inf, x) are x exactly, so the bins equal fill()'s bit for bit. The
  * full bits are set from the counts afterwards.
  */
+/* A second set of bins for the odd primitives: neighbours in memory are
+ * neighbours in space, so consecutive primitives mostly hit the same bins,
+ * and with one set each update waits for the store of the one before. */
+typedef struct bins2 {
+	uint32_t count[3][64];
+	float blo[3][64][4];
+	float bhi[3][64][4];
+} bins2;
+
+static inline void add_dense(uint32_t *count, float *bl, float *bh, v4 lo, v4 hi)
+{
+	(*count)++;
+	v4_store(bl, v4_min(v4_load(bl), lo));
+	v4_store(bh, v4_max(v4_load(bh), hi));
+}
+
 static void fill_dense(binning *g, const sah_prim *prims, uint32_t begin, uint32_t end)
 {
 	const v4 half = v4_set1(0.5f), top = v4_set1((float)(g->nb - 1)), zero = v4_set1(0);
 	const v4 base = v4_set3(g->lo[0], g->lo[1], g->lo[2]);
 	const v4 scale = v4_set3(g->scale[0], g->scale[1], g->scale[2]);
 	const v4 inf = v4_set1(INFINITY), ninf = v4_set1(-INFINITY);
-	int32_t k[4];
+	bins2 h;
+	int32_t k[4], q[4];
 
 	for (int a = 0; a < 3; a++) {
 		for (uint32_t j = 0; j < g->nb; j++) {
-			g->count[a][j] = 0;
+			g->count[a][j] = h.count[a][j] = 0;
 			v4_store(g->blo[a][j], inf);
 			v4_store(g->bhi[a][j], ninf);
+			v4_store(h.blo[a][j], inf);
+			v4_store(h.bhi[a][j], ninf);
 		}
 	}
-	for (uint32_t i = begin; i < end; i++) {
+	uint32_t i = begin;
+	for (; i + 1 < end; i += 2) {
+		v4 lo = v4_load3(prims[i].lo), hi = v4_load3(prims[i].hi);
+		v4 lo2 = v4_load3(prims[i + 1].lo), hi2 = v4_load3(prims[i + 1].hi);
+		v4 f = v4_mul(v4_sub(v4_mul(v4_add(lo, hi), half), base), scale);
+		v4 f2 = v4_mul(v4_sub(v4_mul(v4_add(lo2, hi2), half), base), scale);
+		v4_trunc(v4_max(v4_min(f, top), zero), k);
+		v4_trunc(v4_max(v4_min(f2, top), zero), q);
+		for (int a = 0; a < 3; a++) {
+			add_dense(&g->count[a][k[a]], g->blo[a][k[a]], g->bhi[a][k[a]], lo, hi);
+			add_dense(&h.count[a][q[a]], h.blo[a][q[a]], h.bhi[a][q[a]], lo2, hi2);
+		}
+	}
+	for (; i < end; i++) {
 		v4 lo = v4_load3(prims[i].lo), hi = v4_load3(prims[i].hi);
 		v4 f = v4_mul(v4_sub(v4_mul(v4_add(lo, hi), half), base), scale);
 		v4_trunc(v4_max(v4_min(f, top), zero), k);
-		for (int a = 0; a < 3; a++) {
-			float *bl = g->blo[a][k[a]], *bh = g->bhi[a][k[a]];
-			g->count[a][k[a]]++;
-			v4_store(bl, v4_min(v4_load(bl), lo));
-			v4_store(bh, v4_max(v4_load(bh), hi));
+		for (int a = 0; a < 3; a++)
+			add_dense(&g->count[a][k[a]], g->blo[a][k[a]], g->bhi[a][k[a]], lo, hi);
+	}
+	for (int a = 0; a < 3; a++) {
+		for (uint32_t j = 0; j < g->nb; j++) {
+			g->count[a][j] += h.count[a][j];
+			v4_store(g->blo[a][j], v4_min(v4_load(g->blo[a][j]), v4_load(h.blo[a][j])));
+			v4_store(g->bhi[a][j], v4_max(v4_load(g->bhi[a][j]), v4_load(h.bhi[a][j])));
+			g->full[a][j >> 6] |= (uint64_t)(g->count[a][j] != 0) << (j & 63);
 		}
 	}
-	for (int a = 0; a < 3; a++)
-		for (uint32_t j = 0; j < g->nb; j++)
-			g->full[a][j >> 6] |= (uint64_t)(g->count[a][j] != 0) << (j & 63);
 }
 
 static void fill(binning *g, const sah_prim *prims, uint32_t begin, uint32_t end)
@@ -246,7 +279,7 @@ unsigned sah_binned_split(sah_builder *b, const sah_job *job, sah_job child[2])
 
 	setup(&g, job, b->opt.bins);
 	/* Dense bins pay 3 * bins initialisations to save a branch per add. */
-	if (job->end - job->begin >= 8 * g.nb)
+	if (job->end - job->begin >= 8 * g.nb && g.nb <= 64)
 		fill_dense(&g, b->prims[0], job->begin, job->end);
 	else
 		fill(&g, b->prims[0], job->begin, job->end);

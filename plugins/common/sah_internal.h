@@ -78,6 +78,14 @@ static inline void box_grow_centroid(bvhlab_aabb *b, const sah_prim *p)
 	}
 }
 
+/* Jobs of at most this many primitives are built whole by
+ * sah_small_subtree (exact SAH on local copies, see sah_small.c). Local
+ * indices are bytes, so at most 256. */
+#define SAH_SMALL_MAX 64
+
+/* Builds job's whole subtree on the calling thread. */
+void sah_small_subtree(sah_builder *b, const sah_job *job);
+
 /* Writes job's node as a leaf over its whole range. */
 void sah_write_leaf(sah_builder *b, const sah_job *job);
 
@@ -87,6 +95,19 @@ void sah_write_leaf(sah_builder *b, const sah_job *job);
  * caller's to fill.
  */
 void sah_write_inner(sah_builder *b, const sah_job *job, uint32_t mid, sah_job child[2]);
+
+/*
+ * Writes nodes[node] as an inner node with box and allocates its two
+ * adjacent children; their first slot goes to *first.
+ */
+void sah_write_node(sah_builder *b, uint32_t node, const bvhlab_aabb *box, uint32_t *first);
+
+/*
+ * The leaf rule for a node of n primitives with box, given `found` (a
+ * candidate split exists) and its best weighted area sum A_L*N_L + A_R*N_R.
+ */
+bool sah_leaf_rule(const sah_options *opt, uint32_t n, const bvhlab_aabb *box, bool found,
+                   float best);
 
 /*
  * The leaf rule: true when job should become a leaf given `found` (a

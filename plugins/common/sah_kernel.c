@@ -206,16 +206,23 @@ void sah_write_leaf(sah_builder *b, const sah_job *job)
 		b->ids[i] = prims[i].id;
 }
 
-void sah_write_inner(sah_builder *b, const sah_job *job, uint32_t mid, sah_job child[2])
+void sah_write_node(sah_builder *b, uint32_t node, const bvhlab_aabb *box, uint32_t *first)
 {
-	bvhlab_node *node = &b->nodes[job->node];
+	bvhlab_node *dst = &b->nodes[node];
+
 	/* Relaxed: only uniqueness matters; the scheduler's hand-over of the
 	 * child jobs orders everything else. */
-	uint32_t first = atomic_fetch_add_explicit(&b->node_counter, 2, memory_order_relaxed);
+	*first = atomic_fetch_add_explicit(&b->node_counter, 2, memory_order_relaxed);
+	write_box(dst, box);
+	dst->first = *first;
+	dst->count = 0;
+}
 
-	write_box(node, &job->box);
-	node->first = first;
-	node->count = 0;
+void sah_write_inner(sah_builder *b, const sah_job *job, uint32_t mid, sah_job child[2])
+{
+	uint32_t first;
+
+	sah_write_node(b, job->node, &job->box, &first);
 	child[0].node = first;
 	child[0].begin = job->begin;
 	child[0].end = mid;
@@ -225,26 +232,30 @@ void sah_write_inner(sah_builder *b, const sah_job *job, uint32_t mid, sah_job c
 	child[0].depth = child[1].depth = job->depth + 1;
 }
 
-bool sah_prefer_leaf(const sah_builder *b, const sah_job *job, bool found, float best)
+bool sah_leaf_rule(const sah_options *opt, uint32_t n, const bvhlab_aabb *box, bool found,
+                   float best)
 {
-	uint32_t n = job->end - job->begin;
-
-	if (n > b->opt.max_leaf)
+	if (n > opt->max_leaf)
 		return false;
 	if (!found)
 		return true;
 	/* Both costs multiplied by A, so a zero-area node (all primitives
 	 * degenerate and coincident) compares without dividing by zero. */
-	float area = box_half_area(&job->box);
-	float leaf = b->opt.c_isect * (float)n * area;
-	float split = b->opt.c_trav * area + b->opt.c_isect * best;
+	float area = box_half_area(box);
+	float leaf = opt->c_isect * (float)n * area;
+	float split = opt->c_trav * area + opt->c_isect * best;
 	return leaf <= split;
+}
+
+bool sah_prefer_leaf(const sah_builder *b, const sah_job *job, bool found, float best)
+{
+	return sah_leaf_rule(&b->opt, job->end - job->begin, &job->box, found, best);
 }
 
 unsigned sah_split_job(sah_builder *b, const sah_job *job, sah_job child[2])
 {
-	if (job->end - job->begin == 1) {
-		sah_write_leaf(b, job);
+	if (job->end - job->begin <= SAH_SMALL_MAX) {
+		sah_small_subtree(b, job);
 		return 0;
 	}
 	if (b->opt.method == SAH_SWEEP)

@@ -26,6 +26,8 @@
  * no candidate (every centroid equal along every axis), the range is split
  * in the middle of its current order (object median), so leaves larger
  * than max_leaf never occur.
+ * Jobs of at most 64 primitives (SAH_SMALL_MAX) are built whole at once
+ * with exact SAH whatever the method (sah_small.c); above that:
  *   "sweep":  exact SAH, every position between consecutive distinct
  *             centroids along each axis, from a presort done once per build.
  *   "binned": `bins` equal bins per axis over the node's centroid bounds,
@@ -44,7 +46,8 @@
  *   must only be processed after its parent's sah_split_job returned (the
  *   scheduler's hand-over, e.g. a thread start or a locked queue, provides
  *   the needed happens-before). Per job the kernel writes only
- *   nodes[job->node] and, for a leaf, output->prim_index[begin, end).
+ *   nodes[job->node], and for a leaf or a small job (built whole) the nodes
+ *   it allocates and output->prim_index[begin, end).
  * Determinism: a split depends only on the primitives in the range and
  * their order there, which itself depends only on the ancestors' splits;
  * never on the thread or the order in which jobs run. The SIMD and plain
@@ -53,8 +56,8 @@
  * Cost: sweep keeps 4 primitive arrays of 32 bytes plus 5 bytes of
  * scratch per primitive (~133 MB for 1M triangles) and presorts in
  * sah_builder_init (single-threaded, O(N)); binned keeps one 32-byte
- * array. sah_split_job needs about 30 KB of stack for binned (bins live
- * there), a few hundred bytes for sweep; size thread stacks accordingly.
+ * array. sah_split_job needs about 40 KB of stack for binned (bins live
+ * there) and 6 KB for a small job; size thread stacks accordingly.
  */
 #ifndef BVHLAB_SAH_KERNEL_H
 #define BVHLAB_SAH_KERNEL_H
@@ -181,7 +184,7 @@ void sah_builder_root(const sah_builder *b, sah_job *root);
 
 /*
  * Processes one node: writes nodes[job->node] and returns 0 if it became a
- * leaf, or allocates two adjacent node slots (the node's children, first
+ * leaf or, being small, was built with its whole subtree; or allocates two adjacent node slots (the node's children, first
  * and first + 1), fills child[0] (left) and child[1] (right) and returns 2.
  * Never fails, never allocates. Thread-safe on disjoint jobs (see above).
  */

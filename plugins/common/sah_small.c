@@ -1,0 +1,223 @@
+/*
+ * Small subtrees: a job of at most SAH_SMALL_MAX primitives is built whole,
+ * by the calling thread, with an exact SAH sweep over local copies of its
+ * primitives. Most of a tree's nodes are small, and the per-node cost of
+ * binning (bins to clear and scan for a handful of primitives) dominated a
+ * binned build; here each small node costs a few linear passes over sorted
+ * local index lists, like the sweep method but inside the L1 cache.
+ *
+ * The split rule is the kernel's (sah_kernel.h): every plane strictly
+ * between two consecutive distinct centroids of each axis, cost
+ * A_L * N_L + A_R * N_R, ties to the lower axis, then the lower position.
+ * That is exact SAH, which both methods use below the threshold, so binned
+ * trees get better there. Sets decide everything: the candidates, their
+ * costs and the leaf rule depend on which primitives are in a node, not on
+ * their order; only the object-median fallback (every centroid equal)
+ * reads the order, and for it the x-order here equals the range's order.
+ */
+#include <string.h>
+
+#include "sah_internal.h"
+#include "sah_simd.h"
+
+typedef struct small {
+	sah_builder *b;
+	uint32_t begin;                   /* the subtree's first position */
+	v4 lo[SAH_SMALL_MAX];             /* boxes, by local index */
+	v4 hi[SAH_SMALL_MAX];
+	float cen[3][SAH_SMALL_MAX];      /* centroids, by axis and local index */
+	uint32_t id[SAH_SMALL_MAX];
+	/* Local indices sorted by centroid along each axis (ties by index); a
+	 * node's primitives occupy the same slots [lb, le) of all three. */
+	uint8_t order[3][SAH_SMALL_MAX];
+	uint8_t side[SAH_SMALL_MAX];      /* by local index: 0 left, 1 right */
+	uint8_t tmp[SAH_SMALL_MAX];
+	float right[SAH_SMALL_MAX];       /* A_R * N_R of the slots from j on */
+} small;
+
+typedef struct small_node {
+	uint32_t node, lb, le; /* node slot; its slots [lb, le) */
+	bvhlab_aabb box;
+} small_node;
+
+static void load(small *s, const sah_prim *prims, uint32_t n)
+{
+	for (uint32_t k = 0; k < n; k++) {
+		const sah_prim *p = &prims[s->begin + k];
+		s->lo[k] = v4_load3(p->lo);
+		s->hi[k] = v4_load3(p->hi);
+		for (int a = 0; a < 3; a++)
+			s->cen[a][k] = prim_centroid(p, a);
+		s->id[k] = p->id;
+	}
+}
+
+/* Stable insertion sort of the identity by centroid: the ranges arrive
+ * partly ordered (a binned parent partitioned them along one axis). */
+static void sort_axis(small *s, int a, uint32_t n)
+{
+	const float *c = s->cen[a];
+	uint8_t *o = s->order[a];
+
+	for (uint32_t k = 0; k < n; k++) {
+		uint32_t j = k;
+		float v = c[k];
+		while (j > 0 && c[o[j - 1]] > v) {
+			o[j] = o[j - 1];
+			j--;
+		}
+		o[j] = (uint8_t)k;
+	}
+}
+
+/* The sweep method's ranges are sorted already (x order is the range's
+ * own); the other two axes are translated to local indices through the
+ * kernel's by-id side marks, which only this job's primitives use now. */
+static void take_presorted(small *s, uint32_t n)
+{
+	sah_builder *b = s->b;
+
+	for (uint32_t k = 0; k < n; k++) {
+		s->order[0][k] = (uint8_t)k;
+		b->side[s->id[k]] = (uint8_t)k;
+	}
+	for (int a = 1; a < 3; a++)
+		for (uint32_t k = 0; k < n; k++)
+			s->order[a][k] = b->side[b->prims[a][s->begin + k].id];
+}
+
+/* Lowest cost of one axis' planes below best, first position in *pos. */
+static float eval_axis(small *s, int a, uint32_t lb, uint32_t le, float best, uint32_t *pos)
+{
+	const uint8_t *o = s->order[a];
+	const float *c = s->cen[a];
+	v4 lo = v4_set1(INFINITY), hi = v4_set1(-INFINITY);
+
+	for (uint32_t j = le - 1; j > lb; j--) {
+		lo = v4_min(lo, s->lo[o[j]]);
+		hi = v4_max(hi, s->hi[o[j]]);
+		s->right[j] = v4_half_area(lo, hi) * (float)(le - j);
+	}
+	lo = v4_set1(INFINITY);
+	hi = v4_set1(-INFINITY);
+	for (uint32_t j = lb + 1; j < le; j++) {
+		lo = v4_min(lo, s->lo[o[j - 1]]);
+		hi = v4_max(hi, s->hi[o[j - 1]]);
+		if (!(c[o[j - 1]] < c[o[j]]))
+			continue;
+		float cost = v4_half_area(lo, hi) * (float)(j - lb) + s->right[j];
+		if (cost < best) {
+			best = cost;
+			*pos = j;
+		}
+	}
+	return best;
+}
+
+static void write_leaf(small *s, const small_node *c)
+{
+	sah_builder *b = s->b;
+	bvhlab_node *node = &b->nodes[c->node];
+
+	memcpy(node->lo, c->box.lo, sizeof(node->lo));
+	memcpy(node->hi, c->box.hi, sizeof(node->hi));
+	node->first = s->begin + c->lb;
+	node->count = c->le - c->lb;
+	for (uint32_t k = c->lb; k < c->le; k++)
+		b->ids[s->begin + k] = s->id[s->order[0][k]];
+}
+
+/* Marks the sides by slot of the split axis and takes the children's boxes. */
+static void mark(small *s, int axis, const small_node *c, uint32_t pos, small_node child[2])
+{
+	const uint8_t *o = s->order[axis];
+
+	for (int h = 0; h < 2; h++) {
+		uint32_t from = h ? pos : c->lb, to = h ? c->le : pos;
+		v4 lo = v4_set1(INFINITY), hi = v4_set1(-INFINITY);
+		for (uint32_t k = from; k < to; k++) {
+			s->side[o[k]] = (uint8_t)h;
+			lo = v4_min(lo, s->lo[o[k]]);
+			hi = v4_max(hi, s->hi[o[k]]);
+		}
+		child[h].lb = from;
+		child[h].le = to;
+		v4_store3(child[h].box.lo, lo);
+		v4_store3(child[h].box.hi, hi);
+	}
+}
+
+/* Stable partition of the other axes' slots by side, so they stay sorted. */
+static void partition(small *s, int axis, const small_node *c, uint32_t pos)
+{
+	for (int a = 0; a < 3; a++) {
+		uint8_t *o = s->order[a];
+		uint32_t l = c->lb, r = pos;
+		if (a == axis)
+			continue;
+		for (uint32_t k = c->lb; k < c->le; k++) {
+			uint32_t h = s->side[o[k]], mask = 0u - h;
+			s->tmp[(r & mask) | (l & ~mask)] = o[k];
+			r += h;
+			l += h ^ 1;
+		}
+		memcpy(o + c->lb, s->tmp + c->lb, c->le - c->lb);
+	}
+}
+
+/* Decides one node; returns 2 and fills child[] when it splits. */
+static unsigned split_node(small *s, const small_node *c, small_node child[2])
+{
+	uint32_t n = c->le - c->lb, pos = 0;
+	float best = INFINITY;
+	int axis = -1;
+
+	for (int a = 0; n > 1 && a < 3; a++) {
+		const uint8_t *o = s->order[a];
+		if (!(s->cen[a][o[c->lb]] < s->cen[a][o[c->le - 1]]))
+			continue;
+		float cost = eval_axis(s, a, c->lb, c->le, best, &pos);
+		if (cost < best) {
+			best = cost;
+			axis = a;
+		}
+	}
+	if (n == 1 || sah_leaf_rule(&s->b->opt, n, &c->box, axis >= 0, best)) {
+		write_leaf(s, c);
+		return 0;
+	}
+	if (axis < 0) { /* every centroid coincides: split the x order's middle */
+		axis = 0;
+		pos = c->lb + n / 2;
+	}
+	mark(s, axis, c, pos, child);
+	partition(s, axis, c, pos);
+	sah_write_node(s->b, c->node, &c->box, &child[0].node);
+	child[1].node = child[0].node + 1;
+	return 2;
+}
+
+void sah_small_subtree(sah_builder *b, const sah_job *job)
+{
+	small s;
+	small_node stack[SAH_SMALL_MAX], child[2];
+	uint32_t n = job->end - job->begin, sp = 0;
+
+	s.b = b;
+	s.begin = job->begin;
+	load(&s, b->prims[0], n);
+	if (b->opt.method == SAH_SWEEP) {
+		take_presorted(&s, n);
+	} else {
+		for (int a = 0; a < 3; a++)
+			sort_axis(&s, a, n);
+	}
+	stack[sp++] = (small_node){ .node = job->node, .lb = 0, .le = n, .box = job->box };
+	while (sp > 0) {
+		small_node cur = stack[--sp];
+		if (split_node(&s, &cur, child) == 2) {
+			stack[sp++] = child[1];
+			stack[sp++] = child[0];
+		}
+	}
+}
