@@ -56,13 +56,14 @@
  * Cost: sweep keeps 4 primitive arrays of 32 bytes plus 5 bytes of
  * scratch per primitive (~133 MB for 1M triangles) and presorts in
  * sah_builder_init (single-threaded, O(N)); binned keeps one 32-byte
- * array. sah_split_job needs about 40 KB of stack for binned (bins live
+ * array. sah_split_job needs about 60 KB of stack for binned (bins live
  * there) and 6 KB for a small job; size thread stacks accordingly.
  */
 #ifndef BVHLAB_SAH_KERNEL_H
 #define BVHLAB_SAH_KERNEL_H
 
 #include <stdatomic.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include <bvhlab/builder.h>
@@ -169,6 +170,57 @@ typedef struct sah_builder {
 } sah_builder;
 
 /*
+ * Binning, for the kernel's binned splits and for schedulers that bin one
+ * node in parts (sah_tasks): the grid places centroids, the bins gather
+ * counts and box unions. Unions are min/max and counts integers, so bins
+ * filled in any parts and merged in any order are bit-identical, and the
+ * choice below depends only on the node's set of primitives.
+ */
+typedef struct sah_grid {
+	uint32_t nb;    /* bins per axis */
+	float lo[3];    /* the node's centroid bounds' minimum */
+	float scale[3]; /* bins per unit length; 0 when the axis is flat */
+} sah_grid;
+
+typedef struct sah_bins {
+	uint32_t count[3][SAH_MAX_BINS];  /* primitives per bin */
+	float lo[3][SAH_MAX_BINS][4];     /* union of their boxes (+inf when empty) */
+	float hi[3][SAH_MAX_BINS][4];     /* (-inf when empty); lane 3 unused */
+} sah_bins;
+
+/* The grid of nb bins over job's centroid bounds. */
+void sah_grid_init(sah_grid *g, const sah_job *job, uint32_t nb);
+
+/* A centroid's bin along axis a. sah_bins_fill computes the same, with
+ * the same operations, for three axes at once. */
+static inline uint32_t sah_grid_bin(const sah_grid *g, int a, const sah_prim *p)
+{
+	float f = (0.5f * (p->lo[a] + p->hi[a]) - g->lo[a]) * g->scale[a];
+	float top = (float)(g->nb - 1);
+
+	f = f < top ? f : top;
+	return f > 0 ? (uint32_t)f : 0;
+}
+
+/* Overwrites the grid's bins in out with prims[begin, end). */
+void sah_bins_fill(sah_bins *out, const sah_grid *g, const sah_prim *prims, uint32_t begin,
+                   uint32_t end);
+
+/* Adds src's bins into dst. */
+void sah_bins_merge(sah_bins *dst, const sah_bins *src, uint32_t nb);
+
+/*
+ * The split of lowest cost A_L * N_L + A_R * N_R over every bin boundary
+ * of the three axes (ties: lower axis, then lower boundary); candidate
+ * boundaries separate two non-empty bins. Returns the axis (-1: none) and
+ * sets *split (left = bins below it) and *cost.
+ */
+int sah_bins_choose(const sah_bins *g, const sah_grid *grid, uint32_t *split, float *cost);
+
+/* The union of axis a's bins in [from, to). */
+void sah_bins_box(const sah_bins *g, int a, uint32_t from, uint32_t to, bvhlab_aabb *box);
+
+/*
  * Prepares a build of input into output (prim_index needs prim_count
  * slots, nodes 2 * prim_count - 1): copies the primitives into the working
  * arrays and, for sweep, presorts them along each axis (LSD radix sort,
@@ -207,6 +259,11 @@ static inline uint32_t sah_node_count(sah_builder *b)
  * output->index_count = prim_count. Call once every job is done.
  */
 void sah_builder_finish(sah_builder *b, bvhlab_build_output *output);
+
+/* Large scratch arrays (64-byte aligned or better), in huge pages where
+ * the system allows; sah_big_free(NULL) does nothing. */
+void *sah_big_alloc(size_t size);
+void sah_big_free(void *p);
 
 /* Frees the scratch; the output stays. Safe after a failed init. */
 void sah_builder_free(sah_builder *b);

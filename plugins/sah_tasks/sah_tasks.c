@@ -62,7 +62,13 @@ static const bvhlab_option_decl options[] = {
  * the team split relies on. */
 _Static_assert(128 > 64, "parallel_min's minimum exceeds max_leaf's maximum");
 
-enum command { CMD_BIN, CMD_COUNT, CMD_SCATTER, CMD_COPY, CMD_TASKS, CMD_EXIT };
+enum command { CMD_BIN, CMD_SCATTER, CMD_TASKS, CMD_EXIT };
+
+/* A job of the top phase, and where its primitives are (tasks_split.h). */
+struct top_job {
+	sah_job job;
+	bool in_temp;
+};
 
 struct team {
 	pthread_barrier_t bar;
@@ -72,7 +78,7 @@ struct team {
 	int cmd;              /* set by the caller between barriers */
 	tasks_split split;
 	sah_builder *b;
-	sah_job *tasks;
+	struct top_job *tasks;
 	uint32_t task_count, task_cap;
 	atomic_uint next;     /* first unclaimed task */
 };
@@ -88,17 +94,19 @@ static void run_tasks(struct team *tm)
 	uint32_t i;
 
 	while ((i = atomic_fetch_add_explicit(&tm->next, 1, memory_order_relaxed)) <
-	       tm->task_count)
-		sah_build_subtree(tm->b, &tm->tasks[i]);
+	       tm->task_count) {
+		const struct top_job *t = &tm->tasks[i];
+		if (t->in_temp)
+			tasks_copy_back(&tm->split, &t->job);
+		sah_build_subtree(tm->b, &t->job);
+	}
 }
 
 static void run_part(struct team *tm, uint32_t part)
 {
 	switch (tm->cmd) {
 	case CMD_BIN: tasks_bin(&tm->split, part); break;
-	case CMD_COUNT: tasks_count(&tm->split, part); break;
 	case CMD_SCATTER: tasks_scatter(&tm->split, part); break;
-	case CMD_COPY: tasks_copy(&tm->split, part); break;
 	case CMD_TASKS: run_tasks(tm); break;
 	default: break;
 	}
@@ -135,11 +143,11 @@ static void team_run(struct team *tm, int cmd)
 		pthread_barrier_wait(&tm->bar);
 }
 
-static int add_task(struct team *tm, const sah_job *job)
+static int add_task(struct team *tm, const struct top_job *job)
 {
 	if (tm->task_count == tm->task_cap) {
 		uint32_t cap = tm->task_cap ? 2 * tm->task_cap : 64;
-		sah_job *t = realloc(tm->tasks, cap * sizeof(*t));
+		struct top_job *t = realloc(tm->tasks, cap * sizeof(*t));
 		if (!t)
 			return -ENOMEM;
 		tm->tasks = t;
@@ -149,21 +157,36 @@ static int add_task(struct team *tm, const sah_job *job)
 	return 0;
 }
 
-/* Splits one large node: by the team for binned, else by the kernel. */
-static unsigned split_large(struct team *tm, const sah_job *job, sah_job child[2])
+/* The kernel splits in prims[0]: sweep's large nodes, and the median
+ * fallback when every centroid coincides. */
+static unsigned kernel_split(struct team *tm, const struct top_job *tj, struct top_job child[2])
 {
+	sah_job c[2];
+
+	if (tj->in_temp)
+		tasks_copy_back(&tm->split, &tj->job);
+	if (sah_split_job(tm->b, &tj->job, c) == 0)
+		return 0;
+	child[0] = (struct top_job){ .job = c[0], .in_temp = false };
+	child[1] = (struct top_job){ .job = c[1], .in_temp = false };
+	return 2;
+}
+
+/* Splits one large node: by the team for binned, else by the kernel. */
+static unsigned split_large(struct team *tm, const struct top_job *tj, struct top_job child[2])
+{
+	sah_job c[2];
+
 	if (tm->b->opt.method != SAH_BINNED)
-		return sah_split_job(tm->b, job, child);
-	tasks_split_begin(&tm->split, job);
+		return kernel_split(tm, tj, child);
+	tasks_split_begin(&tm->split, &tj->job, tj->in_temp);
 	team_run(tm, CMD_BIN);
-	/* No candidate: every centroid coincides; the kernel's median. */
 	if (!tasks_choose(&tm->split))
-		return sah_split_job(tm->b, job, child);
-	team_run(tm, CMD_COUNT);
-	tasks_counted(&tm->split);
+		return kernel_split(tm, tj, child);
 	team_run(tm, CMD_SCATTER);
-	team_run(tm, CMD_COPY);
-	tasks_split_end(&tm->split, child);
+	tasks_split_end(&tm->split, c);
+	child[0] = (struct top_job){ .job = c[0], .in_temp = !tj->in_temp };
+	child[1] = (struct top_job){ .job = c[1], .in_temp = !tj->in_temp };
 	return 2;
 }
 
@@ -174,20 +197,20 @@ static unsigned split_large(struct team *tm, const sah_job *job, sah_job child[2
  */
 static int split_top(struct team *tm, uint32_t parallel_min, const sah_job *root)
 {
-	sah_job stack[64], child[2];
+	struct top_job stack[64], child[2];
 	unsigned sp = 0;
 	int rc = 0;
 
-	stack[sp++] = *root;
+	stack[sp++] = (struct top_job){ .job = *root, .in_temp = false };
 	while (sp > 0 && rc == 0) {
-		sah_job job = stack[--sp];
-		if (sah_job_size(&job) <= parallel_min) {
-			rc = add_task(tm, &job);
+		struct top_job tj = stack[--sp];
+		if (sah_job_size(&tj.job) <= parallel_min) {
+			rc = add_task(tm, &tj);
 			continue;
 		}
-		if (split_large(tm, &job, child) == 0)
+		if (split_large(tm, &tj, child) == 0)
 			continue;
-		unsigned big = sah_job_size(&child[1]) > sah_job_size(&child[0]);
+		unsigned big = sah_job_size(&child[1].job) > sah_job_size(&child[0].job);
 		stack[sp++] = child[big];
 		stack[sp++] = child[1 - big];
 	}
@@ -197,7 +220,8 @@ static int split_top(struct team *tm, uint32_t parallel_min, const sah_job *root
 /* Largest first, ties by position: the order is the same on every run. */
 static int by_size_desc(const void *pa, const void *pb)
 {
-	const sah_job *a = pa, *b = pb;
+	const sah_job *a = &((const struct top_job *)pa)->job;
+	const sah_job *b = &((const struct top_job *)pb)->job;
 	uint32_t na = sah_job_size(a), nb = sah_job_size(b);
 
 	if (na != nb)

@@ -13,8 +13,13 @@
  *
  * Protocol, each step a barrier apart: the caller's tasks_split_begin;
  * parts 0..P-1 of tasks_bin; the caller's tasks_choose; parts of
- * tasks_count; the caller's tasks_counted; parts of tasks_scatter; parts of
- * tasks_copy; the caller's tasks_split_end.
+ * tasks_scatter; the caller's tasks_split_end.
+ *
+ * The node's primitives are read from one of two buffers, the kernel's
+ * prims[0] or temp, and scattered into the other, where its children then
+ * are: no pass copies them back. A range that leaves the team in temp
+ * goes back to prims[0] with tasks_copy_back before the kernel takes it,
+ * which the task's own thread does, in parallel with the others.
  */
 #ifndef BVHLAB_TASKS_SPLIT_H
 #define BVHLAB_TASKS_SPLIT_H
@@ -24,40 +29,36 @@
 
 #include "sah_kernel.h"
 
-/* One thread's private bins, all three axes. */
-typedef struct tasks_bins {
-	uint32_t count[3][SAH_MAX_BINS];
-	float lo[3][SAH_MAX_BINS][4];
-	float hi[3][SAH_MAX_BINS][4];
-} tasks_bins;
-
 typedef struct tasks_split {
 	sah_builder *b;
-	sah_prim *temp;     /* [prim_count] scatter target, by position */
+	sah_prim *temp;     /* [prim_count] the second buffer, by position */
+	const sah_prim *src; /* the node's buffer: prims[0] or temp */
+	sah_prim *dst;      /* the other one, where its children go */
 	uint32_t parts;     /* team size P */
-	tasks_bins *bins;   /* [P]; part t writes bins[t] only */
-	uint32_t *left;     /* [P] left count of chunk t */
+	sah_bins *bins;     /* [P]; part t writes bins[t] only */
+	sah_bins *total;    /* the parts' bins merged, for the choice */
+	uint32_t *left;     /* [P] left count of chunk t, from its bins */
 	bvhlab_aabb *cbox;  /* [2P] centroid bounds of chunk t's left and right part */
 	sah_job job;        /* the node being split */
-	uint32_t nb, split, mid;
+	sah_grid grid;      /* the node's bins */
+	uint32_t split, mid;
 	int axis;           /* -1: no candidate */
-	float lo[3], scale[3];
 } tasks_split;
 
 /* Allocates the per-part scratch and the temp array. 0 or -ENOMEM. */
 int tasks_split_init(tasks_split *s, sah_builder *b, uint32_t parts);
 void tasks_split_free(tasks_split *s);
 
-void tasks_split_begin(tasks_split *s, const sah_job *job);
+/* in_temp: the job's primitives are in temp, not in prims[0]. */
+void tasks_split_begin(tasks_split *s, const sah_job *job, bool in_temp);
 void tasks_bin(tasks_split *s, uint32_t part);
-/* Reduces the bins in part order and picks the split; false when no
- * candidate exists (the caller then lets the kernel split the node). */
+/* Reduces the bins in part order, picks the split and sets mid and the
+ * parts' left counts from the bins; false when no candidate exists (the
+ * caller then lets the kernel split the node). */
 bool tasks_choose(tasks_split *s);
-void tasks_count(tasks_split *s, uint32_t part);
-/* Sets mid from the parts' left counts. */
-void tasks_counted(tasks_split *s);
 void tasks_scatter(tasks_split *s, uint32_t part);
-void tasks_copy(tasks_split *s, uint32_t part);
+/* Copies job's range from temp to prims[0]. */
+void tasks_copy_back(tasks_split *s, const sah_job *job);
 /* Writes the inner node and fills both children. */
 void tasks_split_end(tasks_split *s, sah_job child[2]);
 
