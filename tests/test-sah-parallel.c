@@ -193,7 +193,8 @@ static void test_shared(const char *file)
 
 static void test_descriptors(void)
 {
-	static const char *const sah[] = { "method", "bins", "max_leaf", "c_trav", "c_isect" };
+	static const char *const sah[] = { "method", "bins", "max_leaf", "c_trav", "c_isect",
+	                                   "simd" };
 
 	for (size_t v = 0; v < VARIANTS; v++) {
 		const bvhlab_builder *b = bvhlab_plugin_builder(variants[v].handle);
@@ -202,13 +203,13 @@ static void test_descriptors(void)
 		CHECK(strcmp(b->name, variants[v].plugin) == 0);
 		CHECK(b->flags & BVHLAB_BUILDER_PARALLEL);
 		CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
-		CHECK_INT(b->option_count, queue ? 8 : 5);
-		for (uint32_t i = 0; i < 5 && i < b->option_count; i++)
+		CHECK_INT(b->option_count, queue ? 9 : 6);
+		for (uint32_t i = 0; i < 6 && i < b->option_count; i++)
 			CHECK(strcmp(b->options[i].name, sah[i]) == 0);
-		if (queue && b->option_count == 8) {
-			CHECK(strcmp(b->options[5].def_string, "auto") == 0);
-			CHECK(strcmp(b->options[6].name, "depth") == 0);
-			CHECK_INT(b->options[6].def_int, 4);
+		if (queue && b->option_count == 9) {
+			CHECK(strcmp(b->options[6].def_string, "auto") == 0);
+			CHECK(strcmp(b->options[7].name, "depth") == 0);
+			CHECK_INT(b->options[7].def_int, 4);
 		}
 	}
 }

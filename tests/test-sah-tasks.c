@@ -144,10 +144,11 @@ static void test_descriptor(void)
 	CHECK(strcmp(b->name, "sah_tasks") == 0);
 	CHECK(b->flags & BVHLAB_BUILDER_PARALLEL);
 	CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
-	CHECK_INT(b->option_count, 6);
-	if (b->option_count == 6) {
+	CHECK_INT(b->option_count, 7);
+	if (b->option_count == 7) {
 		CHECK(strcmp(b->options[0].def_string, "binned") == 0);
 		CHECK(strcmp(b->options[5].name, "parallel_min") == 0);
+		CHECK(strcmp(b->options[6].name, "simd") == 0);
 	}
 }
 

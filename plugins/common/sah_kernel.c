@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/mman.h>
 
+#include "sah_bins_avx2.h"
 #include "sah_internal.h"
 
 static int read_int(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *name,
@@ -69,6 +70,30 @@ static int read_method(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
 	return 0;
 }
 
+static int read_simd(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
+{
+	const char *s;
+	int rc = host->option_string(ctx, "simd", &s);
+	bool avx2 = sah_cpu_has_avx2();
+
+	if (rc < 0) {
+		host->set_error(ctx, "option \"simd\" is not available (%d)", rc);
+		return rc;
+	}
+	if (s && strcmp(s, "avx2") == 0 && !avx2) {
+		host->set_error(ctx, "option \"simd\" = \"avx2\", but this CPU (or build) has no "
+		                "AVX2; use auto or sse");
+		return -ENOTSUP;
+	}
+	if (!s || (strcmp(s, "auto") && strcmp(s, "avx2") && strcmp(s, "sse"))) {
+		host->set_error(ctx, "option \"simd\" = \"%s\" is not auto, avx2 or sse",
+		                s ? s : "(null)");
+		return -EINVAL;
+	}
+	*out = strcmp(s, "sse") && avx2 ? SAH_SIMD_AVX2 : SAH_SIMD_SSE;
+	return 0;
+}
+
 int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt)
 {
 	int rc;
@@ -77,7 +102,8 @@ int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options
 	    (rc = read_int(host, ctx, "bins", 2, SAH_MAX_BINS, &opt->bins)) < 0 ||
 	    (rc = read_int(host, ctx, "max_leaf", 1, 64, &opt->max_leaf)) < 0 ||
 	    (rc = read_cost(host, ctx, "c_trav", &opt->c_trav)) < 0 ||
-	    (rc = read_cost(host, ctx, "c_isect", &opt->c_isect)) < 0)
+	    (rc = read_cost(host, ctx, "c_isect", &opt->c_isect)) < 0 ||
+	    (rc = read_simd(host, ctx, &opt->simd)) < 0)
 		return rc;
 	return 0;
 }

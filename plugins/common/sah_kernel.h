@@ -73,9 +73,15 @@ enum sah_method {
 	SAH_BINNED = 1, /* binned SAH */
 };
 
+enum sah_simd {
+	SAH_SIMD_SSE = 0,  /* 4-lane vectors (SSE2, or plain C off x86) */
+	SAH_SIMD_AVX2 = 1, /* 8-lane binning, where the CPU has AVX2 */
+};
+
 /* Build parameters, as read from the plugin options. */
 typedef struct sah_options {
 	int method;        /* enum sah_method */
+	int simd;          /* enum sah_simd; same trees either way */
 	uint32_t bins;     /* bins per axis for SAH_BINNED, 2..SAH_MAX_BINS */
 	uint32_t max_leaf; /* largest leaf, >= 1 (except coincident centroids) */
 	float c_trav;      /* cost of visiting an inner node, > 0 */
@@ -104,8 +110,15 @@ typedef struct sah_options {
 	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }, \
 	{ .name = "c_isect", .type = BVHLAB_OPTION_FLOAT, \
 	  .help = "SAH cost of intersecting one primitive (> 0)", \
-	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }
-#define SAH_OPTION_COUNT 5
+	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }, \
+	SAH_SIMD_DECL
+#define SAH_OPTION_COUNT 6
+/* Last, so that plugins with their own copy of the others can add it. */
+#define SAH_SIMD_DECL \
+	{ .name = "simd", .type = BVHLAB_OPTION_STRING, \
+	  .help = "binning vectors: auto (avx2 where the CPU has it), avx2 or sse; " \
+	          "the tree is the same", \
+	  .def_string = "auto", .choices = "auto|avx2|sse" }
 
 /*
  * Reads the SAH_OPTION_DECLS options through the host's getters and checks
@@ -183,9 +196,11 @@ typedef struct sah_grid {
 } sah_grid;
 
 typedef struct sah_bins {
-	uint32_t count[3][SAH_MAX_BINS];  /* primitives per bin */
-	float lo[3][SAH_MAX_BINS][4];     /* union of their boxes (+inf when empty) */
-	float hi[3][SAH_MAX_BINS][4];     /* (-inf when empty); lane 3 unused */
+	uint32_t count[3][SAH_MAX_BINS]; /* primitives per bin */
+	/* Union of their boxes: lanes 0-2 the minimum negated, 4-6 the
+	 * maximum, so that one 8-lane max grows both (3 and 7 unused); all
+	 * -inf when empty. Negation is exact, so this is min/max exactly. */
+	float box[3][SAH_MAX_BINS][8];
 } sah_bins;
 
 /* The grid of nb bins over job's centroid bounds. */
@@ -202,9 +217,11 @@ static inline uint32_t sah_grid_bin(const sah_grid *g, int a, const sah_prim *p)
 	return f > 0 ? (uint32_t)f : 0;
 }
 
-/* Overwrites the grid's bins in out with prims[begin, end). */
+/* Overwrites the grid's bins in out with prims[begin, end), with 8-lane
+ * vectors when simd is SAH_SIMD_AVX2 (which sah_options_read only picks
+ * where the CPU has AVX2). */
 void sah_bins_fill(sah_bins *out, const sah_grid *g, const sah_prim *prims, uint32_t begin,
-                   uint32_t end);
+                   uint32_t end, int simd);
 
 /* Adds src's bins into dst. */
 void sah_bins_merge(sah_bins *dst, const sah_bins *src, uint32_t nb);

@@ -31,6 +31,8 @@ static inline v4 v4_mul(v4 a, v4 b) { return _mm_mul_ps(a, b); }
 /* Per lane a < b ? a : b, and a > b ? a : b: the minps/maxps rule. */
 static inline v4 v4_min(v4 a, v4 b) { return _mm_min_ps(a, b); }
 static inline v4 v4_max(v4 a, v4 b) { return _mm_max_ps(a, b); }
+/* -a, exactly (the sign bit flipped). */
+static inline v4 v4_neg(v4 a) { return _mm_xor_ps(a, _mm_set1_ps(-0.0f)); }
 /* Truncates lanes known to be in [0, 2^31). */
 static inline void v4_trunc(v4 a, int32_t out[4])
 {
@@ -62,6 +64,7 @@ static inline v4 v4_sub(v4 a, v4 b) { V4_LANES(a.f[k] - b.f[k]); }
 static inline v4 v4_mul(v4 a, v4 b) { V4_LANES(a.f[k] * b.f[k]); }
 static inline v4 v4_min(v4 a, v4 b) { V4_LANES(a.f[k] < b.f[k] ? a.f[k] : b.f[k]); }
 static inline v4 v4_max(v4 a, v4 b) { V4_LANES(a.f[k] > b.f[k] ? a.f[k] : b.f[k]); }
+static inline v4 v4_neg(v4 a) { V4_LANES(-a.f[k]); }
 #undef V4_LANES
 static inline void v4_trunc(v4 a, int32_t out[4])
 {

@@ -65,7 +65,7 @@ void tasks_bin(tasks_split *s, uint32_t part)
 	uint32_t from, to;
 
 	chunk(s, part, &from, &to);
-	sah_bins_fill(&s->bins[part], &s->grid, s->src, from, to);
+	sah_bins_fill(&s->bins[part], &s->grid, s->src, from, to, s->b->opt.simd);
 }
 
 static void left_counts(tasks_split *s);
