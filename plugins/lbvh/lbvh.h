@@ -3,9 +3,12 @@
  *
  * A build is a fixed sequence of phases run by a team of T threads (the
  * calling one included), separated by barriers, so every phase sees
- * everything the earlier ones wrote. Each phase splits its index range into
- * T contiguous chunks (chunk()); nothing a phase computes depends on T, so
- * the tree, and the order of its nodes, is the same for every thread count.
+ * everything the earlier ones wrote. The sort and the compaction split
+ * their index ranges into T contiguous chunks (chunk()); Karras and bounds
+ * hand out blocks to whichever thread is free (next_block()), since on a
+ * shared machine a thread can lose its CPU for milliseconds. Nothing a
+ * phase computes depends on T or on who did which block, so the tree, and
+ * the order of its nodes, is the same for every thread count.
  *
  *   1. sort      Morton codes of the centroids, LSD radix sort of (code,
  *                primitive) pairs into output->prim_index, and the common
@@ -90,6 +93,7 @@ typedef struct lbvh {
 	                           * zero from the mapping; then the holes */
 	uint8_t *node_flags;      /* [n - 1] see lbvh_collapse.c */
 	uint32_t *count;          /* [3 T] per-chunk counts for the compaction */
+	atomic_uint blocks[2];    /* blocks handed out in karras and bounds */
 
 	struct team_barrier {
 		atomic_uint arrived;   /* threads at the barrier this round */
@@ -107,6 +111,25 @@ static inline void chunk(const lbvh *b, unsigned t, uint32_t count, uint32_t *lo
 {
 	*lo = (uint32_t)((uint64_t)count * t / b->threads);
 	*hi = (uint32_t)((uint64_t)count * (t + 1) / b->threads);
+}
+
+/*
+ * Hands out the next block of `size` of `count` items, [lo, hi), to
+ * whichever thread asks first; false when none is left. Used where the
+ * result does not depend on who does which part: a thread that runs
+ * slowly (another process on its CPU: this machine is shared) then holds
+ * the team up at the next barrier by one block, not by a whole share.
+ */
+static inline bool next_block(atomic_uint *next, uint32_t count, uint32_t size,
+                              uint32_t *lo, uint32_t *hi)
+{
+	uint64_t first = (uint64_t)atomic_fetch_add_explicit(next, 1, memory_order_relaxed) * size;
+
+	if (first >= count)
+		return false;
+	*lo = (uint32_t)first;
+	*hi = count - *lo < size ? count : *lo + size;
+	return true;
 }
 
 /* Waits for the whole team: everything written before is visible after

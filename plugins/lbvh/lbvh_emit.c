@@ -3,7 +3,7 @@
  * in the construction of BVHs, octrees and k-d trees") and its boxes.
  *
  * Karras: every internal node i finds its range and split on its own, so
- * the n - 1 nodes are independent and the threads simply split them. With
+ * the n - 1 nodes are independent and the threads take them in blocks. With
  * delta(i, j) the common prefix length of sorted keys i and j (extended by
  * their positions where codes are equal, the paper's k_i ++ i, so that the
  * tree stays well formed even when every centroid coincides), node i
@@ -19,7 +19,7 @@
  * no hard-to-predict branches. The scans' total length is bounded by n
  * times the tree depth, at most 97 levels (delta <= 95).
  *
- * Bounds: each thread writes the output slots of the leaves of its chunk
+ * Bounds: each thread takes blocks of leaves, writes their output slots
  * and climbs from each. At every parent the first arrival stops and the
  * second, which now has both children, writes the parent's slot and climbs
  * on. At a node shared by two threads the arrival counter's acq_rel
@@ -122,13 +122,19 @@ static void karras_node(lbvh *b, uint32_t i)
 	b->parent[split + 1 + (leaves & -(uint32_t)(split + 1 == last))] = 2 * i + 1;
 }
 
+/* Nodes per block handed out: tens of microseconds of work. */
+#define KARRAS_BLOCK 8192
+/* Leaves per block of the bounds phase: their slots (512 KiB) are still
+ * in L2 when the climbs from them read them back. */
+#define BOUNDS_BLOCK 16384
+
 void lbvh_karras(lbvh *b, unsigned t)
 {
 	uint32_t lo, hi;
 
-	chunk(b, t, b->n - 1, &lo, &hi);
-	for (uint32_t i = lo; i < hi; i++)
-		karras_node(b, i);
+	while (next_block(&b->blocks[0], b->n - 1, KARRAS_BLOCK, &lo, &hi))
+		for (uint32_t i = lo; i < hi; i++)
+			karras_node(b, i);
 	if (t == 0)
 		b->parent[0] = NO_NODE;
 	team_sync(b);
@@ -164,10 +170,10 @@ static uint32_t finish_node(lbvh *b, uint32_t i, uint32_t size)
 /*
  * Is this the second arrival at node p, of `size` primitives from `first`,
  * coming from side `right`? A node whose range lies inside this thread's
- * leaves [lo, hi) is reached only by this thread, left child first (the
- * leaves go in order), so it needs no counter; only the nodes on the paths
- * from chunk borders to the root are shared, and they take the atomic one
- * (zero from the mapping).
+ * block of leaves [lo, hi) is reached only by this thread, left child
+ * first (the leaves go in order), so it needs no counter; only the nodes
+ * on the paths from block borders to the root are shared, and they take
+ * the atomic one (zero from the mapping).
  */
 static bool second_arrival(lbvh *b, uint32_t p, uint32_t first, uint32_t size, bool right,
                            uint32_t lo, uint32_t hi)
@@ -207,21 +213,25 @@ static void put_leaf(const lbvh *b, uint32_t k, bvhlab_node *out)
 }
 
 /*
- * The leaves first, in a loop of their own: their boxes are the one
- * random read of the build (input order to sorted order), and only a loop
- * with nothing else to wait for keeps many of those misses in flight.
+ * By blocks of leaves, each taken whole by one thread: the leaves first,
+ * in a loop of their own: their boxes are the one random read of the
+ * build (input order to sorted order), and only a loop with nothing else
+ * to wait for keeps many of those misses in flight. Then the climbs from
+ * them, while their slots are still in cache.
  */
 void lbvh_bounds(lbvh *b, unsigned t)
 {
 	uint32_t lo, hi;
 
-	chunk(b, t, b->n, &lo, &hi);
-	for (uint32_t k = lo; k < hi; k++) {
-		if (k + 32 < hi)
-			__builtin_prefetch(&b->in->prim_bounds[b->prim_index[k + 32]]);
-		put_leaf(b, k, slot_of(b, b->parent[b->n - 1 + k]));
+	(void)t;
+	while (next_block(&b->blocks[1], b->n, BOUNDS_BLOCK, &lo, &hi)) {
+		for (uint32_t k = lo; k < hi; k++) {
+			if (k + 32 < hi)
+				__builtin_prefetch(&b->in->prim_bounds[b->prim_index[k + 32]]);
+			put_leaf(b, k, slot_of(b, b->parent[b->n - 1 + k]));
+		}
+		for (uint32_t k = lo; k < hi; k++)
+			climb(b, b->parent[b->n - 1 + k], lo, hi);
 	}
-	for (uint32_t k = lo; k < hi; k++)
-		climb(b, b->parent[b->n - 1 + k], lo, hi);
 	team_sync(b);
 }
