@@ -165,6 +165,25 @@ static void partition(small *s, int axis, const small_node *c, uint32_t pos)
 	}
 }
 
+/* A pair has one candidate at most: the same two sets on every axis
+ * where the centroids differ, so the first such axis wins, at the cost the
+ * sweep would give it (each area times 1; the sum commutes). About half
+ * of all nodes are pairs. */
+static float eval_pair(const small *s, const small_node *c, int *axis, uint32_t *pos)
+{
+	uint32_t i = s->order[0][c->lb], j = s->order[0][c->lb + 1];
+
+	for (int a = 0; a < 3; a++) {
+		if (s->cen[a][i] == s->cen[a][j])
+			continue;
+		*axis = a;
+		*pos = c->lb + 1;
+		return v4_half_area(s->lo[i], s->hi[i]) * 1.0f +
+		       v4_half_area(s->lo[j], s->hi[j]) * 1.0f;
+	}
+	return INFINITY;
+}
+
 /* Decides one node; returns 2 and fills child[] when it splits. */
 static unsigned split_node(small *s, const small_node *c, small_node child[2])
 {
@@ -172,7 +191,9 @@ static unsigned split_node(small *s, const small_node *c, small_node child[2])
 	float best = INFINITY;
 	int axis = -1;
 
-	for (int a = 0; n > 1 && a < 3; a++) {
+	if (n == 2)
+		best = eval_pair(s, c, &axis, &pos);
+	for (int a = 0; n > 2 && a < 3; a++) {
 		const uint8_t *o = s->order[a];
 		if (!(s->cen[a][o[c->lb]] < s->cen[a][o[c->le - 1]]))
 			continue;
