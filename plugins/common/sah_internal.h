@@ -78,6 +78,13 @@ static inline void box_grow_centroid(bvhlab_aabb *b, const sah_prim *p)
 	}
 }
 
+/*
+ * Copies the input boxes into dst (prim_count records, id order) and sets
+ * b->root_cbox; with input->threads > 1 the parts are copied by that many
+ * threads at once (sah_prims.c).
+ */
+void sah_copy_prims(sah_builder *b, const bvhlab_build_input *input, sah_prim *dst);
+
 /* Jobs of at most this many primitives are built whole by
  * sah_small_subtree (exact SAH on local copies, see sah_small.c). Local
  * indices are bytes, so at most 256. */

@@ -6,7 +6,6 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 
 #include "sah_bins_avx2.h"
 #include "sah_internal.h"
@@ -120,59 +119,6 @@ static bool input_ok(const sah_options *opt, const bvhlab_build_input *in,
 	return out->node_capacity >= 2 * n - 1 && out->index_capacity >= n;
 }
 
-/* Copies the input boxes into dst in id order, and gathers the centroid
- * bounds on the way (the kernel's centroids, see sah_prim). */
-static void copy_prims(sah_builder *b, const bvhlab_build_input *input, sah_prim *dst)
-{
-	box_empty(&b->root_cbox);
-	for (uint32_t i = 0; i < b->prim_count; i++) {
-		const bvhlab_aabb *src = &input->prim_bounds[i];
-		sah_prim *p = &dst[i];
-		for (int k = 0; k < 3; k++) {
-			p->lo[k] = src->lo[k];
-			p->hi[k] = src->hi[k];
-		}
-		p->id = i;
-		p->pad = 0;
-		box_grow_centroid(&b->root_cbox, p);
-	}
-}
-
-#define HUGE_PAGE ((size_t)2 << 20)
-#define BIG_HEADER 64
-
-/*
- * The working arrays are tens of megabytes, allocated anew by every build:
- * from malloc they are fresh 4 KiB pages whose faults cost as much as a
- * tree level. A private mapping asking for transparent huge pages takes
- * one fault per 2 MiB instead (where the system allows it; else the same
- * as malloc). The mapping's start and length sit just below the pointer.
- */
-void *sah_big_alloc(size_t size)
-{
-	size_t len = (size + BIG_HEADER + 2 * HUGE_PAGE - 1) & ~(HUGE_PAGE - 1);
-	char *base = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-
-	if (base == MAP_FAILED)
-		return NULL;
-#ifdef MADV_HUGEPAGE
-	(void)madvise(base, len, MADV_HUGEPAGE); /* a hint; fine if refused */
-#endif
-	uintptr_t at = ((uintptr_t)base + BIG_HEADER + HUGE_PAGE - 1) & ~(uintptr_t)(HUGE_PAGE - 1);
-	size_t *header = (size_t *)(void *)(at - BIG_HEADER);
-	header[0] = (uintptr_t)base;
-	header[1] = len;
-	return (void *)at;
-}
-
-void sah_big_free(void *p)
-{
-	if (!p)
-		return;
-	const size_t *header = (const size_t *)(const void *)((char *)p - BIG_HEADER);
-	munmap((void *)(uintptr_t)header[0], header[1]);
-}
-
 static int alloc_sweep(sah_builder *b, const bvhlab_build_input *input)
 {
 	size_t n = b->prim_count;
@@ -184,7 +130,7 @@ static int alloc_sweep(sah_builder *b, const bvhlab_build_input *input)
 	b->side = malloc(n);
 	if (!b->prims[0] || !b->prims[1] || !b->prims[2] || !b->temp || !b->area || !b->side)
 		return -ENOMEM;
-	copy_prims(b, input, b->temp);
+	sah_copy_prims(b, input, b->temp);
 	return sah_presort(b);
 }
 
@@ -210,7 +156,7 @@ int sah_builder_init(sah_builder *b, const sah_options *opt,
 		b->prims[0] = sah_big_alloc((size_t)b->prim_count * sizeof(sah_prim));
 		if (!b->prims[0])
 			goto fail;
-		copy_prims(b, input, b->prims[0]);
+		sah_copy_prims(b, input, b->prims[0]);
 	}
 	return 0;
 fail:
