@@ -1,40 +1,54 @@
 /*
  * Binned SAH: per node, `bins` equal bins per axis over the node's centroid
  * bounds (sah_bins.c); the cost is evaluated at every bin boundary of all
- * three axes and the range of prims[0] is partitioned in place. All bin
- * storage is on the stack of the call, so concurrent jobs share nothing.
+ * three axes and the node's range is partitioned into the builder's other
+ * array (sah_job.alt). All bin storage is on the stack of the call, so
+ * concurrent jobs share nothing.
  */
 #include "sah_internal.h"
 #include "sah_simd.h"
 
-/* Branch-free in-place partition by bin (every element swapped with the
- * left boundary); returns the first right position. The children's
- * centroid bounds are gathered on the way (cbox[0] left, cbox[1] right):
- * they only place bins, never reach a node, so the order they are taken
- * in (which could only flip the sign of a zero) cannot change the tree. */
-static uint32_t partition(const sah_grid *g, sah_prim *prims, uint32_t begin, uint32_t end,
-                          int a, uint32_t split, bvhlab_aabb cbox[2])
+/* The primitives of axis a's bins below split. */
+static uint32_t left_count(const sah_bins *g, int a, uint32_t split)
+{
+	uint32_t n = 0;
+
+	for (uint32_t k = 0; k < split; k++)
+		n += g->count[a][k];
+	return n;
+}
+
+/*
+ * Stable partition by bin from src into dst, the builder's other array:
+ * the bins give the left count, so every record's place is known when it
+ * is read (an arithmetic select, no branch to mispredict, no iteration
+ * waiting for the store of the one before), and no pass copies back. The
+ * children's centroid bounds are gathered on the way (cbox[0] left,
+ * cbox[1] right). Returns the first right position.
+ */
+static uint32_t scatter(const sah_grid *g, const sah_prim *src, sah_prim *dst,
+                        const sah_job *job, int a, uint32_t split, uint32_t left,
+                        bvhlab_aabb cbox[2])
 {
 	const v4 half = v4_set1(0.5f);
 	v4 clo[2] = { v4_set1(INFINITY), v4_set1(INFINITY) };
 	v4 chi[2] = { v4_set1(-INFINITY), v4_set1(-INFINITY) };
-	uint32_t l = begin;
+	uint32_t l = job->begin, mid = job->begin + left, r = mid;
 
-	for (uint32_t i = begin; i < end; i++) {
-		sah_prim p = prims[i];
-		bool left = sah_grid_bin(g, a, &p) < split;
-		v4 cen = v4_mul(v4_add(v4_load3(p.lo), v4_load3(p.hi)), half);
-		prims[i] = prims[l];
-		prims[l] = p;
-		l += left;
-		clo[!left] = v4_min(clo[!left], cen);
-		chi[!left] = v4_max(chi[!left], cen);
+	for (uint32_t i = job->begin; i < job->end; i++) {
+		uint32_t right = sah_grid_bin(g, a, &src[i]) >= split, mask = 0u - right;
+		v4 cen = v4_mul(v4_add(v4_load3(src[i].lo), v4_load3(src[i].hi)), half);
+		dst[(r & mask) | (l & ~mask)] = src[i];
+		r += right;
+		l += right ^ 1;
+		clo[right] = v4_min(clo[right], cen);
+		chi[right] = v4_max(chi[right], cen);
 	}
 	for (int c = 0; c < 2; c++) {
 		v4_store3(cbox[c].lo, clo[c]);
 		v4_store3(cbox[c].hi, chi[c]);
 	}
-	return l;
+	return mid;
 }
 
 /* A median split child's centroid bounds and box. */
@@ -66,7 +80,9 @@ unsigned sah_binned_split(sah_builder *b, const sah_job *job, sah_job child[2])
 	uint32_t split = 0, mid;
 
 	sah_grid_init(&grid, job, b->opt.bins);
-	sah_bins_fill(&bins, &grid, b->prims[0], job->begin, job->end, b->opt.simd);
+	const sah_prim *src = sah_job_prims(b, job);
+
+	sah_bins_fill(&bins, &grid, src, job->begin, job->end, b->opt.simd);
 	int axis = sah_bins_choose(&bins, &grid, &split, &best);
 	if (sah_prefer_leaf(b, job, axis >= 0, best)) {
 		sah_write_leaf(b, job);
@@ -75,13 +91,15 @@ unsigned sah_binned_split(sah_builder *b, const sah_job *job, sah_job child[2])
 	/* No candidate: every centroid coincides; split the current order. */
 	if (axis < 0) {
 		sah_write_inner(b, job, job->begin + (job->end - job->begin) / 2, child);
-		range_bounds(b->prims[0], &child[0]);
-		range_bounds(b->prims[0], &child[1]);
+		range_bounds(src, &child[0]);
+		range_bounds(src, &child[1]);
 		return 2;
 	}
 	bvhlab_aabb cbox[2];
-	mid = partition(&grid, b->prims[0], job->begin, job->end, axis, split, cbox);
+	mid = scatter(&grid, src, job->alt ? b->prims[0] : b->alt, job, axis, split,
+	              left_count(&bins, axis, split), cbox);
 	sah_write_inner(b, job, mid, child);
+	child[0].alt = child[1].alt = !job->alt;
 	sah_bins_box(&bins, axis, 0, split, &child[0].box);
 	sah_bins_box(&bins, axis, split, grid.nb, &child[1].box);
 	child[0].cbox = cbox[0];

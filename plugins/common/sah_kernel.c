@@ -154,7 +154,8 @@ int sah_builder_init(sah_builder *b, const sah_options *opt,
 			goto fail;
 	} else {
 		b->prims[0] = sah_big_alloc((size_t)b->prim_count * sizeof(sah_prim));
-		if (!b->prims[0])
+		b->alt = sah_big_alloc((size_t)b->prim_count * sizeof(sah_prim));
+		if (!b->prims[0] || !b->alt)
 			goto fail;
 		sah_copy_prims(b, input, b->prims[0]);
 	}
@@ -171,6 +172,8 @@ void sah_builder_free(sah_builder *b)
 		b->prims[a] = NULL;
 	}
 	sah_big_free(b->temp);
+	sah_big_free(b->alt);
+	b->alt = NULL;
 	free(b->area);
 	free(b->side);
 	b->temp = NULL;
@@ -184,6 +187,7 @@ void sah_builder_root(const sah_builder *b, sah_job *root)
 	root->begin = 0;
 	root->end = b->prim_count;
 	root->depth = 0;
+	root->alt = 0;
 	root->box = b->root_box;
 	root->cbox = b->root_cbox;
 }
@@ -205,7 +209,7 @@ static void write_box(bvhlab_node *node, const bvhlab_aabb *box)
 void sah_write_leaf(sah_builder *b, const sah_job *job)
 {
 	bvhlab_node *node = &b->nodes[job->node];
-	const sah_prim *prims = b->prims[0];
+	const sah_prim *prims = sah_job_prims(b, job);
 
 	write_box(node, &job->box);
 	node->first = job->begin;
@@ -238,6 +242,7 @@ void sah_write_inner(sah_builder *b, const sah_job *job, uint32_t mid, sah_job c
 	child[1].begin = mid;
 	child[1].end = job->end;
 	child[0].depth = child[1].depth = job->depth + 1;
+	child[0].alt = child[1].alt = job->alt;
 }
 
 bool sah_leaf_rule(const sah_options *opt, uint32_t n, const bvhlab_aabb *box, bool found,

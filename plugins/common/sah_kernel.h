@@ -136,6 +136,8 @@ typedef struct sah_job {
 	                    * arrays (and in output->prim_index) */
 	uint32_t end;      /* one past the last position; end > begin */
 	uint32_t depth;    /* root 0; for schedulers' cutoffs, not used by splits */
+	uint32_t alt;      /* binned: 1 when its primitives are in the builder's
+	                    * alt array, 0 when in prims[0] (sweep: always 0) */
 	bvhlab_aabb box;   /* exact union of its primitives' boxes */
 	bvhlab_aabb cbox;  /* bounds of its primitives' centroids */
 } sah_job;
@@ -175,8 +177,11 @@ typedef struct sah_builder {
 	/* Working primitive arrays, by position; a job's primitives are at
 	 * [begin, end). Sweep: prims[a] holds them sorted by centroid along
 	 * axis a, ties by id (three arrays, same set per range). Binned:
-	 * prims[0] only, partitioned in place; prims[1], prims[2] NULL. */
+	 * prims[0] and alt: a split reads its range from one and scatters
+	 * it into the other, where its children then are (sah_job.alt);
+	 * prims[1], prims[2] NULL. */
 	sah_prim *prims[3];
+	sah_prim *alt;
 	sah_prim *temp;  /* sweep: [prim_count] stable-partition target, by position */
 	float *area;     /* sweep: [prim_count] right-side areas, by position */
 	uint8_t *side;   /* sweep: [prim_count] left(0)/right(1) mark, by primitive id */
@@ -264,6 +269,12 @@ unsigned sah_split_job(sah_builder *b, const sah_job *job, sah_job child[2]);
  * O(log N) depth: the larger child waits, the smaller is processed first).
  */
 void sah_build_subtree(sah_builder *b, const sah_job *job);
+
+/* The array job's primitives are in. */
+static inline sah_prim *sah_job_prims(const sah_builder *b, const sah_job *job)
+{
+	return job->alt ? b->alt : b->prims[0];
+}
 
 /* Node slots used so far. */
 static inline uint32_t sah_node_count(sah_builder *b)

@@ -226,7 +226,7 @@ void sah_small_subtree(sah_builder *b, const sah_job *job)
 
 	s.b = b;
 	s.begin = job->begin;
-	load(&s, b->prims[0], n);
+	load(&s, sah_job_prims(b, job), n);
 	if (b->opt.method == SAH_SWEEP) {
 		take_presorted(&s, n);
 	} else {

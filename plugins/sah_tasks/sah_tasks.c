@@ -65,12 +65,6 @@ _Static_assert(128 > 64, "parallel_min's minimum exceeds max_leaf's maximum");
 
 enum command { CMD_BIN, CMD_SCATTER, CMD_TASKS, CMD_EXIT };
 
-/* A job of the top phase, and where its primitives are (tasks_split.h). */
-struct top_job {
-	sah_job job;
-	bool in_temp;
-};
-
 struct team {
 	pthread_barrier_t bar;
 	pthread_mutex_t gate; /* held while threads start: size is not final yet */
@@ -79,7 +73,7 @@ struct team {
 	int cmd;              /* set by the caller between barriers */
 	tasks_split split;
 	sah_builder *b;
-	struct top_job *tasks;
+	sah_job *tasks;
 	uint32_t task_count, task_cap;
 	atomic_uint next;     /* first unclaimed task */
 };
@@ -95,12 +89,8 @@ static void run_tasks(struct team *tm)
 	uint32_t i;
 
 	while ((i = atomic_fetch_add_explicit(&tm->next, 1, memory_order_relaxed)) <
-	       tm->task_count) {
-		const struct top_job *t = &tm->tasks[i];
-		if (t->in_temp)
-			tasks_copy_back(&tm->split, &t->job);
-		sah_build_subtree(tm->b, &t->job);
-	}
+	       tm->task_count)
+		sah_build_subtree(tm->b, &tm->tasks[i]);
 }
 
 static void run_part(struct team *tm, uint32_t part)
@@ -144,11 +134,11 @@ static void team_run(struct team *tm, int cmd)
 		pthread_barrier_wait(&tm->bar);
 }
 
-static int add_task(struct team *tm, const struct top_job *job)
+static int add_task(struct team *tm, const sah_job *job)
 {
 	if (tm->task_count == tm->task_cap) {
 		uint32_t cap = tm->task_cap ? 2 * tm->task_cap : 64;
-		struct top_job *t = realloc(tm->tasks, cap * sizeof(*t));
+		sah_job *t = realloc(tm->tasks, cap * sizeof(*t));
 		if (!t)
 			return -ENOMEM;
 		tm->tasks = t;
@@ -158,36 +148,18 @@ static int add_task(struct team *tm, const struct top_job *job)
 	return 0;
 }
 
-/* The kernel splits in prims[0]: sweep's large nodes, and the median
- * fallback when every centroid coincides. */
-static unsigned kernel_split(struct team *tm, const struct top_job *tj, struct top_job child[2])
-{
-	sah_job c[2];
-
-	if (tj->in_temp)
-		tasks_copy_back(&tm->split, &tj->job);
-	if (sah_split_job(tm->b, &tj->job, c) == 0)
-		return 0;
-	child[0] = (struct top_job){ .job = c[0], .in_temp = false };
-	child[1] = (struct top_job){ .job = c[1], .in_temp = false };
-	return 2;
-}
-
 /* Splits one large node: by the team for binned, else by the kernel. */
-static unsigned split_large(struct team *tm, const struct top_job *tj, struct top_job child[2])
+static unsigned split_large(struct team *tm, const sah_job *job, sah_job child[2])
 {
-	sah_job c[2];
-
 	if (tm->b->opt.method != SAH_BINNED)
-		return kernel_split(tm, tj, child);
-	tasks_split_begin(&tm->split, &tj->job, tj->in_temp);
+		return sah_split_job(tm->b, job, child);
+	tasks_split_begin(&tm->split, job);
 	team_run(tm, CMD_BIN);
+	/* No candidate: every centroid coincides; the kernel's median. */
 	if (!tasks_choose(&tm->split))
-		return kernel_split(tm, tj, child);
+		return sah_split_job(tm->b, job, child);
 	team_run(tm, CMD_SCATTER);
-	tasks_split_end(&tm->split, c);
-	child[0] = (struct top_job){ .job = c[0], .in_temp = !tj->in_temp };
-	child[1] = (struct top_job){ .job = c[1], .in_temp = !tj->in_temp };
+	tasks_split_end(&tm->split, child);
 	return 2;
 }
 
@@ -198,20 +170,20 @@ static unsigned split_large(struct team *tm, const struct top_job *tj, struct to
  */
 static int split_top(struct team *tm, uint32_t parallel_min, const sah_job *root)
 {
-	struct top_job stack[64], child[2];
+	sah_job stack[64], child[2];
 	unsigned sp = 0;
 	int rc = 0;
 
-	stack[sp++] = (struct top_job){ .job = *root, .in_temp = false };
+	stack[sp++] = *root;
 	while (sp > 0 && rc == 0) {
-		struct top_job tj = stack[--sp];
-		if (sah_job_size(&tj.job) <= parallel_min) {
-			rc = add_task(tm, &tj);
+		sah_job job = stack[--sp];
+		if (sah_job_size(&job) <= parallel_min) {
+			rc = add_task(tm, &job);
 			continue;
 		}
-		if (split_large(tm, &tj, child) == 0)
+		if (split_large(tm, &job, child) == 0)
 			continue;
-		unsigned big = sah_job_size(&child[1].job) > sah_job_size(&child[0].job);
+		unsigned big = sah_job_size(&child[1]) > sah_job_size(&child[0]);
 		stack[sp++] = child[big];
 		stack[sp++] = child[1 - big];
 	}
@@ -221,8 +193,7 @@ static int split_top(struct team *tm, uint32_t parallel_min, const sah_job *root
 /* Largest first, ties by position: the order is the same on every run. */
 static int by_size_desc(const void *pa, const void *pb)
 {
-	const sah_job *a = &((const struct top_job *)pa)->job;
-	const sah_job *b = &((const struct top_job *)pb)->job;
+	const sah_job *a = pa, *b = pb;
 	uint32_t na = sah_job_size(a), nb = sah_job_size(b);
 
 	if (na != nb)

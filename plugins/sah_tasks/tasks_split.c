@@ -17,12 +17,11 @@ int tasks_split_init(tasks_split *s, sah_builder *b, uint32_t parts)
 {
 	s->b = b;
 	s->parts = parts;
-	s->temp = sah_big_alloc((size_t)b->prim_count * sizeof(sah_prim));
 	s->bins = malloc(parts * sizeof(sah_bins));
 	s->total = malloc(sizeof(sah_bins));
 	s->left = malloc(parts * sizeof(uint32_t));
 	s->cbox = malloc(2 * parts * sizeof(bvhlab_aabb));
-	if (s->temp && s->bins && s->total && s->left && s->cbox)
+	if (s->bins && s->total && s->left && s->cbox)
 		return 0;
 	tasks_split_free(s);
 	return -ENOMEM;
@@ -30,12 +29,10 @@ int tasks_split_init(tasks_split *s, sah_builder *b, uint32_t parts)
 
 void tasks_split_free(tasks_split *s)
 {
-	sah_big_free(s->temp);
 	free(s->bins);
 	free(s->total);
 	free(s->left);
 	free(s->cbox);
-	s->temp = NULL;
 	s->bins = NULL;
 	s->total = NULL;
 	s->left = NULL;
@@ -51,11 +48,11 @@ static void chunk(const tasks_split *s, uint32_t part, uint32_t *from, uint32_t 
 	*to = s->job.begin + (uint32_t)(n * (part + 1) / s->parts);
 }
 
-void tasks_split_begin(tasks_split *s, const sah_job *job, bool in_temp)
+void tasks_split_begin(tasks_split *s, const sah_job *job)
 {
 	s->job = *job;
-	s->src = in_temp ? s->temp : s->b->prims[0];
-	s->dst = in_temp ? s->b->prims[0] : s->temp;
+	s->src = sah_job_prims(s->b, job);
+	s->dst = job->alt ? s->b->prims[0] : s->b->alt;
 	s->axis = -1;
 	sah_grid_init(&s->grid, job, s->b->opt.bins);
 }
@@ -140,12 +137,6 @@ void tasks_scatter(tasks_split *s, uint32_t part)
 	}
 }
 
-void tasks_copy_back(tasks_split *s, const sah_job *job)
-{
-	memcpy(s->b->prims[0] + job->begin, s->temp + job->begin,
-	       (size_t)(job->end - job->begin) * sizeof(sah_prim));
-}
-
 static void write_box(bvhlab_node *node, const bvhlab_aabb *box)
 {
 	for (int k = 0; k < 3; k++) {
@@ -185,6 +176,7 @@ void tasks_split_end(tasks_split *s, sah_job child[2])
 		child[c].begin = c ? s->mid : job->begin;
 		child[c].end = c ? job->end : s->mid;
 		child[c].depth = job->depth + 1;
+		child[c].alt = !job->alt;
 		merge_cbox(s, c, &child[c].cbox);
 	}
 	sah_bins_box(s->total, s->axis, 0, s->split, &child[0].box);

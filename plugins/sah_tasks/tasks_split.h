@@ -15,11 +15,9 @@
  * parts 0..P-1 of tasks_bin; the caller's tasks_choose; parts of
  * tasks_scatter; the caller's tasks_split_end.
  *
- * The node's primitives are read from one of two buffers, the kernel's
- * prims[0] or temp, and scattered into the other, where its children then
- * are: no pass copies them back. A range that leaves the team in temp
- * goes back to prims[0] with tasks_copy_back before the kernel takes it,
- * which the task's own thread does, in parallel with the others.
+ * As in the kernel's binned split, the node's primitives are read from one
+ * of the builder's two arrays (sah_job.alt) and scattered into the other,
+ * where its children then are.
  */
 #ifndef BVHLAB_TASKS_SPLIT_H
 #define BVHLAB_TASKS_SPLIT_H
@@ -31,8 +29,7 @@
 
 typedef struct tasks_split {
 	sah_builder *b;
-	sah_prim *temp;     /* [prim_count] the second buffer, by position */
-	const sah_prim *src; /* the node's buffer: prims[0] or temp */
+	const sah_prim *src; /* the node's array: the builder's prims[0] or alt */
 	sah_prim *dst;      /* the other one, where its children go */
 	uint32_t parts;     /* team size P */
 	sah_bins *bins;     /* [P]; part t writes bins[t] only */
@@ -45,20 +42,17 @@ typedef struct tasks_split {
 	int axis;           /* -1: no candidate */
 } tasks_split;
 
-/* Allocates the per-part scratch and the temp array. 0 or -ENOMEM. */
+/* Allocates the per-part scratch. 0 or -ENOMEM. */
 int tasks_split_init(tasks_split *s, sah_builder *b, uint32_t parts);
 void tasks_split_free(tasks_split *s);
 
-/* in_temp: the job's primitives are in temp, not in prims[0]. */
-void tasks_split_begin(tasks_split *s, const sah_job *job, bool in_temp);
+void tasks_split_begin(tasks_split *s, const sah_job *job);
 void tasks_bin(tasks_split *s, uint32_t part);
 /* Reduces the bins in part order, picks the split and sets mid and the
  * parts' left counts from the bins; false when no candidate exists (the
  * caller then lets the kernel split the node). */
 bool tasks_choose(tasks_split *s);
 void tasks_scatter(tasks_split *s, uint32_t part);
-/* Copies job's range from temp to prims[0]. */
-void tasks_copy_back(tasks_split *s, const sah_job *job);
 /* Writes the inner node and fills both children. */
 void tasks_split_end(tasks_split *s, sah_job child[2]);
 
