@@ -97,7 +97,7 @@ static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 struct scratch {
 	void *region;      /* one private mapping */
 	size_t region_size;
-	void *small;       /* hist, span, count */
+	void *small;       /* hist, bucket, count */
 };
 
 static size_t align64(size_t x)
@@ -132,18 +132,16 @@ static void *map_region(size_t size)
  */
 static size_t sort_size(size_t n)
 {
-	return 3 * align64(8 * n) + 2 * align64(4 * n);
+	return 3 * align64(8 * n);
 }
 
 static void place_sort(lbvh *b, char *p)
 {
-	size_t n = b->n, k8 = align64(8 * n), k4 = align64(4 * n);
+	size_t k8 = align64(8 * (size_t)b->n);
 
 	b->codes = (uint64_t *)(void *)p;
 	b->keys[0] = (uint64_t *)(void *)(p + k8);
 	b->keys[1] = (uint64_t *)(void *)(p + 2 * k8);
-	b->vals[0] = (uint32_t *)(void *)(p + 3 * k8);
-	b->vals[1] = (uint32_t *)(void *)(p + 3 * k8 + k4);
 }
 
 /* The hierarchy's arrays: in the fresh mapping, so zero-filled, which the
@@ -172,19 +170,20 @@ static void place_tree(lbvh *b, char *p)
 static int scratch_alloc(lbvh *b, const bvhlab_build_output *out, struct scratch *s)
 {
 	size_t sort = sort_size(b->n), tree = tree_size(b->n, b->collapse);
-	size_t hist = (size_t)b->threads * RADIX * sizeof(uint32_t);
+	size_t hist = (size_t)b->threads * TOP_RADIX * sizeof(uint32_t) +
+	              (TOP_RADIX + 1) * sizeof(uint32_t);
 	bool in_output = (size_t)out->node_capacity * sizeof(bvhlab_node) >= sort;
 
 	s->region_size = (tree + (in_output ? 0 : sort) + HUGE_PAGE - 1) & ~(HUGE_PAGE - 1);
 	s->region = map_region(s->region_size);
-	s->small = malloc(hist + (size_t)b->threads * (2 * sizeof(uint64_t) + 3 * sizeof(uint32_t)));
+	s->small = malloc(hist + (size_t)b->threads * 3 * sizeof(uint32_t));
 	if (!s->region || !s->small)
 		return -ENOMEM;
 	place_tree(b, s->region);
 	place_sort(b, in_output ? (char *)out->nodes : (char *)s->region + tree);
 	b->hist = s->small;
-	b->span = (uint64_t(*)[2])(void *)((char *)s->small + hist);
-	b->count = (uint32_t *)(void *)(b->span + b->threads);
+	b->bucket = (uint32_t *)(void *)(b->hist + b->threads);
+	b->count = b->bucket + TOP_RADIX + 1;
 	return 0;
 }
 

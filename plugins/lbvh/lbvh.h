@@ -3,16 +3,19 @@
  *
  * A build is a fixed sequence of phases run by a team of T threads (the
  * calling one included), separated by barriers, so every phase sees
- * everything the earlier ones wrote. The sort and the compaction split
- * their index ranges into T contiguous chunks (chunk()); Karras and bounds
- * hand out blocks to whichever thread is free (next_block()), since on a
- * shared machine a thread can lose its CPU for milliseconds. Nothing a
+ * everything the earlier ones wrote. The sort's passes over memory and the
+ * compaction split their index ranges into T contiguous chunks (chunk());
+ * the sort's buckets, Karras and bounds hand out blocks to whichever
+ * thread is free (next_block()), since on a shared machine a thread can
+ * lose its CPU for milliseconds. Nothing a
  * phase computes depends on T or on who did which block, so the tree, and
  * the order of its nodes, is the same for every thread count.
  *
- *   1. sort      Morton codes of the centroids, LSD radix sort of (code,
- *                primitive) pairs into output->prim_index, and the common
- *                prefix lengths of neighbours in that order (lbvh_sort.c)
+ *   1. sort      Morton codes of the centroids, sorted as packed (code,
+ *                primitive) words: one pass into buckets by the top code
+ *                bits, then each bucket in cache; the ids into
+ *                output->prim_index, and the common prefix lengths of
+ *                neighbours in that order (lbvh_sort.c)
  *   2. karras    every internal node's range and split (lbvh_emit.c)
  *   3. bounds    bottom-up boxes and SAH collapse decisions (lbvh_emit.c)
  *   4. compact   with collapse: drop the nodes inside the new leaves
@@ -42,8 +45,9 @@
 
 #include <bvhlab/builder.h>
 
-#define RADIX_BITS 8
-#define RADIX (1u << RADIX_BITS)
+/* The sort's first digit: the top bits of the codes (lbvh_sort.c). */
+#define TOP_BITS 11
+#define TOP_RADIX (1u << TOP_BITS)
 #define NO_NODE UINT32_MAX
 #define LBVH_MAX_THREADS 256
 /* Zero bytes before and after lcp[], so that 16-byte scans never leave it. */
@@ -67,14 +71,15 @@ typedef struct lbvh {
 	/* sort: in the output node array, which the bounds phase is the first
 	 * to write (see lbvh.c), so the sorted words last through Karras */
 	uint64_t *codes;          /* [n] Morton code of each primitive, by id */
-	uint64_t *keys[2];        /* [n] pass buffers: code words */
-	uint32_t *vals[2];        /* [n] pass buffers: ids, while pairs are wide */
-	uint32_t (*hist)[RADIX];  /* [T][RADIX] digit counts of each chunk */
-	uint64_t (*span)[2];      /* [T] OR and AND of each chunk's codes */
+	uint64_t *keys[2];        /* [n] packed (code, id) words: buckets, then
+	                           * sorted, in keys[0]; scratch in keys[1] */
+	uint32_t (*hist)[TOP_RADIX]; /* [T][TOP_RADIX] digit counts of each chunk */
+	uint32_t *bucket;         /* [TOP_RADIX + 1] first sorted position of
+	                           * each top digit, n at the end */
 
 	/* the sorted keys, set at the end of the sort: words[k] holds the code
 	 * of sorted position k from bit `base` up, shifted above `id_bits` of
-	 * primitive id (both 0 when the words are the codes themselves) */
+	 * primitive id (base 0 when the whole code fits) */
 	struct {
 		const uint64_t *words;
 		unsigned base, id_bits;
@@ -93,7 +98,8 @@ typedef struct lbvh {
 	                           * zero from the mapping; then the holes */
 	uint8_t *node_flags;      /* [n - 1] see lbvh_collapse.c */
 	uint32_t *count;          /* [3 T] per-chunk counts for the compaction */
-	atomic_uint blocks[2];    /* blocks handed out in karras and bounds */
+	atomic_uint blocks[3];    /* blocks handed out in karras, bounds and
+	                           * the sort's buckets */
 
 	struct team_barrier {
 		atomic_uint arrived;   /* threads at the barrier this round */
@@ -150,7 +156,7 @@ static inline uint8_t common_prefix(const lbvh *b, uint32_t i, uint32_t j)
 
 	if (x)
 		return (uint8_t)(1 + __builtin_clzll(x) - b->sorted.base);
-	if (b->sorted.id_bits)
+	if (b->sorted.base)
 		x = b->codes[wi & id_mask] ^ b->codes[wj & id_mask];
 	if (x)
 		return (uint8_t)(1 + __builtin_clzll(x));

@@ -127,6 +127,10 @@ static void karras_node(lbvh *b, uint32_t i)
 /* Leaves per block of the bounds phase: their slots (512 KiB) are still
  * in L2 when the climbs from them read them back. */
 #define BOUNDS_BLOCK 16384
+/* How far ahead the leaves' boxes are fetched: a miss here is a page walk
+ * and a memory access, some hundreds of nanoseconds, while a leaf takes a
+ * few; 32 ahead was measured 0.6 ms slower on 1M leaves. */
+#define LEAF_AHEAD 96
 
 void lbvh_karras(lbvh *b, unsigned t)
 {
@@ -226,8 +230,8 @@ void lbvh_bounds(lbvh *b, unsigned t)
 	(void)t;
 	while (next_block(&b->blocks[1], b->n, BOUNDS_BLOCK, &lo, &hi)) {
 		for (uint32_t k = lo; k < hi; k++) {
-			if (k + 32 < hi)
-				__builtin_prefetch(&b->in->prim_bounds[b->prim_index[k + 32]]);
+			if (k + LEAF_AHEAD < hi)
+				__builtin_prefetch(&b->in->prim_bounds[b->prim_index[k + LEAF_AHEAD]]);
 			put_leaf(b, k, slot_of(b, b->parent[b->n - 1 + k]));
 		}
 		for (uint32_t k = lo; k < hi; k++)

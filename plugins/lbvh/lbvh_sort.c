@@ -1,49 +1,43 @@
 /*
- * lbvh phase 1: Morton codes of the centroids, a parallel LSD radix sort of
- * (code, primitive) pairs, and what the hierarchy needs from the order.
+ * lbvh phase 1: Morton codes of the centroids, their sort into (code,
+ * primitive) order, and what the hierarchy needs from that order.
  *
- * The sort is stable and starts from primitive order, so pairs with equal
- * codes end up ordered by primitive id: the (code, id) order Karras's tie
- * rule needs, without widening the keys. Every thread histograms its chunk
- * of the current pairs, then scatters that chunk to the offsets its
- * histogram gets among all chunks' histograms, which keeps each pass stable
- * and the result independent of the thread count. A digit that is the same
- * in every code (the upper 34 bits of 30-bit codes, any digit of
- * coincident centroids) cannot change the order and its pass is skipped.
+ * Each pair travels packed as one word, (code >> base) << id_bits | id:
+ * the code's upper bits above the primitive id, so that ordering the words
+ * orders the pairs, and a pass moves 8 bytes per pair. base is 0 when the
+ * whole code fits beside the id (30-bit codes, few primitives), else the
+ * lowest code bits are left out and only runs of words whose code bits are
+ * equal are put in order by the full codes afterwards (fix_ties()); on a
+ * real scene such runs are rare and short.
  *
- * The sort is memory bound, so the pairs shrink as soon as they can: an
- * LSD pass never looks at the digits below its own again, and once the
- * code bits still to sort plus the primitive id fit in 64 bits, the pair
- * travels packed as one word, (code >> base) << id_bits | id. The last pass
- * writes the ids into output->prim_index and keeps its words, the sorted
- * keys that Karras compares (see common_prefix()).
+ * The sort: one MSD pass on the codes' top TOP_BITS bits scatters the
+ * words into buckets (thread t's share of each bucket after the shares of
+ * lower chunks, so each bucket is in id order), then each bucket is
+ * sorted on its own by LSD passes, while it sits in cache: one pass over
+ * memory instead of up to eight, and the buckets are shared out among the
+ * threads as they come free. Nothing depends on the thread count: the
+ * result is the (code, id) order. The sorted words go to keys[0], the ids
+ * to output->prim_index; Karras compares the words (common_prefix()).
  */
 #include <string.h>
 
 #include "lbvh.h"
 
-#define MAX_PASSES ((64 + RADIX_BITS - 1) / RADIX_BITS)
-#define DIGIT(word, shift) ((uint32_t)((word) >> (shift)) & (RADIX - 1))
+/* Digits of the sort inside a bucket: 8 bits, so that the counts of all
+ * of a bucket's digits stay in L1 and cost little to clear per bucket. */
+#define LOCAL_BITS 8
+#define LOCAL_RADIX (1u << LOCAL_BITS)
+#define LOCAL_DIGITS (64 / LOCAL_BITS)
+#define DIGIT(word, shift) ((uint32_t)((word) >> (shift)) & (LOCAL_RADIX - 1))
+/* Buckets this small are insertion sorted: fewer moves than a pass. */
+#define SMALL_RUN 24
+/* Top digits handed out at a time in the bucket sort. */
+#define BUCKET_BLOCK 16
 
-enum src_form { FROM_CODES, FROM_WIDE, FROM_PACKED }; /* FROM_CODES: ids implicit */
-enum dst_form { TO_WIDE, TO_PACKED, TO_FINAL };
-
-/* One pass: where its pairs come from and go, and in which form. */
-struct pass {
-	unsigned shift;        /* digit position in the code */
-	unsigned word_shift;   /* digit position in the source words */
-	int src, dst;          /* enum src_form, enum dst_form */
-	const uint64_t *ks;    /* source words */
-	const uint32_t *vs;    /* source ids, FROM_WIDE */
-	uint64_t *kd;          /* destination words */
-	uint32_t *vd;          /* destination ids, TO_WIDE and TO_FINAL */
-};
-
-/* Packing: code bits from `base` up, shifted above `id_bits` of id; the
- * sorted words have this form too (both 0 when they are the codes). */
+/* The packed form: code bits from `base` up, above `id_bits` of id. */
 struct packing {
 	unsigned base, id_bits;
-	const uint64_t *sorted; /* the last pass's words, in sorted order */
+	unsigned top_shift; /* position of the top digit in the words */
 };
 
 /* The bits of x spread out to every third bit, 21 bits into 63. */
@@ -104,189 +98,270 @@ static inline uint64_t morton(const struct quantiser *q, const float *c)
 	return axis(q, c, 0) << 2 | axis(q, c, 1) << 1 | axis(q, c, 2);
 }
 
+static void packing_init(const lbvh *b, struct packing *pk)
+{
+	unsigned id_bits = 32 - (unsigned)__builtin_clz(b->n - 1);
+	unsigned kept = b->bits < 64 - id_bits ? b->bits : 64 - id_bits;
+
+	pk->id_bits = id_bits;
+	pk->base = b->bits - kept;
+	pk->top_shift = id_bits + kept - TOP_BITS;
+}
+
+static inline uint64_t pack(const struct packing *pk, uint64_t code, uint32_t id)
+{
+	return (code >> pk->base) << pk->id_bits | id;
+}
+
+/* The codes, by id, and how many of thread t's chunk each top digit has. */
 static void codes(lbvh *b, unsigned t)
 {
 	struct quantiser q;
-	uint64_t any = 0, all = ~0ull;
-	uint32_t lo, hi;
+	uint32_t *h = b->hist[t], lo, hi;
+	unsigned top = b->bits - TOP_BITS;
 
 	quantiser_init(&q, b);
+	memset(h, 0, TOP_RADIX * sizeof(*h));
 	chunk(b, t, b->n, &lo, &hi);
 	for (uint32_t i = lo; i < hi; i++) {
 		uint64_t code = morton(&q, b->in->centroids + 3 * (size_t)i);
 		b->codes[i] = code;
-		any |= code;
-		all &= code;
+		h[code >> top]++;
 	}
-	b->span[t][0] = any;
-	b->span[t][1] = all;
 }
 
-/* Shifts of the digits that vary between codes. */
-static unsigned varying_digits(const lbvh *b, unsigned shift[MAX_PASSES])
-{
-	uint64_t any = 0, all = ~0ull;
-	unsigned count = 0;
-
-	for (unsigned t = 0; t < b->threads; t++) {
-		any |= b->span[t][0];
-		all &= b->span[t][1];
-	}
-	for (unsigned s = 0; s < b->bits; s += RADIX_BITS)
-		if (DIGIT(any ^ all, s))
-			shift[count++] = s;
-	return count;
-}
-
-/*
- * The passes: the first reads the codes, then they alternate between the
- * two buffers; the pairs are wide (keys[], vals[]) until the code bits left
- * to sort fit beside the id in one word, packed from then on. Every thread
- * makes the same plan from the same spans.
- */
-static unsigned plan(const lbvh *b, struct pass pass[MAX_PASSES], struct packing *pk)
-{
-	unsigned shift[MAX_PASSES], count = varying_digits(b, shift);
-	int form = FROM_CODES;
-
-	pk->id_bits = 32 - (unsigned)__builtin_clz(b->n - 1);
-	pk->base = 0;
-	for (unsigned k = 0; k < count; k++) {
-		struct pass *p = &pass[k];
-		unsigned next = k + 1 < count ? shift[k + 1] : b->bits;
-
-		*p = (struct pass){ .shift = shift[k], .word_shift = shift[k], .src = form,
-		                    .ks = k ? b->keys[(k + 1) % 2] : b->codes,
-		                    .vs = b->vals[(k + 1) % 2],
-		                    .kd = b->keys[k % 2], .vd = b->vals[k % 2] };
-		if (form == FROM_PACKED)
-			p->word_shift = shift[k] - pk->base + pk->id_bits;
-		if (k + 1 == count) {
-			p->dst = TO_FINAL;
-			p->vd = b->prim_index;
-		} else if (form == FROM_PACKED || b->bits - next + pk->id_bits <= 64) {
-			pk->base = form == FROM_PACKED ? pk->base : next;
-			p->dst = TO_PACKED;
-			form = FROM_PACKED;
-		} else {
-			p->dst = TO_WIDE;
-			form = FROM_WIDE;
-		}
-	}
-	if (form != FROM_PACKED)
-		pk->id_bits = 0;
-	pk->sorted = count ? b->keys[(count - 1) % 2] : b->codes;
-	return count;
-}
-
-static void histogram(lbvh *b, unsigned t, const struct pass *p)
-{
-	uint32_t *h = b->hist[t], lo, hi;
-
-	memset(h, 0, RADIX * sizeof(*h));
-	chunk(b, t, b->n, &lo, &hi);
-	for (uint32_t i = lo; i < hi; i++)
-		h[DIGIT(p->ks[i], p->word_shift)]++;
-}
-
-/* Where thread t's pairs of each digit go: after every pair of a lower
- * digit, and after the same digit's pairs of lower chunks (stability). */
-static void offsets(const lbvh *b, unsigned t, uint32_t off[RADIX])
+/* Where thread t's words of each top digit go: after every word of a
+ * lower digit, and after the same digit's words of lower chunks. Thread
+ * 0 also publishes where each bucket starts. */
+static void offsets(lbvh *b, unsigned t, uint32_t off[TOP_RADIX])
 {
 	uint32_t sum = 0;
 
-	for (unsigned d = 0; d < RADIX; d++)
+	for (unsigned d = 0; d < TOP_RADIX; d++) {
+		if (t == 0)
+			b->bucket[d] = sum;
 		for (unsigned u = 0; u < b->threads; u++) {
 			if (u == t)
 				off[d] = sum;
 			sum += b->hist[u][d];
 		}
-}
-
-/* One scatter loop per (source, destination) form: the forms are
- * constants after inlining, so each loop moves only what it must. */
-static inline __attribute__((always_inline)) void
-scatter_as(const struct pass *p, const struct packing *pk, uint32_t lo, uint32_t hi,
-           uint32_t *off, int src, int dst)
-{
-	const uint64_t id_mask = (1ull << pk->id_bits) - 1;
-
-	for (uint32_t i = lo; i < hi; i++) {
-		uint64_t w = p->ks[i];
-		uint32_t at = off[DIGIT(w, p->word_shift)]++;
-		uint32_t id = src == FROM_PACKED ? (uint32_t)(w & id_mask)
-		              : src == FROM_WIDE ? p->vs[i] : i;
-
-		if (dst == TO_PACKED)
-			p->kd[at] = src == FROM_PACKED ? w : (w >> pk->base) << pk->id_bits | id;
-		else
-			p->kd[at] = w;
-		if (dst != TO_PACKED)
-			p->vd[at] = id;
 	}
+	if (t == 0)
+		b->bucket[TOP_RADIX] = sum;
 }
 
-static void scatter(lbvh *b, unsigned t, const struct pass *p, const struct packing *pk)
+static void scatter(lbvh *b, unsigned t, const struct packing *pk)
 {
-	uint32_t off[RADIX], lo, hi;
+	uint32_t off[TOP_RADIX], lo, hi;
+	uint64_t *dst = b->keys[0];
 
 	offsets(b, t, off);
 	chunk(b, t, b->n, &lo, &hi);
-#define FORMS(s, d) ((s) * 3 + (d))
-#define CASE(s, d) \
-	case FORMS(s, d): \
-		scatter_as(p, pk, lo, hi, off, s, d); \
-		break
-	switch (FORMS(p->src, p->dst)) {
-		CASE(FROM_CODES, TO_WIDE);
-		CASE(FROM_CODES, TO_PACKED);
-		CASE(FROM_CODES, TO_FINAL);
-		CASE(FROM_WIDE, TO_WIDE);
-		CASE(FROM_WIDE, TO_PACKED);
-		CASE(FROM_WIDE, TO_FINAL);
-		CASE(FROM_PACKED, TO_PACKED);
-		CASE(FROM_PACKED, TO_FINAL);
+	for (uint32_t i = lo; i < hi; i++) {
+		uint64_t w = pack(pk, b->codes[i], i);
+		dst[off[w >> pk->top_shift]++] = w;
 	}
-#undef CASE
-#undef FORMS
 }
 
-static void sort_passes(lbvh *b, unsigned t, struct packing *pk)
+static void insertion_sort(uint64_t *w, uint32_t m)
 {
-	struct pass pass[MAX_PASSES];
-	unsigned count = plan(b, pass, pk);
+	for (uint32_t k = 1; k < m; k++) {
+		uint64_t x = w[k];
+		uint32_t j = k;
+
+		for (; j > 0 && w[j - 1] > x; j--)
+			w[j] = w[j - 1];
+		w[j] = x;
+	}
+}
+
+/* How many of the m words have each value of each digit from bit `from`
+ * up; returns the bits that vary. Two sets of counts, one per half, so
+ * that a digit that repeats (neighbours in id order are often neighbours
+ * in space) does not chain every increment to the one before. */
+static uint64_t count_digits(const uint64_t *w, uint32_t m, unsigned from, unsigned digits,
+                             uint32_t count[][LOCAL_RADIX])
+{
+	uint32_t other[LOCAL_DIGITS][LOCAL_RADIX], half = m / 2;
+	uint64_t any = 0, all = ~0ull;
+
+	memset(count, 0, digits * sizeof(count[0]));
+	memset(other, 0, digits * sizeof(other[0]));
+	for (uint32_t k = 0; k < m - half; k++) {
+		uint64_t x = w[k], y = w[m - 1 - k];
+
+		any |= x | y;
+		all &= x & y;
+		for (unsigned d = 0; d < digits; d++) {
+			count[d][DIGIT(x, from + d * LOCAL_BITS)]++;
+			other[d][DIGIT(y, from + d * LOCAL_BITS)]++;
+		}
+	}
+	if (m % 2) /* the middle word was counted twice */
+		for (unsigned d = 0; d < digits; d++)
+			other[d][DIGIT(w[half], from + d * LOCAL_BITS)]--;
+	for (unsigned d = 0; d < digits; d++)
+		for (unsigned v = 0; v < LOCAL_RADIX; v++)
+			count[d][v] += other[d][v];
+	return any ^ all;
+}
+
+/* One stable pass: the first half of the words goes forwards from the
+ * start of each digit's range, the second half backwards from its end,
+ * two independent chains of counter updates that meet in the middle. */
+static void pass(const uint64_t *w, uint64_t *dst, uint32_t m, unsigned shift,
+                 const uint32_t count[LOCAL_RADIX])
+{
+	uint32_t head[LOCAL_RADIX], tail[LOCAL_RADIX], sum = 0, half = m / 2;
+
+	for (unsigned v = 0; v < LOCAL_RADIX; v++) {
+		head[v] = sum;
+		sum += count[v];
+		tail[v] = sum;
+	}
+	for (uint32_t k = 0; k < half; k++) {
+		uint64_t x = w[k], y = w[m - 1 - k];
+
+		dst[head[DIGIT(x, shift)]++] = x;
+		dst[--tail[DIGIT(y, shift)]] = y;
+	}
+	if (m % 2)
+		dst[head[DIGIT(w[half], shift)]] = w[half];
+}
+
+/*
+ * Stable LSD sort of m words on their bits [from, to), digits that are the
+ * same in every word skipped; tmp is as large. The counts of every digit
+ * are taken in one read. Returns where the sorted words are.
+ */
+static uint64_t *radix_sort(uint64_t *w, uint64_t *tmp, uint32_t m, unsigned from,
+                            unsigned to)
+{
+	uint32_t count[LOCAL_DIGITS][LOCAL_RADIX];
+	unsigned digits = (to - from + LOCAL_BITS - 1) / LOCAL_BITS;
+	uint64_t varying = count_digits(w, m, from, digits, count);
+
+	for (unsigned d = 0; d < digits; d++) {
+		uint64_t *swap = w;
+
+		if (!DIGIT(varying, from + d * LOCAL_BITS))
+			continue;
+		pass(w, tmp, m, from + d * LOCAL_BITS, count[d]);
+		w = tmp;
+		tmp = swap;
+	}
+	return w;
+}
+
+/* Sorts m words on their bits from `from` up (those above `to` are equal),
+ * in place, with tmp as scratch. */
+static void sort_words(uint64_t *w, uint64_t *tmp, uint32_t m, unsigned from, unsigned to)
+{
+	uint64_t *sorted;
+
+	if (m <= SMALL_RUN) {
+		insertion_sort(w, m);
+		return;
+	}
+	sorted = radix_sort(w, tmp, m, from, to);
+	if (sorted != w)
+		memcpy(w, sorted, m * sizeof(*w));
+}
+
+/*
+ * A run of m words with the same code bits, in id order: puts it in
+ * (code, id) order. The left-out code bits and the id fit in one word
+ * together (base < id_bits), so the run is sorted as such words, then
+ * packed back.
+ */
+static void fix_run(const lbvh *b, const struct packing *pk, uint64_t *w, uint64_t *tmp,
+                    uint32_t m)
+{
+	uint64_t id_mask = (1ull << pk->id_bits) - 1, low = (1ull << pk->base) - 1;
+	uint64_t upper = w[0] & ~id_mask;
+
+	for (uint32_t k = 0; k < m; k++) {
+		uint32_t id = (uint32_t)(w[k] & id_mask);
+		w[k] = (b->codes[id] & low) << pk->id_bits | id;
+	}
+	sort_words(w, tmp, m, pk->id_bits, pk->id_bits + pk->base);
+	for (uint32_t k = 0; k < m; k++)
+		w[k] = upper | (w[k] & id_mask);
+}
+
+/* Starts loading the full codes of the words in runs: they are random
+ * reads, best all in flight before fix_ties() waits for the first.
+ * Whether there is any run. */
+static bool prefetch_ties(const lbvh *b, const struct packing *pk, const uint64_t *w,
+                          uint32_t m)
+{
+	uint64_t id_mask = (1ull << pk->id_bits) - 1;
+	bool any = false;
+
+	for (uint32_t k = 0; k + 1 < m; k++)
+		if ((w[k] ^ w[k + 1]) >> pk->id_bits == 0) {
+			__builtin_prefetch(&b->codes[w[k] & id_mask]);
+			__builtin_prefetch(&b->codes[w[k + 1] & id_mask]);
+			any = true;
+		}
+	return any;
+}
+
+/* Only where base > 0: the runs of equal code bits, each in code order. */
+static void fix_ties(const lbvh *b, const struct packing *pk, uint64_t *w, uint64_t *tmp,
+                     uint32_t m)
+{
+	for (uint32_t k = 0; k + 1 < m;) {
+		uint32_t j = k + 1;
+
+		while (j < m && (w[j] ^ w[k]) >> pk->id_bits == 0)
+			j++;
+		if (j - k > 1)
+			fix_run(b, pk, w + k, tmp, j - k);
+		k = j;
+	}
+}
+
+/* Sorts the bucket [s, e) in place, its ids to prim_index, and the common
+ * prefixes of its neighbours (those across buckets come after). */
+static void sort_bucket(lbvh *b, const struct packing *pk, uint32_t s, uint32_t e)
+{
+	uint64_t *w = b->keys[0] + s, *tmp = b->keys[1] + s;
+	uint64_t id_mask = (1ull << pk->id_bits) - 1;
+
+	sort_words(w, tmp, e - s, pk->id_bits, pk->top_shift);
+	if (pk->base && prefetch_ties(b, pk, w, e - s))
+		fix_ties(b, pk, w, tmp, e - s);
+	for (uint32_t k = s; k + 1 < e; k++) {
+		b->prim_index[k] = (uint32_t)(b->keys[0][k] & id_mask);
+		b->lcp[k] = common_prefix(b, k, k + 1);
+	}
+	b->prim_index[e - 1] = (uint32_t)(b->keys[0][e - 1] & id_mask);
+}
+
+static void sort_buckets(lbvh *b, const struct packing *pk)
+{
 	uint32_t lo, hi;
 
-	/* Every thread made the same plan; thread 0 publishes the sorted
-	 * words' form, which the others read after the barriers below. */
-	if (t == 0) {
-		b->sorted.words = pk->sorted;
-		b->sorted.base = pk->base;
-		b->sorted.id_bits = pk->id_bits;
-	}
-	if (count == 0) { /* every code equal: already in order */
-		chunk(b, t, b->n, &lo, &hi);
-		for (uint32_t i = lo; i < hi; i++)
-			b->prim_index[i] = i;
-		team_sync(b);
-	}
-	for (unsigned k = 0; k < count; k++) {
-		histogram(b, t, &pass[k]);
-		team_sync(b);
-		scatter(b, t, &pass[k], pk);
-		team_sync(b);
-	}
+	while (next_block(&b->blocks[2], TOP_RADIX, BUCKET_BLOCK, &lo, &hi))
+		for (uint32_t d = lo; d < hi; d++)
+			if (b->bucket[d + 1] > b->bucket[d])
+				sort_bucket(b, pk, b->bucket[d], b->bucket[d + 1]);
 }
 
-/* The common prefixes of sorted neighbours: all Karras needs besides the
- * sorted words. */
-static void common_prefixes(lbvh *b, unsigned t)
+/* The common prefixes across buckets: before the first word of every
+ * bucket but the first non-empty one, and the zero padding. */
+static void border_prefixes(lbvh *b, unsigned t)
 {
 	uint32_t lo, hi, n = b->n;
 
-	chunk(b, t, n, &lo, &hi);
-	for (uint32_t k = lo; k < hi && k + 1 < n; k++)
-		b->lcp[k] = common_prefix(b, k, k + 1);
+	chunk(b, t, TOP_RADIX, &lo, &hi);
+	for (uint32_t d = lo; d < hi; d++) {
+		uint32_t s = b->bucket[d];
+
+		if (s > 0 && b->bucket[d + 1] > s)
+			b->lcp[s - 1] = common_prefix(b, s - 1, s);
+	}
 	if (t == 0) {
 		memset(b->lcp - LCP_PAD, 0, LCP_PAD);
 		memset(b->lcp + n - 1, 0, LCP_PAD + 1);
@@ -297,9 +372,20 @@ void lbvh_sort(lbvh *b, unsigned t)
 {
 	struct packing pk;
 
+	packing_init(b, &pk);
+	/* Every thread has the same packing; thread 0 publishes it, the
+	 * others read it after the barriers below. */
+	if (t == 0) {
+		b->sorted.words = b->keys[0];
+		b->sorted.base = pk.base;
+		b->sorted.id_bits = pk.id_bits;
+	}
 	codes(b, t);
 	team_sync(b);
-	sort_passes(b, t, &pk);
-	common_prefixes(b, t);
+	scatter(b, t, &pk);
+	team_sync(b);
+	sort_buckets(b, &pk);
+	team_sync(b);
+	border_prefixes(b, t);
 	team_sync(b);
 }
