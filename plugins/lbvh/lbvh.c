@@ -76,14 +76,26 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b)
 	return 0;
 }
 
-static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                           const bvhlab_build_input *in, bvhlab_build_output *out)
-{
-	uint32_t nodes = 2 * in->prim_count - 1;
+/* Nodes past the tree's 2n - 1 that hold the hierarchy's scratch (see
+ * scratch_alloc()); 0 when that would not fit a uint32_t count. */
+static uint32_t spare_nodes(uint32_t n, bool collapse);
 
-	if (out->node_capacity >= nodes && out->index_capacity >= in->prim_count)
+/*
+ * Room for the tree, and past it for the scratch of the hierarchy, which
+ * the host keeps between builds: a fresh mapping would be paged in (and
+ * zeroed by the kernel) at every build. Without that room the scratch is
+ * mapped afresh (scratch_alloc()).
+ */
+static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                           const lbvh *b, bvhlab_build_output *out)
+{
+	uint32_t nodes = 2 * b->n - 1, spare = spare_nodes(b->n, b->collapse);
+
+	if (spare && out->node_capacity < nodes + spare)
+		(void)host->grow_output(ctx, out, nodes + spare, b->n); /* fine if refused */
+	if (out->node_capacity >= nodes && out->index_capacity >= b->n)
 		return 0;
-	if (host->grow_output(ctx, out, nodes, in->prim_count) < 0) {
+	if (host->grow_output(ctx, out, nodes, b->n) < 0) {
 		host->set_error(ctx, "cannot grow the output to %u nodes", nodes);
 		return -ENOMEM;
 	}
@@ -144,12 +156,19 @@ static void place_sort(lbvh *b, char *p)
 	b->keys[1] = (uint64_t *)(void *)(p + 2 * k8);
 }
 
-/* The hierarchy's arrays: in the fresh mapping, so zero-filled, which the
- * arrival counters rely on. node_flags only with collapse. */
+/* The hierarchy's arrays; node_flags only with collapse. */
 static size_t tree_size(size_t n, bool collapse)
 {
 	return align64(n + 2 * LCP_PAD) + align64(8 * n) + 2 * align64(4 * n) +
 	       (collapse ? align64(n) : 0);
+}
+
+static uint32_t spare_nodes(uint32_t n, bool collapse)
+{
+	uint64_t spare = (tree_size(n, collapse) + 64 + sizeof(bvhlab_node) - 1) /
+	                 sizeof(bvhlab_node);
+
+	return 2 * (uint64_t)n - 1 + spare > UINT32_MAX ? 0 : (uint32_t)spare;
 }
 
 static void place_tree(lbvh *b, char *p)
@@ -167,20 +186,31 @@ static void place_tree(lbvh *b, char *p)
 	b->node_flags = b->collapse ? (uint8_t *)p : NULL;
 }
 
+/*
+ * The hierarchy's arrays go past the tree in the output when the host
+ * gave the room (ensure_capacity()), else into the fresh mapping; there
+ * the arrival counters and flags start zeroed, in the output the sort
+ * phase zeroes them (scratch_dirty).
+ */
 static int scratch_alloc(lbvh *b, const bvhlab_build_output *out, struct scratch *s)
 {
 	size_t sort = sort_size(b->n), tree = tree_size(b->n, b->collapse);
 	size_t hist = (size_t)b->threads * TOP_RADIX * sizeof(uint32_t) +
 	              (TOP_RADIX + 1) * sizeof(uint32_t);
-	bool in_output = (size_t)out->node_capacity * sizeof(bvhlab_node) >= sort;
+	uint32_t nodes = 2 * b->n - 1, spare = spare_nodes(b->n, b->collapse);
+	bool sort_out = (size_t)out->node_capacity * sizeof(bvhlab_node) >= sort;
+	bool tree_out = spare && out->node_capacity >= nodes + spare;
+	uintptr_t past = (uintptr_t)(out->nodes + nodes);
 
-	s->region_size = (tree + (in_output ? 0 : sort) + HUGE_PAGE - 1) & ~(HUGE_PAGE - 1);
-	s->region = map_region(s->region_size);
+	s->region_size = ((tree_out ? 0 : tree) + (sort_out ? 0 : sort) + HUGE_PAGE - 1) &
+	                 ~(HUGE_PAGE - 1);
+	s->region = s->region_size ? map_region(s->region_size) : NULL;
 	s->small = malloc(hist + (size_t)b->threads * 3 * sizeof(uint32_t));
-	if (!s->region || !s->small)
+	if ((s->region_size && !s->region) || !s->small)
 		return -ENOMEM;
-	place_tree(b, s->region);
-	place_sort(b, in_output ? (char *)out->nodes : (char *)s->region + tree);
+	b->scratch_dirty = tree_out;
+	place_tree(b, tree_out ? (char *)((past + 63) & ~(uintptr_t)63) : (char *)s->region);
+	place_sort(b, sort_out ? (char *)out->nodes : (char *)s->region + (tree_out ? 0 : tree));
 	b->hist = s->small;
 	b->bucket = (uint32_t *)(void *)(b->hist + b->threads);
 	b->count = b->bucket + TOP_RADIX + 1;
@@ -395,7 +425,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		return -EINVAL;
 	}
 	if ((rc = read_options(host, ctx, &b)) < 0 ||
-	    (rc = ensure_capacity(host, ctx, input, output)) < 0)
+	    (rc = ensure_capacity(host, ctx, &b, output)) < 0)
 		return rc;
 	if (input->prim_count == 1) {
 		single_leaf(input, output);

@@ -85,7 +85,7 @@ typedef struct lbvh {
 		unsigned base, id_bits;
 	} sorted;
 
-	/* hierarchy: a fresh mapping, zero-filled */
+	/* hierarchy: past the tree in the output, or a fresh mapping */
 	uint8_t *lcp;             /* [n - 1] 1 + common prefix length of sorted
 	                           * keys k and k + 1; 0 at [-1], [n - 1] and in
 	                           * the LCP_PAD bytes around */
@@ -95,8 +95,10 @@ typedef struct lbvh {
 	uint32_t *end;            /* [n - 1] the other end of node i's range;
 	                           * then the movers of the compaction */
 	atomic_uint *visits;      /* [n - 1] arrivals at nodes shared by threads,
-	                           * zero from the mapping; then the holes */
+	                           * zeroed; then the holes */
 	uint8_t *node_flags;      /* [n - 1] see lbvh_collapse.c */
+	bool scratch_dirty;       /* visits and node_flags left from a build
+	                           * before: the sort zeroes them */
 	uint32_t *count;          /* [3 T] per-chunk counts for the compaction */
 	atomic_uint blocks[3];    /* blocks handed out in karras, bounds and
 	                           * the sort's buckets */

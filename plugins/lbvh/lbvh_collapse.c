@@ -15,7 +15,8 @@
  * choice was to stay inner: its SAH cost in the count field, tagged, until
  * its parent stays inner too and clears it to the output's 0. A node that
  * collapses marks every internal node below it NODE_DEAD; a node is inner
- * in the output exactly when its node_flags are 0 (fresh memory: zero).
+ * in the output exactly when its node_flags are 0 (zeroed before the bounds
+ * phase).
  *
  * Compaction, phase 4: the bounds phase left the children of every
  * internal node i at slots 1 + 2i and 2 + 2i. Let F be the number of

@@ -177,7 +177,7 @@ static uint32_t finish_node(lbvh *b, uint32_t i, uint32_t size)
  * block of leaves [lo, hi) is reached only by this thread, left child
  * first (the leaves go in order), so it needs no counter; only the nodes
  * on the paths from block borders to the root are shared, and they take
- * the atomic one (zero from the mapping).
+ * the atomic one (zeroed before the build's first barrier).
  */
 static bool second_arrival(lbvh *b, uint32_t p, uint32_t first, uint32_t size, bool right,
                            uint32_t lo, uint32_t hi)

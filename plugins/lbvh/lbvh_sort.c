@@ -113,6 +113,15 @@ static inline uint64_t pack(const struct packing *pk, uint64_t code, uint32_t id
 	return (code >> pk->base) << pk->id_bits | id;
 }
 
+/* Zeroes the arrival counters and flags of [lo, hi) (of n; n - 1 flags),
+ * which are left from the build before when the scratch is in the output. */
+static void clear_counters(lbvh *b, uint32_t lo, uint32_t hi)
+{
+	memset(b->visits + lo, 0, (hi - lo) * sizeof(*b->visits));
+	if (b->node_flags)
+		memset(b->node_flags + lo, 0, hi - lo);
+}
+
 /* The codes, by id, and how many of thread t's chunk each top digit has. */
 static void codes(lbvh *b, unsigned t)
 {
@@ -123,6 +132,8 @@ static void codes(lbvh *b, unsigned t)
 	quantiser_init(&q, b);
 	memset(h, 0, TOP_RADIX * sizeof(*h));
 	chunk(b, t, b->n, &lo, &hi);
+	if (b->scratch_dirty) /* read from the bounds phase on */
+		clear_counters(b, lo, hi);
 	for (uint32_t i = lo; i < hi; i++) {
 		uint64_t code = morton(&q, b->in->centroids + 3 * (size_t)i);
 		b->codes[i] = code;
