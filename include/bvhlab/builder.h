@@ -172,7 +172,11 @@ typedef struct bvhlab_build_input {
  * Where a builder writes its tree. On entry the host has allocated
  * nodes[2 * prim_count - 1] and prim_index[prim_count]; grow them with
  * host->grow_output (e.g. for spatial splits). On success the builder sets
- * node_count and index_count; nodes[0] is the root.
+ * node_count and index_count; nodes[0] is the root. Until then the whole
+ * capacity is the builder's, and the host ignores what lies past the
+ * counts, so a builder may keep scratch there (lbvh does). The harness
+ * builds its timed repeats into the same output, so room grown once stays
+ * allocated and paged in; its contents on entry are unspecified.
  */
 typedef struct bvhlab_build_output {
 	uint32_t struct_size;     /* sizeof(bvhlab_build_output) in the host */
