@@ -55,9 +55,10 @@
  *
  * Cost: sweep keeps 4 primitive arrays of 32 bytes plus 5 bytes of
  * scratch per primitive (~133 MB for 1M triangles) and presorts in
- * sah_builder_init (single-threaded, O(N)); binned keeps one 32-byte
- * array. sah_split_job needs about 60 KB of stack for binned (bins live
- * there) and 6 KB for a small job; size thread stacks accordingly.
+ * sah_builder_init (single-threaded, O(N)); binned keeps two 32-byte
+ * arrays (~69 MB for 1M). sah_split_job needs about 60 KB of stack for
+ * binned (bins live there) and 6 KB for a small job; size thread stacks
+ * accordingly.
  */
 #ifndef BVHLAB_SAH_KERNEL_H
 #define BVHLAB_SAH_KERNEL_H
@@ -258,8 +259,9 @@ void sah_builder_root(const sah_builder *b, sah_job *root);
 
 /*
  * Processes one node: writes nodes[job->node] and returns 0 if it became a
- * leaf or, being small, was built with its whole subtree; or allocates two adjacent node slots (the node's children, first
- * and first + 1), fills child[0] (left) and child[1] (right) and returns 2.
+ * leaf or, being small, was built with its whole subtree; or allocates two
+ * adjacent node slots (the node's children, first and first + 1), fills
+ * child[0] (left) and child[1] (right) and returns 2.
  * Never fails, never allocates. Thread-safe on disjoint jobs (see above).
  */
 unsigned sah_split_job(sah_builder *b, const sah_job *job, sah_job child[2]);
