@@ -117,13 +117,14 @@ static int host_grow_output(bvhlab_build_ctx *ctx, bvhlab_build_output *out, uin
                             uint32_t indices)
 {
 	bvhlab_tree *t = ctx->tree;
-	if (bvhlab_tree_reserve(t, nodes, indices) < 0)
-		return -ENOMEM;
+	int rc = bvhlab_tree_reserve(t, nodes, indices);
+	/* Even a refused reserve may have moved the node array (it grows
+	 * first), so the builder gets the current pointers either way. */
 	out->nodes = t->nodes;
 	out->node_capacity = t->node_capacity;
 	out->prim_index = t->prim_index;
 	out->index_capacity = t->index_capacity;
-	return 0;
+	return rc < 0 ? -ENOMEM : 0;
 }
 
 static void host_progress(bvhlab_build_ctx *ctx, double fraction)
