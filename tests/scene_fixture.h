@@ -15,22 +15,6 @@
 
 #ifndef FIXTURE_SEED
 #error "define FIXTURE_SEED before including scene_fixture.h"
-/* A mesh of ../shared/scenes by file name; NULL (a failed check) if it
- * does not load. */
-static inline bvhlab_scene *load_shared(const char *file)
-{
-	char path[1024];
-	bvhlab_scene *scene = NULL;
-	bvhlab_error err = { { 0 } };
-
-	snprintf(path, sizeof(path), "%s/%s", BVHLAB_SHARED_SCENES, file);
-	if (bvhlab_scene_load(path, &scene, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"shared mesh loads");
-	}
-	return scene;
-}
-
 #endif
 
 /* A generated scene; 0 keeps a parameter's default. */

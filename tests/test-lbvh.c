@@ -19,18 +19,6 @@
 #define FIXTURE_SEED 5
 #include "scene_fixture.h"
 
-#if defined(__SANITIZE_THREAD__)
-#define UNDER_TSAN 1
-#elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define UNDER_TSAN 1
-#endif
-#endif
-#ifndef UNDER_TSAN
-#define UNDER_TSAN 0
-#endif
-
-#define SCALE(full, tsan) (UNDER_TSAN ? (tsan) : (full))
 #define RAYS 256
 #define RAY_SEED 4242
 

@@ -24,20 +24,6 @@
 #define FIXTURE_SEED 11
 #include "scene_fixture.h"
 
-#if defined(__SANITIZE_THREAD__)
-#define UNDER_TSAN 1
-#elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define UNDER_TSAN 1
-#endif
-#endif
-#ifndef UNDER_TSAN
-#define UNDER_TSAN 0
-#endif
-
-/* TSan runs ~10x slower: smaller generated scenes, fewer repeats. */
-#define SCALE(full, tsan) (UNDER_TSAN ? (tsan) : (full))
-
 static const char *const methods[] = { "sweep", "binned" };
 
 /* Thread counts and repeats per build; under TSan the shared meshes (which

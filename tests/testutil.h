@@ -48,6 +48,21 @@ static inline int test_finish(void)
 	return test_failures ? 1 : 0;
 }
 
+/* 1 in a ThreadSanitizer build (GCC defines the first, Clang the second). */
+#if defined(__SANITIZE_THREAD__)
+#define UNDER_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define UNDER_TSAN 1
+#endif
+#endif
+#ifndef UNDER_TSAN
+#define UNDER_TSAN 0
+#endif
+
+/* TSan runs ~10x slower: tests shrink their generated scenes and repeats. */
+#define SCALE(full, tsan) (UNDER_TSAN ? (tsan) : (full))
+
 /* Exit code meson treats as "skipped". */
 #define TEST_SKIP 77
 
