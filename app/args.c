@@ -98,3 +98,32 @@ int cli_load_scene(const char *spec, unsigned subdivide, bvhlab_scene **out, bvh
 	cs.generator = name;
 	return harness_load_scene(&cs, out, err);
 }
+
+int cli_target_open(struct cli_target *t, const char *plugin, const char *scene,
+                    unsigned subdivide, const char *const *options, int option_count)
+{
+	bvhlab_error err = {{0}};
+	*t = (struct cli_target){0};
+	if (bvhlab_plugin_open(plugin, &t->plugin, &err) < 0 ||
+	    bvhlab_options_init(&t->opts, bvhlab_plugin_builder(t->plugin)) < 0)
+		goto fail;
+	for (int k = 0; k < option_count; k++)
+		if (bvhlab_options_parse(&t->opts, options[k], &err) < 0)
+			goto fail;
+	if (cli_load_scene(scene, subdivide, &t->scene, &err) < 0)
+		goto fail;
+	return 0;
+fail:
+	fprintf(stderr, "bvhlab: %s\n", err.message[0] ? err.message : "out of memory");
+	cli_target_close(t);
+	return -1;
+}
+
+void cli_target_close(struct cli_target *t)
+{
+	bvhlab_scene_destroy(t->scene);
+	if (t->opts.values)
+		bvhlab_options_finish(&t->opts);
+	bvhlab_plugin_close(t->plugin);
+	*t = (struct cli_target){0};
+}

@@ -21,6 +21,22 @@ int cmd_report(int argc, char **argv);
  */
 int cli_load_scene(const char *spec, unsigned subdivide, bvhlab_scene **out, bvhlab_error *err);
 
+/* What `build` and `render` start from: a plugin, its options, a scene. */
+struct cli_target {
+	bvhlab_plugin *plugin;
+	bvhlab_options opts;
+	bvhlab_scene *scene;
+};
+
+/*
+ * Opens PLUGIN, applies its KEY=VALUE options and loads SCENE (see
+ * cli_load_scene); on failure prints why, leaves nothing open and
+ * returns -1.
+ */
+int cli_target_open(struct cli_target *t, const char *plugin, const char *scene,
+                    unsigned subdivide, const char *const *options, int option_count);
+void cli_target_close(struct cli_target *t);
+
 /* Parses a comma-separated list of thread counts ("1,2,0"). */
 int cli_parse_threads(const char *text, uint32_t *out, size_t max, size_t *count);
 

@@ -127,29 +127,12 @@ out:
 int cmd_build(int argc, char **argv)
 {
 	struct build_args a = {.threads = 1, .repeat = 1, .rays = 256};
-	if (parse(argc, argv, &a) < 0 || a.repeat == 0)
+	struct cli_target t;
+	if (parse(argc, argv, &a) < 0 || a.repeat == 0 ||
+	    cli_target_open(&t, argv[optind], argv[optind + 1], (unsigned)a.subdivide, a.options,
+	                    a.option_count) < 0)
 		return EXIT_USAGE;
-	bvhlab_plugin *p = NULL;
-	bvhlab_scene *scene = NULL;
-	bvhlab_options opts = {0};
-	bvhlab_error err = {{0}};
-	int status = EXIT_USAGE;
-	if (bvhlab_plugin_open(argv[optind], &p, &err) < 0 ||
-	    bvhlab_options_init(&opts, bvhlab_plugin_builder(p)) < 0)
-		goto fail;
-	for (int k = 0; k < a.option_count; k++)
-		if (bvhlab_options_parse(&opts, a.options[k], &err) < 0)
-			goto fail;
-	if (cli_load_scene(argv[optind + 1], (unsigned)a.subdivide, &scene, &err) < 0)
-		goto fail;
-	status = build_and_check(p, &opts, scene, &a);
-	goto out;
-fail:
-	fprintf(stderr, "bvhlab: %s\n", err.message[0] ? err.message : "out of memory");
-out:
-	bvhlab_scene_destroy(scene);
-	if (opts.values)
-		bvhlab_options_finish(&opts);
-	bvhlab_plugin_close(p);
+	int status = build_and_check(t.plugin, &t.opts, t.scene, &a);
+	cli_target_close(&t);
 	return status;
 }

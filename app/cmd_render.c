@@ -116,31 +116,17 @@ static int render(bvhlab_plugin *p, const bvhlab_options *opts, const bvhlab_sce
 int cmd_render(int argc, char **argv)
 {
 	struct render_args a = {.width = 512, .height = 512, .threads = 1};
-	if (parse_render(argc, argv, &a) < 0)
+	struct cli_target t;
+	if (parse_render(argc, argv, &a) < 0 ||
+	    cli_target_open(&t, argv[optind], argv[optind + 1], 0, a.options, a.option_count) < 0)
 		return EXIT_USAGE;
-	bvhlab_plugin *p = NULL;
-	bvhlab_scene *scene = NULL;
-	bvhlab_options opts = {0};
 	bvhlab_error err = {{0}};
-	int status = EXIT_USAGE;
-	if (bvhlab_plugin_open(argv[optind], &p, &err) < 0 ||
-	    bvhlab_options_init(&opts, bvhlab_plugin_builder(p)) < 0)
-		goto fail;
-	for (int k = 0; k < a.option_count; k++)
-		if (bvhlab_options_parse(&opts, a.options[k], &err) < 0)
-			goto fail;
-	if (cli_load_scene(argv[optind + 1], 0, &scene, &err) < 0)
-		goto fail;
-	status = render(p, &opts, scene, &a, &err) < 0 ? EXIT_RUNS_FAILED : 0;
-	if (status == 0)
-		goto out;
-fail:
-	fprintf(stderr, "bvhlab: %s\n", err.message[0] ? err.message : "out of memory");
-out:
-	bvhlab_scene_destroy(scene);
-	if (opts.values)
-		bvhlab_options_finish(&opts);
-	bvhlab_plugin_close(p);
+	int status = 0;
+	if (render(t.plugin, &t.opts, t.scene, &a, &err) < 0) {
+		fprintf(stderr, "bvhlab: %s\n", err.message[0] ? err.message : "out of memory");
+		status = EXIT_RUNS_FAILED;
+	}
+	cli_target_close(&t);
 	return status;
 }
 
