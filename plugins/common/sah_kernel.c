@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "big_alloc.h"
 #include "sah_bins_avx2.h"
 #include "sah_internal.h"
 
@@ -124,8 +125,8 @@ static int alloc_sweep(sah_builder *b, const bvhlab_build_input *input)
 	size_t n = b->prim_count;
 
 	for (int a = 0; a < 3; a++)
-		b->prims[a] = sah_big_alloc(n * sizeof(sah_prim));
-	b->temp = sah_big_alloc(n * sizeof(sah_prim));
+		b->prims[a] = big_alloc(n * sizeof(sah_prim));
+	b->temp = big_alloc(n * sizeof(sah_prim));
 	b->area = malloc(n * sizeof(float));
 	b->side = malloc(n);
 	if (!b->prims[0] || !b->prims[1] || !b->prims[2] || !b->temp || !b->area || !b->side)
@@ -153,8 +154,8 @@ int sah_builder_init(sah_builder *b, const sah_options *opt,
 		if (rc < 0)
 			goto fail;
 	} else {
-		b->prims[0] = sah_big_alloc((size_t)b->prim_count * sizeof(sah_prim));
-		b->alt = sah_big_alloc((size_t)b->prim_count * sizeof(sah_prim));
+		b->prims[0] = big_alloc((size_t)b->prim_count * sizeof(sah_prim));
+		b->alt = big_alloc((size_t)b->prim_count * sizeof(sah_prim));
 		if (!b->prims[0] || !b->alt)
 			goto fail;
 		sah_copy_prims(b, input, b->prims[0]);
@@ -168,11 +169,11 @@ fail:
 void sah_builder_free(sah_builder *b)
 {
 	for (int a = 0; a < 3; a++) {
-		sah_big_free(b->prims[a]);
+		big_free(b->prims[a]);
 		b->prims[a] = NULL;
 	}
-	sah_big_free(b->temp);
-	sah_big_free(b->alt);
+	big_free(b->temp);
+	big_free(b->alt);
 	b->alt = NULL;
 	free(b->area);
 	free(b->side);

@@ -64,7 +64,6 @@
 #define BVHLAB_SAH_KERNEL_H
 
 #include <stdatomic.h>
-#include <stddef.h>
 #include <stdint.h>
 
 #include <bvhlab/builder.h>
@@ -289,11 +288,6 @@ static inline uint32_t sah_node_count(sah_builder *b)
  * output->index_count = prim_count. Call once every job is done.
  */
 void sah_builder_finish(sah_builder *b, bvhlab_build_output *output);
-
-/* Large scratch arrays (64-byte aligned or better), in huge pages where
- * the system allows; sah_big_free(NULL) does nothing. */
-void *sah_big_alloc(size_t size);
-void sah_big_free(void *p);
 
 /* Frees the scratch; the output stays. Safe after a failed init. */
 void sah_builder_free(sah_builder *b);

@@ -1,48 +1,12 @@
 /*
- * The kernel's working arrays: their memory, and the copy of the input
- * boxes into them, which a parallel build shares out among its threads
- * (a serial copy of a million records would cap its speedup).
+ * The copy of the input boxes into the kernel's working arrays, which a
+ * parallel build shares out among its threads (a serial copy of a million
+ * records would cap its speedup).
  */
 #include <pthread.h>
 #include <stdbool.h>
-#include <sys/mman.h>
 
 #include "sah_internal.h"
-
-#define HUGE_PAGE ((size_t)2 << 20)
-#define BIG_HEADER 64
-
-/*
- * The working arrays are tens of megabytes, allocated anew by every build:
- * from malloc they are fresh 4 KiB pages whose faults cost as much as a
- * tree level. A private mapping asking for transparent huge pages takes
- * one fault per 2 MiB instead (where the system allows it; else the same
- * as malloc). The mapping's start and length sit just below the pointer.
- */
-void *sah_big_alloc(size_t size)
-{
-	size_t len = (size + BIG_HEADER + 2 * HUGE_PAGE - 1) & ~(HUGE_PAGE - 1);
-	char *base = mmap(NULL, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-
-	if (base == MAP_FAILED)
-		return NULL;
-#ifdef MADV_HUGEPAGE
-	(void)madvise(base, len, MADV_HUGEPAGE); /* a hint; fine if refused */
-#endif
-	uintptr_t at = ((uintptr_t)base + BIG_HEADER + HUGE_PAGE - 1) & ~(uintptr_t)(HUGE_PAGE - 1);
-	size_t *header = (size_t *)(void *)(at - BIG_HEADER);
-	header[0] = (uintptr_t)base;
-	header[1] = len;
-	return (void *)at;
-}
-
-void sah_big_free(void *p)
-{
-	if (!p)
-		return;
-	const size_t *header = (const size_t *)(const void *)((char *)p - BIG_HEADER);
-	munmap((void *)(uintptr_t)header[0], header[1]);
-}
 
 /* Most threads the copy uses, and fewest records each. */
 #define COPY_PARTS 16

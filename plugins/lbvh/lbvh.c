@@ -9,9 +9,9 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <time.h>
 
+#include "big_alloc.h"
 #include "lbvh.h"
 
 static const bvhlab_option_decl options[] = {
@@ -104,36 +104,14 @@ static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 
 /* ---- scratch ------------------------------------------------------------ */
 
-#define HUGE_PAGE ((size_t)2 << 20)
-
 struct scratch {
-	void *region;      /* one private mapping */
-	size_t region_size;
+	void *region;      /* one huge-page mapping (big_alloc), or NULL */
 	void *small;       /* hist, bucket, count */
 };
 
 static size_t align64(size_t x)
 {
 	return (x + 63) & ~(size_t)63;
-}
-
-/*
- * One private mapping, so that a build gives its memory back whole and,
- * with transparent huge pages, takes one page fault per 2 MiB instead of
- * one per 4 KiB: first touches are a large part of a build. The threads
- * touch the arrays first, each in its own chunk, so the faults are shared
- * out too.
- */
-static void *map_region(size_t size)
-{
-	void *p = mmap(NULL, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-
-	if (p == MAP_FAILED)
-		return NULL;
-#ifdef MADV_HUGEPAGE
-	(void)madvise(p, size, MADV_HUGEPAGE); /* a hint; fine if refused */
-#endif
-	return p;
 }
 
 /*
@@ -202,11 +180,13 @@ static int scratch_alloc(lbvh *b, const bvhlab_build_output *out, struct scratch
 	bool tree_out = spare && out->node_capacity >= nodes + spare;
 	uintptr_t past = (uintptr_t)(out->nodes + nodes);
 
-	s->region_size = ((tree_out ? 0 : tree) + (sort_out ? 0 : sort) + HUGE_PAGE - 1) &
-	                 ~(HUGE_PAGE - 1);
-	s->region = s->region_size ? map_region(s->region_size) : NULL;
+	size_t region = (tree_out ? 0 : tree) + (sort_out ? 0 : sort);
+
+	/* Zero-filled, which the arrival counters rely on when they live here;
+	 * the threads touch it first, each its own chunk, sharing the faults. */
+	s->region = region ? big_alloc(region) : NULL;
 	s->small = malloc(hist + (size_t)b->threads * 3 * sizeof(uint32_t));
-	if ((s->region_size && !s->region) || !s->small)
+	if ((region && !s->region) || !s->small)
 		return -ENOMEM;
 	b->scratch_dirty = tree_out;
 	place_tree(b, tree_out ? (char *)((past + 63) & ~(uintptr_t)63) : (char *)s->region);
@@ -219,8 +199,7 @@ static int scratch_alloc(lbvh *b, const bvhlab_build_output *out, struct scratch
 
 static void scratch_free(struct scratch *s)
 {
-	if (s->region)
-		munmap(s->region, s->region_size);
+	big_free(s->region);
 	free(s->small);
 }
 
