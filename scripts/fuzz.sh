@@ -58,7 +58,9 @@ install_fuzz_deps() {
 
 install_fuzz_deps || exit 1
 if [ ! -f "$build/build.ninja" ]; then
-	CC=clang meson setup "$build" "$BVHLAB_ROOT" -Dfuzz=true -Dtests=false \
+	# clang++ too: the core has C++ (the OpenImageIO writer), so C++ links
+	# the targets, and only clang's driver knows -fsanitize=fuzzer.
+	CC=clang CXX=clang++ meson setup "$build" "$BVHLAB_ROOT" -Dfuzz=true -Dtests=false \
 		-Dbuildtype=debugoptimized -Db_lundef=false -Db_sanitize=address,undefined >&2 || exit 1
 fi
 ninja -C "$build" "${targets[@]/#/fuzz/fuzz-}" >&2 || exit 1
@@ -67,12 +69,13 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
 status=0
 mkdir -p "$build/crashes"
+python3 "$BVHLAB_ROOT/fuzz/seeds.py" "$build/seeds" || exit 1
 for t in "${targets[@]}"; do
 	corpus="$build/corpus/$t"
 	mkdir -p "$corpus"
 	echo "== fuzz-$t: $seconds s ==" >&2
-	# The seeds stay as committed; what libFuzzer adds goes to the build's corpus.
-	"$build/fuzz/fuzz-$t" "$corpus" "$BVHLAB_ROOT/fuzz/corpus/$t" \
+	# The seeds are regenerated each time; what libFuzzer adds goes to the build's corpus.
+	"$build/fuzz/fuzz-$t" "$corpus" "$build/seeds/$t" \
 		-dict="$BVHLAB_ROOT/fuzz/$t.dict" -max_total_time="$seconds" -max_len=4096 \
 		-timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
 		-artifact_prefix="$build/crashes/$t-" ${BVHLAB_FUZZ_FLAGS:-} || status=1
