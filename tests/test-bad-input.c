@@ -237,7 +237,7 @@ static void test_fuzz_inputs(void)
 	static const char *const kinds[] = { "obj", "ply", "config" };
 	for (int k = 0; k < 3; k++) {
 		int regress = load_folder(BVHLAB_TEST_SRCDIR "/fuzz-regress", kinds[k]);
-		int seeds = load_folder(BVHLAB_TEST_SRCDIR "/../fuzz/corpus", kinds[k]);
+		int seeds = load_folder(BVHLAB_TEST_BUILDDIR "/fuzz-seeds", kinds[k]);
 		printf("%s: %d regression inputs, %d seeds\n", kinds[k], regress, seeds);
 		CHECK(seeds > 0);
 	}
