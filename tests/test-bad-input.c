@@ -18,9 +18,8 @@
 #include <bvhlab/bvhlab.h>
 
 #include "config.h"
+#include "scene_files.h"
 #include "testutil.h"
-
-static char tmpdir[64];
 
 static const char *in_tmp(const char *name)
 {
@@ -29,38 +28,6 @@ static const char *in_tmp(const char *name)
 	char *out = buf[next++ % 8];
 	snprintf(out, sizeof(buf[0]), "%s/%s", tmpdir, name);
 	return out;
-}
-
-static const char *write_file(const char *name, const void *data, size_t len)
-{
-	const char *path = in_tmp(name);
-	FILE *f = fopen(path, "wb");
-	if (!f) {
-		perror(path);
-		exit(1);
-	}
-	fwrite(data, 1, len, f);
-	fclose(f);
-	return path;
-}
-
-static const char *write_text(const char *name, const char *text)
-{
-	return write_file(name, text, strlen(text));
-}
-
-/* Loading fails with `code` and a message holding the path, then `needle`. */
-static void expect_scene_error(const char *path, int code, const char *needle)
-{
-	bvhlab_scene *s = NULL;
-	bvhlab_error err = { "" };
-	char where[512];
-
-	CHECK_INT(bvhlab_scene_load(path, &s, &err), code);
-	CHECK(s == NULL);
-	snprintf(where, sizeof(where), "%s%s", path, needle);
-	CHECK_CONTAINS(err.message, where);
-	bvhlab_scene_destroy(s);
 }
 
 #define PLY_XYZ "property float x\nproperty float y\nproperty float z\n"
@@ -245,11 +212,7 @@ static void test_fuzz_inputs(void)
 
 int main(void)
 {
-	snprintf(tmpdir, sizeof(tmpdir), "/tmp/bvhlab-bad-input-XXXXXX");
-	if (!mkdtemp(tmpdir)) {
-		perror("mkdtemp");
-		return 1;
-	}
+	tmp_begin("bad-input");
 	test_empty();
 	test_element_counts();
 	test_degenerate_ply();

@@ -11,53 +11,12 @@
 #include <bvhlab/scene.h>
 
 #include "scene_private.h"
+#include "scene_files.h"
 #include "testutil.h"
-
-static char tmpdir[64];
-static char paths[32][128];
-static int path_count;
-
-/* Writes `text` to tmpdir/name and returns the path. */
-static const char *write_file(const char *name, const char *text)
-{
-	char *path = paths[path_count++];
-	FILE *f;
-
-	snprintf(path, sizeof(paths[0]), "%s/%s", tmpdir, name);
-	f = fopen(path, "wb");
-	if (!f) {
-		perror(path);
-		exit(1);
-	}
-	fputs(text, f);
-	fclose(f);
-	return path;
-}
-
-static void cleanup(void)
-{
-	for (int i = 0; i < path_count; i++)
-		unlink(paths[i]);
-	rmdir(tmpdir);
-}
-
-static bool vertex_is(const bvhlab_scene *s, uint32_t i, float x, float y, float z)
-{
-	const float *v = s->vertices + 3 * i;
-
-	return v[0] == x && v[1] == y && v[2] == z;
-}
-
-static bool triangle_is(const bvhlab_scene *s, uint32_t t, uint32_t a, uint32_t b, uint32_t c)
-{
-	const uint32_t *i = s->indices + 3 * t;
-
-	return i[0] == a && i[1] == b && i[2] == c;
-}
 
 static void test_statements(void)
 {
-	const char *path = write_file("mixed.obj",
+	const char *path = write_text("mixed.obj",
 		"# a comment\r\n"
 		"mtllib scene.mtl\r\n"
 		"o thing\r\n"
@@ -103,7 +62,7 @@ static void test_statements(void)
 
 static void test_relative_and_forward(void)
 {
-	const char *path = write_file("rel.obj",
+	const char *path = write_text("rel.obj",
 		"v 0 0 0\nv 1 0 0\nv 0 1 0\n"
 		"f -3 -2 -1\n"
 		"f 4 1 2\n" /* refers forward to a later vertex */
@@ -124,7 +83,7 @@ static void test_relative_and_forward(void)
 
 static void test_degenerate(void)
 {
-	const char *path = write_file("degen.obj",
+	const char *path = write_text("degen.obj",
 		"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\n"
 		"f 1 2 3\n"  /* collinear */
 		"f 1 1 4\n"  /* repeated vertex */
@@ -140,19 +99,13 @@ static void test_degenerate(void)
 	bvhlab_scene_destroy(s);
 }
 
-/* Loading `text` fails with -EINVAL and a message containing `needle`. */
+/* Loading `text` fails with -EINVAL and a message containing PATH:`needle`. */
 static void check_error(const char *name, const char *text, const char *needle)
 {
-	const char *path = write_file(name, text);
-	bvhlab_scene *s = NULL;
-	bvhlab_error err = { "" };
-	char where[256];
+	char at_line[256];
 
-	CHECK_INT(bvhlab_scene_load(path, &s, &err), -EINVAL);
-	CHECK(s == NULL);
-	snprintf(where, sizeof(where), "%s:%s", path, needle);
-	CHECK_CONTAINS(err.message, where);
-	bvhlab_scene_destroy(s);
+	snprintf(at_line, sizeof(at_line), ":%s", needle);
+	expect_scene_error(write_text(name, text), -EINVAL, at_line);
 }
 
 static void test_errors(void)
@@ -183,7 +136,7 @@ static void test_errors(void)
 
 static void test_no_faces_and_files(void)
 {
-	const char *path = write_file("nofaces.obj", "v 0 0 0\n");
+	const char *path = write_text("nofaces.obj", "v 0 0 0\n");
 	bvhlab_scene *s = NULL;
 	bvhlab_error err = { "" };
 	char missing[160];
@@ -196,12 +149,12 @@ static void test_no_faces_and_files(void)
 	CHECK_CONTAINS(err.message, missing);
 	CHECK(s == NULL);
 
-	path = write_file("model.stl", "solid\n");
+	path = write_text("model.stl", "solid\n");
 	CHECK_INT(bvhlab_scene_load(path, &s, &err), -EINVAL);
 	CHECK_CONTAINS(err.message, "model.stl");
 	CHECK_CONTAINS(err.message, ".obj or .ply");
 
-	path = write_file("UPPER.OBJ", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+	path = write_text("UPPER.OBJ", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
 	CHECK_INT(bvhlab_scene_load(path, &s, &err), 0);
 	CHECK(s && s->triangle_count == 1 && strcmp(s->name, "UPPER") == 0);
 	bvhlab_scene_destroy(s);
@@ -212,14 +165,12 @@ static void test_no_faces_and_files(void)
 static void test_large(void)
 {
 	const int n = 317; /* (n-1)^2 * 2 = 199712 triangles */
-	char path[160];
+	const char *path = tmp_file("grid.obj");
 	bvhlab_scene *s = NULL;
 	bvhlab_error err = { "" };
 	FILE *f;
 	bool ok = true;
 
-	snprintf(path, sizeof(path), "%s/grid.obj", tmpdir);
-	strcpy(paths[path_count++], path);
 	f = fopen(path, "w");
 	for (int i = 0; i < n * n; i++)
 		fprintf(f, "v %d.25 %d.5 -0.125\n", i % n, i / n);
@@ -244,17 +195,13 @@ static void test_large(void)
 
 int main(void)
 {
-	strcpy(tmpdir, "/tmp/bvhlab-test-obj-XXXXXX");
-	if (!mkdtemp(tmpdir)) {
-		perror("mkdtemp");
-		return 1;
-	}
+	tmp_begin("obj");
 	test_statements();
 	test_relative_and_forward();
 	test_degenerate();
 	test_errors();
 	test_no_faces_and_files();
 	test_large();
-	cleanup();
+	tmp_end();
 	return test_finish();
 }

@@ -10,11 +10,8 @@
 
 #include <bvhlab/scene.h>
 
+#include "scene_files.h"
 #include "testutil.h"
-
-static char tmpdir[64];
-static char paths[48][128];
-static int path_count;
 
 /* A file being assembled: header text, then binary or text body. */
 struct buf {
@@ -46,44 +43,9 @@ static void put_u32(struct buf *b, uint32_t v) { put_bytes(b, &v, 4); }
 static void put_f32(struct buf *b, float v) { put_bytes(b, &v, 4); }
 static void put_f64(struct buf *b, double v) { put_bytes(b, &v, 8); }
 
-static const char *write_file(const char *name, const void *data, size_t len)
-{
-	char *path = paths[path_count++];
-	FILE *f;
-
-	snprintf(path, sizeof(paths[0]), "%s/%s", tmpdir, name);
-	f = fopen(path, "wb");
-	if (!f) {
-		perror(path);
-		exit(1);
-	}
-	fwrite(data, 1, len, f);
-	fclose(f);
-	return path;
-}
-
 static const char *write_buf(const char *name, const struct buf *b)
 {
 	return write_file(name, b->data, b->len);
-}
-
-static const char *write_text(const char *name, const char *text)
-{
-	return write_file(name, text, strlen(text));
-}
-
-static bool vertex_is(const bvhlab_scene *s, uint32_t i, float x, float y, float z)
-{
-	const float *v = s->vertices + 3 * i;
-
-	return v[0] == x && v[1] == y && v[2] == z;
-}
-
-static bool triangle_is(const bvhlab_scene *s, uint32_t t, uint32_t a, uint32_t b, uint32_t c)
-{
-	const uint32_t *i = s->indices + 3 * t;
-
-	return i[0] == a && i[1] == b && i[2] == c;
 }
 
 static bvhlab_scene *load_ok(const char *path)
@@ -96,20 +58,6 @@ static bvhlab_scene *load_ok(const char *path)
 	if (ret)
 		fprintf(stderr, "  %s\n", err.message);
 	return s;
-}
-
-/* Loading fails with `code` and a message containing PATH then `needle`. */
-static void check_error(const char *path, int code, const char *needle)
-{
-	bvhlab_scene *s = NULL;
-	bvhlab_error err = { "" };
-	char where[256];
-
-	CHECK_INT(bvhlab_scene_load(path, &s, &err), code);
-	CHECK(s == NULL);
-	snprintf(where, sizeof(where), "%s%s", path, needle);
-	CHECK_CONTAINS(err.message, where);
-	bvhlab_scene_destroy(s);
 }
 
 static const char ascii_ply[] =
@@ -315,32 +263,32 @@ static void test_binary_errors(void)
 	b.len -= 3;
 	path = write_buf("cut.ply", &b);
 	snprintf(needle, sizeof(needle), ": byte offset %zu: truncated file", b.len - 1);
-	check_error(path, -EINVAL, needle);
+	expect_scene_error(path, -EINVAL, needle);
 
 	build_le(&b);
 	b.data[faces + 1 + 4] = 4; /* second index of the first face: 4 of 4 vertices */
 	path = write_buf("badindex.ply", &b);
 	snprintf(needle, sizeof(needle), ": byte offset %zu: vertex index 4 out of range",
 	         faces + 1 + 4);
-	check_error(path, -EINVAL, needle);
+	expect_scene_error(path, -EINVAL, needle);
 
 	build_le(&b);
 	memset(b.data + faces + 1 + 8, 0xff, 4); /* -1 in a face */
 	path = write_buf("negindex.ply", &b);
 	snprintf(needle, sizeof(needle), ": byte offset %zu: negative vertex index", faces + 9);
-	check_error(path, -EINVAL, needle);
+	expect_scene_error(path, -EINVAL, needle);
 
 	build_le(&b);
 	memcpy(b.data + header + 24 + 4, (const unsigned char[]){ 0, 0, 0xc0, 0x7f }, 4); /* NaN */
 	path = write_buf("nan.ply", &b);
 	snprintf(needle, sizeof(needle), ": byte offset %zu: vertex 1: coordinate y is NaN",
 	         header + 28);
-	check_error(path, -EINVAL, needle);
+	expect_scene_error(path, -EINVAL, needle);
 
 	build_le(&b);
 	b.len = header + 10; /* inside the vertices */
 	path = write_buf("cutvertex.ply", &b);
-	check_error(path, -EINVAL, ": byte offset");
+	expect_scene_error(path, -EINVAL, ": byte offset");
 }
 
 static void test_header_errors(void)
@@ -351,31 +299,31 @@ static void test_header_errors(void)
 	char text[1024];
 	char missing[160];
 
-	check_error(write_text("magic.ply", "plx\nformat ascii 1.0\n"), -EINVAL,
+	expect_scene_error(write_text("magic.ply", "plx\nformat ascii 1.0\n"), -EINVAL,
 	            ":1: bad PLY header");
-	check_error(write_text("fmt.ply", "ply\nformat utf8 1.0\n"), -EINVAL, ":2: bad PLY header");
+	expect_scene_error(write_text("fmt.ply", "ply\nformat utf8 1.0\n"), -EINVAL, ":2: bad PLY header");
 	snprintf(text, sizeof(text), "ply\nformat ascii 1.0\nelement vertex 3\nproperty flt x\n%s",
 	         ok_tail);
-	check_error(write_text("type.ply", text), -EINVAL,
+	expect_scene_error(write_text("type.ply", text), -EINVAL,
 	            ":4: bad PLY header: unknown property type");
-	check_error(write_text("noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"), -EINVAL,
+	expect_scene_error(write_text("noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"), -EINVAL,
 	            ":4: bad PLY header: missing 'end_header'");
 	snprintf(text, sizeof(text), "ply\nformat ascii 1.0\nproperty float x\n");
-	check_error(write_text("noelem.ply", text), -EINVAL, ":3: bad PLY header: property before");
+	expect_scene_error(write_text("noelem.ply", text), -EINVAL, ":3: bad PLY header: property before");
 	snprintf(text, sizeof(text), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
 	         "property float y\n%s", ok_tail);
-	check_error(write_text("noz.ply", text), -EINVAL,
+	expect_scene_error(write_text("noz.ply", text), -EINVAL,
 	            ":3: element 'vertex' has no property 'z'");
 	snprintf(text, sizeof(text), "ply\nformat ascii 1.0\nelement vertex 3\n%send_header\n"
 	         "0 0 0\n1 0 0\n0 1 0\n", xyz);
-	check_error(write_text("nofaces.ply", text), -EINVAL, ":7: no faces");
+	expect_scene_error(write_text("nofaces.ply", text), -EINVAL, ":7: no faces");
 	snprintf(text, sizeof(text), "ply\nformat ascii 1.0\nelement vertex 3\n%s"
 	         "element face 0\nproperty list uchar int vertex_indices\nend_header\n"
 	         "0 0 0\n1 0 0\n0 1 0\n", xyz);
-	check_error(write_text("zerofaces.ply", text), -EINVAL, ":9: no faces");
+	expect_scene_error(write_text("zerofaces.ply", text), -EINVAL, ":9: no faces");
 
 	snprintf(missing, sizeof(missing), "%s/missing.ply", tmpdir);
-	check_error(missing, -ENOENT, ": cannot open");
+	expect_scene_error(missing, -ENOENT, ": cannot open");
 }
 
 static void test_ascii_errors(void)
@@ -386,19 +334,19 @@ static void test_ascii_errors(void)
 	char text[512];
 
 	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", head);
-	check_error(write_text("a-range.ply", text), -EINVAL, ":13: vertex index 3 out of range");
+	expect_scene_error(write_text("a-range.ply", text), -EINVAL, ":13: vertex index 3 out of range");
 	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n3 0 -2 1\n", head);
-	check_error(write_text("a-neg.ply", text), -EINVAL, ":13: negative vertex index");
+	expect_scene_error(write_text("a-neg.ply", text), -EINVAL, ":13: negative vertex index");
 	snprintf(text, sizeof(text), "%s0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n", head);
-	check_error(write_text("a-num.ply", text), -EINVAL, ":11: malformed number");
+	expect_scene_error(write_text("a-num.ply", text), -EINVAL, ":11: malformed number");
 	snprintf(text, sizeof(text), "%s0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n", head);
-	check_error(write_text("a-inf.ply", text), -EINVAL, ":11: vertex 1: coordinate y is NaN");
+	expect_scene_error(write_text("a-inf.ply", text), -EINVAL, ":11: vertex 1: coordinate y is NaN");
 	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n3 0 1\n", head);
-	check_error(write_text("a-cut.ply", text), -EINVAL, ":13: truncated file");
+	expect_scene_error(write_text("a-cut.ply", text), -EINVAL, ":13: truncated file");
 	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n2 0 1\n", head);
-	check_error(write_text("a-short.ply", text), -EINVAL, ":13: face 0 has 2 vertices");
+	expect_scene_error(write_text("a-short.ply", text), -EINVAL, ":13: face 0 has 2 vertices");
 	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n300 0 1 2\n", head);
-	check_error(write_text("a-count.ply", text), -EINVAL, ":13: value out of range");
+	expect_scene_error(write_text("a-count.ply", text), -EINVAL, ":13: value out of range");
 }
 
 /* Faces may come before the vertices they index. */
@@ -425,20 +373,9 @@ static void test_extension_case(void)
 	bvhlab_scene_destroy(s);
 }
 
-static void cleanup(void)
-{
-	for (int i = 0; i < path_count; i++)
-		unlink(paths[i]);
-	rmdir(tmpdir);
-}
-
 int main(void)
 {
-	strcpy(tmpdir, "/tmp/bvhlab-test-ply-XXXXXX");
-	if (!mkdtemp(tmpdir)) {
-		perror("mkdtemp");
-		return 1;
-	}
+	tmp_begin("ply");
 	test_ascii();
 	test_binary_le();
 	test_binary_be();
@@ -449,6 +386,6 @@ int main(void)
 	test_ascii_errors();
 	test_faces_first();
 	test_extension_case();
-	cleanup();
+	tmp_end();
 	return test_finish();
 }
