@@ -446,14 +446,23 @@ static int number_text(const struct json_locations *loc, const cJSON *item, cons
 	return *p ? 0 : -EINVAL;
 }
 
-int json_get_int64(const struct json_locations *locations, const cJSON *item, int64_t *out)
+/* A JSON integer as its sign and exact magnitude. */
+static int signed_magnitude(const struct json_locations *loc, const cJSON *item, bool *negative,
+                            uint64_t *m)
 {
 	const char *p;
+	int rc = number_text(loc, item, &p);
+	if (rc)
+		return rc;
+	*negative = *p == '-';
+	return exact_magnitude(p + *negative, m);
+}
+
+int json_get_int64(const struct json_locations *locations, const cJSON *item, int64_t *out)
+{
+	bool negative;
 	uint64_t m;
-	int rc = number_text(locations, item, &p);
-	bool negative = !rc && *p == '-';
-	if (!rc)
-		rc = exact_magnitude(p + negative, &m);
+	int rc = signed_magnitude(locations, item, &negative, &m);
 	if (rc)
 		return rc;
 	if (m > (uint64_t)INT64_MAX + negative)
@@ -467,12 +476,9 @@ int json_get_int64(const struct json_locations *locations, const cJSON *item, in
 
 int json_get_uint64(const struct json_locations *locations, const cJSON *item, uint64_t *out)
 {
-	const char *p;
+	bool negative;
 	uint64_t m;
-	int rc = number_text(locations, item, &p);
-	bool negative = !rc && *p == '-';
-	if (!rc)
-		rc = exact_magnitude(p + negative, &m);
+	int rc = signed_magnitude(locations, item, &negative, &m);
 	if (rc)
 		return rc;
 	if (negative && m != 0)
