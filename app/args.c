@@ -1,11 +1,13 @@
 /* Argument helpers shared by the subcommands. */
 #include <errno.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
 #include "cli.h"
+#include "config.h"
 #include "harness.h"
 
 int cli_parse_uint(const char *opt, const char *text, unsigned long max, unsigned long *out)
@@ -28,8 +30,13 @@ int cli_parse_threads(const char *text, uint32_t *out, size_t max, size_t *count
 		char *end = NULL;
 		errno = 0;
 		unsigned long v = strtoul(p, &end, 10);
-		if (end == p || errno || v > 4096 || (*end && *end != ',') || *count == max ||
-		    *p == '-') {
+		if (end != p && !errno && *p != '-' && v > CONFIG_MAX_THREADS) {
+			fprintf(stderr, "bvhlab: --threads: %.*s is more than the limit of %d threads\n",
+			        (int)strcspn(p, ","), p, CONFIG_MAX_THREADS);
+			return -EINVAL;
+		}
+		if (end == p || errno || (*end && *end != ',') || *count == max || *p < '0' ||
+		    *p > '9') {
 			fprintf(stderr, "bvhlab: --threads needs a list like 1,2,0 (0 = all "
 			                "cores, at most %zu entries), not '%s'\n", max, text);
 			return -EINVAL;
@@ -50,11 +57,13 @@ static int gen_param(bvhlab_gen_params *g, const char *kv, bvhlab_error *err)
 	static const char *keys[] = {"frequency", "count", "size", "seed"};
 	const char *eq = strchr(kv, '=');
 	char *end = NULL;
-	unsigned long long v = eq ? strtoull(eq + 1, &end, 10) : 0;
+	/* strtoull takes "-1" (as 2^64 - 1) and leading blanks: digits only. */
+	bool digits = eq && eq[1] >= '0' && eq[1] <= '9';
+	unsigned long long v = digits ? strtoull(eq + 1, &end, 10) : 0;
 	for (int k = 0; eq && k < 4; k++) {
 		if (strncmp(kv, keys[k], (size_t)(eq - kv)) || strlen(keys[k]) != (size_t)(eq - kv))
 			continue;
-		if (!eq[1] || (end && *end && *end != ',') || (k < 3 && v > UINT32_MAX))
+		if (!digits || (end && *end && *end != ',') || (k < 3 && v > UINT32_MAX))
 			break;
 		uint32_t *fields[] = {&g->frequency, &g->count, &g->size};
 		if (k < 3)

@@ -89,6 +89,11 @@ void config_finish(struct config *cfg);
 int config_apply_options(const struct config *cfg, const struct config_builder *b,
                          bvhlab_options *opts, bvhlab_error *err);
 
+/* The most threads a run may ask for, in a config or on the command line:
+ * beyond any machine this runs on, and small enough that a plugin's
+ * per-thread arrays stay reasonable. */
+#define CONFIG_MAX_THREADS 1024
+
 /* Replaces the thread list (command line --threads). */
 int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count);
 

@@ -304,7 +304,7 @@ static int thread_entries(const struct config *cfg, const cJSON *array, const ch
 		char element[FULL_NAME_SIZE + 24];
 		uint64_t v;
 		snprintf(element, sizeof(element), "%s[%zu]", name, i);
-		int rc = item_uint(cfg, e, element, 0, UINT32_MAX, &v, err);
+		int rc = item_uint(cfg, e, element, 0, CONFIG_MAX_THREADS, &v, err);
 		if (rc)
 			return rc;
 		threads[i] = (uint32_t)v;

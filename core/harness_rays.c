@@ -7,6 +7,7 @@
  * scene is done, because the heat maps share one colour scale.
  */
 #include <errno.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,6 +17,7 @@
 #include "harness.h"
 #include "image.h"
 #include "results.h"
+#include "safe_file.h"
 #include "util.h"
 
 #define DIFFUSE_SEED 0xd1ff05eULL
@@ -82,14 +84,15 @@ int harness_temp_path(char *buf, size_t size, const char *dir, const char *kind,
 
 int harness_write_raw(const char *path, const void *data, size_t bytes)
 {
-	FILE *f = fopen(path, "wb");
-	if (!f)
-		return -errno;
-	bool ok = fwrite(data, 1, bytes, f) == bytes;
-	ok = fclose(f) == 0 && ok;
-	if (!ok)
+	int fd = safe_create(path);
+	if (fd < 0)
+		return fd;
+	int r = safe_write_all(fd, data, bytes);
+	if (close(fd) < 0 && r == 0)
+		r = -errno;
+	if (r < 0)
 		unlink(path);
-	return ok ? 0 : -EIO;
+	return r;
 }
 
 /* Exactly `bytes` bytes of the file, or an error (a short file is one). */
@@ -103,28 +106,94 @@ static int read_raw(const char *path, void *data, size_t bytes)
 	return ok ? 0 : -EIO;
 }
 
+/* FNV-1a: a short, stable tag of a name that had to change. */
+static uint32_t name_hash(const char *name)
+{
+	uint32_t h = 2166136261u;
+	for (const unsigned char *p = (const unsigned char *)name; *p; p++)
+		h = (h ^ *p) * 16777619u;
+	return h;
+}
+
+/*
+ * A file name part for `name`: kept as it is when it is already safe, else
+ * sanitised plus "-" and the hash of the original, so that "a b", "a/b"
+ * and "a_b" (or "ü" and "é") get images of their own. Never hidden (no
+ * leading dot) and never with "--", which separates the parts.
+ */
+static void image_stem(const char *name, char *out, size_t size)
+{
+	const size_t tag = 10; /* "-" + 8 hex digits + NUL */
+	image_sanitise(name, out, size - tag);
+	bool changed = strcmp(out, name) != 0 || !*out || out[0] == '.' || strstr(out, "--");
+	if (out[0] == '.')
+		out[0] = '_';
+	if (changed)
+		snprintf(out + strlen(out), tag, "-%08x", (unsigned)name_hash(name));
+}
+
 /* images/<scene>--<builder>--<what>.png, relative to the output folder. */
 void harness_image_name(char *buf, size_t size, const char *scene, const char *builder,
                         const char *what)
 {
 	char s[128], b[128];
-	image_sanitise(scene, s, sizeof(s));
+	image_stem(scene, s, sizeof(s));
 	if (!builder) {
 		snprintf(buf, size, "images/%s%s%s.png", s, what ? "--" : "", what ? what : "");
 		return;
 	}
-	image_sanitise(builder, b, sizeof(b));
+	image_stem(builder, b, sizeof(b));
 	snprintf(buf, size, "images/%s--%s--%s.png", s, b, what);
+}
+
+/*
+ * dir/images/.tmp-NAME.png, created empty here (no link followed) for the
+ * image writer to fill; the image is renamed into place once complete.
+ */
+static int temp_image(const char *dir, const char *name, char *tmp, char *path, size_t size)
+{
+	const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
+	if ((size_t)snprintf(path, size, "%s/%s", dir, name) >= size ||
+	    (size_t)snprintf(tmp, size, "%s/images/.tmp-%s", dir, base) >= size)
+		return -ENAMETOOLONG;
+	int fd = safe_create(tmp);
+	if (fd < 0)
+		return fd;
+	close(fd);
+	return 0;
+}
+
+static int image_into_place(const char *tmp, const char *path, int r, bvhlab_error *err)
+{
+	if (r == 0 && rename(tmp, path) < 0) {
+		r = -errno;
+		error_set(err, "cannot write %s: %s", path, strerror(-r));
+	}
+	if (r < 0)
+		unlink(tmp);
+	return r;
 }
 
 /* Writes one PNG under dir; name is relative ("images/..."). */
 static int write_png(const char *dir, const char *name, uint32_t w, uint32_t h,
                      const uint8_t *rgb, bvhlab_error *err)
 {
-	char path[4096];
-	if ((size_t)snprintf(path, sizeof(path), "%s/%s", dir, name) >= sizeof(path))
-		return -ENAMETOOLONG;
-	return image_write_rgb8(path, (int)w, (int)h, rgb, err);
+	char path[4096], tmp[4096];
+	int r = temp_image(dir, name, tmp, path, sizeof(path));
+	if (r < 0)
+		return r;
+	r = image_write_rgb8(tmp, (int)w, (int)h, rgb, err);
+	return image_into_place(tmp, path, r, err);
+}
+
+static int write_legend(const char *dir, const char *name, bvhlab_error *err)
+{
+	char path[4096], tmp[4096];
+	int r = temp_image(dir, name, tmp, path, sizeof(path));
+	if (r < 0)
+		return r;
+	r = image_write_legend(tmp, LEGEND_W, LEGEND_H, err);
+	return image_into_place(tmp, path, r, err);
 }
 
 /* Loads every builder's heat file (NULL where there is none) and the range. */
@@ -175,11 +244,7 @@ static int heat_images(struct results *res, const struct scene_images *si, bvhla
 	}
 	if (r == 0 && written) {
 		harness_image_name(name, sizeof(name), si->scene, NULL, "legend");
-		char path[4096];
-		if ((size_t)snprintf(path, sizeof(path), "%s/%s", si->dir, name) >= sizeof(path))
-			r = -ENAMETOOLONG;
-		else
-			r = image_write_legend(path, LEGEND_W, LEGEND_H, err);
+		r = write_legend(si->dir, name, err);
 		if (r == 0)
 			r = results_set_scene_image(res, si->scene, "legend", name, lo, hi);
 	}

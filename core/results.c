@@ -13,6 +13,7 @@
 
 #include "harness.h"
 #include "results.h"
+#include "safe_file.h"
 #include "util.h"
 
 /* mkdir -p: creates every missing folder of `path`. */
@@ -224,28 +225,7 @@ int results_add_run(struct results *res, const struct run_record *run)
 
 int results_write_file(const char *dir, const char *name, const char *text, bvhlab_error *err)
 {
-	char path[4096], tmp[4096];
-	if ((size_t)snprintf(path, sizeof(path), "%s/%s", dir, name) >= sizeof(path) ||
-	    (size_t)snprintf(tmp, sizeof(tmp), "%s/.%s.tmp", dir, name) >= sizeof(tmp)) {
-		error_set(err, "path too long: %s/%s", dir, name);
-		return -ENAMETOOLONG;
-	}
-	FILE *f = fopen(tmp, "w");
-	if (!f)
-		goto fail;
-	size_t len = strlen(text);
-	bool ok = fwrite(text, 1, len, f) == len;
-	ok = (fflush(f) == 0) && ok;
-	/* On disk before the rename: a crash then leaves the old file or the new, never half. */
-	ok = (fsync(fileno(f)) == 0) && ok;
-	ok = (fclose(f) == 0) && ok;
-	if (ok && rename(tmp, path) == 0)
-		return 0;
-fail:;
-	int e = errno ? errno : EIO;
-	error_set(err, "cannot write %s: %s", path, strerror(e));
-	unlink(tmp);
-	return -e;
+	return safe_write_file(dir, name, text, strlen(text), err);
 }
 
 /* One rendering of the document into one file. */

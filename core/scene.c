@@ -9,6 +9,8 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <fcntl.h>
+#include <unistd.h>
 
 #include "scene_private.h"
 
@@ -89,11 +91,11 @@ int scene_set_path_names(bvhlab_scene *scene, const char *path)
 }
 
 /* The size of an open regular file; a directory or a pipe is refused. */
-static int regular_file_size(FILE *f, const char *path, size_t *size, bvhlab_error *err)
+static int regular_file_size(int fd, const char *path, size_t *size, bvhlab_error *err)
 {
 	struct stat st;
 
-	if (fstat(fileno(f), &st) != 0) {
+	if (fstat(fd, &st) != 0) {
 		scene_error(err, "%s: cannot stat: %s", path, strerror(errno));
 		return -EIO;
 	}
@@ -105,25 +107,42 @@ static int regular_file_size(FILE *f, const char *path, size_t *size, bvhlab_err
 	return 0;
 }
 
+/* Exactly `size` bytes from fd; a file that shrank meanwhile is a read error. */
+static int read_exact(int fd, char *buf, size_t size)
+{
+	size_t got = 0;
+	while (got < size) {
+		ssize_t n = read(fd, buf + got, size - got);
+		if (n < 0 && errno == EINTR)
+			continue;
+		if (n <= 0)
+			return -EIO;
+		got += (size_t)n;
+	}
+	return 0;
+}
+
 int scene_read_file(const char *path, char **data, size_t *size, bvhlab_error *err)
 {
-	FILE *f = fopen(path, "rb");
+	/* O_NONBLOCK: opening a FIFO for reading would wait for a writer forever;
+	 * this way it opens at once and fstat refuses it. */
+	int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
 	char *buf = NULL;
 	int ret;
 
-	if (!f) {
+	if (fd < 0) {
 		ret = -errno;
 		scene_error(err, "%s: cannot open: %s", path, strerror(errno));
 		return ret;
 	}
-	ret = regular_file_size(f, path, size, err);
+	ret = regular_file_size(fd, path, size, err);
 	if (ret)
 		goto out;
 	buf = malloc(*size + 1);
 	if (!buf) {
 		ret = -ENOMEM;
 		scene_error(err, "%s: out of memory reading %zu bytes", path, *size);
-	} else if (fread(buf, 1, *size, f) != *size) {
+	} else if (read_exact(fd, buf, *size) < 0) {
 		ret = -EIO;
 		scene_error(err, "%s: read error", path);
 	} else {
@@ -133,7 +152,7 @@ int scene_read_file(const char *path, char **data, size_t *size, bvhlab_error *e
 	}
 out:
 	free(buf);
-	fclose(f);
+	close(fd);
 	return ret;
 }
 

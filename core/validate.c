@@ -58,12 +58,15 @@ static int check_counts(vstate *st)
 	return 0;
 }
 
-static bool has_nan(const float *lo, const float *hi)
+/* Scene coordinates are finite (the loaders refuse others), so a box with
+ * NaN or an infinite bound is the builder's doing; it also makes every
+ * surface area, and so the SAH cost, NaN. */
+static bool non_finite(const float *lo, const float *hi)
 {
 	int k;
 
 	for (k = 0; k < 3; k++)
-		if (isnan(lo[k]) || isnan(hi[k]))
+		if (!isfinite(lo[k]) || !isfinite(hi[k]))
 			return true;
 	return false;
 }
@@ -96,8 +99,8 @@ static int reach(vstate *st, uint32_t node, uint32_t parent)
 	if (test_and_set(st->visited, node))
 		return FAIL(st, "node %" PRIu32 " reachable twice (cycle or shared child; "
 		            "again from node %" PRIu32 ")", node, parent);
-	if (has_nan(n->lo, n->hi))
-		return FAIL(st, "node %" PRIu32 ": box has NaN", node);
+	if (non_finite(n->lo, n->hi))
+		return FAIL(st, "node %" PRIu32 ": box has NaN or an infinite bound", node);
 	if (parent != NONE && !contains(&st->tree->nodes[parent], n->lo, n->hi))
 		return FAIL(st, "node %" PRIu32 ": box does not contain child %" PRIu32, parent,
 		            node);

@@ -176,6 +176,12 @@ static void test_nan(void)
 	snprintf(needle, sizeof(needle), "node %u: box has NaN", leaf);
 	expect(&t, false, needle);
 	bvhlab_tree_finish(&t);
+
+	/* An infinite root box contains every child, yet makes the SAH cost NaN. */
+	tree_copy(&t, &fx.tree, 0);
+	t.nodes[0].lo[0] = -INFINITY;
+	expect(&t, false, "node 0: box has NaN or an infinite bound");
+	bvhlab_tree_finish(&t);
 }
 
 static void test_cycle_and_sharing(void)

@@ -65,4 +65,18 @@ static inline uint32_t sah_job_size(const sah_job *job)
 	return job->end - job->begin;
 }
 
+/*
+ * Threads worth starting for a root job: one per SAH_PRIMS_PER_THREAD
+ * primitives at most. A thread costs its start-up and an 8 MiB stack, and
+ * below this size the jobs are too few to keep more of them busy; a
+ * config asking for 1024 threads on a small scene gets a few.
+ */
+#define SAH_PRIMS_PER_THREAD 4096u
+
+static inline uint32_t sah_useful_threads(uint32_t threads, const sah_job *root)
+{
+	uint32_t useful = sah_job_size(root) / SAH_PRIMS_PER_THREAD + 1;
+	return threads < useful ? threads : useful;
+}
+
 #endif /* BVHLAB_SAH_THREADS_H */

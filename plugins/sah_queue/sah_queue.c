@@ -262,8 +262,10 @@ static void queue_destroy(struct queue *q)
 /* The calling thread works too; a worker that fails to start only means
  * fewer hands on the same queue. */
 static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
-                    const sah_job *root, uint32_t threads, void *arg)
+                    const sah_job *root, uint32_t asked, void *arg)
 {
+	/* no more OS threads than the scene has work for */
+	uint32_t threads = sah_useful_threads(asked, root);
 	struct queue q;
 	pthread_t *tids = calloc(threads, sizeof(*tids));
 	uint32_t started = 0;

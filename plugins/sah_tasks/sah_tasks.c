@@ -274,8 +274,10 @@ static int run_build(struct team *tm, uint32_t parallel_min, const sah_job *root
 }
 
 static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
-                    const sah_job *root, uint32_t threads, void *arg)
+                    const sah_job *root, uint32_t asked, void *arg)
 {
+	/* no more OS threads than the scene has work for */
+	uint32_t threads = sah_useful_threads(asked, root);
 	const uint32_t *parallel_min = arg;
 	struct member *m = calloc(threads, sizeof(*m));
 	struct team tm;
