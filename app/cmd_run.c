@@ -30,6 +30,9 @@ static const char usage[] =
 	"  --out DIR        output folder (overrides the config's \"output\")\n"
 	"  --resume         keep the finished runs of the output folder's results.json\n"
 	"                   and run only the missing ones (a fresh start if there is none)\n"
+	"  --force          start afresh in a folder that holds results: the old files\n"
+	"                   are moved aside to results.json.N, ... (without --resume or\n"
+	"                   --force such a folder is refused)\n"
 	"  --threads LIST   thread counts, e.g. 1,2,0 (0 = all cores; overrides \"threads\")\n"
 	"  --repeat N       timed builds per run (overrides \"repeat\")\n"
 	"  --quiet          no progress lines\n"
@@ -53,6 +56,7 @@ static int parse(int argc, char **argv, struct run_args *a)
 		{"out", required_argument, NULL, 'o'},   {"threads", required_argument, NULL, 't'},
 		{"repeat", required_argument, NULL, 'r'}, {"quiet", no_argument, NULL, 'q'},
 		{"resume", no_argument, NULL, 'R'},      {"help", no_argument, NULL, 'h'},
+		{"force", no_argument, NULL, 'F'},
 		{NULL, 0, NULL, 0}};
 	int c;
 	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
@@ -71,12 +75,19 @@ static int parse(int argc, char **argv, struct run_args *a)
 			a->opts.quiet = true;
 		} else if (c == 'R') {
 			a->opts.resume = true;
+		} else if (c == 'F') {
+			a->opts.force = true;
 		} else {
 			return -1;
 		}
 	}
 	if (optind != argc - 1) {
 		fprintf(stderr, "bvhlab run: expected one config file\n\n%s", usage);
+		return -1;
+	}
+	if (a->opts.resume && a->opts.force) {
+		fprintf(stderr, "bvhlab run: --resume keeps the old results, --force moves them "
+		        "aside: give one of them\n");
 		return -1;
 	}
 	a->config = argv[optind];

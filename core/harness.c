@@ -11,21 +11,14 @@
 #include <unistd.h>
 
 #include "harness.h"
+#include "harness_builders.h"
 #include "isolate.h"
 #include "progress.h"
 #include "results.h"
+#include "safe_file.h"
 #include "util.h"
 
 #define RAY_SEED 0x5eedULL
-
-/* A builder of the config, opened once for the whole sweep. */
-struct harness_builder {
-	const struct config_builder *cb;
-	bvhlab_plugin *plugin; /* NULL when it could not be loaded */
-	bvhlab_options opts;
-	bool opts_ok;
-	bvhlab_error error;
-};
 
 struct harness {
 	const struct config *cfg;
@@ -93,7 +86,7 @@ static const uint32_t *builder_threads(const struct harness *h, const struct con
 
 /* Every run of a builder fails the same way (plugin or scene unusable). */
 static void record_all_failed(struct harness *h, const char *scene, struct harness_builder *hb,
-                              const char *error)
+                              const char *status, const char *error)
 {
 	size_t n;
 	const uint32_t *threads = builder_threads(h, hb->cb, &n);
@@ -101,7 +94,7 @@ static void record_all_failed(struct harness *h, const char *scene, struct harne
 		struct run_record run = {.scene = scene, .builder = hb->cb->name,
 		                         .plugin = hb->cb->plugin, .threads = resolve_threads(threads[k]),
 		                         .opts = hb->opts_ok ? &hb->opts : NULL,
-		                         .status = "failed", .error = error};
+		                         .status = status, .error = error};
 		if (results_has_run(&h->res, run.scene, run.builder, run.threads))
 			h->progress.index++;
 		else
@@ -242,13 +235,6 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->rays = rep->rays.measured ? &rep->rays : NULL;
 }
 
-static struct isolate_limits run_limits(const struct config *cfg, const struct config_builder *cb)
-{
-	uint64_t mb = cb->memory_limit_mb ? cb->memory_limit_mb : cfg->memory_limit_mb;
-	return (struct isolate_limits){.timeout_s = cb->timeout_s > 0 ? cb->timeout_s : cfg->timeout_s,
-	                               .memory_bytes = mb << 20};
-}
-
 /* Runs the series in a child (or here, with "isolate": false) and records it. */
 static void run_series(struct harness *h, struct series_job *job, struct run_record *run,
                        struct series_report *rep, size_t size)
@@ -257,7 +243,7 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	char why[sizeof(rep->error)] = "";
 	int outcome = ISOLATE_REPORTED;
 	if (h->cfg->isolate) {
-		struct isolate_limits limits = run_limits(h->cfg, job->hb->cb);
+		struct isolate_limits limits = harness_run_limits(h->cfg, job->hb->cb);
 		outcome = isolate_call(series_work, job, rep, size, &limits, why, sizeof(why));
 	} else {
 		series_work(job, rep, size);
@@ -320,7 +306,7 @@ static void run_builders(struct harness *h, const bvhlab_scene *scene,
 	for (size_t b = 0; b < h->cfg->builder_count; b++) {
 		struct harness_builder *hb = &h->builders[b];
 		if (!hb->plugin || !hb->opts_ok) {
-			record_all_failed(h, scene->name, hb, hb->error.message);
+			record_all_failed(h, scene->name, hb, hb->status, hb->error.message);
 			continue;
 		}
 		size_t n;
@@ -375,7 +361,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 		results_add_scene(&h->res, cs->name, cs->path ? cs->path : cs->generator, 0,
 		                  err.message);
 		for (size_t b = 0; b < h->cfg->builder_count; b++)
-			record_all_failed(h, cs->name, &h->builders[b], err.message);
+			record_all_failed(h, cs->name, &h->builders[b], "failed", err.message);
 		goto out;
 	}
 	results_add_scene(&h->res, scene->name, scene->source, scene->triangle_count, NULL);
@@ -386,38 +372,6 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 out:
 	bvhlab_prims_finish(&prims);
 	bvhlab_scene_destroy(scene);
-}
-
-/* Opens every plugin and checks its options; a failure is kept, not fatal. */
-static int open_builders(struct harness *h)
-{
-	h->builders = calloc(h->cfg->builder_count, sizeof(*h->builders));
-	if (!h->builders)
-		return -ENOMEM;
-	for (size_t b = 0; b < h->cfg->builder_count; b++) {
-		struct harness_builder *hb = &h->builders[b];
-		hb->cb = &h->cfg->builders[b];
-		if (bvhlab_plugin_open(hb->cb->plugin, &hb->plugin, &hb->error) < 0)
-			goto report;
-		if (bvhlab_options_init(&hb->opts, bvhlab_plugin_builder(hb->plugin)) < 0)
-			return -ENOMEM;
-		hb->opts_ok = config_apply_options(h->cfg, hb->cb, &hb->opts, &hb->error) == 0;
-		if (hb->opts_ok)
-			continue;
-	report:
-		fprintf(stderr, "bvhlab: builder '%s': %s\n", hb->cb->name, hb->error.message);
-	}
-	return 0;
-}
-
-static void close_builders(struct harness *h)
-{
-	for (size_t b = 0; h->builders && b < h->cfg->builder_count; b++) {
-		if (h->builders[b].opts.values)
-			bvhlab_options_finish(&h->builders[b].opts);
-		bvhlab_plugin_close(h->builders[b].plugin);
-	}
-	free(h->builders);
 }
 
 static uint32_t count_runs(const struct harness *h)
@@ -456,7 +410,9 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 {
 	struct harness h = {.cfg = cfg, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
-	int r = results_init(&h.res, cfg, cfg->output, err);
+	int r = opts->resume ? 0 : safe_claim_output(cfg->output, opts->force, err);
+	if (r == 0)
+		r = results_init(&h.res, cfg, cfg->output, err);
 	if (r < 0)
 		return r;
 	bvhlab_set_pinning(cfg->pin);
@@ -464,13 +420,13 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 		r = resume(&h, err);
 	if (r == 0)
 		r = results_write(&h.res, err);
-	if (r == 0 && (r = open_builders(&h)) < 0)
+	if (r == 0 && (r = harness_open_builders(cfg, &h.builders)) < 0)
 		error_set(err, "out of memory opening plugins");
 	h.progress.total = count_runs(&h);
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
 		run_scene(&h, &cfg->scenes[s], s);
 	progress_finish(&h.progress);
-	close_builders(&h);
+	harness_close_builders(cfg, h.builders);
 	results_finish(&h.res);
 	return r < 0 ? r : h.all_ok ? 0 : 1;
 }

@@ -18,6 +18,7 @@ int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab
 struct harness_options {
 	bool quiet;  /* no progress lines on stderr */
 	bool resume; /* keep the finished runs of the output's results.json, skip them */
+	bool force;  /* without resume: move an earlier results.json aside, not refuse */
 };
 
 /*

@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -142,4 +143,43 @@ int safe_move_aside(const char *dir, const char *const *names, unsigned *moved_t
 			*moved_to = n;
 	}
 	return 0;
+}
+
+/* The folder's real path is "/": results.json there would be /results.json. */
+static bool is_root(const char *dir)
+{
+	char *real = realpath(dir, NULL);
+	bool root = real && strcmp(real, "/") == 0;
+	free(real);
+	return root;
+}
+
+int safe_claim_output(const char *dir, bool force, bvhlab_error *err)
+{
+	static const char *const old[] = {"results.json", "results.csv", "report.md",
+	                                  "report.html", "images", NULL};
+	char path[PATH_SIZE];
+	unsigned moved;
+	if (is_root(dir)) {
+		error_set(err, "output folder %s is the file system root; name a folder of its own",
+		          dir);
+		return -EINVAL;
+	}
+	if ((size_t)snprintf(path, sizeof(path), "%s/results.json", dir) >= sizeof(path)) {
+		error_set(err, "output folder name too long: %s", dir);
+		return -ENAMETOOLONG;
+	}
+	if (!exists(path))
+		return 0;
+	if (!force) {
+		error_set(err, "output folder %s already holds a results.json: --resume continues "
+		          "that sweep, --force starts afresh (moving the old files aside to "
+		          "results.json.N, ...)", dir);
+		return -EEXIST;
+	}
+	int r = safe_move_aside(dir, old, &moved, err);
+	if (r == 0 && moved)
+		fprintf(stderr, "bvhlab: --force: the old results of %s/ are now results.json.%u "
+		        "(and the CSV, reports and images with .%u)\n", dir, moved, moved);
+	return r;
 }

@@ -7,6 +7,7 @@
 #ifndef BVHLAB_CORE_SAFE_FILE_H
 #define BVHLAB_CORE_SAFE_FILE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include <bvhlab/types.h>
@@ -40,5 +41,14 @@ int safe_write_file(const char *dir, const char *name, const void *data, size_t 
  */
 int safe_move_aside(const char *dir, const char *const *names, unsigned *moved_to,
                     bvhlab_error *err);
+
+/*
+ * Makes `dir` (and its parents) the output folder of a fresh sweep. One
+ * that already holds a results.json is refused (-EEXIST, err naming the
+ * folder, --resume and --force) unless `force`, which moves the old
+ * results, CSV, reports and images aside (safe_move_aside) instead of
+ * deleting them. The file system root is refused outright.
+ */
+int safe_claim_output(const char *dir, bool force, bvhlab_error *err);
 
 #endif

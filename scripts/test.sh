@@ -16,26 +16,52 @@ esac
 
 passed=0 failed=0 skipped=0
 
-# Runs `meson test` in a build dir and adds its counts to the totals.
+# Counts one failure of the suite itself (not of a test), with the reason.
+suite_broken() {
+	echo "test.sh: $1" >&2
+	failed=$((failed + 1))
+}
+
+# Runs `meson test` in a build dir and adds its counts to the totals. The
+# log is removed first, so a run that never starts cannot count the last
+# one's results; a suite that selects no test, runs fewer tests than it
+# defines, or fails without a failed test counts as a failure.
 run_suite() {
 	local label=$1 dir=$2
 	shift 2
 	echo "== $label ==" >&2
-	meson test -C "$dir" --print-errorlogs "$@"
 	local log="$dir/meson-logs/testlog.json"
-	local ok fail skip
+	local defined rc ran ok fail skip
+	defined=$(meson test -C "$dir" --list "$@" 2>/dev/null | grep -c ' / ' || true)
+	rm -f "$log"
+	meson test -C "$dir" --print-errorlogs "$@"
+	rc=$?
+	if [ ! -f "$log" ]; then
+		suite_broken "$label: meson test did not run (exit status $rc)"
+		return
+	fi
+	ran=$(grep -c '"result": ' "$log" || true)
 	ok=$(grep -c '"result": "OK"' "$log" || true)
 	fail=$(grep -cE '"result": "(FAIL|TIMEOUT|ERROR|UNEXPECTEDPASS)"' "$log" || true)
 	skip=$(grep -c '"result": "SKIP"' "$log" || true)
 	passed=$((passed + ok)); failed=$((failed + fail)); skipped=$((skipped + skip))
+	[ "$defined" -gt 0 ] || suite_broken "$label: the suite selects no test"
+	[ "$ran" -ge "$defined" ] || suite_broken "$label: $ran of the $defined tests ran"
+	[ "$rc" = 0 ] || [ "$fail" -gt 0 ] ||
+		suite_broken "$label: meson test exited with status $rc and no failed test"
 }
 
+# Builds one build dir; an existing one is reconfigured with the options
+# first, so a folder set up without the sanitizers gets them.
 build_or_count() {
 	local label=$1 dir=$2
 	shift 2
+	if [ -f "$dir/build.ninja" ] && [ $# -gt 0 ] && ! meson configure "$dir" "$@" >&2; then
+		suite_broken "$label: cannot reconfigure $dir with $*"
+		return 1
+	fi
 	if ! setup_build "$dir" "$@"; then
-		echo "test.sh: $label build failed" >&2
-		failed=$((failed + 1))
+		suite_broken "$label build failed"
 		return 1
 	fi
 }

@@ -112,6 +112,9 @@ static void check_generated(const char *gen, uint32_t count, bool expect_splits)
 	bvhlab_scene_destroy(s);
 }
 
+/* A missing ../shared reports "skipped" (77), not a pass without the meshes. */
+static bool shared_missing;
+
 static void check_mesh(const char *file)
 {
 	char path[1024];
@@ -120,6 +123,7 @@ static void check_mesh(const char *file)
 	snprintf(path, sizeof(path), "%s/%s", BVHLAB_SHARED_SCENES, file);
 	if (access(path, R_OK) != 0) {
 		printf("skip: %s not found\n", path);
+		shared_missing = true;
 		return;
 	}
 	CHECK_INT(bvhlab_scene_load(path, &s, &err), 0);
@@ -171,5 +175,5 @@ int main(void)
 	check_mesh("horse.ply");
 	check_missing_caught();
 	bvhlab_plugin_close(plugin);
-	return test_finish();
+	return shared_missing && !test_failures ? TEST_SKIP : test_finish();
 }
