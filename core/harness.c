@@ -389,7 +389,7 @@ static uint32_t count_runs(const struct harness *h)
 static int resume(struct harness *h, bvhlab_error *err)
 {
 	size_t kept = 0, not_ok = 0;
-	int r = results_resume(&h->res, &kept, &not_ok, err);
+	int r = results_resume(&h->res, h->cfg, &kept, &not_ok, err);
 	if (r == -ENOENT) {
 		if (!h->progress.quiet)
 			fprintf(stderr, "bvhlab: nothing to resume in %s/; starting afresh\n",

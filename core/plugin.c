@@ -17,13 +17,6 @@
 
 #include "util.h"
 
-#ifndef BVHLAB_BUILD_PLUGIN_DIR
-#define BVHLAB_BUILD_PLUGIN_DIR ""
-#endif
-#ifndef BVHLAB_INSTALL_PLUGIN_DIR
-#define BVHLAB_INSTALL_PLUGIN_DIR ""
-#endif
-
 /* The fields of bvhlab_builder up to and including `build` (ABI 1.0). */
 #define BUILDER_MIN_SIZE (offsetof(bvhlab_builder, build) + sizeof(((bvhlab_builder *)0)->build))
 
@@ -33,25 +26,16 @@ struct bvhlab_plugin {
 	char *path;
 };
 
-const char *bvhlab_plugin_search_path(void)
-{
-	static char path[4096];
-	const char *env = getenv("BVHLAB_PLUGIN_PATH");
-	snprintf(path, sizeof(path), "%s%s%s:%s", env ? env : "", env && *env ? ":" : "",
-	         BVHLAB_BUILD_PLUGIN_DIR, BVHLAB_INSTALL_PLUGIN_DIR);
-	return path;
-}
-
 static bool is_file(const char *path)
 {
 	struct stat st;
 	return stat(path, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-static bool looks_like_path(const char *s)
+static bool ends_in_so(const char *s)
 {
 	size_t n = strlen(s);
-	return strchr(s, '/') || (n > 3 && strcmp(s + n - 3, ".so") == 0);
+	return n > 3 && strcmp(s + n - 3, ".so") == 0;
 }
 
 /* Finds NAME.so or NAME/NAME.so in a search folder; 0 and *out, or -ENOENT. */
@@ -87,10 +71,17 @@ static void not_found(const char *name, bvhlab_error *err)
 	          bvhlab_plugin_search_path(), used ? list : "none");
 }
 
+/*
+ * A name with a '/' is a path; a bare NAME.so is a file in the current
+ * folder (as a config's is one in the config's folder), never left to
+ * dlopen, which would look for it in LD_LIBRARY_PATH and the system's
+ * library folders. Anything else is looked up on the search path.
+ */
 static int resolve(const char *name, char *out, size_t size, bvhlab_error *err)
 {
-	if (looks_like_path(name)) {
-		if ((size_t)snprintf(out, size, "%s", name) >= size) {
+	if (strchr(name, '/') || ends_in_so(name)) {
+		const char *here = strchr(name, '/') ? "" : "./";
+		if ((size_t)snprintf(out, size, "%s%s", here, name) >= size) {
 			error_set(err, "plugin '%s': path too long", name);
 			return -ENAMETOOLONG;
 		}

@@ -315,29 +315,6 @@ static int read_text(const char *path, char **out, bvhlab_error *err)
 	return 0;
 }
 
-/* Each run needs what matching and the reports use; unfinished ones are left to redo. */
-static int check_runs(const cJSON *runs, const char *path, bvhlab_error *err)
-{
-	int k = 0;
-	const cJSON *run;
-	if (!cJSON_IsArray(runs)) {
-		error_set(err, "cannot resume from %s: no \"runs\" array (not a bvhlab results file?)",
-		          path);
-		return -EINVAL;
-	}
-	cJSON_ArrayForEach(run, runs) {
-		const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
-		if (!string_of(run, "scene") || !string_of(run, "builder") || !string_of(run, "status") ||
-		    !cJSON_IsNumber(t)) {
-			error_set(err, "cannot resume from %s: runs[%d] lacks a scene, builder, threads "
-			          "or status", path, k);
-			return -EINVAL;
-		}
-		k++;
-	}
-	return 0;
-}
-
 /* Moves the old document's finished runs and named scenes into ours. */
 static void take_over(struct results *res, cJSON *old, size_t *kept, size_t *not_ok)
 {
@@ -369,7 +346,8 @@ static void take_over(struct results *res, cJSON *old, size_t *kept, size_t *not
 	}
 }
 
-int results_resume(struct results *res, size_t *kept, size_t *not_ok, bvhlab_error *err)
+int results_resume(struct results *res, const struct config *cfg, size_t *kept, size_t *not_ok,
+                   bvhlab_error *err)
 {
 	char path[4096], *text = NULL;
 	*kept = *not_ok = 0;
@@ -387,7 +365,7 @@ int results_resume(struct results *res, size_t *kept, size_t *not_ok, bvhlab_err
 		          "to start afresh)", path);
 		r = -EINVAL;
 	} else {
-		r = check_runs(cJSON_GetObjectItemCaseSensitive(old, "runs"), path, err);
+		r = results_check_runs(cJSON_GetObjectItemCaseSensitive(old, "runs"), cfg, path, err);
 	}
 	if (r == 0)
 		take_over(res, old, kept, not_ok);

@@ -70,9 +70,20 @@ int results_set_run_image(struct results *res, const char *scene, const char *bu
  * scenes of dir/results.json, for `bvhlab run --resume`. *kept counts the
  * runs, *not_ok those whose status is not "ok". -ENOENT when there is no
  * file; another negative errno, with err naming the file, when it cannot be
- * read or is not a results document.
+ * read, is not a results document or fails results_check_runs.
  */
-int results_resume(struct results *res, size_t *kept, size_t *not_ok, bvhlab_error *err);
+int results_resume(struct results *res, const struct config *cfg, size_t *kept, size_t *not_ok,
+                   bvhlab_error *err);
+
+/*
+ * The runs of a results.json to resume, against cfg: each an object with
+ * a known status, a whole thread count up to CONFIG_MAX_THREADS, its
+ * optional members of the right types, and an identity (scene, builder,
+ * resolved thread count) that the config has and no other run repeats.
+ * 0, or -EINVAL with err naming the file and the first bad run.
+ */
+int results_check_runs(const struct cJSON *runs, const struct config *cfg, const char *path,
+                       bvhlab_error *err);
 /* Whether the document holds a run of scene x builder x threads. */
 bool results_has_run(const struct results *res, const char *scene, const char *builder,
                      uint32_t threads);

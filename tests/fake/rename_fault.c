@@ -1,0 +1,34 @@
+/*
+ * An LD_PRELOAD shim for the crash-safety test: the process is killed
+ * (SIGKILL, as by the OOM killer or a power cut, no handler runs) just
+ * before its Nth rename onto a file named results.json, N from
+ * $BVHLAB_FAULT_RENAME. At that moment the new document is complete in its
+ * temporary file and not yet in place: results.json must still be the
+ * previous complete one. A writer that writes results.json in place never
+ * renames, is never killed, and the test sees that.
+ */
+#include <dlfcn.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static int renames;
+
+static int ends_with(const char *s, const char *tail)
+{
+	size_t n = strlen(s), m = strlen(tail);
+	return n >= m && strcmp(s + n - m, tail) == 0;
+}
+
+__attribute__((visibility("default"))) int rename(const char *from, const char *to)
+{
+	const char *at = getenv("BVHLAB_FAULT_RENAME");
+	if (at && ends_with(to, "/results.json") && ++renames == atoi(at))
+		kill(getpid(), SIGKILL);
+	int (*real)(const char *, const char *);
+	void *sym = dlsym(RTLD_NEXT, "rename");
+	memcpy(&real, &sym, sizeof(real));
+	return real(from, to);
+}
