@@ -7,8 +7,8 @@
 #include <sys/stat.h>
 
 #include "cli.h"
-#include "config.h"
-#include "harness.h"
+#include "config/config.h"
+#include "harness/harness.h"
 
 int cli_parse_uint(const char *opt, const char *text, unsigned long max, unsigned long *out)
 {

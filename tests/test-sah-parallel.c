@@ -19,7 +19,7 @@
 
 #include <bvhlab/bvhlab.h>
 
-#include "results.h"
+#include "output/results.h"
 #include "testutil.h"
 
 /* Set when ../shared is not there: the test then reports "skipped" (77),

@@ -1,0 +1,107 @@
+/*
+ * Opening the sweep's plugins, behind a forked probe when runs are
+ * isolated: README promises that nothing a plugin does outside its run's
+ * child ends the sweep, and loading is something it does.
+ */
+#include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/harness_builders.h"
+#include "harness/isolate.h"
+#include "util/util.h"
+
+/* What the probe child sends back. */
+struct probe_report {
+	uint32_t ok;
+	char error[sizeof(((bvhlab_error *)0)->message)];
+};
+
+struct isolate_limits harness_run_limits(const struct config *cfg,
+                                         const struct config_builder *cb)
+{
+	uint64_t mb = cb->memory_limit_mb ? cb->memory_limit_mb : cfg->memory_limit_mb;
+	return (struct isolate_limits){.timeout_s = cb->timeout_s > 0 ? cb->timeout_s : cfg->timeout_s,
+	                               .memory_bytes = mb << 20};
+}
+
+/* In the child: dlopen, entry point and descriptor checks; never closed,
+ * since the child ends with _exit anyway. */
+static void probe_work(void *arg, void *report, size_t size)
+{
+	const struct config_builder *cb = arg;
+	struct probe_report *rep = report;
+	bvhlab_plugin *plugin = NULL;
+	bvhlab_error err = {{0}};
+	(void)size;
+	rep->ok = bvhlab_plugin_open(cb->plugin, &plugin, &err) == 0;
+	if (!rep->ok)
+		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
+}
+
+/* 0 when the plugin loaded in a child; else the builder's status and error. */
+static int probe(const struct config *cfg, struct harness_builder *hb)
+{
+	struct probe_report rep = {0};
+	char why[sizeof(rep.error)] = "";
+	struct isolate_limits limits = harness_run_limits(cfg, hb->cb);
+	int outcome = isolate_call(probe_work, (void *)hb->cb, &rep, sizeof(rep), &limits, why,
+	                           sizeof(why));
+	if (outcome == ISOLATE_REPORTED && rep.ok)
+		return 0;
+	rep.error[sizeof(rep.error) - 1] = '\0';
+	if (outcome == ISOLATE_REPORTED) {
+		error_set(&hb->error, "%s", rep.error);
+		return -EINVAL;
+	}
+	hb->status = outcome == ISOLATE_TIMEOUT ? "timeout" : outcome < 0 ? "failed" : "crashed";
+	error_set(&hb->error, "plugin %s: %s while loading (library constructor or entry "
+	          "point): %s", hb->cb->plugin, outcome == ISOLATE_TIMEOUT ? "hung" : "died",
+	          why);
+	return -EINVAL;
+}
+
+/* 0, -EINVAL with hb's error set, or -ENOMEM. */
+static int open_one(const struct config *cfg, struct harness_builder *hb)
+{
+	hb->status = "failed";
+	if (cfg->isolate && probe(cfg, hb) < 0)
+		return -EINVAL;
+	if (bvhlab_plugin_open(hb->cb->plugin, &hb->plugin, &hb->error) < 0)
+		return -EINVAL;
+	if (bvhlab_options_init(&hb->opts, bvhlab_plugin_builder(hb->plugin)) < 0)
+		return -ENOMEM;
+	hb->opts_ok = config_apply_options(cfg, hb->cb, &hb->opts, &hb->error) == 0;
+	return hb->opts_ok ? 0 : -EINVAL;
+}
+
+int harness_open_builders(const struct config *cfg, struct harness_builder **out)
+{
+	struct harness_builder *builders = calloc(cfg->builder_count ? cfg->builder_count : 1,
+	                                          sizeof(*builders));
+	*out = builders;
+	if (!builders)
+		return -ENOMEM;
+	for (size_t b = 0; b < cfg->builder_count; b++) {
+		struct harness_builder *hb = &builders[b];
+		hb->cb = &cfg->builders[b];
+		int r = open_one(cfg, hb);
+		if (r == -ENOMEM)
+			return r;
+		if (r < 0)
+			fprintf(stderr, "bvhlab: builder '%s': %s\n", hb->cb->name, hb->error.message);
+	}
+	return 0;
+}
+
+void harness_close_builders(const struct config *cfg, struct harness_builder *builders)
+{
+	for (size_t b = 0; builders && b < cfg->builder_count; b++) {
+		if (builders[b].opts.values)
+			bvhlab_options_finish(&builders[b].opts);
+		bvhlab_plugin_close(builders[b].plugin);
+	}
+	free(builders);
+}

@@ -1,0 +1,38 @@
+/*
+ * The builders of a sweep: each config builder's plugin opened once, with
+ * its options checked. Opening runs foreign code (library constructors,
+ * the entry point), so with isolation it is tried first in a forked probe:
+ * a plugin that crashes or hangs while loading costs its own runs only.
+ */
+#ifndef BVHLAB_CORE_HARNESS_BUILDERS_H
+#define BVHLAB_CORE_HARNESS_BUILDERS_H
+
+#include <stdbool.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "config/config.h"
+#include "harness/isolate.h"
+
+struct harness_builder {
+	const struct config_builder *cb;
+	bvhlab_plugin *plugin; /* NULL when it could not be loaded */
+	bvhlab_options opts;
+	bool opts_ok;
+	const char *status;    /* of its runs when unusable: "failed", "crashed", "timeout" */
+	bvhlab_error error;
+};
+
+/* The resource limits of a builder's children (its own or the config's). */
+struct isolate_limits harness_run_limits(const struct config *cfg,
+                                         const struct config_builder *cb);
+
+/*
+ * Opens every builder of cfg into *out ([cfg->builder_count]); a builder
+ * that cannot be used keeps its status and message (printed to stderr
+ * too), and the others go on. 0, or -ENOMEM.
+ */
+int harness_open_builders(const struct config *cfg, struct harness_builder **out);
+void harness_close_builders(const struct config *cfg, struct harness_builder *builders);
+
+#endif

@@ -1,0 +1,204 @@
+/*
+ * What --resume accepts from an earlier results.json. Its runs are taken
+ * over as they are and the sweep skips every combination they cover, so a
+ * run that is duplicated, belongs to no combination of the config, or has
+ * fields of the wrong type or range would be kept forever and shown in
+ * every report. Such a file is refused with the run named; the harness
+ * has written nothing yet, so the file stays as it was.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cJSON.h>
+
+#include "output/results.h"
+#include "util/util.h"
+
+/* The config's scene x builder x thread count combinations, numbered. */
+struct combos {
+	const struct config *cfg;
+	size_t *offset;     /* [builder_count]: first thread slot of each builder */
+	size_t per_scene;   /* thread slots of all builders */
+	unsigned char *seen; /* [scene_count * per_scene] */
+};
+
+static const uint32_t *thread_list(const struct config *cfg, size_t b, size_t *n)
+{
+	const struct config_builder *cb = &cfg->builders[b];
+	*n = cb->threads ? cb->thread_count : cfg->thread_count;
+	return cb->threads ? cb->threads : cfg->threads;
+}
+
+static int combos_init(struct combos *c, const struct config *cfg)
+{
+	c->cfg = cfg;
+	c->per_scene = 0;
+	c->offset = calloc(cfg->builder_count + 1, sizeof(*c->offset));
+	for (size_t b = 0; c->offset && b < cfg->builder_count; b++) {
+		size_t n;
+		thread_list(cfg, b, &n);
+		c->offset[b] = c->per_scene;
+		c->per_scene += n;
+	}
+	c->seen = calloc(cfg->scene_count * c->per_scene + 1, 1);
+	return c->offset && c->seen ? 0 : -ENOMEM;
+}
+
+static void combos_finish(struct combos *c)
+{
+	free(c->offset);
+	free(c->seen);
+}
+
+static long find_scene(const struct config *cfg, const char *name)
+{
+	for (size_t s = 0; s < cfg->scene_count; s++)
+		if (strcmp(cfg->scenes[s].name, name) == 0)
+			return (long)s;
+	return -1;
+}
+
+static long find_builder(const struct config *cfg, const char *name)
+{
+	for (size_t b = 0; b < cfg->builder_count; b++)
+		if (strcmp(cfg->builders[b].name, name) == 0)
+			return (long)b;
+	return -1;
+}
+
+/* The slot of thread count t among builder b's (0 resolved), or -1. */
+static long find_threads(const struct config *cfg, size_t b, double t)
+{
+	size_t n;
+	const uint32_t *list = thread_list(cfg, b, &n);
+	for (size_t k = 0; k < n; k++)
+		if ((list[k] ? list[k] : bvhlab_hardware_threads()) == t)
+			return (long)k;
+	return -1;
+}
+
+static const char *string_of(const cJSON *run, const char *key)
+{
+	const cJSON *v = cJSON_GetObjectItemCaseSensitive(run, key);
+	return cJSON_IsString(v) ? v->valuestring : NULL;
+}
+
+static bool is_count(const cJSON *v, double max)
+{
+	return cJSON_IsNumber(v) && isfinite(v->valuedouble) && v->valuedouble >= 1 &&
+	       v->valuedouble <= max && v->valuedouble == floor(v->valuedouble);
+}
+
+static bool known_status(const char *s)
+{
+	static const char *const known[] = {"ok", "invalid", "failed", "crashed", "timeout"};
+	for (size_t k = 0; s && k < sizeof(known) / sizeof(known[0]); k++)
+		if (strcmp(s, known[k]) == 0)
+			return true;
+	return false;
+}
+
+static bool finite_at(const cJSON *o, const char *key)
+{
+	const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+	return cJSON_IsNumber(v) && isfinite(v->valuedouble) && v->valuedouble >= 0;
+}
+
+/* "build_ms": median, min, max and every sample finite and >= 0. */
+static bool timing_ok(const cJSON *t)
+{
+	const cJSON *samples = cJSON_GetObjectItemCaseSensitive(t, "samples"), *s;
+	if (!cJSON_IsObject(t) || !finite_at(t, "median") || !finite_at(t, "min") ||
+	    !finite_at(t, "max") || !cJSON_IsArray(samples))
+		return false;
+	cJSON_ArrayForEach(s, samples)
+		if (!cJSON_IsNumber(s) || !isfinite(s->valuedouble) || s->valuedouble < 0)
+			return false;
+	return true;
+}
+
+/* The optional members the reports read, each of its type: "" or what is wrong. */
+static const char *optional_fields(const cJSON *run)
+{
+	static const char *const strings[] = {"plugin", "error", "heat_image"};
+	static const char *const objects[] = {"options", "tree", "validation", "rays"};
+	for (size_t k = 0; k < sizeof(strings) / sizeof(strings[0]); k++) {
+		const cJSON *v = cJSON_GetObjectItemCaseSensitive(run, strings[k]);
+		if (v && !cJSON_IsString(v))
+			return strings[k];
+	}
+	for (size_t k = 0; k < sizeof(objects) / sizeof(objects[0]); k++) {
+		const cJSON *v = cJSON_GetObjectItemCaseSensitive(run, objects[k]);
+		if (v && !cJSON_IsObject(v))
+			return objects[k];
+	}
+	const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "build_ms");
+	if (t && !timing_ok(t))
+		return "build_ms";
+	if (cJSON_GetObjectItemCaseSensitive(run, "mtris_per_s") && !finite_at(run, "mtris_per_s"))
+		return "mtris_per_s";
+	return "";
+}
+
+/* NULL when run is acceptable and new; else what is wrong with it. */
+static const char *check_run(struct combos *c, const cJSON *run, char *why, size_t size)
+{
+	const char *scene = string_of(run, "scene"), *builder = string_of(run, "builder");
+	const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
+	if (!cJSON_IsObject(run) || !scene || !builder || !string_of(run, "status"))
+		return "lacks a string scene, builder or status";
+	if (!is_count(t, CONFIG_MAX_THREADS))
+		return "\"threads\" is not a whole number from 1 to the limit of 1024";
+	if (!known_status(string_of(run, "status")))
+		return "\"status\" is none of ok, invalid, failed, crashed, timeout";
+	long s = find_scene(c->cfg, scene), b = find_builder(c->cfg, builder);
+	long k = b < 0 ? -1 : find_threads(c->cfg, (size_t)b, t->valuedouble);
+	if (s < 0 || b < 0 || k < 0)
+		return "is not a run of this config (scene, builder or thread count unknown)";
+	const char *field = optional_fields(run);
+	if (*field) {
+		snprintf(why, size, "\"%s\" has the wrong type or a value out of range", field);
+		return why;
+	}
+	size_t slot = (size_t)s * c->per_scene + c->offset[b] + (size_t)k;
+	if (c->seen[slot])
+		return "repeats an earlier run of the same scene, builder and thread count";
+	c->seen[slot] = 1;
+	return NULL;
+}
+
+int results_check_runs(const cJSON *runs, const struct config *cfg, const char *path,
+                       bvhlab_error *err)
+{
+	struct combos c;
+	char why[128];
+	int k = 0, r = 0;
+	const cJSON *run;
+	if (!cJSON_IsArray(runs)) {
+		error_set(err, "cannot resume from %s: no \"runs\" array (not a bvhlab results file?)",
+		          path);
+		return -EINVAL;
+	}
+	if (combos_init(&c, cfg) < 0) {
+		combos_finish(&c);
+		error_set(err, "cannot resume from %s: out of memory", path);
+		return -ENOMEM;
+	}
+	cJSON_ArrayForEach(run, runs) {
+		const char *bad = check_run(&c, run, why, sizeof(why));
+		if (bad) {
+			const char *s = string_of(run, "scene"), *b = string_of(run, "builder");
+			error_set(err, "cannot resume from %s: runs[%d] (scene '%s', builder '%s') %s; "
+			          "the file is left as it is", path, k, s ? s : "?", b ? b : "?", bad);
+			r = -EINVAL;
+			break;
+		}
+		k++;
+	}
+	combos_finish(&c);
+	return r;
+}
