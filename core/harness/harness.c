@@ -240,19 +240,25 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
                        struct series_report *rep, size_t size)
 {
 	static const char *const outcomes[] = {"ok", "crashed", "timeout"};
-	char why[sizeof(rep->error)] = "";
+	char why[sizeof(rep->error)] = "", limited[sizeof(rep->error) + 64];
 	int outcome = ISOLATE_REPORTED;
-	if (h->cfg->isolate) {
-		struct isolate_limits limits = harness_run_limits(h->cfg, job->hb->cb);
+	struct isolate_limits limits = harness_run_limits(h->cfg, job->hb->cb);
+	if (h->cfg->isolate)
 		outcome = isolate_call(series_work, job, rep, size, &limits, why, sizeof(why));
-	} else {
+	else
 		series_work(job, rep, size);
-	}
 	if (outcome == ISOLATE_REPORTED) {
 		report_to_run(rep, h->cfg->repeat, run);
 	} else {
 		run->status = outcome < 0 ? "failed" : outcomes[outcome];
 		run->error = why;
+	}
+	/* A run that failed or died under a memory limit most likely hit it: say so. */
+	if (h->cfg->isolate && limits.memory_bytes && run->error &&
+	    (!strcmp(run->status, "failed") || !strcmp(run->status, "crashed"))) {
+		snprintf(limited, sizeof(limited), "%s (under memory_limit_mb = %llu)", run->error,
+		         (unsigned long long)(limits.memory_bytes >> 20));
+		run->error = limited;
 	}
 	record(h, run);
 }
@@ -354,7 +360,9 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	bvhlab_error err = {{0}};
 	if (scene_done(h, cs))
 		return;
-	int r = harness_load_scene(cs, &scene, &err);
+	int r = h->cfg->isolate ? harness_probe_scene(h->cfg, cs, &err) : 0;
+	if (r == 0)
+		r = harness_load_scene(cs, &scene, &err);
 	if (r == 0)
 		r = bvhlab_prims_init(&prims, scene, &err);
 	if (r < 0) {

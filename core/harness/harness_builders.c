@@ -46,7 +46,9 @@ static int probe(const struct config *cfg, struct harness_builder *hb)
 {
 	struct probe_report rep = {0};
 	char why[sizeof(rep.error)] = "";
-	struct isolate_limits limits = harness_run_limits(cfg, hb->cb);
+	/* The timeout only: the limit is on the builds, and a child's address
+	 * space starts at the parent's (its libraries), which can exceed it. */
+	struct isolate_limits limits = {.timeout_s = harness_run_limits(cfg, hb->cb).timeout_s};
 	int outcome = isolate_call(probe_work, (void *)hb->cb, &rep, sizeof(rep), &limits, why,
 	                           sizeof(why));
 	if (outcome == ISOLATE_REPORTED && rep.ok)
