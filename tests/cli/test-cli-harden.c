@@ -161,8 +161,8 @@ static void test_output(void)
 	CHECK_INT(run(ARGS("run", "--quiet", "--force", cfg)), 0);
 	char *aside = read_file(dir, "results.json.1");
 	CHECK(first && aside && !strcmp(first, aside));
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", "--out", "/", cfg)), 2);
-	CHECK_CONTAINS(err_text, "output folder / is the file system root");
+	/* "output": "/" is refused in test-safe-file: a bvhlab without the check
+	 * would write /results.json, as root. */
 	free(first);
 	free(after);
 	free(aside);

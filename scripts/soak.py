@@ -1,0 +1,218 @@
+#!/usr/bin/env python3
+"""Soak test of `bvhlab run`: N random configs, each sweep killed at a
+random moment and resumed (sometimes killed again while resuming).
+
+Each config mixes generated scenes, adversarial scene files (empty, NaN,
+a FIFO, a folder, a missing file, all-degenerate triangles), real builders
+and test plugins that crash, abort, hang, exit, leak memory, fail, return
+broken trees or crash while loading. After every sweep:
+  - results.json parses and holds each scene x builder x thread count once;
+  - every run finished before the kill is still there, unchanged;
+  - the exit status matches the runs: 0 all ok, 1 otherwise.
+
+Usage: soak.py N BUILD_DIR [SEED]   (scripts/soak.sh N wraps it)
+"""
+import json
+import os
+import random
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+
+FAKE_FAILS = ["segfault", "abort", "loop", "exit", "invalid", "error", "silent", "alloc"]
+REAL = [("sah_seq", {"method": "sweep"}), ("sah_seq", {"method": "binned"}),
+        ("sah_even", {}), ("sah_tasks", {}), ("lbvh", {})]
+LIMIT_S = 300  # a sweep that needs longer than this has hung
+
+
+def adversarial_file(rng, folder, k):
+    """A scene path that must fail to load, whatever the loader."""
+    kind = rng.choice(["empty", "nan", "fifo", "folder", "missing", "degenerate", "garbage"])
+    path = os.path.join(folder, f"adv{k}.obj")
+    if kind == "empty":
+        open(path, "w").close()
+    elif kind == "nan":
+        with open(path, "w") as f:
+            f.write("v 0 0 0\nv nan 1 0\nv 0 0 1\nf 1 2 3\n")
+    elif kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "folder":
+        os.mkdir(path)
+    elif kind == "garbage":
+        with open(path, "wb") as f:
+            f.write(bytes(rng.randrange(256) for _ in range(rng.randrange(1, 400))))
+    elif kind == "degenerate":
+        # Loads: every triangle the same point; builders must still cope.
+        with open(path, "w") as f:
+            f.write("v 1 1 1\n" + "f 1 1 1\n" * rng.randrange(1, 200))
+    return {"name": f"s{k}", "path": path}
+
+
+def random_scene(rng, folder, k):
+    if rng.random() < 0.3:
+        return adversarial_file(rng, folder, k)
+    gen = rng.choice(["soup", "icosphere", "stadium", "terrain"])
+    scene = {"name": f"s{k}", "generator": gen}
+    if gen in ("soup", "stadium"):
+        scene["count"] = rng.randrange(1, 4000)
+        scene["seed"] = rng.randrange(0, 1000)
+    elif gen == "icosphere":
+        scene["frequency"] = rng.randrange(1, 16)
+    else:
+        scene["size"] = rng.randrange(1, 24)
+    if rng.random() < 0.2:
+        scene["subdivide"] = 1
+    return scene
+
+
+def random_builder(rng, k, loadcrash, memory_limits):
+    name = f"b{k}"
+    roll = rng.random()
+    if roll < 0.45:
+        plugin, options = rng.choice(REAL)
+        return {"plugin": plugin, "name": name, "options": dict(options)}
+    if roll < 0.55:
+        which = rng.choice(["crash_ctor", "crash_entry", "hang_entry"])
+        return {"plugin": os.path.join(loadcrash, which + ".so"), "name": name,
+                "timeout_s": 1}
+    fails = FAKE_FAILS if memory_limits else [f for f in FAKE_FAILS if f != "alloc"]
+    fail = rng.choice(fails + ["no", "no"])
+    b = {"plugin": "fake_good", "name": name, "options": {"fail": fail}}
+    if fail == "loop":
+        b["timeout_s"] = 0.5
+    if fail == "alloc":
+        b["memory_limit_mb"] = 512  # never without a limit: it eats 4 GB
+    return b
+
+
+def random_config(rng, folder, out, loadcrash, memory_limits):
+    threads = sorted(rng.sample([1, 2, 3], rng.randrange(1, 4)))
+    cfg = {"output": out, "repeat": rng.randrange(1, 3), "warmup": rng.randrange(0, 2),
+           "threads": threads, "validate_rays": 64,
+           "rays": {"width": 16, "height": 12, "diffuse": rng.randrange(0, 2)},
+           "images": rng.random() < 0.5,
+           "scenes": [random_scene(rng, folder, k) for k in range(rng.randrange(1, 4))],
+           "builders": [random_builder(rng, k, loadcrash, memory_limits)
+                        for k in range(rng.randrange(1, 5))]}
+    if rng.random() < 0.3:
+        cfg["builders"][0]["threads"] = [1]
+    return cfg
+
+
+def expected_runs(cfg):
+    runs = set()
+    for s in cfg["scenes"]:
+        for b in cfg["builders"]:
+            for t in b.get("threads", cfg["threads"]):
+                runs.add((s["name"], b["name"], t))
+    return runs
+
+
+def load_runs(out):
+    """{identity: run} of results.json; None when there is none yet."""
+    path = os.path.join(out, "results.json")
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        doc = json.load(f)  # must always parse: raises otherwise
+    runs = {}
+    for r in doc["runs"]:
+        key = (r["scene"], r["builder"], r["threads"])
+        if key in runs:
+            raise AssertionError(f"run {key} twice in {path}")
+        runs[key] = r
+    return runs
+
+
+def launch(bvhlab, config, resume):
+    args = [bvhlab, "run", "--quiet", config] + (["--resume"] if resume else [])
+    return subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+
+
+def killed_sweep(rng, bvhlab, config, out, resume):
+    """Starts a sweep, kills it at a random moment; the runs it left."""
+    p = launch(bvhlab, config, resume)
+    try:
+        p.wait(timeout=rng.uniform(0.0, 2.0))
+    except subprocess.TimeoutExpired:
+        p.send_signal(signal.SIGKILL)
+        p.wait()
+    p.stderr.close()
+    return load_runs(out) or {}
+
+
+def same_run(a, b):
+    """Equal but for heat_image, which a resumed sweep may add to a kept run
+    whose heat map the killed attempt had left unconverted."""
+    strip = lambda r: {k: v for k, v in r.items() if k != "heat_image"}
+    return a is not None and b is not None and strip(a) == strip(b)
+
+
+def check_kept(before, after, where):
+    for key, run in before.items():
+        if not same_run(after.get(key), run):
+            raise AssertionError(f"{where}: finished run {key} lost or changed")
+
+
+def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
+    work = os.path.join(folder, f"c{i}")
+    os.mkdir(work)
+    out = os.path.join(work, "out")
+    cfg = random_config(rng, work, out, loadcrash, memory_limits)
+    config = os.path.join(work, "config.json")
+    with open(config, "w") as f:
+        json.dump(cfg, f, indent=1)
+    before = killed_sweep(rng, bvhlab, config, out, False)
+    if rng.random() < 0.4:
+        again = killed_sweep(rng, bvhlab, config, out, True)
+        check_kept(before, again, f"config {i} (second kill)")
+        before = again
+    p = launch(bvhlab, config, True)
+    try:
+        _, err = p.communicate(timeout=LIMIT_S)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        raise AssertionError(f"config {i}: resumed sweep still running after {LIMIT_S} s")
+    after = load_runs(out) or {}
+    check_kept(before, after, f"config {i}")
+    want = expected_runs(cfg)
+    if set(after) != want:
+        raise AssertionError(f"config {i}: runs {sorted(set(after) ^ want)} missing or extra")
+    all_ok = all(r["status"] == "ok" for r in after.values())
+    if p.returncode != (0 if all_ok else 1):
+        raise AssertionError(f"config {i}: exit status {p.returncode} but "
+                             f"{'all' if all_ok else 'not all'} runs ok\n{err.decode()}")
+    shutil.rmtree(work)
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    n, build = int(sys.argv[1]), os.path.abspath(sys.argv[2])
+    seed = int(sys.argv[3]) if len(sys.argv) > 3 else random.randrange(1 << 30)
+    rng = random.Random(seed)
+    bvhlab = os.path.join(build, "app", "bvhlab")
+    loadcrash = os.path.join(build, "tests", "fake", "loadcrash")
+    os.environ["BVHLAB_PLUGIN_PATH"] = os.path.join(build, "tests", "fake")
+    # Crashes are the point here: no sanitizer report in place of the signal.
+    asan = os.environ.get("ASAN_OPTIONS", "")
+    os.environ["ASAN_OPTIONS"] = (asan + ":" if asan else "") + \
+        "handle_segv=0:handle_abort=0:detect_leaks=0:allocator_may_return_null=1"
+    memory_limits = os.environ.get("SOAK_NO_MEMORY_LIMITS") != "1"
+    folder = tempfile.mkdtemp(prefix="bvhlab-soak-")
+    print(f"soak: {n} configs, seed {seed}, in {folder}", flush=True)
+    for i in range(n):
+        try:
+            one_config(rng, i, bvhlab, folder, loadcrash, memory_limits)
+        except (AssertionError, ValueError, KeyError) as e:
+            print(f"soak: FAILED at config {i} (seed {seed}): {e}; files kept in {folder}")
+            sys.exit(1)
+        if (i + 1) % 10 == 0 or i + 1 == n:
+            print(f"soak: {i + 1}/{n} configs ok", flush=True)
+    shutil.rmtree(folder)
+
+
+if __name__ == "__main__":
+    main()
