@@ -62,21 +62,6 @@ double report_num(const cJSON *o, const char *path)
 	return cJSON_IsNumber(v) ? v->valuedouble : NAN;
 }
 
-double report_speedup(const cJSON *runs, const cJSON *run)
-{
-	const cJSON *base;
-	double t = report_num(run, "build_ms.median");
-	cJSON_ArrayForEach(base, runs) {
-		if (report_num(base, "threads") == 1 &&
-		    strcmp(str(base, "scene"), str(run, "scene")) == 0 &&
-		    strcmp(str(base, "builder"), str(run, "builder")) == 0) {
-			double t1 = report_num(base, "build_ms.median");
-			return t > 0 ? t1 / t : NAN;
-		}
-	}
-	return NAN;
-}
-
 void report_escape(struct strbuf *sb, const char *text)
 {
 	for (const char *p = text; *p; p++) {
@@ -163,7 +148,7 @@ static void md_cell(struct strbuf *sb, const char *s)
 	sb_printf(sb, " |");
 }
 
-static void md_run_row(struct strbuf *sb, const cJSON *doc, const cJSON *run)
+static void md_run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run)
 {
 	char buf[64];
 	sb_printf(sb, "|");
@@ -174,7 +159,7 @@ static void md_run_row(struct strbuf *sb, const cJSON *doc, const cJSON *run)
 	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.min", "%.2f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.max", "%.2f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "mtris_per_s", "%.2f"));
-	double speedup = report_speedup(cJSON_GetObjectItem(doc, "runs"), run);
+	double speedup = report_speedup(ix, run);
 	snprintf(buf, sizeof(buf), "%.2f", speedup);
 	md_cell(sb, isnan(speedup) ? "" : buf);
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.sah_cost", "%.3f"));
@@ -202,7 +187,7 @@ static void md_images(struct strbuf *sb, const cJSON *scene)
 		          legend);
 }
 
-static void md_scene(struct strbuf *sb, const cJSON *doc, const cJSON *scene)
+static void md_scene(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
 {
 	const char *name = str(scene, "name");
 	char buf[64];
@@ -215,10 +200,10 @@ static void md_scene(struct strbuf *sb, const cJSON *doc, const cJSON *scene)
 	              "| diffuse Mrays/s | diffuse nodes/ray | nodes | depth | avg leaf | error |\n"
 	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
 	              "|---:|---|\n");
-	const cJSON *run;
-	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
-		if (strcmp(str(run, "scene"), name) == 0)
-			md_run_row(sb, doc, run);
+	size_t n;
+	const cJSON *const *runs = report_scene_runs(ix, name, &n);
+	for (size_t k = 0; k < n; k++)
+		md_run_row(sb, ix, runs[k]);
 	md_images(sb, scene);
 }
 
@@ -240,8 +225,12 @@ char *report_markdown(const cJSON *doc)
 	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);
-	report_thesis(&sb, doc);
+	struct report_index ix;
+	if (report_index_init(&ix, doc) < 0)
+		sb.failed = true;
+	report_thesis(&sb, doc, &ix);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
-		md_scene(&sb, doc, scene);
+		md_scene(&sb, &ix, scene);
+	report_index_finish(&ix);
 	return sb_take(&sb);
 }

@@ -17,9 +17,24 @@ const cJSON *report_at(const cJSON *o, const char *path);
 const char *report_str(const cJSON *o, const char *path);
 /* The number at path, or NaN. */
 double report_num(const cJSON *o, const char *path);
+/* A document's runs by scene, for rendering in time linear in their
+ * number (report_index.c). */
+struct report_slot;
+struct report_index {
+	struct report_slot *scenes, *pairs; /* open-addressed tables of cap slots */
+	const cJSON **order;                /* every run, grouped by scene */
+	size_t cap;
+};
+
+/* 0, or -ENOMEM (the index is then empty, and finishing it is safe). */
+int report_index_init(struct report_index *ix, const cJSON *doc);
+void report_index_finish(struct report_index *ix);
+/* The scene's runs, in document order; *count 0 when it has none. */
+const cJSON *const *report_scene_runs(const struct report_index *ix, const char *scene,
+                                      size_t *count);
 /* Build-time speedup of a run over the same builder's 1-thread run on
  * the same scene, or NaN when there is none. */
-double report_speedup(const cJSON *runs, const cJSON *run);
+double report_speedup(const struct report_index *ix, const cJSON *run);
 
 /* Text with & < > " ' escaped for HTML and SVG. */
 void report_escape(struct strbuf *sb, const char *text);

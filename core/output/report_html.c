@@ -36,7 +36,7 @@ static void num_cell(struct strbuf *sb, double v, const char *fmt)
 	sb_printf(sb, "</td>");
 }
 
-static void run_row(struct strbuf *sb, const cJSON *runs, const cJSON *run)
+static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run)
 {
 	bool ok = strcmp(report_str(run, "status"), "ok") == 0;
 	sb_printf(sb, "<tr><td class=\"l\">");
@@ -50,7 +50,7 @@ static void run_row(struct strbuf *sb, const cJSON *runs, const cJSON *run)
 	num_cell(sb, report_num(run, "build_ms.min"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.max"), "%.2f");
 	num_cell(sb, report_num(run, "mtris_per_s"), "%.2f");
-	num_cell(sb, report_speedup(runs, run), "%.2f");
+	num_cell(sb, report_speedup(ix, run), "%.2f");
 	num_cell(sb, report_num(run, "tree.sah_cost"), "%.3f");
 	num_cell(sb, report_num(run, "rays.primary.mrays_per_s"), "%.2f");
 	num_cell(sb, report_num(run, "rays.primary.nodes_per_ray"), "%.1f");
@@ -62,28 +62,28 @@ static void run_row(struct strbuf *sb, const cJSON *runs, const cJSON *run)
 	sb_printf(sb, "</td></tr>\n");
 }
 
-static void table(struct strbuf *sb, const cJSON *runs, const char *scene)
+static void table(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
-	const cJSON *run;
+	size_t n;
+	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
 	sb_printf(sb, "<table><tr><th class=\"l\">builder</th><th>threads</th>"
 	              "<th class=\"l\">status</th><th>median ms</th><th>min ms</th><th>max ms</th>"
 	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>primary Mrays/s</th>"
 	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s</th>"
 	              "<th>diffuse nodes/ray</th><th class=\"l\">error</th></tr>\n");
-	cJSON_ArrayForEach(run, runs)
-		if (strcmp(report_str(run, "scene"), scene) == 0)
-			run_row(sb, runs, run);
+	for (size_t k = 0; k < n; k++)
+		run_row(sb, ix, runs[k]);
 	sb_printf(sb, "</table>\n");
 }
 
 /* The scene's runs with a build time, as chart points ("builder xT" labels). */
-static size_t points(const cJSON *runs, const char *scene, struct svg_point *p, char (*labels)[96])
+static size_t points(const cJSON *const *runs, size_t count, struct svg_point *p,
+                     char (*labels)[96])
 {
 	size_t n = 0;
-	const cJSON *run;
-	cJSON_ArrayForEach(run, runs) {
-		if (strcmp(report_str(run, "scene"), scene) != 0 ||
-		    !isfinite(report_num(run, "build_ms.median")))
+	for (size_t k = 0; k < count; k++) {
+		const cJSON *run = runs[k];
+		if (!isfinite(report_num(run, "build_ms.median")))
 			continue;
 		snprintf(labels[n], sizeof(labels[n]), "%s x%.0f", report_str(run, "builder"),
 		         report_num(run, "threads"));
@@ -95,14 +95,16 @@ static size_t points(const cJSON *runs, const char *scene, struct svg_point *p, 
 	return n;
 }
 
-static void charts(struct strbuf *sb, const cJSON *runs, const char *scene)
+static void charts(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
-	size_t total = (size_t)cJSON_GetArraySize(runs) + 1;
+	size_t count;
+	const cJSON *const *runs = report_scene_runs(ix, scene, &count);
+	size_t total = count + 1;
 	struct svg_point *p = calloc(total, sizeof(*p)), *q = calloc(total, sizeof(*q));
 	char (*labels)[96] = calloc(total, sizeof(*labels));
 	if (!p || !q || !labels)
 		goto out;
-	size_t n = points(runs, scene, p, labels);
+	size_t n = points(runs, count, p, labels);
 	if (n == 0)
 		goto out;
 	sb_printf(sb, "<div class=\"charts\">\n");
@@ -110,13 +112,12 @@ static void charts(struct strbuf *sb, const cJSON *runs, const char *scene)
 		q[i] = (struct svg_point){p[i].label, p[i].group, 0, p[i].x};
 	svg_bars(sb, "Build time (median)", "ms", q, n);
 	svg_scatter(sb, "SAH cost vs. build time", "build time (ms)", "SAH cost", p, n);
-	const cJSON *run;
 	size_t m = 0;
-	cJSON_ArrayForEach(run, runs) {
-		double s = report_speedup(runs, run);
-		if (strcmp(report_str(run, "scene"), scene) == 0 && isfinite(s))
-			q[m++] = (struct svg_point){"", report_str(run, "builder"),
-			                            report_num(run, "threads"), s};
+	for (size_t k = 0; k < count; k++) {
+		double s = report_speedup(ix, runs[k]);
+		if (isfinite(s))
+			q[m++] = (struct svg_point){"", report_str(runs[k], "builder"),
+			                            report_num(runs[k], "threads"), s};
 	}
 	svg_lines(sb, "Speedup over 1 thread", "threads", "speedup", q, m);
 	sb_printf(sb, "</div>\n");
@@ -137,18 +138,19 @@ static void figure(struct strbuf *sb, const char *src, const char *caption)
 	sb_printf(sb, "</figcaption></figure>\n");
 }
 
-static void images(struct strbuf *sb, const cJSON *runs, const cJSON *scene)
+static void images(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
 {
 	const char *name = report_str(scene, "name"), *legend = report_str(scene, "images.legend");
-	const cJSON *run;
+	size_t n;
+	const cJSON *const *runs = report_scene_runs(ix, name, &n);
 	if (!*report_str(scene, "images.shaded") && !*legend)
 		return;
 	sb_printf(sb, "<div class=\"images\">\n");
 	if (*report_str(scene, "images.shaded"))
 		figure(sb, report_str(scene, "images.shaded"), name);
-	cJSON_ArrayForEach(run, runs)
-		if (strcmp(report_str(run, "scene"), name) == 0 && *report_str(run, "heat_image"))
-			figure(sb, report_str(run, "heat_image"), report_str(run, "builder"));
+	for (size_t k = 0; k < n; k++)
+		if (*report_str(runs[k], "heat_image"))
+			figure(sb, report_str(runs[k], "heat_image"), report_str(runs[k], "builder"));
 	sb_printf(sb, "</div>\n");
 	if (*legend) {
 		sb_printf(sb, "<p>Nodes visited per primary ray, one scale for every builder: "
@@ -159,7 +161,7 @@ static void images(struct strbuf *sb, const cJSON *runs, const cJSON *scene)
 	}
 }
 
-static void scene_section(struct strbuf *sb, const cJSON *runs, const cJSON *scene)
+static void scene_section(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
 {
 	const char *name = report_str(scene, "name");
 	sb_printf(sb, "<h2>");
@@ -172,15 +174,18 @@ static void scene_section(struct strbuf *sb, const cJSON *runs, const cJSON *sce
 		esc(sb, report_str(scene, "error"));
 	}
 	sb_printf(sb, "</p>\n");
-	table(sb, runs, name);
-	charts(sb, runs, name);
-	images(sb, runs, scene);
+	table(sb, ix, name);
+	charts(sb, ix, name);
+	images(sb, ix, scene);
 }
 
 char *report_html(const cJSON *doc)
 {
 	struct strbuf sb = {0};
-	const cJSON *runs = cJSON_GetObjectItem(doc, "runs"), *scene;
+	const cJSON *scene;
+	struct report_index ix;
+	if (report_index_init(&ix, doc) < 0)
+		sb.failed = true;
 	sb_printf(&sb, "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
 	               "<title>bvhlab report</title><style>%s</style></head><body>\n"
 	               "<h1>bvhlab report</h1>\n<p>bvhlab ", css);
@@ -195,7 +200,8 @@ char *report_html(const cJSON *doc)
 	               "thread for every run, so traversal numbers compare trees, not thread "
 	               "counts.</p>\n", report_num(doc, "machine.cores"));
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
-		scene_section(&sb, runs, scene);
+		scene_section(&sb, &ix, scene);
+	report_index_finish(&ix);
 	sb_printf(&sb, "</body></html>\n");
 	return sb_take(&sb);
 }

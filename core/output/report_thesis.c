@@ -12,6 +12,7 @@
 
 #include <cJSON.h>
 
+#include "output/report.h"
 #include "output/results.h"
 #include "util/util.h"
 
@@ -32,15 +33,19 @@ static double number(const cJSON *o, const char *key, double fallback)
 	return cJSON_IsNumber(v) ? v->valuedouble : fallback;
 }
 
-/* Median build time of the first ok run that matches, or a negative number. */
-static double median_ms(const cJSON *runs, const char *scene, const char *key,
+/* Median build time of the scene's first ok run that matches, or a
+ * negative number. Only the scene's runs are looked at (the index), so a
+ * table costs the run count times its columns and thread counts. */
+static double median_ms(const struct report_index *ix, const char *scene, const char *key,
                         const char *value, double threads)
 {
-	const cJSON *run;
+	size_t n;
+	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
 
-	cJSON_ArrayForEach(run, runs) {
+	for (size_t k = 0; k < n; k++) {
+		const cJSON *run = runs[k];
 		if (strcmp(text(run, "status"), "ok") != 0 || number(run, "threads", -1) != threads ||
-		    strcmp(text(run, "scene"), scene) != 0 || strcmp(text(run, key), value) != 0)
+		    strcmp(text(run, key), value) != 0)
 			continue;
 		double ms = number(cJSON_GetObjectItemCaseSensitive(run, "build_ms"), "median", -1);
 		if (ms > 0)
@@ -101,17 +106,17 @@ static void header(struct strbuf *sb, double threads, const char **cols, int n)
 	sb_printf(sb, "\n");
 }
 
-static void row(struct strbuf *sb, const cJSON *runs, const char *scene, double threads,
-                const char **cols, int n)
+static void row(struct strbuf *sb, const struct report_index *ix, const char *scene,
+                double threads, const char **cols, int n)
 {
-	double seq = median_ms(runs, scene, "plugin", SEQ_PLUGIN, 1);
+	double seq = median_ms(ix, scene, "plugin", SEQ_PLUGIN, 1);
 
 	if (seq > 0)
 		sb_printf(sb, "| %s | %.2f |", scene, seq);
 	else
 		sb_printf(sb, "| %s | " MISSING " |", scene);
 	for (int i = 0; i < n; i++) {
-		double t = median_ms(runs, scene, "builder", cols[i], threads);
+		double t = median_ms(ix, scene, "builder", cols[i], threads);
 		if (t <= 0)
 			sb_printf(sb, " " MISSING " | " MISSING " | " MISSING " |");
 		else if (seq <= 0)
@@ -122,7 +127,7 @@ static void row(struct strbuf *sb, const cJSON *runs, const char *scene, double 
 	sb_printf(sb, "\n");
 }
 
-void report_thesis(struct strbuf *sb, const cJSON *doc)
+void report_thesis(struct strbuf *sb, const cJSON *doc, const struct report_index *ix)
 {
 	const cJSON *runs = cJSON_GetObjectItemCaseSensitive(doc, "runs");
 	const cJSON *scene;
@@ -139,6 +144,6 @@ void report_thesis(struct strbuf *sb, const cJSON *doc)
 	for (int k = 0; k < ncounts; k++) {
 		header(sb, counts[k], cols, ncols);
 		cJSON_ArrayForEach(scene, cJSON_GetObjectItemCaseSensitive(doc, "scenes"))
-			row(sb, runs, text(scene, "name"), counts[k], cols, ncols);
+			row(sb, ix, text(scene, "name"), counts[k], cols, ncols);
 	}
 }

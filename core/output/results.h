@@ -105,9 +105,10 @@ char *report_html(const struct cJSON *doc);
 int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err);
 
 struct strbuf;
+struct report_index;
 /* Appends the thesis-style speedup tables (parallel builders against
  * sah_seq on 1 thread, per thread count > 1) to a report; nothing when the
- * document has no such runs. report_thesis.c. */
-void report_thesis(struct strbuf *sb, const struct cJSON *doc);
+ * document has no such runs. ix: the document's runs by scene. report_thesis.c. */
+void report_thesis(struct strbuf *sb, const struct cJSON *doc, const struct report_index *ix);
 
 #endif
