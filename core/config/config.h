@@ -14,8 +14,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include <bvhlab/plugin.h>
-#include <bvhlab/rays.h>
+#include <bvhlab/host.h>
+#include <bvhlab/trace.h>
 #include <bvhlab/scene.h>
 
 struct cJSON;
