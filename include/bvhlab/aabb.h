@@ -87,9 +87,10 @@ static inline float bvhlab_aabb_half_area(const bvhlab_aabb *b)
 	return dx * dy + dy * dz + dz * dx;
 }
 
-/* The full surface area of the box with corners lo[3], hi[3], in double,
- * with a negative extent (an empty or flat box) counted as 0: what the
- * reported SAH cost is computed with, the same for every builder. */
+/* The full surface area 2(xy + yz + zx) of the box with corners lo[3],
+ * hi[3], in double; an inverted (empty) or NaN extent counts as 0 rather
+ * than making the area negative or NaN. The reported SAH cost is computed
+ * with it, the same for every builder. */
 static inline double bvhlab_box_area(const float *lo, const float *hi)
 {
 	double d[3];
