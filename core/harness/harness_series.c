@@ -28,23 +28,6 @@ int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab
 	return r;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-	return (x > y) - (x < y);
-}
-
-void harness_summarise(const double *samples, uint32_t n, double *median, double *min,
-                       double *max)
-{
-	double sorted[n ? n : 1];
-	memcpy(sorted, samples, n * sizeof(double));
-	qsort(sorted, n, sizeof(double), cmp_double);
-	*min = n ? sorted[0] : 0;
-	*max = n ? sorted[n - 1] : 0;
-	*median = n == 0 ? 0 : n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
-}
-
 int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
                         const bvhlab_build_input *input, struct build_series *s,
                         bvhlab_error *err)

@@ -11,7 +11,6 @@
 
 #include <cJSON.h>
 
-#include "harness/harness.h"
 #include "output/results.h"
 #include "util/util.h"
 
@@ -157,7 +156,7 @@ static cJSON *options_json(const bvhlab_options *opts)
 static cJSON *timing_json(const struct run_record *run)
 {
 	double med, mn, mx;
-	harness_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
+	util_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddNumberToObject(o, "median", med);
 	cJSON_AddNumberToObject(o, "min", mn);

@@ -24,7 +24,13 @@ struct results {
 	char *dir;
 };
 
-struct ray_metrics;
+/* Traversal counters of one run's primary and diffuse rays. */
+struct ray_metrics {
+	bool measured;
+	uint32_t threads; /* the threads that traced them: all hardware threads */
+	bvhlab_trace_stats primary, diffuse;
+	double primary_s, diffuse_s;
+};
 
 /* Everything known about one run; fields beyond status are optional. */
 struct run_record {
