@@ -1,32 +1,10 @@
 /*
- * The harness's building blocks that the command's other subcommands
- * (build, render) share: loading a config scene and timing a build series.
+ * Timing a build series: warm-up builds, then timed ones into the same
+ * tree (so room grown once stays allocated); `bvhlab build` and the sweep
+ * share it.
  */
-#include <errno.h>
-#include <stdlib.h>
-#include <string.h>
-
 #include "harness/harness.h"
 #include "util/util.h"
-
-int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab_error *err)
-{
-	int r = cs->path ? bvhlab_scene_load(cs->path, out, err)
-	                 : bvhlab_scene_generate(cs->generator, &cs->gen, out, err);
-	if (r < 0)
-		return r;
-	if (cs->subdivide > 0)
-		r = bvhlab_scene_subdivide(*out, cs->subdivide, err);
-	if (r == 0 && cs->name)
-		r = bvhlab_scene_set_name(*out, cs->name);
-	if (r < 0) {
-		if (r == -ENOMEM && err && !err->message[0])
-			error_set(err, "scene '%s': out of memory", cs->name);
-		bvhlab_scene_destroy(*out);
-		*out = NULL;
-	}
-	return r;
-}
 
 int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
                         const bvhlab_build_input *input, struct build_series *s,
