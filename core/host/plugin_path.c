@@ -19,7 +19,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <bvhlab/plugin.h>
+#include <bvhlab/host.h>
 
 #ifndef BVHLAB_INSTALL_PLUGIN_DIR
 #define BVHLAB_INSTALL_PLUGIN_DIR ""

@@ -13,7 +13,6 @@
 #include <cJSON.h>
 
 #include "output/report.h"
-#include "output/results.h"
 #include "util/util.h"
 
 #define SEQ_PLUGIN "sah_seq"

@@ -1,0 +1,90 @@
+/*
+ * A config scene made real: loaded from its file or generated, subdivided
+ * and named; `bvhlab build`/`render` and the sweep share it.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "harness/harness.h"
+#include "harness/isolate.h"
+#include "util/util.h"
+
+int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab_error *err)
+{
+	int r = cs->path ? bvhlab_scene_load(cs->path, out, err)
+	                 : bvhlab_scene_generate(cs->generator, &cs->gen, out, err);
+	if (r < 0)
+		return r;
+	if (cs->subdivide > 0)
+		r = bvhlab_scene_subdivide(*out, cs->subdivide, err);
+	if (r == 0 && cs->name)
+		r = bvhlab_scene_set_name(*out, cs->name);
+	if (r < 0) {
+		if (r == -ENOMEM && err && !err->message[0])
+			error_set(err, "scene '%s': out of memory", cs->name);
+		bvhlab_scene_destroy(*out);
+		*out = NULL;
+	}
+	return r;
+}
+
+/* What the scene probe sends back. */
+struct scene_probe {
+	uint32_t ok;
+	char error[sizeof(((bvhlab_error *)0)->message)];
+};
+
+/* In the child: the scene and its primitives, as the sweep will make them. */
+static void probe_work(void *arg, void *report, size_t size)
+{
+	struct scene_probe *rep = report;
+	bvhlab_scene *scene = NULL;
+	bvhlab_prims prims = {0};
+	bvhlab_error err = {{0}};
+	(void)size;
+	int r = harness_load_scene(arg, &scene, &err);
+	if (r == 0)
+		r = bvhlab_prims_init(&prims, scene, &err);
+	rep->ok = r == 0;
+	snprintf(rep->error, sizeof(rep->error), "%s", err.message);
+}
+
+/* The largest memory limit any builder runs under; 0 when one has none. */
+static uint64_t largest_limit_mb(const struct config *cfg)
+{
+	uint64_t most = 0;
+	for (size_t b = 0; b < cfg->builder_count; b++) {
+		uint64_t mb = cfg->builders[b].memory_limit_mb ? cfg->builders[b].memory_limit_mb
+		                                                : cfg->memory_limit_mb;
+		if (mb == 0)
+			return 0;
+		most = mb > most ? mb : most;
+	}
+	return most;
+}
+
+int harness_probe_scene(const struct config *cfg, const struct config_scene *cs,
+                        bvhlab_error *err)
+{
+	struct scene_probe rep = {0};
+	char why[sizeof(rep.error)] = "", limit[64] = "";
+	uint64_t mb = largest_limit_mb(cfg);
+	struct isolate_limits limits = {.timeout_s = cfg->timeout_s, .memory_bytes = mb << 20};
+	int outcome = isolate_call(probe_work, (void *)cs, &rep, sizeof(rep), &limits, why,
+	                           sizeof(why));
+	if (outcome == ISOLATE_REPORTED && rep.ok)
+		return 0;
+	rep.error[sizeof(rep.error) - 1] = '\0';
+	if (mb)
+		snprintf(limit, sizeof(limit), " (under memory_limit_mb = %llu)",
+		         (unsigned long long)mb);
+	if (outcome == ISOLATE_TIMEOUT)
+		error_set(err, "scene '%s': loading took longer than timeout_s (%g s); killed",
+		          cs->name, cfg->timeout_s);
+	else if (outcome == ISOLATE_REPORTED)
+		error_set(err, "%s%s", rep.error, strstr(rep.error, "memory") ? limit : "");
+	else
+		error_set(err, "scene '%s': loading %s%s", cs->name, why, limit);
+	return outcome == ISOLATE_TIMEOUT ? -ETIMEDOUT : -EINVAL;
+}
