@@ -20,7 +20,7 @@
 
 #define LOADCRASH_DIR BVHLAB_TEST_BUILDDIR "/fake/loadcrash"
 #define FAKE_DIR BVHLAB_TEST_BUILDDIR "/fake"
-#define SHIM BVHLAB_TEST_BUILDDIR "/fake/rename_fault.so"
+#define SHIM BVHLAB_TEST_BUILDDIR "/fake/shim/rename_fault.so"
 /* Long enough for any of these runs on a loaded machine; a hang ends here. */
 #define LIMIT_S 60
 
