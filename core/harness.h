@@ -18,6 +18,8 @@ int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab
 struct harness_options {
 	bool quiet;  /* no progress lines on stderr */
 	bool resume; /* keep the finished runs of the output's results.json, skip them */
+	const bool *only;      /* [plan_run_count]: run just these ids; NULL: all */
+	const char *plan_hash; /* run from a plan: recorded so merge can match parts */
 };
 
 /*
