@@ -88,9 +88,11 @@ void plan_file_finish(struct plan_file *plan);
 
 /* What a merge found, for the command to report. */
 struct merge_summary {
-	size_t runs, present, not_ok;
+	size_t runs, present;
 	uint32_t *missing;   /* ids without a run in any part */
 	size_t missing_count;
+	uint32_t *not_ok;    /* ids of runs whose status is not "ok" */
+	size_t not_ok_count;
 	size_t machines;     /* distinct machines the runs come from */
 };
 

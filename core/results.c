@@ -43,6 +43,10 @@ static cJSON *machine_json(void)
 	struct machine_info m;
 	machine_info_read(&m);
 	cJSON *o = cJSON_CreateObject();
+	char host[256] = "";
+	/* Parts of one plan may run on several machines: merge tells them apart by it. */
+	gethostname(host, sizeof(host) - 1);
+	cJSON_AddStringToObject(o, "hostname", host);
 	cJSON_AddStringToObject(o, "cpu", m.cpu);
 	cJSON_AddNumberToObject(o, "cores", m.cores);
 	cJSON_AddNumberToObject(o, "threads_available", m.threads_available);

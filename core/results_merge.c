@@ -252,7 +252,8 @@ static int build_runs(const struct merge *m, cJSON *runs, struct merge_summary *
 {
 	sum->runs = m->plan->run_count;
 	sum->missing = calloc(sum->runs ? sum->runs : 1, sizeof(*sum->missing));
-	if (!sum->missing)
+	sum->not_ok = calloc(sum->runs ? sum->runs : 1, sizeof(*sum->not_ok));
+	if (!sum->missing || !sum->not_ok)
 		return -ENOMEM;
 	for (size_t id = 0; id < sum->runs; id++) {
 		const cJSON *run = m->owner_run[id];
@@ -266,7 +267,8 @@ static int build_runs(const struct merge *m, cJSON *runs, struct merge_summary *
 		cJSON_AddItemToArray(runs, copy);
 		sum->present++;
 		const char *status = string_at(run, "status");
-		sum->not_ok += !status || strcmp(status, "ok") != 0;
+		if (!status || strcmp(status, "ok") != 0)
+			sum->not_ok[sum->not_ok_count++] = (uint32_t)id;
 	}
 	sum->machines = count_machines(runs);
 	return 0;
@@ -404,6 +406,7 @@ int plan_merge(const struct plan_file *plan, const char *const *parts, size_t pa
 void merge_summary_finish(struct merge_summary *sum)
 {
 	free(sum->missing);
+	free(sum->not_ok);
 	memset(sum, 0, sizeof(*sum));
 }
 
