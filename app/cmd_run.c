@@ -8,6 +8,7 @@
 #include "config.h"
 #include "harness.h"
 #include "plan.h"
+#include "util.h"
 
 #define MAX_THREAD_COUNTS 64
 
@@ -126,6 +127,12 @@ static int select_runs(const struct config *cfg, struct run_args *a, bool **only
                        bvhlab_error *err)
 {
 	*only = NULL;
+	if (a->thread_count && (a->only || a->opts.plan_hash)) {
+		/* Thread counts are part of a run's identity: other ones renumber the runs. */
+		error_set(err, "--threads cannot be combined with --only or a plan: it changes the "
+		          "runs and their ids (edit the config and plan again)");
+		return -1;
+	}
 	if (!a->only)
 		return 0;
 	if (plan_parse_only(a->only, plan_run_count(cfg), only, err) < 0)
@@ -144,16 +151,17 @@ int cmd_run(int argc, char **argv)
 	if (parse(argc, argv, &a) < 0)
 		return EXIT_USAGE;
 	int status = EXIT_USAGE;
-	if (load(&cfg, &plan, &a, &err) < 0 || select_runs(&cfg, &a, &only, &err) < 0) {
+	int r = load(&cfg, &plan, &a, &err);
+	a.opts.plan_hash = r == 0 && plan.doc ? plan.hash : NULL;
+	if (r < 0 || select_runs(&cfg, &a, &only, &err) < 0) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
-	a.opts.plan_hash = plan.doc ? plan.hash : NULL;
 	if (apply_overrides(&cfg, &a) < 0) {
 		fprintf(stderr, "bvhlab: out of memory\n");
 		goto out;
 	}
-	int r = harness_run(&cfg, &a.opts, &err);
+	r = harness_run(&cfg, &a.opts, &err);
 	if (r < 0) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;

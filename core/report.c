@@ -240,6 +240,7 @@ char *report_markdown(const cJSON *doc)
 	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);
+	report_machines_md(&sb, doc);
 	report_thesis(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		md_scene(&sb, doc, scene);

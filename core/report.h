@@ -21,6 +21,11 @@ double report_num(const cJSON *o, const char *path);
  * the same scene, or NaN when there is none. */
 double report_speedup(const cJSON *runs, const cJSON *run);
 
+/* A section listing the machines the runs come from, when there are several
+ * (a merged sweep; report_machines.c); nothing otherwise. */
+void report_machines_md(struct strbuf *sb, const cJSON *doc);
+void report_machines_html(struct strbuf *sb, const cJSON *doc);
+
 /* Text with & < > " ' escaped for HTML and SVG. */
 void report_escape(struct strbuf *sb, const char *text);
 

@@ -194,6 +194,7 @@ char *report_html(const cJSON *doc)
 	               "normalised by the root's area. Rays are traced with every hardware "
 	               "thread for every run, so traversal numbers compare trees, not thread "
 	               "counts.</p>\n", report_num(doc, "machine.cores"));
+	report_machines_html(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		scene_section(&sb, runs, scene);
 	sb_printf(&sb, "</body></html>\n");
