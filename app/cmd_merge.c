@@ -8,7 +8,7 @@
 #include <cJSON.h>
 
 #include "cli.h"
-#include "plan.h"
+#include "plan/plan.h"
 
 static const char usage[] =
 	"usage: bvhlab merge PART... --out DIR [--plan PLAN.json]\n"

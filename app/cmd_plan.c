@@ -10,10 +10,10 @@
 #include <cJSON.h>
 
 #include "cli.h"
-#include "config.h"
-#include "plan.h"
-#include "results.h"
-#include "util.h"
+#include "config/config.h"
+#include "output/results.h"
+#include "plan/plan.h"
+#include "util/util.h"
 
 static const char usage[] =
 	"usage: bvhlab plan CONFIG.json --out DIR [--format lines|slurm|json] [options]\n"

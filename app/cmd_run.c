@@ -5,10 +5,10 @@
 #include <string.h>
 
 #include "cli.h"
-#include "config.h"
-#include "harness.h"
-#include "plan.h"
-#include "util.h"
+#include "config/config.h"
+#include "harness/harness.h"
+#include "plan/plan.h"
+#include "util/util.h"
 
 #define MAX_THREAD_COUNTS 64
 
