@@ -170,35 +170,42 @@ static int expand_entry(const struct config *cfg, const struct config_builder *b
 	return 0;
 }
 
-int config_expand_grids(struct config *cfg, const cJSON *array, bvhlab_error *err)
+/* Sizes of every entry's expansion; *total builders, *any grid at all. */
+static int sizes_of(const struct config *cfg, const cJSON *array, size_t *sizes, size_t *grids,
+                    size_t *total, bool *any, bvhlab_error *err)
 {
-	size_t total = 0, index = 0, sizes[cfg->builder_count], grids[cfg->builder_count];
+	size_t index = 0;
+	*total = 0;
+	*any = false;
 	for (const cJSON *e = array->child; e && index < cfg->builder_count; e = e->next, index++) {
 		int rc = entry_size(cfg, &cfg->builders[index], index, &sizes[index], &grids[index], err);
 		if (rc)
 			return rc;
-		total += sizes[index];
-		if (total > MAX_EXPANDED)
+		*total += sizes[index];
+		*any = *any || grids[index];
+		if (*total > MAX_EXPANDED)
 			return config_error(cfg, e, false, err, "the grids make more than %d builders",
 			                    MAX_EXPANDED);
 	}
-	size_t any = 0;
-	for (size_t i = 0; i < cfg->builder_count; i++)
-		any += grids[i];
-	if (!any)
-		return 0;
+	return 0;
+}
+
+int config_expand_grids(struct config *cfg, const cJSON *array, bvhlab_error *err)
+{
+	size_t total, sizes[cfg->builder_count], grids[cfg->builder_count];
+	bool any;
+	int rc = sizes_of(cfg, array, sizes, grids, &total, &any, err);
+	if (rc || !any)
+		return rc;
 	struct config_builder *all = calloc(total, sizeof(*all));
 	if (!all)
 		return out_of_memory(cfg, err);
-	size_t at = 0;
-	for (size_t i = 0; i < cfg->builder_count; at += sizes[i], i++) {
+	for (size_t i = 0, at = 0; i < cfg->builder_count; at += sizes[i], i++) {
 		if (!grids[i]) {
 			all[at] = cfg->builders[i];
 			cfg->builders[i] = (struct config_builder){0};
-			continue;
-		}
-		int rc = expand_entry(cfg, &cfg->builders[i], sizes[i], grids[i], &all[at], err);
-		if (rc) {
+		} else if ((rc = expand_entry(cfg, &cfg->builders[i], sizes[i], grids[i], &all[at],
+		                              err)) != 0) {
 			for (size_t k = 0; k < at; k++)
 				free_builder(&all[k]);
 			free(all);
