@@ -34,8 +34,9 @@ static const char usage[] =
 	"\n"
 	"Then `bvhlab merge DIR/parts/* --out DIR` joins the parts. With --missing,\n"
 	"only the runs that no folder of DIR/parts holds yet (--format slurm:\n"
-	"DIR/sweep-missing.sbatch). Planning again into DIR is fine for the same\n"
-	"config; another plan there is refused.\n"
+	"DIR/sweep-missing.sbatch); a run that finished failed counts as done, so\n"
+	"remove its part folder to run it again. Planning again into DIR is fine\n"
+	"for the same config; another plan there is refused.\n"
 	"\n"
 	"options:\n"
 	"  --out DIR        the plan's folder (plan.json, parts/, slurm/)\n"
@@ -81,11 +82,16 @@ static int parse(int argc, char **argv, struct plan_args *a)
 		else if (c == 'f')
 			r = parse_format(optarg, &a->format);
 		else if (c == 'j')
-			r = cli_parse_uint("--jobs", optarg, 1000000, &a->jobs) || a->jobs == 0 ? -1 : 0;
+			r = cli_parse_uint("--jobs", optarg, 1000000, &a->jobs);
 		else
 			r = -1;
 	}
-	if (r == 0 && a->missing ? (optind != argc || a->out) : (optind != argc - 1 || !a->out)) {
+	if (r == 0 && a->jobs == 0) {
+		fprintf(stderr, "bvhlab plan: --jobs must be at least 1\n");
+		r = -1;
+	}
+	bool operands_ok = a->missing ? optind == argc && !a->out : optind == argc - 1 && a->out;
+	if (r == 0 && !operands_ok) {
 		fprintf(stderr, "bvhlab plan: expected CONFIG.json --out DIR, or --missing DIR\n\n%s",
 		        usage);
 		return -1;

@@ -178,13 +178,24 @@ static cJSON *plan_doc(const struct config *cfg, cJSON *copy, const char *hash)
 
 static int load_doc(struct plan_file *plan, const char *path, bvhlab_error *err);
 
-/* An existing DIR/plan.json: kept when it is this plan, else refused. */
-static int existing_plan(const char *path, const char *hash, struct plan_file *plan,
-                         bvhlab_error *err)
+/*
+ * An existing DIR/plan.json: kept (0) when it is this plan from this very
+ * config text; written anew (1) when it is this plan from a config that
+ * changed only in ways that leave its copy alone (spacing, say), so that its
+ * runs do not refuse the config as changed; refused otherwise.
+ */
+static int existing_plan(const struct config *cfg, const char *path, const char *hash,
+                         struct plan_file *plan, bvhlab_error *err)
 {
+	char source_hash[17];
 	if (access(path, F_OK) != 0)
 		return 1;
 	int r = load_doc(plan, path, err);
+	plan_hash_text(cfg->text, source_hash);
+	if (r == 0 && strcmp(plan->hash, hash) == 0 && strcmp(plan->source_hash, source_hash)) {
+		plan_file_finish(plan);
+		return 1;
+	}
 	if (r == 0 && strcmp(plan->hash, hash) != 0) {
 		error_set(err, "%s holds another plan (hash %s; this config's is %s): nothing "
 		          "overwritten; plan into a new folder, or remove that folder to start over",
@@ -213,7 +224,7 @@ int plan_file_write(const struct config *cfg, const char *dir, struct plan_file 
 		error_set(err, r == -ENOMEM ? "out of memory" : "path too long: %s", dir);
 		return r;
 	}
-	if ((r = existing_plan(path, hash, plan, err)) <= 0) {
+	if ((r = existing_plan(cfg, path, hash, plan, err)) <= 0) {
 		cJSON_Delete(copy);
 		return r;
 	}
