@@ -334,6 +334,16 @@ static void test_slurm_file(void)
 	CHECK_CONTAINS(sb, "#SBATCH --cpus-per-task=2\n");
 	CHECK_CONTAINS(sb, " --only \"$SLURM_ARRAY_TASK_ID\" --out ");
 	free(sb);
+	/* json: the plan's runs with their commands. */
+	CHECK_INT(run(ARGS("plan", path_in("merge.json"), "--out", path_in("m"), "--format", "json")),
+	          0);
+	cJSON *runs = cJSON_Parse(out_text);
+	CHECK_INT(cJSON_GetArraySize(runs), 2);
+	const cJSON *second = cJSON_GetArrayItem(runs, 1);
+	CHECK(num(second, "id", NULL) == 1 && num(second, "threads", NULL) == 2);
+	CHECK(!strcmp(run_str(second, "builder"), "sah_seq"));
+	CHECK_CONTAINS(run_str(second, "command"), "/m/plan.json --only 1 --out ");
+	cJSON_Delete(runs);
 }
 
 static void test_errors(void)
