@@ -179,6 +179,13 @@ static int run_part(const char *dir, const char *id, const char *part)
 	return run(ARGS("run", "--quiet", plan, "--only", id, "--out", path_in(part)));
 }
 
+static void check_unchanged(const char *dir, const char *name, const char *before)
+{
+	char *after = read_file(path_in(dir), name);
+	CHECK(after && before && !strcmp(after, before));
+	free(after);
+}
+
 /* The plan's config file changed: its runs, merge and --missing all refuse. */
 static void test_changed_config(void)
 {
@@ -194,8 +201,11 @@ static void test_changed_config(void)
 	CHECK_INT(run(ARGS("plan", "--missing", path_in("chg"))), 2);
 	CHECK_CONTAINS(err_text, "has changed since planning");
 	/* Planning the changed config into the same folder would renumber its runs. */
+	char *before = read_file(path_in("chg"), "plan.json");
 	CHECK_INT(run(ARGS("plan", cfg, "--out", path_in("chg"))), 2);
 	CHECK_CONTAINS(err_text, "holds another plan");
+	check_unchanged("chg", "plan.json", before);
+	free(before);
 }
 
 /* --only with an id the config does not have, or with --threads. */
@@ -217,13 +227,6 @@ static void test_bad_only(void)
 	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 1);
 	CHECK(num(r, "id", NULL) == 1 && num(r, "threads", NULL) == 2);
 	cJSON_Delete(doc);
-}
-
-static void check_unchanged(const char *dir, const char *name, const char *before)
-{
-	char *after = read_file(path_in(dir), name);
-	CHECK(after && before && !strcmp(after, before));
-	free(after);
 }
 
 /* Parts that do not fit: no results.json, the same run twice, another plan. */
