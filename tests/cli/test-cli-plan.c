@@ -312,6 +312,29 @@ static void test_two_machines(void)
 	cJSON_Delete(doc);
 }
 
+/* A failed run is merged as it was recorded, and named. */
+static void test_failed_run(void)
+{
+	const char *cfg = write_config("fail.json",
+		"{ \"repeat\": 1, \"scenes\": [ { \"generator\": \"soup\", \"count\": 50 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
+		"    { \"plugin\": \"fake_good\", \"name\": \"err\", \"options\": { \"fail\": \"error\" } } ] }\n");
+	CHECK_INT(run(ARGS("plan", cfg, "--out", path_in("f"))), 0);
+	CHECK_INT(run_part("f", "0", "f/parts/0"), 0);
+	CHECK_INT(run_part("f", "1", "f/parts/1"), 1);
+	CHECK_INT(run(ARGS("merge", path_in("f/parts/0"), path_in("f/parts/1"), "--out",
+	                   path_in("f"))), 1);
+	CHECK_CONTAINS(err_text, "merged 2 of the plan's 2 runs");
+	CHECK_CONTAINS(err_text, "not ok: run 1 (soup, err, 1 threads)");
+	cJSON *merged = load_results(path_in("f")), *part = load_results(path_in("f/parts/1"));
+	const cJSON *a = cJSON_GetArrayItem(cJSON_GetObjectItem(merged, "runs"), 1);
+	const cJSON *b = cJSON_GetArrayItem(cJSON_GetObjectItem(part, "runs"), 0);
+	CHECK(!strcmp(run_str(a, "status"), "failed"));
+	CHECK(*run_str(a, "error") && !strcmp(run_str(a, "error"), run_str(b, "error")));
+	cJSON_Delete(merged);
+	cJSON_Delete(part);
+}
+
 static void test_usage(void)
 {
 	CHECK_INT(run(ARGS("plan", "--help")), 0);
@@ -356,6 +379,7 @@ static void test_errors(void)
 	test_bad_parts();
 	test_partial();
 	test_two_machines();
+	test_failed_run();
 	test_usage();
 	test_slurm_file();
 }
