@@ -13,6 +13,8 @@ int cmd_info(int argc, char **argv);
 int cmd_build(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_report(int argc, char **argv);
+int cmd_plan(int argc, char **argv);
+int cmd_merge(int argc, char **argv);
 
 /*
  * A scene named on the command line: a mesh file, or a generator with

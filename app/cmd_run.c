@@ -7,11 +7,14 @@
 #include "cli.h"
 #include "config/config.h"
 #include "harness/harness.h"
+#include "plan/plan.h"
+#include "util/util.h"
 
 #define MAX_THREAD_COUNTS 64
 
 static const char usage[] =
 	"usage: bvhlab run CONFIG.json [options]\n"
+	"       bvhlab run PLAN.json --only ID[,ID...] --out DIR [options]\n"
 	"\n"
 	"Runs every scene x builder x thread count of the config: warm-up builds,\n"
 	"timed builds, validation of the last tree (structure and rays against brute\n"
@@ -35,8 +38,14 @@ static const char usage[] =
 	"                   --force such a folder is refused)\n"
 	"  --threads LIST   thread counts, e.g. 1,2,0 (0 = all cores; overrides \"threads\")\n"
 	"  --repeat N       timed builds per run (overrides \"repeat\")\n"
+	"  --only IDS       run just these runs (ids as `bvhlab plan` lists them: the\n"
+	"                   order scenes x builders x thread counts, from 0), e.g. 3,7,10-12\n"
 	"  --quiet          no progress lines\n"
 	"  -h, --help       this text\n"
+	"\n"
+	"A plan.json written by `bvhlab plan` is run like its config; its runs'\n"
+	"results record the plan's hash so `bvhlab merge` can join the parts. It is\n"
+	"refused when the config it was planned from has changed since.\n"
 	"\n"
 	"exit status: 0 every run ok and valid, 1 some run failed or was invalid,\n"
 	"2 bad arguments or config.\n";
@@ -44,6 +53,7 @@ static const char usage[] =
 struct run_args {
 	const char *config;
 	const char *out;
+	const char *only;
 	uint32_t threads[MAX_THREAD_COUNTS];
 	size_t thread_count;
 	unsigned long repeat;
@@ -57,6 +67,7 @@ static int parse(int argc, char **argv, struct run_args *a)
 		{"repeat", required_argument, NULL, 'r'}, {"quiet", no_argument, NULL, 'q'},
 		{"resume", no_argument, NULL, 'R'},      {"help", no_argument, NULL, 'h'},
 		{"force", no_argument, NULL, 'F'},
+		{"only", required_argument, NULL, 'O'},
 		{NULL, 0, NULL, 0}};
 	int c;
 	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
@@ -77,6 +88,8 @@ static int parse(int argc, char **argv, struct run_args *a)
 			a->opts.resume = true;
 		} else if (c == 'F') {
 			a->opts.force = true;
+		} else if (c == 'O') {
+			a->only = optarg;
 		} else {
 			return -1;
 		}
@@ -111,24 +124,55 @@ static int apply_overrides(struct config *cfg, const struct run_args *a)
 	return 0;
 }
 
+/* The config, or a plan's (checked, its hash kept for the results). */
+static int load(struct config *cfg, struct plan_file *plan, const struct run_args *a,
+                bvhlab_error *err)
+{
+	if (plan_file_detect(a->config))
+		return plan_file_load(plan, a->config, cfg, err);
+	return config_load(cfg, a->config, err);
+}
+
+/* --only against the config's runs: an id it does not have is bad input. */
+static int select_runs(const struct config *cfg, struct run_args *a, bool **only,
+                       bvhlab_error *err)
+{
+	*only = NULL;
+	if (a->thread_count && (a->only || a->opts.plan_hash)) {
+		/* Thread counts are part of a run's identity: other ones renumber the runs. */
+		error_set(err, "--threads cannot be combined with --only or a plan: it changes the "
+		          "runs and their ids (edit the config and plan again)");
+		return -1;
+	}
+	if (!a->only)
+		return 0;
+	if (plan_parse_only(a->only, plan_run_count(cfg), only, err) < 0)
+		return -1;
+	a->opts.only = *only;
+	return 0;
+}
+
 int cmd_run(int argc, char **argv)
 {
 	struct run_args a = {0};
 	struct config cfg = {0};
+	struct plan_file plan = {0};
 	bvhlab_error err = {{0}};
+	bool *only = NULL;
 	if (parse(argc, argv, &a) < 0)
 		return EXIT_USAGE;
-	if (config_load(&cfg, a.config, &err) < 0) {
-		fprintf(stderr, "bvhlab: %s\n", err.message);
-		config_finish(&cfg);
-		return EXIT_USAGE;
-	}
 	int status = EXIT_USAGE;
+	int r = load(&cfg, &plan, &a, &err);
+	a.opts.plan_hash = r == 0 && plan.doc ? plan.hash : NULL;
+	if (r < 0 || select_runs(&cfg, &a, &only, &err) < 0) {
+		fprintf(stderr, "bvhlab: %s\n", err.message);
+		goto out;
+	}
 	if (apply_overrides(&cfg, &a) < 0) {
 		fprintf(stderr, "bvhlab: out of memory\n");
 		goto out;
 	}
-	int r = harness_run(&cfg, &a.opts, &err);
+	r = harness_run(&cfg, &a.opts, &err);
 	if (r < 0) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
@@ -138,6 +182,8 @@ int cmd_run(int argc, char **argv)
 		        cfg.output, r ? "; some runs failed or were invalid" : "");
 	status = r ? EXIT_RUNS_FAILED : 0;
 out:
+	free(only);
+	plan_file_finish(&plan);
 	config_finish(&cfg);
 	return status;
 }

@@ -10,7 +10,7 @@ static const char usage[] =
 	"Build, check and compare BVH construction strategies (builder plugins).\n"
 	"\n"
 	"commands:\n"
-	"  run CONFIG.json [--out DIR] [--threads LIST] [--repeat N]\n"
+	"  run CONFIG.json [--out DIR] [--threads LIST] [--repeat N] [--only IDS]\n"
 	"                        run an experiment: every scene x builder x thread count\n"
 	"  list                  the plugins on the search path, with their options\n"
 	"  info SCENE [--json]   triangle count and bounds of a mesh file or generator\n"
@@ -21,6 +21,10 @@ static const char usage[] =
 	"                        one image: the shaded scene or a heat map of nodes visited\n"
 	"  report RESULTS.json [--out DIR]\n"
 	"                        regenerate report.md, report.html and results.csv\n"
+	"  plan CONFIG.json --out DIR [--format lines|slurm|json]\n"
+	"                        split a sweep into commands for GNU parallel or Slurm\n"
+	"  merge PART... --out DIR\n"
+	"                        join the parts' results folders into one\n"
 	"  help                  this text; `bvhlab COMMAND --help` for a command's\n"
 	"  version               the version\n"
 	"\n"
@@ -55,6 +59,10 @@ int main(int argc, char **argv)
 		return cmd_render(argc - 1, argv + 1);
 	if (!strcmp(cmd, "report"))
 		return cmd_report(argc - 1, argv + 1);
+	if (!strcmp(cmd, "plan"))
+		return cmd_plan(argc - 1, argv + 1);
+	if (!strcmp(cmd, "merge"))
+		return cmd_merge(argc - 1, argv + 1);
 	fprintf(stderr, "bvhlab: unknown command '%s'\n\n%s", cmd, usage);
 	return EXIT_USAGE;
 }

@@ -55,6 +55,30 @@ install_optional() {
 	return 0
 }
 
+# Optional: GNU parallel (the cli-plan-parallel test) and a single-node Slurm
+# (scripts/slurm-smoke.sh). Their tests report themselves skipped without
+# them, so this never fails the set-up.
+install_sweep_tools() {
+	local want=""
+	command -v parallel >/dev/null 2>&1 || want="$want parallel"
+	command -v slurmctld >/dev/null 2>&1 || want="$want slurm-wlm"
+	command -v munged >/dev/null 2>&1 || want="$want munge"
+	[ -z "$want" ] && return 0
+	if [ "$(id -u)" != 0 ] || ! command -v apt-get >/dev/null 2>&1; then
+		echo "setup: optional$want missing: their tests will be skipped" >&2
+		return 0
+	fi
+	echo "setup: installing$want (optional: sweeps over GNU parallel and Slurm)" >&2
+	export DEBIAN_FRONTEND=noninteractive
+	local pkg
+	for pkg in $want; do
+		apt-get install -y -qq --no-install-recommends "$pkg" >&2 ||
+			{ apt-get update -qq >&2 && apt-get install -y -qq --no-install-recommends "$pkg" >&2; } ||
+			echo "setup: could not install $pkg: its test will be skipped" >&2
+	done
+	return 0
+}
+
 install_deps() {
 	local missing
 	missing=$(missing_debs)
@@ -69,6 +93,7 @@ setup_build() {
 	shift
 	install_deps || return 1
 	install_optional
+	install_sweep_tools
 	if [ ! -f "$dir/build.ninja" ]; then
 		meson setup "$dir" "$BVHLAB_ROOT" "$@" >&2 || return 1
 	fi

@@ -66,9 +66,25 @@ build_or_count() {
 	fi
 }
 
+# The Slurm smoke test (scripts/slurm-smoke.sh): counted as one test, skipped
+# with its reason where Slurm cannot be started (not root, no slurm-wlm).
+run_slurm_smoke() {
+	echo "== slurm smoke ==" >&2
+	local out rc
+	out=$(bash "$here/slurm-smoke.sh" "$BVHLAB_ROOT/build" 2>&1)
+	rc=$?
+	echo "$out" | tail -n 30 >&2
+	case $rc in
+	0) passed=$((passed + 1)) ;;
+	77) skipped=$((skipped + 1)) ;;
+	*) failed=$((failed + 1)) ;;
+	esac
+}
+
 build_or_count release "$BVHLAB_ROOT/build" && run_suite release "$BVHLAB_ROOT/build"
 
 if [ $quick = 0 ]; then
+	[ -x "$BVHLAB_ROOT/build/app/bvhlab" ] && run_slurm_smoke
 	san_opts=(-Dbuildtype=debugoptimized -Db_lundef=false)
 	export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 	build_or_count asan "$BVHLAB_ROOT/build-asan" "${san_opts[@]}" -Db_sanitize=address,undefined &&

@@ -227,6 +227,7 @@ void config_finish(struct config *cfg)
 		free(cfg->builders[i].plugin);
 		free(cfg->builders[i].name);
 		free(cfg->builders[i].threads);
+		free(cfg->builders[i].picks);
 	}
 	free(cfg->scenes);
 	free(cfg->builders);

@@ -40,6 +40,16 @@ struct config_builder {
 	uint64_t memory_limit_mb; /* "memory_limit_mb" override, or 0 for the config's */
 	const struct cJSON *options; /* "options" object (may be NULL), owned by root */
 	int line, column;  /* where the builder's object starts */
+	/* An option grid's builder (config_grid.c): the value it takes of each grid. */
+	struct config_grid_pick *picks;
+	size_t pick_count;
+};
+
+/* One option of a grid builder: {"grid": [...]} under member, value the chosen element. */
+struct config_grid_pick {
+	const struct cJSON *member;
+	const struct cJSON *value;
+	size_t index;
 };
 
 struct config {
@@ -94,6 +104,13 @@ int config_apply_options(const struct config *cfg, const struct config_builder *
  * beyond any machine this runs on, and small enough that a plugin's
  * per-thread arrays stay reasonable. */
 #define CONFIG_MAX_THREADS 1024
+/*
+ * The value a builder gives an option member: the member itself, or for a
+ * grid option {"grid": [...]} the element this builder was expanded with.
+ * *index gets its position in the grid (SIZE_MAX for a plain value).
+ */
+const struct cJSON *config_grid_value(const struct config_builder *b,
+                                      const struct cJSON *member, size_t *index);
 
 /* Replaces the thread list (command line --threads). */
 int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count);

@@ -239,7 +239,7 @@ int config_parse_builders(struct config *cfg, bvhlab_error *err)
 		names[i] = cfg->builders[i].name;
 	rc = unique_names(cfg, array, names, "builder", "builders", err);
 	free(names);
-	return rc;
+	return rc ? rc : config_expand_grids(cfg, array, err);
 }
 
 /* ---- options ----------------------------------------------------------------- */
@@ -272,54 +272,66 @@ static int unknown_option(const struct config *cfg, const struct config_builder 
 }
 
 static int wrong_type(const struct config *cfg, const struct config_builder *b,
-                      const cJSON *m, const char *expected, bvhlab_error *err)
+                      const cJSON *m, const cJSON *v, const char *expected, bvhlab_error *err)
 {
 	char got[48];
-	return config_error(cfg, m, true, err, "builder '%s': option '%s' must be %s, not %s",
-	                    b->name, m->string, expected, config_describe(cfg, m, got, sizeof(got)));
+	return config_error(cfg, v, true, err, "builder '%s': option '%s' must be %s, not %s",
+	                    b->name, m->string, expected, config_describe(cfg, v, got, sizeof(got)));
 }
 
-/* 0 when the JSON value fits the declared type; *i gets an INT's value. */
+/* 0 when the JSON value v of member m fits the declared type; *i gets an INT's value. */
 static int check_type(const struct config *cfg, const struct config_builder *b,
-                      const cJSON *m, uint32_t type, int64_t *i, bvhlab_error *err)
+                      const cJSON *m, const cJSON *v, uint32_t type, int64_t *i,
+                      bvhlab_error *err)
 {
 	switch (type) {
 	case BVHLAB_OPTION_BOOL:
-		return cJSON_IsBool(m) ? 0 : wrong_type(cfg, b, m, "true or false", err);
+		return cJSON_IsBool(v) ? 0 : wrong_type(cfg, b, m, v, "true or false", err);
 	case BVHLAB_OPTION_INT:
-		switch (cJSON_IsNumber(m) ? json_get_int64(cfg->locations, m, i) : -EINVAL) {
+		switch (cJSON_IsNumber(v) ? json_get_int64(cfg->locations, v, i) : -EINVAL) {
 		case 0:
 			return 0;
 		case -ERANGE:
-			return wrong_type(cfg, b, m, "an integer that fits in 64 bits", err);
+			return wrong_type(cfg, b, m, v, "an integer that fits in 64 bits", err);
 		default:
-			return wrong_type(cfg, b, m, "an integer", err);
+			return wrong_type(cfg, b, m, v, "an integer", err);
 		}
 	case BVHLAB_OPTION_FLOAT:
-		if (!cJSON_IsNumber(m) || !isfinite(m->valuedouble))
-			return wrong_type(cfg, b, m, "a finite number", err);
+		if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble))
+			return wrong_type(cfg, b, m, v, "a finite number", err);
 		return 0;
 	case BVHLAB_OPTION_STRING:
-		return cJSON_IsString(m) ? 0 : wrong_type(cfg, b, m, "a string", err);
+		return cJSON_IsString(v) ? 0 : wrong_type(cfg, b, m, v, "a string", err);
 	default:
 		return config_error(cfg, m, true, err, "builder '%s': option '%s' has no valid type (%u)",
 		                    b->name, m->string, type);
 	}
 }
 
-static int set_value(bvhlab_options *opts, const cJSON *m, uint32_t type, int64_t i,
-                     bvhlab_error *err)
+static int set_value(bvhlab_options *opts, const char *key, const cJSON *v, uint32_t type,
+                     int64_t i, bvhlab_error *err)
 {
 	switch (type) {
 	case BVHLAB_OPTION_BOOL:
-		return bvhlab_options_set_bool(opts, m->string, cJSON_IsTrue(m), err);
+		return bvhlab_options_set_bool(opts, key, cJSON_IsTrue(v), err);
 	case BVHLAB_OPTION_INT:
-		return bvhlab_options_set_int(opts, m->string, i, err);
+		return bvhlab_options_set_int(opts, key, i, err);
 	case BVHLAB_OPTION_FLOAT:
-		return bvhlab_options_set_float(opts, m->string, m->valuedouble, err);
+		return bvhlab_options_set_float(opts, key, v->valuedouble, err);
 	default:
-		return bvhlab_options_set_string(opts, m->string, m->valuestring, err);
+		return bvhlab_options_set_string(opts, key, v->valuestring, err);
 	}
+}
+
+/* A grid value's error also says which element of the grid it is. */
+static int grid_note(int rc, const cJSON *m, size_t index, bvhlab_error *err)
+{
+	char old[sizeof(err->message)];
+	if (!rc || index == SIZE_MAX)
+		return rc;
+	memcpy(old, err->message, sizeof(old));
+	error_set(err, "%s (options.%s.grid[%zu])", old, m->string, index);
+	return rc;
 }
 
 int config_apply_options(const struct config *cfg, const struct config_builder *b,
@@ -329,17 +341,19 @@ int config_apply_options(const struct config *cfg, const struct config_builder *
 		int index = bvhlab_options_find(opts, m->string);
 		if (index < 0)
 			return unknown_option(cfg, b, opts, m, err);
+		size_t at;
+		const cJSON *v = config_grid_value(b, m, &at);
 		uint32_t type = opts->builder->options[index].type;
 		int64_t i = 0;
-		int rc = check_type(cfg, b, m, type, &i, err);
+		int rc = check_type(cfg, b, m, v, type, &i, err);
 		if (rc)
-			return rc;
+			return grid_note(rc, m, at, err);
 		/* The setter's message (range, choices) gets the position and the name. */
 		bvhlab_error inner = { "" };
-		rc = set_value(opts, m, type, i, &inner);
+		rc = set_value(opts, m->string, v, type, i, &inner);
 		if (rc) {
-			config_error(cfg, m, true, err, "builder '%s': %s", b->name, inner.message);
-			return rc;
+			config_error(cfg, v, true, err, "builder '%s': %s", b->name, inner.message);
+			return grid_note(rc, m, at, err);
 		}
 	}
 	return 0;

@@ -123,5 +123,9 @@ char *config_stem(const char *path);
 int config_parse_camera(struct config *cfg, const cJSON *rays, bvhlab_error *err);
 int config_parse_scenes(struct config *cfg, bvhlab_error *err);
 int config_parse_builders(struct config *cfg, bvhlab_error *err);
+/* Expands builders with {"grid": [...]} option values into one builder per
+ * combination, named "NAME[key=value,...]" (config_grid.c); `array` is the
+ * config's "builders" array, one element per builder before expansion. */
+int config_expand_grids(struct config *cfg, const cJSON *array, bvhlab_error *err);
 
 #endif /* BVHLAB_CORE_CONFIG_INTERNAL_H */

@@ -17,12 +17,14 @@
 #include "output/results.h"
 #include "output/scene_images.h"
 #include "output/safe_file.h"
+#include "plan/plan.h"
 #include "util/util.h"
 
 #define RAY_SEED 0x5eedULL
 
 struct harness {
 	const struct config *cfg;
+	const bool *only; /* [run id]: the runs to do; NULL: all */
 	struct results res;
 	struct harness_builder *builders;
 	struct progress progress;
@@ -81,38 +83,52 @@ static void record(struct harness *h, struct run_record *run)
 static const uint32_t *builder_threads(const struct harness *h, const struct config_builder *b,
                                        size_t *count)
 {
-	*count = b->threads ? b->thread_count : h->cfg->thread_count;
-	return b->threads ? b->threads : h->cfg->threads;
+	return plan_builder_threads(h->cfg, b, count);
+}
+
+/* A run left out by --only, or kept from the results resumed (counted as done). */
+static bool skip_run(struct harness *h, uint32_t id, const char *scene, const char *builder,
+                     uint32_t threads)
+{
+	if (h->only && !h->only[id])
+		return true;
+	if (!results_has_run(&h->res, scene, builder, threads))
+		return false;
+	h->progress.index++;
+	return true;
 }
 
 /* Every run of a builder fails the same way (plugin or scene unusable). */
-static void record_all_failed(struct harness *h, const char *scene, struct harness_builder *hb,
-                              const char *status, const char *error)
+static void record_all_failed(struct harness *h, size_t scene_index, const char *scene,
+                              struct harness_builder *hb, const char *status, const char *error)
 {
-	size_t n;
+	size_t n, b = (size_t)(hb - h->builders);
 	const uint32_t *threads = builder_threads(h, hb->cb, &n);
 	for (size_t k = 0; k < n; k++) {
-		struct run_record run = {.scene = scene, .builder = hb->cb->name,
+		struct run_record run = {.id = plan_run_id(h->cfg, scene_index, b, k),
+		                         .scene = scene, .builder = hb->cb->name,
 		                         .plugin = hb->cb->plugin, .threads = resolve_threads(threads[k]),
 		                         .opts = hb->opts_ok ? &hb->opts : NULL,
 		                         .status = status, .error = error};
-		if (results_has_run(&h->res, run.scene, run.builder, run.threads))
-			h->progress.index++;
-		else
+		if (!skip_run(h, run.id, run.scene, run.builder, run.threads))
 			record(h, &run);
 	}
 }
 
 /* Resumed runs already hold every run of the scene: no need to load it. */
-static bool scene_done(struct harness *h, const struct config_scene *cs)
+static bool scene_done(struct harness *h, const struct config_scene *cs, size_t scene_index)
 {
 	uint32_t done = 0, total = 0;
 	for (size_t b = 0; b < h->cfg->builder_count; b++) {
 		size_t n;
 		const uint32_t *threads = builder_threads(h, &h->cfg->builders[b], &n);
-		for (size_t t = 0; t < n; t++, total++)
+		for (size_t t = 0; t < n; t++) {
+			if (h->only && !h->only[plan_run_id(h->cfg, scene_index, b, t)])
+				continue;
+			total++;
 			done += results_has_run(&h->res, cs->name, h->cfg->builders[b].name,
 			                        resolve_threads(threads[t]));
+		}
 	}
 	if (done < total)
 		return false;
@@ -280,18 +296,18 @@ static void image_paths(struct harness *h, struct series_job *job, size_t scene_
 }
 
 static void run_one(struct harness *h, struct series_job *job, size_t scene_index,
-                    size_t builder_index, bool first)
+                    size_t builder_index, size_t thread_index)
 {
 	const bvhlab_builder *desc = bvhlab_plugin_builder(job->hb->plugin);
-	struct run_record run = {.scene = job->scene->name, .builder = job->hb->cb->name,
+	bool first = thread_index == 0;
+	struct run_record run = {.id = plan_run_id(h->cfg, scene_index, builder_index, thread_index),
+	                         .scene = job->scene->name, .builder = job->hb->cb->name,
 	                         .plugin = desc->name, .threads = resolve_threads(job->threads),
 	                         .opts = &job->hb->opts, .status = "failed",
 	                         .triangles = job->scene->triangle_count};
 	char paths[2][4096];
-	if (results_has_run(&h->res, run.scene, run.builder, run.threads)) {
-		h->progress.index++;
+	if (skip_run(h, run.id, run.scene, run.builder, run.threads))
 		return;
-	}
 	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double);
 	struct series_report *rep = calloc(1, size);
 	if (!rep) {
@@ -313,7 +329,7 @@ static void run_builders(struct harness *h, const bvhlab_scene *scene,
 	for (size_t b = 0; b < h->cfg->builder_count; b++) {
 		struct harness_builder *hb = &h->builders[b];
 		if (!hb->plugin || !hb->opts_ok) {
-			record_all_failed(h, scene->name, hb, hb->status, hb->error.message);
+			record_all_failed(h, scene_index, scene->name, hb, hb->status, hb->error.message);
 			continue;
 		}
 		size_t n;
@@ -321,7 +337,7 @@ static void run_builders(struct harness *h, const bvhlab_scene *scene,
 		for (size_t t = 0; t < n; t++) {
 			struct series_job job = {.h = h, .scene = scene, .prims = prims, .hb = hb,
 			                         .threads = threads[t]};
-			run_one(h, &job, scene_index, b, t == 0);
+			run_one(h, &job, scene_index, b, t);
 		}
 	}
 }
@@ -359,7 +375,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	bvhlab_scene *scene = NULL;
 	bvhlab_prims prims = {0};
 	bvhlab_error err = {{0}};
-	if (scene_done(h, cs))
+	if (scene_done(h, cs, scene_index))
 		return;
 	int r = h->cfg->isolate ? harness_probe_scene(h->cfg, cs, &err) : 0;
 	if (r == 0)
@@ -370,7 +386,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 		results_add_scene(&h->res, cs->name, cs->path ? cs->path : cs->generator, 0,
 		                  err.message);
 		for (size_t b = 0; b < h->cfg->builder_count; b++)
-			record_all_failed(h, cs->name, &h->builders[b], "failed", err.message);
+			record_all_failed(h, scene_index, cs->name, &h->builders[b], "failed", err.message);
 		goto out;
 	}
 	results_add_scene(&h->res, scene->name, scene->source, scene->triangle_count, NULL);
@@ -385,13 +401,10 @@ out:
 
 static uint32_t count_runs(const struct harness *h)
 {
-	uint32_t total = 0;
-	for (size_t b = 0; b < h->cfg->builder_count; b++) {
-		size_t n;
-		builder_threads(h, &h->cfg->builders[b], &n);
-		total += (uint32_t)n;
-	}
-	return total * (uint32_t)h->cfg->scene_count;
+	size_t total = plan_run_count(h->cfg), chosen = 0;
+	for (size_t id = 0; h->only && id < total; id++)
+		chosen += h->only[id];
+	return (uint32_t)(h->only ? chosen : total);
 }
 
 /* Takes over the finished runs of the output folder's results.json. */
@@ -417,15 +430,17 @@ static int resume(struct harness *h, bvhlab_error *err)
 int harness_run(const struct config *cfg, const struct harness_options *opts,
                 bvhlab_error *err)
 {
-	struct harness h = {.cfg = cfg, .all_ok = true};
+	struct harness h = {.cfg = cfg, .only = opts->only, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
 	int r = opts->resume ? 0 : safe_claim_output(cfg->output, opts->force, err);
 	if (r == 0)
 		r = results_init(&h.res, cfg, cfg->output, err);
 	if (r < 0)
 		return r;
+	if (opts->plan_hash)
+		r = results_set_plan(&h.res, opts->plan_hash, plan_run_count(cfg), err);
 	bvhlab_set_pinning(cfg->pin);
-	if (opts->resume)
+	if (r == 0 && opts->resume)
 		r = resume(&h, err);
 	if (r == 0)
 		r = results_write(&h.res, err);

@@ -227,6 +227,7 @@ char *report_markdown(const cJSON *doc)
 	struct report_index ix;
 	if (report_index_init(&ix, doc) < 0)
 		sb.failed = true;
+	report_machines_md(&sb, doc);
 	report_thesis(&sb, doc, &ix);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		md_scene(&sb, &ix, scene);

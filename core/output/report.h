@@ -50,6 +50,11 @@ double report_speedup(const struct report_index *ix, const cJSON *run);
  * report_thesis.c. */
 void report_thesis(struct strbuf *sb, const struct cJSON *doc, const struct report_index *ix);
 
+/* A section listing the machines the runs come from, when there are several
+ * (a merged sweep; report_machines.c); nothing otherwise. */
+void report_machines_md(struct strbuf *sb, const cJSON *doc);
+void report_machines_html(struct strbuf *sb, const cJSON *doc);
+
 /* Text with & < > " ' escaped for HTML and SVG. */
 void report_escape(struct strbuf *sb, const char *text);
 

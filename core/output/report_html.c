@@ -198,6 +198,7 @@ char *report_html(const cJSON *doc)
 	               "normalised by the root's area. Rays are traced with every hardware "
 	               "thread for every run, so traversal numbers compare trees, not thread "
 	               "counts.</p>\n", report_num(doc, "machine.cores"));
+	report_machines_html(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		scene_section(&sb, &ix, scene);
 	report_index_finish(&ix);

@@ -16,8 +16,7 @@
 #include "output/safe_file.h"
 #include "util/util.h"
 
-/* mkdir -p: creates every missing folder of `path`. */
-static int make_dirs(const char *path, bvhlab_error *err)
+int results_make_dirs(const char *path, bvhlab_error *err)
 {
 	char buf[4096];
 	if ((size_t)snprintf(buf, sizeof(buf), "%s", path) >= sizeof(buf)) {
@@ -45,6 +44,10 @@ static cJSON *machine_json(void)
 	struct machine_info m;
 	machine_info_read(&m);
 	cJSON *o = cJSON_CreateObject();
+	char host[256] = "";
+	/* Parts of one plan may run on several machines: merge tells them apart by it. */
+	gethostname(host, sizeof(host) - 1);
+	cJSON_AddStringToObject(o, "hostname", host);
 	cJSON_AddStringToObject(o, "cpu", m.cpu);
 	cJSON_AddNumberToObject(o, "cores", m.cores);
 	cJSON_AddNumberToObject(o, "threads_available", m.threads_available);
@@ -77,7 +80,7 @@ int results_init(struct results *res, const struct config *cfg, const char *dir,
                  bvhlab_error *err)
 {
 	memset(res, 0, sizeof(*res));
-	int r = make_dirs(dir, err);
+	int r = results_make_dirs(dir, err);
 	if (r < 0)
 		return r;
 	res->dir = strdup(dir);
@@ -198,6 +201,7 @@ int results_add_run(struct results *res, const struct run_record *run)
 	cJSON *o = cJSON_CreateObject();
 	if (!o)
 		return -ENOMEM;
+	cJSON_AddNumberToObject(o, "id", run->id);
 	cJSON_AddStringToObject(o, "scene", run->scene ? run->scene : "");
 	cJSON_AddStringToObject(o, "builder", run->builder);
 	cJSON_AddStringToObject(o, "plugin", run->plugin ? run->plugin : "");
@@ -424,7 +428,7 @@ int results_render_saved(const char *json_path, const char *dir, bvhlab_error *e
 		r = -EINVAL;
 	}
 	if (r == 0)
-		r = make_dirs(dir, err);
+		r = results_make_dirs(dir, err);
 	if (r == 0)
 		r = write_rendering(&res, "results.csv", report_csv(res.doc), err);
 	if (r == 0)

@@ -34,6 +34,7 @@ struct ray_metrics {
 
 /* Everything known about one run; fields beyond status are optional. */
 struct run_record {
+	uint32_t id;           /* position in the config's run order (plan.h) */
 	const char *scene;
 	const char *builder;   /* the config's label for the builder */
 	const char *plugin;    /* the descriptor's name */
@@ -51,6 +52,9 @@ struct run_record {
 	const struct ray_metrics *rays; /* or NULL: not traced */
 };
 
+
+/* mkdir -p: creates every missing folder of `path`; err names the one that failed. */
+int results_make_dirs(const char *path, bvhlab_error *err);
 
 /* Creates the folder (and parents) and the document. */
 int results_init(struct results *res, const struct config *cfg, const char *dir,

@@ -1,0 +1,339 @@
+/* bvhlab plan: a config's runs as commands for GNU parallel, xargs or Slurm. */
+#include <errno.h>
+#include <getopt.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cJSON.h>
+
+#include "cli.h"
+#include "config/config.h"
+#include "output/results.h"
+#include "plan/plan.h"
+#include "util/util.h"
+
+static const char usage[] =
+	"usage: bvhlab plan CONFIG.json --out DIR [--format lines|slurm|json] [options]\n"
+	"       bvhlab plan --missing DIR [--format lines|slurm|json] [options]\n"
+	"\n"
+	"Splits a sweep into its runs (scene x builder x thread count, ids from 0 in\n"
+	"the order `bvhlab run` takes them) so that other engines can spread them\n"
+	"over machines. Checks every builder's plugin and options, writes\n"
+	"DIR/plan.json (the config with absolute paths, its hash, the run list) and\n"
+	"gives one command per run, each writing the results folder DIR/parts/ID:\n"
+	"\n"
+	"  lines   one shell command per line on stdout, for\n"
+	"          `parallel --jobs 1 --sshloginfile hosts` or `xargs -P`\n"
+	"  slurm   DIR/sweep.sbatch: a job array, one task per run, --exclusive (a\n"
+	"          run's timings are not shared with other jobs), --cpus-per-task\n"
+	"          the largest thread count; submit with `sbatch DIR/sweep.sbatch`\n"
+	"  json    the runs with their commands, as a JSON array on stdout\n"
+	"\n"
+	"Then `bvhlab merge DIR/parts/* --out DIR` joins the parts. With --missing,\n"
+	"only the runs that no folder of DIR/parts holds yet (--format slurm:\n"
+	"DIR/sweep-missing.sbatch); a run that finished failed counts as done, so\n"
+	"remove its part folder to run it again. Planning again into DIR is fine\n"
+	"for the same config; another plan there is refused.\n"
+	"\n"
+	"options:\n"
+	"  --out DIR        the plan's folder (plan.json, parts/, slurm/)\n"
+	"  --missing DIR    commands for the runs not yet done of DIR/plan.json\n"
+	"  --format F       lines (default), slurm or json\n"
+	"  --jobs K         slurm: at most K array tasks at once (default 4)\n"
+	"  --command CMD    how the machines call bvhlab (default: this program's\n"
+	"                   absolute path)\n"
+	"\n"
+	"exit status: 0 planned, 2 bad arguments, config or plugin options.\n";
+
+enum format { FORMAT_LINES, FORMAT_SLURM, FORMAT_JSON };
+
+struct plan_args {
+	const char *config, *out, *missing, *command;
+	enum format format;
+	unsigned long jobs;
+};
+
+static int parse_format(const char *text, enum format *out)
+{
+	static const char *const names[] = {"lines", "slurm", "json"};
+	for (int k = 0; k < 3; k++)
+		if (strcmp(text, names[k]) == 0)
+			return *out = (enum format)k, 0;
+	fprintf(stderr, "bvhlab plan: --format must be lines, slurm or json, not '%s'\n", text);
+	return -1;
+}
+
+static int parse(int argc, char **argv, struct plan_args *a)
+{
+	static const struct option longopts[] = {
+		{"out", required_argument, NULL, 'o'},     {"missing", required_argument, NULL, 'm'},
+		{"format", required_argument, NULL, 'f'},  {"jobs", required_argument, NULL, 'j'},
+		{"command", required_argument, NULL, 'c'}, {"help", no_argument, NULL, 'h'},
+		{NULL, 0, NULL, 0}};
+	int c, r = 0;
+	while (r == 0 && (c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+		if (c == 'h')
+			exit((fputs(usage, stdout), 0));
+		else if (c == 'o' || c == 'm' || c == 'c')
+			*(c == 'o' ? &a->out : c == 'm' ? &a->missing : &a->command) = optarg;
+		else if (c == 'f')
+			r = parse_format(optarg, &a->format);
+		else if (c == 'j')
+			r = cli_parse_uint("--jobs", optarg, 1000000, &a->jobs);
+		else
+			r = -1;
+	}
+	if (r == 0 && a->jobs == 0) {
+		fprintf(stderr, "bvhlab plan: --jobs must be at least 1\n");
+		r = -1;
+	}
+	bool operands_ok = a->missing ? optind == argc && !a->out : optind == argc - 1 && a->out;
+	if (r == 0 && !operands_ok) {
+		fprintf(stderr, "bvhlab plan: expected CONFIG.json --out DIR, or --missing DIR\n\n%s",
+		        usage);
+		return -1;
+	}
+	a->config = a->missing ? NULL : argv[optind];
+	return r;
+}
+
+/* Opens every builder's plugin and applies its options: a plan that cannot run is refused. */
+static int check_builders(const struct config *cfg)
+{
+	int bad = 0;
+	for (size_t b = 0; b < cfg->builder_count; b++) {
+		const struct config_builder *cb = &cfg->builders[b];
+		bvhlab_plugin *p = NULL;
+		bvhlab_options opts = {0};
+		bvhlab_error err = {{0}};
+		if (bvhlab_plugin_open(cb->plugin, &p, &err) < 0 ||
+		    bvhlab_options_init(&opts, bvhlab_plugin_builder(p)) < 0 ||
+		    config_apply_options(cfg, cb, &opts, &err) < 0) {
+			fprintf(stderr, "bvhlab: builder '%s': %s\n", cb->name,
+			        err.message[0] ? err.message : "out of memory");
+			bad = -1;
+		}
+		if (opts.values)
+			bvhlab_options_finish(&opts);
+		bvhlab_plugin_close(p);
+	}
+	return bad;
+}
+
+/* A word for sh: as it is when harmless, else in single quotes. */
+static void shell_word(struct strbuf *sb, const char *w)
+{
+	if (*w && strspn(w, "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789"
+	                    "_./-=,:+@%") == strlen(w)) {
+		sb_printf(sb, "%s", w);
+		return;
+	}
+	sb_printf(sb, "'");
+	for (; *w; w++)
+		sb_printf(sb, *w == '\'' ? "'\\''" : "%c", *w);
+	sb_printf(sb, "'");
+}
+
+/* The command of one run; id NULL: "$SLURM_ARRAY_TASK_ID". */
+static void run_command(struct strbuf *sb, const char *command, const char *dir, const char *id)
+{
+	char plan[PATH_MAX + 16], part[PATH_MAX + 64];
+	snprintf(plan, sizeof(plan), "%s/plan.json", dir);
+	snprintf(part, sizeof(part), "%s/parts/%s", dir, id ? id : "");
+	shell_word(sb, command);
+	sb_printf(sb, " run ");
+	shell_word(sb, plan);
+	sb_printf(sb, " --only %s --out ", id ? id : "\"$SLURM_ARRAY_TASK_ID\"");
+	shell_word(sb, part);
+	sb_printf(sb, "%s --resume --quiet", id ? "" : "\"$SLURM_ARRAY_TASK_ID\"");
+}
+
+/* What to emit: the plan's runs, those with want[id]. */
+struct emit {
+	const struct plan_file *plan;
+	const char *dir;     /* absolute */
+	const char *command; /* absolute or as given */
+	const bool *want;    /* [run_count] */
+	size_t count;        /* how many want */
+};
+
+static void emit_lines(const struct emit *e)
+{
+	const cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(e->plan->doc, "runs")) {
+		int id = cJSON_GetObjectItemCaseSensitive(run, "id")->valueint;
+		char idtext[16];
+		struct strbuf sb = {0};
+		if (!e->want[id])
+			continue;
+		snprintf(idtext, sizeof(idtext), "%d", id);
+		run_command(&sb, e->command, e->dir, idtext);
+		char *line = sb_take(&sb);
+		if (line)
+			puts(line);
+		free(line);
+	}
+}
+
+static int emit_json(const struct emit *e)
+{
+	cJSON *out = cJSON_CreateArray();
+	const cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(e->plan->doc, "runs")) {
+		int id = cJSON_GetObjectItemCaseSensitive(run, "id")->valueint;
+		char idtext[16];
+		struct strbuf sb = {0};
+		if (!e->want[id])
+			continue;
+		snprintf(idtext, sizeof(idtext), "%d", id);
+		run_command(&sb, e->command, e->dir, idtext);
+		char *line = sb_take(&sb);
+		cJSON *o = cJSON_Duplicate(run, 1);
+		cJSON_AddStringToObject(o, "command", line ? line : "");
+		cJSON_AddItemToArray(out, o);
+		free(line);
+	}
+	char *text = cJSON_Print(out);
+	if (text)
+		puts(text);
+	free(text);
+	cJSON_Delete(out);
+	return text ? 0 : -1;
+}
+
+/* "0-11" or "3,5,9": the array indexes, which are the run ids. */
+static void array_spec(struct strbuf *sb, const struct emit *e)
+{
+	if (e->count == e->plan->run_count) {
+		sb_printf(sb, "0-%zu", e->plan->run_count - 1);
+		return;
+	}
+	const char *sep = "";
+	for (size_t id = 0; id < e->plan->run_count; id++)
+		if (e->want[id]) {
+			sb_printf(sb, "%s%zu", sep, id);
+			sep = ",";
+		}
+}
+
+/* The largest thread count; 0 (all cores) asks for no number: --exclusive gives the node. */
+static unsigned max_threads(const struct plan_file *plan)
+{
+	unsigned most = 1;
+	const cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(plan->doc, "runs")) {
+		const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
+		if (cJSON_IsNumber(t) && t->valuedouble > most)
+			most = (unsigned)t->valuedouble;
+	}
+	return most;
+}
+
+static int emit_slurm(const struct emit *e, const char *name, unsigned long jobs)
+{
+	struct strbuf sb = {0};
+	bvhlab_error err = {{0}};
+	char slurm_dir[PATH_MAX + 8];
+	snprintf(slurm_dir, sizeof(slurm_dir), "%s/slurm", e->dir);
+	sb_printf(&sb, "#!/bin/sh\n# bvhlab plan %s: %zu of its %zu runs, one array task each.\n"
+	               "# Submit: sbatch %s/%s\n# Then:   bvhlab merge %s/parts/* --out %s\n",
+	          e->plan->hash, e->count, e->plan->run_count, e->dir, name, e->dir, e->dir);
+	sb_printf(&sb, "#SBATCH --job-name=bvhlab-%.8s\n#SBATCH --array=", e->plan->hash);
+	array_spec(&sb, e);
+	/* --exclusive: another job on the node would skew the timings. */
+	sb_printf(&sb, "%%%lu\n#SBATCH --exclusive\n#SBATCH --cpus-per-task=%u\n"
+	               "#SBATCH --output=%s/task-%%a.out\n\nexec ",
+	          jobs, max_threads(e->plan), slurm_dir);
+	run_command(&sb, e->command, e->dir, NULL);
+	sb_printf(&sb, "\n");
+	char *text = sb_take(&sb);
+	int r = text ? results_make_dirs(slurm_dir, &err) : -1;
+	if (r == 0)
+		r = results_write_file(e->dir, name, text, &err);
+	free(text);
+	if (r < 0) {
+		fprintf(stderr, "bvhlab: %s\n", err.message[0] ? err.message : "out of memory");
+		return -1;
+	}
+	fprintf(stderr, "bvhlab: %s/%s: %zu runs as a Slurm job array; submit it with "
+	                "`sbatch %s/%s`\n", e->dir, name, e->count, e->dir, name);
+	return 0;
+}
+
+static int emit(const struct emit *e, const struct plan_args *a)
+{
+	if (e->count == 0) {
+		fprintf(stderr, "bvhlab: every run of %s is in %s/parts\n", e->plan->path, e->dir);
+		return 0;
+	}
+	if (a->format == FORMAT_LINES)
+		return emit_lines(e), 0;
+	if (a->format == FORMAT_JSON)
+		return emit_json(e);
+	return emit_slurm(e, a->missing ? "sweep-missing.sbatch" : "sweep.sbatch", a->jobs);
+}
+
+/* The plan (new, or DIR/plan.json for --missing) and its folder, absolute. */
+static int load_plan(const struct plan_args *a, struct plan_file *plan, char *dir)
+{
+	struct config cfg = {0};
+	bvhlab_error err = {{0}};
+	const char *d = a->missing ? a->missing : a->out;
+	char path[PATH_MAX + 16];
+	int r = 0;
+	if (!a->missing && (r = config_load(&cfg, a->config, &err)) == 0 &&
+	    (r = check_builders(&cfg)) == 0)
+		r = plan_file_write(&cfg, d, plan, &err);
+	config_finish(&cfg);
+	if (r == 0 && !realpath(d, dir)) {
+		error_set(&err, "cannot resolve %s: %s", d, strerror(errno));
+		r = -1;
+	}
+	snprintf(path, sizeof(path), "%s/plan.json", dir);
+	if (r == 0 && a->missing)
+		r = plan_file_load(plan, path, NULL, &err);
+	if (r < 0 && err.message[0])
+		fprintf(stderr, "bvhlab: %s\n", err.message);
+	return r;
+}
+
+static int wanted(const struct plan_args *a, const struct plan_file *plan, const char *dir,
+                  bool **want, size_t *count)
+{
+	bvhlab_error err = {{0}};
+	char parts[PATH_MAX + 8];
+	snprintf(parts, sizeof(parts), "%s/parts", dir);
+	if (plan_done_runs(plan, parts, want, &err) < 0) {
+		fprintf(stderr, "bvhlab: %s\n", err.message);
+		return -1;
+	}
+	*count = 0;
+	for (size_t id = 0; id < plan->run_count; id++) {
+		(*want)[id] = !a->missing || !(*want)[id];
+		*count += (*want)[id];
+	}
+	return 0;
+}
+
+int cmd_plan(int argc, char **argv)
+{
+	struct plan_args a = {.format = FORMAT_LINES, .jobs = 4};
+	struct plan_file plan = {0};
+	char dir[PATH_MAX], self[PATH_MAX];
+	bool *want = NULL;
+	if (parse(argc, argv, &a) < 0 || load_plan(&a, &plan, dir) < 0)
+		return EXIT_USAGE;
+	if (!a.command)
+		a.command = realpath("/proc/self/exe", self) ? self : "bvhlab";
+	struct emit e = {.plan = &plan, .dir = dir, .command = a.command};
+	int status = wanted(&a, &plan, dir, &want, &e.count) < 0 ? EXIT_USAGE : 0;
+	e.want = want;
+	if (status == 0 && emit(&e, &a) < 0)
+		status = EXIT_USAGE;
+	free(want);
+	plan_file_finish(&plan);
+	return status;
+}

@@ -1,0 +1,362 @@
+/*
+ * plan.json: a config frozen for a sweep split across machines. It holds a
+ * copy of the config with every path absolute (so any machine that sees
+ * the same files can run it from anywhere), the copy's hash (the plan's
+ * identity, recorded in every part's results), the hash of the config file
+ * it came from (so a changed config is noticed before runs get mixed up)
+ * and the run list with ids.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cJSON.h>
+
+#include "output/results.h"
+#include "plan/plan.h"
+#include "util/util.h"
+
+int plan_read_file(const char *path, char **out, bvhlab_error *err)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		int e = errno;
+		error_set(err, "cannot read %s: %s", path, strerror(e));
+		return -e;
+	}
+	struct strbuf sb = {0};
+	char chunk[65536];
+	size_t n;
+	while ((n = fread(chunk, 1, sizeof(chunk), f)) > 0)
+		sb_printf(&sb, "%.*s", (int)n, chunk);
+	bool failed = ferror(f);
+	fclose(f);
+	*out = sb_take(&sb);
+	if (failed || !*out) {
+		free(*out);
+		*out = NULL;
+		error_set(err, "cannot read %s: %s", path, failed ? "read error" : "out of memory");
+		return failed ? -EIO : -ENOMEM;
+	}
+	return 0;
+}
+
+/* path, relative to folder dir (NULL: the working folder), made absolute; the
+ * file need not exist on this machine. */
+static char *absolute_in(const char *dir, const char *path)
+{
+	char cwd[4096];
+	struct strbuf sb = {0};
+	if (path[0] == '/')
+		return strdup(path);
+	if (dir && strcmp(dir, ".") == 0)
+		dir = NULL;
+	if (!getcwd(cwd, sizeof(cwd)))
+		return NULL;
+	if (dir && dir[0] == '/')
+		sb_printf(&sb, "%s/", dir);
+	else
+		sb_printf(&sb, "%s/%s%s", cwd, dir ? dir : "", dir ? "/" : "");
+	sb_printf(&sb, "%s", strncmp(path, "./", 2) == 0 ? path + 2 : path);
+	return sb_take(&sb);
+}
+
+static char *absolute(const char *path)
+{
+	return absolute_in(NULL, path);
+}
+
+/* Replaces the string member key of obj by its path made absolute (relative
+ * paths in a config are relative to its folder). */
+static int absolute_member(const struct config *cfg, cJSON *obj, const char *key)
+{
+	const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+	char *abs = NULL;
+	if (!cJSON_IsString(v))
+		return 0;
+	abs = absolute_in(cfg->dir, v->valuestring);
+	if (!abs)
+		return -ENOMEM;
+	cJSON_ReplaceItemInObjectCaseSensitive(obj, key, cJSON_CreateString(abs));
+	free(abs);
+	return 0;
+}
+
+static bool is_plugin_path(const char *plugin)
+{
+	size_t n = strlen(plugin);
+	return strchr(plugin, '/') || (n >= 3 && strcmp(plugin + n - 3, ".so") == 0);
+}
+
+/* The config with its scene files, plugin files and output absolute. */
+static cJSON *config_copy(const struct config *cfg)
+{
+	cJSON *copy = cJSON_Duplicate(cfg->root, 1), *e;
+	char *output = copy ? absolute(cfg->output) : NULL;
+	int r = output ? 0 : -ENOMEM;
+	if (r == 0)
+		cJSON_DeleteItemFromObjectCaseSensitive(copy, "output");
+	if (r == 0 && !cJSON_AddStringToObject(copy, "output", output))
+		r = -ENOMEM;
+	cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(copy, "scenes"))
+		r = r ? r : absolute_member(cfg, e, "path");
+	cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(copy, "builders")) {
+		const cJSON *p = cJSON_GetObjectItemCaseSensitive(e, "plugin");
+		if (cJSON_IsString(p) && is_plugin_path(p->valuestring))
+			r = r ? r : absolute_member(cfg, e, "plugin");
+	}
+	free(output);
+	if (r == 0)
+		return copy;
+	cJSON_Delete(copy);
+	return NULL;
+}
+
+static cJSON *runs_json(const struct config *cfg)
+{
+	struct plan_run *runs;
+	size_t n;
+	cJSON *array = cJSON_CreateArray();
+	if (!array || plan_runs(cfg, &runs, &n) < 0) {
+		cJSON_Delete(array);
+		return NULL;
+	}
+	for (size_t k = 0; k < n; k++) {
+		cJSON *o = cJSON_CreateObject();
+		cJSON_AddItemToArray(array, o);
+		cJSON_AddNumberToObject(o, "id", runs[k].id);
+		cJSON_AddStringToObject(o, "scene", cfg->scenes[runs[k].scene].name);
+		cJSON_AddStringToObject(o, "builder", cfg->builders[runs[k].builder].name);
+		cJSON_AddStringToObject(o, "plugin", cfg->builders[runs[k].builder].plugin);
+		cJSON_AddNumberToObject(o, "threads", runs[k].threads);
+	}
+	free(runs);
+	return array;
+}
+
+/* Fills plan's fields from a checked document (which it takes). */
+static int adopt(struct plan_file *plan, const char *path, cJSON *doc)
+{
+	const cJSON *source = cJSON_GetObjectItemCaseSensitive(doc, "source");
+	const cJSON *spath = cJSON_GetObjectItemCaseSensitive(source, "path");
+	const cJSON *shash = cJSON_GetObjectItemCaseSensitive(source, "hash");
+	plan->doc = doc;
+	plan->path = strdup(path);
+	snprintf(plan->hash, sizeof(plan->hash), "%s",
+	         cJSON_GetObjectItemCaseSensitive(doc, "hash")->valuestring);
+	if (cJSON_IsString(spath) && cJSON_IsString(shash)) {
+		plan->source = strdup(spath->valuestring);
+		snprintf(plan->source_hash, sizeof(plan->source_hash), "%s", shash->valuestring);
+	}
+	plan->run_count = (size_t)cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(doc, "runs"));
+	return plan->path ? 0 : -ENOMEM;
+}
+
+static cJSON *plan_doc(const struct config *cfg, cJSON *copy, const char *hash)
+{
+	char source_hash[17], stamp[32];
+	char *source = absolute(cfg->path);
+	time_t now = time(NULL);
+	struct tm tm;
+	cJSON *doc = cJSON_CreateObject();
+	plan_hash_text(cfg->text, source_hash);
+	strftime(stamp, sizeof(stamp), "%Y-%m-%dT%H:%M:%SZ", gmtime_r(&now, &tm));
+	cJSON_AddNumberToObject(doc, "bvhlab_plan", 1);
+	cJSON_AddStringToObject(doc, "hash", hash);
+	cJSON *src = cJSON_AddObjectToObject(doc, "source");
+	cJSON_AddStringToObject(src, "path", source ? source : cfg->path);
+	cJSON_AddStringToObject(src, "hash", source_hash);
+	cJSON_AddStringToObject(doc, "created", stamp);
+	cJSON_AddItemToObject(doc, "config", copy);
+	cJSON_AddItemToObject(doc, "runs", runs_json(cfg));
+	free(source);
+	return doc;
+}
+
+static int load_doc(struct plan_file *plan, const char *path, bvhlab_error *err);
+
+/*
+ * An existing DIR/plan.json: kept (0) when it is this plan from this very
+ * config text; written anew (1) when it is this plan from a config that
+ * changed only in ways that leave its copy alone (spacing, say), so that its
+ * runs do not refuse the config as changed; refused otherwise.
+ */
+static int existing_plan(const struct config *cfg, const char *path, const char *hash,
+                         struct plan_file *plan, bvhlab_error *err)
+{
+	char source_hash[17];
+	if (access(path, F_OK) != 0)
+		return 1;
+	int r = load_doc(plan, path, err);
+	plan_hash_text(cfg->text, source_hash);
+	if (r == 0 && strcmp(plan->hash, hash) == 0 && strcmp(plan->source_hash, source_hash)) {
+		plan_file_finish(plan);
+		return 1;
+	}
+	if (r == 0 && strcmp(plan->hash, hash) != 0) {
+		error_set(err, "%s holds another plan (hash %s; this config's is %s): nothing "
+		          "overwritten; plan into a new folder, or remove that folder to start over",
+		          path, plan->hash, hash);
+		plan_file_finish(plan);
+		return -EEXIST;
+	}
+	return r;
+}
+
+int plan_file_write(const struct config *cfg, const char *dir, struct plan_file *plan,
+                    bvhlab_error *err)
+{
+	char hash[17], path[4096];
+	memset(plan, 0, sizeof(*plan));
+	cJSON *copy = config_copy(cfg);
+	char *text = copy ? cJSON_PrintUnformatted(copy) : NULL;
+	int r = text ? 0 : -ENOMEM;
+	if (r == 0 && (size_t)snprintf(path, sizeof(path), "%s/plan.json", dir) >= sizeof(path))
+		r = -ENAMETOOLONG;
+	if (r == 0)
+		plan_hash_text(text, hash);
+	free(text);
+	if (r < 0) {
+		cJSON_Delete(copy);
+		error_set(err, r == -ENOMEM ? "out of memory" : "path too long: %s", dir);
+		return r;
+	}
+	if ((r = existing_plan(cfg, path, hash, plan, err)) <= 0) {
+		cJSON_Delete(copy);
+		return r;
+	}
+	cJSON *doc = plan_doc(cfg, copy, hash);
+	char *out = doc ? cJSON_Print(doc) : NULL;
+	r = out ? results_make_dirs(dir, err) : -ENOMEM;
+	if (r == 0)
+		r = results_write_file(dir, "plan.json", out, err);
+	free(out);
+	if (r == 0)
+		return adopt(plan, path, doc);
+	cJSON_Delete(doc);
+	return r;
+}
+
+/* ---- reading ------------------------------------------------------------------ */
+
+static const char *string_at(const cJSON *o, const char *key)
+{
+	const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+	return cJSON_IsString(v) ? v->valuestring : NULL;
+}
+
+/* The document's shape and its hash against its config copy. */
+static int check_doc(const char *path, const cJSON *doc, bvhlab_error *err)
+{
+	const cJSON *config = cJSON_GetObjectItemCaseSensitive(doc, "config");
+	const char *hash = string_at(doc, "hash");
+	if (!cJSON_IsNumber(cJSON_GetObjectItemCaseSensitive(doc, "bvhlab_plan")) || !hash ||
+	    !cJSON_IsObject(config) ||
+	    !cJSON_IsArray(cJSON_GetObjectItemCaseSensitive(doc, "runs"))) {
+		error_set(err, "%s is not a bvhlab plan (made by `bvhlab plan`: bvhlab_plan, hash, "
+		          "config and runs)", path);
+		return -EINVAL;
+	}
+	char *text = cJSON_PrintUnformatted(config), now[17];
+	if (!text) {
+		error_set(err, "out of memory");
+		return -ENOMEM;
+	}
+	plan_hash_text(text, now);
+	free(text);
+	if (strcmp(now, hash) != 0) {
+		error_set(err, "%s: its config no longer matches its hash (%s, now %s): the plan was "
+		          "edited after planning; plan again", path, hash, now);
+		return -EINVAL;
+	}
+	return 0;
+}
+
+/* Parsed and checked, without looking at the source config. */
+static int load_doc(struct plan_file *plan, const char *path, bvhlab_error *err)
+{
+	char *text = NULL;
+	memset(plan, 0, sizeof(*plan));
+	int r = plan_read_file(path, &text, err);
+	if (r < 0)
+		return r;
+	cJSON *doc = cJSON_Parse(text);
+	free(text);
+	if (!doc) {
+		error_set(err, "%s is not valid JSON (damaged?)", path);
+		return -EINVAL;
+	}
+	r = check_doc(path, doc, err);
+	if (r == 0)
+		r = adopt(plan, path, doc);
+	else
+		cJSON_Delete(doc);
+	return r;
+}
+
+/* The config the plan came from must still read as it did then. */
+static int check_source(const struct plan_file *plan, bvhlab_error *err)
+{
+	char *text = NULL, now[17];
+	if (!plan->source || access(plan->source, F_OK) != 0)
+		return 0; /* not on this machine: the plan's copy is complete */
+	int r = plan_read_file(plan->source, &text, err);
+	if (r < 0)
+		return r;
+	plan_hash_text(text, now);
+	free(text);
+	if (strcmp(now, plan->source_hash) == 0)
+		return 0;
+	error_set(err, "%s: the config %s has changed since planning (hash %s then, %s now); "
+	          "plan again into a new folder so that run ids keep their meaning",
+	          plan->path, plan->source, plan->source_hash, now);
+	return -ESTALE;
+}
+
+bool plan_file_detect(const char *path)
+{
+	char *text = NULL;
+	if (plan_read_file(path, &text, NULL) < 0)
+		return false;
+	cJSON *doc = cJSON_Parse(text);
+	bool plan = cJSON_IsObject(doc) && cJSON_GetObjectItemCaseSensitive(doc, "bvhlab_plan");
+	cJSON_Delete(doc);
+	free(text);
+	return plan;
+}
+
+int plan_file_load(struct plan_file *plan, const char *path, struct config *cfg,
+                   bvhlab_error *err)
+{
+	int r = load_doc(plan, path, err);
+	if (r == 0)
+		r = check_source(plan, err);
+	char *text = NULL;
+	if (r == 0 && cfg) {
+		text = cJSON_PrintUnformatted(cJSON_GetObjectItemCaseSensitive(plan->doc, "config"));
+		r = text ? config_parse(cfg, path, text, err) : -ENOMEM;
+	}
+	free(text);
+	if (r == 0 && cfg && plan_run_count(cfg) != plan->run_count) {
+		error_set(err, "%s: its config makes %zu runs but it lists %zu; plan again", path,
+		          plan_run_count(cfg), plan->run_count);
+		config_finish(cfg);
+		r = -EINVAL;
+	}
+	if (r < 0)
+		plan_file_finish(plan);
+	return r;
+}
+
+void plan_file_finish(struct plan_file *plan)
+{
+	if (!plan)
+		return;
+	cJSON_Delete(plan->doc);
+	free(plan->path);
+	free(plan->source);
+	memset(plan, 0, sizeof(*plan));
+}
