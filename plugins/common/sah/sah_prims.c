@@ -6,7 +6,8 @@
 #include <pthread.h>
 #include <stdbool.h>
 
-#include "sah_internal.h"
+#include "sah_box.h"
+#include "sah_split.h"
 
 /* Most threads the copy uses, and fewest records each. */
 #define COPY_PARTS 16

@@ -17,7 +17,9 @@
  */
 #include <string.h>
 
-#include "sah_internal.h"
+#include "sah_box.h"
+#include "sah_nodes.h"
+#include "sah_split.h"
 #include "sah_simd.h"
 
 typedef struct small {
