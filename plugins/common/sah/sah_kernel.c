@@ -95,6 +95,27 @@ static int read_simd(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
 	return 0;
 }
 
+static int read_quality(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
+{
+	const char *s;
+	int rc = host->option_string(ctx, "quality", &s);
+
+	if (rc < 0) {
+		host->set_error(ctx, "option \"quality\" is not available (%d)", rc);
+		return rc;
+	}
+	if (s && strcmp(s, "high") == 0) {
+		*out = SAH_HIGH;
+	} else if (s && strcmp(s, "fast") == 0) {
+		*out = SAH_FAST;
+	} else {
+		host->set_error(ctx, "option \"quality\" = \"%s\" is not high or fast",
+		                s ? s : "(null)");
+		return -EINVAL;
+	}
+	return 0;
+}
+
 int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt)
 {
 	int rc;
@@ -104,7 +125,8 @@ int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options
 	    (rc = read_int(host, ctx, "max_leaf", 1, 64, &opt->max_leaf)) < 0 ||
 	    (rc = read_cost(host, ctx, "c_trav", &opt->c_trav)) < 0 ||
 	    (rc = read_cost(host, ctx, "c_isect", &opt->c_isect)) < 0 ||
-	    (rc = read_simd(host, ctx, &opt->simd)) < 0)
+	    (rc = read_simd(host, ctx, &opt->simd)) < 0 ||
+	    (rc = read_quality(host, ctx, &opt->quality)) < 0)
 		return rc;
 	return 0;
 }
@@ -203,7 +225,10 @@ void sah_builder_finish(sah_builder *b, bvhlab_build_output *output)
 unsigned sah_split_job(sah_builder *b, const sah_job *job, sah_job child[2])
 {
 	if (job->end - job->begin <= SAH_SMALL_MAX) {
-		sah_small_subtree(b, job);
+		if (b->opt.quality == SAH_FAST)
+			sah_small_fast_subtree(b, job);
+		else
+			sah_small_subtree(b, job);
 		return 0;
 	}
 	if (b->opt.method == SAH_SWEEP)

@@ -87,9 +87,15 @@
 	{ .name = "c_isect", .type = BVHLAB_OPTION_FLOAT, \
 	  .help = "SAH cost of intersecting one primitive (> 0)", \
 	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }, \
-	SAH_SIMD_DECL
-#define SAH_OPTION_COUNT 6
-/* Last, so that plugins with their own copy of the others can add it. */
+	SAH_SIMD_DECL, \
+	SAH_QUALITY_DECL
+#define SAH_OPTION_COUNT 7
+/* Last, so that plugins with their own copy of the others can add them. */
+#define SAH_QUALITY_DECL \
+	{ .name = "quality", .type = BVHLAB_OPTION_STRING, \
+	  .help = "high (every axis, exact SAH on small jobs) or fast (the longest " \
+	          "centroid axis only: a cheaper search, a slightly worse tree)", \
+	  .def_string = "high", .choices = "high|fast" }
 #define SAH_SIMD_DECL \
 	{ .name = "simd", .type = BVHLAB_OPTION_STRING, \
 	  .help = "binning vectors: auto (avx2 where the CPU has it), avx2 or sse; " \

@@ -22,8 +22,10 @@ void sah_copy_prims(sah_builder *b, const bvhlab_build_input *input, sah_prim *d
  * indices are bytes, so at most 256. */
 #define SAH_SMALL_MAX 64
 
-/* Builds job's whole subtree on the calling thread. */
+/* Builds job's whole subtree on the calling thread: quality high
+ * (sah_small.c) and fast (sah_small_fast.c). */
 void sah_small_subtree(sah_builder *b, const sah_job *job);
+void sah_small_fast_subtree(sah_builder *b, const sah_job *job);
 
 /* The methods behind sah_split_job; same contract. */
 unsigned sah_sweep_split(sah_builder *b, const sah_job *job, sah_job child[2]);

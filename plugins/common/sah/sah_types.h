@@ -22,10 +22,23 @@ enum sah_simd {
 	SAH_SIMD_AVX2 = 1, /* 8-lane binning, where the CPU has AVX2 */
 };
 
+/*
+ * How jobs of at most SAH_SMALL_MAX primitives are searched (larger ones
+ * are the same either way). HIGH: exact SAH over all three axes, the
+ * reference trees. FAST: exact SAH along the axis of the node's largest
+ * centroid extent only (sah_small_fast.c), which needs no sorted order of
+ * the other two axes.
+ */
+enum sah_quality {
+	SAH_HIGH = 0,
+	SAH_FAST = 1,
+};
+
 /* Build parameters, as read from the plugin options. */
 typedef struct sah_options {
 	int method;        /* enum sah_method */
 	int simd;          /* enum sah_simd; same trees either way */
+	int quality;       /* enum sah_quality */
 	uint32_t bins;     /* bins per axis for SAH_BINNED, 2..SAH_MAX_BINS */
 	uint32_t max_leaf; /* largest leaf, >= 1 (except coincident centroids) */
 	float c_trav;      /* cost of visiting an inner node, > 0 */
