@@ -7,36 +7,10 @@
  * indices) and builders say how much they used.
  */
 #include <errno.h>
-#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 
 #include <bvhlab/tree.h>
-
-#define PAGE ((uintptr_t)4096)
-#define HUGE_PAGE ((size_t)2 << 20)
-
-/*
- * Asks for transparent huge pages on a large block (malloc maps those on
- * their own): a builder's first build otherwise takes a 4 KiB page fault
- * for every 4 KiB of the output it writes, which at millions of nodes cost
- * more than the build (a cold lbvh build at 20M triangles was 4.6x its
- * warm median). A hint: refused or unsupported, nothing changes.
- */
-static void advise_huge(void *block, size_t bytes)
-{
-#ifdef MADV_HUGEPAGE
-	uintptr_t from = ((uintptr_t)block + PAGE - 1) & ~(PAGE - 1);
-	uintptr_t to = ((uintptr_t)block + bytes) & ~(PAGE - 1);
-
-	if (bytes >= 4 * HUGE_PAGE && to > from)
-		(void)madvise((void *)from, to - from, MADV_HUGEPAGE);
-#else
-	(void)block;
-	(void)bytes;
-#endif
-}
 
 /* realloc that keeps the old block on failure; size 0 keeps what is there. */
 static int grow_array(void **array, size_t count, size_t elem)
@@ -48,7 +22,6 @@ static int grow_array(void **array, size_t count, size_t elem)
 	grown = realloc(*array, count * elem);
 	if (!grown)
 		return -ENOMEM;
-	advise_huge(grown, count * elem);
 	*array = grown;
 	return 0;
 }
