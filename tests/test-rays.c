@@ -10,7 +10,6 @@
 #include <unistd.h>
 
 #include <bvhlab/bvhlab.h>
-#include <bvhlab/rays.h>
 
 #include "harness/harness.h"
 #include "output/image.h"
