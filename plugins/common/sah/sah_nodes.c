@@ -61,7 +61,7 @@ bool sah_leaf_rule(const sah_options *opt, uint32_t n, const bvhlab_aabb *box, b
 		return true;
 	/* Both costs multiplied by A, so a zero-area node (all primitives
 	 * degenerate and coincident) compares without dividing by zero. */
-	float area = box_half_area(box);
+	float area = bvhlab_aabb_half_area(box);
 	float leaf = opt->c_isect * (float)n * area;
 	float split = opt->c_trav * area + opt->c_isect * best;
 	return leaf <= split;
