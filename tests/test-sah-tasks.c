@@ -114,9 +114,14 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool mesh)
 	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
 	for (int q = 0; q < 2; q++) {
 		quality = q ? "quality=fast" : "quality=high";
+		/* Fast differs from high only below the team splits, which
+		 * parallel_min=128 already reaches: no second pass, and none on
+		 * igea, the largest mesh, which high covers. */
+		if (q && strcmp(name, "igea.ply") == 0)
+			continue;
 		if (build_valid(seq, NULL, scene, &prims.input, 1, &ref) == 0) {
 			check_scene(name, scene, &prims.input, &ref, "parallel_min=128");
-			if (mesh)
+			if (mesh && !q)
 				check_scene(name, scene, &prims.input, &ref, NULL);
 		}
 	}
