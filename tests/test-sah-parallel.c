@@ -1,6 +1,8 @@
 /*
  * sah_even, sah_uneven and sah_queue (each policy) build sah_seq's tree:
- * for both methods, on generated and degenerate scenes and two shared
+ * for both methods at quality high (and binned at quality fast, whose
+ * small jobs take their own path, on the generated scenes), on generated
+ * and degenerate scenes and two shared
  * meshes, with 1, 2, 3 and 8 threads, every build is valid and compares
  * equal (bvhlab_tree_compare) to the sequential reference. Builds are
  * repeated so that a scheduling-dependent difference has several chances
@@ -29,7 +31,15 @@ static bool shared_missing;
 #define FIXTURE_SEED 11
 #include "scene_fixture.h"
 
-static const char *const methods[] = { "sweep", "binned" };
+/* A split search: the method and quality options. */
+struct search {
+	const char *method, *quality;
+};
+
+static const struct search searches[] = {
+	{ "sweep", "high" }, { "binned", "high" }, { "binned", "fast" } };
+#define SEARCHES (sizeof(searches) / sizeof(searches[0]))
+static const struct search binned_high = { "binned", "high" };
 
 /* Thread counts and repeats per build; under TSan the shared meshes (which
  * cannot shrink) keep only the counts that run threads, and one repeat. */
@@ -69,16 +79,18 @@ static struct variant variants[] = {
 
 static bvhlab_plugin *reference;
 
-/* Options for one build: the method, then the variant's own settings. */
+/* Options for one build: the search, then the variant's own settings. */
 static int make_options(bvhlab_options *opts, const bvhlab_plugin *plugin,
-                        const struct variant *v, const char *method, bool generated)
+                        const struct variant *v, const struct search *method, bool generated)
 {
 	bvhlab_error err = { { 0 } };
 	int rc = bvhlab_options_init(opts, bvhlab_plugin_builder(plugin));
 
 	if (rc < 0)
 		return rc;
-	rc = bvhlab_options_set_string(opts, "method", method, &err);
+	rc = bvhlab_options_set_string(opts, "method", method->method, &err);
+	if (rc == 0)
+		rc = bvhlab_options_set_string(opts, "quality", method->quality, &err);
 	for (size_t i = 0; v && rc == 0 && i < 2 && v->opts[i]; i++)
 		rc = bvhlab_options_parse(opts, v->opts[i], &err);
 	if (v && rc == 0 && generated && v->small)
@@ -92,7 +104,7 @@ static int make_options(bvhlab_options *opts, const bvhlab_plugin *plugin,
 
 /* Builds and validates; 0 or the failure (already reported). */
 static int build_valid(const bvhlab_plugin *plugin, const struct variant *v,
-                       const bvhlab_build_input *in, const char *method, bool generated,
+                       const bvhlab_build_input *in, const struct search *method, bool generated,
                        uint32_t threads, bvhlab_tree *tree)
 {
 	bvhlab_options opts;
@@ -106,8 +118,8 @@ static int build_valid(const bvhlab_plugin *plugin, const struct variant *v,
 	if (rc == 0)
 		rc = bvhlab_validate_tree(tree, in, false, &err);
 	if (rc != 0) {
-		fprintf(stderr, "%s %s threads=%u: %s\n", v ? v->label : "sah_seq", method,
-		        threads, err.message);
+		fprintf(stderr, "%s %s %s threads=%u: %s\n", v ? v->label : "sah_seq",
+		        method->method, method->quality, threads, err.message);
 		CHECK(!"valid build");
 	}
 	bvhlab_options_finish(&opts);
@@ -116,7 +128,7 @@ static int build_valid(const bvhlab_plugin *plugin, const struct variant *v,
 
 /* Every thread count and repeat of one variant against the reference. */
 static void check_variant(const struct variant *v, const char *scene, const bvhlab_tree *ref,
-                          const bvhlab_build_input *in, const char *method, bool generated,
+                          const bvhlab_build_input *in, const struct search *method, bool generated,
                           const struct plan *plan)
 {
 	bvhlab_tree tree = { 0 };
@@ -128,8 +140,9 @@ static void check_variant(const struct variant *v, const char *scene, const bvhl
 			                &tree) != 0)
 				continue;
 			if (bvhlab_tree_compare(ref, &tree, &err) != 0) {
-				fprintf(stderr, "%s: %s %s threads=%u repeat %d differs from "
-				        "sah_seq: %s\n", scene, v->label, method, plan->threads[t], r,
+				fprintf(stderr, "%s: %s %s %s threads=%u repeat %d differs from "
+				        "sah_seq: %s\n", scene, v->label, method->method, method->quality,
+				        plan->threads[t], r,
 				        err.message);
 				CHECK(!"same tree as sah_seq");
 			}
@@ -148,16 +161,22 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool generated)
 	if (!scene)
 		return;
 	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
-	for (int m = 0; m < 2; m++) {
+	for (size_t m = 0; m < SEARCHES; m++) {
 		bvhlab_tree ref = { 0 };
+
+		/* Fast changes only the small jobs, which the generated scenes
+		 * reach at every size; the meshes would double the test's time. */
+		if (!generated && strcmp(searches[m].quality, "fast") == 0)
+			continue;
 		double t0 = util_now_ms();
 
-		if (build_valid(reference, NULL, &prims.input, methods[m], generated, 1, &ref) == 0)
+		if (build_valid(reference, NULL, &prims.input, &searches[m], generated, 1, &ref) == 0)
 			for (size_t v = 0; v < VARIANTS; v++)
-				check_variant(&variants[v], name, &ref, &prims.input, methods[m],
+				check_variant(&variants[v], name, &ref, &prims.input, &searches[m],
 				              generated, plan);
-		printf("%-18s %8u triangles  %-6s  %zu builders x %zu thread counts x %d: "
-		       "%.0f ms\n", name, scene->triangle_count, methods[m], VARIANTS,
+		printf("%-18s %8u triangles  %-6s %-4s  %zu builders x %zu thread counts x %d: "
+		       "%.0f ms\n", name, scene->triangle_count, searches[m].method,
+		       searches[m].quality, VARIANTS,
 		       plan->count, plan->repeats, util_now_ms() - t0);
 		bvhlab_tree_finish(&ref);
 	}
@@ -177,7 +196,7 @@ static void test_shared(const char *file)
 static void test_descriptors(void)
 {
 	static const char *const sah[] = { "method", "bins", "max_leaf", "c_trav", "c_isect",
-	                                   "simd" };
+	                                   "simd", "quality" };
 
 	for (size_t v = 0; v < VARIANTS; v++) {
 		const bvhlab_builder *b = bvhlab_plugin_builder(variants[v].handle);
@@ -186,13 +205,15 @@ static void test_descriptors(void)
 		CHECK(strcmp(b->name, variants[v].plugin) == 0);
 		CHECK(b->flags & BVHLAB_BUILDER_PARALLEL);
 		CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
-		CHECK_INT(b->option_count, queue ? 9 : 6);
-		for (uint32_t i = 0; i < 6 && i < b->option_count; i++)
+		CHECK_INT(b->option_count, queue ? 10 : 7);
+		for (uint32_t i = 0; i < 7 && i < b->option_count; i++)
 			CHECK(strcmp(b->options[i].name, sah[i]) == 0);
-		if (queue && b->option_count == 9) {
-			CHECK(strcmp(b->options[6].def_string, "auto") == 0);
-			CHECK(strcmp(b->options[7].name, "depth") == 0);
-			CHECK_INT(b->options[7].def_int, 4);
+		if (b->option_count >= 7)
+			CHECK(strcmp(b->options[6].def_string, "high") == 0);
+		if (queue && b->option_count == 10) {
+			CHECK(strcmp(b->options[7].def_string, "auto") == 0);
+			CHECK(strcmp(b->options[8].name, "depth") == 0);
+			CHECK_INT(b->options[8].def_int, 4);
 		}
 	}
 }
@@ -224,9 +245,9 @@ static void test_all_cores(void)
 		bvhlab_scene_destroy(scene);
 		return;
 	}
-	CHECK_INT(build_valid(reference, NULL, &prims.input, "binned", false, 1, &ref), 0);
+	CHECK_INT(build_valid(reference, NULL, &prims.input, &binned_high, false, 1, &ref), 0);
 	for (size_t v = 0; v < VARIANTS; v++) {
-		CHECK_INT(build_valid(variants[v].handle, &variants[v], &prims.input, "binned",
+		CHECK_INT(build_valid(variants[v].handle, &variants[v], &prims.input, &binned_high,
 		                      false, 0, &tree), 0);
 		CHECK_INT(bvhlab_tree_compare(&ref, &tree, &err), 0);
 	}

@@ -1,8 +1,11 @@
 /*
  * sah_seq: both methods on every generator and on degenerate scenes build
  * valid trees that trace like brute force, respect max_leaf, repeat
- * exactly, and the exact sweep is at least as good as binning. Its options
- * are declared with their ranges.
+ * exactly, and the exact sweep is at least as good as binning. Quality
+ * fast builds valid, repeatable trees too, the same with either SIMD path,
+ * and where every centroid lies on one axis (so that high's search has no
+ * other axis either) exactly high's tree. Its options are declared with
+ * their ranges.
  */
 #include <errno.h>
 #include <stdio.h>
@@ -21,6 +24,8 @@
 
 static const char *const methods[] = { "sweep", "binned" };
 static const uint32_t leaf_sizes[] = { 1, 4, 8, 16 };
+/* The quality option of build(); test_quality switches it. */
+static const char *quality = "high";
 #define LEAF_SIZES (sizeof(leaf_sizes) / sizeof(leaf_sizes[0]))
 
 /* A leaf over max_leaf is allowed only when all its centroids coincide. */
@@ -49,9 +54,11 @@ static int build(const bvhlab_plugin *plugin, const bvhlab_build_input *in, cons
 	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin)), 0);
 	CHECK_INT(bvhlab_options_set_string(&opts, "method", method, &err), 0);
 	CHECK_INT(bvhlab_options_set_int(&opts, "max_leaf", max_leaf, &err), 0);
+	CHECK_INT(bvhlab_options_set_string(&opts, "quality", quality, &err), 0);
 	rc = bvhlab_build(plugin, &opts, in, 1, tree, &err);
 	if (rc < 0)
-		fprintf(stderr, "build %s max_leaf=%u: %s\n", method, max_leaf, err.message);
+		fprintf(stderr, "build %s %s max_leaf=%u: %s\n", method, quality, max_leaf,
+		        err.message);
 	bvhlab_options_finish(&opts);
 	return rc;
 }
@@ -129,14 +136,14 @@ static void test_descriptor(const bvhlab_plugin *plugin)
 {
 	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
 	static const char *const names[] = { "method", "bins", "max_leaf", "c_trav", "c_isect",
-	                                     "simd" };
+	                                     "simd", "quality" };
 
 	CHECK(strcmp(b->name, "sah_seq") == 0);
 	CHECK(b->summary && *b->summary);
 	CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
 	CHECK(!(b->flags & BVHLAB_BUILDER_PARALLEL));
-	CHECK_INT(b->option_count, 6);
-	for (uint32_t i = 0; i < b->option_count && i < 6; i++) {
+	CHECK_INT(b->option_count, 7);
+	for (uint32_t i = 0; i < b->option_count && i < 7; i++) {
 		CHECK(strcmp(b->options[i].name, names[i]) == 0);
 		CHECK(b->options[i].help && *b->options[i].help);
 	}
@@ -145,6 +152,7 @@ static void test_descriptor(const bvhlab_plugin *plugin)
 	CHECK_INT(b->options[2].def_int, 8);
 	CHECK(b->options[3].def_float == 1.0 && b->options[4].def_float == 1.0);
 	CHECK(strcmp(b->options[5].def_string, "auto") == 0);
+	CHECK(strcmp(b->options[6].def_string, "high") == 0);
 }
 
 static void test_options(const bvhlab_plugin *plugin)
@@ -163,6 +171,8 @@ static void test_options(const bvhlab_plugin *plugin)
 	CHECK_CONTAINS(err.message, "c_trav");
 	CHECK_INT(bvhlab_options_set_string(&opts, "method", "median", &err), -EINVAL);
 	CHECK_CONTAINS(err.message, "method");
+	CHECK_INT(bvhlab_options_set_string(&opts, "quality", "low", &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "quality");
 	CHECK_INT(bvhlab_options_set_int(&opts, "bins", 2, &err), 0);
 	CHECK_INT(bvhlab_options_set_int(&opts, "bins", 256, &err), 0);
 	bvhlab_options_finish(&opts);
@@ -171,7 +181,9 @@ static void test_options(const bvhlab_plugin *plugin)
 /* With traversal made expensive the SAH wants big leaves: max_leaf caps them. */
 static void test_max_leaf_binds(const bvhlab_plugin *plugin, const bvhlab_prims *prims)
 {
-	const char *const settings[] = { "method=sweep", "method=binned" };
+	/* Parsed in turn: sweep and binned at quality high, then at fast. */
+	const char *const settings[] = { "method=sweep", "method=binned", "quality=fast",
+	                                 "method=sweep" };
 	bvhlab_tree tree = { 0 };
 	bvhlab_tree_stats stats;
 	bvhlab_error err = { { 0 } };
@@ -181,7 +193,8 @@ static void test_max_leaf_binds(const bvhlab_plugin *plugin, const bvhlab_prims 
 	CHECK_INT(bvhlab_options_parse(&opts, "c_trav=1000", &err), 0);
 	for (uint32_t max_leaf = 2; max_leaf <= 16; max_leaf *= 2) {
 		CHECK_INT(bvhlab_options_set_int(&opts, "max_leaf", max_leaf, &err), 0);
-		for (size_t i = 0; i < 2; i++) {
+		CHECK_INT(bvhlab_options_parse(&opts, "quality=high", &err), 0);
+		for (size_t i = 0; i < 4; i++) {
 			CHECK_INT(bvhlab_options_parse(&opts, settings[i], &err), 0);
 			CHECK_INT(bvhlab_build(plugin, &opts, &prims->input, 1, &tree, &err), 0);
 			CHECK_INT(bvhlab_validate_tree(&tree, &prims->input, false, &err), 0);
@@ -229,7 +242,7 @@ static void test_option_values(const bvhlab_plugin *plugin)
 }
 
 /* The 8-lane and 4-lane binning fill the same bins: same trees, for
- * every bin count (2 and 256 reach the grid's ends). On a CPU without
+ * every bin count (2 and 256 reach the grid's ends), at both qualities. On a CPU without
  * AVX2 an explicit simd=avx2 is refused, naming the option. */
 static void test_simd(const bvhlab_plugin *plugin)
 {
@@ -249,8 +262,10 @@ static void test_simd(const bvhlab_plugin *plugin)
 			bvhlab_scene_destroy(scene);
 			continue;
 		}
-		for (size_t i = 0; i < 3; i++) {
-			CHECK_INT(bvhlab_options_parse(&opts, bins[i], &err), 0);
+		for (size_t i = 0; i < 6; i++) {
+			CHECK_INT(bvhlab_options_parse(&opts, bins[i % 3], &err), 0);
+			CHECK_INT(bvhlab_options_parse(&opts, i < 3 ? "quality=high" : "quality=fast",
+			                               &err), 0);
 			CHECK_INT(bvhlab_options_parse(&opts, "simd=sse", &err), 0);
 			CHECK_INT(bvhlab_build(plugin, &opts, &prims.input, 1, &a, &err), 0);
 			CHECK_INT(bvhlab_options_parse(&opts, "simd=avx2", &err), 0);
@@ -271,6 +286,79 @@ static void test_simd(const bvhlab_plugin *plugin)
 	bvhlab_tree_finish(&b);
 }
 
+/* n triangles of varied sizes whose box centres (the kernel's centroids)
+ * all lie on the x axis, in
+ * a shuffled order: y and z offer no split, so high searches x alone, as
+ * fast does. */
+static bvhlab_scene *row_scene(uint32_t n)
+{
+	bvhlab_scene *scene = calloc(1, sizeof(*scene));
+	uint32_t h = 12345;
+
+	CHECK(scene != NULL);
+	if (!scene)
+		return NULL;
+	scene->vertices = malloc(9 * (size_t)n * sizeof(float));
+	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
+	CHECK(scene->vertices && scene->indices);
+	for (uint32_t k = 0; k < n; k++) {
+		h = h * 1664525u + 1013904223u;
+		float x = (float)((k * 7919u) % n), s = 0.1f + (float)(h >> 24) / 64.0f;
+		float w = (float)((h >> 8) & 255) / 32.0f;
+		const float v[9] = { x, -s, -s, x, s, -s, x + w, 0, s };
+		memcpy(scene->vertices + 9 * (size_t)k, v, sizeof(v));
+		for (int i = 0; i < 3; i++)
+			scene->indices[3 * k + i] = 3 * k + i;
+	}
+	scene->vertex_count = 3 * n;
+	scene->triangle_count = n;
+	bvhlab_scene_update(scene);
+	return scene;
+}
+
+/* Fast on generated scenes: valid, repeatable (build_checked); on a row,
+ * high's tree for both methods. */
+static void test_quality(const bvhlab_plugin *plugin)
+{
+	static const char *const scenes[] = { "soup", "terrain", "stadium" };
+	bvhlab_scene *row = row_scene(3000);
+	bvhlab_prims prims;
+	bvhlab_tree tree[2] = { { 0 }, { 0 } };
+	bvhlab_error err = { { 0 } };
+
+	quality = "fast";
+	for (size_t s = 0; s < 3; s++) {
+		bvhlab_scene *scene = generate(scenes[s], 20000, 0, 40);
+		if (!scene || bvhlab_prims_init(&prims, scene, &err) < 0) {
+			CHECK(!"fast scene");
+			bvhlab_scene_destroy(scene);
+			continue;
+		}
+		for (size_t m = 0; m < 2; m++)
+			CHECK(build_checked(plugin, scenes[s], scene, &prims.input, methods[m], 8) > 0);
+		bvhlab_prims_finish(&prims);
+		bvhlab_scene_destroy(scene);
+	}
+	if (row && bvhlab_prims_init(&prims, row, &err) == 0) {
+		for (size_t m = 0; m < 2; m++) {
+			for (int q = 0; q < 2; q++) {
+				quality = q ? "fast" : "high";
+				CHECK_INT(build(plugin, &prims.input, methods[m], 8, &tree[q]), 0);
+			}
+			if (bvhlab_tree_compare(&tree[0], &tree[1], &err) != 0) {
+				fprintf(stderr, "row %s: fast differs from high: %s\n", methods[m],
+				        err.message);
+				CHECK(!"fast is high's tree on a row");
+			}
+		}
+		bvhlab_prims_finish(&prims);
+	}
+	quality = "high";
+	bvhlab_tree_finish(&tree[0]);
+	bvhlab_tree_finish(&tree[1]);
+	bvhlab_scene_destroy(row);
+}
+
 int main(void)
 {
 	bvhlab_plugin *plugin = NULL;
@@ -285,6 +373,7 @@ int main(void)
 	test_options(plugin);
 	test_option_values(plugin);
 	test_simd(plugin);
+	test_quality(plugin);
 	test_scene(plugin, "soup", generate("soup", 20000, 0, 0));
 	test_scene(plugin, "icosphere", generate("icosphere", 0, 24, 0));
 	test_scene(plugin, "stadium", generate("stadium", 10000, 0, 0));

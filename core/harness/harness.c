@@ -41,6 +41,7 @@ enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };
 struct series_report {
 	uint32_t status;       /* enum series_status */
 	uint32_t sample_count; /* repeat, or 0 when the builds failed */
+	double cold_ms;        /* the first build */
 	bool has_stats, validated, valid;
 	uint64_t rays_checked, mismatches;
 	bvhlab_tree_stats stats;
@@ -218,6 +219,7 @@ static void series_work(void *arg, void *report, size_t size)
 		rep->status = SERIES_FAILED;
 	} else {
 		rep->sample_count = s.repeat;
+		rep->cold_ms = s.cold_ms;
 		validate(job, &s.tree, rep, &err);
 		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
 		if (rep->has_stats)
@@ -244,6 +246,7 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->error = rep->status != SERIES_OK ? rep->error : NULL;
 	run->samples_ms = rep->samples;
 	run->sample_count = rep->sample_count;
+	run->cold_ms = rep->cold_ms;
 	run->stats = rep->has_stats ? &rep->stats : NULL;
 	run->validated = rep->validated;
 	run->valid = rep->valid;

@@ -49,6 +49,8 @@ struct build_series {
 	uint32_t warmup, repeat;
 	uint32_t threads;      /* 0: all hardware threads */
 	double *samples_ms;    /* [repeat], filled */
+	double cold_ms;        /* the first build (warm-up or not): fresh output
+	                        * and builder scratch, page faults included */
 	bvhlab_tree tree;      /* the last build's tree */
 };
 

@@ -16,6 +16,8 @@ int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		double t1 = util_now();
 		if (r < 0)
 			return r;
+		if (k == 0)
+			s->cold_ms = (t1 - t0) * 1e3;
 		if (k >= s->warmup)
 			s->samples_ms[k - s->warmup] = (t1 - t0) * 1e3;
 	}

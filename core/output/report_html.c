@@ -48,6 +48,7 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 	num_cell(sb, report_num(run, "build_ms.median"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.min"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.max"), "%.2f");
+	num_cell(sb, report_num(run, "build_ms.cold"), "%.2f");
 	num_cell(sb, report_num(run, "mtris_per_s"), "%.2f");
 	num_cell(sb, report_speedup(ix, run), "%.2f");
 	num_cell(sb, report_num(run, "tree.sah_cost"), "%.3f");
@@ -67,6 +68,7 @@ static void table(struct strbuf *sb, const struct report_index *ix, const char *
 	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
 	sb_printf(sb, "<table><tr><th class=\"l\">builder</th><th>threads</th>"
 	              "<th class=\"l\">status</th><th>median ms</th><th>min ms</th><th>max ms</th>"
+	              "<th>cold ms</th>"
 	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>primary Mrays/s</th>"
 	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s</th>"
 	              "<th>diffuse nodes/ray</th><th class=\"l\">error</th></tr>\n");

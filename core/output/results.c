@@ -166,6 +166,7 @@ static cJSON *timing_json(const struct run_record *run)
 	cJSON_AddNumberToObject(o, "median", med);
 	cJSON_AddNumberToObject(o, "min", mn);
 	cJSON_AddNumberToObject(o, "max", mx);
+	cJSON_AddNumberToObject(o, "cold", run->cold_ms);
 	cJSON *samples = cJSON_AddArrayToObject(o, "samples");
 	for (uint32_t k = 0; k < run->sample_count; k++)
 		cJSON_AddItemToArray(samples, cJSON_CreateNumber(run->samples_ms[k]));

@@ -44,6 +44,7 @@ struct run_record {
 	const char *error;     /* message when status is not "ok", or NULL */
 	const double *samples_ms;
 	uint32_t sample_count; /* 0: no timing */
+	double cold_ms;        /* the first build, before any warm-up repeat */
 	uint32_t triangles;
 	const bvhlab_tree_stats *stats; /* or NULL */
 	bool validated;

@@ -55,6 +55,7 @@ static const bvhlab_option_decl options[] = {
 	          "smaller ones are tasks built by one thread each",
 	  .def_int = 65536, .min = 128, .max = 1 << 30 },
 	SAH_SIMD_DECL,
+	SAH_QUALITY_DECL,
 };
 
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))

@@ -1,7 +1,7 @@
 /*
  * Team binning and stable parallel partition of one large node (see
  * tasks_split.h). Every float operation that decides the split is the
- * kernel's own (sah_grid / sah_bins in sah_kernel.h): each part fills its
+ * kernel's own (sah_grid / sah_bins in sah_bins.h): each part fills its
  * bins, the caller merges them and the kernel chooses.
  * tests/test-sah-tasks.c compares the trees with sah_seq's.
  */

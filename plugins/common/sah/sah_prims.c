@@ -6,7 +6,8 @@
 #include <pthread.h>
 #include <stdbool.h>
 
-#include "sah_internal.h"
+#include "sah_box.h"
+#include "sah_split.h"
 
 /* Most threads the copy uses, and fewest records each. */
 #define COPY_PARTS 16
@@ -27,7 +28,7 @@ static void *copy_part(void *arg)
 {
 	struct copy_part *c = arg;
 
-	box_empty(&c->cbox);
+	bvhlab_aabb_empty(&c->cbox);
 	for (uint32_t i = c->from; i < c->to; i++) {
 		sah_prim *p = &c->dst[i];
 		for (int k = 0; k < 3; k++) {
@@ -44,11 +45,11 @@ static void *copy_part(void *arg)
 /* Min/max of the parts' bounds: the same whatever the parts. */
 static void merge_parts(sah_builder *b, struct copy_part *part, uint32_t parts)
 {
-	box_empty(&b->root_cbox);
+	bvhlab_aabb_empty(&b->root_cbox);
 	for (uint32_t t = 0; t < parts; t++) {
 		if (part[t].started)
 			pthread_join(part[t].tid, NULL);
-		box_grow(&b->root_cbox, &part[t].cbox);
+		bvhlab_aabb_grow(&b->root_cbox, &part[t].cbox);
 	}
 }
 

@@ -63,32 +63,8 @@
 #ifndef BVHLAB_SAH_KERNEL_H
 #define BVHLAB_SAH_KERNEL_H
 
-#include <stdatomic.h>
-#include <stdint.h>
-
-#include <bvhlab/builder.h>
-
-enum sah_method {
-	SAH_SWEEP = 0,  /* exact SAH over presorted centroids */
-	SAH_BINNED = 1, /* binned SAH */
-};
-
-enum sah_simd {
-	SAH_SIMD_SSE = 0,  /* 4-lane vectors (SSE2, or plain C off x86) */
-	SAH_SIMD_AVX2 = 1, /* 8-lane binning, where the CPU has AVX2 */
-};
-
-/* Build parameters, as read from the plugin options. */
-typedef struct sah_options {
-	int method;        /* enum sah_method */
-	int simd;          /* enum sah_simd; same trees either way */
-	uint32_t bins;     /* bins per axis for SAH_BINNED, 2..SAH_MAX_BINS */
-	uint32_t max_leaf; /* largest leaf, >= 1 (except coincident centroids) */
-	float c_trav;      /* cost of visiting an inner node, > 0 */
-	float c_isect;     /* cost of one primitive test, > 0 */
-} sah_options;
-
-#define SAH_MAX_BINS 256
+#include "sah_bins.h"
+#include "sah_types.h"
 
 /*
  * The option declarations of the kernel, to put first into a plugin's
@@ -111,9 +87,15 @@ typedef struct sah_options {
 	{ .name = "c_isect", .type = BVHLAB_OPTION_FLOAT, \
 	  .help = "SAH cost of intersecting one primitive (> 0)", \
 	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }, \
-	SAH_SIMD_DECL
-#define SAH_OPTION_COUNT 6
-/* Last, so that plugins with their own copy of the others can add it. */
+	SAH_SIMD_DECL, \
+	SAH_QUALITY_DECL
+#define SAH_OPTION_COUNT 7
+/* Last, so that plugins with their own copy of the others can add them. */
+#define SAH_QUALITY_DECL \
+	{ .name = "quality", .type = BVHLAB_OPTION_STRING, \
+	  .help = "high (every axis, exact SAH on small jobs) or fast (the longest " \
+	          "centroid axis only: a cheaper search, a slightly worse tree)", \
+	  .def_string = "high", .choices = "high|fast" }
 #define SAH_SIMD_DECL \
 	{ .name = "simd", .type = BVHLAB_OPTION_STRING, \
 	  .help = "binning vectors: auto (avx2 where the CPU has it), avx2 or sse; " \
@@ -125,122 +107,6 @@ typedef struct sah_options {
  * them. 0, or a negative errno after host->set_error.
  */
 int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt);
-
-/*
- * One node to build: the slot it goes to, its primitives and their bounds.
- * Small and self-contained, so schedulers can copy it into queues.
- */
-typedef struct sah_job {
-	uint32_t node;     /* index of the node slot this job fills */
-	uint32_t begin;    /* first position of its primitives in the working
-	                    * arrays (and in output->prim_index) */
-	uint32_t end;      /* one past the last position; end > begin */
-	uint32_t depth;    /* root 0; for schedulers' cutoffs, not used by splits */
-	uint32_t alt;      /* binned: 1 when its primitives are in the builder's
-	                    * alt array, 0 when in prims[0] (sweep: always 0) */
-	bvhlab_aabb box;   /* exact union of its primitives' boxes */
-	bvhlab_aabb cbox;  /* bounds of its primitives' centroids */
-} sah_job;
-
-/*
- * A primitive's box and id, copied from the input into the kernel's working
- * arrays so that the split searches stream through memory instead of
- * gathering boxes by id. Its centroid is the box centre, 0.5f * (lo + hi),
- * computed the same way everywhere in the kernel (the core's
- * input->centroids hold the same values).
- */
-typedef struct sah_prim {
-	float lo[3];  /* box minimum */
-	uint32_t id;  /* primitive id, index into input->prim_bounds */
-	float hi[3];  /* box maximum */
-	uint32_t pad; /* keeps the record 32 bytes and 16-byte aligned */
-} sah_prim;
-
-_Static_assert(sizeof(sah_prim) == 32, "sah_prim is 32 bytes");
-
-/*
- * State shared by every job of one build. Set up by sah_builder_init; only
- * node_counter changes afterwards, and the arrays below are written only
- * at positions in [begin, end) of the job being processed or at ids of
- * primitives in that range.
- */
-typedef struct sah_builder {
-	sah_options opt;            /* copy of the build parameters */
-	uint32_t prim_count;        /* primitives in the build, >= 1 */
-	bvhlab_aabb root_box;       /* input->bounds */
-	bvhlab_aabb root_cbox;      /* bounds of all centroids (computed) */
-	bvhlab_node *nodes;         /* output->nodes, >= 2 * prim_count - 1 slots */
-	atomic_uint node_counter;   /* node slots handed out; slot 0 is the root */
-	/* output->prim_index: a leaf writes the ids of its range [begin, end)
-	 * there, in its range's order in prims[0]. */
-	uint32_t *ids;
-	/* Working primitive arrays, by position; a job's primitives are at
-	 * [begin, end). Sweep: prims[a] holds them sorted by centroid along
-	 * axis a, ties by id (three arrays, same set per range). Binned:
-	 * prims[0] and alt: a split reads its range from one and scatters
-	 * it into the other, where its children then are (sah_job.alt);
-	 * prims[1], prims[2] NULL. */
-	sah_prim *prims[3];
-	sah_prim *alt;
-	sah_prim *temp;  /* sweep: [prim_count] stable-partition target, by position */
-	float *area;     /* sweep: [prim_count] right-side areas, by position */
-	uint8_t *side;   /* sweep: [prim_count] left(0)/right(1) mark, by primitive id */
-} sah_builder;
-
-/*
- * Binning, for the kernel's binned splits and for schedulers that bin one
- * node in parts (sah_tasks): the grid places centroids, the bins gather
- * counts and box unions. Unions are min/max and counts integers, so bins
- * filled in any parts and merged in any order are bit-identical, and the
- * choice below depends only on the node's set of primitives.
- */
-typedef struct sah_grid {
-	uint32_t nb;    /* bins per axis */
-	float lo[3];    /* the node's centroid bounds' minimum */
-	float scale[3]; /* bins per unit length; 0 when the axis is flat */
-} sah_grid;
-
-typedef struct sah_bins {
-	uint32_t count[3][SAH_MAX_BINS]; /* primitives per bin */
-	/* Union of their boxes: lanes 0-2 the minimum negated, 4-6 the
-	 * maximum, so that one 8-lane max grows both (3 and 7 unused); all
-	 * -inf when empty. Negation is exact, so this is min/max exactly. */
-	float box[3][SAH_MAX_BINS][8];
-} sah_bins;
-
-/* The grid of nb bins over job's centroid bounds. */
-void sah_grid_init(sah_grid *g, const sah_job *job, uint32_t nb);
-
-/* A centroid's bin along axis a. sah_bins_fill computes the same, with
- * the same operations, for three axes at once. */
-static inline uint32_t sah_grid_bin(const sah_grid *g, int a, const sah_prim *p)
-{
-	float f = (0.5f * (p->lo[a] + p->hi[a]) - g->lo[a]) * g->scale[a];
-	float top = (float)(g->nb - 1);
-
-	f = f < top ? f : top;
-	return f > 0 ? (uint32_t)f : 0;
-}
-
-/* Overwrites the grid's bins in out with prims[begin, end), with 8-lane
- * vectors when simd is SAH_SIMD_AVX2 (which sah_options_read only picks
- * where the CPU has AVX2). */
-void sah_bins_fill(sah_bins *out, const sah_grid *g, const sah_prim *prims, uint32_t begin,
-                   uint32_t end, int simd);
-
-/* Adds src's bins into dst. */
-void sah_bins_merge(sah_bins *dst, const sah_bins *src, uint32_t nb);
-
-/*
- * The split of lowest cost A_L * N_L + A_R * N_R over every bin boundary
- * of the three axes (ties: lower axis, then lower boundary); candidate
- * boundaries separate two non-empty bins. Returns the axis (-1: none) and
- * sets *split (left = bins below it) and *cost.
- */
-int sah_bins_choose(const sah_bins *g, const sah_grid *grid, uint32_t *split, float *cost);
-
-/* The union of axis a's bins in [from, to). */
-void sah_bins_box(const sah_bins *g, int a, uint32_t from, uint32_t to, bvhlab_aabb *box);
 
 /*
  * Prepares a build of input into output (prim_index needs prim_count
@@ -270,18 +136,6 @@ unsigned sah_split_job(sah_builder *b, const sah_job *job, sah_job child[2]);
  * O(log N) depth: the larger child waits, the smaller is processed first).
  */
 void sah_build_subtree(sah_builder *b, const sah_job *job);
-
-/* The array job's primitives are in. */
-static inline sah_prim *sah_job_prims(const sah_builder *b, const sah_job *job)
-{
-	return job->alt ? b->alt : b->prims[0];
-}
-
-/* Node slots used so far. */
-static inline uint32_t sah_node_count(sah_builder *b)
-{
-	return atomic_load_explicit(&b->node_counter, memory_order_relaxed);
-}
 
 /*
  * Reports the finished tree: output->node_count from the node counter,

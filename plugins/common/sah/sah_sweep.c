@@ -9,7 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sah_internal.h"
+#include "sah_box.h"
+#include "sah_nodes.h"
+#include "sah_split.h"
 #include "sah_simd.h"
 
 /* ---- presort: stable LSD radix sort on order-preserving float keys ---- */

@@ -5,9 +5,10 @@
  * node's split is the same whoever bins it and in how many parts.
  */
 #include <float.h>
+#include <math.h>
 
+#include "sah_bins.h"
 #include "sah_bins_avx2.h"
-#include "sah_internal.h"
 #include "sah_simd.h"
 
 void sah_grid_init(sah_grid *g, const sah_job *job, uint32_t nb)

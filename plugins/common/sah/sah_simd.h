@@ -86,7 +86,7 @@ static inline void v4_store3(float *p, v4 a)
 }
 
 /* Half the surface area of the box [lo, hi], summed in the same order as
- * the scalar box_half_area: (dx*dy + dy*dz) + dz*dx. The SSE version stays
+ * the scalar bvhlab_aabb_half_area: (dx*dy + dy*dz) + dz*dx. The SSE version stays
  * in registers: a store and three loads per area cost more than the area
  * in the sweeps' inner loops. */
 #if defined(__SSE2__) && !defined(SAH_NO_SIMD)

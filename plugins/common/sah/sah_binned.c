@@ -5,7 +5,11 @@
  * array (sah_job.alt). All bin storage is on the stack of the call, so
  * concurrent jobs share nothing.
  */
-#include "sah_internal.h"
+#include <math.h>
+
+#include "sah_bins.h"
+#include "sah_nodes.h"
+#include "sah_split.h"
 #include "sah_simd.h"
 
 /* The primitives of axis a's bins below split. */

@@ -1,7 +1,7 @@
 /*
- * The SAH kernel's shared part: options, builder setup, node writing, the
- * leaf rule and the sequential subtree builder. The split searches are in
- * sah_sweep.c and sah_binned.c.
+ * The SAH kernel's entry points: options, builder set-up and tear-down, the
+ * dispatch of one job to its split search (sah_split.h) and the sequential
+ * subtree builder. Node writing and the leaf rule are in sah_nodes.c.
  */
 #include <errno.h>
 #include <stdlib.h>
@@ -9,7 +9,8 @@
 
 #include "big_alloc.h"
 #include "sah_bins_avx2.h"
-#include "sah_internal.h"
+#include "sah_kernel.h"
+#include "sah_split.h"
 
 static int read_int(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *name,
                     int64_t lo, int64_t hi, uint32_t *out)
@@ -94,6 +95,27 @@ static int read_simd(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
 	return 0;
 }
 
+static int read_quality(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
+{
+	const char *s;
+	int rc = host->option_string(ctx, "quality", &s);
+
+	if (rc < 0) {
+		host->set_error(ctx, "option \"quality\" is not available (%d)", rc);
+		return rc;
+	}
+	if (s && strcmp(s, "high") == 0) {
+		*out = SAH_HIGH;
+	} else if (s && strcmp(s, "fast") == 0) {
+		*out = SAH_FAST;
+	} else {
+		host->set_error(ctx, "option \"quality\" = \"%s\" is not high or fast",
+		                s ? s : "(null)");
+		return -EINVAL;
+	}
+	return 0;
+}
+
 int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt)
 {
 	int rc;
@@ -103,7 +125,8 @@ int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options
 	    (rc = read_int(host, ctx, "max_leaf", 1, 64, &opt->max_leaf)) < 0 ||
 	    (rc = read_cost(host, ctx, "c_trav", &opt->c_trav)) < 0 ||
 	    (rc = read_cost(host, ctx, "c_isect", &opt->c_isect)) < 0 ||
-	    (rc = read_simd(host, ctx, &opt->simd)) < 0)
+	    (rc = read_simd(host, ctx, &opt->simd)) < 0 ||
+	    (rc = read_quality(host, ctx, &opt->quality)) < 0)
 		return rc;
 	return 0;
 }
@@ -199,77 +222,13 @@ void sah_builder_finish(sah_builder *b, bvhlab_build_output *output)
 	output->index_count = b->prim_count;
 }
 
-static void write_box(bvhlab_node *node, const bvhlab_aabb *box)
-{
-	for (int k = 0; k < 3; k++) {
-		node->lo[k] = box->lo[k];
-		node->hi[k] = box->hi[k];
-	}
-}
-
-void sah_write_leaf(sah_builder *b, const sah_job *job)
-{
-	bvhlab_node *node = &b->nodes[job->node];
-	const sah_prim *prims = sah_job_prims(b, job);
-
-	write_box(node, &job->box);
-	node->first = job->begin;
-	node->count = job->end - job->begin;
-	for (uint32_t i = job->begin; i < job->end; i++)
-		b->ids[i] = prims[i].id;
-}
-
-void sah_write_node(sah_builder *b, uint32_t node, const bvhlab_aabb *box, uint32_t *first)
-{
-	bvhlab_node *dst = &b->nodes[node];
-
-	/* Relaxed: only uniqueness matters; the scheduler's hand-over of the
-	 * child jobs orders everything else. */
-	*first = atomic_fetch_add_explicit(&b->node_counter, 2, memory_order_relaxed);
-	write_box(dst, box);
-	dst->first = *first;
-	dst->count = 0;
-}
-
-void sah_write_inner(sah_builder *b, const sah_job *job, uint32_t mid, sah_job child[2])
-{
-	uint32_t first;
-
-	sah_write_node(b, job->node, &job->box, &first);
-	child[0].node = first;
-	child[0].begin = job->begin;
-	child[0].end = mid;
-	child[1].node = first + 1;
-	child[1].begin = mid;
-	child[1].end = job->end;
-	child[0].depth = child[1].depth = job->depth + 1;
-	child[0].alt = child[1].alt = job->alt;
-}
-
-bool sah_leaf_rule(const sah_options *opt, uint32_t n, const bvhlab_aabb *box, bool found,
-                   float best)
-{
-	if (n > opt->max_leaf)
-		return false;
-	if (!found)
-		return true;
-	/* Both costs multiplied by A, so a zero-area node (all primitives
-	 * degenerate and coincident) compares without dividing by zero. */
-	float area = box_half_area(box);
-	float leaf = opt->c_isect * (float)n * area;
-	float split = opt->c_trav * area + opt->c_isect * best;
-	return leaf <= split;
-}
-
-bool sah_prefer_leaf(const sah_builder *b, const sah_job *job, bool found, float best)
-{
-	return sah_leaf_rule(&b->opt, job->end - job->begin, &job->box, found, best);
-}
-
 unsigned sah_split_job(sah_builder *b, const sah_job *job, sah_job child[2])
 {
 	if (job->end - job->begin <= SAH_SMALL_MAX) {
-		sah_small_subtree(b, job);
+		if (b->opt.quality == SAH_FAST)
+			sah_small_fast_subtree(b, job);
+		else
+			sah_small_subtree(b, job);
 		return 0;
 	}
 	if (b->opt.method == SAH_SWEEP)
