@@ -17,6 +17,7 @@
 #include <bvhlab/plugin.h>
 #include <bvhlab/rays.h>
 #include <bvhlab/scene.h>
+#include <bvhlab/traversal.h>
 
 struct cJSON;
 struct json_locations;
@@ -58,6 +59,13 @@ struct config {
 	uint32_t validate_rays; /* "validate_rays", default 256 */
 	uint32_t ray_width, ray_height, ray_diffuse; /* "rays": width/height/diffuse,
 	                                              * default 256, 256, 1 */
+	uint32_t ray_threads; /* "rays": "threads", default 1; 0 = all hardware threads */
+	double ray_min_ms; /* "rays": "min_ms", default 200: each batch repeated this long */
+	unsigned ray_traversals; /* "rays": "traversal" stack|stackless|both, default stack:
+	                          * bit (1 << enum bvhlab_traversal) per traversal */
+	int ray_traversal; /* the main one (stack for "both") */
+	char *report_reference; /* "report": {"reference"}, default "sah_seq": a builder
+	                         * name or, failing that, a plugin name */
 	bool has_camera;   /* "rays": {"camera": ...} given; else framed per scene */
 	bvhlab_camera camera;
 	bool images;       /* "images", default false */

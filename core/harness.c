@@ -176,13 +176,14 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 	uint32_t *nodes;
 	uint8_t *shade;
 	bvhlab_camera cam;
+	struct ray_settings rs;
 	if (n == 0)
 		return;
 	harness_camera(cfg, job->scene, &cam);
+	harness_ray_settings(cfg, &rs);
 	int r = image_buffers(job, n, &nodes, &shade);
 	if (r == 0)
-		r = harness_trace_rays(tree, job->scene, &cam, cfg->ray_width, cfg->ray_height,
-		                       cfg->ray_diffuse, &rep->rays, nodes, shade);
+		r = harness_trace_rays(tree, job->scene, &cam, &rs, &rep->rays, nodes, shade);
 	if (r == 0 && nodes)
 		rep->heat_written = harness_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)

@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include <bvhlab/bvhlab.h>
+#include <bvhlab/traversal.h>
 
 #include "config.h"
 
@@ -49,12 +50,27 @@ void harness_summarise(const double *samples, uint32_t n, double *median, double
 
 /* ---- rays and images (harness_rays.c) ------------------------------------ */
 
-/* Traversal counters of one run's primary and diffuse rays. */
+/* What rays a run is measured with: the config's "rays". */
+struct ray_settings {
+	uint32_t width, height; /* primary rays: one per pixel */
+	uint32_t diffuse;       /* bounces per primary hit */
+	uint32_t threads;       /* tracing threads; 0: all hardware threads */
+	double min_ms;          /* each batch is repeated for at least this long */
+	unsigned traversals;    /* bit (1 << enum bvhlab_traversal) for each one measured */
+	int main;               /* the traversal whose hits feed images and diffuse rays */
+};
+
+/* The config's settings (cfg NULL: one quick stack pass, all threads). */
+void harness_ray_settings(const struct config *cfg, struct ray_settings *rs);
+
+/* Traversal counters and timings of one run's primary and diffuse rays. */
 struct ray_metrics {
 	bool measured;
-	uint32_t threads; /* the threads that traced them: all hardware threads */
-	bvhlab_trace_stats primary, diffuse;
-	double primary_s, diffuse_s;
+	uint32_t threads;      /* the threads that traced them */
+	unsigned traversals;   /* as in ray_settings: those measured */
+	int main;              /* the traversal "primary"/"diffuse" report */
+	bvhlab_trace_timing primary[2], diffuse[2]; /* by enum bvhlab_traversal */
+	uint64_t disagreements; /* rays whose hits differ between the two traversals */
 };
 
 /* The config's camera, or the automatic framing of the scene. */
@@ -62,13 +78,14 @@ void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_
 
 /*
  * Primary rays (width x height) and `diffuse` bounces per primary hit,
- * traced with all hardware threads. nodes ([width * height], may be NULL)
- * gets nodes visited per pixel, shade ([3 * width * height], may be NULL)
- * the shaded render. 0 or a negative errno.
+ * each batch timed (bvhlab_trace_measure) with every traversal of rs.
+ * nodes ([width * height], may be NULL) gets nodes visited per pixel,
+ * shade ([3 * width * height], may be NULL) the shaded render, both from
+ * the main traversal. 0 or a negative errno.
  */
 int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
-                       const bvhlab_camera *cam, uint32_t width, uint32_t height,
-                       uint32_t diffuse, struct ray_metrics *m, uint32_t *nodes, uint8_t *shade);
+                       const bvhlab_camera *cam, const struct ray_settings *rs,
+                       struct ray_metrics *m, uint32_t *nodes, uint8_t *shade);
 
 /* dir/.KIND-SCENE-BUILDER.raw: per-pixel data a run's child hands back. */
 int harness_temp_path(char *buf, size_t size, const char *dir, const char *kind, size_t scene,
