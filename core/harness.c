@@ -10,6 +10,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <bvhlab/epo.h>
+
 #include "harness.h"
 #include "isolate.h"
 #include "progress.h"
@@ -17,6 +19,10 @@
 #include "util.h"
 
 #define RAY_SEED 0x5eedULL
+/* EPO points: a relative standard error of a few per mille on the scenes
+ * tried, in tens of milliseconds. Fixed seed: reruns give the same value. */
+#define EPO_SAMPLES 65536
+#define EPO_SEED 0xe90ULL
 
 /* A builder of the config, opened once for the whole sweep. */
 struct harness_builder {
@@ -48,6 +54,9 @@ struct series_report {
 	bool has_stats, validated, valid;
 	uint64_t rays_checked, mismatches;
 	bvhlab_tree_stats stats;
+	bool has_epo;
+	double epo;
+	struct build_memory memory;
 	struct ray_metrics rays;
 	bool heat_written, shade_written;
 	char error[sizeof(((bvhlab_error *)0)->message)];
@@ -205,7 +214,10 @@ static void series_work(void *arg, void *report, size_t size)
 	bvhlab_error err = {{0}};
 	(void)size;
 	rep->status = SERIES_OK;
-	if (harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err) < 0) {
+	harness_memory_begin(&rep->memory);
+	int r = harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err);
+	harness_memory_end(&rep->memory, &s.tree);
+	if (r < 0) {
 		rep->status = SERIES_FAILED;
 	} else {
 		rep->sample_count = s.repeat;
@@ -213,6 +225,9 @@ static void series_work(void *arg, void *report, size_t size)
 		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
 		if (rep->has_stats)
 			bvhlab_tree_stats_compute(&s.tree, &rep->stats);
+		if (rep->status == SERIES_OK)
+			rep->has_epo = bvhlab_tree_epo(&s.tree, job->scene, EPO_SAMPLES, EPO_SEED,
+			                               &rep->epo) == 0;
 		if (rep->status == SERIES_OK)
 			trace_rays(job, &s.tree, rep, &err);
 	}
@@ -236,6 +251,8 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->samples_ms = rep->samples;
 	run->sample_count = rep->sample_count;
 	run->stats = rep->has_stats ? &rep->stats : NULL;
+	run->epo = rep->has_epo ? &rep->epo : NULL;
+	run->memory = rep->memory.measured ? &rep->memory : NULL;
 	run->validated = rep->validated;
 	run->valid = rep->valid;
 	run->rays_checked = rep->rays_checked;

@@ -48,6 +48,22 @@ int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 void harness_summarise(const double *samples, uint32_t n, double *median, double *min,
                        double *max);
 
+/* ---- peak memory of the builds (harness_memory.c) ------------------------ */
+
+struct build_memory {
+	bool measured;            /* /proc/self/status was readable */
+	bool reset;               /* the high-water mark was reset before the builds */
+	uint64_t start_rss_bytes; /* resident set before the first build */
+	uint64_t peak_rss_bytes;  /* the process's peak resident set over the builds */
+	uint64_t peak_bytes;      /* peak_rss - start_rss: what the builds added at peak
+	                           * (0 when the mark could not be reset) */
+	uint64_t output_bytes;    /* the output buffers the host allocated, capacity */
+};
+
+/* Before the first build (warm-up included), and after the last one. */
+void harness_memory_begin(struct build_memory *m);
+void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree);
+
 /* ---- rays and images (harness_rays.c) ------------------------------------ */
 
 /* What rays a run is measured with: the config's "rays". */

@@ -25,6 +25,7 @@ struct results {
 };
 
 struct ray_metrics;
+struct build_memory;
 
 /* Everything known about one run; fields beyond status are optional. */
 struct run_record {
@@ -39,6 +40,8 @@ struct run_record {
 	uint32_t sample_count; /* 0: no timing */
 	uint32_t triangles;
 	const bvhlab_tree_stats *stats; /* or NULL */
+	const double *epo;     /* end-point overlap (bvhlab_tree_epo), or NULL */
+	const struct build_memory *memory; /* peak memory of the builds, or NULL */
 	bool validated;
 	bool valid;
 	uint64_t rays_checked, mismatches;
