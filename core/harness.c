@@ -396,7 +396,10 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 			record_all_failed(h, cs->name, &h->builders[b], err.message);
 		goto out;
 	}
-	results_add_scene(&h->res, scene->name, scene->source, scene->triangle_count, NULL);
+	char *shown = cs->path ? util_path_shown(h->cfg->dir, cs->path) : NULL;
+	results_add_scene(&h->res, scene->name, shown ? shown : scene->source,
+	                  scene->triangle_count, NULL);
+	free(shown);
 	h->shade_done = false;
 	run_builders(h, scene, &prims, scene_index);
 	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)

@@ -125,6 +125,22 @@ static const char *const csv_numbers[][2] = {
 	{"rays.diffuse.mrays_per_s", "%.4f"},
 	{"rays.diffuse.nodes_per_ray", "%.4f"},
 	{"rays.diffuse.tris_per_ray", "%.4f"},
+	{"tree.epo", "%.6f"},
+	{"memory.peak_bytes", "%.0f"},
+	{"memory.peak_rss_bytes", "%.0f"},
+	{"memory.output_bytes", "%.0f"},
+	{"rays.threads", "%.0f"},
+	{"rays.primary.mrays_min", "%.4f"},
+	{"rays.primary.mrays_max", "%.4f"},
+	{"rays.primary.wall_mrays_per_s", "%.4f"},
+	{"rays.primary.repeats", "%.0f"},
+	{"rays.diffuse.mrays_min", "%.4f"},
+	{"rays.diffuse.mrays_max", "%.4f"},
+	{"rays.stackless.primary.mrays_per_s", "%.4f"},
+	{"rays.stackless.primary.nodes_per_ray", "%.4f"},
+	{"rays.stackless.diffuse.mrays_per_s", "%.4f"},
+	{"rays.stackless.diffuse.nodes_per_ray", "%.4f"},
+	{"rays.traversal_disagreements", "%.0f"},
 };
 
 static void csv_row(struct strbuf *sb, const cJSON *run)
@@ -178,6 +194,8 @@ static void md_run_row(struct strbuf *sb, const cJSON *doc, const cJSON *run)
 	snprintf(buf, sizeof(buf), "%.2f", speedup);
 	md_cell(sb, isnan(speedup) ? "" : buf);
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.sah_cost", "%.3f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.epo", "%.3f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "memory.peak_bytes", "%.0f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.mrays_per_s", "%.2f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.nodes_per_ray", "%.1f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "rays.diffuse.mrays_per_s", "%.2f"));
@@ -211,10 +229,10 @@ static void md_scene(struct strbuf *sb, const cJSON *doc, const cJSON *scene)
 	if (*str(scene, "error"))
 		sb_printf(sb, ". **Could not be loaded:** %s", str(scene, "error"));
 	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | Mtris/s "
-	              "| speedup | SAH cost | primary Mrays/s | primary nodes/ray "
+	              "| speedup | SAH cost | EPO | peak bytes | primary Mrays/s | primary nodes/ray "
 	              "| diffuse Mrays/s | diffuse nodes/ray | nodes | depth | avg leaf | error |\n"
 	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
-	              "|---:|---|\n");
+	              "|---:|---:|---:|---|\n");
 	const cJSON *run;
 	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
 		if (strcmp(str(run, "scene"), name) == 0)
@@ -233,13 +251,17 @@ char *report_markdown(const cJSON *doc)
 	sb_printf(&sb, "# bvhlab report\n\nbvhlab %s, %s. Machine: %s, %s cores, %s available "
 	               "to this process.\n\n%d runs, %d ok. Times are build times in ms over "
 	               "the timed repeats; SAH cost with c_trav = c_isect = 1, normalised by "
-	               "the root's surface area. Speedup: over the same builder's 1-thread run. "
-	               "Rays (primary from the camera, diffuse bounces from their hits) are "
-	               "traced with every hardware thread for every run, whatever its build "
-	               "thread count, so traversal numbers compare trees.\n",
+	               "the root's surface area; EPO: end-point overlap, sampled. Peak bytes: "
+	               "what the builds added to the process's resident set at its peak. "
+	               "Speedup: over the same builder's 1-thread run. Rays (primary from the "
+	               "camera, diffuse bounces from their hits) are traced with the same "
+	               "threads for every run, whatever its build thread count, so traversal "
+	               "numbers compare trees; Mrays/s is the median over repeated passes of "
+	               "rays per CPU second of the tracing threads, times their number.\n",
 	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);
+	report_summary_md(&sb, doc);
 	report_thesis(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		md_scene(&sb, doc, scene);
