@@ -39,6 +39,9 @@ struct config_builder {
 	double timeout_s;  /* "timeout_s" override, or 0 for the config's */
 	uint64_t memory_limit_mb; /* "memory_limit_mb" override, or 0 for the config's */
 	const struct cJSON *options; /* "options" object (may be NULL), owned by root */
+	bool optional;     /* "optional", default false: a plugin that is not there (not
+	                    * built, say) drops the builder from the sweep instead of
+	                    * failing its runs */
 	int line, column;  /* where the builder's object starts */
 };
 

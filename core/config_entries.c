@@ -19,7 +19,7 @@ static const char *const scene_keys[] = {
 };
 static const char *const generator_keys[] = { "frequency", "count", "size", "seed", NULL };
 static const char *const builder_keys[] = {
-	"plugin", "name", "threads", "timeout_s", "memory_limit_mb", "options", NULL,
+	"plugin", "name", "threads", "timeout_s", "memory_limit_mb", "options", "optional", NULL,
 };
 
 static int out_of_memory(const struct config *cfg, bvhlab_error *err)
@@ -257,6 +257,8 @@ static int parse_builder(struct config *cfg, const cJSON *obj, size_t index,
 	if (!rc)
 		rc = config_get_uint(cfg, obj, "memory_limit_mb", prefix, 1, CONFIG_MAX_MEMORY_MB,
 		                     &b->memory_limit_mb, err);
+	if (!rc)
+		rc = config_get_bool(cfg, obj, "optional", prefix, &b->optional, err);
 	if (!rc)
 		rc = builder_options(cfg, obj, index, b, err);
 	return rc;

@@ -21,7 +21,7 @@
 #define RAY_SEED 0x5eedULL
 /* EPO points: a relative standard error of a few per mille on the scenes
  * tried, in tens of milliseconds. Fixed seed: reruns give the same value. */
-#define EPO_SAMPLES 65536
+#define EPO_SAMPLES 16384
 #define EPO_SEED 0xe90ULL
 
 /* A builder of the config, opened once for the whole sweep. */
@@ -30,6 +30,7 @@ struct harness_builder {
 	bvhlab_plugin *plugin; /* NULL when it could not be loaded */
 	bvhlab_options opts;
 	bool opts_ok;
+	bool skipped; /* optional, and its plugin is not there: no runs at all */
 	bvhlab_error error;
 };
 
@@ -97,6 +98,8 @@ static const uint32_t *builder_threads(const struct harness *h, const struct con
                                        size_t *count)
 {
 	*count = b->threads ? b->thread_count : h->cfg->thread_count;
+	if (h->builders && h->builders[b - h->cfg->builders].skipped)
+		*count = 0;
 	return b->threads ? b->threads : h->cfg->threads;
 }
 
@@ -418,8 +421,15 @@ static int open_builders(struct harness *h)
 	for (size_t b = 0; b < h->cfg->builder_count; b++) {
 		struct harness_builder *hb = &h->builders[b];
 		hb->cb = &h->cfg->builders[b];
-		if (bvhlab_plugin_open(hb->cb->plugin, &hb->plugin, &hb->error) < 0)
+		if (bvhlab_plugin_open(hb->cb->plugin, &hb->plugin, &hb->error) < 0) {
+			hb->skipped = hb->cb->optional;
+			if (hb->skipped) {
+				fprintf(stderr, "bvhlab: optional builder '%s' skipped: %s\n", hb->cb->name,
+				        hb->error.message);
+				continue;
+			}
 			goto report;
+		}
 		if (bvhlab_options_init(&hb->opts, bvhlab_plugin_builder(hb->plugin)) < 0)
 			return -ENOMEM;
 		hb->opts_ok = config_apply_options(h->cfg, hb->cb, &hb->opts, &hb->error) == 0;

@@ -132,7 +132,7 @@ static inline bool isect_prim(const ray_prep *p, const bvhlab_scene *scene, uint
 		return false;
 	/* An exact tie in t goes to the smaller id, so every visiting order
 	 * (stack, stackless, brute force) picks the same triangle. */
-	if (out[0] == hit->t && (hit->prim == BVHLAB_NO_HIT || prim > hit->prim))
+	if (out[0] == hit->t && (hit->prim == BVHLAB_NO_HIT || prim >= hit->prim))
 		return false;
 	hit->t = out[0];
 	hit->u = out[1];
@@ -186,7 +186,7 @@ static inline bool isect_slot(const ray_prep *p, const bvhlab_tree *tree,
 	const float *v = tris + 9 * (size_t)slot;
 	if (!isect(p, v, v + 3, v + 6, hit->t, out))
 		return false;
-	if (out[0] == hit->t && (hit->prim == BVHLAB_NO_HIT || prim > hit->prim))
+	if (out[0] == hit->t && (hit->prim == BVHLAB_NO_HIT || prim >= hit->prim))
 		return false;
 	hit->t = out[0];
 	hit->u = out[1];
