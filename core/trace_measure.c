@@ -18,6 +18,7 @@
 #include "util.h"
 
 #define DEFAULT_MAX_REPEATS 10000
+#define MIN_REPEATS_CAP 10.0
 
 const char *bvhlab_traversal_name(int traversal)
 {
@@ -65,7 +66,11 @@ static bool more(const bvhlab_trace_options *o, uint32_t done, double seconds, u
 	uint32_t min = o->min_repeats ? o->min_repeats : 1;
 	if (done >= max)
 		return false;
-	return done < min || seconds * 1e3 < o->min_ms || rays < o->min_rays;
+	if (seconds * 1e3 < o->min_ms || rays < o->min_rays)
+		return true;
+	/* min_repeats gives way once passes are so slow that they took ten
+	 * times min_ms: a median of a few long passes is steady anyway. */
+	return done < min && seconds * 1e3 < MIN_REPEATS_CAP * o->min_ms;
 }
 
 /* Median, min and max of n samples (sorts them). */

@@ -158,7 +158,7 @@ static void test_measure(void)
 	for (int i = 0; i < N; i++)
 		rays[i] = grid_ray(&seed, 20);
 	for (int t = 0; t < 2; t++) {
-		bvhlab_trace_options o = {.traversal = t, .threads = 2, .min_repeats = 4, .min_ms = 1};
+		bvhlab_trace_options o = {.traversal = t, .threads = 2, .min_repeats = 4, .min_ms = 20};
 		bvhlab_trace_timing tm;
 		CHECK_INT(bvhlab_trace_measure(&f.tree, &f.scene, rays, N, &o, hits, nodes, &tm), 0);
 		CHECK(tm.repeats >= 4 && tm.stats.rays == N);

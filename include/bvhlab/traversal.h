@@ -61,7 +61,8 @@ typedef struct bvhlab_trace_options {
 	uint32_t threads;     /* tracing threads; 0: bvhlab_hardware_threads() */
 	double min_ms;        /* repeat the batch until this much tracing time has passed */
 	uint64_t min_rays;    /* ... and at least this many rays were traced (0: no minimum) */
-	uint32_t min_repeats; /* ... and at least this many passes (0 counts as 1) */
+	uint32_t min_repeats; /* ... and at least this many passes (0 counts as 1), unless
+	                       * the passes so far took 10 x min_ms */
 	uint32_t max_repeats; /* at most this many passes (0: 10000) */
 } bvhlab_trace_options;
 
