@@ -25,7 +25,7 @@
 #include <bvhlab/rays.h>
 #include <bvhlab/traversal.h>
 
-#include "util.h"
+#include "util/util.h"
 
 #define MAX_SAMPLES 4096
 #define MIN_REPEATS 5

@@ -23,6 +23,8 @@
 #include "scene.h"
 #include "tree.h"
 
+BVHLAB_BEGIN_DECLS
+
 /*
  * EPO of a valid tree (bvhlab_validate_tree) over `scene`, from `samples`
  * points drawn with `seed`: the same tree, samples and seed always give
@@ -34,5 +36,7 @@
  */
 int bvhlab_tree_epo(const bvhlab_tree *tree, const bvhlab_scene *scene, uint32_t samples,
                     uint64_t seed, double *epo);
+
+BVHLAB_END_DECLS
 
 #endif /* BVHLAB_EPO_H */

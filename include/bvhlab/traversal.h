@@ -1,10 +1,10 @@
 /*
  * bvhlab — the core's two traversals and timed ray batches (issue 17).
  *
- * A second, stackless traversal beside the stack-based one of tree.h, and
+ * A second, stackless traversal beside the stack-based one of trace.h, and
  * a batch tracer that repeats a batch until enough time has passed, so a
  * throughput figure is a median of many passes rather than one short
- * interval. Kept apart from tree.h and rays.h so it can move as one block.
+ * interval. Kept apart from trace.h so it can move into it as one block.
  *
  * Both traversals return the same closest hit for any ray on a valid tree:
  * the closest (t, prim) pair, ties in t broken by the smaller primitive id
@@ -19,8 +19,11 @@
 #include <stdint.h>
 
 #include "scene.h"
+#include "trace.h"
 #include "tree.h"
 #include "types.h"
+
+BVHLAB_BEGIN_DECLS
 
 /* Which traversal a batch uses. */
 enum bvhlab_traversal {
@@ -98,5 +101,7 @@ typedef struct bvhlab_trace_timing {
 int bvhlab_trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene,
                          const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
                          bvhlab_hit *hits, uint32_t *nodes, bvhlab_trace_timing *timing);
+
+BVHLAB_END_DECLS
 
 #endif /* BVHLAB_TRAVERSAL_H */

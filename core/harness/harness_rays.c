@@ -1,0 +1,122 @@
+/*
+ * The harness's ray measurements. Rays are traced in the run's child,
+ * right after validation, with the config's ray threads whatever the run's
+ * build thread count: traversal numbers then compare trees, not thread
+ * counts. Each batch is timed over repeated passes (bvhlab_trace_measure),
+ * with one or both traversals. The per-pixel data they give becomes images
+ * in output/scene_images.c.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/harness.h"
+#include "output/image.h"
+#include "output/results.h"
+#include "util/util.h"
+
+#define DIFFUSE_SEED 0xd1ff05eULL
+/* A median of fewer passes is one unlucky pass away from an outlier. */
+#define MIN_REPEATS 5
+
+void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam)
+{
+	if (cfg && cfg->has_camera)
+		*cam = cfg->camera;
+	else
+		bvhlab_camera_frame(&scene->bounds, cam);
+}
+
+void harness_ray_settings(const struct config *cfg, struct ray_settings *rs)
+{
+	if (!cfg) {
+		*rs = (struct ray_settings){.traversals = 1u << BVHLAB_TRAVERSAL_STACK,
+		                            .main = BVHLAB_TRAVERSAL_STACK};
+		return;
+	}
+	*rs = (struct ray_settings){.width = cfg->ray_width, .height = cfg->ray_height,
+	                            .diffuse = cfg->ray_diffuse, .threads = cfg->ray_threads,
+	                            .min_ms = cfg->ray_min_ms, .traversals = cfg->ray_traversals,
+	                            .main = cfg->ray_traversal};
+}
+
+/* Same triangle at bit-identical t, u, v. */
+static bool same_hit(const bvhlab_hit *a, const bvhlab_hit *b)
+{
+	return a->prim == b->prim && memcmp(&a->t, &b->t, sizeof(a->t)) == 0 &&
+	       memcmp(&a->u, &b->u, sizeof(a->u)) == 0 && memcmp(&a->v, &b->v, sizeof(a->v)) == 0;
+}
+
+/*
+ * One batch with every traversal of rs, the main one first (its hits go to
+ * hits, its node counts to nodes); another traversal's hits are compared
+ * with the main one's, ray by ray, into m->disagreements.
+ */
+static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                      const bvhlab_ray *rays, size_t n, const struct ray_settings *rs,
+                      bvhlab_trace_timing *out, bvhlab_hit *hits, uint32_t *nodes,
+                      struct ray_metrics *m)
+{
+	bvhlab_trace_options o = {.traversal = rs->main, .threads = rs->threads,
+	                          .min_ms = rs->min_ms, .min_repeats = MIN_REPEATS};
+	int r = bvhlab_trace_measure(tree, scene, rays, n, &o, hits, nodes, &out[rs->main]);
+	m->threads = out[rs->main].threads;
+	for (int k = 0; r == 0 && k < 2; k++) {
+		if (k == rs->main || !(rs->traversals & (1u << k)))
+			continue;
+		bvhlab_hit *other = malloc(n * sizeof(*other));
+		o.traversal = k;
+		r = other ? bvhlab_trace_measure(tree, scene, rays, n, &o, other, NULL, &out[k])
+		          : -ENOMEM;
+		for (size_t i = 0; r == 0 && i < n; i++)
+			m->disagreements += !same_hit(&hits[i], &other[i]);
+		free(other);
+	}
+	return r;
+}
+
+static int trace_diffuse(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                         const bvhlab_ray *primary, const bvhlab_hit *hits, size_t n,
+                         const struct ray_settings *rs, struct ray_metrics *m)
+{
+	bvhlab_ray *rays = NULL;
+	size_t count = 0;
+	int r = bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, DIFFUSE_SEED, &rays,
+	                            &count);
+	bvhlab_hit *dh = r == 0 && count ? malloc(count * sizeof(*dh)) : NULL;
+	if (r == 0 && count)
+		r = dh ? trace_kind(tree, scene, rays, count, rs, m->diffuse, dh, NULL, m) : -ENOMEM;
+	free(dh);
+	free(rays);
+	return r;
+}
+
+int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                       const bvhlab_camera *cam, const struct ray_settings *rs,
+                       struct ray_metrics *m, uint32_t *nodes, uint8_t *shade)
+{
+	bvhlab_ray *rays = NULL;
+	size_t n = (size_t)rs->width * rs->height;
+	memset(m, 0, sizeof(*m));
+	m->traversals = rs->traversals;
+	m->main = rs->main;
+	int r = bvhlab_rays_primary(cam, rs->width, rs->height, &rays);
+	if (r < 0)
+		return r;
+	bvhlab_hit *hits = malloc(n * sizeof(*hits));
+	if (!hits) {
+		r = -ENOMEM;
+		goto out;
+	}
+	r = trace_kind(tree, scene, rays, n, rs, m->primary, hits, nodes, m);
+	if (r == 0 && shade)
+		image_shade(scene, rays, hits, n, shade);
+	if (r == 0)
+		r = trace_diffuse(tree, scene, rays, hits, n, rs, m);
+	m->measured = r == 0;
+out:
+	free(hits);
+	free(rays);
+	return r;
+}
