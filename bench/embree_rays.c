@@ -4,12 +4,13 @@
  * the yardstick of the per-thread traversal speed (issue 17).
  *
  *   build/bench/embree-rays SCENE [--subdivide K] [--size N] [--min-ms MS]
- *                           [--builder PLUGIN] [--traversal stack|stackless]
+ *                           [--builder PLUGIN]
  *
- * The two trace the whole batch in turn, pass after pass, until --min-ms
- * (default 1000) has passed and at least 5 times each; the medians are
- * printed with the ratio, once timed by the thread's CPU time (what the
- * harness reports) and once by the wall clock.
+ * Embree and both core traversals (stack, stackless) trace the whole batch
+ * in turn, pass after pass, until --min-ms (default 1000) has passed and at
+ * least 5 times each; the medians are printed with the ratios, once timed
+ * by the thread's CPU time (what the harness reports) and once by the wall
+ * clock.
  * Embree's BVH is its own (rtcCommitScene, default quality, 4- or 8-wide
  * nodes); ours is the plugin's tree in the 32-byte binary layout.
  */
@@ -35,13 +36,11 @@ struct args {
 	unsigned subdivide;
 	uint32_t size;
 	double min_ms;
-	int traversal;
 };
 
 static int parse_args(int argc, char **argv, struct args *a)
 {
-	*a = (struct args){.builder = "sah_seq", .size = 512, .min_ms = 1000,
-	                   .traversal = BVHLAB_TRAVERSAL_STACK};
+	*a = (struct args){.builder = "sah_seq", .size = 512, .min_ms = 1000};
 	for (int i = 1; i < argc; i++) {
 		const char *v = i + 1 < argc ? argv[i + 1] : NULL;
 		if (strcmp(argv[i], "--subdivide") == 0 && v)
@@ -52,9 +51,6 @@ static int parse_args(int argc, char **argv, struct args *a)
 			a->min_ms = atof(argv[++i]);
 		else if (strcmp(argv[i], "--builder") == 0 && v)
 			a->builder = argv[++i];
-		else if (strcmp(argv[i], "--traversal") == 0 && v)
-			a->traversal = strcmp(argv[++i], "stackless") == 0 ? BVHLAB_TRAVERSAL_STACKLESS
-			                                                    : BVHLAB_TRAVERSAL_STACK;
 		else if (argv[i][0] != '-' && !a->scene)
 			a->scene = argv[i];
 		else
@@ -126,50 +122,74 @@ static double median(double *s, size_t n)
 	return n % 2 ? s[n / 2] : 0.5 * (s[n / 2 - 1] + s[n / 2]);
 }
 
-/* Passes of both tracers, alternating, so a burst of load from elsewhere
- * on the machine falls on both alike; medians of each. */
-static void time_both(bool wall_clock, RTCScene sc, const bvhlab_tree *tree, const bvhlab_scene *s,
-                      const bvhlab_ray *rays, size_t n, const struct args *a, double mrays[2],
-                      size_t hits[2], double *nodes)
+static double cpu_now(void)
 {
-	static double se[MAX_SAMPLES], so[MAX_SAMPLES];
-	bvhlab_trace_options o = {.traversal = a->traversal, .threads = 1, .max_repeats = 1};
+	struct timespec c;
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c);
+	return (double)c.tv_sec + 1e-9 * (double)c.tv_nsec;
+}
+
+/* What one tracer measured. */
+struct tracer {
+	double samples[MAX_SAMPLES];
+	double mrays;
+	size_t hits;
+	double nodes; /* per ray; the core's traversals only */
+};
+
+/* One pass of the core's traversal k, timed by its own clocks. */
+static bool ours_pass(bool wall_clock, const bvhlab_tree *tree, const bvhlab_scene *s,
+                      const bvhlab_ray *rays, size_t n, int k, bvhlab_hit *h,
+                      struct tracer *t, size_t pass)
+{
+	bvhlab_trace_options o = {.traversal = k, .threads = 1, .max_repeats = 1};
+	bvhlab_trace_timing tm;
+	if (bvhlab_trace_measure(tree, s, rays, n, &o, h, NULL, &tm) < 0)
+		return false;
+	t->samples[pass] = wall_clock ? tm.wall_mrays_median : tm.mrays_median;
+	t->nodes = (double)tm.stats.nodes_visited / (double)tm.stats.rays;
+	t->hits = 0;
+	for (size_t i = 0; i < n; i++)
+		t->hits += h[i].prim != BVHLAB_NO_HIT;
+	return true;
+}
+
+/* Passes of Embree and of both core traversals in turn, so a burst of
+ * load from elsewhere on the machine falls on all three alike; medians. */
+static void time_all(bool wall_clock, RTCScene sc, const bvhlab_tree *tree,
+                     const bvhlab_scene *s, const bvhlab_ray *rays, size_t n,
+                     const struct args *a, struct tracer t[3])
+{
 	bvhlab_hit *h = malloc(n * sizeof(*h));
-	double total = 0, start = util_now();
+	double start = util_now();
 	size_t k = 0;
-	while (h && k < MAX_SAMPLES && (k < MIN_REPEATS || total < a->min_ms * 1e-3)) {
-		bvhlab_trace_timing t;
-		struct timespec c0, c1;
-		double t0 = util_now();
-		clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
-		hits[0] = embree_pass(sc, rays, n);
-		clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
-		double cpu = (double)(c1.tv_sec - c0.tv_sec) + 1e-9 * (double)(c1.tv_nsec - c0.tv_nsec);
-		se[k] = (double)n / (wall_clock ? util_now() - t0 : cpu) * 1e-6;
-		if (bvhlab_trace_measure(tree, s, rays, n, &o, h, NULL, &t) < 0)
+	while (h && k < MAX_SAMPLES && (k < MIN_REPEATS || util_now() - start < a->min_ms * 1e-3)) {
+		double w0 = util_now(), c0 = cpu_now();
+		t[0].hits = embree_pass(sc, rays, n);
+		double secs = wall_clock ? util_now() - w0 : cpu_now() - c0;
+		t[0].samples[k] = (double)n / secs * 1e-6;
+		if (!ours_pass(wall_clock, tree, s, rays, n, BVHLAB_TRAVERSAL_STACK, h, &t[1], k) ||
+		    !ours_pass(wall_clock, tree, s, rays, n, BVHLAB_TRAVERSAL_STACKLESS, h, &t[2], k))
 			break;
-		so[k++] = wall_clock ? t.wall_mrays_median : t.mrays_median;
-		total = util_now() - start;
-		*nodes = (double)t.stats.nodes_visited / (double)t.stats.rays;
+		k++;
 	}
-	hits[1] = 0;
-	for (size_t i = 0; h && i < n; i++)
-		hits[1] += h[i].prim != BVHLAB_NO_HIT;
-	mrays[0] = k ? median(se, k) : 0;
-	mrays[1] = k ? median(so, k) : 0;
+	for (int i = 0; i < 3; i++)
+		t[i].mrays = k ? median(t[i].samples, k) : 0;
 	free(h);
 }
 
 static void report(const struct args *a, const bvhlab_scene *s, bool wall_clock,
-                   const double mrays[2], const size_t hits[2], double nodes)
+                   const struct tracer t[3])
 {
 	printf("scene %s (%u triangles), %ux%u primary rays, 1 thread, %s\n", s->name,
 	       s->triangle_count, a->size, a->size,
 	       wall_clock ? "wall clock" : "thread CPU time");
-	printf("  embree rtcIntersect1: %.2f Mrays/s (%zu hits)\n", mrays[0], hits[0]);
-	printf("  bvhlab %s tree, %s traversal: %.2f Mrays/s (%zu hits, %.2f nodes/ray)\n",
-	       a->builder, bvhlab_traversal_name(a->traversal), mrays[1], hits[1], nodes);
-	printf("  ratio bvhlab/embree: %.2f\n", mrays[0] > 0 ? mrays[1] / mrays[0] : 0);
+	printf("  embree rtcIntersect1: %.2f Mrays/s (%zu hits)\n", t[0].mrays, t[0].hits);
+	for (int k = 1; k < 3; k++)
+		printf("  bvhlab %s tree, %s traversal: %.2f Mrays/s (%zu hits, %.2f nodes/ray), "
+		       "ratio to embree %.2f\n",
+		       a->builder, bvhlab_traversal_name(k - 1), t[k].mrays, t[k].hits, t[k].nodes,
+		       t[0].mrays > 0 ? t[k].mrays / t[0].mrays : 0);
 }
 
 static int build(const struct args *a, const bvhlab_scene *s, bvhlab_tree *tree,
@@ -202,7 +222,7 @@ int main(int argc, char **argv)
 	bvhlab_error err = {{0}};
 	if (parse_args(argc, argv, &a) < 0) {
 		fprintf(stderr, "usage: embree-rays SCENE [--subdivide K] [--size N] [--min-ms MS] "
-		                "[--builder PLUGIN] [--traversal stack|stackless]\n");
+		                "[--builder PLUGIN]\n");
 		return 2;
 	}
 	int r = load(&a, &s, &err);
@@ -213,15 +233,15 @@ int main(int argc, char **argv)
 		return 1;
 	}
 	bvhlab_camera_frame(&s->bounds, &cam);
-	size_t n = (size_t)a.size * a.size, hits[2] = {0, 0};
-	double nodes = 0, mrays[2];
+	size_t n = (size_t)a.size * a.size;
+	static struct tracer t[3];
 	if (bvhlab_rays_primary(&cam, a.size, a.size, &rays) < 0)
 		return 1;
 	RTCDevice dev = rtcNewDevice("threads=1");
 	RTCScene sc = embree_scene(dev, s);
 	for (int clock = 0; clock < 2; clock++) {
-		time_both(clock == 1, sc, &tree, s, rays, n, &a, mrays, hits, &nodes);
-		report(&a, s, clock == 1, mrays, hits, nodes);
+		time_all(clock == 1, sc, &tree, s, rays, n, &a, t);
+		report(&a, s, clock == 1, t);
 	}
 	rtcReleaseScene(sc);
 	rtcReleaseDevice(dev);

@@ -163,6 +163,9 @@ static void test_measure(void)
 		CHECK_INT(bvhlab_trace_measure(&f.tree, &f.scene, rays, N, &o, hits, nodes, &tm), 0);
 		CHECK(tm.repeats >= 4 && tm.stats.rays == N);
 		CHECK(tm.mrays_min <= tm.mrays_median && tm.mrays_median <= tm.mrays_max);
+		/* The tiles' best times are disjoint parts of every pass's CPU time,
+		 * so their sum is at most the fastest pass's. */
+		CHECK(tm.mrays_best >= tm.mrays_max * (1 - 1e-9));
 		CHECK(tm.wall_mrays_min <= tm.wall_mrays_median && tm.mrays_median > 0);
 		uint64_t node_sum = 0;
 		bvhlab_trace_stats st = {0};

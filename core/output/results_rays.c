@@ -1,8 +1,9 @@
 /*
  * The "rays" member of a run: what the core's traverser measured on the
  * run's tree. Per-ray averages make runs with different ray counts
- * (resolutions, scenes with more misses) comparable; throughput is the
- * median over repeated passes of the batch, with the extremes beside it.
+ * (resolutions, scenes with more misses) comparable. Throughput:
+ * mrays_per_s from each tile's best pass (see bvhlab_trace_timing), and the
+ * median, min and max over the passes beside it.
  */
 #include <cJSON.h>
 
@@ -14,7 +15,8 @@ static cJSON *kind_json(const bvhlab_trace_timing *t)
 	const bvhlab_trace_stats *st = &t->stats;
 	double rays = (double)st->rays;
 	cJSON_AddNumberToObject(o, "rays", rays);
-	cJSON_AddNumberToObject(o, "mrays_per_s", t->mrays_median);
+	cJSON_AddNumberToObject(o, "mrays_per_s", t->mrays_best);
+	cJSON_AddNumberToObject(o, "mrays_median", t->mrays_median);
 	cJSON_AddNumberToObject(o, "mrays_min", t->mrays_min);
 	cJSON_AddNumberToObject(o, "mrays_max", t->mrays_max);
 	cJSON_AddNumberToObject(o, "wall_mrays_per_s", t->wall_mrays_median);

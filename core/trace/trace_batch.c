@@ -35,21 +35,30 @@ static void trace_tile(struct batch *b, size_t begin, size_t end, bvhlab_trace_s
 	}
 }
 
+static double cpu_seconds(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 static void *work(void *arg)
 {
 	struct worker *w = arg;
 	struct batch *b = w->b;
-	struct timespec t0, t1;
-	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
+	double t0 = cpu_seconds();
 	for (;;) {
 		size_t begin = atomic_fetch_add_explicit(&b->next, TILE, memory_order_relaxed);
 		if (begin >= b->count)
 			break;
 		size_t end = b->count - begin < TILE ? b->count : begin + TILE;
+		double c0 = b->tile_cpu ? cpu_seconds() : 0;
 		trace_tile(b, begin, end, &w->stats);
+		/* Each tile is one thread's: no other thread writes this slot. */
+		if (b->tile_cpu)
+			b->tile_cpu[begin / TILE] = cpu_seconds() - c0;
 	}
-	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
-	w->cpu_s = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+	w->cpu_s = cpu_seconds() - t0;
 	return NULL;
 }
 

@@ -28,6 +28,7 @@ struct batch {
 	bool any;
 	int traversal;          /* enum bvhlab_traversal */
 	struct trace_view view; /* what the traversal reads */
+	double *tile_cpu;       /* [tiles] CPU seconds of each tile of a pass, or NULL */
 	bvhlab_hit *hits;
 	uint32_t *nodes;
 	atomic_size_t next;
@@ -39,6 +40,12 @@ struct worker {
 	bvhlab_trace_stats stats;
 	double cpu_s; /* the thread's CPU time in the batch (CLOCK_THREAD_CPUTIME_ID) */
 };
+
+/* Tiles of a batch of `count` rays. */
+static inline size_t trace_tiles(size_t count)
+{
+	return (count + TILE - 1) / TILE;
+}
 
 /* Threads a batch of `count` rays gets: 0 means all hardware threads, and
  * never more than there are tiles. */

@@ -62,7 +62,9 @@ typedef struct bvhlab_trace_options {
 	int traversal;        /* enum bvhlab_traversal */
 	bool any_hit;         /* occlusion rays: the first hit ends a ray */
 	uint32_t threads;     /* tracing threads; 0: bvhlab_hardware_threads() */
-	double min_ms;        /* repeat the batch until this much tracing time has passed */
+	double min_ms;        /* repeat the batch until the tracing threads have run this
+	                       * long (CPU time per thread: a busy machine stretches a
+	                       * measurement instead of cutting its passes short) */
 	uint64_t min_rays;    /* ... and at least this many rays were traced (0: no minimum) */
 	uint32_t min_repeats; /* ... and at least this many passes (0 counts as 1), unless
 	                       * the passes so far took 10 x min_ms */
@@ -74,15 +76,24 @@ typedef struct bvhlab_trace_options {
  * and the CPU time of the tracing threads (CLOCK_THREAD_CPUTIME_ID), which
  * leaves out the time they waited for a core while other processes ran.
  * cpu figures are rays per CPU second times the thread count: the
- * throughput the threads would give with a core each to themselves, which
- * is what compares trees on a shared machine; wall figures are what the
- * batch really took.
+ * throughput the threads would give with a core each to themselves; wall
+ * figures are what the batch really took.
+ *
+ * mrays_best goes one step further for a shared machine, where even CPU
+ * time swings with what else runs (caches refilled after each switch to
+ * another process): every tile of rays is timed on its own in every pass,
+ * each tile keeps its least CPU time over the passes, and the batch's time
+ * is the sum of those. A tile lasts tens of microseconds, so most passes
+ * leave each tile undisturbed at least once: the figure is the traversal's
+ * own speed, and it repeats between runs where the medians do not.
  */
 typedef struct bvhlab_trace_timing {
 	bvhlab_trace_stats stats; /* counters of ONE pass: exact per-ray averages */
 	uint32_t threads;         /* threads that traced */
 	uint32_t repeats;         /* passes timed */
 	double seconds_total;     /* wall time of all passes */
+	double mrays_best;        /* million rays per CPU second x threads, from the
+	                           * least time of every tile over the passes */
 	double mrays_median;      /* million rays per CPU second x threads: median over passes */
 	double mrays_min, mrays_max;
 	double wall_mrays_median; /* million rays per wall-clock second: median over passes */
@@ -91,7 +102,7 @@ typedef struct bvhlab_trace_timing {
 
 /*
  * Traces the batch of `count` rays once, then again until the minimums of
- * *opts (min_ms counts wall time) are met; every pass is timed on its
+ * *opts are met; every pass is timed on its
  * own, on both clocks, and the figures are over passes. Threads take tiles of rays
  * from a shared counter; per ray nothing is allocated or locked. hits and
  * nodes (may be NULL) get each ray's hit and count of nodes entered, from
