@@ -255,8 +255,9 @@ char *report_markdown(const cJSON *doc)
 	               "Speedup: over the same builder's 1-thread run. Rays (primary from the "
 	               "camera, diffuse bounces from their hits) are traced with the same "
 	               "threads for every run, whatever its build thread count, so traversal "
-	               "numbers compare trees; Mrays/s is the median over repeated passes of "
-	               "rays per CPU second of the tracing threads, times their number.\n",
+	               "numbers compare trees; Mrays/s: rays per CPU second of the tracing "
+	               "threads times their number, each tile of rays at its best of the "
+	               "repeated passes.\n",
 	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);

@@ -232,9 +232,9 @@ char *report_html(const cJSON *doc)
 	               "normalised by the root's area; EPO: end-point overlap, sampled; peak "
 	               "MiB: what the builds added to the process's resident set at its peak. "
 	               "Rays are traced with the same threads for every run, so traversal "
-	               "numbers compare trees, not thread counts; Mrays/s is the median over "
-	               "repeated passes of rays per CPU second of the tracing threads, times "
-	               "their number (min–max over the passes beside it).</p>\n",
+	               "numbers compare trees, not thread counts; Mrays/s: rays per CPU "
+	               "second of the tracing threads times their number, each tile of rays "
+	               "at its best of the repeated passes (min–max: whole passes).</p>\n",
 	          report_num(doc, "machine.cores"));
 	report_summary_html(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
