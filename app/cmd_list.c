@@ -36,7 +36,9 @@ static void print_option(const bvhlab_option_decl *d)
 	printf("    %-12s %-6s default %s", d->name, types[d->type <= 4 ? d->type : 0], def);
 	if (d->choices)
 		printf(", one of %s", d->choices);
-	else if (d->min <= d->max)
+	else if (d->min <= d->max && (d->type == BVHLAB_OPTION_INT || d->type == BVHLAB_OPTION_FLOAT))
+		/* Ranges mean something for numbers only; a bool's zeroed
+		 * min and max would print as [0, 0]. */
 		printf(", range [%g, %g]", d->min, d->max);
 	printf("\n      %s\n", d->help ? d->help : "");
 }

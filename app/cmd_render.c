@@ -75,12 +75,15 @@ static int draw(const bvhlab_tree *tree, const bvhlab_scene *scene, const struct
 	size_t n = a->width * a->height;
 	uint32_t *nodes = a->heat ? malloc(n * sizeof(*nodes)) : NULL, lo = UINT32_MAX, hi = 0;
 	struct ray_metrics m;
+	struct ray_settings rs;
 	bvhlab_camera cam;
 	if (a->heat && !nodes)
 		return -ENOMEM;
 	harness_camera(NULL, scene, &cam);
-	int r = harness_trace_rays(tree, scene, &cam, (uint32_t)a->width, (uint32_t)a->height, 0,
-	                           &m, nodes, a->heat ? NULL : rgb);
+	harness_ray_settings(NULL, &rs);
+	rs.width = (uint32_t)a->width;
+	rs.height = (uint32_t)a->height;
+	int r = harness_trace_rays(tree, scene, &cam, &rs, &m, nodes, a->heat ? NULL : rgb);
 	for (size_t i = 0; r == 0 && nodes && i < n; i++) {
 		lo = nodes[i] < lo ? nodes[i] : lo;
 		hi = nodes[i] > hi ? nodes[i] : hi;

@@ -245,7 +245,8 @@ static void test_unknown_keys(void)
 	EXPECT_ERROR_AT(t, "\"repet\"", 0,
 	                "unknown key 'repet' at the top level (known: format_version, output, "
 	                "repeat, warmup, threads, validate, validate_rays, rays, images, isolate, "
-	                "timeout_s, memory_limit_mb, pin, scenes, builders); did you mean 'repeat'?");
+	                "timeout_s, memory_limit_mb, pin, report, scenes, builders); did you mean "
+	                "'repeat'?");
 	t = "{ " SCENES ", " BUILDERS ", \"zzzzzz\": 3 }";
 	EXPECT_ERROR_AT(t, "\"zzzzzz\"", 0, "unknown key 'zzzzzz' at the top level");
 	CHECK(load(&cfg, t, &err) < 0 && !strstr(err.message, "did you mean"));
@@ -258,10 +259,10 @@ static void test_unknown_keys(void)
 	             "    { \"plugin\": \"b\", \"threds\": [2] } ] }",
 	             3, 22,
 	             "unknown key 'threds' in builders[1] (known: plugin, name, threads, "
-	             "timeout_s, memory_limit_mb, options); did you mean 'threads'?");
+	             "timeout_s, memory_limit_mb, options, optional); did you mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
-	                "diffuse, camera); did you mean 'width'?");
+	                "diffuse, camera, threads, min_ms, traversal); did you mean 'width'?");
 }
 
 static void test_types(void)

@@ -15,6 +15,8 @@
 #define READ_CHUNK 65536
 /* Generous: a run that takes longer is stuck rather than slow. */
 #define DEFAULT_TIMEOUT_S 600
+/* Long enough that a pass of a few ms is repeated dozens of times. */
+#define DEFAULT_RAY_MIN_MS 200.0
 
 static int out_of_memory(const char *path, bvhlab_error *err)
 {
@@ -32,6 +34,13 @@ static int set_defaults(struct config *cfg)
 	cfg->ray_width = 256;
 	cfg->ray_height = 256;
 	cfg->ray_diffuse = 1;
+	cfg->ray_threads = 1;
+	cfg->ray_min_ms = DEFAULT_RAY_MIN_MS;
+	cfg->ray_traversals = 1u << BVHLAB_TRAVERSAL_STACK;
+	cfg->ray_traversal = BVHLAB_TRAVERSAL_STACK;
+	cfg->report_reference = strdup("sah_seq");
+	if (!cfg->report_reference)
+		return -ENOMEM;
 	cfg->images = false;
 	cfg->isolate = true;
 	cfg->timeout_s = DEFAULT_TIMEOUT_S;
@@ -80,6 +89,28 @@ static int resolve_output(struct config *cfg, bvhlab_error *err)
 	return rc ? out_of_memory(cfg->path, err) : 0;
 }
 
+/* "traversal": "stack", "stackless" or "both" (stack is then the main one). */
+static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *err)
+{
+	char *name = NULL;
+	int rc = config_get_string(cfg, rays, "traversal", "rays.", &name, err);
+	if (rc || !name)
+		return rc;
+	if (strcmp(name, "both") == 0) {
+		cfg->ray_traversals = 1u << BVHLAB_TRAVERSAL_STACK | 1u << BVHLAB_TRAVERSAL_STACKLESS;
+		cfg->ray_traversal = BVHLAB_TRAVERSAL_STACK;
+	} else if (strcmp(name, "stack") == 0 || strcmp(name, "stackless") == 0) {
+		cfg->ray_traversal = name[5] ? BVHLAB_TRAVERSAL_STACKLESS : BVHLAB_TRAVERSAL_STACK;
+		cfg->ray_traversals = 1u << cfg->ray_traversal;
+	} else {
+		rc = config_error(cfg, config_member(rays, "traversal"), false, err,
+		                  "'rays.traversal' must be \"stack\", \"stackless\" or \"both\", "
+		                  "not \"%s\"", name);
+	}
+	free(name);
+	return rc;
+}
+
 static int parse_rays(struct config *cfg, bvhlab_error *err)
 {
 	const cJSON *rays = config_member(cfg->root, "rays");
@@ -95,7 +126,26 @@ static int parse_rays(struct config *cfg, bvhlab_error *err)
 	if (!rc)
 		rc = config_read_keys(cfg, rays, config_ray_keys, "rays.", cfg, err);
 	if (!rc)
+		rc = parse_traversal(cfg, rays, err);
+	if (!rc)
 		rc = config_parse_camera(cfg, rays, err);
+	return rc;
+}
+
+static int parse_report(struct config *cfg, bvhlab_error *err)
+{
+	const cJSON *report = config_member(cfg->root, "report");
+	if (!report)
+		return 0;
+	if (!cJSON_IsObject(report)) {
+		char got[48];
+		return config_error(cfg, report, false, err,
+		                    "'report' must be an object {reference}, not %s",
+		                    config_describe(cfg, report, got, sizeof(got)));
+	}
+	int rc = config_check_keys(cfg, report, config_report_keys, "in report", err);
+	if (!rc)
+		rc = config_read_keys(cfg, report, config_report_keys, "report.", cfg, err);
 	return rc;
 }
 
@@ -115,6 +165,8 @@ static int parse_top(struct config *cfg, bvhlab_error *err)
 		rc = resolve_output(cfg, err);
 	if (!rc)
 		rc = parse_rays(cfg, err);
+	if (!rc)
+		rc = parse_report(cfg, err);
 	if (!rc)
 		rc = config_parse_scenes(cfg, err);
 	if (!rc)
@@ -233,6 +285,7 @@ void config_finish(struct config *cfg)
 	free(cfg->builders);
 	free(cfg->threads);
 	free(cfg->output);
+	free(cfg->report_reference);
 	json_locations_destroy(cfg->locations);
 	cJSON_Delete(cfg->root);
 	free(cfg->text);

@@ -18,6 +18,7 @@
 #include <bvhlab/host.h>
 #include <bvhlab/trace.h>
 #include <bvhlab/scene.h>
+#include <bvhlab/traversal.h>
 
 struct cJSON;
 struct json_locations;
@@ -39,6 +40,9 @@ struct config_builder {
 	double timeout_s;  /* "timeout_s" override, or 0 for the config's */
 	uint64_t memory_limit_mb; /* "memory_limit_mb" override, or 0 for the config's */
 	const struct cJSON *options; /* "options" object (may be NULL), owned by root */
+	bool optional;     /* "optional", default false: a plugin that is not there (not
+	                    * built, say) drops the builder from the sweep instead of
+	                    * failing its runs */
 	int line, column;  /* where the builder's object starts */
 	/* An option grid's builder (config_grid.c): the value it takes of each grid. */
 	struct config_grid_pick *picks;
@@ -69,6 +73,13 @@ struct config {
 	uint32_t validate_rays; /* "validate_rays", default 256 */
 	uint32_t ray_width, ray_height, ray_diffuse; /* "rays": width/height/diffuse,
 	                                              * default 256, 256, 1 */
+	uint32_t ray_threads; /* "rays": "threads", default 1; 0 = all hardware threads */
+	double ray_min_ms; /* "rays": "min_ms", default 200: each batch repeated this long */
+	unsigned ray_traversals; /* "rays": "traversal" stack|stackless|both, default stack:
+	                          * bit (1 << enum bvhlab_traversal) per traversal */
+	int ray_traversal; /* the main one (stack for "both") */
+	char *report_reference; /* "report": {"reference"}, default "sah_seq": a builder
+	                         * name or, failing that, a plugin name */
 	bool has_camera;   /* "rays": {"camera": ...} given; else framed per scene */
 	bvhlab_camera camera;
 	bool images;       /* "images", default false */

@@ -69,6 +69,7 @@ struct config_key {
  * in the order they are listed in messages and read. */
 extern const struct config_key config_top_keys[];   /* struct config */
 extern const struct config_key config_ray_keys[];   /* struct config */
+extern const struct config_key config_report_keys[]; /* struct config */
 extern const struct config_key config_scene_keys[]; /* struct config_scene */
 extern const struct config_key config_builder_keys[]; /* struct config_builder */
 extern const struct config_key config_camera_keys[]; /* bvhlab_camera */

@@ -16,6 +16,7 @@
 /* Image sides beyond this are mistakes, and width * height stays far from 2^32. */
 #define MAX_RAY_SIDE 16384
 #define MAX_DIFFUSE 1024
+#define MAX_RAY_THREADS 1024
 /* 16 subdivisions turn one triangle into 4^16 = 2^32, past a uint32_t count. */
 #define MAX_SUBDIVIDE 15
 
@@ -41,6 +42,7 @@ const struct config_key config_top_keys[] = {
 	TOP("timeout_s", CONFIG_POSITIVE, timeout_s, 0, 0),
 	TOP("memory_limit_mb", CONFIG_U64, memory_limit_mb, 1, CONFIG_MAX_MEMORY_MB),
 	TOP("pin", CONFIG_BOOL, pin, 0, 0),
+	CUSTOM("report"),
 	CUSTOM("scenes"),
 	CUSTOM("builders"),
 	END,
@@ -51,6 +53,14 @@ const struct config_key config_ray_keys[] = {
 	TOP("height", CONFIG_U32, ray_height, 1, MAX_RAY_SIDE),
 	TOP("diffuse", CONFIG_U32, ray_diffuse, 0, MAX_DIFFUSE),
 	CUSTOM("camera"),
+	TOP("threads", CONFIG_U32, ray_threads, 0, MAX_RAY_THREADS),
+	TOP("min_ms", CONFIG_POSITIVE, ray_min_ms, 0, 0),
+	CUSTOM("traversal"), /* "stack" | "stackless" | "both": config.c */
+	END,
+};
+
+const struct config_key config_report_keys[] = {
+	TOP("reference", CONFIG_STRING, report_reference, 0, 0),
 	END,
 };
 
@@ -77,6 +87,7 @@ const struct config_key config_builder_keys[] = {
 	BUILDER("timeout_s", CONFIG_POSITIVE, timeout_s, 0, 0),
 	BUILDER("memory_limit_mb", CONFIG_U64, memory_limit_mb, 1, CONFIG_MAX_MEMORY_MB),
 	CUSTOM("options"),
+	BUILDER("optional", CONFIG_BOOL, optional, 0, 0),
 	END,
 };
 

@@ -10,6 +10,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <bvhlab/epo.h>
+
 #include "harness/harness.h"
 #include "harness/harness_builders.h"
 #include "harness/isolate.h"
@@ -21,6 +23,10 @@
 #include "util/util.h"
 
 #define RAY_SEED 0x5eedULL
+/* EPO points: a relative standard error of a few per mille on the scenes
+ * tried, in tens of milliseconds. Fixed seed: reruns give the same value. */
+#define EPO_SAMPLES 16384
+#define EPO_SEED 0xe90ULL
 
 struct harness {
 	const struct config *cfg;
@@ -45,6 +51,9 @@ struct series_report {
 	bool has_stats, validated, valid;
 	uint64_t rays_checked, mismatches;
 	bvhlab_tree_stats stats;
+	bool has_epo;
+	double epo;
+	struct build_memory memory;
 	struct ray_metrics rays;
 	bool heat_written, shade_written;
 	char error[sizeof(((bvhlab_error *)0)->message)];
@@ -84,7 +93,10 @@ static void record(struct harness *h, struct run_record *run)
 static const uint32_t *builder_threads(const struct harness *h, const struct config_builder *b,
                                        size_t *count)
 {
-	return plan_builder_threads(h->cfg, b, count);
+	const uint32_t *threads = plan_builder_threads(h->cfg, b, count);
+	if (h->builders && h->builders[b - h->cfg->builders].skipped)
+		*count = 0;
+	return threads;
 }
 
 /* A run left out by --only, or kept from the results resumed (counted as done). */
@@ -187,13 +199,14 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 	uint32_t *nodes;
 	uint8_t *shade;
 	bvhlab_camera cam;
+	struct ray_settings rs;
 	if (n == 0)
 		return;
 	harness_camera(cfg, job->scene, &cam);
+	harness_ray_settings(cfg, &rs);
 	int r = image_buffers(job, n, &nodes, &shade);
 	if (r == 0)
-		r = harness_trace_rays(tree, job->scene, &cam, cfg->ray_width, cfg->ray_height,
-		                       cfg->ray_diffuse, &rep->rays, nodes, shade);
+		r = harness_trace_rays(tree, job->scene, &cam, &rs, &rep->rays, nodes, shade);
 	if (r == 0 && nodes)
 		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)
@@ -215,7 +228,10 @@ static void series_work(void *arg, void *report, size_t size)
 	bvhlab_error err = {{0}};
 	(void)size;
 	rep->status = SERIES_OK;
-	if (harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err) < 0) {
+	harness_memory_begin(&rep->memory);
+	int r = harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err);
+	harness_memory_end(&rep->memory, &s.tree);
+	if (r < 0) {
 		rep->status = SERIES_FAILED;
 	} else {
 		rep->sample_count = s.repeat;
@@ -224,6 +240,9 @@ static void series_work(void *arg, void *report, size_t size)
 		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
 		if (rep->has_stats)
 			bvhlab_tree_stats_compute(&s.tree, &rep->stats);
+		if (rep->status == SERIES_OK)
+			rep->has_epo = bvhlab_tree_epo(&s.tree, job->scene, EPO_SAMPLES, EPO_SEED,
+			                               &rep->epo) == 0;
 		if (rep->status == SERIES_OK)
 			trace_rays(job, &s.tree, rep, &err);
 	}
@@ -248,6 +267,8 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->sample_count = rep->sample_count;
 	run->cold_ms = rep->cold_ms;
 	run->stats = rep->has_stats ? &rep->stats : NULL;
+	run->epo = rep->has_epo ? &rep->epo : NULL;
+	run->memory = rep->memory.measured ? &rep->memory : NULL;
 	run->validated = rep->validated;
 	run->valid = rep->valid;
 	run->rays_checked = rep->rays_checked;
@@ -392,7 +413,10 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 			record_all_failed(h, scene_index, cs->name, &h->builders[b], "failed", err.message);
 		goto out;
 	}
-	results_add_scene(&h->res, scene->name, scene->source, scene->triangle_count, NULL);
+	char *shown = cs->path ? util_path_shown(h->cfg->dir, cs->path) : NULL;
+	results_add_scene(&h->res, scene->name, shown ? shown : scene->source,
+	                  scene->triangle_count, NULL);
+	free(shown);
 	h->shade_done = false;
 	run_builders(h, scene, &prims, scene_index);
 	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)
@@ -404,10 +428,16 @@ out:
 
 static uint32_t count_runs(const struct harness *h)
 {
-	size_t total = plan_run_count(h->cfg), chosen = 0;
+	size_t total = plan_run_count(h->cfg), chosen = 0, n;
 	for (size_t id = 0; h->only && id < total; id++)
 		chosen += h->only[id];
-	return (uint32_t)(h->only ? chosen : total);
+	if (h->only)
+		return (uint32_t)chosen;
+	for (size_t b = 0; b < h->cfg->builder_count; b++) {
+		builder_threads(h, &h->cfg->builders[b], &n);
+		chosen += n;
+	}
+	return (uint32_t)(chosen * h->cfg->scene_count);
 }
 
 /* Takes over the finished runs of the output folder's results.json. */

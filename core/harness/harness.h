@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include <bvhlab/bvhlab.h>
+#include <bvhlab/traversal.h>
 
 #include "config/config.h"
 #include "output/results.h"
@@ -60,19 +61,43 @@ int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
                         bvhlab_error *err);
 
 
-/* ---- rays (harness_rays.c) ------------------------------------------------ */
+/* ---- peak memory of the builds (harness_memory.c) ------------------------ */
+
+struct build_memory; /* output/results.h */
+
+/* Before the first build (warm-up included), and after the last one. */
+void harness_memory_begin(struct build_memory *m);
+void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree);
+
+/* ---- rays and images (harness_rays.c) ------------------------------------ */
+
+struct ray_metrics; /* output/results.h */
+
+/* What rays a run is measured with: the config's "rays". */
+struct ray_settings {
+	uint32_t width, height; /* primary rays: one per pixel */
+	uint32_t diffuse;       /* bounces per primary hit */
+	uint32_t threads;       /* tracing threads; 0: all hardware threads */
+	double min_ms;          /* each batch is repeated for at least this long */
+	unsigned traversals;    /* bit (1 << enum bvhlab_traversal) for each one measured */
+	int main;               /* the traversal whose hits feed images and diffuse rays */
+};
+
+/* The config's settings (cfg NULL: one quick stack pass, all threads). */
+void harness_ray_settings(const struct config *cfg, struct ray_settings *rs);
 
 /* The config's camera, or the automatic framing of the scene. */
 void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam);
 
 /*
  * Primary rays (width x height) and `diffuse` bounces per primary hit,
- * traced with all hardware threads. nodes ([width * height], may be NULL)
- * gets nodes visited per pixel, shade ([3 * width * height], may be NULL)
- * the shaded render. 0 or a negative errno.
+ * each batch timed (bvhlab_trace_measure) with every traversal of rs.
+ * nodes ([width * height], may be NULL) gets nodes visited per pixel,
+ * shade ([3 * width * height], may be NULL) the shaded render, both from
+ * the main traversal. 0 or a negative errno.
  */
 int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
-                       const bvhlab_camera *cam, uint32_t width, uint32_t height,
-                       uint32_t diffuse, struct ray_metrics *m, uint32_t *nodes, uint8_t *shade);
+                       const bvhlab_camera *cam, const struct ray_settings *rs,
+                       struct ray_metrics *m, uint32_t *nodes, uint8_t *shade);
 
 #endif

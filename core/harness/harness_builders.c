@@ -92,7 +92,11 @@ int harness_open_builders(const struct config *cfg, struct harness_builder **out
 		int r = open_one(cfg, hb);
 		if (r == -ENOMEM)
 			return r;
-		if (r < 0)
+		hb->skipped = r < 0 && !hb->plugin && hb->cb->optional;
+		if (hb->skipped)
+			fprintf(stderr, "bvhlab: optional builder '%s' skipped: %s\n", hb->cb->name,
+			        hb->error.message);
+		else if (r < 0)
 			fprintf(stderr, "bvhlab: builder '%s': %s\n", hb->cb->name, hb->error.message);
 	}
 	return 0;

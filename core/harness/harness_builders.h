@@ -20,6 +20,8 @@ struct harness_builder {
 	bvhlab_options opts;
 	bool opts_ok;
 	const char *status;    /* of its runs when unusable: "failed", "crashed", "timeout" */
+	bool skipped;          /* optional ("optional": true) and its plugin could not be
+	                        * loaded: it has no runs at all */
 	bvhlab_error error;
 };
 

@@ -1,16 +1,15 @@
 /*
  * The harness's ray measurements. Rays are traced in the run's child,
- * right after validation, with every hardware thread whatever the run's
+ * right after validation, with the config's ray threads whatever the run's
  * build thread count: traversal numbers then compare trees, not thread
- * counts. The per-pixel data they give becomes images in
- * output/scene_images.c.
+ * counts. Each batch is timed over repeated passes (bvhlab_trace_measure),
+ * with one or both traversals. The per-pixel data they give becomes images
+ * in output/scene_images.c.
  */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "harness/harness.h"
 #include "output/image.h"
@@ -18,6 +17,9 @@
 #include "util/util.h"
 
 #define DIFFUSE_SEED 0xd1ff05eULL
+/* Each tile keeps its best of at least this many passes (see
+ * bvhlab_trace_timing): enough chances to run undisturbed. */
+#define MIN_REPEATS 10
 
 void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam)
 {
@@ -27,29 +29,80 @@ void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_
 		bvhlab_camera_frame(&scene->bounds, cam);
 }
 
+void harness_ray_settings(const struct config *cfg, struct ray_settings *rs)
+{
+	if (!cfg) {
+		*rs = (struct ray_settings){.traversals = 1u << BVHLAB_TRAVERSAL_STACK,
+		                            .main = BVHLAB_TRAVERSAL_STACK};
+		return;
+	}
+	*rs = (struct ray_settings){.width = cfg->ray_width, .height = cfg->ray_height,
+	                            .diffuse = cfg->ray_diffuse, .threads = cfg->ray_threads,
+	                            .min_ms = cfg->ray_min_ms, .traversals = cfg->ray_traversals,
+	                            .main = cfg->ray_traversal};
+}
+
+/* Same triangle at bit-identical t, u, v. */
+static bool same_hit(const bvhlab_hit *a, const bvhlab_hit *b)
+{
+	return a->prim == b->prim && memcmp(&a->t, &b->t, sizeof(a->t)) == 0 &&
+	       memcmp(&a->u, &b->u, sizeof(a->u)) == 0 && memcmp(&a->v, &b->v, sizeof(a->v)) == 0;
+}
+
+/*
+ * One batch with every traversal of rs, the main one first (its hits go to
+ * hits, its node counts to nodes); another traversal's hits are compared
+ * with the main one's, ray by ray, into m->disagreements.
+ */
+static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                      const bvhlab_ray *rays, size_t n, const struct ray_settings *rs,
+                      bvhlab_trace_timing *out, bvhlab_hit *hits, uint32_t *nodes,
+                      struct ray_metrics *m)
+{
+	bvhlab_trace_options o = {.traversal = rs->main, .threads = rs->threads,
+	                          .min_ms = rs->min_ms, .min_repeats = MIN_REPEATS};
+	int r = bvhlab_trace_measure(tree, scene, rays, n, &o, hits, nodes, &out[rs->main]);
+	m->threads = out[rs->main].threads;
+	for (int k = 0; r == 0 && k < 2; k++) {
+		if (k == rs->main || !(rs->traversals & (1u << k)))
+			continue;
+		bvhlab_hit *other = malloc(n * sizeof(*other));
+		o.traversal = k;
+		r = other ? bvhlab_trace_measure(tree, scene, rays, n, &o, other, NULL, &out[k])
+		          : -ENOMEM;
+		for (size_t i = 0; r == 0 && i < n; i++)
+			m->disagreements += !same_hit(&hits[i], &other[i]);
+		free(other);
+	}
+	return r;
+}
+
 static int trace_diffuse(const bvhlab_tree *tree, const bvhlab_scene *scene,
                          const bvhlab_ray *primary, const bvhlab_hit *hits, size_t n,
-                         uint32_t diffuse, struct ray_metrics *m)
+                         const struct ray_settings *rs, struct ray_metrics *m)
 {
 	bvhlab_ray *rays = NULL;
 	size_t count = 0;
-	int r = bvhlab_rays_diffuse(scene, primary, hits, n, diffuse, DIFFUSE_SEED, &rays, &count);
+	int r = bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, DIFFUSE_SEED, &rays,
+	                            &count);
+	bvhlab_hit *dh = r == 0 && count ? malloc(count * sizeof(*dh)) : NULL;
 	if (r == 0 && count)
-		r = bvhlab_trace_batch(tree, scene, rays, count, false, 0, NULL, NULL, &m->diffuse,
-		                       &m->diffuse_s);
+		r = dh ? trace_kind(tree, scene, rays, count, rs, m->diffuse, dh, NULL, m) : -ENOMEM;
+	free(dh);
 	free(rays);
 	return r;
 }
 
 int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
-                       const bvhlab_camera *cam, uint32_t width, uint32_t height,
-                       uint32_t diffuse, struct ray_metrics *m, uint32_t *nodes, uint8_t *shade)
+                       const bvhlab_camera *cam, const struct ray_settings *rs,
+                       struct ray_metrics *m, uint32_t *nodes, uint8_t *shade)
 {
 	bvhlab_ray *rays = NULL;
-	size_t n = (size_t)width * height;
+	size_t n = (size_t)rs->width * rs->height;
 	memset(m, 0, sizeof(*m));
-	m->threads = bvhlab_hardware_threads();
-	int r = bvhlab_rays_primary(cam, width, height, &rays);
+	m->traversals = rs->traversals;
+	m->main = rs->main;
+	int r = bvhlab_rays_primary(cam, rs->width, rs->height, &rays);
 	if (r < 0)
 		return r;
 	bvhlab_hit *hits = malloc(n * sizeof(*hits));
@@ -57,12 +110,11 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
 		r = -ENOMEM;
 		goto out;
 	}
-	r = bvhlab_trace_batch(tree, scene, rays, n, false, 0, hits, nodes, &m->primary,
-	                       &m->primary_s);
+	r = trace_kind(tree, scene, rays, n, rs, m->primary, hits, nodes, m);
 	if (r == 0 && shade)
 		image_shade(scene, rays, hits, n, shade);
 	if (r == 0)
-		r = trace_diffuse(tree, scene, rays, hits, n, diffuse, m);
+		r = trace_diffuse(tree, scene, rays, hits, n, rs, m);
 	m->measured = r == 0;
 out:
 	free(hits);

@@ -60,8 +60,10 @@ void progress_done(struct progress *p, const struct run_record *run)
 		fprintf(stderr, ", %.2f ms median, SAH %.3f", med, run->stats->sah_cost);
 	}
 	if (run->rays)
-		fprintf(stderr, ", %.1f nodes/ray", run->rays->primary.rays
-		        ? (double)run->rays->primary.nodes_visited / (double)run->rays->primary.rays : 0);
+		fprintf(stderr, ", %.1f nodes/ray", run->rays->primary[run->rays->main].stats.rays
+		        ? (double)run->rays->primary[run->rays->main].stats.nodes_visited /
+		                  (double)run->rays->primary[run->rays->main].stats.rays
+		        : 0);
 	if (run->error)
 		fprintf(stderr, " (%s)", run->error);
 	elapsed_and_left(p);

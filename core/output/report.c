@@ -110,6 +110,22 @@ static const char *const csv_numbers[][2] = {
 	{"rays.diffuse.mrays_per_s", "%.4f"},
 	{"rays.diffuse.nodes_per_ray", "%.4f"},
 	{"rays.diffuse.tris_per_ray", "%.4f"},
+	{"tree.epo", "%.6f"},
+	{"memory.peak_bytes", "%.0f"},
+	{"memory.peak_rss_bytes", "%.0f"},
+	{"memory.output_bytes", "%.0f"},
+	{"rays.threads", "%.0f"},
+	{"rays.primary.mrays_min", "%.4f"},
+	{"rays.primary.mrays_max", "%.4f"},
+	{"rays.primary.wall_mrays_per_s", "%.4f"},
+	{"rays.primary.repeats", "%.0f"},
+	{"rays.diffuse.mrays_min", "%.4f"},
+	{"rays.diffuse.mrays_max", "%.4f"},
+	{"rays.stackless.primary.mrays_per_s", "%.4f"},
+	{"rays.stackless.primary.nodes_per_ray", "%.4f"},
+	{"rays.stackless.diffuse.mrays_per_s", "%.4f"},
+	{"rays.stackless.diffuse.nodes_per_ray", "%.4f"},
+	{"rays.traversal_disagreements", "%.0f"},
 };
 
 static void csv_row(struct strbuf *sb, const cJSON *run)
@@ -164,6 +180,8 @@ static void md_run_row(struct strbuf *sb, const struct report_index *ix, const c
 	snprintf(buf, sizeof(buf), "%.2f", speedup);
 	md_cell(sb, isnan(speedup) ? "" : buf);
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.sah_cost", "%.3f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.epo", "%.3f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "memory.peak_bytes", "%.0f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.mrays_per_s", "%.2f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.nodes_per_ray", "%.1f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "rays.diffuse.mrays_per_s", "%.2f"));
@@ -197,10 +215,11 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cJS
 	if (*str(scene, "error"))
 		sb_printf(sb, ". **Could not be loaded:** %s", str(scene, "error"));
 	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | cold ms "
-	              "| Mtris/s | speedup | SAH cost | primary Mrays/s | primary nodes/ray "
-	              "| diffuse Mrays/s | diffuse nodes/ray | nodes | depth | avg leaf | error |\n"
+	              "| Mtris/s | speedup | SAH cost | EPO | peak bytes | primary Mrays/s "
+	              "| primary nodes/ray | diffuse Mrays/s | diffuse nodes/ray | nodes | depth "
+	              "| avg leaf | error |\n"
 	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
-	              "|---:|---:|---|\n");
+	              "|---:|---:|---:|---:|---|\n");
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
 	for (size_t k = 0; k < n; k++)
@@ -219,16 +238,21 @@ char *report_markdown(const cJSON *doc)
 	sb_printf(&sb, "# bvhlab report\n\nbvhlab %s, %s. Machine: %s, %s cores, %s available "
 	               "to this process.\n\n%d runs, %d ok. Times are build times in ms over "
 	               "the timed repeats; SAH cost with c_trav = c_isect = 1, normalised by "
-	               "the root's surface area. Speedup: over the same builder's 1-thread run. "
-	               "Rays (primary from the camera, diffuse bounces from their hits) are "
-	               "traced with every hardware thread for every run, whatever its build "
-	               "thread count, so traversal numbers compare trees.\n",
+	               "the root's surface area; EPO: end-point overlap, sampled. Peak bytes: "
+	               "what the builds added to the process's resident set at its peak. "
+	               "Speedup: over the same builder's 1-thread run. Rays (primary from the "
+	               "camera, diffuse bounces from their hits) are traced with the same "
+	               "threads for every run, whatever its build thread count, so traversal "
+	               "numbers compare trees; Mrays/s: rays per CPU second of the tracing "
+	               "threads times their number, each tile of rays at its best of the "
+	               "repeated passes.\n",
 	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);
 	struct report_index ix;
 	if (report_index_init(&ix, doc) < 0)
 		sb.failed = true;
+	report_summary_md(&sb, doc);
 	report_machines_md(&sb, doc);
 	report_thesis(&sb, doc, &ix);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))

@@ -75,4 +75,26 @@ void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const 
 void svg_lines(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                const struct svg_point *p, size_t n);
 
+/* ---- the summary across scenes (report_summary.c) ------------------------ */
+
+#define SUMMARY_METRICS 5 /* build time, SAH, EPO, primary and diffuse nodes/ray */
+
+/* One builder x thread count: geometric means over scenes of its figures
+ * relative to the reference builder's (NaN: no scene had both). */
+struct summary_row {
+	const char *builder; /* points into the document */
+	double threads;
+	int scenes;          /* scenes with ok runs of both */
+	double ratio[SUMMARY_METRICS];
+};
+
+/* The rows (malloc'd, in run order) and the reference builder's label;
+ * 0 rows (and *ref NULL) when the reference builder has no run. */
+int report_summary(const cJSON *doc, struct summary_row **rows, const char **ref);
+/* The column name of metric m. */
+const char *report_summary_metric(int m);
+/* The summary section of report.md / report.html. */
+void report_summary_md(struct strbuf *sb, const cJSON *doc);
+void report_summary_html(struct strbuf *sb, const cJSON *doc);
+
 #endif

@@ -19,7 +19,8 @@ static const char css[] =
 	"th{background:#f0f0f0}td.l,th.l{text-align:left}"
 	".bad{color:#b00}.charts,.images{display:flex;flex-wrap:wrap;gap:1em}"
 	"figure{margin:0}figcaption{font-size:12px;text-align:center}"
-	"img{image-rendering:pixelated;border:1px solid #ccc}";
+	"img{image-rendering:pixelated;border:1px solid #ccc}"
+	"table.summary td.good{background:#e3f4e3}table.summary td.worse{background:#fbe7e7}";
 
 static void esc(struct strbuf *sb, const char *s)
 {
@@ -35,7 +36,21 @@ static void num_cell(struct strbuf *sb, double v, const char *fmt)
 	sb_printf(sb, "</td>");
 }
 
-static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run)
+/* "min–max" of a ray kind's throughput over the passes. */
+static void range_cell(struct strbuf *sb, const cJSON *run, const char *kind)
+{
+	char lo[64], hi[64];
+	snprintf(lo, sizeof(lo), "%s.mrays_min", kind);
+	snprintf(hi, sizeof(hi), "%s.mrays_max", kind);
+	double a = report_num(run, lo), b = report_num(run, hi);
+	sb_printf(sb, "<td>");
+	if (isfinite(a) && isfinite(b))
+		sb_printf(sb, "%.2f–%.2f", a, b);
+	sb_printf(sb, "</td>");
+}
+
+static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
+                    bool stackless)
 {
 	bool ok = strcmp(report_str(run, "status"), "ok") == 0;
 	sb_printf(sb, "<tr><td class=\"l\">");
@@ -52,28 +67,52 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 	num_cell(sb, report_num(run, "mtris_per_s"), "%.2f");
 	num_cell(sb, report_speedup(ix, run), "%.2f");
 	num_cell(sb, report_num(run, "tree.sah_cost"), "%.3f");
+	num_cell(sb, report_num(run, "tree.epo"), "%.3f");
+	num_cell(sb, report_num(run, "memory.peak_bytes") / 1048576.0, "%.1f");
 	num_cell(sb, report_num(run, "rays.primary.mrays_per_s"), "%.2f");
+	range_cell(sb, run, "rays.primary");
 	num_cell(sb, report_num(run, "rays.primary.nodes_per_ray"), "%.1f");
 	num_cell(sb, report_num(run, "rays.primary.tris_per_ray"), "%.1f");
 	num_cell(sb, report_num(run, "rays.diffuse.mrays_per_s"), "%.2f");
 	num_cell(sb, report_num(run, "rays.diffuse.nodes_per_ray"), "%.1f");
+	if (stackless) {
+		num_cell(sb, report_num(run, "rays.stackless.primary.mrays_per_s"), "%.2f");
+		num_cell(sb, report_num(run, "rays.stackless.primary.nodes_per_ray"), "%.1f");
+		num_cell(sb, report_num(run, "rays.stackless.diffuse.mrays_per_s"), "%.2f");
+		num_cell(sb, report_num(run, "rays.traversal_disagreements"), "%.0f");
+	}
 	sb_printf(sb, "<td class=\"l\">");
 	esc(sb, report_str(run, "error"));
 	sb_printf(sb, "</td></tr>\n");
+}
+
+/* Whether some run of the scene was also traced stacklessly. */
+static bool has_stackless(const cJSON *const *runs, size_t n)
+{
+	for (size_t k = 0; k < n; k++)
+		if (report_at(runs[k], "rays.stackless"))
+			return true;
+	return false;
 }
 
 static void table(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
+	bool stackless = has_stackless(runs, n);
 	sb_printf(sb, "<table><tr><th class=\"l\">builder</th><th>threads</th>"
 	              "<th class=\"l\">status</th><th>median ms</th><th>min ms</th><th>max ms</th>"
 	              "<th>cold ms</th>"
-	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>primary Mrays/s</th>"
+	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>EPO</th>"
+	              "<th>peak MiB</th><th>primary Mrays/s</th><th>min–max</th>"
 	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s</th>"
-	              "<th>diffuse nodes/ray</th><th class=\"l\">error</th></tr>\n");
+	              "<th>diffuse nodes/ray</th>");
+	if (stackless)
+		sb_printf(sb, "<th>stackless primary Mrays/s</th><th>stackless primary nodes/ray</th>"
+		              "<th>stackless diffuse Mrays/s</th><th>hits differing</th>");
+	sb_printf(sb, "<th class=\"l\">error</th></tr>\n");
 	for (size_t k = 0; k < n; k++)
-		run_row(sb, ix, runs[k]);
+		run_row(sb, ix, runs[k], stackless);
 	sb_printf(sb, "</table>\n");
 }
 
@@ -197,9 +236,14 @@ char *report_html(const cJSON *doc)
 	esc(&sb, report_str(doc, "machine.cpu"));
 	sb_printf(&sb, ", %.0f cores. Build times in ms over the timed repeats; speedup over the "
 	               "same builder's 1-thread run; SAH cost with c_trav = c_isect = 1, "
-	               "normalised by the root's area. Rays are traced with every hardware "
-	               "thread for every run, so traversal numbers compare trees, not thread "
-	               "counts.</p>\n", report_num(doc, "machine.cores"));
+	               "normalised by the root's area; EPO: end-point overlap, sampled; peak "
+	               "MiB: what the builds added to the process's resident set at its peak. "
+	               "Rays are traced with the same threads for every run, so traversal "
+	               "numbers compare trees, not thread counts; Mrays/s: rays per CPU "
+	               "second of the tracing threads times their number, each tile of rays "
+	               "at its best of the repeated passes (min–max: whole passes).</p>\n",
+	          report_num(doc, "machine.cores"));
+	report_summary_html(&sb, doc);
 	report_machines_html(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		scene_section(&sb, &ix, scene);

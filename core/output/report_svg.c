@@ -3,14 +3,15 @@
  * so the report opens anywhere and the charts print.
  */
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "output/report.h"
 
-#define W 640
+#define W 720
 #define PAD_L 190
-#define PAD_R 60
+#define PAD_R 140
 #define PAD_T 28
 #define PAD_B 40
 #define BAR_H 18
@@ -56,77 +57,202 @@ void svg_bars(struct strbuf *sb, const char *title, const char *unit,
 	sb_printf(sb, "</svg>\n");
 }
 
+/* One axis: its range and whether it is logarithmic. */
+struct axis {
+	double lo, hi;
+	bool log;
+};
+
+/* Values spanning more than this factor get a log axis: a linear one
+ * would crush the small ones into the corner. */
+#define LOG_SPAN 20.0
+
 /* The range of the points' x or y, padded; never empty. */
-static void range(const struct svg_point *p, size_t n, bool y, double *lo, double *hi)
+static void range(const struct svg_point *p, size_t n, bool y, struct axis *a)
 {
-	*lo = INFINITY;
-	*hi = -INFINITY;
+	double lo = INFINITY, hi = -INFINITY;
 	for (size_t i = 0; i < n; i++) {
 		double v = y ? p[i].y : p[i].x;
 		if (isfinite(v)) {
-			*lo = v < *lo ? v : *lo;
-			*hi = v > *hi ? v : *hi;
+			lo = v < lo ? v : lo;
+			hi = v > hi ? v : hi;
 		}
 	}
-	if (!(*lo <= *hi))
-		*lo = 0, *hi = 1;
-	double pad = *hi > *lo ? 0.08 * (*hi - *lo) : (*hi != 0 ? 0.1 * fabs(*hi) : 1);
-	*lo -= pad;
-	*hi += pad;
+	if (!(lo <= hi))
+		lo = 0, hi = 1;
+	a->log = lo > 0 && hi / lo > LOG_SPAN;
+	if (a->log) {
+		a->lo = log10(lo) - 0.05 * (log10(hi) - log10(lo));
+		a->hi = log10(hi) + 0.05 * (log10(hi) - log10(lo));
+		return;
+	}
+	double pad = hi > lo ? 0.08 * (hi - lo) : (hi != 0 ? 0.1 * fabs(hi) : 1);
+	a->lo = lo - pad;
+	a->hi = hi + pad;
 }
 
 struct frame {
-	double x0, x1, y0, y1;
+	struct axis x, y;
 };
+
+/* Position along an axis in [0, 1]. */
+static double unit(const struct axis *a, double v)
+{
+	double t = a->log ? log10(v) : v;
+	return (t - a->lo) / (a->hi - a->lo);
+}
 
 static double px(const struct frame *f, double x)
 {
-	return 60 + (x - f->x0) / (f->x1 - f->x0) * (W - 60 - PAD_R);
+	return 60 + unit(&f->x, x) * (W - 60 - PAD_R);
 }
 
 static double py(const struct frame *f, double y)
 {
-	return PAD_T + PLOT_H - (y - f->y0) / (f->y1 - f->y0) * PLOT_H;
+	return PAD_T + PLOT_H - unit(&f->y, y) * PLOT_H;
+}
+
+/* A 1, 2 or 5 times a power of ten step giving 3 to 7 ticks, and the
+ * decimals that keep every tick label distinct at that step. */
+static double tick_step(double lo, double hi, int *decimals)
+{
+	double raw = (hi - lo) / 5, mag = pow(10, floor(log10(raw))), step = mag;
+	if (raw / mag > 5)
+		step = 10 * mag;
+	else if (raw / mag > 2)
+		step = 5 * mag;
+	else if (raw / mag > 1)
+		step = 2 * mag;
+	int d = -(int)floor(log10(step) + 1e-9);
+	*decimals = d > 0 ? d : 0;
+	return step;
+}
+
+/* Tick values of an axis, at most max; returns how many. */
+static int ticks(const struct axis *a, double *v, int *decimals, int max)
+{
+	int n = 0;
+	if (a->log) {
+		/* Powers of ten, with 2 and 5 between them when there are few. */
+		bool fine = a->hi - a->lo < 2.5;
+		for (double e = floor(a->lo); e <= ceil(a->hi) && n < max; e++) {
+			static const double mult[] = {1, 2, 5};
+			for (int m = 0; m < (fine ? 3 : 1) && n < max; m++) {
+				double t = mult[m] * pow(10, e);
+				if (log10(t) >= a->lo && log10(t) <= a->hi)
+					v[n++] = t;
+			}
+		}
+		*decimals = v[0] < 1 ? (int)ceil(-log10(v[0])) : 0;
+		return n;
+	}
+	double step = tick_step(a->lo, a->hi, decimals);
+	for (double t = ceil(a->lo / step) * step; t <= a->hi && n < max; t += step)
+		v[n++] = fabs(t) < step * 1e-9 ? 0 : t;
+	return n;
 }
 
 static void axes(struct strbuf *sb, const struct frame *f, const char *xname, const char *yname)
 {
 	char buf[64];
+	double v[16];
+	int d;
 	sb_printf(sb, "<rect x=\"60\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" "
 	              "stroke=\"#888\"/>", PAD_T, W - 60 - PAD_R, PLOT_H);
-	for (int k = 0; k <= 4; k++) {
-		double x = f->x0 + (f->x1 - f->x0) * k / 4, y = f->y0 + (f->y1 - f->y0) * k / 4;
-		snprintf(buf, sizeof(buf), "%.3g", x);
-		text_at(sb, px(f, x), PAD_T + PLOT_H + 14, "middle", buf);
-		snprintf(buf, sizeof(buf), "%.3g", y);
-		text_at(sb, 56, py(f, y) + 4, "end", buf);
+	int n = ticks(&f->x, v, &d, 16);
+	for (int k = 0; k < n; k++) {
+		snprintf(buf, sizeof(buf), "%.*f", d, v[k]);
+		text_at(sb, px(f, v[k]), PAD_T + PLOT_H + 14, "middle", buf);
 	}
-	text_at(sb, px(f, 0.5 * (f->x0 + f->x1)), PAD_T + PLOT_H + 32, "middle", xname);
-	text_at(sb, 62, PAD_T - 4, "start", yname);
+	n = ticks(&f->y, v, &d, 16);
+	for (int k = 0; k < n; k++) {
+		snprintf(buf, sizeof(buf), "%.*f", d, v[k]);
+		text_at(sb, 56, py(f, v[k]) + 4, "end", buf);
+	}
+	char name[160];
+	snprintf(name, sizeof(name), "%s%s", xname, f->x.log ? " (log scale)" : "");
+	text_at(sb, 60 + 0.5 * (W - 60 - PAD_R), PAD_T + PLOT_H + 32, "middle", name);
+	snprintf(name, sizeof(name), "%s%s", yname, f->y.log ? " (log scale)" : "");
+	text_at(sb, 62, PAD_T - 4, "start", name);
 }
 
 static void plot_frame(struct strbuf *sb, const char *title, const char *xname,
                        const char *yname, const struct svg_point *p, size_t n, struct frame *f)
 {
-	range(p, n, false, &f->x0, &f->x1);
-	range(p, n, true, &f->y0, &f->y1);
+	range(p, n, false, &f->x);
+	range(p, n, true, &f->y);
 	open_svg(sb, title, PAD_T + PLOT_H + PAD_B + 4);
 	axes(sb, f, xname, yname);
+}
+
+/* Text boxes already placed, to keep labels apart. */
+struct placed {
+	double x0, y0, x1, y1;
+};
+
+#define CHAR_W 6.2
+#define LINE_H 12.0
+
+static bool overlaps(const struct placed *a, const struct placed *b)
+{
+	return a->x0 < b->x1 && b->x0 < a->x1 && a->y0 < b->y1 && b->y0 < a->y1;
+}
+
+/* The first free slot for a label near (x, y): right of the point, moving
+ * down (then up) a line at a time; *moved when it is not the first slot. */
+static struct placed place(const struct placed *taken, size_t n, double x, double y,
+                           size_t len, bool *moved)
+{
+	for (int k = 0; k < 40; k++) {
+		int step = k % 2 ? (k + 1) / 2 : -(k / 2);
+		struct placed b = {x + 6, y - 4 - LINE_H + 2 + step * LINE_H, 0, 0};
+		b.x1 = b.x0 + CHAR_W * (double)len;
+		b.y1 = b.y0 + LINE_H;
+		bool free_slot = b.y0 >= PAD_T - 2 && b.y1 <= PAD_T + PLOT_H + 2;
+		for (size_t i = 0; i < n && free_slot; i++)
+			free_slot = !overlaps(&b, &taken[i]);
+		if (free_slot) {
+			*moved = k > 0;
+			return b;
+		}
+	}
+	*moved = false;
+	return (struct placed){x + 6, y - 16, x + 6 + CHAR_W * (double)len, y - 4};
 }
 
 void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                  const struct svg_point *p, size_t n)
 {
 	struct frame f;
+	struct placed taken[64];
+	size_t nt = 0;
 	plot_frame(sb, title, xname, yname, p, n, &f);
 	for (size_t i = 0; i < n; i++) {
 		if (!isfinite(p[i].x) || !isfinite(p[i].y))
 			continue;
-		sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>", px(&f, p[i].x),
-		          py(&f, p[i].y), palette[i % 8]);
-		text_at(sb, px(&f, p[i].x) + 6, py(&f, p[i].y) - 4, "start", p[i].label);
+		double x = px(&f, p[i].x), y = py(&f, p[i].y);
+		sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>", x, y,
+		          palette[i % 8]);
+		bool moved;
+		struct placed b = place(taken, nt, x, y, strlen(p[i].label), &moved);
+		if (nt < sizeof(taken) / sizeof(taken[0]))
+			taken[nt++] = b;
+		if (moved) /* a leader line ties a displaced label to its point */
+			sb_printf(sb, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" "
+			              "stroke=\"#999\" stroke-width=\"0.7\"/>",
+			          x, y, b.x0 - 1, b.y1 - 4);
+		text_at(sb, b.x0, b.y1 - 2, "start", p[i].label);
 	}
 	sb_printf(sb, "</svg>\n");
+}
+
+/* Whether group g has a point that can be drawn. */
+static bool drawable(const struct svg_point *p, size_t n, const char *g)
+{
+	for (size_t j = 0; j < n; j++)
+		if (strcmp(p[j].group, g) == 0 && isfinite(p[j].x) && isfinite(p[j].y))
+			return true;
+	return false;
 }
 
 void svg_lines(struct strbuf *sb, const char *title, const char *xname, const char *yname,
@@ -139,15 +265,22 @@ void svg_lines(struct strbuf *sb, const char *title, const char *xname, const ch
 		bool seen = false;
 		for (size_t j = 0; j < i && !seen; j++)
 			seen = strcmp(p[j].group, p[i].group) == 0;
-		if (seen)
-			continue;
+		if (seen || !drawable(p, n, p[i].group))
+			continue; /* the legend names only what is drawn */
 		const char *c = palette[color++ % 8];
 		sb_printf(sb, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\" points=\"", c);
 		for (size_t j = i; j < n; j++)
 			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y))
 				sb_printf(sb, "%.1f,%.1f ", px(&f, p[j].x), py(&f, p[j].y));
 		sb_printf(sb, "\"/>");
-		text_at(sb, W - PAD_R + 4, PAD_T + 12 * (double)color, "start", p[i].group);
+		/* Markers too: a series of one point draws no line. */
+		for (size_t j = i; j < n; j++)
+			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y))
+				sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>",
+				          px(&f, p[j].x), py(&f, p[j].y), c);
+		sb_printf(sb, "<rect x=\"%d\" y=\"%.1f\" width=\"8\" height=\"8\" fill=\"%s\"/>",
+		          W - PAD_R + 4, PAD_T + 12 * (double)color - 8, c);
+		text_at(sb, W - PAD_R + 15, PAD_T + 12 * (double)color, "start", p[i].group);
 	}
 	sb_printf(sb, "</svg>\n");
 }

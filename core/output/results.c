@@ -173,6 +173,16 @@ static cJSON *timing_json(const struct run_record *run)
 	return o;
 }
 
+static cJSON *memory_json(const struct build_memory *m)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddNumberToObject(o, "peak_bytes", (double)m->peak_bytes);
+	cJSON_AddNumberToObject(o, "peak_rss_bytes", (double)m->peak_rss_bytes);
+	cJSON_AddNumberToObject(o, "start_rss_bytes", (double)m->start_rss_bytes);
+	cJSON_AddNumberToObject(o, "output_bytes", (double)m->output_bytes);
+	return o;
+}
+
 static cJSON *tree_json(const bvhlab_tree_stats *st)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -220,6 +230,10 @@ int results_add_run(struct results *res, const struct run_record *run)
 	}
 	if (run->stats)
 		cJSON_AddItemToObject(o, "tree", tree_json(run->stats));
+	if (run->stats && run->epo)
+		cJSON_AddNumberToObject(cJSON_GetObjectItem(o, "tree"), "epo", *run->epo);
+	if (run->memory)
+		cJSON_AddItemToObject(o, "memory", memory_json(run->memory));
 	if (run->validated)
 		cJSON_AddItemToObject(o, "validation", validation_json(run));
 	if (run->rays)

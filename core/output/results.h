@@ -24,12 +24,26 @@ struct results {
 	char *dir;
 };
 
-/* Traversal counters of one run's primary and diffuse rays. */
+/* Traversal counters and timings of one run's primary and diffuse rays,
+ * by traversal (harness/harness_rays.c measures them). */
 struct ray_metrics {
 	bool measured;
-	uint32_t threads; /* the threads that traced them: all hardware threads */
-	bvhlab_trace_stats primary, diffuse;
-	double primary_s, diffuse_s;
+	uint32_t threads;      /* the threads that traced them */
+	unsigned traversals;   /* bit (1 << enum bvhlab_traversal) for each one measured */
+	int main;              /* the traversal "primary"/"diffuse" report */
+	bvhlab_trace_timing primary[2], diffuse[2]; /* by enum bvhlab_traversal */
+	uint64_t disagreements; /* rays whose hits differ between the two traversals */
+};
+
+/* Peak memory of one run's builds (harness/harness_memory.c measures it). */
+struct build_memory {
+	bool measured;            /* /proc/self/status was readable */
+	bool reset;               /* the high-water mark was reset before the builds */
+	uint64_t start_rss_bytes; /* resident set before the first build */
+	uint64_t peak_rss_bytes;  /* the process's peak resident set over the builds */
+	uint64_t peak_bytes;      /* peak_rss - start_rss: what the builds added at peak
+	                           * (0 when the mark could not be reset) */
+	uint64_t output_bytes;    /* the output buffers the host allocated, capacity */
 };
 
 /* Everything known about one run; fields beyond status are optional. */
@@ -47,6 +61,8 @@ struct run_record {
 	double cold_ms;        /* the first build, before any warm-up repeat */
 	uint32_t triangles;
 	const bvhlab_tree_stats *stats; /* or NULL */
+	const double *epo;     /* end-point overlap (bvhlab_tree_epo), or NULL */
+	const struct build_memory *memory; /* peak memory of the builds, or NULL */
 	bool validated;
 	bool valid;
 	uint64_t rays_checked, mismatches;

@@ -1,29 +1,52 @@
 /*
  * The "rays" member of a run: what the core's traverser measured on the
  * run's tree. Per-ray averages make runs with different ray counts
- * (resolutions, scenes with more misses) comparable.
+ * (resolutions, scenes with more misses) comparable. Throughput:
+ * mrays_per_s from each tile's best pass (see bvhlab_trace_timing), and the
+ * median, min and max over the passes beside it.
  */
 #include <cJSON.h>
 
 #include "output/results.h"
 
-static cJSON *kind_json(const bvhlab_trace_stats *st, double seconds)
+static cJSON *kind_json(const bvhlab_trace_timing *t)
 {
 	cJSON *o = cJSON_CreateObject();
+	const bvhlab_trace_stats *st = &t->stats;
 	double rays = (double)st->rays;
 	cJSON_AddNumberToObject(o, "rays", rays);
-	cJSON_AddNumberToObject(o, "mrays_per_s", seconds > 0 ? rays / seconds * 1e-6 : 0);
+	cJSON_AddNumberToObject(o, "mrays_per_s", t->mrays_best);
+	cJSON_AddNumberToObject(o, "mrays_median", t->mrays_median);
+	cJSON_AddNumberToObject(o, "mrays_min", t->mrays_min);
+	cJSON_AddNumberToObject(o, "mrays_max", t->mrays_max);
+	cJSON_AddNumberToObject(o, "wall_mrays_per_s", t->wall_mrays_median);
+	cJSON_AddNumberToObject(o, "repeats", t->repeats);
 	cJSON_AddNumberToObject(o, "nodes_per_ray", rays > 0 ? (double)st->nodes_visited / rays : 0);
 	cJSON_AddNumberToObject(o, "tris_per_ray", rays > 0 ? (double)st->tris_tested / rays : 0);
-	cJSON_AddNumberToObject(o, "seconds", seconds);
+	cJSON_AddNumberToObject(o, "seconds", t->seconds_total);
 	return o;
+}
+
+static void add_kinds(cJSON *o, const struct ray_metrics *m, int k)
+{
+	cJSON_AddItemToObject(o, "primary", kind_json(&m->primary[k]));
+	cJSON_AddItemToObject(o, "diffuse", kind_json(&m->diffuse[k]));
 }
 
 cJSON *results_rays_json(const struct ray_metrics *m)
 {
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddNumberToObject(o, "threads", m->threads);
-	cJSON_AddItemToObject(o, "primary", kind_json(&m->primary, m->primary_s));
-	cJSON_AddItemToObject(o, "diffuse", kind_json(&m->diffuse, m->diffuse_s));
+	cJSON_AddStringToObject(o, "traversal", bvhlab_traversal_name(m->main));
+	add_kinds(o, m, m->main);
+	for (int k = 0; k < 2; k++) {
+		if (k == m->main || !(m->traversals & (1u << k)))
+			continue;
+		cJSON *other = cJSON_CreateObject();
+		add_kinds(other, m, k);
+		cJSON_AddItemToObject(o, bvhlab_traversal_name(k), other);
+		/* Rays (primary and diffuse) whose hit differs between the two. */
+		cJSON_AddNumberToObject(o, "traversal_disagreements", (double)m->disagreements);
+	}
 	return o;
 }

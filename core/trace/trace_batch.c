@@ -8,42 +8,26 @@
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
+#include <time.h>
 
 #include <bvhlab/machine.h>
 #include <bvhlab/trace.h>
+#include <bvhlab/traversal.h>
 
 #include "util/util.h"
 
-/* Rays per tile: large enough that the counter is rarely touched, small
- * enough to balance 2 to 64 threads over 64k rays. */
-#define TILE 256
-
-struct batch {
-	const bvhlab_tree *tree;
-	const bvhlab_scene *scene;
-	const bvhlab_ray *rays;
-	size_t count;
-	bool any;
-	bvhlab_hit *hits;
-	uint32_t *nodes;
-	atomic_size_t next;
-};
-
-struct worker {
-	struct batch *b;
-	pthread_t thread;
-	bvhlab_trace_stats stats;
-};
+#include "trace/trace_batch.h"
+#include "trace/trace_kernel.h"
 
 static void trace_tile(struct batch *b, size_t begin, size_t end, bvhlab_trace_stats *st)
 {
 	for (size_t i = begin; i < end; i++) {
 		bvhlab_hit hit;
 		uint64_t before = st->nodes_visited;
-		if (b->any)
-			bvhlab_trace_any(b->tree, b->scene, &b->rays[i], &hit, st);
+		if (b->traversal == BVHLAB_TRAVERSAL_STACKLESS)
+			trace_ray_stackless(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
 		else
-			bvhlab_trace_closest(b->tree, b->scene, &b->rays[i], &hit, st);
+			trace_ray_stack(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
 		if (b->hits)
 			b->hits[i] = hit;
 		if (b->nodes)
@@ -51,22 +35,45 @@ static void trace_tile(struct batch *b, size_t begin, size_t end, bvhlab_trace_s
 	}
 }
 
+static double cpu_seconds(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 static void *work(void *arg)
 {
 	struct worker *w = arg;
 	struct batch *b = w->b;
+	double t0 = cpu_seconds();
 	for (;;) {
 		size_t begin = atomic_fetch_add_explicit(&b->next, TILE, memory_order_relaxed);
 		if (begin >= b->count)
 			break;
 		size_t end = b->count - begin < TILE ? b->count : begin + TILE;
+		double c0 = b->tile_cpu ? cpu_seconds() : 0;
 		trace_tile(b, begin, end, &w->stats);
+		/* Each tile is one thread's: no other thread writes this slot. */
+		if (b->tile_cpu)
+			b->tile_cpu[begin / TILE] = cpu_seconds() - c0;
 	}
+	w->cpu_s = cpu_seconds() - t0;
 	return NULL;
 }
 
+uint32_t trace_thread_count(uint32_t threads, size_t count)
+{
+	size_t tiles = (count + TILE - 1) / TILE;
+	if (threads == 0)
+		threads = bvhlab_hardware_threads();
+	if (threads > tiles)
+		threads = tiles ? (uint32_t)tiles : 1;
+	return threads;
+}
+
 /* Starts threads - 1 helpers and works on the calling thread too. */
-static void run_workers(struct batch *b, struct worker *w, uint32_t threads)
+void trace_run_workers(struct batch *b, struct worker *w, uint32_t threads)
 {
 	uint32_t started = 0;
 	for (uint32_t k = 1; k < threads; k++, started++) {
@@ -86,18 +93,15 @@ int bvhlab_trace_batch(const bvhlab_tree *tree, const bvhlab_scene *scene,
                        double *seconds)
 {
 	struct batch b = {.tree = tree, .scene = scene, .rays = rays, .count = count,
-	                  .any = any_hit, .hits = hits, .nodes = nodes};
+	                  .any = any_hit, .hits = hits, .nodes = nodes,
+	                  .view = trace_view_plain(tree)};
 	atomic_init(&b.next, 0);
-	if (threads == 0)
-		threads = bvhlab_hardware_threads();
-	size_t tiles = (count + TILE - 1) / TILE;
-	if (threads > tiles)
-		threads = tiles ? (uint32_t)tiles : 1;
+	threads = trace_thread_count(threads, count);
 	struct worker *w = calloc(threads, sizeof(*w));
 	if (!w)
 		return -ENOMEM;
 	double t0 = util_now();
-	run_workers(&b, w, threads);
+	trace_run_workers(&b, w, threads);
 	if (seconds)
 		*seconds = util_now() - t0;
 	for (uint32_t k = 0; stats && k < threads; k++) {

@@ -106,3 +106,46 @@ void util_summarise(const double *samples, uint32_t n, double *median, double *m
 	*max = n ? sorted[n - 1] : 0;
 	*median = n == 0 ? 0 : n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
 }
+
+char *util_path_normalise(const char *path)
+{
+	size_t len = strlen(path), n = 0, kept = 0;
+	char *out = malloc(len + 2);
+	bool abs = path[0] == '/';
+	if (!out)
+		return NULL;
+	if (abs)
+		out[n++] = '/';
+	for (const char *p = path; *p;) {
+		size_t c = strcspn(p, "/");
+		if (c == 2 && p[0] == '.' && p[1] == '.' && kept > 0) {
+			/* Drop the last kept component (and its slash). */
+			while (n > (abs ? 1u : 0u) && out[n - 1] != '/')
+				n--;
+			if (n > (abs ? 1u : 0u))
+				n--;
+			kept--;
+		} else if (!(c == 0 || (c == 1 && p[0] == '.') || (c == 2 && abs && n == 1 &&
+		                                                    p[0] == '.' && p[1] == '.'))) {
+			if (n > (abs ? 1u : 0u))
+				out[n++] = '/';
+			memcpy(out + n, p, c);
+			n += c;
+			/* A leading ".." of a relative path cannot be dropped later. */
+			kept += !(c == 2 && p[0] == '.' && p[1] == '.');
+		}
+		p += c + (p[c] == '/');
+	}
+	if (n == 0)
+		out[n++] = '.';
+	out[n] = '\0';
+	return out;
+}
+
+char *util_path_shown(const char *dir, const char *path)
+{
+	size_t n = strlen(dir);
+	if (path[0] != '/' && strncmp(path, dir, n) == 0 && path[n] == '/')
+		path += n + 1;
+	return util_path_normalise(path);
+}

@@ -42,6 +42,14 @@ static inline uint64_t util_splitmix64(uint64_t *state)
 	return z ^ (z >> 31);
 }
 
+/* The path with "." components and "dir/.." pairs removed, lexically
+ * (symbolic links are not looked at): "configs/../../shared/x.obj" becomes
+ * "../shared/x.obj". malloc'd, or NULL when out of memory. */
+char *util_path_normalise(const char *path);
+/* A path the config resolved against its folder dir, as the reports show
+ * it: relative to that folder again, normalised. malloc'd, or NULL. */
+char *util_path_shown(const char *dir, const char *path);
+
 /* Monotonic clock in seconds. */
 double util_now(void);
 

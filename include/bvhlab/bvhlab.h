@@ -10,6 +10,8 @@
  *   scene.h    triangle scenes: loading, generators, per-primitive data
  *   tree.h     the tree, validation, metrics, canonical compare
  *   trace.h    traversal, cameras and rays, batch tracing
+ *   traversal.h  the stackless traversal and timed batches (repeated passes)
+ *   epo.h      end-point overlap, the sampled tree metric beside SAH
  *   host.h     loading plugins, their options, running a build
  *   machine.h  what threads = 0 means, thread pinning
  * All are C11 and C++17 (extern "C").
@@ -19,10 +21,12 @@
 
 #include "aabb.h"
 #include "builder.h"
+#include "epo.h"
 #include "host.h"
 #include "machine.h"
 #include "scene.h"
 #include "trace.h"
+#include "traversal.h"
 #include "tree.h"
 #include "types.h"
 

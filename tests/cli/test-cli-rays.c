@@ -12,7 +12,8 @@
 
 static const char config[] =
 	"{ \"format_version\": 1, \"output\": \"out-rays\", \"repeat\": 1, \"threads\": [1, 2],\n"
-	"  \"images\": true, \"rays\": { \"width\": 40, \"height\": 30, \"diffuse\": 2 },\n"
+	"  \"images\": true, \"rays\": { \"width\": 40, \"height\": 30, \"diffuse\": 2,\n"
+	"    \"min_ms\": 1, \"traversal\": \"both\" },\n"
 	"  \"scenes\": [ { \"name\": \"ico<1>\", \"generator\": \"icosphere\", \"frequency\": 10 },\n"
 	"              { \"name\": \"terrain\", \"generator\": \"terrain\", \"size\": 16 } ],\n"
 	"  \"builders\": [ { \"plugin\": \"sah_seq\", \"name\": \"sweep\" },\n"
@@ -80,6 +81,29 @@ static void check_html(const char *dir)
 	free(html);
 }
 
+/* Every run: both traversals with the same hits, repeated passes, EPO and
+ * peak memory; the summary at the top of both reports. */
+static void check_measures(const cJSON *doc)
+{
+	const cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs")) {
+		const cJSON *rays = cJSON_GetObjectItem(run, "rays");
+		const cJSON *sl = cJSON_GetObjectItem(cJSON_GetObjectItem(rays, "stackless"), "primary");
+		const cJSON *st = cJSON_GetObjectItem(rays, "primary");
+		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(rays, "traversal_disagreements")) &&
+		      cJSON_GetObjectItem(rays, "traversal_disagreements")->valuedouble == 0);
+		CHECK(sl && cJSON_GetObjectItem(sl, "rays")->valueint == 40 * 30);
+		CHECK(cJSON_GetObjectItem(st, "repeats")->valueint >= 1);
+		CHECK(cJSON_GetObjectItem(st, "mrays_min")->valuedouble <=
+		      cJSON_GetObjectItem(st, "mrays_max")->valuedouble);
+		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(cJSON_GetObjectItem(run, "tree"), "epo")));
+		const cJSON *mem = cJSON_GetObjectItem(run, "memory");
+		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(mem, "peak_bytes")));
+		CHECK(cJSON_GetObjectItem(mem, "peak_rss_bytes")->valuedouble > 0);
+		CHECK(cJSON_GetObjectItem(mem, "output_bytes")->valuedouble > 0);
+	}
+}
+
 static void test_run(void)
 {
 	const char *cfg = write_config("rays.json", config);
@@ -95,6 +119,7 @@ static void test_run(void)
 	CHECK_INT(cJSON_GetObjectItem(prim, "rays")->valueint, 40 * 30);
 	CHECK(cJSON_GetObjectItem(cJSON_GetObjectItem(rays, "diffuse"), "rays")->valueint > 0);
 	CHECK_INT(count_runs(doc, "sweep", "ok"), 4);
+	check_measures(doc);
 	cJSON_Delete(doc);
 	check_image(dir, "images/ico_1_-382d5051.png", 40, 30);
 	check_image(dir, "images/ico_1_-382d5051--sweep--heat.png", 40, 30);
@@ -110,7 +135,16 @@ static void test_run(void)
 	check_html(regen);
 	char *md = read_file(regen, "report.md");
 	CHECK_CONTAINS(md, "primary Mrays/s");
+	/* No sah_seq-labelled builder: the reference falls back to the plugin's
+	 * first builder, sweep, which is 1.00x itself on every scene. */
+	CHECK_CONTAINS(md, "## Summary");
+	CHECK_CONTAINS(md, "reference builder **sweep**");
+	CHECK_CONTAINS(md, "| sweep | 1 | 2 | 1.00× | 1.00× |");
 	free(md);
+	char *html = read_file(regen, "report.html");
+	CHECK_CONTAINS(html, "<h2 id=\"summary\">Summary</h2>");
+	CHECK_CONTAINS(html, "stackless primary Mrays/s");
+	free(html);
 	CHECK_INT(run(ARGS("report", "/nonexistent/results.json")), 2);
 }
 

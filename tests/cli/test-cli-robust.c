@@ -55,6 +55,7 @@ static void plain_crashes(void)
 
 static const char misbehaving_config[] =
 	"{ \"output\": \"out-mis\", \"repeat\": 2, \"threads\": [1, 2],\n"
+	"  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64 },\n"
 	"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 300 } ],\n"
 	"  \"builders\": [\n"
 	"    { \"plugin\": \"fake_good\", \"name\": \"segv\", \"options\": { \"fail\": \"segfault\" } },\n"
@@ -113,6 +114,7 @@ static void test_in_process(void)
 {
 	const char *cfg = write_config("inproc.json",
 		"{ \"output\": \"out-inproc\", \"repeat\": 1, \"isolate\": false,\n"
+		"  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64 },\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
 		"    { \"plugin\": \"fake_good\", \"name\": \"bad\", \"options\": { \"fail\": \"invalid\" } },\n"
@@ -184,6 +186,7 @@ static void test_kill_and_resume(void)
 	snprintf(dir, sizeof(dir), "%s/out-kill", tmpdir);
 	snprintf(text, sizeof(text),
 	         "{ \"output\": \"out-kill\", \"repeat\": 3, \"threads\": [1, 2],\n"
+	         "  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64 },\n"
 	         "  \"scenes\": [ { \"name\": \"a\", \"generator\": \"soup\", \"count\": 200 },\n"
 	         "    { \"name\": \"b\", \"generator\": \"icosphere\", \"frequency\": 4 },\n"
 	         "    { \"name\": \"c\", \"generator\": \"soup\", \"count\": 300, \"seed\": 5 } ],\n"
@@ -241,6 +244,7 @@ static void test_resume_errors(void)
 {
 	const char *cfg = write_config("resume.json",
 		"{ \"output\": \"out-resume\", \"repeat\": 1,\n"
+		"  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64 },\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
 	char dir[512], path[600];

@@ -32,6 +32,7 @@ static void test_help(void)
 
 static const char good_config[] =
 	"{ \"format_version\": 1, \"output\": \"out-good\", \"repeat\": 2, \"warmup\": 1,\n"
+	"  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64 },\n"
 	"  \"threads\": [1, 2],\n"
 	"  \"scenes\": [ { \"name\": \"ico\", \"generator\": \"icosphere\", \"frequency\": 12 },\n"
 	"              { \"generator\": \"soup\", \"count\": 3000, \"seed\": 7 } ],\n"
@@ -101,6 +102,7 @@ static void test_pin(void)
 {
 	static const char fmt[] =
 		"{ \"output\": \"out-pin-%s\", \"repeat\": 1, \"pin\": %s, \"threads\": [2],\n"
+		"  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64 },\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 2000 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"%s/pin_probe.so\",\n"
 		"                  \"options\": { \"expect\": \"%s\" } } ] }\n";
@@ -169,7 +171,7 @@ static void test_config_errors(void)
 static void test_bad_builders(void)
 {
 	const char *cfg = write_config("bad.json",
-		"{ \"output\": \"out-bad\", \"repeat\": 1,\n"
+		"{ \"output\": \"out-bad\", \"repeat\": 1, \"rays\": { \"min_ms\": 1 },\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 500 },\n"
 		"              { \"name\": \"broken\", \"path\": \"missing.obj\" } ],\n"
 		"  \"builders\": [ { \"plugin\": \"no_such_plugin\" },\n"
@@ -209,6 +211,7 @@ static void test_shared_meshes(void)
 	char text[4096];
 	int n = snprintf(text, sizeof(text),
 	                 "{ \"output\": \"out-shared\", \"repeat\": 1, \"warmup\": 0,\n"
+	                 "  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64 },\n"
 	                 "  \"validate_rays\": 64, \"scenes\": [");
 	for (int k = 0; k < 5; k++)
 		n += snprintf(text + n, sizeof(text) - (size_t)n, "%s{ \"path\": \"%s/%s\" }",

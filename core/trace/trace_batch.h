@@ -1,0 +1,58 @@
+/*
+ * The batch tracer's internals, shared by bvhlab_trace_batch (one pass,
+ * trace_batch.c) and bvhlab_trace_measure (timed passes, trace_measure.c).
+ */
+#ifndef BVHLAB_CORE_TRACE_BATCH_H
+#define BVHLAB_CORE_TRACE_BATCH_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <bvhlab/trace.h>
+#include <bvhlab/tree.h>
+
+#include "trace/trace_kernel.h"
+
+/* Rays per tile: large enough that the counter is rarely touched, small
+ * enough to balance 2 to 64 threads over 64k rays. */
+#define TILE 256
+
+struct batch {
+	const bvhlab_tree *tree;
+	const bvhlab_scene *scene;
+	const bvhlab_ray *rays;
+	size_t count;
+	bool any;
+	int traversal;          /* enum bvhlab_traversal */
+	struct trace_view view; /* what the traversal reads */
+	double *tile_cpu;       /* [tiles] CPU seconds of each tile of a pass, or NULL */
+	bvhlab_hit *hits;
+	uint32_t *nodes;
+	atomic_size_t next;
+};
+
+struct worker {
+	struct batch *b;
+	pthread_t thread;
+	bvhlab_trace_stats stats;
+	double cpu_s; /* the thread's CPU time in the batch (CLOCK_THREAD_CPUTIME_ID) */
+};
+
+/* Tiles of a batch of `count` rays. */
+static inline size_t trace_tiles(size_t count)
+{
+	return (count + TILE - 1) / TILE;
+}
+
+/* Threads a batch of `count` rays gets: 0 means all hardware threads, and
+ * never more than there are tiles. */
+uint32_t trace_thread_count(uint32_t threads, size_t count);
+
+/* Traces the batch with w[0] on the calling thread and threads - 1 helpers;
+ * each worker's counters are added to its own stats. */
+void trace_run_workers(struct batch *b, struct worker *w, uint32_t threads);
+
+#endif

@@ -1,0 +1,171 @@
+/*
+ * The stackless traversal: down into the near child, back up through the
+ * parent links (Hapala, Davidovic, Wald, Havran and Slusallek, "Efficient
+ * Stack-less BVH Traversal for Ray Tracing", SCCG 2011). GPU ray tracers
+ * use it where a per-ray stack costs registers or local memory; here it is
+ * the second traversal the harness can measure trees with.
+ *
+ * Going down, the near child is tried first, then the far one. Coming up
+ * from a child, the walk knows where it was: from the near child it still
+ * has to try the far one, from the far child it goes on up. That needs the
+ * near/far decision to come out the same both times, so it depends only on
+ * the ray and the two child boxes (their centres along the ray direction),
+ * not on distances that shrink as hits are found.
+ */
+#include <errno.h>
+#include <stdlib.h>
+
+#include <bvhlab/traversal.h>
+
+#include "trace/trace_kernel.h"
+
+#define NONE UINT32_MAX
+
+int bvhlab_tree_parents(const bvhlab_tree *tree, uint32_t **parents)
+{
+	uint32_t n = tree->node_count;
+	uint32_t *par = malloc((n ? n : 1) * sizeof(*par));
+	*parents = NULL;
+	if (!par)
+		return -ENOMEM;
+	for (uint32_t i = 0; i < n; i++)
+		par[i] = NONE;
+	for (uint32_t i = 0; i < n; i++) {
+		const bvhlab_node *nd = &tree->nodes[i];
+		if (nd->count)
+			continue;
+		/* The root (0) is nobody's child; a child with a parent already is
+		 * shared or part of a cycle: either way not a tree. */
+		if (nd->first == 0 || nd->first >= n - 1 || par[nd->first] != NONE ||
+		    par[nd->first + 1] != NONE) {
+			free(par);
+			return -EINVAL;
+		}
+		par[nd->first] = i;
+		par[nd->first + 1] = i;
+	}
+	*parents = par;
+	return 0;
+}
+
+/* The near child of an inner node: the one whose box centre comes first
+ * along the ray (the first child on a tie). */
+static inline uint32_t near_child(const ray_prep *p, const bvhlab_node *nodes, uint32_t first)
+{
+	const bvhlab_node *a = &nodes[first], *b = &nodes[first + 1];
+	float d = 0.0f;
+	for (int k = 0; k < 3; k++)
+		d += ((b->lo[k] + b->hi[k]) - (a->lo[k] + a->hi[k])) * p->dir[k];
+	return d < 0.0f ? first + 1 : first;
+}
+
+struct walk {
+	const bvhlab_tree *tree;
+	const bvhlab_node *node_array;
+	const uint32_t *parents;
+	const bvhlab_scene *scene;
+	const float *tris;
+	const ray_prep *p;
+	bvhlab_hit *hit;
+	uint64_t nodes, tests;
+	bool any;
+};
+
+/* Tests a leaf's triangles; true when an any-hit walk may stop. */
+static bool leaf(struct walk *w, const bvhlab_node *n)
+{
+	const bvhlab_tree *tree = w->tree;
+	if (n->first > tree->index_count || n->count > tree->index_count - n->first)
+		return false;
+	for (uint32_t i = n->first; i < n->first + n->count; i++) {
+		if (tree->prim_index[i] >= w->scene->triangle_count)
+			continue;
+		w->tests++;
+		if (isect_slot(w->p, tree, w->scene, w->tris, i, w->hit) && w->any)
+			return true;
+	}
+	return false;
+}
+
+static inline bool enters(const struct walk *w, uint32_t node)
+{
+	return box_enter(w->p, &w->node_array[node], w->hit->t) != INFINITY;
+}
+
+/* From a node whose subtree is done, up to the next far child to enter;
+ * false when the walk is back at the root. */
+static bool climb(struct walk *w, uint32_t *node)
+{
+	uint32_t at = *node;
+	while (at != 0) {
+		uint32_t parent = w->parents[at], first = w->node_array[parent].first;
+		uint32_t near = near_child(w->p, w->node_array, first);
+		uint32_t far = near == first ? first + 1 : first;
+		if (at == near && enters(w, far)) {
+			*node = far;
+			return true;
+		}
+		at = parent;
+	}
+	return false;
+}
+
+static void walk(struct walk *w)
+{
+	const bvhlab_node *nodes = w->node_array;
+	uint32_t node = 0;
+	if (!enters(w, 0))
+		return;
+	for (;;) {
+		const bvhlab_node *n = &nodes[node];
+		/* Each node is entered at most once on a tree; more means the
+		 * links are not one, and stopping keeps a bad tree from hanging. */
+		if (++w->nodes > w->tree->node_count)
+			return;
+		if (n->count == 0) {
+			uint32_t near = near_child(w->p, nodes, n->first);
+			uint32_t far = near == n->first ? n->first + 1 : n->first;
+			if (enters(w, near)) {
+				node = near;
+				continue;
+			}
+			if (enters(w, far)) {
+				node = far;
+				continue;
+			}
+		} else if (leaf(w, n)) {
+			return;
+		}
+		if (!climb(w, &node))
+			return;
+	}
+}
+
+void trace_ray_stackless(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                         const struct trace_view *view, const bvhlab_ray *ray, bool any_hit,
+                         bvhlab_hit *hit, bvhlab_trace_stats *stats)
+{
+	ray_prep p;
+	struct walk w = {tree, view->nodes, view->parents, scene, view->tris, &p, hit, 0, 0,
+	                 any_hit};
+	hit->t = ray->tmax;
+	hit->u = hit->v = 0.0f;
+	hit->prim = BVHLAB_NO_HIT;
+	if (prep_ray(ray, &p) && tree->node_count > 0)
+		walk(&w);
+	if (stats) {
+		stats->rays++;
+		stats->nodes_visited += w.nodes;
+		stats->tris_tested += w.tests;
+	}
+}
+
+bool bvhlab_trace_stackless(const bvhlab_tree *tree, const uint32_t *parents,
+                            const bvhlab_scene *scene, const bvhlab_ray *ray, bool any_hit,
+                            bvhlab_hit *hit, bvhlab_trace_stats *stats)
+{
+	struct trace_view v = trace_view_plain(tree);
+	v.parents = parents;
+	trace_ray_stackless(tree, scene, &v, ray, any_hit, hit, stats);
+	return hit->prim != BVHLAB_NO_HIT;
+}

@@ -1,0 +1,270 @@
+/*
+ * The stackless traversal against the stack traversal and brute force:
+ * the same closest hit (triangle, and t, u, v bit for bit) on hand-made
+ * trees with shared edges, coincident triangles (ties) and a deep chain,
+ * and on every shared mesh with trees of two builders. The timed batch
+ * tracer: exact counters of one pass, its repeats and its errors.
+ */
+#include <errno.h>
+#include <math.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <bvhlab/bvhlab.h>
+#include <bvhlab/rays.h>
+#include <bvhlab/traversal.h>
+
+#include "testutil.h"
+#define FIXTURE_SEED 17 /* scene_fixture.h's generators are not used here */
+#include "scene_fixture.h"
+#include "tree_fixture.h"
+
+static bool same_hit(const bvhlab_hit *a, const bvhlab_hit *b)
+{
+	return a->prim == b->prim && memcmp(a, b, sizeof(*a)) == 0;
+}
+
+/* Rays from above a z = 0 grid, through cell corners, edges and insides. */
+static bvhlab_ray grid_ray(uint64_t *seed, float size)
+{
+	bvhlab_ray r = {.tmin = 0, .tmax = INFINITY};
+	float quant = (float)(fx_rand(seed) % 4) * 0.5f; /* 0, .5, 1, 1.5: on edges */
+	r.org[0] = (float)(fx_rand(seed) % (uint64_t)size) + (fx_rand(seed) % 2 ? quant : fx_unit(seed));
+	r.org[1] = (float)(fx_rand(seed) % (uint64_t)size) + (fx_rand(seed) % 2 ? quant : fx_unit(seed));
+	r.org[2] = 3.0f;
+	r.dir[0] = fx_rand(seed) % 2 ? 0.0f : fx_unit(seed) - 0.5f;
+	r.dir[1] = fx_rand(seed) % 2 ? 0.0f : fx_unit(seed) - 0.5f;
+	r.dir[2] = -1.0f;
+	return r;
+}
+
+/* Every traversal and brute force agree on ray r over f's tree. */
+static int agree(const fixture *f, const uint32_t *parents, const bvhlab_ray *r)
+{
+	bvhlab_hit a, b, c, d;
+	bvhlab_trace_closest(&f->tree, &f->scene, r, &a, NULL);
+	bvhlab_trace_stackless(&f->tree, parents, &f->scene, r, false, &b, NULL);
+	bvhlab_trace_brute(&f->scene, r, &c);
+	bool any = bvhlab_trace_stackless(&f->tree, parents, &f->scene, r, true, &d, NULL);
+	return same_hit(&a, &b) && same_hit(&a, &c) && any == (a.prim != BVHLAB_NO_HIT);
+}
+
+static void check_tree(fixture *f, uint64_t seed, float size, int rays, const char *what)
+{
+	uint32_t *parents = NULL;
+	int bad = 0;
+	CHECK_INT(bvhlab_tree_parents(&f->tree, &parents), 0);
+	if (!parents)
+		return;
+	CHECK(parents[0] == UINT32_MAX);
+	for (int i = 0; i < rays; i++) {
+		bvhlab_ray r = grid_ray(&seed, size);
+		bad += !agree(f, parents, &r);
+	}
+	if (bad)
+		fprintf(stderr, "%s: %d of %d rays disagree\n", what, bad, rays);
+	CHECK_INT(bad, 0);
+	free(parents);
+}
+
+/* A grid with shared edges (rays through edges and corners tie between
+ * neighbours), leaves of 1 and 4, and the same trees with nodes and
+ * leaves shuffled: the visiting order changes, the hits must not. */
+static void test_grid(void)
+{
+	for (uint32_t leaf = 1; leaf <= 4; leaf += 3) {
+		fixture f;
+		bvhlab_tree shuffled;
+		fixture_grid(&f, 12, 9, 0.0f);
+		fixture_build(&f, leaf);
+		check_tree(&f, 11 + leaf, 9, 4000, "grid");
+		tree_permute(&shuffled, &f.tree, 5 + leaf, NULL);
+		bvhlab_tree_finish(&f.tree);
+		f.tree = shuffled;
+		check_tree(&f, 17 + leaf, 9, 4000, "shuffled grid");
+		fixture_free(&f);
+	}
+}
+
+/* Two copies of every triangle: each ray hits both at the same t, and the
+ * smaller id must win whatever order the leaves are visited in. */
+static void test_ties(void)
+{
+	fixture f, g;
+	bvhlab_tree shuffled;
+	fixture_grid(&g, 4, 4, 0.1f);
+	fixture_alloc(&f, 2 * g.scene.vertex_count, 2 * g.scene.triangle_count);
+	for (uint32_t c = 0; c < 2; c++) {
+		memcpy(f.scene.vertices + c * 3 * g.scene.vertex_count, g.scene.vertices,
+		       3 * sizeof(float) * g.scene.vertex_count);
+		for (uint32_t i = 0; i < 3 * g.scene.triangle_count; i++)
+			f.scene.indices[c * 3 * g.scene.triangle_count + i] =
+				g.scene.indices[i] + c * g.scene.vertex_count;
+	}
+	fixture_prepare(&f);
+	fixture_build(&f, 1);
+	tree_permute(&shuffled, &f.tree, 3, NULL);
+	bvhlab_tree_finish(&f.tree);
+	f.tree = shuffled;
+	check_tree(&f, 23, 4, 2000, "coincident triangles");
+	bvhlab_ray r = {{0.3f, 0.3f, 2.0f}, 0, {0, 0, -1}, INFINITY};
+	bvhlab_hit h;
+	bvhlab_trace_closest(&f.tree, &f.scene, &r, &h, NULL);
+	CHECK(h.prim < g.scene.triangle_count); /* the first copy */
+	fixture_free(&f);
+	fixture_free(&g);
+}
+
+/* A chain 3000 deep: no stack at all, so no stack limit either. */
+static void test_chain(void)
+{
+	fixture f;
+	uint32_t *parents = NULL;
+	fixture_chain(&f, 3000);
+	CHECK_INT(bvhlab_tree_parents(&f.tree, &parents), 0);
+	bvhlab_ray down = {{0, 0, 5000}, 0, {0, 0, -1}, INFINITY};
+	bvhlab_ray up = {{0, 0, -5}, 0, {0, 0, 1}, INFINITY};
+	bvhlab_hit h;
+	bvhlab_trace_stats st = {0};
+	bvhlab_trace_stackless(&f.tree, parents, &f.scene, &down, false, &h, &st);
+	CHECK(h.prim == 2999 && h.t == 2001.0f);
+	/* Near first: the chain's box is nearer than each level's leaf all the
+	 * way down, and once the top triangle is hit every leaf below is culled
+	 * on the way back up. */
+	CHECK_INT(st.tris_tested, 1);
+	CHECK_INT(st.nodes_visited, 3000);
+	bvhlab_trace_stackless(&f.tree, parents, &f.scene, &up, false, &h, NULL);
+	CHECK(h.prim == 0 && h.t == 5.0f);
+	free(parents);
+	/* Links that are not a tree: a child shared by two parents. */
+	f.tree.nodes[2].first = 1;
+	CHECK_INT(bvhlab_tree_parents(&f.tree, &parents), -EINVAL);
+	CHECK(parents == NULL);
+	fixture_free(&f);
+}
+
+/* One pass's counters are the per-ray traversal's; passes repeat. */
+static void test_measure(void)
+{
+	fixture f;
+	enum { N = 3000 };
+	bvhlab_ray rays[N];
+	bvhlab_hit hits[N], h;
+	uint32_t nodes[N];
+	uint64_t seed = 99;
+	bvhlab_trace_stats ref = {0};
+	fixture_grid(&f, 20, 20, 0.05f);
+	fixture_build(&f, 2);
+	for (int i = 0; i < N; i++)
+		rays[i] = grid_ray(&seed, 20);
+	for (int t = 0; t < 2; t++) {
+		bvhlab_trace_options o = {.traversal = t, .threads = 2, .min_repeats = 4, .min_ms = 20};
+		bvhlab_trace_timing tm;
+		CHECK_INT(bvhlab_trace_measure(&f.tree, &f.scene, rays, N, &o, hits, nodes, &tm), 0);
+		CHECK(tm.repeats >= 4 && tm.stats.rays == N);
+		CHECK(tm.mrays_min <= tm.mrays_median && tm.mrays_median <= tm.mrays_max);
+		/* The tiles' best times are disjoint parts of every pass's CPU time,
+		 * so their sum is at most the fastest pass's. */
+		CHECK(tm.mrays_best >= tm.mrays_max * (1 - 1e-9));
+		CHECK(tm.wall_mrays_min <= tm.wall_mrays_median && tm.mrays_median > 0);
+		uint64_t node_sum = 0;
+		bvhlab_trace_stats st = {0};
+		for (int i = 0; i < N; i++) {
+			bvhlab_trace_closest(&f.tree, &f.scene, &rays[i], &h, t == 0 ? &st : NULL);
+			CHECK(same_hit(&h, &hits[i]));
+			node_sum += nodes[i];
+		}
+		CHECK_INT(node_sum, tm.stats.nodes_visited);
+		if (t == 0) {
+			ref = st;
+			CHECK_INT(tm.stats.nodes_visited, ref.nodes_visited);
+			CHECK_INT(tm.stats.tris_tested, ref.tris_tested);
+		}
+	}
+	bvhlab_trace_options bad = {.traversal = 7};
+	bvhlab_trace_timing tm;
+	CHECK_INT(bvhlab_trace_measure(&f.tree, &f.scene, rays, N, &bad, NULL, NULL, &tm), -EINVAL);
+	CHECK(bvhlab_traversal_name(0) && !strcmp(bvhlab_traversal_name(1), "stackless"));
+	fixture_free(&f);
+}
+
+/* Stack and stackless on a builder's tree of a shared mesh: primary and
+ * diffuse rays, hits compared bit for bit. */
+static void shared_mesh(const char *file, const char *plugin)
+{
+	bvhlab_scene *s = load_shared(file);
+	bvhlab_plugin *p = NULL;
+	bvhlab_options opts = {0};
+	bvhlab_prims prims = {0};
+	bvhlab_tree tree = {0};
+	bvhlab_error err = {{0}};
+	bvhlab_camera cam;
+	bvhlab_ray *rays = NULL, *diffuse = NULL;
+	uint32_t side = SCALE(160, 48);
+	size_t n = (size_t)side * side, nd = 0, differ = 0;
+	bvhlab_hit *a = calloc(n * 2, sizeof(*a)), *b = calloc(n * 2, sizeof(*b));
+	if (!s || !a || !b || bvhlab_prims_init(&prims, s, &err) < 0 ||
+	    bvhlab_plugin_open(plugin, &p, &err) < 0 ||
+	    bvhlab_options_init(&opts, bvhlab_plugin_builder(p)) < 0 ||
+	    bvhlab_build(p, &opts, &prims.input, 1, &tree, &err) < 0) {
+		fprintf(stderr, "%s, %s: %s\n", file, plugin, err.message);
+		CHECK(0);
+		goto out;
+	}
+	bvhlab_camera_frame(&s->bounds, &cam);
+	CHECK_INT(bvhlab_rays_primary(&cam, side, side, &rays), 0);
+	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_STACK, .threads = 2};
+	bvhlab_trace_timing tm;
+	CHECK_INT(bvhlab_trace_measure(&tree, s, rays, n, &o, a, NULL, &tm), 0);
+	CHECK_INT(bvhlab_rays_diffuse(s, rays, a, n, 1, 5, &diffuse, &nd), 0);
+	CHECK(nd > 0 && nd <= n);
+	if (nd)
+		CHECK_INT(bvhlab_trace_measure(&tree, s, diffuse, nd, &o, a + n, NULL, &tm), 0);
+	o.traversal = BVHLAB_TRAVERSAL_STACKLESS;
+	CHECK_INT(bvhlab_trace_measure(&tree, s, rays, n, &o, b, NULL, &tm), 0);
+	if (nd)
+		CHECK_INT(bvhlab_trace_measure(&tree, s, diffuse, nd, &o, b + n, NULL, &tm), 0);
+	for (size_t i = 0; i < n; i++)
+		differ += !same_hit(&a[i], &b[i]);
+	for (size_t i = 0; i < nd; i++)
+		differ += !same_hit(&a[n + i], &b[n + i]);
+	printf("%s, %s: %zu primary and %zu diffuse rays, %zu differ\n", file, plugin, n, nd,
+	       differ);
+	CHECK_INT(differ, 0);
+out:
+	free(rays);
+	free(diffuse);
+	free(a);
+	free(b);
+	bvhlab_tree_finish(&tree);
+	if (opts.values)
+		bvhlab_options_finish(&opts);
+	bvhlab_plugin_close(p);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(s);
+}
+
+static void test_shared_meshes(void)
+{
+	static const char *const files[] = {"stanford-bunny.obj", "ogre.obj", "nefertiti.obj",
+	                                    "horse.ply", "igea.ply"};
+	struct stat st;
+	if (stat(BVHLAB_SHARED_SCENES, &st) != 0) {
+		printf("no shared scenes at %s: that part skipped\n", BVHLAB_SHARED_SCENES);
+		return;
+	}
+	for (size_t i = 0; i < sizeof(files) / sizeof(files[0]); i++) {
+		shared_mesh(files[i], "sah_seq");
+		shared_mesh(files[i], "lbvh");
+	}
+}
+
+int main(void)
+{
+	test_grid();
+	test_ties();
+	test_chain();
+	test_measure();
+	test_shared_meshes();
+	return test_finish();
+}
