@@ -15,9 +15,12 @@
 #define MAX_SUBDIVIDE 15
 
 static const char *const scene_keys[] = {
-	"name", "path", "generator", "frequency", "count", "size", "seed", "subdivide", NULL,
+	"name", "path", "generator", "parts", "frequency", "count", "size", "seed", "width",
+	"subdivide", NULL,
 };
-static const char *const generator_keys[] = { "frequency", "count", "size", "seed", NULL };
+static const char *const generator_keys[] = {
+	"frequency", "count", "size", "seed", "width", NULL,
+};
 static const char *const builder_keys[] = {
 	"plugin", "name", "threads", "timeout_s", "memory_limit_mb", "options", NULL,
 };
@@ -72,7 +75,7 @@ static int unique_names(const struct config *cfg, const cJSON *array, const char
 
 /* ---- scenes ------------------------------------------------------------------ */
 
-static int scene_source(struct config *cfg, const cJSON *obj, const char *prefix,
+int config_scene_source(struct config *cfg, const cJSON *obj, const char *prefix,
                         struct config_scene *sc, bvhlab_error *err)
 {
 	int rc = config_get_string(cfg, obj, "path", prefix, &sc->path, err);
@@ -98,7 +101,7 @@ static int scene_source(struct config *cfg, const cJSON *obj, const char *prefix
 	return 0;
 }
 
-static int scene_params(struct config *cfg, const cJSON *obj, const char *prefix,
+int config_scene_params(struct config *cfg, const cJSON *obj, const char *prefix,
                         struct config_scene *sc, bvhlab_error *err)
 {
 	bvhlab_gen_params *gen = &sc->gen;
@@ -110,6 +113,8 @@ static int scene_params(struct config *cfg, const cJSON *obj, const char *prefix
 		rc = config_get_u32(cfg, obj, "size", prefix, 1, UINT32_MAX, &gen->size, err);
 	if (!rc)
 		rc = config_get_uint(cfg, obj, "seed", prefix, 0, UINT64_MAX, &gen->seed, err);
+	if (!rc)
+		rc = config_get_positive(cfg, obj, "width", prefix, &gen->width, err);
 	if (!rc)
 		rc = config_get_u32(cfg, obj, "subdivide", prefix, 0, MAX_SUBDIVIDE, &subdivide, err);
 	sc->subdivide = subdivide;
@@ -123,7 +128,9 @@ static int scene_name_and_path(struct config *cfg, const cJSON *obj, const char 
 	if (rc)
 		return rc;
 	if (!sc->name) {
-		sc->name = sc->path ? config_stem(sc->path) : strdup(sc->generator);
+		sc->name = sc->path        ? config_stem(sc->path)
+		           : sc->generator ? strdup(sc->generator)
+		                           : strdup("composite");
 		if (!sc->name)
 			return out_of_memory(cfg, err);
 	}
@@ -149,11 +156,13 @@ static int parse_scene(struct config *cfg, const cJSON *obj, size_t index,
 		                    index, config_describe(cfg, obj, got, sizeof(got)));
 	json_locate_value(cfg->locations, obj, &sc->line, &sc->column);
 	bvhlab_gen_params_init(&sc->gen);
+	const cJSON *parts = config_member(obj, "parts");
 	int rc = config_check_keys(cfg, obj, scene_keys, where, err);
 	if (!rc)
-		rc = scene_source(cfg, obj, prefix, sc, err);
+		rc = parts ? config_parse_parts(cfg, obj, prefix, sc, err)
+		           : config_scene_source(cfg, obj, prefix, sc, err);
 	if (!rc)
-		rc = scene_params(cfg, obj, prefix, sc, err);
+		rc = config_scene_params(cfg, obj, prefix, sc, err);
 	if (!rc)
 		rc = scene_name_and_path(cfg, obj, prefix, sc, err);
 	return rc;

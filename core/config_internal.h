@@ -77,6 +77,15 @@ char *config_stem(const char *path);
 /* "rays": {"camera": {position, target, up, fov}}; absent: automatic framing. */
 int config_parse_camera(struct config *cfg, const cJSON *rays, bvhlab_error *err);
 int config_parse_scenes(struct config *cfg, bvhlab_error *err);
+/* A scene's (or a part's) "path"/"generator" and generator parameters. */
+int config_scene_source(struct config *cfg, const cJSON *obj, const char *prefix,
+                        struct config_scene *sc, bvhlab_error *err);
+int config_scene_params(struct config *cfg, const cJSON *obj, const char *prefix,
+                        struct config_scene *sc, bvhlab_error *err);
+/* "parts" of the composite scene obj (config_parts.c); freed in config_finish. */
+int config_parse_parts(struct config *cfg, const cJSON *obj, const char *prefix,
+                       struct config_scene *sc, bvhlab_error *err);
+void config_parts_free(struct config_scene *sc);
 int config_parse_builders(struct config *cfg, bvhlab_error *err);
 
 #endif /* BVHLAB_CORE_CONFIG_INTERNAL_H */
