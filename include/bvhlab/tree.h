@@ -36,7 +36,12 @@ void bvhlab_tree_finish(bvhlab_tree *tree);
  * no empty leaf, leaf ranges inside index_count, every prim_index slot used by
  * exactly one leaf, every primitive referenced exactly once (at least once
  * when allow_duplicates, for spatial-split builders), every node's box
- * containing its children's boxes or its primitives' boxes.
+ * containing its children's boxes, and every leaf's box its primitives'
+ * boxes. With allow_duplicates (spatial splits) a leaf's box may hold only
+ * the part of a triangle inside it: then every reference's box must overlap
+ * its triangle and the triangle clipped to its references' leaf boxes must
+ * cover the whole triangle (uncovered area at most 1e-5 of it, boxes
+ * widened by a few float ulps for rounding).
  * 0, or -EINVAL with the first problem found in err (node index included).
  */
 int bvhlab_validate_tree(const bvhlab_tree *tree, const bvhlab_build_input *input,
