@@ -116,6 +116,8 @@ static const char *const csv_numbers[][2] = {
 	{"tree.max_depth", "%.0f"},
 	{"tree.avg_leaf_size", "%.4f"},
 	{"tree.sah_cost", "%.6f"},
+	{"tree.refs", "%.0f"},
+	{"tree.dup_ratio", "%.4f"},
 	{"tree.memory_bytes", "%.0f"},
 	{"validation.rays_checked", "%.0f"},
 	{"validation.mismatches", "%.0f"},
@@ -185,6 +187,8 @@ static void md_run_row(struct strbuf *sb, const cJSON *doc, const cJSON *run)
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.nodes", "%.0f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.max_depth", "%.0f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.avg_leaf_size", "%.2f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.refs", "%.0f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.dup_ratio", "%.3f"));
 	md_cell(sb, str(run, "error"));
 	sb_printf(sb, "\n");
 }
@@ -212,9 +216,10 @@ static void md_scene(struct strbuf *sb, const cJSON *doc, const cJSON *scene)
 		sb_printf(sb, ". **Could not be loaded:** %s", str(scene, "error"));
 	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | Mtris/s "
 	              "| speedup | SAH cost | primary Mrays/s | primary nodes/ray "
-	              "| diffuse Mrays/s | diffuse nodes/ray | nodes | depth | avg leaf | error |\n"
+	              "| diffuse Mrays/s | diffuse nodes/ray | nodes | depth | avg leaf | refs "
+	              "| refs/tri | error |\n"
 	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
-	              "|---:|---|\n");
+	              "|---:|---:|---:|---|\n");
 	const cJSON *run;
 	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
 		if (strcmp(str(run, "scene"), name) == 0)

@@ -57,6 +57,8 @@ static void run_row(struct strbuf *sb, const cJSON *runs, const cJSON *run)
 	num_cell(sb, report_num(run, "rays.primary.tris_per_ray"), "%.1f");
 	num_cell(sb, report_num(run, "rays.diffuse.mrays_per_s"), "%.2f");
 	num_cell(sb, report_num(run, "rays.diffuse.nodes_per_ray"), "%.1f");
+	num_cell(sb, report_num(run, "tree.refs"), "%.0f");
+	num_cell(sb, report_num(run, "tree.dup_ratio"), "%.3f");
 	sb_printf(sb, "<td class=\"l\">");
 	esc(sb, report_str(run, "error"));
 	sb_printf(sb, "</td></tr>\n");
@@ -69,7 +71,8 @@ static void table(struct strbuf *sb, const cJSON *runs, const char *scene)
 	              "<th class=\"l\">status</th><th>median ms</th><th>min ms</th><th>max ms</th>"
 	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>primary Mrays/s</th>"
 	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s</th>"
-	              "<th>diffuse nodes/ray</th><th class=\"l\">error</th></tr>\n");
+	              "<th>diffuse nodes/ray</th><th>refs</th><th>refs/tri</th>"
+	              "<th class=\"l\">error</th></tr>\n");
 	cJSON_ArrayForEach(run, runs)
 		if (strcmp(report_str(run, "scene"), scene) == 0)
 			run_row(sb, runs, run);

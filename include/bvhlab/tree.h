@@ -72,6 +72,8 @@ typedef struct bvhlab_tree_stats {
 	uint32_t leaves;
 	uint32_t max_depth;      /* root has depth 0 */
 	double avg_leaf_size;    /* primitive references per leaf */
+	uint64_t refs;           /* primitive references in all leaves: the primitive
+	                          * count, more with spatial splits' duplicates */
 	double sah_cost;
 	uint64_t memory_bytes;
 	uint32_t leaf_histogram[BVHLAB_LEAF_HISTOGRAM]; /* [k] leaves of size k + 1 */
