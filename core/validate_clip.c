@@ -27,7 +27,7 @@
 #include "validate_clip.h"
 
 #define MAX_VERTS 16   /* a triangle clipped by 6 planes has at most 9 */
-#define MAX_PIECES 512 /* uncovered pieces kept per triangle */
+#define MAX_PIECES (1 << 18) /* uncovered pieces kept per triangle */
 #define PAD_ULPS 0x1p-20 /* 8 float ulps of a coordinate's magnitude */
 #define PAD_EXTENT 1e-6
 #define AREA_TOLERANCE 1e-5
@@ -37,9 +37,10 @@ typedef struct poly {
 	double v[MAX_VERTS][3];
 } poly;
 
+/* The uncovered pieces before and after one box's subtraction. */
 typedef struct cover {
-	poly pieces[2][MAX_PIECES];
-	int count[2];
+	poly *pieces[2];
+	int count[2], cap;
 } cover;
 
 /* The part of p with sign * (x[axis] - at) >= 0 (Sutherland-Hodgman). */
@@ -110,25 +111,65 @@ static void clip_box(const poly *p, const double lo[3], const double hi[3], poly
 	*out = *cur;
 }
 
+static bool disjoint(const poly *p, const double lo[3], const double hi[3])
+{
+	for (int k = 0; k < 3; k++) {
+		bool below = true, above = true;
+		for (int i = 0; i < p->n; i++) {
+			below = below && p->v[i][k] < lo[k];
+			above = above && p->v[i][k] > hi[k];
+		}
+		if (below || above)
+			return true;
+	}
+	return false;
+}
+
+/* Room for one more piece in c->pieces[to]; false past MAX_PIECES or
+ * out of memory. */
+static bool room(cover *c, int to)
+{
+	if (c->count[to] < c->cap)
+		return true;
+	int cap = c->cap ? 2 * c->cap : 64;
+	if (cap > MAX_PIECES)
+		return false;
+	for (int s = 0; s < 2; s++) {
+		poly *grown = realloc(c->pieces[s], (size_t)cap * sizeof(poly));
+		if (!grown)
+			return false;
+		c->pieces[s] = grown;
+	}
+	c->cap = cap;
+	return true;
+}
+
 /*
- * p minus the box, as up to 6 convex pieces appended to `to`: what lies
- * below lo[0], then what lies above hi[0] of the rest, and so on. Pieces
- * of no area are dropped. False when `to` is full.
+ * p minus the box, as up to 6 convex pieces appended to c->pieces[to]:
+ * what lies below lo[0], then what lies above hi[0] of the rest, and so
+ * on. Pieces of no area are dropped; a piece the box misses is kept whole.
+ * False when the pieces outgrow MAX_PIECES or memory.
  */
-static bool subtract(const poly *p, const double lo[3], const double hi[3], poly *to,
-                     int *count, double min_area)
+static bool subtract(const poly *p, const double lo[3], const double hi[3], cover *c, int to,
+                     double min_area)
 {
 	poly rest = *p, next, out;
 
+	if (disjoint(p, lo, hi)) {
+		if (!room(c, to))
+			return false;
+		c->pieces[to][c->count[to]++] = *p;
+		return true;
+	}
 	for (int k = 0; k < 3 && rest.n > 0; k++) {
 		for (int side = 0; side < 2; side++) {
 			double at = side ? hi[k] : lo[k], sign = side ? 1.0 : -1.0;
 
 			clip(&rest, k, at, sign, &out);
 			if (out.n >= 3 && area(&out) > min_area) {
-				if (*count == MAX_PIECES)
+				if (!room(c, to))
 					return false;
-				to[(*count)++] = out;
+				c->pieces[to][c->count[to]++] = out;
 			}
 			clip(&rest, k, at, -sign, &next);
 			rest = next;
@@ -188,6 +229,9 @@ static int check_prim(const bvhlab_tree *t, const bvhlab_build_input *in, const 
 	full = area(&tri);
 	if (!(full > 0.0))
 		return check_degenerate(t, &tri, leaves, count, prim, err);
+	c->count[0] = c->count[1] = 0;
+	if (!room(c, 0))
+		return FAIL(err, "out of memory checking primitive %" PRIu32, prim);
 	c->pieces[0][0] = tri;
 	c->count[0] = 1;
 	for (uint32_t i = 0; i < count; i++) {
@@ -202,8 +246,7 @@ static int check_prim(const bvhlab_tree *t, const bvhlab_build_input *in, const 
 		}
 		c->count[!cur] = 0;
 		for (int j = 0; j < c->count[cur]; j++)
-			if (!subtract(&c->pieces[cur][j], lo, hi, c->pieces[!cur], &c->count[!cur],
-			              1e-3 * AREA_TOLERANCE * full))
+			if (!subtract(&c->pieces[cur][j], lo, hi, c, !cur, 1e-3 * AREA_TOLERANCE * full))
 				return FAIL(err, "primitive %" PRIu32 ": its %" PRIu32 " references "
 				            "leave it in more than %d pieces", prim, count, MAX_PIECES);
 		cur = !cur;
@@ -244,7 +287,7 @@ int validate_coverage(const bvhlab_tree *tree, const bvhlab_build_input *input,
 {
 	refs r = { malloc(((size_t)input->prim_count + 1) * sizeof(uint32_t)),
 	           malloc(((size_t)tree->index_count + 1) * sizeof(uint32_t)) };
-	cover *c = malloc(sizeof(*c));
+	cover *c = calloc(1, sizeof(*c));
 	int rc = 0;
 
 	if (!r.offset || !r.leaf || !c) {
@@ -260,6 +303,10 @@ int validate_coverage(const bvhlab_tree *tree, const bvhlab_build_input *input,
 out:
 	free(r.offset);
 	free(r.leaf);
+	if (c) {
+		free(c->pieces[0]);
+		free(c->pieces[1]);
+	}
 	free(c);
 	return rc;
 }

@@ -34,11 +34,16 @@ static const bvhlab_option_decl options[] = {
 	  .help = "object and spatial bins per axis",
 	  .def_int = 32, .min = 2, .max = SBVH_MAX_BINS },
 	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,
-	  .help = "most references in a leaf", .def_int = 8, .min = 1, .max = 64 },
+	  .help = "most references in a leaf", .def_int = 8, .min = 1, .max = SBVH_MAX_LEAF },
 	{ .name = "parallel_min", .type = BVHLAB_OPTION_INT,
 	  .help = "nodes of at least this many references are split by all threads "
 	          "together; smaller ones are built as one-thread tasks",
 	  .def_int = 32768, .min = 2, .max = UINT32_MAX },
+	{ .name = "presplit", .type = BVHLAB_OPTION_FLOAT,
+	  .help = "share of the budget's room spent before the build cutting the references "
+	          "with the largest boxes in two (early split clipping); the rest is left "
+	          "to spatial splits",
+	  .def_float = 0.0, .min = 0.0, .max = 1.0 },
 };
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
@@ -51,7 +56,8 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, sbvh_opt
 	    (rc = host->option_float(ctx, "alpha", &o->alpha)) < 0 ||
 	    (rc = host->option_int(ctx, "bins", &bins)) < 0 ||
 	    (rc = host->option_int(ctx, "max_leaf", &max_leaf)) < 0 ||
-	    (rc = host->option_int(ctx, "parallel_min", &parallel_min)) < 0) {
+	    (rc = host->option_int(ctx, "parallel_min", &parallel_min)) < 0 ||
+	    (rc = host->option_float(ctx, "presplit", &o->presplit)) < 0) {
 		host->set_error(ctx, "cannot read the options (%d)", rc);
 		return rc;
 	}
@@ -81,24 +87,31 @@ static int reserve(const bvhlab_host *host, bvhlab_build_ctx *ctx, bvhlab_build_
 	return 0;
 }
 
-/* Every triangle one reference with its whole box; the root job over them. */
-static void init_root(sbvh_build *B, sbvh_job *root)
+/* Every triangle one reference with its whole box. */
+static void init_refs(sbvh_build *B)
 {
 	const bvhlab_build_input *in = B->in;
 
-	*root = (sbvh_job){ .end = in->prim_count, .rend = B->capacity };
+	for (uint32_t i = 0; i < in->prim_count; i++) {
+		sbvh_ref *r = &B->refs[0][i];
+		*r = (sbvh_ref){ .prim = i };
+		memcpy(r->lo, in->prim_bounds[i].lo, sizeof(r->lo));
+		memcpy(r->hi, in->prim_bounds[i].hi, sizeof(r->hi));
+	}
+}
+
+/* The root job over refs[0][0 .. count). */
+static void init_root(const sbvh_build *B, uint32_t count, sbvh_job *root)
+{
+	*root = (sbvh_job){ .end = count, .rend = B->capacity };
 	for (int k = 0; k < 3; k++) {
 		root->lo[k] = root->clo[k] = INFINITY;
 		root->hi[k] = root->chi[k] = -INFINITY;
 	}
-	for (uint32_t i = 0; i < in->prim_count; i++) {
-		sbvh_ref *r = &B->refs[0][i];
-		*r = (sbvh_ref){ .prim = i };
+	for (uint32_t i = 0; i < count; i++) {
+		const sbvh_ref *r = &B->refs[0][i];
 		for (int k = 0; k < 3; k++) {
-			float c;
-			r->lo[k] = in->prim_bounds[i].lo[k];
-			r->hi[k] = in->prim_bounds[i].hi[k];
-			c = 0.5f * (r->lo[k] + r->hi[k]);
+			float c = 0.5f * (r->lo[k] + r->hi[k]);
 			root->lo[k] = r->lo[k] < root->lo[k] ? r->lo[k] : root->lo[k];
 			root->hi[k] = r->hi[k] > root->hi[k] ? r->hi[k] : root->hi[k];
 			root->clo[k] = c < root->clo[k] ? c : root->clo[k];
@@ -141,7 +154,17 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		rc = -ENOMEM;
 		goto out;
 	}
-	init_root(&B, &root);
+	init_refs(&B);
+	uint32_t count = input->prim_count;
+	if (B.opt.presplit > 0.0) {
+		uint32_t room = B.capacity - count;
+		rc = sbvh_presplit(&B, count, count + (uint32_t)(B.opt.presplit * room), &count);
+		if (rc < 0) {
+			host->set_error(ctx, "out of memory pre-splitting");
+			goto out;
+		}
+	}
+	init_root(&B, count, &root);
 	B.root_area = box_area(root.lo, root.hi);
 	atomic_init(&B.next_node, 1);
 	atomic_init(&B.next_slot, 0);

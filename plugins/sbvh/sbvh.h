@@ -32,6 +32,7 @@
 #include <bvhlab/builder.h>
 
 #define SBVH_MAX_BINS 64
+#define SBVH_MAX_LEAF 64 /* max_leaf's upper bound */
 
 /* A reference: 32 bytes. */
 typedef struct sbvh_ref {
@@ -47,6 +48,7 @@ typedef struct sbvh_options {
 	uint32_t bins;       /* object and spatial bins per axis */
 	uint32_t max_leaf;
 	uint32_t parallel_min; /* jobs of at least this many references use every thread */
+	double presplit;     /* share of the budget's room spent on pre-splitting */
 } sbvh_options;
 
 /* A node to build: its references and region (see the top). */
@@ -149,6 +151,15 @@ void sbvh_make_children(sbvh_build *B, const sbvh_job *job, uint32_t nl, uint32_
                         sbvh_job *left, sbvh_job *right);
 /* Builds the whole subtree of job on the calling thread. 0 or -ENOMEM. */
 int sbvh_build_subtree(sbvh_build *B, const sbvh_job *job, sbvh_bins *scratch);
+
+/* ---- sbvh_presplit.c ------------------------------------------------------ */
+
+/*
+ * Cuts the references refs[0][0 .. count) with the largest boxes in two
+ * until there are `target` (or none can be cut); *out_count gets the new
+ * count. One thread. 0 or -ENOMEM.
+ */
+int sbvh_presplit(const sbvh_build *B, uint32_t count, uint32_t target, uint32_t *out_count);
 
 /* ---- sbvh_par.c: the top nodes with every thread, then tasks --------------- */
 

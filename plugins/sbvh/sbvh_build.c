@@ -53,15 +53,23 @@ void sbvh_choose_final(const sbvh_build *B, const sbvh_job *job, sbvh_split *bes
 		best->kind = SPLIT_MEDIAN;
 }
 
+/* Pieces of one triangle that meet in a leaf become one reference there:
+ * the leaf's box already covers them all, and a ray tests it once. */
 void sbvh_write_leaf(sbvh_build *B, const sbvh_job *job)
 {
-	uint32_t n = job->end - job->begin;
-	uint32_t slot = atomic_fetch_add_explicit(&B->next_slot, n, memory_order_relaxed);
 	const sbvh_ref *refs = B->refs[job->buf];
+	uint32_t prims[SBVH_MAX_LEAF], n = 0;
 	bvhlab_node *node = &B->out->nodes[job->node];
 
-	for (uint32_t i = 0; i < n; i++)
-		B->out->prim_index[slot + i] = refs[job->begin + i].prim;
+	for (uint32_t i = job->begin; i < job->end; i++) {
+		uint32_t j = 0;
+		while (j < n && prims[j] != refs[i].prim)
+			j++;
+		if (j == n)
+			prims[n++] = refs[i].prim;
+	}
+	uint32_t slot = atomic_fetch_add_explicit(&B->next_slot, n, memory_order_relaxed);
+	memcpy(&B->out->prim_index[slot], prims, n * sizeof(uint32_t));
 	memcpy(node->lo, job->lo, sizeof(node->lo));
 	memcpy(node->hi, job->hi, sizeof(node->hi));
 	node->first = slot;

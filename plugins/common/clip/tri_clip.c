@@ -85,6 +85,22 @@ void tri_poly_bounds(const tri_poly *p, const bvhlab_aabb *within, bvhlab_aabb *
 	}
 }
 
+double tri_poly_area(const tri_poly *p)
+{
+	double s[3] = { 0.0, 0.0, 0.0 };
+
+	for (int i = 1; i + 1 < p->n; i++) {
+		const double *a = p->v[0], *b = p->v[i], *c = p->v[i + 1];
+		double e[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+		double f[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+
+		s[0] += e[1] * f[2] - e[2] * f[1];
+		s[1] += e[2] * f[0] - e[0] * f[2];
+		s[2] += e[0] * f[1] - e[1] * f[0];
+	}
+	return 0.5 * sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+}
+
 void tri_clip_split(const float *vertices, const uint32_t *tri, const bvhlab_aabb *box,
                     int axis, float pos, bvhlab_aabb *left, bvhlab_aabb *right)
 {

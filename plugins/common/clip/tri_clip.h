@@ -36,6 +36,9 @@ void tri_poly_split(const tri_poly *p, int axis, double pos, tri_poly *left,
  * empty polygon gives an empty box (lo = +inf, hi = -inf). */
 void tri_poly_bounds(const tri_poly *p, const bvhlab_aabb *within, bvhlab_aabb *out);
 
+/* Area of p (one side). */
+double tri_poly_area(const tri_poly *p);
+
 /*
  * The boxes of the part of triangle `tri` inside `box` on either side of
  * the plane x[axis] = pos (each within box; empty when that side has
