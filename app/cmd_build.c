@@ -4,7 +4,8 @@
 #include <stdlib.h>
 
 #include "cli.h"
-#include "harness.h"
+#include "harness/harness.h"
+#include "util/util.h"
 
 #define MAX_OPTIONS 64
 
@@ -112,7 +113,7 @@ static int build_and_check(bvhlab_plugin *p, const bvhlab_options *opts,
 		goto out;
 	}
 	double med, mn, mx;
-	harness_summarise(samples, s.repeat, &med, &mn, &mx);
+	util_summarise(samples, s.repeat, &med, &mn, &mx);
 	printf("builder:    %s, %u thread(s)\nscene:      %s, %u triangles\n"
 	       "build:      %.3f ms median (min %.3f, max %.3f, %u timed), %.2f Mtris/s\n",
 	       bvhlab_plugin_builder(p)->name, s.threads ? s.threads : bvhlab_hardware_threads(),

@@ -7,9 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <bvhlab/plugin.h>
+#include <bvhlab/host.h>
 
-#include "config.h"
+#include "config/config.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

@@ -8,8 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "config.h"
-#include "harness.h"
+#include "config/config.h"
+#include "harness/harness.h"
 #include "testutil.h"
 
 #define BUILDERS "\"builders\": [ { \"plugin\": \"sah_seq\" } ]"

@@ -11,8 +11,11 @@
  *
  *     const bvhlab_builder *bvhlab_plugin_entry(uint32_t host_abi_major);
  *
- * (declare it with BVHLAB_PLUGIN_ENTRY). It returns a static descriptor owned
- * by the plugin, or NULL when it cannot serve that ABI major. The host refuses
+ * (BVHLAB_PLUGIN(...) writes the descriptor and the entry point; or write
+ * BVHLAB_PLUGIN_EXPORT(descriptor) after a descriptor of your own, or declare
+ * the function with BVHLAB_PLUGIN_ENTRY). It returns a static descriptor owned by the
+ * plugin, or NULL when it cannot serve that ABI major. C++ plugins include
+ * this header as it is: its declarations are extern "C". The host refuses
  * a descriptor of another major and never reads past its struct_size; a
  * plugin built against an older minor therefore keeps working.
  *
@@ -29,6 +32,8 @@
 #include <stdint.h>
 
 #include "types.h"
+
+BVHLAB_BEGIN_DECLS
 
 #define BVHLAB_ABI_MAJOR 1
 #define BVHLAB_ABI_MINOR 1
@@ -49,9 +54,45 @@ typedef const struct bvhlab_builder *(*bvhlab_plugin_entry_fn)(uint32_t host_abi
 #define BVHLAB_PRINTF(fmt, args)
 #endif
 
+/* The entry point's linkage: C names in a C++ plugin too, so dlsym finds it. */
+#ifdef __cplusplus
+#define BVHLAB_ENTRY_LINKAGE extern "C"
+#else
+#define BVHLAB_ENTRY_LINKAGE
+#endif
+
 /* Use as: BVHLAB_PLUGIN_ENTRY { return host_abi_major == 1 ? &desc : NULL; } */
-#define BVHLAB_PLUGIN_ENTRY \
-	BVHLAB_EXPORT const struct bvhlab_builder *bvhlab_plugin_entry(uint32_t host_abi_major)
+#define BVHLAB_PLUGIN_ENTRY                              \
+	BVHLAB_ENTRY_LINKAGE BVHLAB_EXPORT const struct bvhlab_builder * \
+	bvhlab_plugin_entry(uint32_t host_abi_major)
+
+/*
+ * The whole entry point of a plugin with one descriptor, at file scope after
+ * it: BVHLAB_PLUGIN_EXPORT(descriptor). Serves this header's ABI major only
+ * and returns NULL for any other, which the host reports by name.
+ */
+#define BVHLAB_PLUGIN_EXPORT(descriptor)                                      \
+	BVHLAB_PLUGIN_ENTRY                                                   \
+	{                                                                     \
+		return host_abi_major == BVHLAB_ABI_MAJOR ? &(descriptor) : NULL; \
+	}
+
+/*
+ * A C plugin's descriptor and entry point in one, at file scope, from the
+ * descriptor's designated fields; abi_version and struct_size are filled in
+ * (the ones a hand-written descriptor most easily gets wrong):
+ *
+ *     BVHLAB_PLUGIN(.name = "mine", .summary = "...", .flags = 0,
+ *                   .option_count = 1, .options = options, .build = build)
+ *
+ * C++17 has no designated initializers: C++ plugins write the descriptor
+ * and BVHLAB_PLUGIN_EXPORT(descriptor) (examples/plugin-template-cpp/).
+ */
+#define BVHLAB_PLUGIN(...)                                                       \
+	static const bvhlab_builder bvhlab_plugin_descriptor = {                 \
+		.abi_version = BVHLAB_ABI_CURRENT, .struct_size = sizeof(bvhlab_builder), \
+		__VA_ARGS__};                                                    \
+	BVHLAB_PLUGIN_EXPORT(bvhlab_plugin_descriptor)
 
 /* ---- options -------------------------------------------------------- */
 
@@ -216,5 +257,7 @@ typedef struct bvhlab_builder {
 	int (*build)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	             const bvhlab_build_input *input, bvhlab_build_output *output);
 } bvhlab_builder;
+
+BVHLAB_END_DECLS
 
 #endif /* BVHLAB_BUILDER_H */

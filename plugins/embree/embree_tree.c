@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
+
 #include "embree_internal.h"
 #include "tri_clip.h"
 
@@ -62,17 +64,6 @@ static void *create_leaf(RTCThreadLocalAllocator alloc, const struct RTCBuildPri
 		l->hi[2] = p->upper_z > l->hi[2] ? p->upper_z : l->hi[2];
 	}
 	return l;
-}
-
-/* Not fminf/fmaxf: without -ffinite-math-only those are calls into libm. */
-static inline float min(float a, float b)
-{
-	return a < b ? a : b;
-}
-
-static inline float max(float a, float b)
-{
-	return a > b ? a : b;
 }
 
 /*
@@ -203,26 +194,20 @@ static int write_nodes(writer *w, const tnode *root)
 	return rc;
 }
 
-static void unite(bvhlab_node *n, const float *lo, const float *hi)
-{
-	for (int k = 0; k < 3; k++) {
-		n->lo[k] = min(n->lo[k], lo[k]);
-		n->hi[k] = max(n->hi[k], hi[k]);
-	}
-}
-
 /* Inner boxes bottom-up (leaf boxes are written with the leaves); a
  * reverse scan, since children follow their parents. */
 static void compute_boxes(bvhlab_build_output *o)
 {
 	for (uint32_t i = o->node_count; i-- > 0;) {
 		bvhlab_node *n = &o->nodes[i];
+		bvhlab_aabb box;
 		if (n->count != 0)
 			continue;
-		for (int k = 0; k < 3; k++)
-			n->lo[k] = INFINITY, n->hi[k] = -INFINITY;
-		unite(n, o->nodes[n->first].lo, o->nodes[n->first].hi);
-		unite(n, o->nodes[n->first + 1].lo, o->nodes[n->first + 1].hi);
+		bvhlab_aabb_empty(&box);
+		bvhlab_aabb_grow_corners(&box, o->nodes[n->first].lo, o->nodes[n->first].hi);
+		bvhlab_aabb_grow_corners(&box, o->nodes[n->first + 1].lo, o->nodes[n->first + 1].hi);
+		memcpy(n->lo, box.lo, sizeof(n->lo));
+		memcpy(n->hi, box.hi, sizeof(n->hi));
 	}
 }
 

@@ -1,0 +1,107 @@
+/*
+ * Experiment configs (private to the core and the bvhlab command).
+ *
+ * A config is plain JSON (README.md, "Experiment configs"; every key is
+ * declared once, in config_keys.c). Loading checks
+ * the syntax and every key and type; errors read
+ *   FILE:LINE:COLUMN: message naming the key
+ * Builder options are checked later, against the plugin's declarations,
+ * by config_apply_options, with the same FILE:LINE:COLUMN prefix.
+ */
+#ifndef BVHLAB_CORE_CONFIG_H
+#define BVHLAB_CORE_CONFIG_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <bvhlab/host.h>
+#include <bvhlab/trace.h>
+#include <bvhlab/scene.h>
+
+struct cJSON;
+struct json_locations;
+
+struct config_part;
+
+struct config_scene {
+	char *name;        /* "name", default: file stem, generator name or "composite" */
+	char *path;        /* "path" resolved against the config's folder, or NULL */
+	char *generator;   /* "generator", or NULL; exactly one of path/generator/parts */
+	bvhlab_gen_params gen; /* "frequency", "count", "size", "seed", "width" */
+	uint32_t subdivide; /* "subdivide", default 0 */
+	int line, column;  /* where the scene's object starts */
+	struct config_part *parts; /* "parts" of a composite scene, or NULL */
+	size_t part_count;
+};
+
+/* One entry of a composite scene's "parts": a mesh or generator (src, whose
+ * name is unused) placed by "scale", "rotate" (degrees) and "translate". */
+struct config_part {
+	struct config_scene src;
+	bvhlab_transform xf;
+};
+
+struct config_builder {
+	char *plugin;      /* "plugin": a name on the search path or a path to a .so */
+	char *name;        /* "name", default: plugin */
+	uint32_t *threads; /* "threads" override, or NULL for the config's list */
+	size_t thread_count;
+	double timeout_s;  /* "timeout_s" override, or 0 for the config's */
+	uint64_t memory_limit_mb; /* "memory_limit_mb" override, or 0 for the config's */
+	const struct cJSON *options; /* "options" object (may be NULL), owned by root */
+	int line, column;  /* where the builder's object starts */
+};
+
+struct config {
+	char *path;        /* the file as given */
+	char *dir;         /* its folder: relative paths resolve against it */
+	char *text;        /* file contents */
+	struct cJSON *root;
+	struct json_locations *locations;
+
+	int format_version; /* "format_version", must be 1 */
+	char *output;      /* "output" resolved against dir; default "results" */
+	uint32_t repeat;   /* "repeat", default 5, >= 1 */
+	uint32_t warmup;   /* "warmup", default 1 */
+	uint32_t *threads; /* "threads", default [1]; 0 = all hardware threads */
+	size_t thread_count;
+	bool validate;     /* "validate", default true */
+	uint32_t validate_rays; /* "validate_rays", default 256 */
+	uint32_t ray_width, ray_height, ray_diffuse; /* "rays": width/height/diffuse,
+	                                              * default 256, 256, 1 */
+	bool has_camera;   /* "rays": {"camera": ...} given; else framed per scene */
+	bvhlab_camera camera;
+	bool images;       /* "images", default false */
+	bool isolate;      /* "isolate", default true: each run's builds in a child process */
+	bool pin;          /* "pin", default false: host->pin_thread binds builder threads
+	                    * to distinct physical cores */
+	double timeout_s;  /* "timeout_s", default 600: an isolated run is killed after it */
+	uint64_t memory_limit_mb; /* "memory_limit_mb", default 0 = none: the child's RLIMIT_AS */
+
+	struct config_scene *scenes;
+	size_t scene_count;
+	struct config_builder *builders;
+	size_t builder_count;
+};
+
+/* Reads and checks a config file. On error err holds FILE:LINE:COLUMN: ... */
+int config_load(struct config *cfg, const char *path, bvhlab_error *err);
+
+/* Same, from text already in memory; `path` is used for messages and dir. */
+int config_parse(struct config *cfg, const char *path, const char *text, bvhlab_error *err);
+
+void config_finish(struct config *cfg);
+
+/*
+ * Applies a builder's "options" to opts (initialised from the plugin's
+ * declarations). Unknown keys, wrong types and bad values are errors with
+ * FILE:LINE:COLUMN of the offending key and the builder's name.
+ */
+int config_apply_options(const struct config *cfg, const struct config_builder *b,
+                         bvhlab_options *opts, bvhlab_error *err);
+
+/* Replaces the thread list (command line --threads). */
+int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count);
+
+#endif /* BVHLAB_CORE_CONFIG_H */

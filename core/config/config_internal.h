@@ -1,0 +1,138 @@
+/*
+ * Helpers shared by config.c, config_keys.c, config_check.c and
+ * config_entries.c. Every
+ * error is -EINVAL (or -ENOMEM) with err->message starting FILE:LINE:COL.
+ * `prefix` arguments name the enclosing object for messages ("",
+ * "rays.", "scenes[2]."); `where` says the same in words ("at the top
+ * level", "in scenes[2]").
+ */
+#ifndef BVHLAB_CORE_CONFIG_INTERNAL_H
+#define BVHLAB_CORE_CONFIG_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cJSON.h>
+
+#include "config/config.h"
+#include "util/util.h"
+
+/* Long enough for "builders[18446744073709551615]." and the like. */
+#define CONFIG_NAME_SIZE 64
+
+/* "FILE:LINE:COL: message" at the item's key (at_key) or value; -EINVAL. */
+int config_error(const struct config *cfg, const cJSON *item, bool at_key,
+                 bvhlab_error *err, const char *fmt, ...) UTIL_PRINTF(5, 6);
+
+/* "a string", "2.5", "true", "null", "an array", "an object". */
+const char *config_describe(const struct config *cfg, const cJSON *item, char *buf,
+                            size_t size);
+
+/* Closest name within edit distance 2 (transpositions count 1), if any. */
+struct config_suggestion {
+	const char *best;
+	int distance;
+};
+void config_suggest_init(struct config_suggestion *s);
+void config_suggest_consider(struct config_suggestion *s, const char *typed,
+                             const char *candidate);
+
+/* What a key's value must be, and how it is read (config_keys.c). */
+enum config_kind {
+	CONFIG_CUSTOM,   /* read by its own code; in the table so it is known */
+	CONFIG_U32,      /* an integer in [min, max] into a uint32_t */
+	CONFIG_U64,      /* an integer in [min, max] into a uint64_t */
+	CONFIG_BOOL,     /* true or false into a bool */
+	CONFIG_POSITIVE, /* a finite number > 0 into a double */
+	CONFIG_STRING,   /* a non-empty string, copied into a char * */
+	CONFIG_THREADS,  /* distinct thread counts into a uint32_t * and a size_t */
+	CONFIG_VEC3,     /* an array of 3 finite numbers into a float[3] */
+};
+
+/* Flags of a key. */
+enum {
+	CONFIG_GENERATED = 1u << 0, /* a scene key for generators only, not with a 'path' */
+};
+
+/* One key of a config object. Tables end with a NULL name. */
+struct config_key {
+	const char *name;
+	enum config_kind kind;
+	uint64_t min, max;   /* CONFIG_U32, CONFIG_U64: inclusive range */
+	size_t offset;       /* the field the value goes to, in the object's struct */
+	size_t count_offset; /* CONFIG_THREADS: the field the count goes to */
+	unsigned flags;
+};
+
+/* The keys of the top level, "rays", a scene, a builder and "rays.camera",
+ * in the order they are listed in messages and read. */
+extern const struct config_key config_top_keys[];   /* struct config */
+extern const struct config_key config_ray_keys[];   /* struct config */
+extern const struct config_key config_scene_keys[]; /* struct config_scene */
+extern const struct config_key config_part_keys[];  /* struct config_part */
+extern const struct config_key config_builder_keys[]; /* struct config_builder */
+extern const struct config_key config_camera_keys[]; /* bvhlab_camera */
+
+/* Reads every key of the table present in obj into base (the table's
+ * struct), in table order; CONFIG_CUSTOM keys are left to the caller. */
+int config_read_keys(const struct config *cfg, const cJSON *obj,
+                     const struct config_key *table, const char *prefix, void *base,
+                     bvhlab_error *err);
+
+/* Unknown keys (not in the table) and duplicate keys of obj. */
+int config_check_keys(const struct config *cfg, const cJSON *obj,
+                      const struct config_key *table, const char *where, bvhlab_error *err);
+int config_check_duplicates(const struct config *cfg, const cJSON *obj, const char *where,
+                            bvhlab_error *err);
+
+/* The member `key` of obj (exact case), or NULL. */
+const cJSON *config_member(const cJSON *obj, const char *key);
+
+/* Typed members; an absent key leaves *out untouched and returns 0. */
+int config_get_uint(const struct config *cfg, const cJSON *obj, const char *key,
+                    const char *prefix, uint64_t min, uint64_t max, uint64_t *out,
+                    bvhlab_error *err);
+int config_get_u32(const struct config *cfg, const cJSON *obj, const char *key,
+                   const char *prefix, uint32_t min, uint32_t max, uint32_t *out,
+                   bvhlab_error *err);
+int config_get_bool(const struct config *cfg, const cJSON *obj, const char *key,
+                    const char *prefix, bool *out, bvhlab_error *err);
+/* A finite number > 0 (a duration, say). */
+int config_get_positive(const struct config *cfg, const cJSON *obj, const char *key,
+                        const char *prefix, double *out, bvhlab_error *err);
+/* A non-empty string, copied into *out (freeing what was there). */
+int config_get_string(const struct config *cfg, const cJSON *obj, const char *key,
+                      const char *prefix, char **out, bvhlab_error *err);
+/* A [x, y, z] array of finite numbers (magnitude <= 1e30) into out. */
+int config_get_vec3(const struct config *cfg, const cJSON *obj, const char *key,
+                    const char *prefix, float out[3], bvhlab_error *err);
+/* A non-empty array of distinct thread counts (0 = all hardware threads). */
+int config_get_threads(const struct config *cfg, const cJSON *obj, const char *key,
+                       const char *prefix, uint32_t **out, size_t *count,
+                       bvhlab_error *err);
+
+/* `path` as seen from the config's folder (absolute paths unchanged). */
+int config_resolve(const struct config *cfg, const char *path, char **out);
+/* The file name without folder and last extension ("a/b/ogre.obj" -> "ogre"). */
+char *config_stem(const char *path);
+
+/* Highest "memory_limit_mb": the limit in bytes must fit in 64 bits. */
+#define CONFIG_MAX_MEMORY_MB (UINT64_MAX >> 20)
+
+/* "rays": {"camera": {position, target, up, fov}}; absent: automatic framing. */
+int config_parse_camera(struct config *cfg, const cJSON *rays, bvhlab_error *err);
+int config_parse_scenes(struct config *cfg, bvhlab_error *err);
+/* After its table's keys are read: a scene's (or a part's) one source,
+ * without generator parameters (the table's CONFIG_GENERATED keys) for a
+ * file. */
+int config_scene_source(struct config *cfg, const cJSON *obj, const char *prefix,
+                        const struct config_key *table, struct config_scene *sc,
+                        bvhlab_error *err);
+/* "parts" of the composite scene obj (config_parts.c); freed in config_finish. */
+int config_parse_parts(struct config *cfg, const cJSON *obj, const char *prefix,
+                       struct config_scene *sc, bvhlab_error *err);
+void config_parts_free(struct config_scene *sc);
+int config_parse_builders(struct config *cfg, bvhlab_error *err);
+
+#endif /* BVHLAB_CORE_CONFIG_INTERNAL_H */

@@ -1,0 +1,63 @@
+/*
+ * The experiment harness: every scene x builder x thread count of a config,
+ * timed, validated and measured, with results written as runs finish.
+ */
+#ifndef BVHLAB_CORE_HARNESS_H
+#define BVHLAB_CORE_HARNESS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "config/config.h"
+#include "output/results.h"
+
+/* Loads or generates one config scene, subdivides it and names it. */
+int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab_error *err);
+
+struct harness_options {
+	bool quiet;  /* no progress lines on stderr */
+	bool resume; /* keep the finished runs of the output's results.json, skip them */
+};
+
+/*
+ * Runs the whole config; each run's builds in a child process unless the
+ * config says "isolate": false. Returns 0 when every run (kept ones
+ * included) is ok and valid, 1 when some run is not (all are still
+ * recorded), or a negative errno when nothing could be recorded (output
+ * folder not writable, results.json to resume unreadable) with err set.
+ */
+int harness_run(const struct config *cfg, const struct harness_options *opts,
+                bvhlab_error *err);
+
+/* One timed build series of a plugin on prepared primitives. */
+struct build_series {
+	uint32_t warmup, repeat;
+	uint32_t threads;      /* 0: all hardware threads */
+	double *samples_ms;    /* [repeat], filled */
+	bvhlab_tree tree;      /* the last build's tree */
+};
+
+/* Runs warmup + repeat builds; stops at the first failure (err set). */
+int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                        const bvhlab_build_input *input, struct build_series *s,
+                        bvhlab_error *err);
+
+
+/* ---- rays (harness_rays.c) ------------------------------------------------ */
+
+/* The config's camera, or the automatic framing of the scene. */
+void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam);
+
+/*
+ * Primary rays (width x height) and `diffuse` bounces per primary hit,
+ * traced with all hardware threads. nodes ([width * height], may be NULL)
+ * gets nodes visited per pixel, shade ([3 * width * height], may be NULL)
+ * the shaded render. 0 or a negative errno.
+ */
+int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                       const bvhlab_camera *cam, uint32_t width, uint32_t height,
+                       uint32_t diffuse, struct ray_metrics *m, uint32_t *nodes, uint8_t *shade);
+
+#endif

@@ -1,0 +1,58 @@
+/* Small helpers private to the core. */
+#ifndef BVHLAB_CORE_UTIL_H
+#define BVHLAB_CORE_UTIL_H
+
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <bvhlab/types.h>
+
+#if defined(__GNUC__)
+#define UTIL_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define UTIL_PRINTF(a, b)
+#endif
+
+/* printf into err->message (truncated with "..." if it must be); NULL err is fine. */
+void error_set(bvhlab_error *err, const char *fmt, ...) UTIL_PRINTF(2, 3);
+void error_setv(bvhlab_error *err, const char *fmt, va_list ap);
+/* Prepends "prefix: " to the message already in err. */
+void error_prefix(bvhlab_error *err, const char *fmt, ...) UTIL_PRINTF(2, 3);
+
+/* A growable string; a failed allocation sticks (failed = true). */
+struct strbuf {
+	char *data;
+	size_t len, cap;
+	bool failed;
+};
+
+void sb_printf(struct strbuf *sb, const char *fmt, ...) UTIL_PRINTF(2, 3);
+/* Returns the text (caller frees), or NULL if any append failed. */
+char *sb_take(struct strbuf *sb);
+
+/* splitmix64: the core's one seeded generator, so every random choice
+ * (generators, sampled rays) is reproducible from a seed. */
+static inline uint64_t util_splitmix64(uint64_t *state)
+{
+	uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
+	z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+	z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+	return z ^ (z >> 31);
+}
+
+/* Monotonic clock in seconds. */
+double util_now(void);
+
+/* The same clock in milliseconds, for messages and test reports. */
+static inline double util_now_ms(void)
+{
+	return util_now() * 1e3;
+}
+
+/* Median, min and max of n samples (sorts a copy); all 0 when n is 0. */
+void util_summarise(const double *samples, uint32_t n, double *median, double *min,
+                    double *max);
+
+#endif
