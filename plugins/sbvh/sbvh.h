@@ -39,7 +39,7 @@ typedef struct sbvh_ref {
 	float lo[3];
 	uint32_t prim;
 	float hi[3];
-	uint32_t pad;
+	uint32_t cuts; /* pre-splitting: cuts that made this piece */
 } sbvh_ref;
 
 typedef struct sbvh_options {

@@ -13,6 +13,11 @@
  * the gain only shows a few levels down. Pre-splitting spends the room up
  * front on the references that waste the most area.
  *
+ * A triangle is cut at most MAX_CUTS times deep (8 pieces): cutting a
+ * lone huge triangle into many tiles only stacks levels of nodes over it,
+ * each costing about its whole box again; spatial splits decide where
+ * cutting further pays.
+ *
  * Order: a max-heap on the area a reference's box wastes, its half
  * surface area minus the area of the triangle's piece in it (a flat
  * piece's tightest box has a half surface of at least the piece's area):
@@ -27,6 +32,8 @@
 
 #include "sbvh.h"
 #include "tri_clip.h"
+
+#define MAX_CUTS 3
 
 static double ref_area(const sbvh_ref *r)
 {
@@ -110,7 +117,7 @@ static bool cut(const sbvh_build *B, sbvh_ref *refs, uint32_t i, uint32_t j, dou
 		if (r->hi[m] - r->lo[m] > r->hi[k] - r->lo[k])
 			k = m;
 	float pos = 0.5f * (r->lo[k] + r->hi[k]);
-	if (!(pos > r->lo[k] && pos < r->hi[k]))
+	if (!(pos > r->lo[k] && pos < r->hi[k]) || r->cuts >= MAX_CUTS)
 		return false;
 	piece(B, r, &p);
 	tri_poly_split(&p, k, pos, &l, &h);
@@ -118,6 +125,7 @@ static bool cut(const sbvh_build *B, sbvh_ref *refs, uint32_t i, uint32_t j, dou
 	tri_poly_bounds(&h, &box, &hb);
 	if (!(lb.lo[0] <= lb.hi[0] && hb.lo[0] <= hb.hi[0]))
 		return false;
+	r->cuts++; /* how often this piece's triangle was cut to make it */
 	refs[j] = *r;
 	memcpy(r->lo, lb.lo, sizeof(r->lo));
 	memcpy(r->hi, lb.hi, sizeof(r->hi));
