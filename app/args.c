@@ -51,9 +51,26 @@ int cli_parse_threads(const char *text, uint32_t *out, size_t max, size_t *count
 	return 0;
 }
 
+/* "width=X" (needles), the one generator parameter that is not an integer. */
+static int gen_width(bvhlab_gen_params *g, const char *kv, bvhlab_error *err)
+{
+	char *end = NULL;
+	double v = strtod(kv + 6, &end);
+	if (end == kv + 6 || (*end && *end != ',') || !(v > 0.0)) {
+		snprintf(err->message, sizeof(err->message),
+		         "bad generator parameter '%.*s' (width needs a number > 0)",
+		         (int)strcspn(kv, ","), kv);
+		return -EINVAL;
+	}
+	g->width = v;
+	return 0;
+}
+
 /* "key=value" of a generator spec into params. */
 static int gen_param(bvhlab_gen_params *g, const char *kv, bvhlab_error *err)
 {
+	if (strncmp(kv, "width=", 6) == 0)
+		return gen_width(g, kv, err);
 	static const char *keys[] = {"frequency", "count", "size", "seed"};
 	const char *eq = strchr(kv, '=');
 	char *end = NULL;
@@ -73,7 +90,7 @@ static int gen_param(bvhlab_gen_params *g, const char *kv, bvhlab_error *err)
 		return 0;
 	}
 	snprintf(err->message, sizeof(err->message),
-	         "bad generator parameter '%.*s' (known: frequency, count, size, seed, as key=N)",
+	         "bad generator parameter '%.*s' (known: frequency, count, size, seed, width, as key=N)",
 	         (int)strcspn(kv, ","), kv);
 	return -EINVAL;
 }
@@ -86,10 +103,39 @@ static bool is_generator_spec(const char *spec)
 	return !strchr(spec, '.') || strchr(spec, ':');
 }
 
+/* "CONFIG.json:NAME": the scene NAME of an experiment config (composites too). */
+static int load_config_scene(const char *spec, const char *colon, unsigned subdivide,
+                             bvhlab_scene **out, bvhlab_error *err)
+{
+	struct config cfg;
+	char *path = strndup(spec, (size_t)(colon - spec));
+	int r = path ? config_load(&cfg, path, err) : -ENOMEM;
+	free(path);
+	if (r < 0)
+		return r;
+	r = -ENOENT;
+	snprintf(err->message, sizeof(err->message), "%s: no scene named '%s'", cfg.path,
+	         colon + 1);
+	for (size_t i = 0; i < cfg.scene_count; i++) {
+		struct config_scene cs = cfg.scenes[i];
+		if (strcmp(cs.name, colon + 1) != 0)
+			continue;
+		cs.subdivide += subdivide;
+		err->message[0] = '\0';
+		r = harness_load_scene(&cs, out, err);
+		break;
+	}
+	config_finish(&cfg);
+	return r;
+}
+
 int cli_load_scene(const char *spec, unsigned subdivide, bvhlab_scene **out, bvhlab_error *err)
 {
 	struct config_scene cs = {.subdivide = subdivide};
+	const char *json = strstr(spec, ".json:");
 	char name[64];
+	if (json)
+		return load_config_scene(spec, json + 5, subdivide, out, err);
 	bvhlab_gen_params_init(&cs.gen);
 	if (!is_generator_spec(spec)) {
 		cs.path = (char *)spec;

@@ -64,9 +64,10 @@ static int parse(int argc, char **argv, struct build_args *a)
 
 static void print_stats(const bvhlab_tree_stats *st)
 {
-	printf("nodes:      %u (%u leaves)\nmax depth:  %u\navg leaf:   %.3f\n"
+	printf("nodes:      %u (%u leaves)\nmax depth:  %u\navg leaf:   %.3f\nrefs:       %llu\n"
 	       "SAH cost:   %.4f\nmemory:     %llu bytes\nleaf sizes:",
-	       st->nodes, st->leaves, st->max_depth, st->avg_leaf_size, st->sah_cost,
+	       st->nodes, st->leaves, st->max_depth, st->avg_leaf_size,
+	       (unsigned long long)st->refs, st->sah_cost,
 	       (unsigned long long)st->memory_bytes);
 	for (int k = 0; k < BVHLAB_LEAF_HISTOGRAM; k++)
 		if (st->leaf_histogram[k])

@@ -15,7 +15,9 @@ static const char usage[] =
 	"Loads a scene and prints its triangle and vertex counts, degenerate\n"
 	"(zero-area) triangles and bounds. SCENE is an .obj or .ply file, or a\n"
 	"generator with parameters: icosphere:frequency=300, soup:count=100000,seed=2,\n"
-	"stadium:count=50000, terrain:size=512.\n"
+	"stadium:count=50000, terrain:size=512, needles:count=1000,width=0.001,\n"
+	"or a scene of an experiment config, CONFIG.json:NAME (composite scenes\n"
+	"print their part count).\n"
 	"\n"
 	"With --machine, prints the CPU topology this process may use (hwloc,\n"
 	"narrowed by its affinity mask and cgroup cpuset): packages, physical\n"
@@ -34,6 +36,7 @@ static void print_json(const bvhlab_scene *s)
 	cJSON_AddNumberToObject(o, "triangles", s->triangle_count);
 	cJSON_AddNumberToObject(o, "vertices", s->vertex_count);
 	cJSON_AddNumberToObject(o, "degenerate", s->degenerate_count);
+	cJSON_AddNumberToObject(o, "parts", s->part_count);
 	cJSON_AddItemToObject(o, "lo", cJSON_CreateFloatArray(s->bounds.lo, 3));
 	cJSON_AddItemToObject(o, "hi", cJSON_CreateFloatArray(s->bounds.hi, 3));
 	char *text = cJSON_Print(o);
@@ -45,10 +48,10 @@ static void print_json(const bvhlab_scene *s)
 
 static void print_text(const bvhlab_scene *s)
 {
-	printf("scene:      %s\nsource:     %s\ntriangles:  %u\nvertices:   %u\n"
-	       "degenerate: %u\nbounds:     (%g, %g, %g) - (%g, %g, %g)\n",
-	       s->name ? s->name : "", s->source ? s->source : "", s->triangle_count,
-	       s->vertex_count, s->degenerate_count, s->bounds.lo[0], s->bounds.lo[1],
+	printf("scene:      %s\nsource:     %s\nparts:      %u\ntriangles:  %u\n"
+	       "vertices:   %u\ndegenerate: %u\nbounds:     (%g, %g, %g) - (%g, %g, %g)\n",
+	       s->name ? s->name : "", s->source ? s->source : "", s->part_count,
+	       s->triangle_count, s->vertex_count, s->degenerate_count, s->bounds.lo[0], s->bounds.lo[1],
 	       s->bounds.lo[2], s->bounds.hi[0], s->bounds.hi[1], s->bounds.hi[2]);
 }
 

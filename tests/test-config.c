@@ -252,8 +252,9 @@ static void test_unknown_keys(void)
 	CHECK(load(&cfg, t, &err) < 0 && !strstr(err.message, "did you mean"));
 	t = "{ \"scenes\": [ { \"generator\": \"icosphere\", \"frequncy\": 4 } ], " BUILDERS " }";
 	EXPECT_ERROR_AT(t, "\"frequncy\"", 0,
-	                "unknown key 'frequncy' in scenes[0] (known: name, path, generator, "
-	                "frequency, count, size, seed, subdivide); did you mean 'frequency'?");
+	                "unknown key 'frequncy' in scenes[0] (known: name, path, generator, parts, "
+	                "frequency, count, size, seed, width, subdivide); did you mean "
+	                "'frequency'?");
 	EXPECT_ERROR("{ " SCENES ",\n"
 	             "  \"builders\": [ { \"plugin\": \"a\" },\n"
 	             "    { \"plugin\": \"b\", \"threds\": [2] } ] }",

@@ -44,7 +44,7 @@ static void test_single_leaf(void)
 	CHECK_INT(s.nodes, 1);
 	CHECK_INT(s.leaves, 1);
 	CHECK_INT(s.max_depth, 0);
-	CHECK(s.avg_leaf_size == 5.0);
+	CHECK(s.avg_leaf_size == 5.0 && s.refs == 5);
 	CHECK_INT(s.memory_bytes, 32 + 5 * 4);
 	for (k = 0; k < BVHLAB_LEAF_HISTOGRAM; k++)
 		CHECK_INT(s.leaf_histogram[k], k == 4);
@@ -69,7 +69,7 @@ static void test_two_boxes(void)
 	CHECK_INT(s.nodes, 3);
 	CHECK_INT(s.leaves, 2);
 	CHECK_INT(s.max_depth, 1);
-	CHECK(s.avg_leaf_size == 2.0);
+	CHECK(s.avg_leaf_size == 2.0 && s.refs == 4);
 	CHECK_INT(s.leaf_histogram[0], 1);
 	CHECK_INT(s.leaf_histogram[2], 1);
 	CHECK_INT(s.memory_bytes, 3 * 32 + 4 * 4);

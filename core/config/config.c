@@ -274,6 +274,7 @@ void config_finish(struct config *cfg)
 		free(cfg->scenes[i].name);
 		free(cfg->scenes[i].path);
 		free(cfg->scenes[i].generator);
+		config_parts_free(&cfg->scenes[i]);
 	}
 	for (size_t i = 0; cfg->builders && i < cfg->builder_count; i++) {
 		free(cfg->builders[i].plugin);

@@ -23,13 +23,24 @@
 struct cJSON;
 struct json_locations;
 
+struct config_part;
+
 struct config_scene {
-	char *name;        /* "name", default: file stem or generator name */
+	char *name;        /* "name", default: file stem, generator name or "composite" */
 	char *path;        /* "path" resolved against the config's folder, or NULL */
-	char *generator;   /* "generator", or NULL; exactly one of path/generator */
-	bvhlab_gen_params gen; /* "frequency", "count", "size", "seed" */
+	char *generator;   /* "generator", or NULL; exactly one of path/generator/parts */
+	bvhlab_gen_params gen; /* "frequency", "count", "size", "seed", "width" */
 	uint32_t subdivide; /* "subdivide", default 0 */
 	int line, column;  /* where the scene's object starts */
+	struct config_part *parts; /* "parts" of a composite scene, or NULL */
+	size_t part_count;
+};
+
+/* One entry of a composite scene's "parts": a mesh or generator (src, whose
+ * name is unused) placed by "scale", "rotate" (degrees) and "translate". */
+struct config_part {
+	struct config_scene src;
+	bvhlab_transform xf;
 };
 
 struct config_builder {

@@ -62,9 +62,10 @@ static int unique_names(const struct config *cfg, const cJSON *array, const char
 /* ---- scenes ------------------------------------------------------------------ */
 
 /* After the table's keys are read: exactly one source, and no generator
- * parameters for a file. */
-static int scene_source(struct config *cfg, const cJSON *obj, const char *prefix,
-                        struct config_scene *sc, bvhlab_error *err)
+ * parameters (the table's CONFIG_GENERATED keys) for a file. */
+int config_scene_source(struct config *cfg, const cJSON *obj, const char *prefix,
+                        const struct config_key *table, struct config_scene *sc,
+                        bvhlab_error *err)
 {
 	if (sc->path && sc->generator)
 		return config_error(cfg, config_member(obj, "generator"), true, err,
@@ -74,7 +75,7 @@ static int scene_source(struct config *cfg, const cJSON *obj, const char *prefix
 		return config_error(cfg, obj, false, err,
 		                    "'%.*s' needs a 'path' (a mesh file) or a 'generator'",
 		                    (int)strlen(prefix) - 1, prefix);
-	for (const struct config_key *k = config_scene_keys; sc->path && k->name; k++) {
+	for (const struct config_key *k = table; sc->path && k->name; k++) {
 		const cJSON *item = config_member(obj, k->name);
 		if (item && (k->flags & CONFIG_GENERATED))
 			return config_error(cfg, item, true, err,
@@ -84,12 +85,15 @@ static int scene_source(struct config *cfg, const cJSON *obj, const char *prefix
 	return 0;
 }
 
-/* The default name (file stem or generator), and the path as seen from here. */
+/* The default name (file stem, generator or "composite"), and the path as
+ * seen from here. */
 static int scene_name_and_path(struct config *cfg, struct config_scene *sc,
                                bvhlab_error *err)
 {
 	if (!sc->name) {
-		sc->name = sc->path ? config_stem(sc->path) : strdup(sc->generator);
+		sc->name = sc->path        ? config_stem(sc->path)
+		           : sc->generator ? strdup(sc->generator)
+		                           : strdup("composite");
 		if (!sc->name)
 			return out_of_memory(cfg, err);
 	}
@@ -118,8 +122,10 @@ static int parse_scene(struct config *cfg, const cJSON *obj, size_t index,
 	int rc = config_check_keys(cfg, obj, config_scene_keys, where, err);
 	if (!rc)
 		rc = config_read_keys(cfg, obj, config_scene_keys, prefix, sc, err);
-	if (!rc)
-		rc = scene_source(cfg, obj, prefix, sc, err);
+	if (!rc && config_member(obj, "parts"))
+		rc = config_parse_parts(cfg, obj, prefix, sc, err);
+	else if (!rc)
+		rc = config_scene_source(cfg, obj, prefix, config_scene_keys, sc, err);
 	if (!rc)
 		rc = scene_name_and_path(cfg, sc, err);
 	return rc;

@@ -71,6 +71,7 @@ extern const struct config_key config_top_keys[];   /* struct config */
 extern const struct config_key config_ray_keys[];   /* struct config */
 extern const struct config_key config_report_keys[]; /* struct config */
 extern const struct config_key config_scene_keys[]; /* struct config_scene */
+extern const struct config_key config_part_keys[];  /* struct config_part */
 extern const struct config_key config_builder_keys[]; /* struct config_builder */
 extern const struct config_key config_camera_keys[]; /* bvhlab_camera */
 
@@ -123,6 +124,16 @@ char *config_stem(const char *path);
 /* "rays": {"camera": {position, target, up, fov}}; absent: automatic framing. */
 int config_parse_camera(struct config *cfg, const cJSON *rays, bvhlab_error *err);
 int config_parse_scenes(struct config *cfg, bvhlab_error *err);
+/* After its table's keys are read: a scene's (or a part's) one source,
+ * without generator parameters (the table's CONFIG_GENERATED keys) for a
+ * file. */
+int config_scene_source(struct config *cfg, const cJSON *obj, const char *prefix,
+                        const struct config_key *table, struct config_scene *sc,
+                        bvhlab_error *err);
+/* "parts" of the composite scene obj (config_parts.c); freed in config_finish. */
+int config_parse_parts(struct config *cfg, const cJSON *obj, const char *prefix,
+                       struct config_scene *sc, bvhlab_error *err);
+void config_parts_free(struct config_scene *sc);
 int config_parse_builders(struct config *cfg, bvhlab_error *err);
 /* Expands builders with {"grid": [...]} option values into one builder per
  * combination, named "NAME[key=value,...]" (config_grid.c); `array` is the

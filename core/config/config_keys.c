@@ -70,11 +70,31 @@ const struct config_key config_scene_keys[] = {
 	SCENE("name", CONFIG_STRING, name, 0, 0, 0),
 	SCENE("path", CONFIG_STRING, path, 0, 0, 0),
 	SCENE("generator", CONFIG_STRING, generator, 0, 0, 0),
+	CUSTOM("parts"), /* a composite scene: config_parts.c */
 	SCENE("frequency", CONFIG_U32, gen.frequency, 1, UINT32_MAX, CONFIG_GENERATED),
 	SCENE("count", CONFIG_U32, gen.count, 1, UINT32_MAX, CONFIG_GENERATED),
 	SCENE("size", CONFIG_U32, gen.size, 1, UINT32_MAX, CONFIG_GENERATED),
 	SCENE("seed", CONFIG_U64, gen.seed, 0, UINT64_MAX, CONFIG_GENERATED),
+	SCENE("width", CONFIG_POSITIVE, gen.width, 0, 0, CONFIG_GENERATED),
 	SCENE("subdivide", CONFIG_U32, subdivide, 0, MAX_SUBDIVIDE, 0),
+	END,
+};
+
+/* One of a composite scene's "parts": a scene's source keys, and where it goes. */
+#define PART(name, kind, field, min, max, flags) \
+	KEY(struct config_part, name, kind, field, min, max, flags)
+const struct config_key config_part_keys[] = {
+	PART("path", CONFIG_STRING, src.path, 0, 0, 0),
+	PART("generator", CONFIG_STRING, src.generator, 0, 0, 0),
+	PART("frequency", CONFIG_U32, src.gen.frequency, 1, UINT32_MAX, CONFIG_GENERATED),
+	PART("count", CONFIG_U32, src.gen.count, 1, UINT32_MAX, CONFIG_GENERATED),
+	PART("size", CONFIG_U32, src.gen.size, 1, UINT32_MAX, CONFIG_GENERATED),
+	PART("seed", CONFIG_U64, src.gen.seed, 0, UINT64_MAX, CONFIG_GENERATED),
+	PART("width", CONFIG_POSITIVE, src.gen.width, 0, 0, CONFIG_GENERATED),
+	PART("subdivide", CONFIG_U32, src.subdivide, 0, MAX_SUBDIVIDE, 0),
+	PART("scale", CONFIG_POSITIVE, xf.scale, 0, 0, 0),
+	CUSTOM("rotate"),    /* degrees, doubles: config_parts.c */
+	CUSTOM("translate"),
 	END,
 };
 

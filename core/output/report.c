@@ -101,6 +101,8 @@ static const char *const csv_numbers[][2] = {
 	{"tree.max_depth", "%.0f"},
 	{"tree.avg_leaf_size", "%.4f"},
 	{"tree.sah_cost", "%.6f"},
+	{"tree.refs", "%.0f"},
+	{"tree.dup_ratio", "%.4f"},
 	{"tree.memory_bytes", "%.0f"},
 	{"validation.rays_checked", "%.0f"},
 	{"validation.mismatches", "%.0f"},
@@ -189,6 +191,8 @@ static void md_run_row(struct strbuf *sb, const struct report_index *ix, const c
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.nodes", "%.0f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.max_depth", "%.0f"));
 	md_cell(sb, num(buf, sizeof(buf), run, "tree.avg_leaf_size", "%.2f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.refs", "%.0f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.dup_ratio", "%.3f"));
 	md_cell(sb, str(run, "error"));
 	sb_printf(sb, "\n");
 }
@@ -217,9 +221,9 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cJS
 	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | cold ms "
 	              "| Mtris/s | speedup | SAH cost | EPO | peak bytes | primary Mrays/s "
 	              "| primary nodes/ray | diffuse Mrays/s | diffuse nodes/ray | nodes | depth "
-	              "| avg leaf | error |\n"
+	              "| avg leaf | refs | refs/tri | error |\n"
 	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
-	              "|---:|---:|---:|---:|---|\n");
+	              "|---:|---:|---:|---:|---:|---:|---|\n");
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
 	for (size_t k = 0; k < n; k++)

@@ -75,6 +75,8 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 	num_cell(sb, report_num(run, "rays.primary.tris_per_ray"), "%.1f");
 	num_cell(sb, report_num(run, "rays.diffuse.mrays_per_s"), "%.2f");
 	num_cell(sb, report_num(run, "rays.diffuse.nodes_per_ray"), "%.1f");
+	num_cell(sb, report_num(run, "tree.refs"), "%.0f");
+	num_cell(sb, report_num(run, "tree.dup_ratio"), "%.3f");
 	if (stackless) {
 		num_cell(sb, report_num(run, "rays.stackless.primary.mrays_per_s"), "%.2f");
 		num_cell(sb, report_num(run, "rays.stackless.primary.nodes_per_ray"), "%.1f");
@@ -106,7 +108,7 @@ static void table(struct strbuf *sb, const struct report_index *ix, const char *
 	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>EPO</th>"
 	              "<th>peak MiB</th><th>primary Mrays/s</th><th>min–max</th>"
 	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s</th>"
-	              "<th>diffuse nodes/ray</th>");
+	              "<th>diffuse nodes/ray</th><th>refs</th><th>refs/tri</th>");
 	if (stackless)
 		sb_printf(sb, "<th>stackless primary Mrays/s</th><th>stackless primary nodes/ray</th>"
 		              "<th>stackless diffuse Mrays/s</th><th>hits differing</th>");

@@ -183,7 +183,8 @@ static cJSON *memory_json(const struct build_memory *m)
 	return o;
 }
 
-static cJSON *tree_json(const bvhlab_tree_stats *st)
+/* dup_ratio: references per triangle, 1 unless spatial splits duplicated some. */
+static cJSON *tree_json(const bvhlab_tree_stats *st, uint32_t triangles)
 {
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddNumberToObject(o, "nodes", st->nodes);
@@ -191,6 +192,9 @@ static cJSON *tree_json(const bvhlab_tree_stats *st)
 	cJSON_AddNumberToObject(o, "max_depth", st->max_depth);
 	cJSON_AddNumberToObject(o, "avg_leaf_size", st->avg_leaf_size);
 	cJSON_AddNumberToObject(o, "sah_cost", st->sah_cost);
+	cJSON_AddNumberToObject(o, "refs", (double)st->refs);
+	if (triangles)
+		cJSON_AddNumberToObject(o, "dup_ratio", (double)st->refs / triangles);
 	cJSON_AddNumberToObject(o, "memory_bytes", (double)st->memory_bytes);
 	cJSON *hist = cJSON_AddArrayToObject(o, "leaf_size_histogram");
 	for (int k = 0; k < BVHLAB_LEAF_HISTOGRAM; k++)
@@ -229,7 +233,7 @@ int results_add_run(struct results *res, const struct run_record *run)
 		                        med > 0 ? run->triangles / (med * 1e3) : 0);
 	}
 	if (run->stats)
-		cJSON_AddItemToObject(o, "tree", tree_json(run->stats));
+		cJSON_AddItemToObject(o, "tree", tree_json(run->stats, run->triangles));
 	if (run->stats && run->epo)
 		cJSON_AddNumberToObject(cJSON_GetObjectItem(o, "tree"), "epo", *run->epo);
 	if (run->memory)

@@ -43,6 +43,7 @@ int scene_alloc(uint32_t vertex_count, uint32_t triangle_count, bvhlab_scene **o
 		goto fail;
 	scene->vertex_count = vertex_count;
 	scene->triangle_count = triangle_count;
+	scene->part_count = 1;
 	bvhlab_aabb_empty(&scene->bounds);
 	*out = scene;
 	return 0;
@@ -214,6 +215,7 @@ int scene_mesh_finish(struct scene_mesh *mesh, const char *path, bvhlab_scene **
 	scene->vertex_count = (uint32_t)mesh->vertex_count;
 	scene->indices = mesh->indices;
 	scene->triangle_count = (uint32_t)mesh->triangle_count;
+	scene->part_count = 1;
 	memset(mesh, 0, sizeof(*mesh));
 	bvhlab_scene_update(scene);
 	*out = scene;
@@ -281,4 +283,5 @@ void bvhlab_gen_params_init(bvhlab_gen_params *params)
 	params->count = 10000;
 	params->size = 256;
 	params->seed = 1;
+	params->width = 0.001;
 }

@@ -439,6 +439,12 @@ static int gen_terrain(const bvhlab_gen_params *params, bvhlab_scene **out, char
 
 /* ---- dispatch ------------------------------------------------------------- */
 
+static int gen_needles(const bvhlab_gen_params *params, bvhlab_scene **out, char *source,
+                       bvhlab_error *err)
+{
+	return scene_gen_needles(params, out, source, SOURCE_SIZE, err);
+}
+
 typedef int generate_fn(const bvhlab_gen_params *params, bvhlab_scene **out, char *source,
                         bvhlab_error *err);
 
@@ -450,6 +456,7 @@ static const struct {
 	{ "soup", gen_soup },
 	{ "stadium", gen_stadium },
 	{ "terrain", gen_terrain },
+	{ "needles", gen_needles },
 };
 
 int bvhlab_scene_generate(const char *generator, const bvhlab_gen_params *params,
@@ -480,7 +487,7 @@ int bvhlab_scene_generate(const char *generator, const bvhlab_gen_params *params
 		*out = scene;
 		return 0;
 	}
-	scene_error(err, "unknown generator '%s' (known: icosphere, soup, stadium, terrain)",
+	scene_error(err, "unknown generator '%s' (known: icosphere, soup, stadium, terrain, needles)",
 	            generator ? generator : "(null)");
 	return -EINVAL;
 }

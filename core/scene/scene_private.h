@@ -84,4 +84,8 @@ struct scene_load_stats {
 int scene_load_obj_stats(const char *path, bvhlab_scene **out,
                          struct scene_load_stats *stats, bvhlab_error *err);
 
+/* The "needles" generator (scene_needles.c); `source` gets its description. */
+int scene_gen_needles(const bvhlab_gen_params *params, bvhlab_scene **out, char *source,
+                      size_t source_size, bvhlab_error *err);
+
 #endif /* BVHLAB_CORE_SCENE_PRIVATE_H */

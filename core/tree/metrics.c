@@ -114,5 +114,6 @@ void bvhlab_tree_stats_compute(const bvhlab_tree *tree, bvhlab_tree_stats *stats
 	else
 		stats->sah_cost = (double)inner + (double)refs;
 	stats->avg_leaf_size = stats->leaves ? (double)refs / stats->leaves : 0.0;
+	stats->refs = refs;
 	stats->max_depth = max_depth(tree);
 }

@@ -235,7 +235,9 @@ typedef struct bvhlab_build_output {
 enum bvhlab_builder_flags {
 	BVHLAB_BUILDER_PARALLEL = 1u << 0,      /* uses input->threads > 1 */
 	BVHLAB_BUILDER_DETERMINISTIC = 1u << 1, /* same tree for any thread count and run */
-	BVHLAB_BUILDER_SPATIAL_SPLITS = 1u << 2, /* may reference a primitive more than once */
+	/* may reference a primitive more than once, and give a leaf a box that
+	 * holds only the part of a triangle inside it (judged by coverage) */
+	BVHLAB_BUILDER_SPATIAL_SPLITS = 1u << 2,
 	BVHLAB_BUILDER_UNFINISHED = 1u << 3,    /* work in progress: reported as such */
 };
 

@@ -23,6 +23,7 @@ typedef struct bvhlab_scene {
 	uint32_t triangle_count;
 	uint32_t degenerate_count; /* zero-area triangles (kept, counted) */
 	bvhlab_aabb bounds;       /* of all referenced vertices */
+	uint32_t part_count;      /* meshes merged into it: 1, more for a composite */
 } bvhlab_scene;
 
 /* Parameters of the procedural generators; unused fields are ignored. */
@@ -30,10 +31,12 @@ typedef struct bvhlab_gen_params {
 	uint32_t frequency; /* icosphere: edge subdivisions, 20 * f^2 triangles */
 	uint32_t count;     /* soup: triangles; stadium: triangles of the dense object */
 	uint32_t size;      /* terrain: grid cells per side, 2 * size^2 triangles */
-	uint64_t seed;      /* soup, stadium, terrain: random seed */
+	uint64_t seed;      /* soup, stadium, terrain, needles: random seed */
+	double width;       /* needles: distance of the third vertex from the first */
 } bvhlab_gen_params;
 
-/* Default generator parameters (frequency 16, count 10000, size 256, seed 1). */
+/* Default generator parameters (frequency 16, count 10000, size 256, seed 1,
+ * width 0.001). */
 void bvhlab_gen_params_init(bvhlab_gen_params *params);
 
 /*
@@ -46,7 +49,10 @@ int bvhlab_scene_load_obj(const char *path, bvhlab_scene **out, bvhlab_error *er
 int bvhlab_scene_load_ply(const char *path, bvhlab_scene **out, bvhlab_error *err);
 
 /*
- * Generates "icosphere", "soup", "stadium" or "terrain". An unknown
+ * Generates "icosphere", "soup", "stadium", "terrain" or "needles" (count
+ * long thin triangles across the unit cube: each joins a random point of
+ * one face to a random point of the opposite face, the face pair random,
+ * the third vertex `width` from the first). An unknown
  * generator is -EINVAL with a message listing the known ones.
  */
 int bvhlab_scene_generate(const char *generator, const bvhlab_gen_params *params,
@@ -54,6 +60,32 @@ int bvhlab_scene_generate(const char *generator, const bvhlab_gen_params *params
 
 /* Splits every triangle into 4 (edge midpoints), `levels` times. */
 int bvhlab_scene_subdivide(bvhlab_scene *scene, unsigned levels, bvhlab_error *err);
+
+/*
+ * Where a part of a composite scene goes: scaled by `scale` about the
+ * origin, rotated by rotate[0], [1], [2] degrees about x, then y, then z
+ * (right-handed), then moved by `translate`.
+ */
+typedef struct bvhlab_transform {
+	double scale;
+	double rotate[3];
+	double translate[3];
+} bvhlab_transform;
+
+/* Identity: scale 1, no rotation, no translation. */
+void bvhlab_transform_init(bvhlab_transform *xf);
+
+/* Applies xf to every vertex and recomputes the bounds. */
+void bvhlab_scene_transform(bvhlab_scene *scene, const bvhlab_transform *xf);
+
+/*
+ * One scene holding the triangles of parts[0 .. count) in order (their
+ * vertices concatenated, indices offset), part_count the sum of theirs,
+ * named `name`. The parts are left as they are. 0, -ENOMEM or -EOVERFLOW
+ * (more than UINT32_MAX vertices or triangles in all), explained in err.
+ */
+int bvhlab_scene_merge(bvhlab_scene *const *parts, uint32_t count, const char *name,
+                       bvhlab_scene **out, bvhlab_error *err);
 
 /* Recomputes bounds and degenerate_count from the arrays. */
 void bvhlab_scene_update(bvhlab_scene *scene);

@@ -39,7 +39,12 @@ void bvhlab_tree_finish(bvhlab_tree *tree);
  * no empty leaf, leaf ranges inside index_count, every prim_index slot used by
  * exactly one leaf, every primitive referenced exactly once (at least once
  * when allow_duplicates, for spatial-split builders), every node's box
- * containing its children's boxes or its primitives' boxes.
+ * containing its children's boxes, and every leaf's box its primitives'
+ * boxes. With allow_duplicates (spatial splits) a leaf's box may hold only
+ * the part of a triangle inside it: then every reference's box must overlap
+ * its triangle and the triangle clipped to its references' leaf boxes must
+ * cover the whole triangle (uncovered area at most 1e-5 of it, boxes
+ * widened by a few float ulps for rounding).
  * 0, or -EINVAL with the first problem found in err (node index included).
  */
 int bvhlab_validate_tree(const bvhlab_tree *tree, const bvhlab_build_input *input,
@@ -70,6 +75,8 @@ typedef struct bvhlab_tree_stats {
 	uint32_t leaves;
 	uint32_t max_depth;      /* root has depth 0 */
 	double avg_leaf_size;    /* primitive references per leaf */
+	uint64_t refs;           /* primitive references in all leaves: the primitive
+	                          * count, more with spatial splits' duplicates */
 	double sah_cost;
 	uint64_t memory_bytes;
 	uint32_t leaf_histogram[BVHLAB_LEAF_HISTOGRAM]; /* [k] leaves of size k + 1 */

@@ -191,7 +191,7 @@ static int build_locked(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		rc = -EIO;
 		goto out;
 	}
-	rc = embree_write_tree(host, ctx, input, root, output);
+	rc = embree_write_tree(host, ctx, root, output);
 	host->log(ctx, BVHLAB_LOG_DEBUG, "ms: device %.2f, primitives %.2f, rtcBuildBVH %.2f, "
 	          "conversion %.2f", t1 - t0, t2 - t1, t3 - t2, now_ms() - t3);
 out:

@@ -28,7 +28,9 @@ typedef struct tinner {
 
 typedef struct tleaf {
 	tnode head;
-	uint32_t prim[]; /* [head.count] */
+	float lo[3], hi[3]; /* union of Embree's boxes of its references (clipped
+	                     * to the part of the triangle in the leaf for "high") */
+	uint32_t prim[];    /* [head.count] */
 } tleaf;
 
 /* What the callbacks see through Embree's userPtr. */
@@ -41,12 +43,11 @@ void embree_set_callbacks(struct RTCBuildArguments *args, bool spatial);
 
 /*
  * Writes the tree under `root` into `out` (growing it through the host
- * when spatial splits made more references than primitives) with boxes
- * recomputed from the input's primitive boxes. 0, or a negative errno
+ * when spatial splits made more references than primitives): leaf boxes
+ * as Embree gave them, inner boxes the union of their children's. 0, or a negative errno
  * after host->set_error.
  */
-int embree_write_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                      const bvhlab_build_input *input, const tnode *root,
+int embree_write_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const tnode *root,
                       bvhlab_build_output *out);
 
 #endif

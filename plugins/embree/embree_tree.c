@@ -2,12 +2,10 @@
  * The callbacks Embree builds its tree through, the exact triangle split
  * behind quality "high", and the conversion into the standard layout.
  *
- * Boxes: Embree's spatial splits give a leaf only the box of the clipped
- * part of each triangle, but the core validator requires a leaf's box to
- * contain its primitives' whole boxes. So the output's boxes are recomputed
- * from input->prim_bounds (leaves) and children (inner nodes): identical to
- * Embree's for "low" and "medium", widened for "high", whose split choices
- * and duplicated references are kept.
+ * Boxes: a leaf's box is the union of the boxes Embree hands create_leaf,
+ * which for "high" hold only the clipped part of each triangle (the
+ * validator checks such trees by coverage, since the plugin declares
+ * spatial splits); inner boxes are the union of their children's.
  */
 #include <errno.h>
 #include <math.h>
@@ -17,6 +15,7 @@
 #include <bvhlab/aabb.h>
 
 #include "embree_internal.h"
+#include "tri_clip.h"
 
 /* ---- callbacks (run on Embree's worker threads) --------------------------- */
 
@@ -52,56 +51,40 @@ static void *create_leaf(RTCThreadLocalAllocator alloc, const struct RTCBuildPri
 	tleaf *l = rtcThreadLocalAlloc(alloc, sizeof(tleaf) + count * sizeof(uint32_t), 16);
 	l->head.count = (uint32_t)count;
 	l->head.arity = 0;
-	for (size_t k = 0; k < count; k++)
-		l->prim[k] = prims[k].primID;
+	for (int k = 0; k < 3; k++)
+		l->lo[k] = INFINITY, l->hi[k] = -INFINITY;
+	for (size_t k = 0; k < count; k++) {
+		const struct RTCBuildPrimitive *p = &prims[k];
+		l->prim[k] = p->primID;
+		l->lo[0] = p->lower_x < l->lo[0] ? p->lower_x : l->lo[0];
+		l->lo[1] = p->lower_y < l->lo[1] ? p->lower_y : l->lo[1];
+		l->lo[2] = p->lower_z < l->lo[2] ? p->lower_z : l->lo[2];
+		l->hi[0] = p->upper_x > l->hi[0] ? p->upper_x : l->hi[0];
+		l->hi[1] = p->upper_y > l->hi[1] ? p->upper_y : l->hi[1];
+		l->hi[2] = p->upper_z > l->hi[2] ? p->upper_z : l->hi[2];
+	}
 	return l;
 }
 
-/* Clips to the reference's current box (already clipped by earlier splits). */
-static void box_store(bvhlab_aabb *b, const struct RTCBuildPrimitive *p,
-                      struct RTCBounds *out)
-{
-	const float lo[3] = {p->lower_x, p->lower_y, p->lower_z};
-	const float hi[3] = {p->upper_x, p->upper_y, p->upper_z};
-	for (int k = 0; k < 3; k++) {
-		b->lo[k] = bvhlab_maxf(b->lo[k], lo[k]);
-		b->hi[k] = bvhlab_minf(b->hi[k], hi[k]);
-	}
-	*out = (struct RTCBounds){b->lo[0], b->lo[1], b->lo[2], 0, b->hi[0], b->hi[1], b->hi[2], 0};
-}
-
 /*
- * Splits the triangle behind a reference at the plane x[dim] = pos: each
- * side's box holds that side's vertices and the points where edges cross
- * the plane (those lie on it exactly: their dim coordinate is pos itself).
+ * Splits a reference at the plane x[dim] = pos: each side gets the box of
+ * the part of the triangle that lies in the reference's box and on that
+ * side (tri_clip.c), so a box never holds space its triangle does not
+ * reach. Embree's own triangle splitter instead cuts the whole triangle
+ * and intersects the halves' boxes with the reference's box, which can
+ * leave a side a box that misses the triangle altogether.
  */
 static void split_prim(const struct RTCBuildPrimitive *prim, unsigned int dim, float pos,
                        struct RTCBounds *left, struct RTCBounds *right, void *user)
 {
 	const embree_job *job = user;
-	const uint32_t *tri = &job->input->indices[3 * (size_t)prim->primID];
+	const bvhlab_aabb box = {{prim->lower_x, prim->lower_y, prim->lower_z},
+	                         {prim->upper_x, prim->upper_y, prim->upper_z}};
 	bvhlab_aabb l, r;
-	bvhlab_aabb_empty(&l);
-	bvhlab_aabb_empty(&r);
-	for (int e = 0; e < 3; e++) {
-		const float *a = &job->input->vertices[3 * (size_t)tri[e]];
-		const float *b = &job->input->vertices[3 * (size_t)tri[(e + 1) % 3]];
-		if (a[dim] <= pos)
-			bvhlab_aabb_grow_point(&l, a);
-		if (a[dim] >= pos)
-			bvhlab_aabb_grow_point(&r, a);
-		if ((a[dim] < pos && pos < b[dim]) || (b[dim] < pos && pos < a[dim])) {
-			double t = ((double)pos - a[dim]) / ((double)b[dim] - a[dim]);
-			float c[3];
-			for (int k = 0; k < 3; k++)
-				c[k] = (float)(a[k] + t * ((double)b[k] - a[k]));
-			c[dim] = pos;
-			bvhlab_aabb_grow_point(&l, c);
-			bvhlab_aabb_grow_point(&r, c);
-		}
-	}
-	box_store(&l, prim, left);
-	box_store(&r, prim, right);
+	tri_clip_split(job->input->vertices, &job->input->indices[3 * (size_t)prim->primID], &box,
+	               (int)dim, pos, &l, &r);
+	*left = (struct RTCBounds){l.lo[0], l.lo[1], l.lo[2], 0, l.hi[0], l.hi[1], l.hi[2], 0};
+	*right = (struct RTCBounds){r.lo[0], r.lo[1], r.lo[2], 0, r.hi[0], r.hi[1], r.hi[2], 0};
 }
 
 void embree_set_callbacks(struct RTCBuildArguments *args, bool spatial)
@@ -167,6 +150,8 @@ static int write_leaf(writer *w, const tleaf *l, uint32_t slot)
 	int rc = ensure(w, o->node_count, o->index_count + l->head.count);
 	if (rc < 0)
 		return rc;
+	memcpy(o->nodes[slot].lo, l->lo, sizeof(l->lo));
+	memcpy(o->nodes[slot].hi, l->hi, sizeof(l->hi));
 	o->nodes[slot].first = o->index_count;
 	o->nodes[slot].count = l->head.count;
 	memcpy(&o->prim_index[o->index_count], l->prim, l->head.count * sizeof(uint32_t));
@@ -209,33 +194,30 @@ static int write_nodes(writer *w, const tnode *root)
 	return rc;
 }
 
-/* Bottom-up is a reverse scan, since children follow their parents. */
-static void compute_boxes(const bvhlab_build_input *in, bvhlab_build_output *o)
+/* Inner boxes bottom-up (leaf boxes are written with the leaves); a
+ * reverse scan, since children follow their parents. */
+static void compute_boxes(bvhlab_build_output *o)
 {
 	for (uint32_t i = o->node_count; i-- > 0;) {
 		bvhlab_node *n = &o->nodes[i];
 		bvhlab_aabb box;
+		if (n->count != 0)
+			continue;
 		bvhlab_aabb_empty(&box);
-		if (n->count == 0) {
-			bvhlab_aabb_grow_corners(&box, o->nodes[n->first].lo, o->nodes[n->first].hi);
-			bvhlab_aabb_grow_corners(&box, o->nodes[n->first + 1].lo,
-			                         o->nodes[n->first + 1].hi);
-		}
-		for (uint32_t s = n->first; n->count && s < n->first + n->count; s++)
-			bvhlab_aabb_grow(&box, &in->prim_bounds[o->prim_index[s]]);
+		bvhlab_aabb_grow_corners(&box, o->nodes[n->first].lo, o->nodes[n->first].hi);
+		bvhlab_aabb_grow_corners(&box, o->nodes[n->first + 1].lo, o->nodes[n->first + 1].hi);
 		memcpy(n->lo, box.lo, sizeof(n->lo));
 		memcpy(n->hi, box.hi, sizeof(n->hi));
 	}
 }
 
-int embree_write_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                      const bvhlab_build_input *input, const tnode *root,
+int embree_write_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const tnode *root,
                       bvhlab_build_output *out)
 {
 	writer w = {.host = host, .ctx = ctx, .out = out};
 	int rc = write_nodes(&w, root);
 	free(w.stack);
 	if (rc == 0)
-		compute_boxes(input, out);
+		compute_boxes(out);
 	return rc;
 }

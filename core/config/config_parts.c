@@ -1,0 +1,132 @@
+/*
+ * Composite scenes in configs: a scene whose "parts" are meshes or
+ * generators, each placed with "scale", "rotate" (degrees about x, y, z)
+ * and "translate" and optionally subdivided, merged into one scene when it
+ * is loaded (harness_load_scene).
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "config/config_internal.h"
+
+/* A [x, y, z] array of finite numbers (|v| <= 1e30) into out; absent keeps out. */
+static int get_vec3(const struct config *cfg, const cJSON *obj, const char *key,
+                    const char *prefix, double out[3], bvhlab_error *err)
+{
+	const cJSON *item = config_member(obj, key), *e;
+	char got[48];
+	double v[3];
+	int k = 0;
+
+	if (!item)
+		return 0;
+	if (cJSON_IsArray(item) && cJSON_GetArraySize(item) == 3) {
+		cJSON_ArrayForEach(e, item) {
+			if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) ||
+			    fabs(e->valuedouble) > 1e30)
+				break;
+			v[k++] = e->valuedouble;
+		}
+	}
+	if (k != 3)
+		return config_error(cfg, item, false, err,
+		                    "'%s%s' must be an array of 3 finite numbers, not %s", prefix,
+		                    key, config_describe(cfg, item, got, sizeof(got)));
+	memcpy(out, v, sizeof(v));
+	return 0;
+}
+
+static int part_path(struct config *cfg, struct config_scene *src, bvhlab_error *err)
+{
+	char *resolved;
+
+	if (!src->path)
+		return 0;
+	if (config_resolve(cfg, src->path, &resolved)) {
+		error_set(err, "%s: out of memory", cfg->path);
+		return -ENOMEM;
+	}
+	free(src->path);
+	src->path = resolved;
+	return 0;
+}
+
+static int parse_part(struct config *cfg, const cJSON *obj, const char *scene_prefix,
+                      size_t index, struct config_part *part, bvhlab_error *err)
+{
+	char prefix[2 * CONFIG_NAME_SIZE], where[2 * CONFIG_NAME_SIZE], got[48];
+	int rc;
+
+	snprintf(prefix, sizeof(prefix), "%sparts[%zu].", scene_prefix, index);
+	snprintf(where, sizeof(where), "in %sparts[%zu]", scene_prefix, index);
+	if (!cJSON_IsObject(obj))
+		return config_error(cfg, obj, false, err, "'%.*s' must be an object, not %s",
+		                    (int)strlen(prefix) - 1, prefix,
+		                    config_describe(cfg, obj, got, sizeof(got)));
+	bvhlab_gen_params_init(&part->src.gen);
+	bvhlab_transform_init(&part->xf);
+	rc = config_check_keys(cfg, obj, config_part_keys, where, err);
+	if (!rc)
+		rc = config_read_keys(cfg, obj, config_part_keys, prefix, part, err);
+	if (!rc)
+		rc = config_scene_source(cfg, obj, prefix, config_part_keys, &part->src, err);
+	if (!rc)
+		rc = get_vec3(cfg, obj, "rotate", prefix, part->xf.rotate, err);
+	if (!rc)
+		rc = get_vec3(cfg, obj, "translate", prefix, part->xf.translate, err);
+	return rc ? rc : part_path(cfg, &part->src, err);
+}
+
+/* A composite's own source keys would be silently ignored: refuse them. */
+static int no_own_source(struct config *cfg, const cJSON *obj, const char *prefix,
+                         bvhlab_error *err)
+{
+	for (const struct config_key *k = config_scene_keys; k->name; k++) {
+		const cJSON *item = config_member(obj, k->name);
+		bool source = strcmp(k->name, "path") == 0 || strcmp(k->name, "generator") == 0;
+		if (item && (source || (k->flags & CONFIG_GENERATED)))
+			return config_error(cfg, item, true, err,
+			                    "'%s%s' does not apply to a scene with 'parts': give it "
+			                    "to a part", prefix, k->name);
+	}
+	return 0;
+}
+
+int config_parse_parts(struct config *cfg, const cJSON *obj, const char *prefix,
+                       struct config_scene *sc, bvhlab_error *err)
+{
+	const cJSON *parts = config_member(obj, "parts");
+	char got[48];
+	size_t n, i = 0;
+	int rc = no_own_source(cfg, obj, prefix, err);
+
+	if (rc)
+		return rc;
+	if (!cJSON_IsArray(parts) || (n = (size_t)cJSON_GetArraySize(parts)) == 0)
+		return config_error(cfg, parts, false, err,
+		                    "'%sparts' must be a non-empty array of parts, not %s", prefix,
+		                    config_describe(cfg, parts, got, sizeof(got)));
+	sc->parts = calloc(n, sizeof(*sc->parts));
+	if (!sc->parts) {
+		error_set(err, "%s: out of memory", cfg->path);
+		return -ENOMEM;
+	}
+	sc->part_count = n; /* before filling, so config_parts_free frees what was filled */
+	for (const cJSON *e = parts->child; e && !rc; e = e->next, i++)
+		rc = parse_part(cfg, e, prefix, i, &sc->parts[i], err);
+	return rc;
+}
+
+void config_parts_free(struct config_scene *sc)
+{
+	for (size_t i = 0; sc->parts && i < sc->part_count; i++) {
+		free(sc->parts[i].src.path);
+		free(sc->parts[i].src.generator);
+	}
+	free(sc->parts);
+	sc->parts = NULL;
+	sc->part_count = 0;
+}

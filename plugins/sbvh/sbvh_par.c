@@ -1,0 +1,339 @@
+/*
+ * The sbvh plugin's schedule: jobs of at least parallel_min references are
+ * split by every thread together (each bins, counts and partitions its
+ * share of the references; bins merge by box union and count sums, and
+ * shares are written at prefix-summed offsets, so the result is what one
+ * thread would write), breadth first; the smaller jobs left over are then
+ * built as whole subtrees, largest first, one per thread at a time.
+ *
+ * The same jobs take the same path whatever the thread count (a single
+ * thread runs the team path with one share), so the tree is the same.
+ */
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sbvh.h"
+
+enum phase { PH_OBJECT, PH_SPATIAL, PH_COUNT, PH_WRITE };
+
+typedef struct member {
+	struct team *team;
+	uint32_t t;
+	uint32_t begin, end;   /* its share of the job's references */
+	uint32_t nl, nr;       /* PH_COUNT */
+	uint32_t lout, rout;   /* PH_WRITE: where its share goes */
+	sbvh_job l, r;         /* PH_WRITE: boxes of what it wrote */
+	sbvh_bins bins;
+} member;
+
+typedef struct team {
+	sbvh_build *B;
+	const sbvh_job *job;
+	const sbvh_split *split;
+	enum phase phase;
+	member *m;             /* [B->threads] */
+} team;
+
+static void child_empty(sbvh_job *j)
+{
+	for (int k = 0; k < 3; k++) {
+		j->lo[k] = j->clo[k] = INFINITY;
+		j->hi[k] = j->chi[k] = -INFINITY;
+	}
+}
+
+static void grow_job(sbvh_job *j, const sbvh_ref *r)
+{
+	for (int k = 0; k < 3; k++) {
+		float c = 0.5f * (r->lo[k] + r->hi[k]);
+		j->lo[k] = r->lo[k] < j->lo[k] ? r->lo[k] : j->lo[k];
+		j->hi[k] = r->hi[k] > j->hi[k] ? r->hi[k] : j->hi[k];
+		j->clo[k] = c < j->clo[k] ? c : j->clo[k];
+		j->chi[k] = c > j->chi[k] ? c : j->chi[k];
+	}
+}
+
+static unsigned side_of(const team *tm, uint32_t i, sbvh_ref *l, sbvh_ref *r)
+{
+	const sbvh_ref *ref = &tm->B->refs[tm->job->buf][i];
+
+	if (tm->split->kind == SPLIT_MEDIAN) {
+		*l = *r = *ref;
+		return i < tm->job->begin + (tm->job->end - tm->job->begin) / 2 ? 1u : 2u;
+	}
+	return sbvh_place(tm->B, tm->split, ref, l, r);
+}
+
+static void count_share(member *m)
+{
+	sbvh_ref l, r;
+
+	m->nl = m->nr = 0;
+	for (uint32_t i = m->begin; i < m->end; i++) {
+		unsigned side = side_of(m->team, i, &l, &r);
+		m->nl += (side & 1) != 0;
+		m->nr += (side & 2) != 0;
+	}
+}
+
+static void write_share(member *m)
+{
+	sbvh_ref *out = m->team->B->refs[!m->team->job->buf], l, r;
+	uint32_t li = m->lout, ri = m->rout;
+
+	child_empty(&m->l);
+	child_empty(&m->r);
+	for (uint32_t i = m->begin; i < m->end; i++) {
+		unsigned side = side_of(m->team, i, &l, &r);
+		if (side & 1) {
+			out[li++] = l;
+			grow_job(&m->l, &l);
+		}
+		if (side & 2) {
+			out[ri++] = r;
+			grow_job(&m->r, &r);
+		}
+	}
+}
+
+static void *run_share(void *arg)
+{
+	member *m = arg;
+	team *tm = m->team;
+
+	switch (tm->phase) {
+	case PH_OBJECT:
+		sbvh_bin_object(tm->B, tm->job, tm->job->clo, tm->job->chi, m->begin, m->end,
+		                &m->bins);
+		break;
+	case PH_SPATIAL:
+		sbvh_bin_spatial(tm->B, tm->job, m->begin, m->end, &m->bins);
+		break;
+	case PH_COUNT:
+		count_share(m);
+		break;
+	case PH_WRITE:
+		write_share(m);
+		break;
+	}
+	return NULL;
+}
+
+/* Every member runs the phase on its share; the caller is member 0. A
+ * thread that cannot start has its share run here instead. */
+static void run_phase(team *tm, enum phase phase)
+{
+	uint32_t T = tm->B->threads;
+	pthread_t tid[T];
+	bool started[T];
+
+	tm->phase = phase;
+	for (uint32_t t = 1; t < T; t++)
+		started[t] = pthread_create(&tid[t], NULL, run_share, &tm->m[t]) == 0;
+	run_share(&tm->m[0]);
+	for (uint32_t t = 1; t < T; t++) {
+		if (started[t])
+			pthread_join(tid[t], NULL);
+		else
+			run_share(&tm->m[t]);
+	}
+}
+
+/* A share's boxes into the child's. */
+static void unite_job(sbvh_job *to, const sbvh_job *from)
+{
+	for (int k = 0; k < 3; k++) {
+		to->lo[k] = from->lo[k] < to->lo[k] ? from->lo[k] : to->lo[k];
+		to->hi[k] = from->hi[k] > to->hi[k] ? from->hi[k] : to->hi[k];
+		to->clo[k] = from->clo[k] < to->clo[k] ? from->clo[k] : to->clo[k];
+		to->chi[k] = from->chi[k] > to->chi[k] ? from->chi[k] : to->chi[k];
+	}
+}
+
+static void merge_bins(team *tm)
+{
+	for (uint32_t t = 1; t < tm->B->threads; t++)
+		sbvh_bins_merge(&tm->m[0].bins, &tm->m[t].bins, tm->B->opt.bins);
+}
+
+/* Counts every share under split s; false when the result overflows the
+ * job's region. */
+static bool count_all(team *tm, const sbvh_split *s, uint32_t *nl, uint32_t *nr)
+{
+	uint64_t l = 0, r = 0;
+
+	tm->split = s;
+	run_phase(tm, PH_COUNT);
+	for (uint32_t t = 0; t < tm->B->threads; t++)
+		l += tm->m[t].nl, r += tm->m[t].nr;
+	*nl = (uint32_t)l;
+	*nr = (uint32_t)r;
+	return l + r <= tm->job->rend - tm->job->rbegin;
+}
+
+static void decide(team *tm, sbvh_split *obj, sbvh_split *best)
+{
+	run_phase(tm, PH_OBJECT);
+	merge_bins(tm);
+	sbvh_choose_object(tm->B, tm->job, &tm->m[0].bins, obj);
+	*best = *obj;
+	if (sbvh_want_spatial(tm->B, tm->job, obj)) {
+		run_phase(tm, PH_SPATIAL);
+		merge_bins(tm);
+		sbvh_choose_spatial(tm->B, tm->job, &tm->m[0].bins, best);
+	}
+	sbvh_choose_final(tm->B, tm->job, best);
+	sbvh_choose_final(tm->B, tm->job, obj);
+}
+
+/* Splits a big job with the whole team; false if it became a leaf. */
+static bool team_split(team *tm, const sbvh_job *job, sbvh_job *left, sbvh_job *right)
+{
+	uint32_t T = tm->B->threads, n = job->end - job->begin, nl, nr;
+	sbvh_split obj, best;
+
+	tm->job = job;
+	for (uint32_t t = 0; t < T; t++) {
+		tm->m[t].begin = job->begin + (uint32_t)((uint64_t)n * t / T);
+		tm->m[t].end = job->begin + (uint32_t)((uint64_t)n * (t + 1) / T);
+	}
+	decide(tm, &obj, &best);
+	if (best.kind != SPLIT_LEAF && !count_all(tm, &best, &nl, &nr)) {
+		best = obj;
+		if (best.kind != SPLIT_LEAF)
+			count_all(tm, &best, &nl, &nr);
+	}
+	if (best.kind == SPLIT_LEAF) {
+		sbvh_write_leaf(tm->B, job);
+		return false;
+	}
+	if (best.kind == SPLIT_SPATIAL)
+		atomic_fetch_add_explicit(&tm->B->spatial, 1, memory_order_relaxed);
+	sbvh_make_children(tm->B, job, nl, nr, left, right);
+	for (uint32_t t = 0, lo = left->begin, ro = right->begin; t < T; t++) {
+		tm->m[t].lout = lo;
+		tm->m[t].rout = ro;
+		lo += tm->m[t].nl;
+		ro += tm->m[t].nr;
+	}
+	run_phase(tm, PH_WRITE);
+	for (uint32_t t = 0; t < T; t++) {
+		unite_job(left, &tm->m[t].l);
+		unite_job(right, &tm->m[t].r);
+	}
+	return true;
+}
+
+/* A growable list of jobs. */
+typedef struct job_list {
+	sbvh_job *jobs;
+	size_t n, cap;
+} job_list;
+
+static int push(job_list *l, const sbvh_job *j)
+{
+	if (l->n == l->cap) {
+		size_t cap = l->cap ? 2 * l->cap : 64;
+		sbvh_job *grown = realloc(l->jobs, cap * sizeof(*grown));
+		if (!grown)
+			return -ENOMEM;
+		l->jobs = grown;
+		l->cap = cap;
+	}
+	l->jobs[l->n++] = *j;
+	return 0;
+}
+
+/* Largest first, so a big subtree does not start last. */
+static int by_size(const void *a, const void *b)
+{
+	const sbvh_job *x = a, *y = b;
+	uint32_t nx = x->end - x->begin, ny = y->end - y->begin;
+
+	return (nx < ny) - (nx > ny);
+}
+
+/* The big jobs, breadth first with the whole team; the rest into `small`. */
+static int top_phase(team *tm, const sbvh_job *root, job_list *small)
+{
+	job_list big = { 0 };
+	size_t next = 0;
+	int rc = push(&big, root);
+
+	while (rc == 0 && next < big.n) {
+		sbvh_job job = big.jobs[next++], child[2];
+		if (!team_split(tm, &job, &child[0], &child[1]))
+			continue;
+		for (int c = 0; c < 2 && rc == 0; c++)
+			rc = push(child[c].end - child[c].begin >= tm->B->opt.parallel_min ? &big
+			                                                                  : small,
+			          &child[c]);
+	}
+	free(big.jobs);
+	return rc;
+}
+
+typedef struct worker {
+	sbvh_build *B;
+	const job_list *small;
+	_Atomic size_t *next;
+	int rc;
+	sbvh_bins bins;
+} worker;
+
+static void *run_worker(void *arg)
+{
+	worker *w = arg;
+	size_t i;
+
+	while (w->rc == 0 &&
+	       (i = atomic_fetch_add_explicit(w->next, 1, memory_order_relaxed)) < w->small->n)
+		w->rc = sbvh_build_subtree(w->B, &w->small->jobs[i], &w->bins);
+	return NULL;
+}
+
+static int task_phase(sbvh_build *B, job_list *small)
+{
+	uint32_t T = B->threads;
+	worker *w = calloc(T, sizeof(*w));
+	pthread_t tid[T];
+	bool started[T];
+	_Atomic size_t next = 0;
+	int rc = 0;
+
+	if (!w)
+		return -ENOMEM;
+	qsort(small->jobs, small->n, sizeof(*small->jobs), by_size);
+	for (uint32_t t = 0; t < T; t++)
+		w[t] = (worker){ .B = B, .small = small, .next = &next };
+	for (uint32_t t = 1; t < T; t++)
+		started[t] = pthread_create(&tid[t], NULL, run_worker, &w[t]) == 0;
+	run_worker(&w[0]);
+	for (uint32_t t = 0; t < T; t++) {
+		if (t > 0 && started[t])
+			pthread_join(tid[t], NULL);
+		rc = rc ? rc : w[t].rc;
+	}
+	free(w);
+	return rc;
+}
+
+int sbvh_build_all(sbvh_build *B, const sbvh_job *root)
+{
+	team tm = { .B = B, .m = calloc(B->threads, sizeof(member)) };
+	job_list small = { 0 };
+	int rc = tm.m ? 0 : -ENOMEM;
+
+	for (uint32_t t = 0; rc == 0 && t < B->threads; t++)
+		tm.m[t] = (member){ .team = &tm, .t = t };
+	if (rc == 0)
+		rc = top_phase(&tm, root, &small);
+	if (rc == 0)
+		rc = task_phase(B, &small);
+	free(tm.m);
+	free(small.jobs);
+	return rc;
+}

@@ -1,0 +1,356 @@
+/*
+ * Choosing a split for the sbvh plugin: binned object splits over the
+ * references' centroids, binned spatial splits over the node's box with
+ * every reference clipped exactly into the bins it crosses, Stich's alpha
+ * test for when spatial splits are worth trying, and reference
+ * unsplitting when a cut reference is cheaper left whole on one side.
+ *
+ * Costs are SAH in units of the node's area with c_trav = c_isect = 1:
+ * 1 + (A_L * N_L + A_R * N_R) / A, against N for a leaf.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "sbvh.h"
+#include "tri_clip.h"
+
+static inline float minf(float a, float b)
+{
+	return a < b ? a : b;
+}
+
+static inline float maxf(float a, float b)
+{
+	return a > b ? a : b;
+}
+
+static double area(const float lo[3], const float hi[3])
+{
+	double d[3];
+
+	for (int k = 0; k < 3; k++)
+		d[k] = hi[k] > lo[k] ? (double)hi[k] - lo[k] : 0.0;
+	return 2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
+}
+
+static void grow(float lo[3], float hi[3], const float *blo, const float *bhi)
+{
+	for (int k = 0; k < 3; k++) {
+		lo[k] = minf(lo[k], blo[k]);
+		hi[k] = maxf(hi[k], bhi[k]);
+	}
+}
+
+static void empty(float lo[3], float hi[3])
+{
+	for (int k = 0; k < 3; k++)
+		lo[k] = INFINITY, hi[k] = -INFINITY;
+}
+
+void sbvh_bins_clear(sbvh_bins *b, uint32_t bins)
+{
+	for (int a = 0; a < 3; a++)
+		for (uint32_t i = 0; i < bins; i++) {
+			empty(b->lo[a][i], b->hi[a][i]);
+			b->count[a][i] = b->exits[a][i] = 0;
+		}
+}
+
+void sbvh_bins_merge(sbvh_bins *to, const sbvh_bins *from, uint32_t bins)
+{
+	for (int a = 0; a < 3; a++)
+		for (uint32_t i = 0; i < bins; i++) {
+			grow(to->lo[a][i], to->hi[a][i], from->lo[a][i], from->hi[a][i]);
+			to->count[a][i] += from->count[a][i];
+			to->exits[a][i] += from->exits[a][i];
+		}
+}
+
+void sbvh_centroid_bounds(const sbvh_build *B, const sbvh_job *job, uint32_t begin,
+                          uint32_t end, float clo[3], float chi[3])
+{
+	const sbvh_ref *refs = B->refs[job->buf];
+
+	empty(clo, chi);
+	for (uint32_t i = begin; i < end; i++)
+		for (int k = 0; k < 3; k++) {
+			float c = 0.5f * (refs[i].lo[k] + refs[i].hi[k]);
+			clo[k] = minf(clo[k], c);
+			chi[k] = maxf(chi[k], c);
+		}
+}
+
+/* Centroid bin along axis k; the same function bins and places. */
+static uint32_t object_bin(const sbvh_ref *r, int k, float clo, float scale, uint32_t bins)
+{
+	float c = 0.5f * (r->lo[k] + r->hi[k]);
+	int64_t i = (int64_t)((c - clo) * scale);
+
+	return i < 0 ? 0 : i >= (int64_t)bins ? bins - 1 : (uint32_t)i;
+}
+
+static float object_scale(const float clo[3], const float chi[3], int k, uint32_t bins)
+{
+	float ext = chi[k] - clo[k];
+
+	return ext > 0.0f ? (float)bins * 0.99999f / ext : 0.0f;
+}
+
+void sbvh_bin_object(const sbvh_build *B, const sbvh_job *job, const float clo[3],
+                     const float chi[3], uint32_t begin, uint32_t end, sbvh_bins *b)
+{
+	const sbvh_ref *refs = B->refs[job->buf];
+	uint32_t bins = B->opt.bins;
+
+	sbvh_bins_clear(b, bins);
+	for (int k = 0; k < 3; k++) {
+		float scale = object_scale(clo, chi, k, bins);
+
+		for (uint32_t i = begin; i < end; i++) {
+			uint32_t j = object_bin(&refs[i], k, clo[k], scale, bins);
+
+			grow(b->lo[k][j], b->hi[k][j], refs[i].lo, refs[i].hi);
+			b->count[k][j]++;
+		}
+	}
+}
+
+/* The plane between spatial bins j and j + 1 along axis k. */
+static float plane(const sbvh_job *job, int k, uint32_t j, uint32_t bins)
+{
+	return job->lo[k] + (job->hi[k] - job->lo[k]) * ((float)(j + 1) / (float)bins);
+}
+
+/* Spatial bin of coordinate x along k, made consistent with plane(). */
+static uint32_t spatial_bin(const sbvh_job *job, int k, float x, uint32_t bins)
+{
+	float ext = job->hi[k] - job->lo[k];
+	int64_t i = (int64_t)((x - job->lo[k]) * ((float)bins / ext));
+	uint32_t j = i < 0 ? 0 : i >= (int64_t)bins ? bins - 1 : (uint32_t)i;
+
+	while (j > 0 && x < plane(job, k, j - 1, bins))
+		j--;
+	while (j + 1 < bins && x > plane(job, k, j, bins))
+		j++;
+	return j;
+}
+
+/* Adds the points where the triangle's edges cross x[k] = at. */
+static void add_crossings(const float v[3][3], int k, float at, float lo[3], float hi[3])
+{
+	for (int e = 0; e < 3; e++) {
+		const float *a = v[e], *b = v[e == 2 ? 0 : e + 1];
+		if (!((a[k] < at && at < b[k]) || (b[k] < at && at < a[k])))
+			continue;
+		float t = (at - a[k]) / (b[k] - a[k]), p[3];
+		for (int m = 0; m < 3; m++)
+			p[m] = a[m] + t * (b[m] - a[m]);
+		p[k] = at;
+		grow(lo, hi, p, p);
+	}
+}
+
+/*
+ * A reference crossing bins b0 < b1 along k: the box of its triangle's
+ * part in each bin's slab, cut down to the reference's box. Binning only
+ * estimates a split's cost, so this is Embree's cheap bound (the slab
+ * piece of the whole triangle, O(1) per plane from the edges' crossings)
+ * instead of clipping the reference's polygon; the references a split
+ * actually cuts are clipped exactly (sbvh_place). Float rounding here
+ * only moves an estimate.
+ */
+static void clip_into_bins(const sbvh_build *B, const sbvh_job *job, const sbvh_ref *r,
+                           int k, uint32_t b0, uint32_t b1, sbvh_bins *b)
+{
+	const uint32_t *tri = &B->in->indices[3 * (size_t)r->prim];
+	uint32_t bins = B->opt.bins;
+	float v[3][3], below = -INFINITY;
+
+	for (int j = 0; j < 3; j++)
+		memcpy(v[j], &B->in->vertices[3 * (size_t)tri[j]], sizeof(v[j]));
+	for (uint32_t j = b0; j <= b1; j++) {
+		float above = j < b1 ? plane(job, k, j, bins) : INFINITY, lo[3], hi[3];
+		empty(lo, hi);
+		for (int m = 0; m < 3; m++)
+			if (below <= v[m][k] && v[m][k] <= above)
+				grow(lo, hi, v[m], v[m]);
+		if (j > b0)
+			add_crossings(v, k, below, lo, hi);
+		if (j < b1)
+			add_crossings(v, k, above, lo, hi);
+		for (int m = 0; m < 3; m++) {
+			lo[m] = maxf(lo[m], r->lo[m]);
+			hi[m] = minf(hi[m], r->hi[m]);
+		}
+		if (lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2])
+			grow(b->lo[k][j], b->hi[k][j], lo, hi);
+		below = above;
+	}
+	b->count[k][b0]++;
+	b->exits[k][b1]++;
+}
+
+void sbvh_bin_spatial(const sbvh_build *B, const sbvh_job *job, uint32_t begin,
+                      uint32_t end, sbvh_bins *b)
+{
+	const sbvh_ref *refs = B->refs[job->buf];
+	uint32_t bins = B->opt.bins;
+
+	sbvh_bins_clear(b, bins);
+	for (int k = 0; k < 3; k++) {
+		if (!(job->hi[k] > job->lo[k]))
+			continue;
+		for (uint32_t i = begin; i < end; i++) {
+			uint32_t b0 = spatial_bin(job, k, refs[i].lo[k], bins);
+			uint32_t b1 = spatial_bin(job, k, refs[i].hi[k], bins);
+
+			if (b0 == b1) {
+				grow(b->lo[k][b0], b->hi[k][b0], refs[i].lo, refs[i].hi);
+				b->count[k][b0]++;
+				b->exits[k][b0]++;
+			} else {
+				clip_into_bins(B, job, &refs[i], k, b0, b1, b);
+			}
+		}
+	}
+}
+
+/* Sweeps one axis's bins: the best boundary by SAH. enter/leave: counts of
+ * the left side (bins <= j) and right side (bins > j). */
+static void sweep(const sbvh_bins *b, int k, uint32_t bins, const uint32_t *enter,
+                  const uint32_t *leave, double inv_area, sbvh_split *best, int kind)
+{
+	float rlo[SBVH_MAX_BINS][3], rhi[SBVH_MAX_BINS][3], lo[3], hi[3];
+	uint32_t rn[SBVH_MAX_BINS], n = 0;
+
+	empty(lo, hi);
+	for (uint32_t j = bins; j-- > 1;) {
+		grow(lo, hi, b->lo[k][j], b->hi[k][j]);
+		n += leave[j];
+		memcpy(rlo[j], lo, sizeof(lo));
+		memcpy(rhi[j], hi, sizeof(hi));
+		rn[j] = n;
+	}
+	empty(lo, hi);
+	n = 0;
+	for (uint32_t j = 0; j + 1 < bins; j++) {
+		grow(lo, hi, b->lo[k][j], b->hi[k][j]);
+		n += enter[j];
+		if (n == 0 || rn[j + 1] == 0)
+			continue;
+		double cost = 1.0 + (area(lo, hi) * n + area(rlo[j + 1], rhi[j + 1]) * rn[j + 1]) *
+		                        inv_area;
+		if (cost < best->cost) {
+			best->cost = cost;
+			best->kind = kind;
+			best->axis = k;
+			best->bin = j;
+			best->nl = n;
+			best->nr = rn[j + 1];
+			memcpy(best->llo, lo, sizeof(lo));
+			memcpy(best->lhi, hi, sizeof(hi));
+			memcpy(best->rlo, rlo[j + 1], sizeof(lo));
+			memcpy(best->rhi, rhi[j + 1], sizeof(hi));
+		}
+	}
+}
+
+void sbvh_best_object(const sbvh_build *B, const sbvh_job *job, const sbvh_bins *b,
+                      const float clo[3], const float chi[3], sbvh_split *s)
+{
+	double a = area(job->lo, job->hi), inv = a > 0.0 ? 1.0 / a : 0.0;
+
+	for (int k = 0; k < 3; k++)
+		if (chi[k] > clo[k])
+			sweep(b, k, B->opt.bins, b->count[k], b->count[k], inv, s, SPLIT_OBJECT);
+	memcpy(s->clo, clo, sizeof(s->clo));
+	memcpy(s->chi, chi, sizeof(s->chi));
+}
+
+void sbvh_best_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_bins *b,
+                       sbvh_split *s)
+{
+	double a = area(job->lo, job->hi), inv = a > 0.0 ? 1.0 / a : 0.0;
+	int kind = s->kind;
+
+	for (int k = 0; k < 3; k++)
+		if (job->hi[k] > job->lo[k])
+			sweep(b, k, B->opt.bins, b->count[k], b->exits[k], inv, s, SPLIT_SPATIAL);
+	if (s->kind == SPLIT_SPATIAL && kind != SPLIT_SPATIAL)
+		s->pos = plane(job, s->axis, s->bin, B->opt.bins);
+}
+
+bool sbvh_try_spatial(const sbvh_build *B, const sbvh_split *s)
+{
+	float lo[3], hi[3];
+
+	if (s->kind != SPLIT_OBJECT)
+		return true; /* no object split at all: maybe a spatial one */
+	for (int k = 0; k < 3; k++) {
+		lo[k] = maxf(s->llo[k], s->rlo[k]);
+		hi[k] = minf(s->lhi[k], s->rhi[k]);
+		if (!(hi[k] >= lo[k]))
+			return false;
+	}
+	return area(lo, hi) > B->opt.alpha * B->root_area;
+}
+
+/* Stich's reference unsplitting: 1 (all left), 2 (all right) or 3 (cut). */
+static unsigned unsplit(const sbvh_split *s, const sbvh_ref *r)
+{
+	float lo[3], hi[3];
+	double al = area(s->llo, s->lhi), ar = area(s->rlo, s->rhi);
+	double cut = al * s->nl + ar * s->nr, to_left, to_right;
+
+	memcpy(lo, s->llo, sizeof(lo));
+	memcpy(hi, s->lhi, sizeof(hi));
+	grow(lo, hi, r->lo, r->hi);
+	to_left = area(lo, hi) * s->nl + ar * (s->nr - 1);
+	memcpy(lo, s->rlo, sizeof(lo));
+	memcpy(hi, s->rhi, sizeof(hi));
+	grow(lo, hi, r->lo, r->hi);
+	to_right = al * (s->nl - 1) + area(lo, hi) * s->nr;
+	if (to_left < cut && to_left <= to_right)
+		return 1;
+	return to_right < cut ? 2 : 3;
+}
+
+static void set_box(sbvh_ref *to, const sbvh_ref *from, const bvhlab_aabb *box)
+{
+	*to = *from;
+	memcpy(to->lo, box->lo, sizeof(to->lo));
+	memcpy(to->hi, box->hi, sizeof(to->hi));
+}
+
+unsigned sbvh_place(const sbvh_build *B, const sbvh_split *s, const sbvh_ref *ref,
+                    sbvh_ref *l, sbvh_ref *r)
+{
+	int k = s->axis;
+	unsigned side;
+
+	if (s->kind == SPLIT_OBJECT) {
+		float scale = object_scale(s->clo, s->chi, k, B->opt.bins);
+		side = object_bin(ref, k, s->clo[k], scale, B->opt.bins) <= s->bin ? 1 : 2;
+	} else {
+		side = ref->hi[k] <= s->pos ? 1 : ref->lo[k] >= s->pos ? 2 : unsplit(s, ref);
+	}
+	if (side != 3) {
+		*(side == 1 ? l : r) = *ref;
+		return side;
+	}
+	const bvhlab_aabb box = { { ref->lo[0], ref->lo[1], ref->lo[2] },
+		                  { ref->hi[0], ref->hi[1], ref->hi[2] } };
+	bvhlab_aabb lb, rb;
+	tri_clip_split(B->in->vertices, &B->in->indices[3 * (size_t)ref->prim], &box, k, s->pos,
+	               &lb, &rb);
+	bool has_l = lb.lo[0] <= lb.hi[0], has_r = rb.lo[0] <= rb.hi[0];
+	if (has_l)
+		set_box(l, ref, &lb);
+	if (has_r)
+		set_box(r, ref, &rb);
+	if (!has_l && !has_r)
+		*l = *ref; /* rounding lost the triangle: keep the reference whole */
+	/* Rounding can leave a reference straddling the plane with nothing of
+	 * its triangle on one side: it goes to the other side only. */
+	return has_l && has_r ? 3 : has_r ? 2 : 1;
+}
