@@ -6,7 +6,7 @@
 #include <sys/stat.h>
 
 #include "cli.h"
-#include "harness.h"
+#include "harness/harness.h"
 
 int cli_parse_uint(const char *opt, const char *text, unsigned long max, unsigned long *out)
 {

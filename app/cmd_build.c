@@ -4,7 +4,7 @@
 #include <stdlib.h>
 
 #include "cli.h"
-#include "harness.h"
+#include "harness/harness.h"
 
 #define MAX_OPTIONS 64
 

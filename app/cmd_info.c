@@ -6,7 +6,7 @@
 #include <cJSON.h>
 
 #include "cli.h"
-#include "machine.h"
+#include "machine/machine.h"
 
 static const char usage[] =
 	"usage: bvhlab info SCENE [--subdivide K] [--json]\n"

@@ -6,9 +6,9 @@
 #include <string.h>
 
 #include "cli.h"
-#include "harness.h"
-#include "image.h"
-#include "results.h"
+#include "harness/harness.h"
+#include "output/image.h"
+#include "output/results.h"
 
 #define MAX_OPTIONS 64
 

@@ -5,8 +5,8 @@
 #include <string.h>
 
 #include "cli.h"
-#include "config.h"
-#include "harness.h"
+#include "config/config.h"
+#include "harness/harness.h"
 
 #define MAX_THREAD_COUNTS 64
 

@@ -9,7 +9,7 @@
 
 #include <bvhlab/plugin.h>
 
-#include "config.h"
+#include "config/config.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

@@ -2,7 +2,7 @@
 #include <stdint.h>
 
 #include "fuzz_input.h"
-#include "scene_private.h"
+#include "scene/scene_private.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

@@ -17,7 +17,7 @@
 
 #include <bvhlab/bvhlab.h>
 
-#include "config.h"
+#include "config/config.h"
 #include "scene_files.h"
 #include "testutil.h"
 

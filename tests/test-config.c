@@ -12,8 +12,8 @@
 
 #include <cJSON.h>
 
-#include "config.h"
-#include "json_locate.h"
+#include "config/config.h"
+#include "config/json_locate.h"
 #include "testutil.h"
 
 #define SCENES "\"scenes\": [ { \"generator\": \"icosphere\" } ]"

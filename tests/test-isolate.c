@@ -12,7 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "isolate.h"
+#include "harness/isolate.h"
 #include "testutil.h"
 
 #define BIG (1u << 20) /* 16 pipe buffers */

@@ -12,8 +12,8 @@
 #include <bvhlab/bvhlab.h>
 #include <bvhlab/rays.h>
 
-#include "harness.h"
-#include "image.h"
+#include "harness/harness.h"
+#include "output/image.h"
 #include "testutil.h"
 
 #define W 48

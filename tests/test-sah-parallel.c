@@ -18,7 +18,7 @@
 
 #include <bvhlab/bvhlab.h>
 
-#include "results.h"
+#include "output/results.h"
 #include "testutil.h"
 
 #define FIXTURE_SEED 11

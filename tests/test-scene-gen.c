@@ -9,7 +9,7 @@
 
 #include <bvhlab/scene.h>
 
-#include "scene_private.h"
+#include "scene/scene_private.h"
 #include "testutil.h"
 
 static bvhlab_scene *generate(const char *name, const bvhlab_gen_params *params)

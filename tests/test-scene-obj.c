@@ -10,7 +10,7 @@
 
 #include <bvhlab/scene.h>
 
-#include "scene_private.h"
+#include "scene/scene_private.h"
 #include "scene_files.h"
 #include "testutil.h"
 

@@ -11,7 +11,7 @@
 
 #include <bvhlab/bvhlab.h>
 
-#include "machine.h"
+#include "machine/machine.h"
 #include "testutil.h"
 
 static cpu_set_t original;

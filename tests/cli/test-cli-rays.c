@@ -8,7 +8,7 @@
 #include <stdint.h>
 
 #include "cliutil.h"
-#include "image.h"
+#include "output/image.h"
 
 static const char config[] =
 	"{ \"format_version\": 1, \"output\": \"out-rays\", \"repeat\": 1, \"threads\": [1, 2],\n"

@@ -1,0 +1,310 @@
+/*
+ * Experiment configs: reading the file, the top-level keys, defaults and
+ * cleanup. Scenes and builders are in config_entries.c, the checking
+ * helpers in config_check.c.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "config/config_internal.h"
+#include "config/json_locate.h"
+
+#define DEFAULT_OUTPUT "results"
+/* Image sides beyond this are mistakes, and width * height stays far from 2^32. */
+#define MAX_RAY_SIDE 16384
+#define MAX_DIFFUSE 1024
+#define READ_CHUNK 65536
+/* Generous: a run that takes longer is stuck rather than slow. */
+#define DEFAULT_TIMEOUT_S 600
+
+static const char *const top_keys[] = {
+	"format_version", "output", "repeat", "warmup", "threads", "validate",
+	"validate_rays", "rays", "images", "isolate", "timeout_s", "memory_limit_mb", "pin",
+	"scenes", "builders", NULL,
+};
+static const char *const ray_keys[] = { "width", "height", "diffuse", "camera", NULL };
+
+static int out_of_memory(const char *path, bvhlab_error *err)
+{
+	error_set(err, "%s: out of memory", path);
+	return -ENOMEM;
+}
+
+static int set_defaults(struct config *cfg)
+{
+	cfg->format_version = 1;
+	cfg->repeat = 5;
+	cfg->warmup = 1;
+	cfg->validate = true;
+	cfg->validate_rays = 256;
+	cfg->ray_width = 256;
+	cfg->ray_height = 256;
+	cfg->ray_diffuse = 1;
+	cfg->images = false;
+	cfg->isolate = true;
+	cfg->timeout_s = DEFAULT_TIMEOUT_S;
+	cfg->threads = malloc(sizeof(*cfg->threads));
+	if (!cfg->threads)
+		return -ENOMEM;
+	cfg->threads[0] = 1;
+	cfg->thread_count = 1;
+	return 0;
+}
+
+static char *folder_of(const char *path)
+{
+	const char *slash = strrchr(path, '/');
+	if (!slash)
+		return strdup(".");
+	if (slash == path)
+		return strdup("/");
+	return strndup(path, (size_t)(slash - path));
+}
+
+static int parse_format_version(struct config *cfg, bvhlab_error *err)
+{
+	const cJSON *item = config_member(cfg->root, "format_version");
+	uint64_t v = 0;
+	if (!item)
+		return 0;
+	if (!cJSON_IsNumber(item) || json_get_uint64(cfg->locations, item, &v) || v != 1) {
+		char got[48];
+		return config_error(cfg, item, false, err,
+		                    "'format_version' must be 1 (the version this bvhlab reads), not %s",
+		                    config_describe(cfg, item, got, sizeof(got)));
+	}
+	cfg->format_version = 1;
+	return 0;
+}
+
+static int parse_output(struct config *cfg, bvhlab_error *err)
+{
+	char *output = NULL;
+	int rc = config_get_string(cfg, cfg->root, "output", "", &output, err);
+	if (rc)
+		return rc;
+	rc = config_resolve(cfg, output ? output : DEFAULT_OUTPUT, &cfg->output);
+	free(output);
+	return rc ? out_of_memory(cfg->path, err) : 0;
+}
+
+static int parse_rays(struct config *cfg, bvhlab_error *err)
+{
+	const cJSON *rays = config_member(cfg->root, "rays");
+	if (!rays)
+		return 0;
+	if (!cJSON_IsObject(rays)) {
+		char got[48];
+		return config_error(cfg, rays, false, err,
+		                    "'rays' must be an object {width, height, diffuse, camera}, not %s",
+		                    config_describe(cfg, rays, got, sizeof(got)));
+	}
+	int rc = config_check_keys(cfg, rays, ray_keys, "in rays", err);
+	if (!rc)
+		rc = config_get_u32(cfg, rays, "width", "rays.", 1, MAX_RAY_SIDE, &cfg->ray_width, err);
+	if (!rc)
+		rc = config_get_u32(cfg, rays, "height", "rays.", 1, MAX_RAY_SIDE, &cfg->ray_height,
+		                    err);
+	if (!rc)
+		rc = config_get_u32(cfg, rays, "diffuse", "rays.", 0, MAX_DIFFUSE, &cfg->ray_diffuse,
+		                    err);
+	if (!rc)
+		rc = config_parse_camera(cfg, rays, err);
+	return rc;
+}
+
+static int parse_runs(struct config *cfg, bvhlab_error *err)
+{
+	const cJSON *root = cfg->root;
+	int rc = config_get_u32(cfg, root, "repeat", "", 1, UINT32_MAX, &cfg->repeat, err);
+	if (!rc)
+		rc = config_get_u32(cfg, root, "warmup", "", 0, UINT32_MAX, &cfg->warmup, err);
+	if (!rc)
+		rc = config_get_threads(cfg, root, "threads", "", &cfg->threads, &cfg->thread_count,
+		                        err);
+	if (!rc)
+		rc = config_get_bool(cfg, root, "validate", "", &cfg->validate, err);
+	if (!rc)
+		rc = config_get_u32(cfg, root, "validate_rays", "", 1, UINT32_MAX,
+		                    &cfg->validate_rays, err);
+	if (!rc)
+		rc = config_get_bool(cfg, root, "images", "", &cfg->images, err);
+	return rc;
+}
+
+static int parse_isolation(struct config *cfg, bvhlab_error *err)
+{
+	const cJSON *root = cfg->root;
+	int rc = config_get_bool(cfg, root, "isolate", "", &cfg->isolate, err);
+	if (!rc)
+		rc = config_get_positive(cfg, root, "timeout_s", "", &cfg->timeout_s, err);
+	if (!rc)
+		rc = config_get_uint(cfg, root, "memory_limit_mb", "", 1, CONFIG_MAX_MEMORY_MB,
+		                     &cfg->memory_limit_mb, err);
+	if (!rc)
+		rc = config_get_bool(cfg, root, "pin", "", &cfg->pin, err);
+	return rc;
+}
+
+static int parse_top(struct config *cfg, bvhlab_error *err)
+{
+	if (!cJSON_IsObject(cfg->root)) {
+		char got[48];
+		return config_error(cfg, cfg->root, false, err, "a config must be an object, not %s",
+		                    config_describe(cfg, cfg->root, got, sizeof(got)));
+	}
+	int rc = config_check_keys(cfg, cfg->root, top_keys, "at the top level", err);
+	if (!rc)
+		rc = parse_format_version(cfg, err);
+	if (!rc)
+		rc = parse_output(cfg, err);
+	if (!rc)
+		rc = parse_runs(cfg, err);
+	if (!rc)
+		rc = parse_isolation(cfg, err);
+	if (!rc)
+		rc = parse_rays(cfg, err);
+	if (!rc)
+		rc = config_parse_scenes(cfg, err);
+	if (!rc)
+		rc = config_parse_builders(cfg, err);
+	return rc;
+}
+
+/* Takes ownership of text. */
+static int parse_owned(struct config *cfg, const char *path, char *text, bvhlab_error *err)
+{
+	memset(cfg, 0, sizeof(*cfg));
+	cfg->text = text;
+	cfg->path = strdup(path);
+	cfg->dir = folder_of(path);
+	int rc = cfg->path && cfg->dir ? set_defaults(cfg) : -ENOMEM;
+	if (rc) {
+		out_of_memory(path, err);
+		goto fail;
+	}
+	rc = json_parse_located(path, text, &cfg->root, &cfg->locations, err);
+	if (!rc)
+		rc = parse_top(cfg, err);
+	if (rc)
+		goto fail;
+	return 0;
+fail:
+	config_finish(cfg);
+	return rc;
+}
+
+int config_parse(struct config *cfg, const char *path, const char *text, bvhlab_error *err)
+{
+	char *copy = strdup(text);
+	if (!copy) {
+		memset(cfg, 0, sizeof(*cfg));
+		return out_of_memory(path, err);
+	}
+	return parse_owned(cfg, path, copy, err);
+}
+
+static int read_all(FILE *f, char **out, size_t *length)
+{
+	char *buf = NULL;
+	size_t used = 0, capacity = 0;
+	for (;;) {
+		if (capacity - used < READ_CHUNK + 1) {
+			char *grown = realloc(buf, capacity + READ_CHUNK + 1);
+			if (!grown) {
+				free(buf);
+				return -ENOMEM;
+			}
+			buf = grown;
+			capacity += READ_CHUNK + 1;
+		}
+		size_t n = fread(buf + used, 1, READ_CHUNK, f);
+		used += n;
+		if (n < READ_CHUNK)
+			break;
+	}
+	if (ferror(f)) {
+		free(buf);
+		return errno ? -errno : -EIO;
+	}
+	buf[used] = '\0';
+	*out = buf;
+	*length = used;
+	return 0;
+}
+
+int config_load(struct config *cfg, const char *path, bvhlab_error *err)
+{
+	char *text = NULL;
+	size_t length = 0;
+	memset(cfg, 0, sizeof(*cfg));
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		int e = errno;
+		error_set(err, "%s: cannot open: %s", path, strerror(e));
+		return -e;
+	}
+	errno = 0;
+	int rc = read_all(f, &text, &length);
+	fclose(f);
+	if (rc) {
+		error_set(err, "%s: cannot read: %s", path, strerror(-rc));
+		return rc;
+	}
+	if (strlen(text) != length) {
+		/* cJSON would stop at the NUL and read half the file. */
+		int line, col;
+		json_offset_position(text, strlen(text), &line, &col);
+		error_set(err, "%s:%d:%d: NUL byte in the file (not a JSON text file?)", path, line,
+		          col);
+		free(text);
+		return -EINVAL;
+	}
+	return parse_owned(cfg, path, text, err);
+}
+
+void config_finish(struct config *cfg)
+{
+	if (!cfg)
+		return;
+	for (size_t i = 0; cfg->scenes && i < cfg->scene_count; i++) {
+		free(cfg->scenes[i].name);
+		free(cfg->scenes[i].path);
+		free(cfg->scenes[i].generator);
+	}
+	for (size_t i = 0; cfg->builders && i < cfg->builder_count; i++) {
+		free(cfg->builders[i].plugin);
+		free(cfg->builders[i].name);
+		free(cfg->builders[i].threads);
+	}
+	free(cfg->scenes);
+	free(cfg->builders);
+	free(cfg->threads);
+	free(cfg->output);
+	json_locations_destroy(cfg->locations);
+	cJSON_Delete(cfg->root);
+	free(cfg->text);
+	free(cfg->dir);
+	free(cfg->path);
+	memset(cfg, 0, sizeof(*cfg));
+}
+
+int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count)
+{
+	if (!threads || count == 0)
+		return -EINVAL;
+	for (size_t i = 0; i < count; i++)
+		for (size_t j = 0; j < i; j++)
+			if (threads[i] == threads[j])
+				return -EINVAL;
+	uint32_t *copy = malloc(count * sizeof(*copy));
+	if (!copy)
+		return -ENOMEM;
+	memcpy(copy, threads, count * sizeof(*copy));
+	free(cfg->threads);
+	cfg->threads = copy;
+	cfg->thread_count = count;
+	return 0;
+}

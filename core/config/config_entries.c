@@ -1,0 +1,390 @@
+/*
+ * Config entries: the "scenes" and "builders" arrays, and applying a
+ * builder's "options" to its plugin's declared options.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "config/config_internal.h"
+#include "config/json_locate.h"
+
+/* 16 subdivisions turn one triangle into 4^16 = 2^32, past a uint32_t count. */
+#define MAX_SUBDIVIDE 15
+
+static const char *const scene_keys[] = {
+	"name", "path", "generator", "frequency", "count", "size", "seed", "subdivide", NULL,
+};
+static const char *const generator_keys[] = { "frequency", "count", "size", "seed", NULL };
+static const char *const builder_keys[] = {
+	"plugin", "name", "threads", "timeout_s", "memory_limit_mb", "options", NULL,
+};
+
+static int out_of_memory(const struct config *cfg, bvhlab_error *err)
+{
+	error_set(err, "%s: out of memory", cfg->path);
+	return -ENOMEM;
+}
+
+/* The array under `key`, required and non-empty; *count entries allocated. */
+static int entry_array(struct config *cfg, const char *key, size_t size, const cJSON **array,
+                       void **entries, size_t *count, bvhlab_error *err)
+{
+	const cJSON *item = config_member(cfg->root, key);
+	char got[48];
+	if (!item)
+		return config_error(cfg, cfg->root, false, err,
+		                    "missing '%s' (an array of at least one entry)", key);
+	if (!cJSON_IsArray(item))
+		return config_error(cfg, item, false, err, "'%s' must be an array, not %s", key,
+		                    config_describe(cfg, item, got, sizeof(got)));
+	size_t n = (size_t)cJSON_GetArraySize(item);
+	if (n == 0)
+		return config_error(cfg, item, false, err, "'%s' must not be empty", key);
+	*entries = calloc(n, size);
+	if (!*entries)
+		return out_of_memory(cfg, err);
+	*count = n; /* before filling, so config_finish frees whatever was filled */
+	*array = item;
+	return 0;
+}
+
+/* Scene and builder names label runs and reports: two alike would mix them up. */
+static int unique_names(const struct config *cfg, const cJSON *array, const char **names,
+                        const char *what, const char *key, bvhlab_error *err)
+{
+	size_t i = 0;
+	for (const cJSON *e = array->child; e; e = e->next, i++) {
+		for (size_t j = 0; j < i; j++) {
+			if (strcmp(names[i], names[j]) != 0)
+				continue;
+			const cJSON *name = config_member(e, "name");
+			return config_error(cfg, name ? name : e, false, err,
+			                    "duplicate %s name '%s': %s[%zu] has it too%s", what,
+			                    names[i], key, j,
+			                    name ? "" : "; set 'name' to tell them apart");
+		}
+	}
+	return 0;
+}
+
+/* ---- scenes ------------------------------------------------------------------ */
+
+static int scene_source(struct config *cfg, const cJSON *obj, const char *prefix,
+                        struct config_scene *sc, bvhlab_error *err)
+{
+	int rc = config_get_string(cfg, obj, "path", prefix, &sc->path, err);
+	if (!rc)
+		rc = config_get_string(cfg, obj, "generator", prefix, &sc->generator, err);
+	if (rc)
+		return rc;
+	if (sc->path && sc->generator)
+		return config_error(cfg, config_member(obj, "generator"), true, err,
+		                    "'%.*s' has both 'path' and 'generator': give exactly one",
+		                    (int)strlen(prefix) - 1, prefix);
+	if (!sc->path && !sc->generator)
+		return config_error(cfg, obj, false, err,
+		                    "'%.*s' needs a 'path' (a mesh file) or a 'generator'",
+		                    (int)strlen(prefix) - 1, prefix);
+	for (const char *const *k = generator_keys; sc->path && *k; k++) {
+		const cJSON *item = config_member(obj, *k);
+		if (item)
+			return config_error(cfg, item, true, err,
+			                    "'%s%s' applies to generated scenes only, not to a 'path'",
+			                    prefix, *k);
+	}
+	return 0;
+}
+
+static int scene_params(struct config *cfg, const cJSON *obj, const char *prefix,
+                        struct config_scene *sc, bvhlab_error *err)
+{
+	bvhlab_gen_params *gen = &sc->gen;
+	uint32_t subdivide = 0;
+	int rc = config_get_u32(cfg, obj, "frequency", prefix, 1, UINT32_MAX, &gen->frequency, err);
+	if (!rc)
+		rc = config_get_u32(cfg, obj, "count", prefix, 1, UINT32_MAX, &gen->count, err);
+	if (!rc)
+		rc = config_get_u32(cfg, obj, "size", prefix, 1, UINT32_MAX, &gen->size, err);
+	if (!rc)
+		rc = config_get_uint(cfg, obj, "seed", prefix, 0, UINT64_MAX, &gen->seed, err);
+	if (!rc)
+		rc = config_get_u32(cfg, obj, "subdivide", prefix, 0, MAX_SUBDIVIDE, &subdivide, err);
+	sc->subdivide = subdivide;
+	return rc;
+}
+
+static int scene_name_and_path(struct config *cfg, const cJSON *obj, const char *prefix,
+                               struct config_scene *sc, bvhlab_error *err)
+{
+	int rc = config_get_string(cfg, obj, "name", prefix, &sc->name, err);
+	if (rc)
+		return rc;
+	if (!sc->name) {
+		sc->name = sc->path ? config_stem(sc->path) : strdup(sc->generator);
+		if (!sc->name)
+			return out_of_memory(cfg, err);
+	}
+	if (sc->path) {
+		char *resolved;
+		if (config_resolve(cfg, sc->path, &resolved))
+			return out_of_memory(cfg, err);
+		free(sc->path);
+		sc->path = resolved;
+	}
+	return 0;
+}
+
+static int parse_scene(struct config *cfg, const cJSON *obj, size_t index,
+                       bvhlab_error *err)
+{
+	struct config_scene *sc = &cfg->scenes[index];
+	char prefix[CONFIG_NAME_SIZE], where[CONFIG_NAME_SIZE], got[48];
+	snprintf(prefix, sizeof(prefix), "scenes[%zu].", index);
+	snprintf(where, sizeof(where), "in scenes[%zu]", index);
+	if (!cJSON_IsObject(obj))
+		return config_error(cfg, obj, false, err, "'scenes[%zu]' must be an object, not %s",
+		                    index, config_describe(cfg, obj, got, sizeof(got)));
+	json_locate_value(cfg->locations, obj, &sc->line, &sc->column);
+	bvhlab_gen_params_init(&sc->gen);
+	int rc = config_check_keys(cfg, obj, scene_keys, where, err);
+	if (!rc)
+		rc = scene_source(cfg, obj, prefix, sc, err);
+	if (!rc)
+		rc = scene_params(cfg, obj, prefix, sc, err);
+	if (!rc)
+		rc = scene_name_and_path(cfg, obj, prefix, sc, err);
+	return rc;
+}
+
+int config_parse_scenes(struct config *cfg, bvhlab_error *err)
+{
+	const cJSON *array;
+	void *entries;
+	int rc = entry_array(cfg, "scenes", sizeof(*cfg->scenes), &array, &entries,
+	                     &cfg->scene_count, err);
+	if (rc)
+		return rc;
+	cfg->scenes = entries;
+	size_t i = 0;
+	for (const cJSON *e = array->child; e && !rc; e = e->next, i++)
+		rc = parse_scene(cfg, e, i, err);
+	if (rc)
+		return rc;
+	const char **names = malloc(cfg->scene_count * sizeof(*names));
+	if (!names)
+		return out_of_memory(cfg, err);
+	for (i = 0; i < cfg->scene_count; i++)
+		names[i] = cfg->scenes[i].name;
+	rc = unique_names(cfg, array, names, "scene", "scenes", err);
+	free(names);
+	return rc;
+}
+
+/* ---- builders ---------------------------------------------------------------- */
+
+static bool is_plugin_path(const char *plugin)
+{
+	size_t n = strlen(plugin);
+	return strchr(plugin, '/') || (n >= 3 && strcmp(plugin + n - 3, ".so") == 0);
+}
+
+static int builder_plugin(struct config *cfg, const cJSON *obj, const char *prefix,
+                          struct config_builder *b, bvhlab_error *err)
+{
+	int rc = config_get_string(cfg, obj, "plugin", prefix, &b->plugin, err);
+	if (rc)
+		return rc;
+	if (!b->plugin)
+		return config_error(cfg, obj, false, err,
+		                    "'%.*s' needs a 'plugin' (a plugin name or a path to a .so)",
+		                    (int)strlen(prefix) - 1, prefix);
+	rc = config_get_string(cfg, obj, "name", prefix, &b->name, err);
+	if (rc)
+		return rc;
+	if (!is_plugin_path(b->plugin)) {
+		b->name = b->name ? b->name : strdup(b->plugin);
+		return b->name ? 0 : out_of_memory(cfg, err);
+	}
+	/* A path: relative to the config, and named after the file by default. */
+	char *resolved;
+	if (!b->name && !(b->name = config_stem(b->plugin)))
+		return out_of_memory(cfg, err);
+	if (config_resolve(cfg, b->plugin, &resolved))
+		return out_of_memory(cfg, err);
+	free(b->plugin);
+	b->plugin = resolved;
+	return 0;
+}
+
+static int builder_options(struct config *cfg, const cJSON *obj, size_t index,
+                           struct config_builder *b, bvhlab_error *err)
+{
+	const cJSON *options = config_member(obj, "options");
+	char where[CONFIG_NAME_SIZE], got[48];
+	if (!options)
+		return 0;
+	if (!cJSON_IsObject(options))
+		return config_error(cfg, options, false, err,
+		                    "'builders[%zu].options' must be an object, not %s", index,
+		                    config_describe(cfg, options, got, sizeof(got)));
+	snprintf(where, sizeof(where), "in builders[%zu].options", index);
+	b->options = options;
+	return config_check_duplicates(cfg, options, where, err);
+}
+
+static int parse_builder(struct config *cfg, const cJSON *obj, size_t index,
+                         bvhlab_error *err)
+{
+	struct config_builder *b = &cfg->builders[index];
+	char prefix[CONFIG_NAME_SIZE], where[CONFIG_NAME_SIZE], got[48];
+	snprintf(prefix, sizeof(prefix), "builders[%zu].", index);
+	snprintf(where, sizeof(where), "in builders[%zu]", index);
+	if (!cJSON_IsObject(obj))
+		return config_error(cfg, obj, false, err, "'builders[%zu]' must be an object, not %s",
+		                    index, config_describe(cfg, obj, got, sizeof(got)));
+	json_locate_value(cfg->locations, obj, &b->line, &b->column);
+	int rc = config_check_keys(cfg, obj, builder_keys, where, err);
+	if (!rc)
+		rc = builder_plugin(cfg, obj, prefix, b, err);
+	if (!rc)
+		rc = config_get_threads(cfg, obj, "threads", prefix, &b->threads, &b->thread_count,
+		                        err);
+	if (!rc)
+		rc = config_get_positive(cfg, obj, "timeout_s", prefix, &b->timeout_s, err);
+	if (!rc)
+		rc = config_get_uint(cfg, obj, "memory_limit_mb", prefix, 1, CONFIG_MAX_MEMORY_MB,
+		                     &b->memory_limit_mb, err);
+	if (!rc)
+		rc = builder_options(cfg, obj, index, b, err);
+	return rc;
+}
+
+int config_parse_builders(struct config *cfg, bvhlab_error *err)
+{
+	const cJSON *array;
+	void *entries;
+	int rc = entry_array(cfg, "builders", sizeof(*cfg->builders), &array, &entries,
+	                     &cfg->builder_count, err);
+	if (rc)
+		return rc;
+	cfg->builders = entries;
+	size_t i = 0;
+	for (const cJSON *e = array->child; e && !rc; e = e->next, i++)
+		rc = parse_builder(cfg, e, i, err);
+	if (rc)
+		return rc;
+	const char **names = malloc(cfg->builder_count * sizeof(*names));
+	if (!names)
+		return out_of_memory(cfg, err);
+	for (i = 0; i < cfg->builder_count; i++)
+		names[i] = cfg->builders[i].name;
+	rc = unique_names(cfg, array, names, "builder", "builders", err);
+	free(names);
+	return rc;
+}
+
+/* ---- options ----------------------------------------------------------------- */
+
+static int unknown_option(const struct config *cfg, const struct config_builder *b,
+                          const bvhlab_options *opts, const cJSON *m, bvhlab_error *err)
+{
+	const bvhlab_builder *desc = opts->builder;
+	char list[256] = "", hint[96] = "";
+	size_t used = 0;
+	struct config_suggestion s;
+	config_suggest_init(&s);
+	for (uint32_t i = 0; desc && i < desc->option_count; i++) {
+		const char *name = desc->options[i].name;
+		config_suggest_consider(&s, m->string, name);
+		if (used >= sizeof(list))
+			continue;
+		used += (size_t)snprintf(list + used, sizeof(list) - used, "%s%s", i ? ", " : "", name);
+		if (used >= sizeof(list)) /* a long list: say it goes on */
+			memcpy(list + sizeof(list) - 4, "...", 4);
+	}
+	if (s.best)
+		snprintf(hint, sizeof(hint), "; did you mean '%s'?", s.best);
+	if (used == 0)
+		return config_error(cfg, m, true, err,
+		                    "builder '%s': unknown option '%s' (it takes no options)", b->name,
+		                    m->string);
+	return config_error(cfg, m, true, err, "builder '%s': unknown option '%s' (known: %s)%s",
+	                    b->name, m->string, list, hint);
+}
+
+static int wrong_type(const struct config *cfg, const struct config_builder *b,
+                      const cJSON *m, const char *expected, bvhlab_error *err)
+{
+	char got[48];
+	return config_error(cfg, m, true, err, "builder '%s': option '%s' must be %s, not %s",
+	                    b->name, m->string, expected, config_describe(cfg, m, got, sizeof(got)));
+}
+
+/* 0 when the JSON value fits the declared type; *i gets an INT's value. */
+static int check_type(const struct config *cfg, const struct config_builder *b,
+                      const cJSON *m, uint32_t type, int64_t *i, bvhlab_error *err)
+{
+	switch (type) {
+	case BVHLAB_OPTION_BOOL:
+		return cJSON_IsBool(m) ? 0 : wrong_type(cfg, b, m, "true or false", err);
+	case BVHLAB_OPTION_INT:
+		switch (cJSON_IsNumber(m) ? json_get_int64(cfg->locations, m, i) : -EINVAL) {
+		case 0:
+			return 0;
+		case -ERANGE:
+			return wrong_type(cfg, b, m, "an integer that fits in 64 bits", err);
+		default:
+			return wrong_type(cfg, b, m, "an integer", err);
+		}
+	case BVHLAB_OPTION_FLOAT:
+		if (!cJSON_IsNumber(m) || !isfinite(m->valuedouble))
+			return wrong_type(cfg, b, m, "a finite number", err);
+		return 0;
+	case BVHLAB_OPTION_STRING:
+		return cJSON_IsString(m) ? 0 : wrong_type(cfg, b, m, "a string", err);
+	default:
+		return config_error(cfg, m, true, err, "builder '%s': option '%s' has no valid type (%u)",
+		                    b->name, m->string, type);
+	}
+}
+
+static int set_value(bvhlab_options *opts, const cJSON *m, uint32_t type, int64_t i,
+                     bvhlab_error *err)
+{
+	switch (type) {
+	case BVHLAB_OPTION_BOOL:
+		return bvhlab_options_set_bool(opts, m->string, cJSON_IsTrue(m), err);
+	case BVHLAB_OPTION_INT:
+		return bvhlab_options_set_int(opts, m->string, i, err);
+	case BVHLAB_OPTION_FLOAT:
+		return bvhlab_options_set_float(opts, m->string, m->valuedouble, err);
+	default:
+		return bvhlab_options_set_string(opts, m->string, m->valuestring, err);
+	}
+}
+
+int config_apply_options(const struct config *cfg, const struct config_builder *b,
+                         bvhlab_options *opts, bvhlab_error *err)
+{
+	for (const cJSON *m = b->options ? b->options->child : NULL; m; m = m->next) {
+		int index = bvhlab_options_find(opts, m->string);
+		if (index < 0)
+			return unknown_option(cfg, b, opts, m, err);
+		uint32_t type = opts->builder->options[index].type;
+		int64_t i = 0;
+		int rc = check_type(cfg, b, m, type, &i, err);
+		if (rc)
+			return rc;
+		/* The setter's message (range, choices) gets the position and the name. */
+		bvhlab_error inner = { "" };
+		rc = set_value(opts, m, type, i, &inner);
+		if (rc) {
+			config_error(cfg, m, true, err, "builder '%s': %s", b->name, inner.message);
+			return rc;
+		}
+	}
+	return 0;
+}

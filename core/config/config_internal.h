@@ -1,0 +1,82 @@
+/*
+ * Helpers shared by config.c, config_check.c and config_entries.c. Every
+ * error is -EINVAL (or -ENOMEM) with err->message starting FILE:LINE:COL.
+ * `prefix` arguments name the enclosing object for messages ("",
+ * "rays.", "scenes[2]."); `where` says the same in words ("at the top
+ * level", "in scenes[2]").
+ */
+#ifndef BVHLAB_CORE_CONFIG_INTERNAL_H
+#define BVHLAB_CORE_CONFIG_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cJSON.h>
+
+#include "config/config.h"
+#include "util/util.h"
+
+/* Long enough for "builders[18446744073709551615]." and the like. */
+#define CONFIG_NAME_SIZE 64
+
+/* "FILE:LINE:COL: message" at the item's key (at_key) or value; -EINVAL. */
+int config_error(const struct config *cfg, const cJSON *item, bool at_key,
+                 bvhlab_error *err, const char *fmt, ...) UTIL_PRINTF(5, 6);
+
+/* "a string", "2.5", "true", "null", "an array", "an object". */
+const char *config_describe(const struct config *cfg, const cJSON *item, char *buf,
+                            size_t size);
+
+/* Closest name within edit distance 2 (transpositions count 1), if any. */
+struct config_suggestion {
+	const char *best;
+	int distance;
+};
+void config_suggest_init(struct config_suggestion *s);
+void config_suggest_consider(struct config_suggestion *s, const char *typed,
+                             const char *candidate);
+
+/* Unknown keys (known is NULL-terminated) and duplicate keys of obj. */
+int config_check_keys(const struct config *cfg, const cJSON *obj, const char *const *known,
+                      const char *where, bvhlab_error *err);
+int config_check_duplicates(const struct config *cfg, const cJSON *obj, const char *where,
+                            bvhlab_error *err);
+
+/* The member `key` of obj (exact case), or NULL. */
+const cJSON *config_member(const cJSON *obj, const char *key);
+
+/* Typed members; an absent key leaves *out untouched and returns 0. */
+int config_get_uint(const struct config *cfg, const cJSON *obj, const char *key,
+                    const char *prefix, uint64_t min, uint64_t max, uint64_t *out,
+                    bvhlab_error *err);
+int config_get_u32(const struct config *cfg, const cJSON *obj, const char *key,
+                   const char *prefix, uint32_t min, uint32_t max, uint32_t *out,
+                   bvhlab_error *err);
+int config_get_bool(const struct config *cfg, const cJSON *obj, const char *key,
+                    const char *prefix, bool *out, bvhlab_error *err);
+/* A finite number > 0 (a duration, say). */
+int config_get_positive(const struct config *cfg, const cJSON *obj, const char *key,
+                        const char *prefix, double *out, bvhlab_error *err);
+/* A non-empty string, copied into *out (freeing what was there). */
+int config_get_string(const struct config *cfg, const cJSON *obj, const char *key,
+                      const char *prefix, char **out, bvhlab_error *err);
+/* A non-empty array of distinct thread counts (0 = all hardware threads). */
+int config_get_threads(const struct config *cfg, const cJSON *obj, const char *key,
+                       const char *prefix, uint32_t **out, size_t *count,
+                       bvhlab_error *err);
+
+/* `path` as seen from the config's folder (absolute paths unchanged). */
+int config_resolve(const struct config *cfg, const char *path, char **out);
+/* The file name without folder and last extension ("a/b/ogre.obj" -> "ogre"). */
+char *config_stem(const char *path);
+
+/* Highest "memory_limit_mb": the limit in bytes must fit in 64 bits. */
+#define CONFIG_MAX_MEMORY_MB (UINT64_MAX >> 20)
+
+/* "rays": {"camera": {position, target, up, fov}}; absent: automatic framing. */
+int config_parse_camera(struct config *cfg, const cJSON *rays, bvhlab_error *err);
+int config_parse_scenes(struct config *cfg, bvhlab_error *err);
+int config_parse_builders(struct config *cfg, bvhlab_error *err);
+
+#endif /* BVHLAB_CORE_CONFIG_INTERNAL_H */

@@ -1,0 +1,476 @@
+/*
+ * The experiment harness. Scenes are the outer loop so only one scene is in
+ * memory at a time; plugins are opened once. Whatever fails (a scene, a
+ * plugin, a build, a tree) is recorded as a run with its status and message,
+ * and the sweep goes on.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "harness/harness.h"
+#include "harness/isolate.h"
+#include "harness/progress.h"
+#include "output/results.h"
+#include "util/util.h"
+
+#define RAY_SEED 0x5eedULL
+
+/* A builder of the config, opened once for the whole sweep. */
+struct harness_builder {
+	const struct config_builder *cb;
+	bvhlab_plugin *plugin; /* NULL when it could not be loaded */
+	bvhlab_options opts;
+	bool opts_ok;
+	bvhlab_error error;
+};
+
+struct harness {
+	const struct config *cfg;
+	struct results res;
+	struct harness_builder *builders;
+	struct progress progress;
+	bool all_ok;
+	bool shade_done; /* this scene's shaded render is on its way */
+};
+
+enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };
+
+/*
+ * What one run's build series produces, sent back from its child as plain
+ * bytes: the tree stays behind, only its measurements come back.
+ */
+struct series_report {
+	uint32_t status;       /* enum series_status */
+	uint32_t sample_count; /* repeat, or 0 when the builds failed */
+	bool has_stats, validated, valid;
+	uint64_t rays_checked, mismatches;
+	bvhlab_tree_stats stats;
+	struct ray_metrics rays;
+	bool heat_written, shade_written;
+	char error[sizeof(((bvhlab_error *)0)->message)];
+	double samples[];      /* [repeat] */
+};
+
+/* One run's build series, as handed to the child. */
+struct series_job {
+	const struct harness *h;
+	const bvhlab_scene *scene;
+	const bvhlab_prims *prims;
+	const struct harness_builder *hb;
+	uint32_t threads;
+	const char *heat_path;  /* where the child leaves nodes per pixel, or NULL */
+	const char *shade_path; /* where it leaves the shaded render, or NULL */
+};
+
+static uint32_t resolve_threads(uint32_t t)
+{
+	return t ? t : bvhlab_hardware_threads();
+}
+
+/* Records a run and rewrites the files, so nothing finished is ever lost. */
+static void record(struct harness *h, struct run_record *run)
+{
+	bvhlab_error err = {{0}};
+	if (strcmp(run->status, "ok") != 0)
+		h->all_ok = false;
+	progress_done(&h->progress, run);
+	if (results_add_run(&h->res, run) < 0 || results_write(&h->res, &err) < 0) {
+		fprintf(stderr, "bvhlab: cannot write results: %s\n",
+		        err.message[0] ? err.message : "out of memory");
+		h->all_ok = false;
+	}
+}
+
+static const uint32_t *builder_threads(const struct harness *h, const struct config_builder *b,
+                                       size_t *count)
+{
+	*count = b->threads ? b->thread_count : h->cfg->thread_count;
+	return b->threads ? b->threads : h->cfg->threads;
+}
+
+/* Every run of a builder fails the same way (plugin or scene unusable). */
+static void record_all_failed(struct harness *h, const char *scene, struct harness_builder *hb,
+                              const char *error)
+{
+	size_t n;
+	const uint32_t *threads = builder_threads(h, hb->cb, &n);
+	for (size_t k = 0; k < n; k++) {
+		struct run_record run = {.scene = scene, .builder = hb->cb->name,
+		                         .plugin = hb->cb->plugin, .threads = resolve_threads(threads[k]),
+		                         .opts = hb->opts_ok ? &hb->opts : NULL,
+		                         .status = "failed", .error = error};
+		if (results_has_run(&h->res, run.scene, run.builder, run.threads))
+			h->progress.index++;
+		else
+			record(h, &run);
+	}
+}
+
+/* Resumed runs already hold every run of the scene: no need to load it. */
+static bool scene_done(struct harness *h, const struct config_scene *cs)
+{
+	uint32_t done = 0, total = 0;
+	for (size_t b = 0; b < h->cfg->builder_count; b++) {
+		size_t n;
+		const uint32_t *threads = builder_threads(h, &h->cfg->builders[b], &n);
+		for (size_t t = 0; t < n; t++, total++)
+			done += results_has_run(&h->res, cs->name, h->cfg->builders[b].name,
+			                        resolve_threads(threads[t]));
+	}
+	if (done < total)
+		return false;
+	h->progress.index += total;
+	return true;
+}
+
+/*
+ * Structure is always checked: the metrics are meaningless (and a cyclic tree
+ * unsafe to walk) otherwise. The brute-force ray check is what "validate"
+ * switches, since it is the expensive part.
+ */
+static void validate(const struct series_job *job, const bvhlab_tree *tree,
+                     struct series_report *rep, bvhlab_error *err)
+{
+	const struct config *cfg = job->h->cfg;
+	const bvhlab_builder *desc = bvhlab_plugin_builder(job->hb->plugin);
+	bool dup = desc->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
+	rep->validated = true;
+	rep->valid = bvhlab_validate_tree(tree, &job->prims->input, dup, err) == 0;
+	if (!rep->valid) {
+		rep->status = SERIES_INVALID;
+		return;
+	}
+	if (!cfg->validate)
+		return;
+	rep->rays_checked = cfg->validate_rays;
+	if (bvhlab_validate_rays(tree, job->scene, cfg->validate_rays, RAY_SEED, &rep->mismatches,
+	                         err) < 0) {
+		rep->status = SERIES_FAILED;
+	} else if (rep->mismatches) {
+		rep->valid = false;
+		rep->status = SERIES_INVALID;
+		error_set(err, "%llu of %llu sampled rays disagree with brute force",
+		          (unsigned long long)rep->mismatches, (unsigned long long)rep->rays_checked);
+	}
+}
+
+/* Per-pixel buffers of the images this run draws; NULL when it draws none. */
+static int image_buffers(const struct series_job *job, size_t n, uint32_t **nodes,
+                         uint8_t **shade)
+{
+	*nodes = job->heat_path ? malloc(n * sizeof(**nodes)) : NULL;
+	*shade = job->shade_path ? malloc(3 * n) : NULL;
+	return (job->heat_path && !*nodes) || (job->shade_path && !*shade) ? -ENOMEM : 0;
+}
+
+/* Traversal statistics on the valid tree, and the raw image data. A
+ * failure here costs the numbers, not the run: the tree itself is fine. */
+static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
+                       struct series_report *rep, bvhlab_error *err)
+{
+	const struct config *cfg = job->h->cfg;
+	size_t n = (size_t)cfg->ray_width * cfg->ray_height;
+	uint32_t *nodes;
+	uint8_t *shade;
+	bvhlab_camera cam;
+	if (n == 0)
+		return;
+	harness_camera(cfg, job->scene, &cam);
+	int r = image_buffers(job, n, &nodes, &shade);
+	if (r == 0)
+		r = harness_trace_rays(tree, job->scene, &cam, cfg->ray_width, cfg->ray_height,
+		                       cfg->ray_diffuse, &rep->rays, nodes, shade);
+	if (r == 0 && nodes)
+		rep->heat_written = harness_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
+	if (r == 0 && shade)
+		rep->shade_written = harness_write_raw(job->shade_path, shade, 3 * n) == 0;
+	if (r < 0)
+		error_set(err, "tracing rays: %s", strerror(-r));
+	free(nodes);
+	free(shade);
+}
+
+/* Warm-up, timed builds, validation and metrics: what runs in the child. */
+static void series_work(void *arg, void *report, size_t size)
+{
+	const struct series_job *job = arg;
+	struct series_report *rep = report;
+	const struct config *cfg = job->h->cfg;
+	struct build_series s = {.warmup = cfg->warmup, .repeat = cfg->repeat,
+	                         .threads = job->threads, .samples_ms = rep->samples};
+	bvhlab_error err = {{0}};
+	(void)size;
+	rep->status = SERIES_OK;
+	if (harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err) < 0) {
+		rep->status = SERIES_FAILED;
+	} else {
+		rep->sample_count = s.repeat;
+		validate(job, &s.tree, rep, &err);
+		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
+		if (rep->has_stats)
+			bvhlab_tree_stats_compute(&s.tree, &rep->stats);
+		if (rep->status == SERIES_OK)
+			trace_rays(job, &s.tree, rep, &err);
+	}
+	if (rep->status != SERIES_OK)
+		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
+	bvhlab_tree_finish(&s.tree);
+}
+
+/* A report from a child is checked before use: the child ran foreign code. */
+static void report_to_run(struct series_report *rep, uint32_t repeat, struct run_record *run)
+{
+	static const char *const names[] = {"ok", "invalid", "failed"};
+	rep->error[sizeof(rep->error) - 1] = '\0';
+	if (rep->status > SERIES_FAILED || rep->sample_count > repeat) {
+		run->status = "crashed";
+		run->error = "sent back a malformed report";
+		return;
+	}
+	run->status = names[rep->status];
+	run->error = rep->status != SERIES_OK ? rep->error : NULL;
+	run->samples_ms = rep->samples;
+	run->sample_count = rep->sample_count;
+	run->stats = rep->has_stats ? &rep->stats : NULL;
+	run->validated = rep->validated;
+	run->valid = rep->valid;
+	run->rays_checked = rep->rays_checked;
+	run->mismatches = rep->mismatches;
+	run->rays = rep->rays.measured ? &rep->rays : NULL;
+}
+
+static struct isolate_limits run_limits(const struct config *cfg, const struct config_builder *cb)
+{
+	uint64_t mb = cb->memory_limit_mb ? cb->memory_limit_mb : cfg->memory_limit_mb;
+	return (struct isolate_limits){.timeout_s = cb->timeout_s > 0 ? cb->timeout_s : cfg->timeout_s,
+	                               .memory_bytes = mb << 20};
+}
+
+/* Runs the series in a child (or here, with "isolate": false) and records it. */
+static void run_series(struct harness *h, struct series_job *job, struct run_record *run,
+                       struct series_report *rep, size_t size)
+{
+	static const char *const outcomes[] = {"ok", "crashed", "timeout"};
+	char why[sizeof(rep->error)] = "";
+	int outcome = ISOLATE_REPORTED;
+	if (h->cfg->isolate) {
+		struct isolate_limits limits = run_limits(h->cfg, job->hb->cb);
+		outcome = isolate_call(series_work, job, rep, size, &limits, why, sizeof(why));
+	} else {
+		series_work(job, rep, size);
+	}
+	if (outcome == ISOLATE_REPORTED) {
+		report_to_run(rep, h->cfg->repeat, run);
+	} else {
+		run->status = outcome < 0 ? "failed" : outcomes[outcome];
+		run->error = why;
+	}
+	record(h, run);
+}
+
+/* Images are drawn in the children: the heat map by each builder's first
+ * thread count, the shaded render by the first run to get that far. */
+static void image_paths(struct harness *h, struct series_job *job, size_t scene_index,
+                        size_t builder_index, bool first, char (*paths)[4096])
+{
+	if (!h->cfg->images || h->cfg->ray_width == 0 || h->cfg->ray_height == 0)
+		return;
+	if (first && harness_temp_path(paths[0], sizeof(paths[0]), h->cfg->output, "heat",
+	                               scene_index, builder_index) == 0)
+		job->heat_path = paths[0];
+	if (!h->shade_done && harness_temp_path(paths[1], sizeof(paths[1]), h->cfg->output,
+	                                        "shade", scene_index, 0) == 0)
+		job->shade_path = paths[1];
+}
+
+static void run_one(struct harness *h, struct series_job *job, size_t scene_index,
+                    size_t builder_index, bool first)
+{
+	const bvhlab_builder *desc = bvhlab_plugin_builder(job->hb->plugin);
+	struct run_record run = {.scene = job->scene->name, .builder = job->hb->cb->name,
+	                         .plugin = desc->name, .threads = resolve_threads(job->threads),
+	                         .opts = &job->hb->opts, .status = "failed",
+	                         .triangles = job->scene->triangle_count};
+	char paths[2][4096];
+	if (results_has_run(&h->res, run.scene, run.builder, run.threads)) {
+		h->progress.index++;
+		return;
+	}
+	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double);
+	struct series_report *rep = calloc(1, size);
+	if (!rep) {
+		run.error = "out of memory for the run's samples";
+		record(h, &run);
+		return;
+	}
+	image_paths(h, job, scene_index, builder_index, first, paths);
+	progress_start(&h->progress, &run);
+	run_series(h, job, &run, rep, size);
+	h->shade_done = h->shade_done || (job->shade_path && rep->shade_written);
+	free(rep);
+}
+
+/* Every builder's runs on one loaded scene. */
+static void run_builders(struct harness *h, const bvhlab_scene *scene,
+                         const bvhlab_prims *prims, size_t scene_index)
+{
+	for (size_t b = 0; b < h->cfg->builder_count; b++) {
+		struct harness_builder *hb = &h->builders[b];
+		if (!hb->plugin || !hb->opts_ok) {
+			record_all_failed(h, scene->name, hb, hb->error.message);
+			continue;
+		}
+		size_t n;
+		const uint32_t *threads = builder_threads(h, hb->cb, &n);
+		for (size_t t = 0; t < n; t++) {
+			struct series_job job = {.h = h, .scene = scene, .prims = prims, .hb = hb,
+			                         .threads = threads[t]};
+			run_one(h, &job, scene_index, b, t == 0);
+		}
+	}
+}
+
+/* Turns the children's raw files into the scene's PNGs. */
+static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t scene_index)
+{
+	size_t nb = h->cfg->builder_count;
+	const char **names = calloc(nb ? nb : 1, sizeof(*names));
+	uint32_t *threads = calloc(nb ? nb : 1, sizeof(*threads));
+	bvhlab_error err = {{0}};
+	int r = names && threads ? 0 : -ENOMEM;
+	for (size_t b = 0; r == 0 && b < nb; b++) {
+		size_t n;
+		names[b] = h->cfg->builders[b].name;
+		threads[b] = resolve_threads(builder_threads(h, &h->cfg->builders[b], &n)[0]);
+	}
+	struct scene_images si = {.dir = h->cfg->output, .scene_index = scene_index,
+	                          .scene = scene->name, .width = h->cfg->ray_width,
+	                          .height = h->cfg->ray_height, .builders = names,
+	                          .threads = threads, .builder_count = nb};
+	if (r == 0)
+		r = harness_scene_images(&h->res, &si, &err);
+	if (r == 0)
+		r = results_write(&h->res, &err);
+	if (r < 0)
+		fprintf(stderr, "%sbvhlab: images of scene '%s': %s\n", h->progress.tty ? "\n" : "",
+		        scene->name, err.message[0] ? err.message : strerror(-r));
+	free(names);
+	free(threads);
+}
+
+static void run_scene(struct harness *h, const struct config_scene *cs, size_t scene_index)
+{
+	bvhlab_scene *scene = NULL;
+	bvhlab_prims prims = {0};
+	bvhlab_error err = {{0}};
+	if (scene_done(h, cs))
+		return;
+	int r = harness_load_scene(cs, &scene, &err);
+	if (r == 0)
+		r = bvhlab_prims_init(&prims, scene, &err);
+	if (r < 0) {
+		results_add_scene(&h->res, cs->name, cs->path ? cs->path : cs->generator, 0,
+		                  err.message);
+		for (size_t b = 0; b < h->cfg->builder_count; b++)
+			record_all_failed(h, cs->name, &h->builders[b], err.message);
+		goto out;
+	}
+	results_add_scene(&h->res, scene->name, scene->source, scene->triangle_count, NULL);
+	h->shade_done = false;
+	run_builders(h, scene, &prims, scene_index);
+	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)
+		scene_images(h, scene, scene_index);
+out:
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+/* Opens every plugin and checks its options; a failure is kept, not fatal. */
+static int open_builders(struct harness *h)
+{
+	h->builders = calloc(h->cfg->builder_count, sizeof(*h->builders));
+	if (!h->builders)
+		return -ENOMEM;
+	for (size_t b = 0; b < h->cfg->builder_count; b++) {
+		struct harness_builder *hb = &h->builders[b];
+		hb->cb = &h->cfg->builders[b];
+		if (bvhlab_plugin_open(hb->cb->plugin, &hb->plugin, &hb->error) < 0)
+			goto report;
+		if (bvhlab_options_init(&hb->opts, bvhlab_plugin_builder(hb->plugin)) < 0)
+			return -ENOMEM;
+		hb->opts_ok = config_apply_options(h->cfg, hb->cb, &hb->opts, &hb->error) == 0;
+		if (hb->opts_ok)
+			continue;
+	report:
+		fprintf(stderr, "bvhlab: builder '%s': %s\n", hb->cb->name, hb->error.message);
+	}
+	return 0;
+}
+
+static void close_builders(struct harness *h)
+{
+	for (size_t b = 0; h->builders && b < h->cfg->builder_count; b++) {
+		if (h->builders[b].opts.values)
+			bvhlab_options_finish(&h->builders[b].opts);
+		bvhlab_plugin_close(h->builders[b].plugin);
+	}
+	free(h->builders);
+}
+
+static uint32_t count_runs(const struct harness *h)
+{
+	uint32_t total = 0;
+	for (size_t b = 0; b < h->cfg->builder_count; b++) {
+		size_t n;
+		builder_threads(h, &h->cfg->builders[b], &n);
+		total += (uint32_t)n;
+	}
+	return total * (uint32_t)h->cfg->scene_count;
+}
+
+/* Takes over the finished runs of the output folder's results.json. */
+static int resume(struct harness *h, bvhlab_error *err)
+{
+	size_t kept = 0, not_ok = 0;
+	int r = results_resume(&h->res, &kept, &not_ok, err);
+	if (r == -ENOENT) {
+		if (!h->progress.quiet)
+			fprintf(stderr, "bvhlab: nothing to resume in %s/; starting afresh\n",
+			        h->cfg->output);
+		return 0;
+	}
+	if (r < 0)
+		return r;
+	h->all_ok = not_ok == 0;
+	if (!h->progress.quiet)
+		fprintf(stderr, "bvhlab: resuming %s/: %zu finished run%s kept\n", h->cfg->output,
+		        kept, kept == 1 ? "" : "s");
+	return 0;
+}
+
+int harness_run(const struct config *cfg, const struct harness_options *opts,
+                bvhlab_error *err)
+{
+	struct harness h = {.cfg = cfg, .all_ok = true};
+	progress_init(&h.progress, opts->quiet);
+	int r = results_init(&h.res, cfg, cfg->output, err);
+	if (r < 0)
+		return r;
+	bvhlab_set_pinning(cfg->pin);
+	if (opts->resume)
+		r = resume(&h, err);
+	if (r == 0)
+		r = results_write(&h.res, err);
+	if (r == 0 && (r = open_builders(&h)) < 0)
+		error_set(err, "out of memory opening plugins");
+	h.progress.total = count_runs(&h);
+	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
+		run_scene(&h, &cfg->scenes[s], s);
+	progress_finish(&h.progress);
+	close_builders(&h);
+	results_finish(&h.res);
+	return r < 0 ? r : h.all_ok ? 0 : 1;
+}

@@ -1,0 +1,244 @@
+/*
+ * Running one build: the host's function table and the call into a plugin.
+ */
+#include <errno.h>
+#include <pthread.h>
+#include <sched.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <bvhlab/plugin.h>
+
+#include "machine/machine.h"
+#include "util/util.h"
+
+struct bvhlab_build_ctx {
+	const bvhlab_builder *builder;
+	const bvhlab_options *opts;
+	bvhlab_tree *tree;
+	bvhlab_error *err;
+	bool error_set;
+	bool pinning;          /* plan is set: pin_thread binds */
+	struct pin_plan plan;
+	cpu_set_t caller_mask; /* restored after build(): the caller may be a worker */
+};
+
+/* Messages above this level are dropped; BVHLAB_LOG=error|warn|info|debug. */
+static int log_threshold(void)
+{
+	static const char *names[] = {"error", "warn", "info", "debug"};
+	const char *env = getenv("BVHLAB_LOG");
+	for (int k = 0; env && k < 4; k++)
+		if (strcmp(env, names[k]) == 0)
+			return k;
+	return BVHLAB_LOG_WARN;
+}
+
+static void host_log(bvhlab_build_ctx *ctx, int level, const char *fmt, ...)
+{
+	static const char *names[] = {"error", "warning", "info", "debug"};
+	if (level > log_threshold())
+		return;
+	char line[1024];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(line, sizeof(line), fmt, ap);
+	va_end(ap);
+	/* One fprintf per line keeps lines from different threads whole. */
+	fprintf(stderr, "[%s] %s: %s\n", ctx->builder->name,
+	        names[level < 0 ? 0 : level > 3 ? 3 : level], line);
+}
+
+static void host_set_error(bvhlab_build_ctx *ctx, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	error_setv(ctx->err, fmt, ap);
+	va_end(ap);
+	ctx->error_set = true;
+}
+
+/* The declared option `name` of type `type`, or NULL with *r set. */
+static const bvhlab_option_value *get(bvhlab_build_ctx *ctx, const char *name, uint32_t type,
+                                      int *r)
+{
+	int k = bvhlab_options_find(ctx->opts, name);
+	if (k < 0) {
+		*r = -ENOENT;
+		return NULL;
+	}
+	if (ctx->opts->values[k].type != type) {
+		*r = -EINVAL;
+		return NULL;
+	}
+	*r = 0;
+	return &ctx->opts->values[k];
+}
+
+static int host_option_bool(bvhlab_build_ctx *ctx, const char *name, bool *out)
+{
+	int r;
+	const bvhlab_option_value *v = get(ctx, name, BVHLAB_OPTION_BOOL, &r);
+	if (v)
+		*out = v->b;
+	return r;
+}
+
+static int host_option_int(bvhlab_build_ctx *ctx, const char *name, int64_t *out)
+{
+	int r;
+	const bvhlab_option_value *v = get(ctx, name, BVHLAB_OPTION_INT, &r);
+	if (v)
+		*out = v->i;
+	return r;
+}
+
+static int host_option_float(bvhlab_build_ctx *ctx, const char *name, double *out)
+{
+	int r;
+	const bvhlab_option_value *v = get(ctx, name, BVHLAB_OPTION_FLOAT, &r);
+	if (v)
+		*out = v->f;
+	return r;
+}
+
+static int host_option_string(bvhlab_build_ctx *ctx, const char *name, const char **out)
+{
+	int r;
+	const bvhlab_option_value *v = get(ctx, name, BVHLAB_OPTION_STRING, &r);
+	if (v)
+		*out = v->s ? v->s : "";
+	return r;
+}
+
+static int host_grow_output(bvhlab_build_ctx *ctx, bvhlab_build_output *out, uint32_t nodes,
+                            uint32_t indices)
+{
+	bvhlab_tree *t = ctx->tree;
+	int rc = bvhlab_tree_reserve(t, nodes, indices);
+	/* Even a refused reserve may have moved the node array (it grows
+	 * first), so the builder gets the current pointers either way. */
+	out->nodes = t->nodes;
+	out->node_capacity = t->node_capacity;
+	out->prim_index = t->prim_index;
+	out->index_capacity = t->index_capacity;
+	return rc < 0 ? -ENOMEM : 0;
+}
+
+static void host_progress(bvhlab_build_ctx *ctx, double fraction)
+{
+	(void)ctx;
+	(void)fraction;
+}
+
+static uint32_t host_hardware_threads(bvhlab_build_ctx *ctx)
+{
+	/* A pinned worker's own mask holds one CPU; the plan holds the set the
+	 * build started with, which is what the answer must describe. */
+	return ctx->pinning ? ctx->plan.count : bvhlab_hardware_threads();
+}
+
+static int host_pin_thread(bvhlab_build_ctx *ctx, uint32_t worker)
+{
+	return ctx->pinning ? pin_plan_apply(&ctx->plan, worker) : 0;
+}
+
+static const bvhlab_host host_table = {
+	.abi_version = BVHLAB_ABI_CURRENT,
+	.struct_size = sizeof(bvhlab_host),
+	.log = host_log,
+	.set_error = host_set_error,
+	.option_bool = host_option_bool,
+	.option_int = host_option_int,
+	.option_float = host_option_float,
+	.option_string = host_option_string,
+	.grow_output = host_grow_output,
+	.progress = host_progress,
+	.hardware_threads = host_hardware_threads,
+	.pin_thread = host_pin_thread,
+};
+
+static int prepare_tree(bvhlab_tree *tree, uint32_t prims)
+{
+	uint32_t nodes = prims > 0 ? 2 * prims - 1 : 1;
+	if (tree->nodes)
+		return bvhlab_tree_reserve(tree, nodes, prims);
+	return bvhlab_tree_init(tree, nodes, prims);
+}
+
+/* The plan comes from the caller's mask now, before any worker narrows it. */
+static int pinning_begin(struct bvhlab_build_ctx *ctx)
+{
+	if (!machine_pinning())
+		return 0;
+	int r = -pthread_getaffinity_np(pthread_self(), sizeof(ctx->caller_mask),
+	                                &ctx->caller_mask);
+	if (r == 0)
+		r = pin_plan_init(&ctx->plan);
+	if (r < 0) {
+		pin_plan_finish(&ctx->plan);
+		error_set(ctx->err, "builder '%s': cannot plan thread pinning (%s)",
+		          ctx->builder->name, strerror(-r));
+		return r;
+	}
+	ctx->pinning = true;
+	return 0;
+}
+
+static void pinning_end(struct bvhlab_build_ctx *ctx)
+{
+	if (!ctx->pinning)
+		return;
+	pthread_setaffinity_np(pthread_self(), sizeof(ctx->caller_mask), &ctx->caller_mask);
+	pin_plan_finish(&ctx->plan);
+	ctx->pinning = false;
+}
+
+/* The plugin's status, with a message that names it whatever it said. */
+static int explain(const struct bvhlab_build_ctx *ctx, int r)
+{
+	const char *name = ctx->builder->name;
+	if (r < 0 && !ctx->error_set)
+		error_set(ctx->err, "builder '%s' failed (%s) without saying why", name,
+		          strerror(-r));
+	else if (r < 0)
+		error_prefix(ctx->err, "builder '%s'", name);
+	else if (r > 0) {
+		error_set(ctx->err, "builder '%s' returned %d; the ABI allows 0 or a negative errno",
+		          name, r);
+		r = -EPROTO;
+	}
+	return r;
+}
+
+int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                 const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
+                 bvhlab_error *err)
+{
+	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
+	if (prepare_tree(tree, input->prim_count) < 0) {
+		error_set(err, "builder '%s': cannot allocate the output for %u primitives", b->name,
+		          input->prim_count);
+		return -ENOMEM;
+	}
+	bvhlab_build_input in = *input;
+	in.threads = threads ? threads : bvhlab_hardware_threads();
+	bvhlab_build_output out = {
+		.struct_size = sizeof(out),
+		.node_capacity = tree->node_capacity,
+		.nodes = tree->nodes,
+		.prim_index = tree->prim_index,
+		.index_capacity = tree->index_capacity,
+	};
+	struct bvhlab_build_ctx ctx = {.builder = b, .opts = opts, .tree = tree, .err = err};
+	int r = pinning_begin(&ctx);
+	if (r < 0)
+		return r;
+	r = b->build(&host_table, &ctx, &in, &out);
+	pinning_end(&ctx);
+	tree->node_count = out.node_count;
+	tree->index_count = out.index_count;
+	return explain(&ctx, r);
+}

@@ -1,0 +1,221 @@
+/*
+ * Finding, loading and checking builder plugins.
+ *
+ * Every way a plugin can be unusable is caught here, once, with a message
+ * naming the plugin, so the harness can report it and go on.
+ */
+#include <dirent.h>
+#include <dlfcn.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <bvhlab/plugin.h>
+
+#include "util/util.h"
+
+#ifndef BVHLAB_BUILD_PLUGIN_DIR
+#define BVHLAB_BUILD_PLUGIN_DIR ""
+#endif
+#ifndef BVHLAB_INSTALL_PLUGIN_DIR
+#define BVHLAB_INSTALL_PLUGIN_DIR ""
+#endif
+
+/* The fields of bvhlab_builder up to and including `build` (ABI 1.0). */
+#define BUILDER_MIN_SIZE (offsetof(bvhlab_builder, build) + sizeof(((bvhlab_builder *)0)->build))
+
+struct bvhlab_plugin {
+	void *handle;
+	const bvhlab_builder *builder;
+	char *path;
+};
+
+const char *bvhlab_plugin_search_path(void)
+{
+	static char path[4096];
+	const char *env = getenv("BVHLAB_PLUGIN_PATH");
+	snprintf(path, sizeof(path), "%s%s%s:%s", env ? env : "", env && *env ? ":" : "",
+	         BVHLAB_BUILD_PLUGIN_DIR, BVHLAB_INSTALL_PLUGIN_DIR);
+	return path;
+}
+
+static bool is_file(const char *path)
+{
+	struct stat st;
+	return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+static bool looks_like_path(const char *s)
+{
+	size_t n = strlen(s);
+	return strchr(s, '/') || (n > 3 && strcmp(s + n - 3, ".so") == 0);
+}
+
+/* Finds NAME.so or NAME/NAME.so in a search folder; 0 and *out, or -ENOENT. */
+static int find_in_dir(const char *dir, size_t dirlen, const char *name, char *out,
+                       size_t size)
+{
+	if (dirlen == 0)
+		return -ENOENT;
+	int n = snprintf(out, size, "%.*s/%s.so", (int)dirlen, dir, name);
+	if (n > 0 && (size_t)n < size && is_file(out))
+		return 0;
+	n = snprintf(out, size, "%.*s/%s/%s.so", (int)dirlen, dir, name, name);
+	if (n > 0 && (size_t)n < size && is_file(out))
+		return 0;
+	return -ENOENT;
+}
+
+/* Names what there is to choose from: a typo is then plain to see. */
+static void not_found(const char *name, bvhlab_error *err)
+{
+	char list[300] = "";
+	char **names = NULL;
+	size_t used = 0;
+	if (bvhlab_plugin_names(&names, NULL) == 0) {
+		for (char **p = names; *p && used < sizeof(list); p++)
+			used += (size_t)snprintf(list + used, sizeof(list) - used, "%s%s",
+			                         p == names ? "" : ", ", *p);
+		if (used >= sizeof(list)) /* a long list: say it goes on */
+			memcpy(list + sizeof(list) - 4, "...", 4);
+		bvhlab_plugin_names_free(names);
+	}
+	error_set(err, "plugin '%s' not found on the search path %s (available: %s)", name,
+	          bvhlab_plugin_search_path(), used ? list : "none");
+}
+
+static int resolve(const char *name, char *out, size_t size, bvhlab_error *err)
+{
+	if (looks_like_path(name)) {
+		if ((size_t)snprintf(out, size, "%s", name) >= size) {
+			error_set(err, "plugin '%s': path too long", name);
+			return -ENAMETOOLONG;
+		}
+		return 0;
+	}
+	const char *sp = bvhlab_plugin_search_path();
+	for (const char *p = sp; *p;) {
+		const char *colon = strchr(p, ':');
+		size_t len = colon ? (size_t)(colon - p) : strlen(p);
+		if (find_in_dir(p, len, name, out, size) == 0)
+			return 0;
+		p += len + (colon ? 1 : 0);
+	}
+	not_found(name, err);
+	return -ENOENT;
+}
+
+static int check_options(const bvhlab_builder *b, const char *path, bvhlab_error *err)
+{
+	if (b->option_count && !b->options) {
+		error_set(err, "plugin %s: option_count %u but no option table", path,
+		          b->option_count);
+		return -EINVAL;
+	}
+	for (uint32_t k = 0; k < b->option_count; k++) {
+		const bvhlab_option_decl *d = &b->options[k];
+		if (!d->name || !*d->name || d->type < BVHLAB_OPTION_BOOL ||
+		    d->type > BVHLAB_OPTION_STRING) {
+			error_set(err, "plugin %s: option %u has no name or an unknown type", path, k);
+			return -EINVAL;
+		}
+	}
+	return 0;
+}
+
+/* The descriptor checks, in the order a user would want them reported. */
+static int check_builder(const bvhlab_builder *b, const char *path, bvhlab_error *err)
+{
+	if (!b) {
+		error_set(err, "plugin %s: entry point returned no builder for ABI major %d",
+		          path, BVHLAB_ABI_MAJOR);
+		return -ENOTSUP;
+	}
+	uint32_t major = BVHLAB_ABI_VERSION_MAJOR(b->abi_version);
+	if (major != BVHLAB_ABI_MAJOR) {
+		error_set(err, "plugin %s: built for ABI %u.%u, this host speaks ABI %d.x", path,
+		          major, BVHLAB_ABI_VERSION_MINOR(b->abi_version), BVHLAB_ABI_MAJOR);
+		return -ENOTSUP;
+	}
+	if (b->struct_size < BUILDER_MIN_SIZE) {
+		error_set(err, "plugin %s: descriptor struct_size %u is smaller than ABI 1.0's %zu",
+		          path, b->struct_size, (size_t)BUILDER_MIN_SIZE);
+		return -EINVAL;
+	}
+	if (!b->name || !*b->name) {
+		error_set(err, "plugin %s: descriptor has no name", path);
+		return -EINVAL;
+	}
+	if (!b->build) {
+		error_set(err, "plugin %s ('%s'): descriptor has no build function", path, b->name);
+		return -EINVAL;
+	}
+	return check_options(b, path, err);
+}
+
+static int load(bvhlab_plugin *p, bvhlab_error *err)
+{
+	p->handle = dlopen(p->path, RTLD_NOW | RTLD_LOCAL);
+	if (!p->handle) {
+		const char *why = dlerror();
+		error_set(err, "plugin %s: cannot load: %s", p->path, why ? why : "unknown error");
+		return access(p->path, F_OK) == 0 ? -ENOEXEC : -ENOENT;
+	}
+	dlerror();
+	void *sym = dlsym(p->handle, BVHLAB_PLUGIN_ENTRY_NAME);
+	if (!sym) {
+		error_set(err, "plugin %s: no entry point '%s' (not a bvhlab plugin?)", p->path,
+		          BVHLAB_PLUGIN_ENTRY_NAME);
+		return -ENOEXEC;
+	}
+	bvhlab_plugin_entry_fn entry;
+	/* POSIX guarantees object/function pointer round trips for dlsym. */
+	memcpy(&entry, &sym, sizeof(entry));
+	p->builder = entry(BVHLAB_ABI_MAJOR);
+	return check_builder(p->builder, p->path, err);
+}
+
+int bvhlab_plugin_open(const char *name_or_path, bvhlab_plugin **out, bvhlab_error *err)
+{
+	char path[4096];
+	*out = NULL;
+	int r = resolve(name_or_path, path, sizeof(path), err);
+	if (r < 0)
+		return r;
+	bvhlab_plugin *p = calloc(1, sizeof(*p));
+	if (!p || !(p->path = strdup(path))) {
+		free(p);
+		error_set(err, "plugin '%s': out of memory", name_or_path);
+		return -ENOMEM;
+	}
+	r = load(p, err);
+	if (r < 0) {
+		bvhlab_plugin_close(p);
+		return r;
+	}
+	*out = p;
+	return 0;
+}
+
+void bvhlab_plugin_close(bvhlab_plugin *plugin)
+{
+	if (!plugin)
+		return;
+	if (plugin->handle)
+		dlclose(plugin->handle);
+	free(plugin->path);
+	free(plugin);
+}
+
+const bvhlab_builder *bvhlab_plugin_builder(const bvhlab_plugin *plugin)
+{
+	return plugin->builder;
+}
+
+const char *bvhlab_plugin_path(const bvhlab_plugin *plugin)
+{
+	return plugin->path;
+}

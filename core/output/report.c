@@ -1,0 +1,247 @@
+/*
+ * Renderings of a results document: results.csv (one row per run) and
+ * report.md (one table per scene). Both read only the document, so a saved
+ * results.json can be rendered again later.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cJSON.h>
+
+#include "output/report.h"
+#include "output/results.h"
+#include "util/util.h"
+
+/* The number at a dotted path ("build_ms.median"), or NULL. */
+static const cJSON *at(const cJSON *o, const char *path)
+{
+	char key[64];
+	while (o && *path) {
+		size_t len = strcspn(path, ".");
+		if (len >= sizeof(key))
+			return NULL;
+		memcpy(key, path, len);
+		key[len] = '\0';
+		o = cJSON_GetObjectItemCaseSensitive(o, key);
+		path += len + (path[len] == '.');
+	}
+	return o;
+}
+
+static const char *str(const cJSON *o, const char *path)
+{
+	const cJSON *v = at(o, path);
+	return cJSON_IsString(v) ? v->valuestring : "";
+}
+
+/* Formats a number at path with fmt, or "" when absent. */
+static const char *num(char *buf, size_t size, const cJSON *o, const char *path, const char *fmt)
+{
+	const cJSON *v = at(o, path);
+	if (!cJSON_IsNumber(v))
+		return "";
+	snprintf(buf, size, fmt, v->valuedouble);
+	return buf;
+}
+
+const cJSON *report_at(const cJSON *o, const char *path)
+{
+	return at(o, path);
+}
+
+const char *report_str(const cJSON *o, const char *path)
+{
+	return str(o, path);
+}
+
+double report_num(const cJSON *o, const char *path)
+{
+	const cJSON *v = at(o, path);
+	return cJSON_IsNumber(v) ? v->valuedouble : NAN;
+}
+
+double report_speedup(const cJSON *runs, const cJSON *run)
+{
+	const cJSON *base;
+	double t = report_num(run, "build_ms.median");
+	cJSON_ArrayForEach(base, runs) {
+		if (report_num(base, "threads") == 1 &&
+		    strcmp(str(base, "scene"), str(run, "scene")) == 0 &&
+		    strcmp(str(base, "builder"), str(run, "builder")) == 0) {
+			double t1 = report_num(base, "build_ms.median");
+			return t > 0 ? t1 / t : NAN;
+		}
+	}
+	return NAN;
+}
+
+void report_escape(struct strbuf *sb, const char *text)
+{
+	for (const char *p = text; *p; p++) {
+		switch (*p) {
+		case '&': sb_printf(sb, "&amp;"); break;
+		case '<': sb_printf(sb, "&lt;"); break;
+		case '>': sb_printf(sb, "&gt;"); break;
+		case '"': sb_printf(sb, "&quot;"); break;
+		case '\'': sb_printf(sb, "&#39;"); break;
+		default: sb_printf(sb, "%c", *p);
+		}
+	}
+}
+
+/* CSV field: quoted when it holds a separator, quote or newline. */
+static void csv_field(struct strbuf *sb, const char *s, bool last)
+{
+	if (strpbrk(s, ",\"\n\r")) {
+		sb_printf(sb, "\"");
+		for (const char *p = s; *p; p++)
+			sb_printf(sb, *p == '"' ? "\"\"" : "%c", *p);
+		sb_printf(sb, "\"");
+	} else {
+		sb_printf(sb, "%s", s);
+	}
+	sb_printf(sb, last ? "\n" : ",");
+}
+
+static const char *const csv_numbers[][2] = {
+	{"threads", "%.0f"},
+	{"build_ms.median", "%.4f"},
+	{"build_ms.min", "%.4f"},
+	{"build_ms.max", "%.4f"},
+	{"mtris_per_s", "%.4f"},
+	{"tree.nodes", "%.0f"},
+	{"tree.leaves", "%.0f"},
+	{"tree.max_depth", "%.0f"},
+	{"tree.avg_leaf_size", "%.4f"},
+	{"tree.sah_cost", "%.6f"},
+	{"tree.memory_bytes", "%.0f"},
+	{"validation.rays_checked", "%.0f"},
+	{"validation.mismatches", "%.0f"},
+	{"rays.primary.mrays_per_s", "%.4f"},
+	{"rays.primary.nodes_per_ray", "%.4f"},
+	{"rays.primary.tris_per_ray", "%.4f"},
+	{"rays.diffuse.mrays_per_s", "%.4f"},
+	{"rays.diffuse.nodes_per_ray", "%.4f"},
+	{"rays.diffuse.tris_per_ray", "%.4f"},
+};
+
+static void csv_row(struct strbuf *sb, const cJSON *run)
+{
+	char buf[64];
+	csv_field(sb, str(run, "scene"), false);
+	csv_field(sb, str(run, "builder"), false);
+	csv_field(sb, str(run, "plugin"), false);
+	csv_field(sb, str(run, "status"), false);
+	for (size_t k = 0; k < sizeof(csv_numbers) / sizeof(csv_numbers[0]); k++)
+		csv_field(sb, num(buf, sizeof(buf), run, csv_numbers[k][0], csv_numbers[k][1]), false);
+	const cJSON *valid = at(run, "validation.valid");
+	csv_field(sb, cJSON_IsBool(valid) ? (cJSON_IsTrue(valid) ? "true" : "false") : "", false);
+	csv_field(sb, str(run, "error"), true);
+}
+
+char *results_csv(const cJSON *doc)
+{
+	struct strbuf sb = {0};
+	sb_printf(&sb, "scene,builder,plugin,status");
+	for (size_t k = 0; k < sizeof(csv_numbers) / sizeof(csv_numbers[0]); k++)
+		sb_printf(&sb, ",%s", csv_numbers[k][0]);
+	sb_printf(&sb, ",validation.valid,error\n");
+	const cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
+		csv_row(&sb, run);
+	return sb_take(&sb);
+}
+
+/* Markdown cell text: pipes and newlines would break the table. */
+static void md_cell(struct strbuf *sb, const char *s)
+{
+	sb_printf(sb, " ");
+	for (const char *p = s; *p; p++)
+		sb_printf(sb, *p == '|' ? "\\|" : *p == '\n' ? " " : "%c", *p);
+	sb_printf(sb, " |");
+}
+
+static void md_run_row(struct strbuf *sb, const cJSON *doc, const cJSON *run)
+{
+	char buf[64];
+	sb_printf(sb, "|");
+	md_cell(sb, str(run, "builder"));
+	md_cell(sb, num(buf, sizeof(buf), run, "threads", "%.0f"));
+	md_cell(sb, str(run, "status"));
+	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.median", "%.2f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.min", "%.2f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.max", "%.2f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "mtris_per_s", "%.2f"));
+	double speedup = report_speedup(cJSON_GetObjectItem(doc, "runs"), run);
+	snprintf(buf, sizeof(buf), "%.2f", speedup);
+	md_cell(sb, isnan(speedup) ? "" : buf);
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.sah_cost", "%.3f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.mrays_per_s", "%.2f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.nodes_per_ray", "%.1f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "rays.diffuse.mrays_per_s", "%.2f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "rays.diffuse.nodes_per_ray", "%.1f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.nodes", "%.0f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.max_depth", "%.0f"));
+	md_cell(sb, num(buf, sizeof(buf), run, "tree.avg_leaf_size", "%.2f"));
+	md_cell(sb, str(run, "error"));
+	sb_printf(sb, "\n");
+}
+
+/* The scene's images, when the run drew them (paths relative to the report). */
+static void md_images(struct strbuf *sb, const cJSON *scene)
+{
+	const char *shaded = str(scene, "images.shaded"), *legend = str(scene, "images.legend");
+	if (*shaded)
+		sb_printf(sb, "\n![%s](%s)\n", str(scene, "name"), shaded);
+	if (*legend)
+		sb_printf(sb, "\nHeat maps (nodes visited per primary ray, %.0f to %.0f): "
+		              "![scale](%s) and per builder in report.html.\n",
+		          report_num(scene, "images.heat_min"), report_num(scene, "images.heat_max"),
+		          legend);
+}
+
+static void md_scene(struct strbuf *sb, const cJSON *doc, const cJSON *scene)
+{
+	const char *name = str(scene, "name");
+	char buf[64];
+	sb_printf(sb, "\n## %s\n\n%s, %s triangles", name, str(scene, "source"),
+	          num(buf, sizeof(buf), scene, "triangles", "%.0f"));
+	if (*str(scene, "error"))
+		sb_printf(sb, ". **Could not be loaded:** %s", str(scene, "error"));
+	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | Mtris/s "
+	              "| speedup | SAH cost | primary Mrays/s | primary nodes/ray "
+	              "| diffuse Mrays/s | diffuse nodes/ray | nodes | depth | avg leaf | error |\n"
+	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
+	              "|---:|---|\n");
+	const cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
+		if (strcmp(str(run, "scene"), name) == 0)
+			md_run_row(sb, doc, run);
+	md_images(sb, scene);
+}
+
+char *report_markdown(const cJSON *doc)
+{
+	struct strbuf sb = {0};
+	const cJSON *runs = cJSON_GetObjectItem(doc, "runs");
+	int total = cJSON_GetArraySize(runs), ok = 0;
+	const cJSON *run, *scene;
+	cJSON_ArrayForEach(run, runs)
+		ok += strcmp(str(run, "status"), "ok") == 0;
+	sb_printf(&sb, "# bvhlab report\n\nbvhlab %s, %s. Machine: %s, %s cores, %s available "
+	               "to this process.\n\n%d runs, %d ok. Times are build times in ms over "
+	               "the timed repeats; SAH cost with c_trav = c_isect = 1, normalised by "
+	               "the root's surface area. Speedup: over the same builder's 1-thread run. "
+	               "Rays (primary from the camera, diffuse bounces from their hits) are "
+	               "traced with every hardware thread for every run, whatever its build "
+	               "thread count, so traversal numbers compare trees.\n",
+	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
+	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
+	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);
+	report_thesis(&sb, doc);
+	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
+		md_scene(&sb, doc, scene);
+	return sb_take(&sb);
+}

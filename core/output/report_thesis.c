@@ -1,0 +1,144 @@
+/*
+ * The thesis's table shape in report.md: for each thread count above 1,
+ * one row per scene with the sequential build time and, for every other
+ * builder, its time, its gain (t_seq - t) / t_seq and its speedup
+ * t_seq / t. The sequential time is the first ok run of plugin sah_seq
+ * with 1 thread. Only ok runs count; a missing one shows as "—". When a
+ * thread count appears twice for a builder (threads 0 resolving to a
+ * count also listed), the first ok run is used.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include <cJSON.h>
+
+#include "output/results.h"
+#include "util/util.h"
+
+#define SEQ_PLUGIN "sah_seq"
+#define MAX_COLUMNS 32
+#define MAX_THREAD_COUNTS 32
+#define MISSING "—"
+
+static const char *text(const cJSON *o, const char *key)
+{
+	const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+	return cJSON_IsString(v) ? v->valuestring : "";
+}
+
+static double number(const cJSON *o, const char *key, double fallback)
+{
+	const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+	return cJSON_IsNumber(v) ? v->valuedouble : fallback;
+}
+
+/* Median build time of the first ok run that matches, or a negative number. */
+static double median_ms(const cJSON *runs, const char *scene, const char *key,
+                        const char *value, double threads)
+{
+	const cJSON *run;
+
+	cJSON_ArrayForEach(run, runs) {
+		if (strcmp(text(run, "status"), "ok") != 0 || number(run, "threads", -1) != threads ||
+		    strcmp(text(run, "scene"), scene) != 0 || strcmp(text(run, key), value) != 0)
+			continue;
+		double ms = number(cJSON_GetObjectItemCaseSensitive(run, "build_ms"), "median", -1);
+		if (ms > 0)
+			return ms;
+	}
+	return -1;
+}
+
+/* Labels of the builders compared with sah_seq, in order of appearance. */
+static int columns(const cJSON *runs, const char **out)
+{
+	const cJSON *run;
+	int n = 0;
+
+	cJSON_ArrayForEach(run, runs) {
+		const char *label = text(run, "builder");
+		bool seen = strcmp(text(run, "plugin"), SEQ_PLUGIN) == 0 || !*label;
+		for (int i = 0; i < n && !seen; i++)
+			seen = strcmp(out[i], label) == 0;
+		if (!seen && n < MAX_COLUMNS)
+			out[n++] = label;
+	}
+	return n;
+}
+
+static int by_value(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+/* Distinct thread counts above 1, ascending. */
+static int thread_counts(const cJSON *runs, double *out)
+{
+	const cJSON *run;
+	int n = 0;
+
+	cJSON_ArrayForEach(run, runs) {
+		double t = number(run, "threads", 0);
+		bool seen = t <= 1;
+		for (int i = 0; i < n && !seen; i++)
+			seen = out[i] == t;
+		if (!seen && n < MAX_THREAD_COUNTS)
+			out[n++] = t;
+	}
+	qsort(out, (size_t)n, sizeof(*out), by_value);
+	return n;
+}
+
+static void header(struct strbuf *sb, double threads, const char **cols, int n)
+{
+	sb_printf(sb, "\n### %.0f threads\n\n| scene | " SEQ_PLUGIN " 1 thread ms |", threads);
+	for (int i = 0; i < n; i++)
+		sb_printf(sb, " %s ms | gain | speedup |", cols[i]);
+	sb_printf(sb, "\n|---|---:|");
+	for (int i = 0; i < n; i++)
+		sb_printf(sb, "---:|---:|---:|");
+	sb_printf(sb, "\n");
+}
+
+static void row(struct strbuf *sb, const cJSON *runs, const char *scene, double threads,
+                const char **cols, int n)
+{
+	double seq = median_ms(runs, scene, "plugin", SEQ_PLUGIN, 1);
+
+	if (seq > 0)
+		sb_printf(sb, "| %s | %.2f |", scene, seq);
+	else
+		sb_printf(sb, "| %s | " MISSING " |", scene);
+	for (int i = 0; i < n; i++) {
+		double t = median_ms(runs, scene, "builder", cols[i], threads);
+		if (t <= 0)
+			sb_printf(sb, " " MISSING " | " MISSING " | " MISSING " |");
+		else if (seq <= 0)
+			sb_printf(sb, " %.2f | " MISSING " | " MISSING " |", t);
+		else
+			sb_printf(sb, " %.2f | %.1f %% | %.2f |", t, 100 * (seq - t) / seq, seq / t);
+	}
+	sb_printf(sb, "\n");
+}
+
+void report_thesis(struct strbuf *sb, const cJSON *doc)
+{
+	const cJSON *runs = cJSON_GetObjectItemCaseSensitive(doc, "runs");
+	const cJSON *scene;
+	const char *cols[MAX_COLUMNS];
+	double counts[MAX_THREAD_COUNTS];
+	int ncols = columns(runs, cols), ncounts = thread_counts(runs, counts);
+
+	if (ncols == 0 || ncounts == 0)
+		return;
+	sb_printf(sb, "\n## Parallel builders against " SEQ_PLUGIN "\n\n"
+	              "The thesis's table: median build times in ms; the sequential time is "
+	              SEQ_PLUGIN " on 1 thread; gain = (t_seq − t) / t_seq, speedup = t_seq / t. "
+	              "Only ok runs count; " MISSING " marks a missing one.\n");
+	for (int k = 0; k < ncounts; k++) {
+		header(sb, counts[k], cols, ncols);
+		cJSON_ArrayForEach(scene, cJSON_GetObjectItemCaseSensitive(doc, "scenes"))
+			row(sb, runs, text(scene, "name"), counts[k], cols, ncols);
+	}
+}

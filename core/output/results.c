@@ -1,0 +1,478 @@
+/*
+ * results.json: the document (schema in DESIGN.md) and its atomic writing.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cJSON.h>
+
+#include "harness/harness.h"
+#include "output/results.h"
+#include "util/util.h"
+
+/* mkdir -p: creates every missing folder of `path`. */
+static int make_dirs(const char *path, bvhlab_error *err)
+{
+	char buf[4096];
+	if ((size_t)snprintf(buf, sizeof(buf), "%s", path) >= sizeof(buf)) {
+		error_set(err, "output folder name too long: %s", path);
+		return -ENAMETOOLONG;
+	}
+	for (char *p = buf + 1;; p++) {
+		char c = *p;
+		if (c != '/' && c != '\0')
+			continue;
+		*p = '\0';
+		if (mkdir(buf, 0777) < 0 && errno != EEXIST) {
+			int e = errno;
+			error_set(err, "cannot create output folder %s: %s", buf, strerror(e));
+			return -e;
+		}
+		*p = c;
+		if (c == '\0')
+			return 0;
+	}
+}
+
+static cJSON *machine_json(void)
+{
+	struct machine_info m;
+	machine_info_read(&m);
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "cpu", m.cpu);
+	cJSON_AddNumberToObject(o, "cores", m.cores);
+	cJSON_AddNumberToObject(o, "threads_available", m.threads_available);
+	cJSON_AddNumberToObject(o, "packages", m.topo.packages);
+	cJSON_AddNumberToObject(o, "physical_cores", m.topo.physical_cores);
+	cJSON_AddNumberToObject(o, "logical_cpus", m.topo.logical_cpus);
+	/* "caches": { "L1d": { "bytes": 49152, "instances": 2 }, ... }, known levels. */
+	cJSON *caches = cJSON_AddObjectToObject(o, "caches");
+	for (int k = 0; caches && k < MACHINE_CACHE_LEVELS; k++) {
+		if (m.topo.caches[k].size == 0)
+			continue;
+		cJSON *c = cJSON_AddObjectToObject(caches, machine_cache_name(k));
+		cJSON_AddNumberToObject(c, "bytes", (double)m.topo.caches[k].size);
+		cJSON_AddNumberToObject(c, "instances", m.topo.caches[k].instances);
+	}
+	return o;
+}
+
+static void add_created(cJSON *doc)
+{
+	char stamp[64];
+	time_t now = time(NULL);
+	struct tm tm;
+	gmtime_r(&now, &tm);
+	strftime(stamp, sizeof(stamp), "%Y-%m-%dT%H:%M:%SZ", &tm);
+	cJSON_AddStringToObject(doc, "created", stamp);
+}
+
+int results_init(struct results *res, const struct config *cfg, const char *dir,
+                 bvhlab_error *err)
+{
+	memset(res, 0, sizeof(*res));
+	int r = make_dirs(dir, err);
+	if (r < 0)
+		return r;
+	res->dir = strdup(dir);
+	res->doc = cJSON_CreateObject();
+	if (!res->dir || !res->doc)
+		goto nomem;
+	cJSON_AddStringToObject(res->doc, "bvhlab_version", bvhlab_version());
+	add_created(res->doc);
+	cJSON_AddItemToObject(res->doc, "machine", machine_json());
+	cJSON_AddItemToObject(res->doc, "config", cJSON_Duplicate(cfg->root, 1));
+	res->scenes = cJSON_AddArrayToObject(res->doc, "scenes");
+	res->runs = cJSON_AddArrayToObject(res->doc, "runs");
+	if (!res->scenes || !res->runs)
+		goto nomem;
+	return 0;
+nomem:
+	results_finish(res);
+	error_set(err, "out of memory creating results");
+	return -ENOMEM;
+}
+
+void results_finish(struct results *res)
+{
+	cJSON_Delete(res->doc);
+	free(res->dir);
+	memset(res, 0, sizeof(*res));
+}
+
+static cJSON *find_scene(const struct results *res, const char *name)
+{
+	cJSON *scene;
+	cJSON_ArrayForEach(scene, res->scenes) {
+		const cJSON *n = cJSON_GetObjectItemCaseSensitive(scene, "name");
+		if (cJSON_IsString(n) && strcmp(n->valuestring, name) == 0)
+			return scene;
+	}
+	return NULL;
+}
+
+/* A scene seen again (a resumed sweep loads it anew) replaces its entry. */
+int results_add_scene(struct results *res, const char *name, const char *source,
+                      uint32_t triangles, const char *error)
+{
+	cJSON *o = cJSON_CreateObject();
+	if (!o)
+		return -ENOMEM;
+	cJSON_AddStringToObject(o, "name", name ? name : "");
+	cJSON_AddStringToObject(o, "source", source ? source : "");
+	cJSON_AddNumberToObject(o, "triangles", triangles);
+	if (error)
+		cJSON_AddStringToObject(o, "error", error);
+	cJSON *old = find_scene(res, name ? name : "");
+	if (old)
+		cJSON_ReplaceItemViaPointer(res->scenes, old, o);
+	else
+		cJSON_AddItemToArray(res->scenes, o);
+	return 0;
+}
+
+static cJSON *options_json(const bvhlab_options *opts)
+{
+	cJSON *o = cJSON_CreateObject();
+	for (uint32_t k = 0; opts && k < opts->builder->option_count; k++) {
+		const char *name = opts->builder->options[k].name;
+		const bvhlab_option_value *v = &opts->values[k];
+		if (v->type == BVHLAB_OPTION_BOOL)
+			cJSON_AddBoolToObject(o, name, v->b);
+		else if (v->type == BVHLAB_OPTION_INT)
+			cJSON_AddNumberToObject(o, name, (double)v->i);
+		else if (v->type == BVHLAB_OPTION_FLOAT)
+			cJSON_AddNumberToObject(o, name, v->f);
+		else
+			cJSON_AddStringToObject(o, name, v->s ? v->s : "");
+	}
+	return o;
+}
+
+static cJSON *timing_json(const struct run_record *run)
+{
+	double med, mn, mx;
+	harness_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddNumberToObject(o, "median", med);
+	cJSON_AddNumberToObject(o, "min", mn);
+	cJSON_AddNumberToObject(o, "max", mx);
+	cJSON *samples = cJSON_AddArrayToObject(o, "samples");
+	for (uint32_t k = 0; k < run->sample_count; k++)
+		cJSON_AddItemToArray(samples, cJSON_CreateNumber(run->samples_ms[k]));
+	return o;
+}
+
+static cJSON *tree_json(const bvhlab_tree_stats *st)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddNumberToObject(o, "nodes", st->nodes);
+	cJSON_AddNumberToObject(o, "leaves", st->leaves);
+	cJSON_AddNumberToObject(o, "max_depth", st->max_depth);
+	cJSON_AddNumberToObject(o, "avg_leaf_size", st->avg_leaf_size);
+	cJSON_AddNumberToObject(o, "sah_cost", st->sah_cost);
+	cJSON_AddNumberToObject(o, "memory_bytes", (double)st->memory_bytes);
+	cJSON *hist = cJSON_AddArrayToObject(o, "leaf_size_histogram");
+	for (int k = 0; k < BVHLAB_LEAF_HISTOGRAM; k++)
+		cJSON_AddItemToArray(hist, cJSON_CreateNumber(st->leaf_histogram[k]));
+	return o;
+}
+
+static cJSON *validation_json(const struct run_record *run)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddBoolToObject(o, "valid", run->valid);
+	cJSON_AddNumberToObject(o, "rays_checked", (double)run->rays_checked);
+	cJSON_AddNumberToObject(o, "mismatches", (double)run->mismatches);
+	return o;
+}
+
+int results_add_run(struct results *res, const struct run_record *run)
+{
+	cJSON *o = cJSON_CreateObject();
+	if (!o)
+		return -ENOMEM;
+	cJSON_AddStringToObject(o, "scene", run->scene ? run->scene : "");
+	cJSON_AddStringToObject(o, "builder", run->builder);
+	cJSON_AddStringToObject(o, "plugin", run->plugin ? run->plugin : "");
+	cJSON_AddNumberToObject(o, "threads", run->threads);
+	cJSON_AddItemToObject(o, "options", options_json(run->opts));
+	cJSON_AddStringToObject(o, "status", run->status);
+	if (run->error)
+		cJSON_AddStringToObject(o, "error", run->error);
+	if (run->sample_count) {
+		cJSON *t = timing_json(run);
+		double med = cJSON_GetObjectItem(t, "median")->valuedouble;
+		cJSON_AddItemToObject(o, "build_ms", t);
+		cJSON_AddNumberToObject(o, "mtris_per_s",
+		                        med > 0 ? run->triangles / (med * 1e3) : 0);
+	}
+	if (run->stats)
+		cJSON_AddItemToObject(o, "tree", tree_json(run->stats));
+	if (run->validated)
+		cJSON_AddItemToObject(o, "validation", validation_json(run));
+	if (run->rays)
+		cJSON_AddItemToObject(o, "rays", results_rays_json(run->rays));
+	cJSON_AddItemToArray(res->runs, o);
+	return 0;
+}
+
+int results_write_file(const char *dir, const char *name, const char *text, bvhlab_error *err)
+{
+	char path[4096], tmp[4096];
+	if ((size_t)snprintf(path, sizeof(path), "%s/%s", dir, name) >= sizeof(path) ||
+	    (size_t)snprintf(tmp, sizeof(tmp), "%s/.%s.tmp", dir, name) >= sizeof(tmp)) {
+		error_set(err, "path too long: %s/%s", dir, name);
+		return -ENAMETOOLONG;
+	}
+	FILE *f = fopen(tmp, "w");
+	if (!f)
+		goto fail;
+	size_t len = strlen(text);
+	bool ok = fwrite(text, 1, len, f) == len;
+	ok = (fflush(f) == 0) && ok;
+	/* On disk before the rename: a crash then leaves the old file or the new, never half. */
+	ok = (fsync(fileno(f)) == 0) && ok;
+	ok = (fclose(f) == 0) && ok;
+	if (ok && rename(tmp, path) == 0)
+		return 0;
+fail:;
+	int e = errno ? errno : EIO;
+	error_set(err, "cannot write %s: %s", path, strerror(e));
+	unlink(tmp);
+	return -e;
+}
+
+/* One rendering of the document into one file. */
+static int write_rendering(const struct results *res, const char *name, char *text,
+                           bvhlab_error *err)
+{
+	if (!text) {
+		error_set(err, "out of memory rendering %s", name);
+		return -ENOMEM;
+	}
+	int r = results_write_file(res->dir, name, text, err);
+	free(text);
+	return r;
+}
+
+int results_write(const struct results *res, bvhlab_error *err)
+{
+	int r = write_rendering(res, "results.json", cJSON_Print(res->doc), err);
+	if (r == 0)
+		r = write_rendering(res, "results.csv", results_csv(res->doc), err);
+	if (r == 0)
+		r = write_rendering(res, "report.md", report_markdown(res->doc), err);
+	if (r == 0)
+		r = write_rendering(res, "report.html", report_html(res->doc), err);
+	return r;
+}
+
+/* ---- resuming ---------------------------------------------------------------- */
+
+static bool is_finished(const char *status)
+{
+	static const char *const finished[] = {"ok", "invalid", "failed", "crashed", "timeout"};
+	for (size_t k = 0; k < sizeof(finished) / sizeof(finished[0]); k++)
+		if (strcmp(status, finished[k]) == 0)
+			return true;
+	return false;
+}
+
+static const char *string_of(const cJSON *obj, const char *key)
+{
+	const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+	return cJSON_IsString(v) ? v->valuestring : NULL;
+}
+
+static bool run_matches(const cJSON *run, const char *scene, const char *builder,
+                        uint32_t threads)
+{
+	const char *s = string_of(run, "scene"), *b = string_of(run, "builder");
+	const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
+	return s && b && cJSON_IsNumber(t) && t->valuedouble == threads && strcmp(s, scene) == 0 &&
+	       strcmp(b, builder) == 0;
+}
+
+bool results_has_run(const struct results *res, const char *scene, const char *builder,
+                     uint32_t threads)
+{
+	const cJSON *run;
+	cJSON_ArrayForEach(run, res->runs)
+		if (run_matches(run, scene, builder, threads))
+			return true;
+	return false;
+}
+
+/* The file's text; -ENOENT quietly when there is none. */
+static int read_text(const char *path, char **out, bvhlab_error *err)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f) {
+		int e = errno;
+		if (e != ENOENT)
+			error_set(err, "cannot resume from %s: %s", path, strerror(e));
+		return -e;
+	}
+	struct strbuf sb = {0};
+	char chunk[65536];
+	size_t n;
+	while ((n = fread(chunk, 1, sizeof(chunk), f)) > 0)
+		sb_printf(&sb, "%.*s", (int)n, chunk);
+	bool failed = ferror(f);
+	fclose(f);
+	*out = sb_take(&sb);
+	if (failed || !*out) {
+		free(*out);
+		error_set(err, "cannot resume from %s: %s", path, failed ? "read error" : "out of memory");
+		return failed ? -EIO : -ENOMEM;
+	}
+	return 0;
+}
+
+/* Each run needs what matching and the reports use; unfinished ones are left to redo. */
+static int check_runs(const cJSON *runs, const char *path, bvhlab_error *err)
+{
+	int k = 0;
+	const cJSON *run;
+	if (!cJSON_IsArray(runs)) {
+		error_set(err, "cannot resume from %s: no \"runs\" array (not a bvhlab results file?)",
+		          path);
+		return -EINVAL;
+	}
+	cJSON_ArrayForEach(run, runs) {
+		const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
+		if (!string_of(run, "scene") || !string_of(run, "builder") || !string_of(run, "status") ||
+		    !cJSON_IsNumber(t)) {
+			error_set(err, "cannot resume from %s: runs[%d] lacks a scene, builder, threads "
+			          "or status", path, k);
+			return -EINVAL;
+		}
+		k++;
+	}
+	return 0;
+}
+
+/* Moves the old document's finished runs and named scenes into ours. */
+static void take_over(struct results *res, cJSON *old, size_t *kept, size_t *not_ok)
+{
+	cJSON *runs = cJSON_GetObjectItemCaseSensitive(old, "runs");
+	cJSON *scenes = cJSON_GetObjectItemCaseSensitive(old, "scenes");
+	while (runs->child) {
+		cJSON *run = cJSON_DetachItemViaPointer(runs, runs->child);
+		const char *status = string_of(run, "status");
+		if (!is_finished(status)) {
+			cJSON_Delete(run);
+			continue;
+		}
+		(*kept)++;
+		*not_ok += strcmp(status, "ok") != 0;
+		cJSON_AddItemToArray(res->runs, run);
+	}
+	while (cJSON_IsArray(scenes) && scenes->child) {
+		cJSON *scene = cJSON_DetachItemViaPointer(scenes, scenes->child);
+		if (string_of(scene, "name") && !find_scene(res, string_of(scene, "name")))
+			cJSON_AddItemToArray(res->scenes, scene);
+		else
+			cJSON_Delete(scene);
+	}
+	/* The sweep began when the first attempt did. */
+	const char *created = string_of(old, "created");
+	if (created) {
+		cJSON_AddStringToObject(res->doc, "resumed", string_of(res->doc, "created"));
+		cJSON_ReplaceItemInObjectCaseSensitive(res->doc, "created", cJSON_CreateString(created));
+	}
+}
+
+int results_resume(struct results *res, size_t *kept, size_t *not_ok, bvhlab_error *err)
+{
+	char path[4096], *text = NULL;
+	*kept = *not_ok = 0;
+	if ((size_t)snprintf(path, sizeof(path), "%s/results.json", res->dir) >= sizeof(path)) {
+		error_set(err, "path too long: %s/results.json", res->dir);
+		return -ENAMETOOLONG;
+	}
+	int r = read_text(path, &text, err);
+	if (r < 0)
+		return r;
+	cJSON *old = cJSON_Parse(text);
+	free(text);
+	if (!cJSON_IsObject(old)) {
+		error_set(err, "cannot resume from %s: not a valid JSON object (damaged? move it away "
+		          "to start afresh)", path);
+		r = -EINVAL;
+	} else {
+		r = check_runs(cJSON_GetObjectItemCaseSensitive(old, "runs"), path, err);
+	}
+	if (r == 0)
+		take_over(res, old, kept, not_ok);
+	cJSON_Delete(old);
+	return r;
+}
+
+/* ---- images and saved documents ----------------------------------------------- */
+
+int results_set_scene_image(struct results *res, const char *scene, const char *kind,
+                            const char *name, uint32_t lo, uint32_t hi)
+{
+	cJSON *s = find_scene(res, scene);
+	if (!s)
+		return -ENOENT;
+	cJSON *images = cJSON_GetObjectItemCaseSensitive(s, "images");
+	if (!images && !(images = cJSON_AddObjectToObject(s, "images")))
+		return -ENOMEM;
+	cJSON_DeleteItemFromObjectCaseSensitive(images, kind);
+	cJSON_AddStringToObject(images, kind, name);
+	if (strcmp(kind, "legend") == 0) {
+		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_min");
+		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_max");
+		cJSON_AddNumberToObject(images, "heat_min", lo);
+		cJSON_AddNumberToObject(images, "heat_max", hi);
+	}
+	return 0;
+}
+
+int results_set_run_image(struct results *res, const char *scene, const char *builder,
+                          uint32_t threads, const char *name)
+{
+	cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
+		if (!run_matches(run, scene, builder, threads))
+			continue;
+		cJSON_DeleteItemFromObjectCaseSensitive(run, "heat_image");
+		return cJSON_AddStringToObject(run, "heat_image", name) ? 0 : -ENOMEM;
+	}
+	return -ENOENT;
+}
+
+int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err)
+{
+	char *text = NULL;
+	int r = read_text(json_path, &text, err);
+	if (r == -ENOENT)
+		error_set(err, "cannot read %s: %s", json_path, strerror(ENOENT));
+	if (r < 0)
+		return r;
+	struct results res = {.doc = cJSON_Parse(text), .dir = (char *)dir};
+	free(text);
+	if (!cJSON_IsObject(res.doc) ||
+	    !cJSON_IsArray(cJSON_GetObjectItemCaseSensitive(res.doc, "runs"))) {
+		error_set(err, "%s is not a bvhlab results document", json_path);
+		r = -EINVAL;
+	}
+	if (r == 0)
+		r = make_dirs(dir, err);
+	if (r == 0)
+		r = write_rendering(&res, "results.csv", results_csv(res.doc), err);
+	if (r == 0)
+		r = write_rendering(&res, "report.md", report_markdown(res.doc), err);
+	if (r == 0)
+		r = write_rendering(&res, "report.html", report_html(res.doc), err);
+	cJSON_Delete(res.doc);
+	return r;
+}

@@ -1,0 +1,102 @@
+/*
+ * results.json (DESIGN.md schema), results.csv and report.md of one output
+ * folder. The document lives in memory as cJSON and every file is rewritten
+ * through a temporary file and rename after each run, so an interrupted
+ * sweep always leaves complete files with every finished run.
+ */
+#ifndef BVHLAB_CORE_RESULTS_H
+#define BVHLAB_CORE_RESULTS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "config/config.h"
+#include "machine/machine.h"
+
+struct cJSON;
+
+struct results {
+	struct cJSON *doc;
+	struct cJSON *scenes;
+	struct cJSON *runs;
+	char *dir;
+};
+
+struct ray_metrics;
+
+/* Everything known about one run; fields beyond status are optional. */
+struct run_record {
+	const char *scene;
+	const char *builder;   /* the config's label for the builder */
+	const char *plugin;    /* the descriptor's name */
+	uint32_t threads;      /* resolved thread count */
+	const bvhlab_options *opts; /* resolved options, or NULL */
+	const char *status;    /* "ok", "invalid", "failed", ... */
+	const char *error;     /* message when status is not "ok", or NULL */
+	const double *samples_ms;
+	uint32_t sample_count; /* 0: no timing */
+	uint32_t triangles;
+	const bvhlab_tree_stats *stats; /* or NULL */
+	bool validated;
+	bool valid;
+	uint64_t rays_checked, mismatches;
+	const struct ray_metrics *rays; /* or NULL: not traced */
+};
+
+
+/* Creates the folder (and parents) and the document. */
+int results_init(struct results *res, const struct config *cfg, const char *dir,
+                 bvhlab_error *err);
+void results_finish(struct results *res);
+
+int results_add_scene(struct results *res, const char *name, const char *source,
+                      uint32_t triangles, const char *error);
+int results_add_run(struct results *res, const struct run_record *run);
+
+/* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of DESIGN.md. */
+struct cJSON *results_rays_json(const struct ray_metrics *m);
+
+/* The scene's "images": {"<kind>": name}; a legend also sets "heat_min"/"heat_max". */
+int results_set_scene_image(struct results *res, const char *scene, const char *kind,
+                            const char *name, uint32_t lo, uint32_t hi);
+/* The run's "heat_image": name. */
+int results_set_run_image(struct results *res, const char *scene, const char *builder,
+                          uint32_t threads, const char *name);
+
+/*
+ * Takes over the finished runs (any status of DESIGN.md's list) and the
+ * scenes of dir/results.json, for `bvhlab run --resume`. *kept counts the
+ * runs, *not_ok those whose status is not "ok". -ENOENT when there is no
+ * file; another negative errno, with err naming the file, when it cannot be
+ * read or is not a results document.
+ */
+int results_resume(struct results *res, size_t *kept, size_t *not_ok, bvhlab_error *err);
+/* Whether the document holds a run of scene x builder x threads. */
+bool results_has_run(const struct results *res, const char *scene, const char *builder,
+                     uint32_t threads);
+
+/* Rewrites results.json, results.csv and report.md atomically. */
+int results_write(const struct results *res, bvhlab_error *err);
+
+/* Writes `text` to dir/name through dir/.name.tmp and rename. */
+int results_write_file(const char *dir, const char *name, const char *text, bvhlab_error *err);
+
+/* The CSV and Markdown renderings of a results document (malloc'd text). */
+char *results_csv(const struct cJSON *doc);
+char *report_markdown(const struct cJSON *doc);
+/* report.html: self-contained but for the PNGs it names (images/...). */
+char *report_html(const struct cJSON *doc);
+
+/* Regenerates results.csv, report.md and report.html in dir from a saved
+ * results.json (bvhlab report). */
+int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err);
+
+struct strbuf;
+/* Appends the thesis-style speedup tables (parallel builders against
+ * sah_seq on 1 thread, per thread count > 1) to a report; nothing when the
+ * document has no such runs. report_thesis.c. */
+void report_thesis(struct strbuf *sb, const struct cJSON *doc);
+
+#endif

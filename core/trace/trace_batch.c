@@ -1,0 +1,110 @@
+/*
+ * Tracing a batch of rays with a pool of threads. Rays are handed out in
+ * tiles from one atomic counter, so threads that draw cheap rays take more
+ * tiles; each thread keeps its own counters and they are summed at the
+ * end, so nothing is shared in the hot loop but the counter.
+ */
+#include <errno.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+
+#include <bvhlab/plugin.h>
+#include <bvhlab/rays.h>
+
+#include "util/util.h"
+
+/* Rays per tile: large enough that the counter is rarely touched, small
+ * enough to balance 2 to 64 threads over 64k rays. */
+#define TILE 256
+
+struct batch {
+	const bvhlab_tree *tree;
+	const bvhlab_scene *scene;
+	const bvhlab_ray *rays;
+	size_t count;
+	bool any;
+	bvhlab_hit *hits;
+	uint32_t *nodes;
+	atomic_size_t next;
+};
+
+struct worker {
+	struct batch *b;
+	pthread_t thread;
+	bvhlab_trace_stats stats;
+};
+
+static void trace_tile(struct batch *b, size_t begin, size_t end, bvhlab_trace_stats *st)
+{
+	for (size_t i = begin; i < end; i++) {
+		bvhlab_hit hit;
+		uint64_t before = st->nodes_visited;
+		if (b->any)
+			bvhlab_trace_any(b->tree, b->scene, &b->rays[i], &hit, st);
+		else
+			bvhlab_trace_closest(b->tree, b->scene, &b->rays[i], &hit, st);
+		if (b->hits)
+			b->hits[i] = hit;
+		if (b->nodes)
+			b->nodes[i] = (uint32_t)(st->nodes_visited - before);
+	}
+}
+
+static void *work(void *arg)
+{
+	struct worker *w = arg;
+	struct batch *b = w->b;
+	for (;;) {
+		size_t begin = atomic_fetch_add_explicit(&b->next, TILE, memory_order_relaxed);
+		if (begin >= b->count)
+			break;
+		size_t end = b->count - begin < TILE ? b->count : begin + TILE;
+		trace_tile(b, begin, end, &w->stats);
+	}
+	return NULL;
+}
+
+/* Starts threads - 1 helpers and works on the calling thread too. */
+static void run_workers(struct batch *b, struct worker *w, uint32_t threads)
+{
+	uint32_t started = 0;
+	for (uint32_t k = 1; k < threads; k++, started++) {
+		w[k].b = b;
+		if (pthread_create(&w[k].thread, NULL, work, &w[k]) != 0)
+			break; /* fewer threads still trace everything */
+	}
+	w[0].b = b;
+	work(&w[0]);
+	for (uint32_t k = 1; k <= started; k++)
+		pthread_join(w[k].thread, NULL);
+}
+
+int bvhlab_trace_batch(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                       const bvhlab_ray *rays, size_t count, bool any_hit, uint32_t threads,
+                       bvhlab_hit *hits, uint32_t *nodes, bvhlab_trace_stats *stats,
+                       double *seconds)
+{
+	struct batch b = {.tree = tree, .scene = scene, .rays = rays, .count = count,
+	                  .any = any_hit, .hits = hits, .nodes = nodes};
+	atomic_init(&b.next, 0);
+	if (threads == 0)
+		threads = bvhlab_hardware_threads();
+	size_t tiles = (count + TILE - 1) / TILE;
+	if (threads > tiles)
+		threads = tiles ? (uint32_t)tiles : 1;
+	struct worker *w = calloc(threads, sizeof(*w));
+	if (!w)
+		return -ENOMEM;
+	double t0 = util_now();
+	run_workers(&b, w, threads);
+	if (seconds)
+		*seconds = util_now() - t0;
+	for (uint32_t k = 0; stats && k < threads; k++) {
+		stats->rays += w[k].stats.rays;
+		stats->nodes_visited += w[k].stats.nodes_visited;
+		stats->tris_tested += w[k].stats.tris_tested;
+	}
+	free(w);
+	return 0;
+}

@@ -1,0 +1,91 @@
+/* Error text and clock helpers shared by the core's modules. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "util/util.h"
+
+void error_setv(bvhlab_error *err, const char *fmt, va_list ap)
+{
+	if (!err)
+		return;
+	int n = vsnprintf(err->message, sizeof(err->message), fmt, ap);
+	/* Say so when a message did not fit rather than cutting it silently. */
+	if (n >= (int)sizeof(err->message))
+		memcpy(err->message + sizeof(err->message) - 4, "...", 4);
+}
+
+void error_set(bvhlab_error *err, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	error_setv(err, fmt, ap);
+	va_end(ap);
+}
+
+void error_prefix(bvhlab_error *err, const char *fmt, ...)
+{
+	if (!err)
+		return;
+	char prefix[256], old[sizeof(err->message)];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(prefix, sizeof(prefix), fmt, ap);
+	va_end(ap);
+	memcpy(old, err->message, sizeof(old));
+	error_set(err, "%s: %s", prefix, old);
+}
+
+double util_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+static bool sb_reserve(struct strbuf *sb, size_t extra)
+{
+	if (sb->len + extra + 1 <= sb->cap)
+		return true;
+	size_t cap = sb->cap ? sb->cap : 256;
+	while (cap < sb->len + extra + 1)
+		cap *= 2;
+	char *data = realloc(sb->data, cap);
+	if (!data)
+		return false;
+	sb->data = data;
+	sb->cap = cap;
+	return true;
+}
+
+void sb_printf(struct strbuf *sb, const char *fmt, ...)
+{
+	if (sb->failed)
+		return;
+	va_list ap;
+	va_start(ap, fmt);
+	int n = vsnprintf(NULL, 0, fmt, ap);
+	va_end(ap);
+	if (n < 0 || !sb_reserve(sb, (size_t)n)) {
+		sb->failed = true;
+		return;
+	}
+	va_start(ap, fmt);
+	vsnprintf(sb->data + sb->len, (size_t)n + 1, fmt, ap);
+	va_end(ap);
+	sb->len += (size_t)n;
+}
+
+char *sb_take(struct strbuf *sb)
+{
+	if (sb->failed || !sb_reserve(sb, 0)) {
+		free(sb->data);
+		*sb = (struct strbuf){0};
+		return NULL;
+	}
+	char *text = sb->data;
+	text[sb->len] = '\0';
+	*sb = (struct strbuf){0};
+	return text;
+}
