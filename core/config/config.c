@@ -278,6 +278,7 @@ void config_finish(struct config *cfg)
 		free(cfg->builders[i].plugin);
 		free(cfg->builders[i].name);
 		free(cfg->builders[i].threads);
+		config_refine_finish(&cfg->builders[i]);
 	}
 	free(cfg->scenes);
 	free(cfg->builders);

@@ -30,14 +30,27 @@ struct config_scene {
 	int line, column;  /* where the scene's object starts */
 };
 
+/* One refinement stage of a builder (config_refine.c). */
+struct config_refine {
+	char *plugin;      /* "plugin": a refining plugin's name or a path to a .so */
+	const struct cJSON *options; /* "options" object (may be NULL), owned by root */
+	int line, column;  /* where the stage's object starts */
+};
+
+/* Most stages in one builder's "refine" list. */
+#define CONFIG_MAX_REFINE 8
+
 struct config_builder {
 	char *plugin;      /* "plugin": a name on the search path or a path to a .so */
-	char *name;        /* "name", default: plugin */
+	char *name;        /* "name", default: plugin, then "+stage" per refine stage */
 	uint32_t *threads; /* "threads" override, or NULL for the config's list */
 	size_t thread_count;
 	double timeout_s;  /* "timeout_s" override, or 0 for the config's */
 	uint64_t memory_limit_mb; /* "memory_limit_mb" override, or 0 for the config's */
 	const struct cJSON *options; /* "options" object (may be NULL), owned by root */
+	struct config_refine *refine; /* "refine": stages applied in order after the
+	                               * build, or NULL */
+	size_t refine_count;
 	int line, column;  /* where the builder's object starts */
 };
 
@@ -88,6 +101,10 @@ void config_finish(struct config *cfg);
  */
 int config_apply_options(const struct config *cfg, const struct config_builder *b,
                          bvhlab_options *opts, bvhlab_error *err);
+
+/* Same for the options of stage k of the builder's "refine" list. */
+int config_apply_refine_options(const struct config *cfg, const struct config_builder *b,
+                                size_t k, bvhlab_options *opts, bvhlab_error *err);
 
 /* Replaces the thread list (command line --threads). */
 int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count);

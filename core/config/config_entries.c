@@ -19,7 +19,7 @@ static const char *const scene_keys[] = {
 };
 static const char *const generator_keys[] = { "frequency", "count", "size", "seed", NULL };
 static const char *const builder_keys[] = {
-	"plugin", "name", "threads", "timeout_s", "memory_limit_mb", "options", NULL,
+	"plugin", "name", "threads", "timeout_s", "memory_limit_mb", "options", "refine", NULL,
 };
 
 static int out_of_memory(const struct config *cfg, bvhlab_error *err)
@@ -259,6 +259,8 @@ static int parse_builder(struct config *cfg, const cJSON *obj, size_t index,
 		                     &b->memory_limit_mb, err);
 	if (!rc)
 		rc = builder_options(cfg, obj, index, b, err);
+	if (!rc)
+		rc = config_parse_refine(cfg, obj, index, b, err);
 	return rc;
 }
 

@@ -78,5 +78,10 @@ char *config_stem(const char *path);
 int config_parse_camera(struct config *cfg, const cJSON *rays, bvhlab_error *err);
 int config_parse_scenes(struct config *cfg, bvhlab_error *err);
 int config_parse_builders(struct config *cfg, bvhlab_error *err);
+/* builders[index]'s "refine" list (config_refine.c); without a "name",
+ * "+PLUGIN" of each stage is appended to the builder's name. */
+int config_parse_refine(struct config *cfg, const cJSON *obj, size_t index,
+                        struct config_builder *b, bvhlab_error *err);
+void config_refine_finish(struct config_builder *b);
 
 #endif /* BVHLAB_CORE_CONFIG_INTERNAL_H */

@@ -23,8 +23,13 @@ struct harness_builder {
 	const struct config_builder *cb;
 	bvhlab_plugin *plugin; /* NULL when it could not be loaded */
 	bvhlab_options opts;
-	bool opts_ok;
+	bool opts_ok;          /* and every stage's plugin and options too */
 	bvhlab_error error;
+	struct harness_stage {
+		bvhlab_plugin *plugin;
+		bvhlab_options opts;
+	} stages[HARNESS_MAX_STAGES];
+	struct refine_stage refine[HARNESS_MAX_STAGES]; /* views of stages[] */
 };
 
 struct harness {
@@ -50,6 +55,8 @@ struct series_report {
 	bvhlab_tree_stats stats;
 	struct ray_metrics rays;
 	bool heat_written, shade_written;
+	uint32_t stage_count;
+	struct stage_metrics stages[HARNESS_MAX_STAGES];
 	char error[sizeof(((bvhlab_error *)0)->message)];
 	double samples[];      /* [repeat] */
 };
@@ -200,7 +207,10 @@ static void series_work(void *arg, void *report, size_t size)
 	struct series_report *rep = report;
 	const struct config *cfg = job->h->cfg;
 	struct build_series s = {.warmup = cfg->warmup, .repeat = cfg->repeat,
-	                         .threads = job->threads, .samples_ms = rep->samples};
+	                         .threads = job->threads, .samples_ms = rep->samples,
+	                         .stages = job->hb->refine,
+	                         .stage_count = (uint32_t)job->hb->cb->refine_count,
+	                         .stage_out = rep->stages};
 	bvhlab_error err = {{0}};
 	(void)size;
 	rep->status = SERIES_OK;
@@ -208,6 +218,7 @@ static void series_work(void *arg, void *report, size_t size)
 		rep->status = SERIES_FAILED;
 	} else {
 		rep->sample_count = s.repeat;
+		rep->stage_count = s.stage_count;
 		validate(job, &s.tree, rep, &err);
 		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
 		if (rep->has_stats)
@@ -225,7 +236,8 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 {
 	static const char *const names[] = {"ok", "invalid", "failed"};
 	rep->error[sizeof(rep->error) - 1] = '\0';
-	if (rep->status > SERIES_FAILED || rep->sample_count > repeat) {
+	if (rep->status > SERIES_FAILED || rep->sample_count > repeat ||
+	    rep->stage_count > HARNESS_MAX_STAGES) {
 		run->status = "crashed";
 		run->error = "sent back a malformed report";
 		return;
@@ -240,6 +252,10 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->rays_checked = rep->rays_checked;
 	run->mismatches = rep->mismatches;
 	run->rays = rep->rays.measured ? &rep->rays : NULL;
+	for (uint32_t k = 0; k < rep->stage_count; k++)
+		rep->stages[k].plugin[sizeof(rep->stages[k].plugin) - 1] = '\0';
+	run->stages = rep->stages;
+	run->stage_count = rep->stage_count;
 }
 
 static struct isolate_limits run_limits(const struct config *cfg, const struct config_builder *cb)
@@ -388,6 +404,31 @@ out:
 	bvhlab_scene_destroy(scene);
 }
 
+/* Opens a builder's refinement stages; false (hb->error set) when one
+ * cannot be used. -ENOMEM only for options that cannot be set up. */
+static int open_stages(struct harness *h, struct harness_builder *hb, bool *ok)
+{
+	*ok = true;
+	for (size_t k = 0; *ok && k < hb->cb->refine_count; k++) {
+		struct harness_stage *st = &hb->stages[k];
+		if (bvhlab_plugin_open(hb->cb->refine[k].plugin, &st->plugin, &hb->error) < 0) {
+			*ok = false;
+			break;
+		}
+		if (!bvhlab_builder_refine(bvhlab_plugin_builder(st->plugin))) {
+			error_set(&hb->error, "refine stage %zu: plugin '%s' has no refinement stage",
+			          k + 1, hb->cb->refine[k].plugin);
+			*ok = false;
+			break;
+		}
+		if (bvhlab_options_init(&st->opts, bvhlab_plugin_builder(st->plugin)) < 0)
+			return -ENOMEM;
+		*ok = config_apply_refine_options(h->cfg, hb->cb, k, &st->opts, &hb->error) == 0;
+		hb->refine[k] = (struct refine_stage){.plugin = st->plugin, .opts = &st->opts};
+	}
+	return 0;
+}
+
 /* Opens every plugin and checks its options; a failure is kept, not fatal. */
 static int open_builders(struct harness *h)
 {
@@ -402,6 +443,8 @@ static int open_builders(struct harness *h)
 		if (bvhlab_options_init(&hb->opts, bvhlab_plugin_builder(hb->plugin)) < 0)
 			return -ENOMEM;
 		hb->opts_ok = config_apply_options(h->cfg, hb->cb, &hb->opts, &hb->error) == 0;
+		if (hb->opts_ok && open_stages(h, hb, &hb->opts_ok) < 0)
+			return -ENOMEM;
 		if (hb->opts_ok)
 			continue;
 	report:
@@ -413,9 +456,15 @@ static int open_builders(struct harness *h)
 static void close_builders(struct harness *h)
 {
 	for (size_t b = 0; h->builders && b < h->cfg->builder_count; b++) {
-		if (h->builders[b].opts.values)
-			bvhlab_options_finish(&h->builders[b].opts);
-		bvhlab_plugin_close(h->builders[b].plugin);
+		struct harness_builder *hb = &h->builders[b];
+		if (hb->opts.values)
+			bvhlab_options_finish(&hb->opts);
+		bvhlab_plugin_close(hb->plugin);
+		for (size_t k = 0; k < HARNESS_MAX_STAGES; k++) {
+			if (hb->stages[k].opts.values)
+				bvhlab_options_finish(&hb->stages[k].opts);
+			bvhlab_plugin_close(hb->stages[k].plugin);
+		}
 	}
 	free(h->builders);
 }
