@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <bvhlab/plugin.h>
+#include <bvhlab/host.h>
 
 #include "config/config.h"
 

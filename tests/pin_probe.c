@@ -156,7 +156,4 @@ static const bvhlab_builder descriptor = {
 	.build = build,
 };
 
-BVHLAB_PLUGIN_ENTRY
-{
-	return host_abi_major == BVHLAB_ABI_MAJOR ? &descriptor : NULL;
-}
+BVHLAB_PLUGIN_EXPORT(descriptor)

@@ -105,7 +105,8 @@ static void test_full(void)
 		"  \"repeat\": 7, \"warmup\": 0,\n"
 		"  \"threads\": [0, 2, 4],\n"
 		"  \"validate\": false, \"validate_rays\": 100,\n"
-		"  \"rays\": { \"width\": 64, \"height\": 32, \"diffuse\": 3 },\n"
+		"  \"rays\": { \"width\": 64, \"height\": 32, \"diffuse\": 3, \"camera\": {"
+		" \"position\": [1, 2, 3], \"target\": [0, 0.5, 0], \"up\": [0, 0, 1], \"fov\": 30 } },\n"
 		"  \"images\": true,\n"
 		"  \"scenes\": [\n"
 		"    { \"name\": \"ico\", \"generator\": \"icosphere\", \"frequency\": 12,"
@@ -131,6 +132,9 @@ static void test_full(void)
 	CHECK(cfg.threads[0] == 0 && cfg.threads[1] == 2 && cfg.threads[2] == 4);
 	CHECK(!cfg.validate && cfg.images && cfg.validate_rays == 100);
 	CHECK(cfg.ray_width == 64 && cfg.ray_height == 32 && cfg.ray_diffuse == 3);
+	const bvhlab_camera *cam = &cfg.camera;
+	CHECK(cfg.has_camera && cam->fov_deg == 30.0f && cam->position[2] == 3.0f);
+	CHECK(cam->target[1] == 0.5f && cam->up[1] == 0.0f && cam->up[2] == 1.0f);
 
 	CHECK_INT(cfg.scene_count, 3);
 	struct config_scene *s = cfg.scenes;
@@ -254,7 +258,7 @@ static void test_unknown_keys(void)
 	             "    { \"plugin\": \"b\", \"threds\": [2] } ] }",
 	             3, 22,
 	             "unknown key 'threds' in builders[1] (known: plugin, name, threads, "
-	             "timeout_s, memory_limit_mb, options); did you mean 'threads'?");
+	             "timeout_s, memory_limit_mb, options, refine); did you mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
 	                "diffuse, camera); did you mean 'width'?");

@@ -1,14 +1,17 @@
 #!/bin/sh
 # The SDK end to end: installs bvhlab into a temporary prefix, builds the
-# template plugin from a copy of examples/plugin-template against the
-# installed files only (pkg-config), loads it with the installed bvhlab by
-# path and then by name after installing it, and checks its tree is valid.
+# template plugins from copies of examples/plugin-template (C) and
+# examples/plugin-template-cpp (C++17) against the installed files only
+# (pkg-config), checks each exports only its entry point, loads the C one
+# with the installed bvhlab by path and then by name after installing it,
+# and runs the C++ one through `bvhlab run` beside sah_seq: every run ok,
+# every tree valid.
 # Usage: test-sdk.sh SOURCE_ROOT
 set -eu
 src=$1
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/bvhlab-sdk.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT INT TERM
-unset BVHLAB_PLUGIN_PATH PKG_CONFIG_PATH CFLAGS LDFLAGS
+unset BVHLAB_PLUGIN_PATH PKG_CONFIG_PATH CFLAGS CXXFLAGS LDFLAGS
 
 step() { echo "== $*"; }
 
@@ -25,15 +28,21 @@ echo "pkg-config: $(pkg-config --cflags bvhlab) | plugindir $plugindir"
 [ -f "$plugindir/sah_seq.so" ] || { echo "sah_seq.so not in plugindir"; exit 1; }
 bvhlab=$tmp/prefix/bin/bvhlab
 
-step "build the template out of tree"
-cp -R "$src/examples/plugin-template" "$tmp/template"
-meson setup "$tmp/tbuild" "$tmp/template" -Dwerror=true >"$tmp/tsetup.log" 2>&1 ||
-	{ cat "$tmp/tsetup.log"; exit 1; }
-ninja -C "$tmp/tbuild" >"$tmp/tbuild.log" 2>&1 || { cat "$tmp/tbuild.log"; exit 1; }
-# Headers from the prefix, nothing from the source tree.
-if grep -q -- "-I$src" "$tmp/tbuild/build.ninja"; then
-	echo "the template saw the source tree's headers"; exit 1
-fi
+# Copies examples/$1 and builds it out of tree; $2 is the module's name.
+build_template() {
+	step "build $1 out of tree"
+	cp -R "$src/examples/$1" "$tmp/$1"
+	meson setup "$tmp/$1-build" "$tmp/$1" -Dwerror=true >"$tmp/$1-setup.log" 2>&1 ||
+		{ cat "$tmp/$1-setup.log"; exit 1; }
+	ninja -C "$tmp/$1-build" >"$tmp/$1-build.log" 2>&1 || { cat "$tmp/$1-build.log"; exit 1; }
+	# Headers from the prefix, nothing from the source tree.
+	if grep -q -- "-I$src" "$tmp/$1-build/build.ninja"; then
+		echo "$1 saw the source tree's headers"; exit 1
+	fi
+	exports=$(nm -D --defined-only "$tmp/$1-build/$2.so" | awk '{print $3}')
+	[ "$exports" = bvhlab_plugin_entry ] ||
+		{ echo "$2.so exports more than its entry point:"; echo "$exports"; exit 1; }
+}
 
 check() {
 	out=$("$bvhlab" build "$1" icosphere:frequency=8) || { echo "$out"; exit 1; }
@@ -41,9 +50,29 @@ check() {
 	echo "$out" | grep -q "^valid:      yes" || { echo "tree not valid"; exit 1; }
 }
 
+build_template plugin-template template
 step "load it by path"
-check "$tmp/tbuild/template.so"
+check "$tmp/plugin-template-build/template.so"
 step "install it into plugindir and load it by name"
-ninja -C "$tmp/tbuild" install >/dev/null
+ninja -C "$tmp/plugin-template-build" install >/dev/null
 check template
+
+build_template plugin-template-cpp template_cpp
+step "bvhlab run: the C++ template and sah_seq, 2 scenes, 1 and 2 threads"
+cat >"$tmp/cpp.json" <<EOF
+{ "format_version": 1, "output": "cpp-results", "repeat": 1, "warmup": 0,
+  "threads": [1, 2],
+  "scenes": [ { "generator": "icosphere", "frequency": 16 },
+              { "generator": "stadium", "count": 3000 } ],
+  "builders": [ { "plugin": "$tmp/plugin-template-cpp-build/template_cpp.so",
+                  "options": { "bins": 32, "max_leaf": 8 } },
+                { "plugin": "sah_seq", "options": { "method": "binned" } } ] }
+EOF
+"$bvhlab" run "$tmp/cpp.json" --quiet || { echo "bvhlab run failed"; exit 1; }
+results=$tmp/cpp-results/results.json
+runs=$(grep -cE '"status":[[:space:]]*"ok"' "$results" || true)
+valid=$(grep -cE '"valid":[[:space:]]*true' "$results" || true)
+cpp=$(grep -cE '"builder":[[:space:]]*"template_cpp"' "$results" || true)
+echo "runs ok: $runs of 8, valid trees: $valid, template_cpp runs: $cpp"
+[ "$runs" = 8 ] && [ "$valid" = 8 ] && [ "$cpp" = 4 ] || { cat "$results"; exit 1; }
 echo "sdk: ok"

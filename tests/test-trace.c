@@ -7,6 +7,8 @@
  */
 #include <math.h>
 
+#include <bvhlab/trace.h>
+
 #include "testutil.h"
 #include "tree_fixture.h"
 

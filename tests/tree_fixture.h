@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
 #include <bvhlab/tree.h>
 
 typedef struct fixture {
@@ -49,26 +50,6 @@ static inline float fx_unit(uint64_t *state)
 	return (float)(fx_rand(state) >> 40) * 0x1p-24f;
 }
 
-static inline void fx_box_empty(bvhlab_aabb *b)
-{
-	int k;
-
-	for (k = 0; k < 3; k++) {
-		b->lo[k] = INFINITY;
-		b->hi[k] = -INFINITY;
-	}
-}
-
-static inline void fx_box_grow(float *lo, float *hi, const float *plo, const float *phi)
-{
-	int k;
-
-	for (k = 0; k < 3; k++) {
-		lo[k] = fminf(lo[k], plo[k]);
-		hi[k] = fmaxf(hi[k], phi[k]);
-	}
-}
-
 static inline void fixture_alloc(fixture *f, uint32_t vertex_count, uint32_t tri_count)
 {
 	memset(f, 0, sizeof(*f));
@@ -89,20 +70,19 @@ static inline void fixture_prepare(fixture *f)
 	f->boxes = fx_alloc((size_t)n * sizeof(bvhlab_aabb));
 	f->centroids = fx_alloc((size_t)n * 3 * sizeof(float));
 	memset(in, 0, sizeof(*in));
-	fx_box_empty(&in->bounds);
-	fx_box_empty(&in->centroid_bounds);
+	bvhlab_aabb_empty(&in->bounds);
+	bvhlab_aabb_empty(&in->centroid_bounds);
 	for (i = 0; i < n; i++) {
-		fx_box_empty(&f->boxes[i]);
+		bvhlab_aabb_empty(&f->boxes[i]);
 		for (j = 0; j < 3; j++) {
 			const float *v = f->scene.vertices + 3 * (size_t)f->scene.indices[3 * i + j];
 
-			fx_box_grow(f->boxes[i].lo, f->boxes[i].hi, v, v);
+			bvhlab_aabb_grow_point(&f->boxes[i], v);
 		}
 		for (j = 0; j < 3; j++)
-			f->centroids[3 * i + j] = 0.5f * (f->boxes[i].lo[j] + f->boxes[i].hi[j]);
-		fx_box_grow(in->bounds.lo, in->bounds.hi, f->boxes[i].lo, f->boxes[i].hi);
-		fx_box_grow(in->centroid_bounds.lo, in->centroid_bounds.hi, f->centroids + 3 * i,
-		            f->centroids + 3 * i);
+			f->centroids[3 * i + j] = bvhlab_aabb_center(&f->boxes[i], (int)j);
+		bvhlab_aabb_grow(&in->bounds, &f->boxes[i]);
+		bvhlab_aabb_grow_point(&in->centroid_bounds, f->centroids + 3 * i);
 	}
 	in->struct_size = sizeof(*in);
 	in->prim_count = n;
@@ -199,14 +179,13 @@ static inline void fx_build_node(fx_build *b, uint32_t node, uint32_t begin, uin
 	uint32_t i, first;
 	int k;
 
-	fx_box_empty(&box);
-	fx_box_empty(&cbox);
+	bvhlab_aabb_empty(&box);
+	bvhlab_aabb_empty(&cbox);
 	for (i = begin; i < end; i++) {
 		const float *c = b->f->centroids + 3 * (size_t)t->prim_index[i];
 
-		fx_box_grow(box.lo, box.hi, b->f->boxes[t->prim_index[i]].lo,
-		            b->f->boxes[t->prim_index[i]].hi);
-		fx_box_grow(cbox.lo, cbox.hi, c, c);
+		bvhlab_aabb_grow(&box, &b->f->boxes[t->prim_index[i]]);
+		bvhlab_aabb_grow_point(&cbox, c);
 	}
 	memcpy(n->lo, box.lo, sizeof(n->lo));
 	memcpy(n->hi, box.hi, sizeof(n->hi));
@@ -255,15 +234,14 @@ static inline void fixture_refit_node(bvhlab_tree *t, const bvhlab_build_input *
 	bvhlab_aabb box;
 	uint32_t i;
 
-	fx_box_empty(&box);
+	bvhlab_aabb_empty(&box);
 	if (n->count) {
 		for (i = n->first; i < n->first + n->count; i++)
-			fx_box_grow(box.lo, box.hi, in->prim_bounds[t->prim_index[i]].lo,
-			            in->prim_bounds[t->prim_index[i]].hi);
+			bvhlab_aabb_grow(&box, &in->prim_bounds[t->prim_index[i]]);
 	} else {
 		for (i = n->first; i < n->first + 2; i++) {
 			fixture_refit_node(t, in, i);
-			fx_box_grow(box.lo, box.hi, t->nodes[i].lo, t->nodes[i].hi);
+			bvhlab_aabb_grow_corners(&box, t->nodes[i].lo, t->nodes[i].hi);
 		}
 	}
 	memcpy(n->lo, box.lo, sizeof(n->lo));

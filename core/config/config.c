@@ -12,19 +12,9 @@
 #include "config/json_locate.h"
 
 #define DEFAULT_OUTPUT "results"
-/* Image sides beyond this are mistakes, and width * height stays far from 2^32. */
-#define MAX_RAY_SIDE 16384
-#define MAX_DIFFUSE 1024
 #define READ_CHUNK 65536
 /* Generous: a run that takes longer is stuck rather than slow. */
 #define DEFAULT_TIMEOUT_S 600
-
-static const char *const top_keys[] = {
-	"format_version", "output", "repeat", "warmup", "threads", "validate",
-	"validate_rays", "rays", "images", "isolate", "timeout_s", "memory_limit_mb", "pin",
-	"scenes", "builders", NULL,
-};
-static const char *const ray_keys[] = { "width", "height", "diffuse", "camera", NULL };
 
 static int out_of_memory(const char *path, bvhlab_error *err)
 {
@@ -79,14 +69,14 @@ static int parse_format_version(struct config *cfg, bvhlab_error *err)
 	return 0;
 }
 
-static int parse_output(struct config *cfg, bvhlab_error *err)
+/* "output" as read (or the default), resolved against the config's folder. */
+static int resolve_output(struct config *cfg, bvhlab_error *err)
 {
-	char *output = NULL;
-	int rc = config_get_string(cfg, cfg->root, "output", "", &output, err);
-	if (rc)
-		return rc;
-	rc = config_resolve(cfg, output ? output : DEFAULT_OUTPUT, &cfg->output);
+	char *output = cfg->output;
+	int rc = config_resolve(cfg, output ? output : DEFAULT_OUTPUT, &cfg->output);
 	free(output);
+	if (rc)
+		cfg->output = NULL;
 	return rc ? out_of_memory(cfg->path, err) : 0;
 }
 
@@ -101,50 +91,11 @@ static int parse_rays(struct config *cfg, bvhlab_error *err)
 		                    "'rays' must be an object {width, height, diffuse, camera}, not %s",
 		                    config_describe(cfg, rays, got, sizeof(got)));
 	}
-	int rc = config_check_keys(cfg, rays, ray_keys, "in rays", err);
+	int rc = config_check_keys(cfg, rays, config_ray_keys, "in rays", err);
 	if (!rc)
-		rc = config_get_u32(cfg, rays, "width", "rays.", 1, MAX_RAY_SIDE, &cfg->ray_width, err);
-	if (!rc)
-		rc = config_get_u32(cfg, rays, "height", "rays.", 1, MAX_RAY_SIDE, &cfg->ray_height,
-		                    err);
-	if (!rc)
-		rc = config_get_u32(cfg, rays, "diffuse", "rays.", 0, MAX_DIFFUSE, &cfg->ray_diffuse,
-		                    err);
+		rc = config_read_keys(cfg, rays, config_ray_keys, "rays.", cfg, err);
 	if (!rc)
 		rc = config_parse_camera(cfg, rays, err);
-	return rc;
-}
-
-static int parse_runs(struct config *cfg, bvhlab_error *err)
-{
-	const cJSON *root = cfg->root;
-	int rc = config_get_u32(cfg, root, "repeat", "", 1, UINT32_MAX, &cfg->repeat, err);
-	if (!rc)
-		rc = config_get_u32(cfg, root, "warmup", "", 0, UINT32_MAX, &cfg->warmup, err);
-	if (!rc)
-		rc = config_get_threads(cfg, root, "threads", "", &cfg->threads, &cfg->thread_count,
-		                        err);
-	if (!rc)
-		rc = config_get_bool(cfg, root, "validate", "", &cfg->validate, err);
-	if (!rc)
-		rc = config_get_u32(cfg, root, "validate_rays", "", 1, UINT32_MAX,
-		                    &cfg->validate_rays, err);
-	if (!rc)
-		rc = config_get_bool(cfg, root, "images", "", &cfg->images, err);
-	return rc;
-}
-
-static int parse_isolation(struct config *cfg, bvhlab_error *err)
-{
-	const cJSON *root = cfg->root;
-	int rc = config_get_bool(cfg, root, "isolate", "", &cfg->isolate, err);
-	if (!rc)
-		rc = config_get_positive(cfg, root, "timeout_s", "", &cfg->timeout_s, err);
-	if (!rc)
-		rc = config_get_uint(cfg, root, "memory_limit_mb", "", 1, CONFIG_MAX_MEMORY_MB,
-		                     &cfg->memory_limit_mb, err);
-	if (!rc)
-		rc = config_get_bool(cfg, root, "pin", "", &cfg->pin, err);
 	return rc;
 }
 
@@ -155,15 +106,13 @@ static int parse_top(struct config *cfg, bvhlab_error *err)
 		return config_error(cfg, cfg->root, false, err, "a config must be an object, not %s",
 		                    config_describe(cfg, cfg->root, got, sizeof(got)));
 	}
-	int rc = config_check_keys(cfg, cfg->root, top_keys, "at the top level", err);
+	int rc = config_check_keys(cfg, cfg->root, config_top_keys, "at the top level", err);
 	if (!rc)
 		rc = parse_format_version(cfg, err);
 	if (!rc)
-		rc = parse_output(cfg, err);
+		rc = config_read_keys(cfg, cfg->root, config_top_keys, "", cfg, err);
 	if (!rc)
-		rc = parse_runs(cfg, err);
-	if (!rc)
-		rc = parse_isolation(cfg, err);
+		rc = resolve_output(cfg, err);
 	if (!rc)
 		rc = parse_rays(cfg, err);
 	if (!rc)

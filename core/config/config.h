@@ -1,7 +1,8 @@
 /*
  * Experiment configs (private to the core and the bvhlab command).
  *
- * A config is plain JSON (DESIGN.md, "Experiment config"). Loading checks
+ * A config is plain JSON (README.md, "Experiment configs"; every key is
+ * declared once, in config_keys.c). Loading checks
  * the syntax and every key and type; errors read
  *   FILE:LINE:COLUMN: message naming the key
  * Builder options are checked later, against the plugin's declarations,
@@ -14,8 +15,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include <bvhlab/plugin.h>
-#include <bvhlab/rays.h>
+#include <bvhlab/host.h>
+#include <bvhlab/trace.h>
 #include <bvhlab/scene.h>
 
 struct cJSON;
@@ -26,7 +27,7 @@ struct config_scene {
 	char *path;        /* "path" resolved against the config's folder, or NULL */
 	char *generator;   /* "generator", or NULL; exactly one of path/generator */
 	bvhlab_gen_params gen; /* "frequency", "count", "size", "seed" */
-	unsigned subdivide; /* "subdivide", default 0 */
+	uint32_t subdivide; /* "subdivide", default 0 */
 	int line, column;  /* where the scene's object starts */
 };
 

@@ -2,40 +2,9 @@
  * The optional "camera" of "rays": a fixed view for scenes whose automatic
  * framing is not the view a user wants to measure.
  */
-#include <math.h>
 #include <string.h>
 
 #include "config/config_internal.h"
-
-static const char *const camera_keys[] = { "position", "target", "up", "fov", NULL };
-
-/* A [x, y, z] array of finite numbers into out; absent keeps out. */
-static int get_vec3(const struct config *cfg, const cJSON *obj, const char *key, float out[3],
-                    bvhlab_error *err)
-{
-	const cJSON *item = config_member(obj, key);
-	char got[48];
-	if (!item)
-		return 0;
-	if (cJSON_IsArray(item) && cJSON_GetArraySize(item) == 3) {
-		float v[3];
-		int k = 0;
-		const cJSON *e;
-		cJSON_ArrayForEach(e, item) {
-			if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) ||
-			    fabs(e->valuedouble) > 1e30)
-				break;
-			v[k++] = (float)e->valuedouble;
-		}
-		if (k == 3) {
-			memcpy(out, v, sizeof(v));
-			return 0;
-		}
-	}
-	return config_error(cfg, item, false, err,
-	                    "'rays.camera.%s' must be an array of 3 finite numbers, not %s", key,
-	                    config_describe(cfg, item, got, sizeof(got)));
-}
 
 static int check_camera(const struct config *cfg, const cJSON *cam, bvhlab_error *err)
 {
@@ -66,15 +35,12 @@ int config_parse_camera(struct config *cfg, const cJSON *rays, bvhlab_error *err
 		                    "not %s", config_describe(cfg, cam, got, sizeof(got)));
 	memset(&cfg->camera, 0, sizeof(cfg->camera));
 	cfg->camera.up[1] = 1.0f;
-	int rc = config_check_keys(cfg, cam, camera_keys, "in rays.camera", err);
+	int rc = config_check_keys(cfg, cam, config_camera_keys, "in rays.camera", err);
 	if (!rc && !config_member(cam, "position"))
 		rc = config_error(cfg, cam, false, err, "'rays.camera' needs a \"position\"");
 	if (!rc)
-		rc = get_vec3(cfg, cam, "position", cfg->camera.position, err);
-	if (!rc)
-		rc = get_vec3(cfg, cam, "target", cfg->camera.target, err);
-	if (!rc)
-		rc = get_vec3(cfg, cam, "up", cfg->camera.up, err);
+		rc = config_read_keys(cfg, cam, config_camera_keys, "rays.camera.", &cfg->camera,
+		                      err);
 	if (!rc)
 		rc = config_get_positive(cfg, cam, "fov", "rays.camera.", &fov, err);
 	if (!rc && fov >= 180.0)

@@ -124,26 +124,26 @@ const cJSON *config_member(const cJSON *obj, const char *key)
 	return cJSON_GetObjectItemCaseSensitive(obj, key);
 }
 
-static bool is_known(const char *const *known, const char *key)
+static bool is_known(const struct config_key *table, const char *key)
 {
-	for (; *known; known++)
-		if (strcmp(*known, key) == 0)
+	for (; table->name; table++)
+		if (strcmp(table->name, key) == 0)
 			return true;
 	return false;
 }
 
 static int unknown_key(const struct config *cfg, const cJSON *member,
-                       const char *const *known, const char *where, bvhlab_error *err)
+                       const struct config_key *table, const char *where, bvhlab_error *err)
 {
 	char list[256] = "", hint[96] = "";
 	size_t used = 0;
 	struct config_suggestion s;
 	config_suggest_init(&s);
-	for (const char *const *k = known; *k; k++) {
-		config_suggest_consider(&s, member->string, *k);
+	for (const struct config_key *k = table; k->name; k++) {
+		config_suggest_consider(&s, member->string, k->name);
 		if (used >= sizeof(list))
 			continue;
-		int n = snprintf(list + used, sizeof(list) - used, "%s%s", used ? ", " : "", *k);
+		int n = snprintf(list + used, sizeof(list) - used, "%s%s", used ? ", " : "", k->name);
 		used += (size_t)n;
 		if (used >= sizeof(list)) /* not with the static key tables, but say so */
 			memcpy(list + sizeof(list) - 4, "...", 4);
@@ -171,12 +171,12 @@ int config_check_duplicates(const struct config *cfg, const cJSON *obj, const ch
 	return 0;
 }
 
-int config_check_keys(const struct config *cfg, const cJSON *obj, const char *const *known,
-                      const char *where, bvhlab_error *err)
+int config_check_keys(const struct config *cfg, const cJSON *obj,
+                      const struct config_key *table, const char *where, bvhlab_error *err)
 {
 	for (const cJSON *m = obj->child; m; m = m->next)
-		if (!is_known(known, m->string))
-			return unknown_key(cfg, m, known, where, err);
+		if (!is_known(table, m->string))
+			return unknown_key(cfg, m, table, where, err);
 	return config_check_duplicates(cfg, obj, where, err);
 }
 
@@ -294,6 +294,33 @@ int config_get_string(const struct config *cfg, const cJSON *obj, const char *ke
 	free(*out);
 	*out = copy;
 	return 0;
+}
+
+int config_get_vec3(const struct config *cfg, const cJSON *obj, const char *key,
+                    const char *prefix, float out[3], bvhlab_error *err)
+{
+	const cJSON *item = config_member(obj, key);
+	char got[48];
+	if (!item)
+		return 0;
+	if (cJSON_IsArray(item) && cJSON_GetArraySize(item) == 3) {
+		float v[3];
+		int k = 0;
+		const cJSON *e;
+		cJSON_ArrayForEach(e, item) {
+			if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) ||
+			    fabs(e->valuedouble) > 1e30)
+				break;
+			v[k++] = (float)e->valuedouble;
+		}
+		if (k == 3) {
+			memcpy(out, v, sizeof(v));
+			return 0;
+		}
+	}
+	return config_error(cfg, item, false, err,
+	                    "'%s%s' must be an array of 3 finite numbers, not %s", prefix, key,
+	                    config_describe(cfg, item, got, sizeof(got)));
 }
 
 static int thread_entries(const struct config *cfg, const cJSON *array, const char *name,

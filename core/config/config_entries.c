@@ -11,17 +11,6 @@
 #include "config/config_internal.h"
 #include "config/json_locate.h"
 
-/* 16 subdivisions turn one triangle into 4^16 = 2^32, past a uint32_t count. */
-#define MAX_SUBDIVIDE 15
-
-static const char *const scene_keys[] = {
-	"name", "path", "generator", "frequency", "count", "size", "seed", "subdivide", NULL,
-};
-static const char *const generator_keys[] = { "frequency", "count", "size", "seed", NULL };
-static const char *const builder_keys[] = {
-	"plugin", "name", "threads", "timeout_s", "memory_limit_mb", "options", "refine", NULL,
-};
-
 static int out_of_memory(const struct config *cfg, bvhlab_error *err)
 {
 	error_set(err, "%s: out of memory", cfg->path);
@@ -72,14 +61,11 @@ static int unique_names(const struct config *cfg, const cJSON *array, const char
 
 /* ---- scenes ------------------------------------------------------------------ */
 
+/* After the table's keys are read: exactly one source, and no generator
+ * parameters for a file. */
 static int scene_source(struct config *cfg, const cJSON *obj, const char *prefix,
                         struct config_scene *sc, bvhlab_error *err)
 {
-	int rc = config_get_string(cfg, obj, "path", prefix, &sc->path, err);
-	if (!rc)
-		rc = config_get_string(cfg, obj, "generator", prefix, &sc->generator, err);
-	if (rc)
-		return rc;
 	if (sc->path && sc->generator)
 		return config_error(cfg, config_member(obj, "generator"), true, err,
 		                    "'%.*s' has both 'path' and 'generator': give exactly one",
@@ -88,40 +74,20 @@ static int scene_source(struct config *cfg, const cJSON *obj, const char *prefix
 		return config_error(cfg, obj, false, err,
 		                    "'%.*s' needs a 'path' (a mesh file) or a 'generator'",
 		                    (int)strlen(prefix) - 1, prefix);
-	for (const char *const *k = generator_keys; sc->path && *k; k++) {
-		const cJSON *item = config_member(obj, *k);
-		if (item)
+	for (const struct config_key *k = config_scene_keys; sc->path && k->name; k++) {
+		const cJSON *item = config_member(obj, k->name);
+		if (item && (k->flags & CONFIG_GENERATED))
 			return config_error(cfg, item, true, err,
 			                    "'%s%s' applies to generated scenes only, not to a 'path'",
-			                    prefix, *k);
+			                    prefix, k->name);
 	}
 	return 0;
 }
 
-static int scene_params(struct config *cfg, const cJSON *obj, const char *prefix,
-                        struct config_scene *sc, bvhlab_error *err)
+/* The default name (file stem or generator), and the path as seen from here. */
+static int scene_name_and_path(struct config *cfg, struct config_scene *sc,
+                               bvhlab_error *err)
 {
-	bvhlab_gen_params *gen = &sc->gen;
-	uint32_t subdivide = 0;
-	int rc = config_get_u32(cfg, obj, "frequency", prefix, 1, UINT32_MAX, &gen->frequency, err);
-	if (!rc)
-		rc = config_get_u32(cfg, obj, "count", prefix, 1, UINT32_MAX, &gen->count, err);
-	if (!rc)
-		rc = config_get_u32(cfg, obj, "size", prefix, 1, UINT32_MAX, &gen->size, err);
-	if (!rc)
-		rc = config_get_uint(cfg, obj, "seed", prefix, 0, UINT64_MAX, &gen->seed, err);
-	if (!rc)
-		rc = config_get_u32(cfg, obj, "subdivide", prefix, 0, MAX_SUBDIVIDE, &subdivide, err);
-	sc->subdivide = subdivide;
-	return rc;
-}
-
-static int scene_name_and_path(struct config *cfg, const cJSON *obj, const char *prefix,
-                               struct config_scene *sc, bvhlab_error *err)
-{
-	int rc = config_get_string(cfg, obj, "name", prefix, &sc->name, err);
-	if (rc)
-		return rc;
 	if (!sc->name) {
 		sc->name = sc->path ? config_stem(sc->path) : strdup(sc->generator);
 		if (!sc->name)
@@ -149,13 +115,13 @@ static int parse_scene(struct config *cfg, const cJSON *obj, size_t index,
 		                    index, config_describe(cfg, obj, got, sizeof(got)));
 	json_locate_value(cfg->locations, obj, &sc->line, &sc->column);
 	bvhlab_gen_params_init(&sc->gen);
-	int rc = config_check_keys(cfg, obj, scene_keys, where, err);
+	int rc = config_check_keys(cfg, obj, config_scene_keys, where, err);
+	if (!rc)
+		rc = config_read_keys(cfg, obj, config_scene_keys, prefix, sc, err);
 	if (!rc)
 		rc = scene_source(cfg, obj, prefix, sc, err);
 	if (!rc)
-		rc = scene_params(cfg, obj, prefix, sc, err);
-	if (!rc)
-		rc = scene_name_and_path(cfg, obj, prefix, sc, err);
+		rc = scene_name_and_path(cfg, sc, err);
 	return rc;
 }
 
@@ -191,19 +157,15 @@ static bool is_plugin_path(const char *plugin)
 	return strchr(plugin, '/') || (n >= 3 && strcmp(plugin + n - 3, ".so") == 0);
 }
 
+/* After the table's keys are read: the plugin is required; a path is
+ * resolved against the config's folder. */
 static int builder_plugin(struct config *cfg, const cJSON *obj, const char *prefix,
                           struct config_builder *b, bvhlab_error *err)
 {
-	int rc = config_get_string(cfg, obj, "plugin", prefix, &b->plugin, err);
-	if (rc)
-		return rc;
 	if (!b->plugin)
 		return config_error(cfg, obj, false, err,
 		                    "'%.*s' needs a 'plugin' (a plugin name or a path to a .so)",
 		                    (int)strlen(prefix) - 1, prefix);
-	rc = config_get_string(cfg, obj, "name", prefix, &b->name, err);
-	if (rc)
-		return rc;
 	if (!is_plugin_path(b->plugin)) {
 		b->name = b->name ? b->name : strdup(b->plugin);
 		return b->name ? 0 : out_of_memory(cfg, err);
@@ -246,17 +208,11 @@ static int parse_builder(struct config *cfg, const cJSON *obj, size_t index,
 		return config_error(cfg, obj, false, err, "'builders[%zu]' must be an object, not %s",
 		                    index, config_describe(cfg, obj, got, sizeof(got)));
 	json_locate_value(cfg->locations, obj, &b->line, &b->column);
-	int rc = config_check_keys(cfg, obj, builder_keys, where, err);
+	int rc = config_check_keys(cfg, obj, config_builder_keys, where, err);
+	if (!rc)
+		rc = config_read_keys(cfg, obj, config_builder_keys, prefix, b, err);
 	if (!rc)
 		rc = builder_plugin(cfg, obj, prefix, b, err);
-	if (!rc)
-		rc = config_get_threads(cfg, obj, "threads", prefix, &b->threads, &b->thread_count,
-		                        err);
-	if (!rc)
-		rc = config_get_positive(cfg, obj, "timeout_s", prefix, &b->timeout_s, err);
-	if (!rc)
-		rc = config_get_uint(cfg, obj, "memory_limit_mb", prefix, 1, CONFIG_MAX_MEMORY_MB,
-		                     &b->memory_limit_mb, err);
 	if (!rc)
 		rc = builder_options(cfg, obj, index, b, err);
 	if (!rc)

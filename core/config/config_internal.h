@@ -1,5 +1,6 @@
 /*
- * Helpers shared by config.c, config_check.c and config_entries.c. Every
+ * Helpers shared by config.c, config_keys.c, config_check.c and
+ * config_entries.c. Every
  * error is -EINVAL (or -ENOMEM) with err->message starting FILE:LINE:COL.
  * `prefix` arguments name the enclosing object for messages ("",
  * "rays.", "scenes[2]."); `where` says the same in words ("at the top
@@ -37,9 +38,51 @@ void config_suggest_init(struct config_suggestion *s);
 void config_suggest_consider(struct config_suggestion *s, const char *typed,
                              const char *candidate);
 
-/* Unknown keys (known is NULL-terminated) and duplicate keys of obj. */
-int config_check_keys(const struct config *cfg, const cJSON *obj, const char *const *known,
-                      const char *where, bvhlab_error *err);
+/* What a key's value must be, and how it is read (config_keys.c). */
+enum config_kind {
+	CONFIG_CUSTOM,   /* read by its own code; in the table so it is known */
+	CONFIG_U32,      /* an integer in [min, max] into a uint32_t */
+	CONFIG_U64,      /* an integer in [min, max] into a uint64_t */
+	CONFIG_BOOL,     /* true or false into a bool */
+	CONFIG_POSITIVE, /* a finite number > 0 into a double */
+	CONFIG_STRING,   /* a non-empty string, copied into a char * */
+	CONFIG_THREADS,  /* distinct thread counts into a uint32_t * and a size_t */
+	CONFIG_VEC3,     /* an array of 3 finite numbers into a float[3] */
+};
+
+/* Flags of a key. */
+enum {
+	CONFIG_GENERATED = 1u << 0, /* a scene key for generators only, not with a 'path' */
+};
+
+/* One key of a config object. Tables end with a NULL name. */
+struct config_key {
+	const char *name;
+	enum config_kind kind;
+	uint64_t min, max;   /* CONFIG_U32, CONFIG_U64: inclusive range */
+	size_t offset;       /* the field the value goes to, in the object's struct */
+	size_t count_offset; /* CONFIG_THREADS: the field the count goes to */
+	unsigned flags;
+};
+
+/* The keys of the top level, "rays", a scene, a builder and "rays.camera",
+ * in the order they are listed in messages and read. */
+extern const struct config_key config_top_keys[];   /* struct config */
+extern const struct config_key config_ray_keys[];   /* struct config */
+extern const struct config_key config_scene_keys[]; /* struct config_scene */
+extern const struct config_key config_builder_keys[]; /* struct config_builder */
+extern const struct config_key config_camera_keys[]; /* bvhlab_camera */
+extern const struct config_key config_refine_keys[]; /* struct config_refine */
+
+/* Reads every key of the table present in obj into base (the table's
+ * struct), in table order; CONFIG_CUSTOM keys are left to the caller. */
+int config_read_keys(const struct config *cfg, const cJSON *obj,
+                     const struct config_key *table, const char *prefix, void *base,
+                     bvhlab_error *err);
+
+/* Unknown keys (not in the table) and duplicate keys of obj. */
+int config_check_keys(const struct config *cfg, const cJSON *obj,
+                      const struct config_key *table, const char *where, bvhlab_error *err);
 int config_check_duplicates(const struct config *cfg, const cJSON *obj, const char *where,
                             bvhlab_error *err);
 
@@ -61,6 +104,9 @@ int config_get_positive(const struct config *cfg, const cJSON *obj, const char *
 /* A non-empty string, copied into *out (freeing what was there). */
 int config_get_string(const struct config *cfg, const cJSON *obj, const char *key,
                       const char *prefix, char **out, bvhlab_error *err);
+/* A [x, y, z] array of finite numbers (magnitude <= 1e30) into out. */
+int config_get_vec3(const struct config *cfg, const cJSON *obj, const char *key,
+                    const char *prefix, float out[3], bvhlab_error *err);
 /* A non-empty array of distinct thread counts (0 = all hardware threads). */
 int config_get_threads(const struct config *cfg, const cJSON *obj, const char *key,
                        const char *prefix, uint32_t **out, size_t *count,

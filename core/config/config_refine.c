@@ -13,8 +13,6 @@
 #include "config/config_internal.h"
 #include "config/json_locate.h"
 
-static const char *const refine_keys[] = { "plugin", "options", NULL };
-
 static int out_of_memory(const struct config *cfg, bvhlab_error *err)
 {
 	error_set(err, "%s: out of memory", cfg->path);
@@ -74,7 +72,7 @@ static int parse_stage(struct config *cfg, const cJSON *obj, const char *prefix,
 		                    (int)strlen(prefix) - 1, prefix,
 		                    config_describe(cfg, obj, got, sizeof(got)));
 	json_locate_value(cfg->locations, obj, &r->line, &r->column);
-	int rc = config_check_keys(cfg, obj, refine_keys, where, err);
+	int rc = config_check_keys(cfg, obj, config_refine_keys, where, err);
 	if (!rc)
 		rc = stage_plugin(cfg, obj, prefix, r, err);
 	if (rc || !(options = config_member(obj, "options")))

@@ -9,7 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <bvhlab/plugin.h>
+#include <bvhlab/host.h>
+#include <bvhlab/machine.h>
 
 #include "machine/machine.h"
 #include "util/util.h"

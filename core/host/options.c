@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <bvhlab/plugin.h>
+#include <bvhlab/host.h>
 
 #include "util/util.h"
 

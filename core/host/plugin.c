@@ -13,7 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <bvhlab/plugin.h>
+#include <bvhlab/host.h>
 
 #include "util/util.h"
 

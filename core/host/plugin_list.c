@@ -6,7 +6,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include <bvhlab/plugin.h>
+#include <bvhlab/host.h>
 
 #include "util/util.h"
 

@@ -19,7 +19,7 @@
 
 #include <hwloc.h>
 
-#include <bvhlab/plugin.h>
+#include <bvhlab/machine.h>
 
 #include "machine/machine.h"
 

@@ -9,7 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include <bvhlab/rays.h>
+#include <bvhlab/trace.h>
 
 #ifdef __cplusplus
 extern "C" {

@@ -9,8 +9,6 @@
 
 #include <OpenImageIO/imageio.h>
 
-// The core's headers are C11; the layout checks they hold read the same in C++.
-#define _Static_assert static_assert
 #include "output/image.h"
 
 namespace {

@@ -6,51 +6,31 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
+
 #include "scene/scene_private.h"
-
-static void box_empty(bvhlab_aabb *box)
-{
-	for (int k = 0; k < 3; k++) {
-		box->lo[k] = INFINITY;
-		box->hi[k] = -INFINITY;
-	}
-}
-
-static void box_grow(bvhlab_aabb *box, const float *p)
-{
-	for (int k = 0; k < 3; k++) {
-		box->lo[k] = fminf(box->lo[k], p[k]);
-		box->hi[k] = fmaxf(box->hi[k], p[k]);
-	}
-}
-
-static void box_union(bvhlab_aabb *box, const bvhlab_aabb *other)
-{
-	box_grow(box, other->lo);
-	box_grow(box, other->hi);
-}
 
 /* Fills the per-primitive arrays and the two overall boxes. */
 static void compute_prims(bvhlab_prims *prims, const bvhlab_scene *scene)
 {
 	bvhlab_build_input *in = &prims->input;
 
-	box_empty(&in->bounds);
-	box_empty(&in->centroid_bounds);
+	bvhlab_aabb_empty(&in->bounds);
+	bvhlab_aabb_empty(&in->centroid_bounds);
 	for (size_t t = 0; t < scene->triangle_count; t++) {
 		const uint32_t *tri = scene->indices + 3 * t;
 		bvhlab_aabb *box = &prims->bounds_storage[t];
 		float *c = prims->centroid_storage + 3 * t;
 
-		box_empty(box);
+		bvhlab_aabb_empty(box);
 		for (int j = 0; j < 3; j++)
-			box_grow(box, scene->vertices + 3 * (size_t)tri[j]);
+			bvhlab_aabb_grow_point(box, scene->vertices + 3 * (size_t)tri[j]);
 		/* The box centre, not the vertex average: builders bin by the
 		 * same boxes they bound with. */
 		for (int k = 0; k < 3; k++)
-			c[k] = 0.5f * (box->lo[k] + box->hi[k]);
-		box_union(&in->bounds, box);
-		box_grow(&in->centroid_bounds, c);
+			c[k] = bvhlab_aabb_center(box, k);
+		bvhlab_aabb_grow(&in->bounds, box);
+		bvhlab_aabb_grow_point(&in->centroid_bounds, c);
 	}
 }
 

@@ -10,6 +10,8 @@
 #include <strings.h>
 #include <sys/stat.h>
 
+#include <bvhlab/aabb.h>
+
 #include "scene/scene_private.h"
 
 void scene_error(bvhlab_error *err, const char *fmt, ...)
@@ -21,14 +23,6 @@ void scene_error(bvhlab_error *err, const char *fmt, ...)
 	va_start(ap, fmt);
 	vsnprintf(err->message, sizeof(err->message), fmt, ap);
 	va_end(ap);
-}
-
-static void aabb_empty(bvhlab_aabb *box)
-{
-	for (int k = 0; k < 3; k++) {
-		box->lo[k] = INFINITY;
-		box->hi[k] = -INFINITY;
-	}
 }
 
 int scene_alloc(uint32_t vertex_count, uint32_t triangle_count, bvhlab_scene **out,
@@ -46,7 +40,7 @@ int scene_alloc(uint32_t vertex_count, uint32_t triangle_count, bvhlab_scene **o
 		goto fail;
 	scene->vertex_count = vertex_count;
 	scene->triangle_count = triangle_count;
-	aabb_empty(&scene->bounds);
+	bvhlab_aabb_empty(&scene->bounds);
 	*out = scene;
 	return 0;
 fail:
@@ -241,16 +235,11 @@ void bvhlab_scene_update(bvhlab_scene *scene)
 	const float *v = scene->vertices;
 	bvhlab_aabb box;
 
-	aabb_empty(&box);
+	bvhlab_aabb_empty(&box);
 	scene->degenerate_count = 0;
 	for (size_t t = 0; t < scene->triangle_count; t++, idx += 3) {
-		for (int j = 0; j < 3; j++) {
-			const float *p = v + 3 * (size_t)idx[j];
-			for (int k = 0; k < 3; k++) {
-				box.lo[k] = fminf(box.lo[k], p[k]);
-				box.hi[k] = fmaxf(box.hi[k], p[k]);
-			}
-		}
+		for (int j = 0; j < 3; j++)
+			bvhlab_aabb_grow_point(&box, v + 3 * (size_t)idx[j]);
 		if (triangle_degenerate(v + 3 * (size_t)idx[0], v + 3 * (size_t)idx[1],
 		                        v + 3 * (size_t)idx[2]))
 			scene->degenerate_count++;

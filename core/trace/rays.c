@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <bvhlab/rays.h>
+#include <bvhlab/trace.h>
 
 #include "util/util.h"
 

@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/trace.h>
 #include <bvhlab/tree.h>
 
 /* The blocked brute force relies on its vector pass computing the very same

@@ -9,8 +9,8 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 
-#include <bvhlab/plugin.h>
-#include <bvhlab/rays.h>
+#include <bvhlab/machine.h>
+#include <bvhlab/trace.h>
 
 #include "util/util.h"
 

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
 #include <bvhlab/tree.h>
 
 #define LOCAL_STACK 128
@@ -18,21 +19,6 @@ typedef struct depth_entry {
 	uint32_t node;
 	uint32_t depth;
 } depth_entry;
-
-/* Surface area 2(xy + yz + zx) in double; an inverted (empty) or NaN
- * extent counts as 0 rather than making the area negative or NaN. */
-static double surface_area(const bvhlab_node *n)
-{
-	double d[3];
-	int k;
-
-	for (k = 0; k < 3; k++) {
-		d[k] = (double)n->hi[k] - (double)n->lo[k];
-		if (!(d[k] > 0.0))
-			d[k] = 0.0;
-	}
-	return 2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
-}
 
 /* Doubles a heap copy of the stack; false when out of memory. */
 static bool grow(depth_entry **stack, uint32_t *cap, depth_entry *local)
@@ -115,14 +101,14 @@ void bvhlab_tree_stats_compute(const bvhlab_tree *tree, bvhlab_tree_stats *stats
 
 		if (n->count == 0) {
 			inner++;
-			inner_area += surface_area(n);
+			inner_area += bvhlab_box_area(n->lo, n->hi);
 			continue;
 		}
 		count_leaf(stats, n->count);
 		refs += n->count;
-		leaf_area += surface_area(n) * n->count;
+		leaf_area += bvhlab_box_area(n->lo, n->hi) * n->count;
 	}
-	root_area = surface_area(&tree->nodes[0]);
+	root_area = bvhlab_box_area(tree->nodes[0].lo, tree->nodes[0].hi);
 	if (root_area > 0.0)
 		stats->sah_cost = (inner_area + leaf_area) / root_area;
 	else

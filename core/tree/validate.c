@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include <bvhlab/trace.h>
 #include <bvhlab/tree.h>
 
 #include "util/util.h"

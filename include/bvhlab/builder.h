@@ -14,8 +14,10 @@
  *
  *     const bvhlab_builder *bvhlab_plugin_entry(uint32_t host_abi_major);
  *
- * (declare it with BVHLAB_PLUGIN_ENTRY). It returns a static descriptor owned
- * by the plugin, or NULL when it cannot serve that ABI major. The host refuses
+ * (write BVHLAB_PLUGIN_EXPORT(descriptor) after the descriptor, or declare it
+ * with BVHLAB_PLUGIN_ENTRY). It returns a static descriptor owned by the
+ * plugin, or NULL when it cannot serve that ABI major. C++ plugins include
+ * this header as it is: its declarations are extern "C". The host refuses
  * a descriptor of another major and never reads past its struct_size; a
  * plugin built against an older minor therefore keeps working.
  *
@@ -32,6 +34,8 @@
 #include <stdint.h>
 
 #include "types.h"
+
+BVHLAB_BEGIN_DECLS
 
 #define BVHLAB_ABI_MAJOR 1
 #define BVHLAB_ABI_MINOR 2
@@ -52,9 +56,28 @@ typedef const struct bvhlab_builder *(*bvhlab_plugin_entry_fn)(uint32_t host_abi
 #define BVHLAB_PRINTF(fmt, args)
 #endif
 
+/* The entry point's linkage: C names in a C++ plugin too, so dlsym finds it. */
+#ifdef __cplusplus
+#define BVHLAB_ENTRY_LINKAGE extern "C"
+#else
+#define BVHLAB_ENTRY_LINKAGE
+#endif
+
 /* Use as: BVHLAB_PLUGIN_ENTRY { return host_abi_major == 1 ? &desc : NULL; } */
-#define BVHLAB_PLUGIN_ENTRY \
-	BVHLAB_EXPORT const struct bvhlab_builder *bvhlab_plugin_entry(uint32_t host_abi_major)
+#define BVHLAB_PLUGIN_ENTRY                              \
+	BVHLAB_ENTRY_LINKAGE BVHLAB_EXPORT const struct bvhlab_builder * \
+	bvhlab_plugin_entry(uint32_t host_abi_major)
+
+/*
+ * The whole entry point of a plugin with one descriptor, at file scope after
+ * it: BVHLAB_PLUGIN_EXPORT(descriptor). Serves this header's ABI major only
+ * and returns NULL for any other, which the host reports by name.
+ */
+#define BVHLAB_PLUGIN_EXPORT(descriptor)                                      \
+	BVHLAB_PLUGIN_ENTRY                                                   \
+	{                                                                     \
+		return host_abi_major == BVHLAB_ABI_MAJOR ? &(descriptor) : NULL; \
+	}
 
 /* ---- options -------------------------------------------------------- */
 
@@ -240,5 +263,7 @@ typedef struct bvhlab_builder {
  * lacks the fields that came later, e.g. BVHLAB_BUILDER_HAS(b, refine). */
 #define BVHLAB_BUILDER_HAS(b, field) \
 	((b)->struct_size >= offsetof(bvhlab_builder, field) + sizeof((b)->field))
+
+BVHLAB_END_DECLS
 
 #endif /* BVHLAB_BUILDER_H */

@@ -1,19 +1,36 @@
 /*
- * bvhlab — umbrella header for the core library.
+ * bvhlab — umbrella header for the core library: every public header.
  *
- * Plugins include only <bvhlab/builder.h>; programs that drive builders
- * (the bvhlab command, tests, other tools) include this.
+ * Plugins include only <bvhlab/builder.h> (and <bvhlab/aabb.h> for box
+ * helpers); programs that drive builders (the bvhlab command, tests, other
+ * tools) include this. Each header holds one concept:
+ *   types.h    boxes, nodes, rays, hits, errors (plain data, fixed layouts)
+ *   aabb.h     box helpers (header-only)
+ *   builder.h  the plugin ABI
+ *   scene.h    triangle scenes: loading, generators, per-primitive data
+ *   tree.h     the tree, validation, metrics, canonical compare
+ *   trace.h    traversal, cameras and rays, batch tracing
+ *   host.h     loading plugins, their options, running a build
+ *   machine.h  what threads = 0 means, thread pinning
+ * All are C11 and C++17 (extern "C").
  */
 #ifndef BVHLAB_BVHLAB_H
 #define BVHLAB_BVHLAB_H
 
+#include "aabb.h"
 #include "builder.h"
-#include "plugin.h"
+#include "host.h"
+#include "machine.h"
 #include "scene.h"
+#include "trace.h"
 #include "tree.h"
 #include "types.h"
 
+BVHLAB_BEGIN_DECLS
+
 /* The library's version, e.g. "0.1.0". */
 const char *bvhlab_version(void);
+
+BVHLAB_END_DECLS
 
 #endif /* BVHLAB_BVHLAB_H */

@@ -11,6 +11,8 @@
 #include "builder.h"
 #include "types.h"
 
+BVHLAB_BEGIN_DECLS
+
 /* An indexed triangle mesh. Owns all its arrays. */
 typedef struct bvhlab_scene {
 	char *name;               /* label used in reports */
@@ -74,5 +76,7 @@ typedef struct bvhlab_prims {
 
 int bvhlab_prims_init(bvhlab_prims *prims, const bvhlab_scene *scene, bvhlab_error *err);
 void bvhlab_prims_finish(bvhlab_prims *prims);
+
+BVHLAB_END_DECLS
 
 #endif /* BVHLAB_SCENE_H */

@@ -1,7 +1,8 @@
 /*
  * bvhlab — a built tree, and everything the core judges it by: structural
- * validation, a brute-force ray check, quality metrics, traversal and a
- * canonical comparison of two trees. Every builder is judged by this code.
+ * validation, a brute-force ray check, quality metrics and a canonical
+ * comparison of two trees. Every builder is judged by this code. Tracing
+ * rays through a tree is trace.h.
  */
 #ifndef BVHLAB_TREE_H
 #define BVHLAB_TREE_H
@@ -11,6 +12,8 @@
 
 #include "scene.h"
 #include "types.h"
+
+BVHLAB_BEGIN_DECLS
 
 /* A tree in the standard layout (see bvhlab_node). Owns its arrays. */
 typedef struct bvhlab_tree {
@@ -75,39 +78,6 @@ typedef struct bvhlab_tree_stats {
 /* Requires a tree that passed bvhlab_validate_tree. */
 void bvhlab_tree_stats_compute(const bvhlab_tree *tree, bvhlab_tree_stats *stats);
 
-/* ---- traversal ---------------------------------------------------------- */
-
-/* Counters a traversal adds to (may be NULL). */
-typedef struct bvhlab_trace_stats {
-	uint64_t rays;
-	uint64_t nodes_visited;
-	uint64_t tris_tested;
-} bvhlab_trace_stats;
-
-/*
- * Watertight ray/triangle test (Woop, Benthin, Wald 2013), two-sided. Uses
- * the caller's hit->t as the upper bound (initialise it to ray->tmax) and
- * reports hits with tmin < t < hit->t; u and v weight vertices 1 and 2.
- */
-bool bvhlab_intersect_triangle(const bvhlab_ray *ray, const bvhlab_scene *scene,
-                               uint32_t prim, bvhlab_hit *hit);
-
-/* Closest hit through the tree (stack-based, near child first). Initialises
- * *hit (t = tmax, prim = BVHLAB_NO_HIT); nodes_visited counts nodes entered. */
-void bvhlab_trace_closest(const bvhlab_tree *tree, const bvhlab_scene *scene,
-                          const bvhlab_ray *ray, bvhlab_hit *hit, bvhlab_trace_stats *stats);
-
-/*
- * Any hit (occlusion): true when some triangle is hit with tmin < t < tmax.
- * Stops at the first hit found, which fills *hit but need not be the
- * closest; *hit is initialised like bvhlab_trace_closest's. Same counters.
- */
-bool bvhlab_trace_any(const bvhlab_tree *tree, const bvhlab_scene *scene,
-                      const bvhlab_ray *ray, bvhlab_hit *hit, bvhlab_trace_stats *stats);
-
-/* Closest hit by testing every triangle; initialises *hit like the above. */
-void bvhlab_trace_brute(const bvhlab_scene *scene, const bvhlab_ray *ray, bvhlab_hit *hit);
-
 /* ---- canonical comparison ------------------------------------------------ */
 
 /*
@@ -117,5 +87,7 @@ void bvhlab_trace_brute(const bvhlab_scene *scene, const bvhlab_ray *ray, bvhlab
  * out of range: validate first); -ENOMEM on allocation failure.
  */
 int bvhlab_tree_compare(const bvhlab_tree *a, const bvhlab_tree *b, bvhlab_error *err);
+
+BVHLAB_END_DECLS
 
 #endif /* BVHLAB_TREE_H */

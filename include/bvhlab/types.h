@@ -2,13 +2,28 @@
  * bvhlab — basic geometric types shared by the plugin ABI and the core API.
  *
  * Every type here is plain data with a fixed layout; the layouts are part of
- * ABI v1 (see builder.h) and are checked by _Static_assert.
+ * ABI v1 (see builder.h) and are checked at compile time. Every bvhlab
+ * header includes this one, and with it the two macros that let C++
+ * include them: BVHLAB_BEGIN_DECLS/BVHLAB_END_DECLS (extern "C") and
+ * BVHLAB_STATIC_ASSERT (static_assert in C++, _Static_assert in C11).
  */
 #ifndef BVHLAB_TYPES_H
 #define BVHLAB_TYPES_H
 
 #include <stddef.h>
 #include <stdint.h>
+
+#ifdef __cplusplus
+#define BVHLAB_BEGIN_DECLS extern "C" {
+#define BVHLAB_END_DECLS }
+#define BVHLAB_STATIC_ASSERT(cond, msg) static_assert(cond, msg)
+#else
+#define BVHLAB_BEGIN_DECLS
+#define BVHLAB_END_DECLS
+#define BVHLAB_STATIC_ASSERT(cond, msg) _Static_assert(cond, msg)
+#endif
+
+BVHLAB_BEGIN_DECLS
 
 /* An axis-aligned box. An empty box has lo = +inf and hi = -inf. */
 typedef struct bvhlab_aabb {
@@ -31,11 +46,11 @@ typedef struct bvhlab_node {
 	uint32_t count; /* 0 for an inner node, else the leaf's primitive count */
 } bvhlab_node;
 
-_Static_assert(sizeof(bvhlab_node) == 32, "bvhlab_node must be 32 bytes");
-_Static_assert(offsetof(bvhlab_node, first) == 12, "bvhlab_node.first at 12");
-_Static_assert(offsetof(bvhlab_node, hi) == 16, "bvhlab_node.hi at 16");
-_Static_assert(offsetof(bvhlab_node, count) == 28, "bvhlab_node.count at 28");
-_Static_assert(sizeof(bvhlab_aabb) == 24, "bvhlab_aabb must be 24 bytes");
+BVHLAB_STATIC_ASSERT(sizeof(bvhlab_node) == 32, "bvhlab_node must be 32 bytes");
+BVHLAB_STATIC_ASSERT(offsetof(bvhlab_node, first) == 12, "bvhlab_node.first at 12");
+BVHLAB_STATIC_ASSERT(offsetof(bvhlab_node, hi) == 16, "bvhlab_node.hi at 16");
+BVHLAB_STATIC_ASSERT(offsetof(bvhlab_node, count) == 28, "bvhlab_node.count at 28");
+BVHLAB_STATIC_ASSERT(sizeof(bvhlab_aabb) == 24, "bvhlab_aabb must be 24 bytes");
 
 /* A ray segment org + t * dir for t in [tmin, tmax]. */
 typedef struct bvhlab_ray {
@@ -58,5 +73,7 @@ typedef struct bvhlab_hit {
 typedef struct bvhlab_error {
 	char message[512];
 } bvhlab_error;
+
+BVHLAB_END_DECLS
 
 #endif /* BVHLAB_TYPES_H */

@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
+
 #include "embree_internal.h"
 
 /* ---- callbacks (run on Embree's worker threads) --------------------------- */
@@ -55,37 +57,15 @@ static void *create_leaf(RTCThreadLocalAllocator alloc, const struct RTCBuildPri
 	return l;
 }
 
-typedef struct box {
-	float lo[3], hi[3];
-} box;
-
-/* Not fminf/fmaxf: without -ffinite-math-only those are calls into libm. */
-static inline float min(float a, float b)
-{
-	return a < b ? a : b;
-}
-
-static inline float max(float a, float b)
-{
-	return a > b ? a : b;
-}
-
-static void box_extend(box *b, const float *p)
-{
-	for (int k = 0; k < 3; k++) {
-		b->lo[k] = min(b->lo[k], p[k]);
-		b->hi[k] = max(b->hi[k], p[k]);
-	}
-}
-
 /* Clips to the reference's current box (already clipped by earlier splits). */
-static void box_store(box *b, const struct RTCBuildPrimitive *p, struct RTCBounds *out)
+static void box_store(bvhlab_aabb *b, const struct RTCBuildPrimitive *p,
+                      struct RTCBounds *out)
 {
 	const float lo[3] = {p->lower_x, p->lower_y, p->lower_z};
 	const float hi[3] = {p->upper_x, p->upper_y, p->upper_z};
 	for (int k = 0; k < 3; k++) {
-		b->lo[k] = max(b->lo[k], lo[k]);
-		b->hi[k] = min(b->hi[k], hi[k]);
+		b->lo[k] = bvhlab_maxf(b->lo[k], lo[k]);
+		b->hi[k] = bvhlab_minf(b->hi[k], hi[k]);
 	}
 	*out = (struct RTCBounds){b->lo[0], b->lo[1], b->lo[2], 0, b->hi[0], b->hi[1], b->hi[2], 0};
 }
@@ -100,22 +80,24 @@ static void split_prim(const struct RTCBuildPrimitive *prim, unsigned int dim, f
 {
 	const embree_job *job = user;
 	const uint32_t *tri = &job->input->indices[3 * (size_t)prim->primID];
-	box l = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}}, r = l;
+	bvhlab_aabb l, r;
+	bvhlab_aabb_empty(&l);
+	bvhlab_aabb_empty(&r);
 	for (int e = 0; e < 3; e++) {
 		const float *a = &job->input->vertices[3 * (size_t)tri[e]];
 		const float *b = &job->input->vertices[3 * (size_t)tri[(e + 1) % 3]];
 		if (a[dim] <= pos)
-			box_extend(&l, a);
+			bvhlab_aabb_grow_point(&l, a);
 		if (a[dim] >= pos)
-			box_extend(&r, a);
+			bvhlab_aabb_grow_point(&r, a);
 		if ((a[dim] < pos && pos < b[dim]) || (b[dim] < pos && pos < a[dim])) {
 			double t = ((double)pos - a[dim]) / ((double)b[dim] - a[dim]);
 			float c[3];
 			for (int k = 0; k < 3; k++)
 				c[k] = (float)(a[k] + t * ((double)b[k] - a[k]));
 			c[dim] = pos;
-			box_extend(&l, c);
-			box_extend(&r, c);
+			bvhlab_aabb_grow_point(&l, c);
+			bvhlab_aabb_grow_point(&r, c);
 		}
 	}
 	box_store(&l, prim, left);
@@ -227,31 +209,22 @@ static int write_nodes(writer *w, const tnode *root)
 	return rc;
 }
 
-static void unite(bvhlab_node *n, const float *lo, const float *hi)
-{
-	for (int k = 0; k < 3; k++) {
-		n->lo[k] = min(n->lo[k], lo[k]);
-		n->hi[k] = max(n->hi[k], hi[k]);
-	}
-}
-
 /* Bottom-up is a reverse scan, since children follow their parents. */
 static void compute_boxes(const bvhlab_build_input *in, bvhlab_build_output *o)
 {
 	for (uint32_t i = o->node_count; i-- > 0;) {
 		bvhlab_node *n = &o->nodes[i];
-		const bvhlab_aabb *b;
-		for (int k = 0; k < 3; k++)
-			n->lo[k] = INFINITY, n->hi[k] = -INFINITY;
+		bvhlab_aabb box;
+		bvhlab_aabb_empty(&box);
 		if (n->count == 0) {
-			unite(n, o->nodes[n->first].lo, o->nodes[n->first].hi);
-			unite(n, o->nodes[n->first + 1].lo, o->nodes[n->first + 1].hi);
-			continue;
+			bvhlab_aabb_grow_corners(&box, o->nodes[n->first].lo, o->nodes[n->first].hi);
+			bvhlab_aabb_grow_corners(&box, o->nodes[n->first + 1].lo,
+			                         o->nodes[n->first + 1].hi);
 		}
-		for (uint32_t s = n->first; s < n->first + n->count; s++) {
-			b = &in->prim_bounds[o->prim_index[s]];
-			unite(n, b->lo, b->hi);
-		}
+		for (uint32_t s = n->first; n->count && s < n->first + n->count; s++)
+			bvhlab_aabb_grow(&box, &in->prim_bounds[o->prim_index[s]]);
+		memcpy(n->lo, box.lo, sizeof(n->lo));
+		memcpy(n->hi, box.hi, sizeof(n->hi));
 	}
 }
 

@@ -43,6 +43,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include <bvhlab/aabb.h>
 #include <bvhlab/builder.h>
 
 #include "morton.h"

@@ -160,8 +160,8 @@ static uint32_t finish_node(lbvh *b, uint32_t i, uint32_t size)
 #else
 	/* Plain compares, not fminf: boxes hold no NaN, and these inline. */
 	for (int k = 0; k < 3; k++) {
-		out->lo[k] = l->lo[k] < r->lo[k] ? l->lo[k] : r->lo[k];
-		out->hi[k] = l->hi[k] > r->hi[k] ? l->hi[k] : r->hi[k];
+		out->lo[k] = bvhlab_minf(l->lo[k], r->lo[k]);
+		out->hi[k] = bvhlab_maxf(l->hi[k], r->hi[k]);
 	}
 #endif
 	out->first = 1 + 2 * i;

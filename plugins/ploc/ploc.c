@@ -9,6 +9,8 @@
 #include <string.h>
 #include <time.h>
 
+#include <bvhlab/aabb.h>
+
 #include "big_alloc.h"
 #include "ploc.h"
 
@@ -219,9 +221,7 @@ static void first_clusters(ploc *p, unsigned t)
 		}
 		c->first[k] = id;
 		c->info[k] = 1 | REC_PRIM;
-		c->cost[k] = p->c_isect * half_area3(box->hi[0] - box->lo[0],
-		                                     box->hi[1] - box->lo[1],
-		                                     box->hi[2] - box->lo[2]);
+		c->cost[k] = p->c_isect * bvhlab_aabb_half_area(box);
 		c->desc[k] = 0;
 	}
 }
@@ -341,7 +341,4 @@ static const bvhlab_builder descriptor = {
 	.build = build,
 };
 
-BVHLAB_PLUGIN_ENTRY
-{
-	return host_abi_major == BVHLAB_ABI_MAJOR ? &descriptor : NULL;
-}
+BVHLAB_PLUGIN_EXPORT(descriptor)

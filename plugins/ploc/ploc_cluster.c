@@ -21,6 +21,8 @@
  */
 #include <string.h>
 
+#include <bvhlab/aabb.h>
+
 #include "ploc.h"
 
 /* Clusters per block of the nearest-neighbour search: a block repeats
@@ -199,8 +201,8 @@ static void merge(ploc *p, const struct clusters *c, uint32_t i, uint32_t j, uin
 	put_record(p, c, i, x);
 	put_record(p, c, j, x + 1);
 	for (int a = 0; a < 3; a++) {
-		to->lo[a][k] = c->lo[a][i] < c->lo[a][j] ? c->lo[a][i] : c->lo[a][j];
-		to->hi[a][k] = c->hi[a][i] > c->hi[a][j] ? c->hi[a][i] : c->hi[a][j];
+		to->lo[a][k] = bvhlab_minf(c->lo[a][i], c->lo[a][j]);
+		to->hi[a][k] = bvhlab_maxf(c->hi[a][i], c->hi[a][j]);
 	}
 	to->first[k] = x;
 	merge_cost(p, c, i, j, to, k);

@@ -30,6 +30,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include <bvhlab/aabb.h>
 #include <bvhlab/builder.h>
 
 #include "team.h"
@@ -56,17 +57,11 @@ typedef struct reinsert {
 	team team;
 } reinsert;
 
-/* Half the surface area, in double as the core's metric, 0 for an
- * inverted extent. */
+/* The surface area as the core's SAH metric computes it, so that the
+ * bookkeeping adds up to the reported cost. */
 static inline double area_of(const float lo[3], const float hi[3])
 {
-	double d[3];
-
-	for (int k = 0; k < 3; k++) {
-		d[k] = (double)hi[k] - (double)lo[k];
-		d[k] = d[k] > 0 ? d[k] : 0;
-	}
-	return d[0] * d[1] + d[1] * d[2] + d[2] * d[0];
+	return bvhlab_box_area(lo, hi);
 }
 
 static inline double node_area(const bvhlab_node *n)
@@ -78,8 +73,8 @@ static inline void box_union(const bvhlab_node *a, const bvhlab_node *b, float l
                              float hi[3])
 {
 	for (int k = 0; k < 3; k++) {
-		lo[k] = a->lo[k] < b->lo[k] ? a->lo[k] : b->lo[k];
-		hi[k] = a->hi[k] > b->hi[k] ? a->hi[k] : b->hi[k];
+		lo[k] = bvhlab_minf(a->lo[k], b->lo[k]);
+		hi[k] = bvhlab_maxf(a->hi[k], b->hi[k]);
 	}
 }
 

@@ -1,0 +1,137 @@
+/*
+ * Every config key, declared once: its name, JSON type, range and the field
+ * it fills. One table per object (the top level, "rays", a scene, a
+ * builder, "rays.camera") drives both the unknown-key check (config_check_keys, with its
+ * did-you-mean) and the reading (config_read_keys), in the table's order.
+ * A key whose value needs more than a typed read (an object, the list of
+ * scenes, a path resolved later) is CONFIG_CUSTOM: declared here so it is
+ * known, read by config.c or config_entries.c after the table's keys.
+ * A new key is one line here and one field in config.h.
+ */
+#include <stddef.h>
+#include <stdint.h>
+
+#include "config/config_internal.h"
+
+/* Image sides beyond this are mistakes, and width * height stays far from 2^32. */
+#define MAX_RAY_SIDE 16384
+#define MAX_DIFFUSE 1024
+/* 16 subdivisions turn one triangle into 4^16 = 2^32, past a uint32_t count. */
+#define MAX_SUBDIVIDE 15
+
+#define KEY(type, name, kind, field, min, max, flags) \
+	{ name, kind, min, max, offsetof(type, field), 0, flags }
+#define CUSTOM(name) { name, CONFIG_CUSTOM, 0, 0, 0, 0, 0 }
+#define THREADS(type, name, field, count) \
+	{ name, CONFIG_THREADS, 0, UINT32_MAX, offsetof(type, field), offsetof(type, count), 0 }
+#define END { NULL, CONFIG_CUSTOM, 0, 0, 0, 0, 0 }
+
+#define TOP(name, kind, field, min, max) KEY(struct config, name, kind, field, min, max, 0)
+const struct config_key config_top_keys[] = {
+	CUSTOM("format_version"),
+	TOP("output", CONFIG_STRING, output, 0, 0),
+	TOP("repeat", CONFIG_U32, repeat, 1, UINT32_MAX),
+	TOP("warmup", CONFIG_U32, warmup, 0, UINT32_MAX),
+	THREADS(struct config, "threads", threads, thread_count),
+	TOP("validate", CONFIG_BOOL, validate, 0, 0),
+	TOP("validate_rays", CONFIG_U32, validate_rays, 1, UINT32_MAX),
+	CUSTOM("rays"),
+	TOP("images", CONFIG_BOOL, images, 0, 0),
+	TOP("isolate", CONFIG_BOOL, isolate, 0, 0),
+	TOP("timeout_s", CONFIG_POSITIVE, timeout_s, 0, 0),
+	TOP("memory_limit_mb", CONFIG_U64, memory_limit_mb, 1, CONFIG_MAX_MEMORY_MB),
+	TOP("pin", CONFIG_BOOL, pin, 0, 0),
+	CUSTOM("scenes"),
+	CUSTOM("builders"),
+	END,
+};
+
+const struct config_key config_ray_keys[] = {
+	TOP("width", CONFIG_U32, ray_width, 1, MAX_RAY_SIDE),
+	TOP("height", CONFIG_U32, ray_height, 1, MAX_RAY_SIDE),
+	TOP("diffuse", CONFIG_U32, ray_diffuse, 0, MAX_DIFFUSE),
+	CUSTOM("camera"),
+	END,
+};
+
+#define SCENE(name, kind, field, min, max, flags) \
+	KEY(struct config_scene, name, kind, field, min, max, flags)
+const struct config_key config_scene_keys[] = {
+	SCENE("name", CONFIG_STRING, name, 0, 0, 0),
+	SCENE("path", CONFIG_STRING, path, 0, 0, 0),
+	SCENE("generator", CONFIG_STRING, generator, 0, 0, 0),
+	SCENE("frequency", CONFIG_U32, gen.frequency, 1, UINT32_MAX, CONFIG_GENERATED),
+	SCENE("count", CONFIG_U32, gen.count, 1, UINT32_MAX, CONFIG_GENERATED),
+	SCENE("size", CONFIG_U32, gen.size, 1, UINT32_MAX, CONFIG_GENERATED),
+	SCENE("seed", CONFIG_U64, gen.seed, 0, UINT64_MAX, CONFIG_GENERATED),
+	SCENE("subdivide", CONFIG_U32, subdivide, 0, MAX_SUBDIVIDE, 0),
+	END,
+};
+
+#define BUILDER(name, kind, field, min, max) \
+	KEY(struct config_builder, name, kind, field, min, max, 0)
+const struct config_key config_builder_keys[] = {
+	BUILDER("plugin", CONFIG_STRING, plugin, 0, 0),
+	BUILDER("name", CONFIG_STRING, name, 0, 0),
+	THREADS(struct config_builder, "threads", threads, thread_count),
+	BUILDER("timeout_s", CONFIG_POSITIVE, timeout_s, 0, 0),
+	BUILDER("memory_limit_mb", CONFIG_U64, memory_limit_mb, 1, CONFIG_MAX_MEMORY_MB),
+	CUSTOM("options"),
+	CUSTOM("refine"), /* config_refine.c */
+	END,
+};
+
+#define STAGE(name, kind, field) KEY(struct config_refine, name, kind, field, 0, 0, 0)
+const struct config_key config_refine_keys[] = {
+	STAGE("plugin", CONFIG_STRING, plugin),
+	CUSTOM("options"),
+	END,
+};
+
+#define CAMERA(name, kind, field) KEY(bvhlab_camera, name, kind, field, 0, 0, 0)
+const struct config_key config_camera_keys[] = {
+	CAMERA("position", CONFIG_VEC3, position),
+	CAMERA("target", CONFIG_VEC3, target),
+	CAMERA("up", CONFIG_VEC3, up),
+	CUSTOM("fov"), /* a float below 180 degrees: config_camera.c */
+	END,
+};
+
+/* Reads one key into its field; an absent key leaves the field as it is. */
+static int read_key(const struct config *cfg, const cJSON *obj, const struct config_key *k,
+                    const char *prefix, void *base, bvhlab_error *err)
+{
+	char *field = (char *)base + k->offset;
+	switch (k->kind) {
+	case CONFIG_U32:
+		return config_get_u32(cfg, obj, k->name, prefix, (uint32_t)k->min, (uint32_t)k->max,
+		                      (uint32_t *)(void *)field, err);
+	case CONFIG_U64:
+		return config_get_uint(cfg, obj, k->name, prefix, k->min, k->max,
+		                       (uint64_t *)(void *)field, err);
+	case CONFIG_BOOL:
+		return config_get_bool(cfg, obj, k->name, prefix, (bool *)(void *)field, err);
+	case CONFIG_POSITIVE:
+		return config_get_positive(cfg, obj, k->name, prefix, (double *)(void *)field, err);
+	case CONFIG_STRING:
+		return config_get_string(cfg, obj, k->name, prefix, (char **)(void *)field, err);
+	case CONFIG_THREADS:
+		return config_get_threads(cfg, obj, k->name, prefix, (uint32_t **)(void *)field,
+		                          (size_t *)(void *)((char *)base + k->count_offset), err);
+	case CONFIG_VEC3:
+		return config_get_vec3(cfg, obj, k->name, prefix, (float *)(void *)field, err);
+	case CONFIG_CUSTOM:
+		break;
+	}
+	return 0;
+}
+
+int config_read_keys(const struct config *cfg, const cJSON *obj,
+                     const struct config_key *table, const char *prefix, void *base,
+                     bvhlab_error *err)
+{
+	int rc = 0;
+	for (const struct config_key *k = table; k->name && !rc; k++)
+		rc = read_key(cfg, obj, k, prefix, base, err);
+	return rc;
+}
