@@ -20,6 +20,14 @@ static const bvhlab_option_decl options[] = {
 	  .help = "stop after an iteration that lowers the SAH by less than this fraction "
 	          "of it (0: run every iteration)",
 	  .def_float = 0.001, .min = 0.0, .max = 1.0 },
+	{ .name = "leaves", .type = BVHLAB_OPTION_BOOL,
+	  .help = "split leaves of several primitives first, so that their primitives can "
+	          "move too, and cut the tree into leaves by the SAH afterwards (kept only "
+	          "if the SAH fell)",
+	  .def_bool = true },
+	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,
+	  .help = "most primitives in a leaf of that final cut (8, as the builders)",
+	  .def_int = 8, .min = 1, .max = 64 },
 	{ .name = "max_visits", .type = BVHLAB_OPTION_INT,
 	  .help = "most nodes one candidate's search may look at",
 	  .def_int = 4096, .min = 16, .max = 1 << 24 },
@@ -29,7 +37,8 @@ static const bvhlab_option_decl options[] = {
 
 struct params {
 	double batch, min_gain;
-	int64_t iterations, max_visits;
+	int64_t iterations, max_visits, max_leaf;
+	bool leaves;
 };
 
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, struct params *o)
@@ -39,12 +48,15 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, struct p
 	if ((rc = host->option_float(ctx, "batch", &o->batch)) < 0 ||
 	    (rc = host->option_int(ctx, "iterations", &o->iterations)) < 0 ||
 	    (rc = host->option_float(ctx, "min_gain", &o->min_gain)) < 0 ||
-	    (rc = host->option_int(ctx, "max_visits", &o->max_visits)) < 0) {
+	    (rc = host->option_int(ctx, "max_visits", &o->max_visits)) < 0 ||
+	    (rc = host->option_bool(ctx, "leaves", &o->leaves)) < 0 ||
+	    (rc = host->option_int(ctx, "max_leaf", &o->max_leaf)) < 0) {
 		host->set_error(ctx, "cannot read the options");
 		return rc;
 	}
 	if (!(o->batch > 0 && o->batch <= 1) || o->iterations < 1 || !(o->min_gain >= 0) ||
-	    o->max_visits < 16 || o->max_visits > (1 << 24)) {
+	    o->max_visits < 16 || o->max_visits > (1 << 24) || o->max_leaf < 1 ||
+	    o->max_leaf > 64) {
 		host->set_error(ctx, "options out of range");
 		return -EINVAL;
 	}
@@ -188,21 +200,60 @@ static int iterate(reinsert *r, const struct params *o, uint32_t threads, uint32
 	return 0;
 }
 
-/* ---- refine --------------------------------------------------------------- */
+/* ---- refine ------------------------------------------------------------- */
 
-static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                  const bvhlab_build_input *input, bvhlab_build_output *tree)
+/* The tree as it came in, to put back if splitting leaves did not pay. */
+struct saved {
+	bvhlab_node *nodes;
+	uint32_t *index;
+	uint32_t node_count;
+	double sah;
+};
+
+static int save(struct saved *s, const bvhlab_build_output *t)
 {
-	reinsert r = { .nodes = tree->nodes, .node_count = tree->node_count };
-	struct params o;
+	s->node_count = t->node_count;
+	s->nodes = malloc((size_t)t->node_count * sizeof(*s->nodes));
+	s->index = malloc((size_t)t->index_count * sizeof(*s->index));
+	if (!s->nodes || !s->index)
+		return -ENOMEM;
+	memcpy(s->nodes, t->nodes, (size_t)t->node_count * sizeof(*s->nodes));
+	memcpy(s->index, t->prim_index, (size_t)t->index_count * sizeof(*s->index));
+	s->sah = reinsert_sah(t->nodes, t->node_count);
+	return 0;
+}
+
+/* Keeps the cut tree only when its SAH is lower than the saved one's. */
+static void keep_or_restore(const struct saved *s, bvhlab_build_output *t)
+{
+	if (reinsert_sah(t->nodes, t->node_count) < s->sah)
+		return;
+	memcpy(t->nodes, s->nodes, (size_t)s->node_count * sizeof(*s->nodes));
+	memcpy(t->prim_index, s->index, (size_t)t->index_count * sizeof(*s->index));
+	t->node_count = s->node_count;
+}
+
+/* Room for the split leaves; false (go on without splitting) if refused. */
+static bool split_leaves(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                         const bvhlab_build_input *in, bvhlab_build_output *t)
+{
+	uint32_t need = reinsert_split_room(t);
+
+	if (need > t->node_capacity &&
+	    (need == UINT32_MAX || host->grow_output(ctx, t, need, t->index_capacity) < 0))
+		return false;
+	reinsert_split_leaves(t, in);
+	return true;
+}
+
+static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct params *o,
+                    const bvhlab_build_input *input, bvhlab_build_output *tree)
+{
+	reinsert r = { .nodes = tree->nodes, .node_count = tree->node_count,
+	               .max_visits = (uint32_t)o->max_visits };
 	size_t n = tree->node_count;
 	int rc;
 
-	if ((rc = read_options(host, ctx, &o)) < 0)
-		return rc;
-	if (n < 3) /* a leaf, or a root and two leaves: nothing can move */
-		return 0;
-	r.max_visits = (uint32_t)o.max_visits;
 	r.parent = malloc(n * sizeof(*r.parent));
 	r.cand = malloc(n * sizeof(*r.cand));
 	r.moves = malloc(n * sizeof(*r.moves));
@@ -214,7 +265,7 @@ static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		goto out;
 	}
 	find_parents(&r);
-	if ((rc = iterate(&r, &o, input->threads, host->hardware_threads(ctx))) < 0)
+	if ((rc = iterate(&r, o, input->threads, host->hardware_threads(ctx))) < 0)
 		host->set_error(ctx, "cannot start the search threads");
 out:
 	free(r.parent);
@@ -222,6 +273,37 @@ out:
 	free(r.moves);
 	free(r.keys);
 	free(r.hist);
+	return rc;
+}
+
+static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                  const bvhlab_build_input *input, bvhlab_build_output *tree)
+{
+	struct saved s = { 0 };
+	struct params o;
+	bool split = false;
+	int rc;
+
+	if ((rc = read_options(host, ctx, &o)) < 0)
+		return rc;
+	if (tree->node_count < 3 && !(o.leaves && tree->node_count == 1 && tree->nodes[0].count > 1))
+		return 0; /* nothing can move */
+	if (o.leaves) {
+		if ((rc = save(&s, tree)) < 0) {
+			host->set_error(ctx, "out of memory for a copy of the tree");
+			goto out;
+		}
+		split = split_leaves(host, ctx, input, tree);
+	}
+	if (tree->node_count >= 3 && (rc = optimise(host, ctx, &o, input, tree)) < 0)
+		goto out;
+	if (split && (rc = reinsert_collapse(tree, (uint32_t)o.max_leaf)) < 0)
+		host->set_error(ctx, "out of memory for the collapse");
+	if (split && rc == 0)
+		keep_or_restore(&s, tree);
+out:
+	free(s.nodes);
+	free(s.index);
 	return rc;
 }
 
