@@ -79,6 +79,11 @@ static uint32_t offer_row(const uint32_t *key, uint32_t count, uint32_t *best)
 }
 
 /* best[] covers [from, hi + radius): rows update it without bounds tests. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+/* Eight lanes where the CPU has AVX2 (chosen when the plugin loads): the
+ * same operations in the same order, so the same keys. */
+__attribute__((target_clones("avx2", "default")))
+#endif
 static void nearest_block(ploc *p, const struct clusters *c, uint32_t m, uint32_t lo,
                           uint32_t hi)
 {
