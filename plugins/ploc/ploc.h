@@ -38,6 +38,9 @@
 #include "team.h"
 
 #define PLOC_MAX_RADIUS 64
+/* Iterations over fewer clusters, and the emit phase's ranges of those
+ * iterations, are run by thread 0 alone. */
+#define PLOC_SOLO_BELOW 32768
 /* Record flags in the count field of the merge tree (below). */
 #define REC_PRIM 0x80000000u      /* one primitive; first: its sorted position */
 #define REC_COLLAPSED 0x40000000u /* the SAH made this subtree one leaf */
@@ -91,6 +94,7 @@ typedef struct ploc {
 	struct place *place;    /* [2n - 1] */
 	uint32_t *iter_first;   /* [n] first record of iteration k's pairs */
 	uint32_t iterations;
+	uint32_t solo_from;     /* first iteration that thread 0 ran alone */
 	uint32_t *count;        /* [2 T] per-chunk counts of merges, survivors */
 	atomic_uint blocks[2];  /* blocks handed out, by iteration parity */
 	team team;

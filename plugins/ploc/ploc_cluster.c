@@ -121,7 +121,7 @@ static inline bool mutual(const ploc *p, uint32_t i)
 }
 
 /* Merges and survivors of chunk [lo, hi), into count[t] and count[T + t]. */
-static void count_chunk(ploc *p, unsigned t, uint32_t lo, uint32_t hi)
+static void count_chunk(ploc *p, unsigned chunks, unsigned t, uint32_t lo, uint32_t hi)
 {
 	uint32_t merges = 0, survivors = 0;
 
@@ -132,16 +132,17 @@ static void count_chunk(ploc *p, unsigned t, uint32_t lo, uint32_t hi)
 		survivors += !pair || i < p->nn[i];
 	}
 	p->count[t] = merges;
-	p->count[p->team.threads + t] = survivors;
+	p->count[chunks + t] = survivors;
 }
 
 /* Sum of count[base + u] over the chunks before t, and over all. */
-static uint32_t prefix(const ploc *p, unsigned t, unsigned base, uint32_t *total)
+static uint32_t prefix(const ploc *p, unsigned chunks, unsigned t, unsigned base,
+                       uint32_t *total)
 {
 	uint32_t before = 0;
 
 	*total = 0;
-	for (unsigned u = 0; u < p->team.threads; u++) {
+	for (unsigned u = 0; u < chunks; u++) {
 		before += u < t ? p->count[base + u] : 0;
 		*total += p->count[base + u];
 	}
@@ -215,11 +216,12 @@ static void merge(ploc *p, const struct clusters *c, uint32_t i, uint32_t j, uin
 
 /* Chunk [lo, hi): merges take the pairs below `base` in order. Returns
  * the survivors of all chunks; *merges gets the merges of all. */
-static uint32_t write_chunk(ploc *p, unsigned t, const struct clusters *c, struct clusters *to,
-                            uint32_t lo, uint32_t hi, uint32_t base, uint32_t *merges)
+static uint32_t write_chunk(ploc *p, unsigned chunks, unsigned t, const struct clusters *c,
+                            struct clusters *to, uint32_t lo, uint32_t hi, uint32_t base,
+                            uint32_t *merges)
 {
-	uint32_t survivors, k = prefix(p, t, p->team.threads, &survivors);
-	uint32_t pair = base - 2 * prefix(p, t, 0, merges);
+	uint32_t survivors, k = prefix(p, chunks, t, chunks, &survivors);
+	uint32_t pair = base - 2 * prefix(p, chunks, t, 0, merges);
 
 	for (uint32_t i = lo; i < hi; i++) {
 		uint32_t j = p->nn[i];
@@ -234,29 +236,54 @@ static uint32_t write_chunk(ploc *p, unsigned t, const struct clusters *c, struc
 	return survivors;
 }
 
-/* The iterations; every thread keeps the same count, m and base. */
+/* Barriers only while there is work for the team (team false: thread 0
+ * alone, no barrier). */
+static void sync_if(ploc *p, bool team)
+{
+	if (team)
+		team_sync(&p->team);
+}
+
+/* One iteration over *m clusters, by `chunks` members (1: thread 0 alone);
+ * every member keeps the same *m and *base. */
+static void iteration(ploc *p, unsigned t, unsigned chunks, uint32_t it, uint32_t *m,
+                      uint32_t *base)
+{
+	const struct clusters *c = &p->cl[it & 1];
+	struct clusters *to = &p->cl[(it + 1) & 1];
+	uint32_t lo, hi, merges;
+	bool team = chunks > 1;
+
+	nearest(p, c, *m, &p->blocks[it & 1]);
+	sync_if(p, team);
+	team_chunk(chunks, t, *m, &lo, &hi);
+	count_chunk(p, chunks, t, lo, hi);
+	sync_if(p, team);
+	if (t == 0) /* last used an iteration ago; next used after the sync below */
+		atomic_store_explicit(&p->blocks[(it + 1) & 1], 0, memory_order_relaxed);
+	*m = write_chunk(p, chunks, t, c, to, lo, hi, *base, &merges);
+	*base -= 2 * merges;
+	if (t == 0)
+		p->iter_first[it] = *base;
+	sync_if(p, team);
+}
+
+/*
+ * The iterations: by the team while there are many clusters, then by
+ * thread 0 alone, the others done: the last few dozen iterations have
+ * little work each, and three barriers apiece would cost more than they
+ * share out (on a busy machine, a barrier waits for a descheduled thread).
+ */
 void ploc_cluster(ploc *p, unsigned t)
 {
-	uint32_t m = p->n, base = 2 * p->n - 1, it = 0, lo, hi, merges;
+	uint32_t m = p->n, base = 2 * p->n - 1, it = 0;
 
-	for (; m > 1; it++) {
-		const struct clusters *c = &p->cl[it & 1];
-		struct clusters *to = &p->cl[(it + 1) & 1];
-
-		nearest(p, c, m, &p->blocks[it & 1]);
-		team_sync(&p->team);
-		team_chunk(p->team.threads, t, m, &lo, &hi);
-		count_chunk(p, t, lo, hi);
-		team_sync(&p->team);
-		if (t == 0) /* last used an iteration ago; next used after the sync below */
-			atomic_store_explicit(&p->blocks[(it + 1) & 1], 0, memory_order_relaxed);
-		m = write_chunk(p, t, c, to, lo, hi, base, &merges);
-		base -= 2 * merges;
-		if (t == 0)
-			p->iter_first[it] = base;
-		team_sync(&p->team);
-	}
+	for (; m > PLOC_SOLO_BELOW; it++)
+		iteration(p, t, p->team.threads, it, &m, &base);
 	if (t == 0) {
+		p->solo_from = it;
+		for (; m > 1; it++)
+			iteration(p, 0, 1, it, &m, &base);
 		put_record(p, &p->cl[it & 1], 0, 0);
 		p->iterations = it;
 	}

@@ -79,23 +79,31 @@ static void emit_record(ploc *p, uint32_t x)
 	                                     pl.first + (p->tree[left].count & REC_PRIMS) };
 }
 
+/* The records of iteration it's pairs, chunk t of `chunks`. */
+static void emit_range(ploc *p, uint32_t it, unsigned chunks, unsigned t)
+{
+	uint32_t first = p->iter_first[it], lo, hi;
+	uint32_t size = (it ? p->iter_first[it - 1] : 2 * p->n - 1) - first;
+
+	team_chunk(chunks, t, size, &lo, &hi);
+	for (uint32_t x = first + lo; x < first + hi; x++)
+		emit_record(p, x);
+}
+
+/* The root and the small late iterations' ranges by thread 0 alone (as
+ * they were clustered), then the large ones by the team. */
 void ploc_emit(ploc *p, unsigned t)
 {
-	uint32_t end = 2 * p->n - 1, lo, hi;
-
 	if (t == 0) {
 		p->place[0] = (struct place){ 0, 1, 0 };
 		emit_record(p, 0);
 		p->node_count = 1 + p->desc[0];
+		for (uint32_t it = p->iterations; it-- > p->solo_from;)
+			emit_range(p, it, 1, 0);
 	}
 	team_sync(&p->team);
-	for (uint32_t it = p->iterations; it-- > 0;) {
-		uint32_t first = p->iter_first[it];
-		uint32_t size = (it ? p->iter_first[it - 1] : end) - first;
-
-		team_chunk(p->team.threads, t, size, &lo, &hi);
-		for (uint32_t x = first + lo; x < first + hi; x++)
-			emit_record(p, x);
+	for (uint32_t it = p->solo_from; it-- > 0;) {
+		emit_range(p, it, p->team.threads, t);
 		team_sync(&p->team);
 	}
 }
