@@ -5,6 +5,7 @@
 
 #include "cli.h"
 #include "harness/harness.h"
+#include "util/util.h"
 
 #define MAX_OPTIONS 64
 
@@ -185,7 +186,7 @@ static int build_and_check(bvhlab_plugin *p, const bvhlab_options *opts,
 		goto out;
 	}
 	double med, mn, mx;
-	harness_summarise(samples, s.repeat, &med, &mn, &mx);
+	util_summarise(samples, s.repeat, &med, &mn, &mx);
 	printf("builder:    %s, %u thread(s)\nscene:      %s, %u triangles\n"
 	       "build:      %.3f ms median (min %.3f, max %.3f, %u timed), %.2f Mtris/s\n",
 	       bvhlab_plugin_builder(p)->name, s.threads ? s.threads : bvhlab_hardware_threads(),

@@ -41,19 +41,11 @@ install_fuzz_deps() {
 	local missing
 	missing=$(fuzz_missing_debs)
 	[ -z "$missing" ] && return 0
-	if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-		echo "fuzz: installing $missing" >&2
-		export DEBIAN_FRONTEND=noninteractive
-		apt-get update -qq >&2 || true
-		apt-get install -y -qq --no-install-recommends "$missing" >&2 || return 1
-		# clang alone may still lack the runtime
-		missing=$(fuzz_missing_debs)
-		[ -z "$missing" ] && return 0
-		apt-get install -y -qq --no-install-recommends "$missing" >&2 || return 1
-	else
-		echo "fuzz: missing Debian package: $missing (sudo apt-get install $missing)" >&2
-		return 1
-	fi
+	apt_install fuzz "$missing" || return 1
+	# clang alone may still lack the runtime
+	missing=$(fuzz_missing_debs)
+	[ -z "$missing" ] && return 0
+	apt_install fuzz "$missing"
 }
 
 install_fuzz_deps || exit 1

@@ -17,7 +17,7 @@ missing_debs() {
 	if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists hwloc; then
 		missing="$missing libhwloc-dev"
 	fi
-	# Images (core/image_oiio.cpp): OpenImageIO and a C++ compiler for that one file.
+	# Images (core/output/image_oiio.cpp): OpenImageIO and a C++ compiler for that one file.
 	command -v c++ >/dev/null 2>&1 || missing="$missing g++"
 	if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists OpenImageIO; then
 		missing="$missing libopenimageio-dev"
@@ -25,18 +25,33 @@ missing_debs() {
 	echo "$missing"
 }
 
+# Installs Debian packages when root with apt-get, after one `apt-get
+# update` per shell; otherwise says what to install. 0, or 1 when nothing
+# could be installed. Usage: apt_install WHO PACKAGE...
+apt_install() {
+	local who=$1
+	shift
+	if [ "$(id -u)" != 0 ] || ! command -v apt-get >/dev/null 2>&1; then
+		echo "$who: missing Debian packages: $* (install them with: sudo apt-get install $*)" >&2
+		return 1
+	fi
+	echo "$who: installing $*" >&2
+	export DEBIAN_FRONTEND=noninteractive
+	if [ -z "${BVHLAB_APT_UPDATED:-}" ]; then
+		apt-get update -qq >&2 || true
+		BVHLAB_APT_UPDATED=1
+	fi
+	apt-get install -y -qq --no-install-recommends "$@" >&2 || {
+		echo "$who: apt-get could not install: $*" >&2
+		return 1
+	}
+}
+
 # Optional: Embree 3 for the embree peer plugin. Never fails the set-up.
 install_optional() {
 	[ -f /usr/include/embree3/rtcore.h ] && return 0
-	if [ "$(id -u)" != 0 ] || ! command -v apt-get >/dev/null 2>&1; then
-		echo "setup: optional libembree-dev missing: building without the embree plugin" >&2
-		return 0
-	fi
-	echo "setup: installing libembree-dev (optional: the embree plugin)" >&2
-	export DEBIAN_FRONTEND=noninteractive
-	apt-get install -y -qq --no-install-recommends libembree-dev >&2 ||
-		{ apt-get update -qq >&2 && apt-get install -y -qq --no-install-recommends libembree-dev >&2; } ||
-		echo "setup: could not install libembree-dev: building without the embree plugin" >&2
+	apt_install "setup (optional: the embree plugin)" libembree-dev ||
+		echo "setup: building without the embree plugin" >&2
 	return 0
 }
 
@@ -44,20 +59,8 @@ install_deps() {
 	local missing
 	missing=$(missing_debs)
 	[ -z "$missing" ] && return 0
-	if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-		echo "setup: installing$missing" >&2
-		export DEBIAN_FRONTEND=noninteractive
-		apt-get update -qq >&2 || true
-		# shellcheck disable=SC2086
-		apt-get install -y -qq --no-install-recommends $missing >&2 || {
-			echo "setup: apt-get could not install:$missing" >&2
-			return 1
-		}
-	else
-		echo "setup: missing Debian packages:$missing" >&2
-		echo "setup: install them with: sudo apt-get install$missing" >&2
-		return 1
-	fi
+	# shellcheck disable=SC2086
+	apt_install setup $missing
 }
 
 # Configures (once) and builds one build directory.

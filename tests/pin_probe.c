@@ -145,15 +145,6 @@ static const bvhlab_option_decl options[] = {
 	 .def_string = "free", .choices = "pinned|free"},
 };
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
-	.name = "pin_probe",
+BVHLAB_PLUGIN(.name = "pin_probe", .flags = BVHLAB_BUILDER_PARALLEL,
 	.summary = "test plugin: checks host->pin_thread from its workers",
-	.flags = BVHLAB_BUILDER_PARALLEL,
-	.option_count = 1,
-	.options = options,
-	.build = build,
-};
-
-BVHLAB_PLUGIN_EXPORT(descriptor)
+	.option_count = 1, .options = options, .build = build)

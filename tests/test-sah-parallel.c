@@ -12,14 +12,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 
 #include <cJSON.h>
 
 #include <bvhlab/bvhlab.h>
 
-#include "output/results.h"
+#include "output/report.h"
 #include "testutil.h"
+#include "util/util.h"
 
 #define FIXTURE_SEED 11
 #include "scene_fixture.h"
@@ -63,14 +63,6 @@ static struct variant variants[] = {
 #define VARIANTS (sizeof(variants) / sizeof(variants[0]))
 
 static bvhlab_plugin *reference;
-
-static double now_ms(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
-}
 
 /* Options for one build: the method, then the variant's own settings. */
 static int make_options(bvhlab_options *opts, const bvhlab_plugin *plugin,
@@ -153,7 +145,7 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool generated)
 	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
 	for (int m = 0; m < 2; m++) {
 		bvhlab_tree ref = { 0 };
-		double t0 = now_ms();
+		double t0 = util_now_ms();
 
 		if (build_valid(reference, NULL, &prims.input, methods[m], generated, 1, &ref) == 0)
 			for (size_t v = 0; v < VARIANTS; v++)
@@ -161,7 +153,7 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool generated)
 				              generated, plan);
 		printf("%-18s %8u triangles  %-6s  %zu builders x %zu thread counts x %d: "
 		       "%.0f ms\n", name, scene->triangle_count, methods[m], VARIANTS,
-		       plan->count, plan->repeats, now_ms() - t0);
+		       plan->count, plan->repeats, util_now_ms() - t0);
 		bvhlab_tree_finish(&ref);
 	}
 	bvhlab_prims_finish(&prims);

@@ -5,31 +5,23 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 
 #include <bvhlab/scene.h>
 
 #include "testutil.h"
-
-static double now_ms(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
-}
+#include "util/util.h"
 
 static bvhlab_scene *load(const char *file, uint32_t triangles)
 {
 	char path[1024];
 	bvhlab_scene *s = NULL;
 	bvhlab_error err = { "" };
-	double t0 = now_ms(), ms;
+	double t0 = util_now_ms(), ms;
 	int ret;
 
 	snprintf(path, sizeof(path), "%s/%s", BVHLAB_SHARED_SCENES, file);
 	ret = bvhlab_scene_load(path, &s, &err);
-	ms = now_ms() - t0;
+	ms = util_now_ms() - t0;
 	CHECK_INT(ret, 0);
 	if (ret) {
 		fprintf(stderr, "  %s\n", err.message);
@@ -69,11 +61,11 @@ int main(void)
 			bvhlab_scene_destroy(s);
 	}
 	if (igea) {
-		t0 = now_ms();
+		t0 = util_now_ms();
 		CHECK_INT(bvhlab_scene_subdivide(igea, 1, &err), 0);
 		printf("%-20s %9u triangles %8u vertices %4u degenerate  %7.1f ms\n",
 		       "igea.ply subdivide 1", igea->triangle_count, igea->vertex_count,
-		       igea->degenerate_count, now_ms() - t0);
+		       igea->degenerate_count, util_now_ms() - t0);
 		CHECK_INT(igea->triangle_count, 1074744);
 	}
 	bvhlab_scene_destroy(igea);

@@ -14,6 +14,7 @@
 #include "harness/isolate.h"
 #include "harness/progress.h"
 #include "output/results.h"
+#include "output/scene_images.h"
 #include "util/util.h"
 
 #define RAY_SEED 0x5eedULL
@@ -191,9 +192,9 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		r = harness_trace_rays(tree, job->scene, &cam, cfg->ray_width, cfg->ray_height,
 		                       cfg->ray_diffuse, &rep->rays, nodes, shade);
 	if (r == 0 && nodes)
-		rep->heat_written = harness_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
+		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)
-		rep->shade_written = harness_write_raw(job->shade_path, shade, 3 * n) == 0;
+		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
 	if (r < 0)
 		error_set(err, "tracing rays: %s", strerror(-r));
 	free(nodes);
@@ -294,10 +295,10 @@ static void image_paths(struct harness *h, struct series_job *job, size_t scene_
 {
 	if (!h->cfg->images || h->cfg->ray_width == 0 || h->cfg->ray_height == 0)
 		return;
-	if (first && harness_temp_path(paths[0], sizeof(paths[0]), h->cfg->output, "heat",
+	if (first && images_temp_path(paths[0], sizeof(paths[0]), h->cfg->output, "heat",
 	                               scene_index, builder_index) == 0)
 		job->heat_path = paths[0];
-	if (!h->shade_done && harness_temp_path(paths[1], sizeof(paths[1]), h->cfg->output,
+	if (!h->shade_done && images_temp_path(paths[1], sizeof(paths[1]), h->cfg->output,
 	                                        "shade", scene_index, 0) == 0)
 		job->shade_path = paths[1];
 }
@@ -367,7 +368,7 @@ static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t sc
 	                          .height = h->cfg->ray_height, .builders = names,
 	                          .threads = threads, .builder_count = nb};
 	if (r == 0)
-		r = harness_scene_images(&h->res, &si, &err);
+		r = images_write_scene(&h->res, &si, &err);
 	if (r == 0)
 		r = results_write(&h->res, &err);
 	if (r < 0)

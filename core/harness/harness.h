@@ -11,6 +11,7 @@
 #include <bvhlab/bvhlab.h>
 
 #include "config/config.h"
+#include "output/results.h"
 
 /* Loads or generates one config scene, subdivides it and names it. */
 int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab_error *err);
@@ -62,19 +63,8 @@ int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
                         const bvhlab_build_input *input, struct build_series *s,
                         bvhlab_error *err);
 
-/* Median, min and max of n samples (sorts a copy). */
-void harness_summarise(const double *samples, uint32_t n, double *median, double *min,
-                       double *max);
 
-/* ---- rays and images (harness_rays.c) ------------------------------------ */
-
-/* Traversal counters of one run's primary and diffuse rays. */
-struct ray_metrics {
-	bool measured;
-	uint32_t threads; /* the threads that traced them: all hardware threads */
-	bvhlab_trace_stats primary, diffuse;
-	double primary_s, diffuse_s;
-};
+/* ---- rays (harness_rays.c) ------------------------------------------------ */
 
 /* The config's camera, or the automatic framing of the scene. */
 void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam);
@@ -88,31 +78,5 @@ void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_
 int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
                        const bvhlab_camera *cam, uint32_t width, uint32_t height,
                        uint32_t diffuse, struct ray_metrics *m, uint32_t *nodes, uint8_t *shade);
-
-/* dir/.KIND-SCENE-BUILDER.raw: per-pixel data a run's child hands back. */
-int harness_temp_path(char *buf, size_t size, const char *dir, const char *kind, size_t scene,
-                      size_t builder);
-int harness_write_raw(const char *path, const void *data, size_t bytes);
-
-/* "images/<scene>.png", "images/<scene>--<what>.png" (builder NULL) or
- * "images/<scene>--<builder>--<what>.png", names sanitised. */
-void harness_image_name(char *buf, size_t size, const char *scene, const char *builder,
-                        const char *what);
-
-struct results;
-/* What the parent needs to turn a scene's temporary files into PNGs. */
-struct scene_images {
-	const char *dir;
-	size_t scene_index;
-	const char *scene;
-	uint32_t width, height;
-	const char *const *builders; /* [builder_count]: labels, by config index */
-	const uint32_t *threads;     /* [builder_count]: the run that drew each heat map */
-	size_t builder_count;
-};
-
-/* Writes the scene's PNGs (shaded, heat maps on one scale, legend),
- * removes the temporary files and records the names in the results. */
-int harness_scene_images(struct results *res, const struct scene_images *si, bvhlab_error *err);
 
 #endif

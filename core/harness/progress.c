@@ -3,7 +3,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "harness/harness.h"
 #include "harness/progress.h"
 #include "util/util.h"
 
@@ -57,7 +56,7 @@ void progress_done(struct progress *p, const struct run_record *run)
 	fputs(run->status, stderr);
 	if (run->sample_count && run->stats) {
 		double med, mn, mx;
-		harness_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
+		util_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
 		fprintf(stderr, ", %.2f ms median, SAH %.3f", med, run->stats->sah_cost);
 	}
 	if (run->rays)

@@ -1,28 +1,20 @@
 /*
- * Finding, loading and checking builder plugins.
+ * Loading and checking builder plugins (finding them is plugin_search.c).
  *
  * Every way a plugin can be unusable is caught here, once, with a message
  * naming the plugin, so the harness can report it and go on.
  */
-#include <dirent.h>
 #include <dlfcn.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <bvhlab/host.h>
 
+#include "host/plugin_search.h"
 #include "util/util.h"
-
-#ifndef BVHLAB_BUILD_PLUGIN_DIR
-#define BVHLAB_BUILD_PLUGIN_DIR ""
-#endif
-#ifndef BVHLAB_INSTALL_PLUGIN_DIR
-#define BVHLAB_INSTALL_PLUGIN_DIR ""
-#endif
 
 /* The fields of bvhlab_builder up to and including `build` (ABI 1.0). */
 #define BUILDER_MIN_SIZE (offsetof(bvhlab_builder, build) + sizeof(((bvhlab_builder *)0)->build))
@@ -32,81 +24,6 @@ struct bvhlab_plugin {
 	const bvhlab_builder *builder;
 	char *path;
 };
-
-const char *bvhlab_plugin_search_path(void)
-{
-	static char path[4096];
-	const char *env = getenv("BVHLAB_PLUGIN_PATH");
-	snprintf(path, sizeof(path), "%s%s%s:%s", env ? env : "", env && *env ? ":" : "",
-	         BVHLAB_BUILD_PLUGIN_DIR, BVHLAB_INSTALL_PLUGIN_DIR);
-	return path;
-}
-
-static bool is_file(const char *path)
-{
-	struct stat st;
-	return stat(path, &st) == 0 && S_ISREG(st.st_mode);
-}
-
-static bool looks_like_path(const char *s)
-{
-	size_t n = strlen(s);
-	return strchr(s, '/') || (n > 3 && strcmp(s + n - 3, ".so") == 0);
-}
-
-/* Finds NAME.so or NAME/NAME.so in a search folder; 0 and *out, or -ENOENT. */
-static int find_in_dir(const char *dir, size_t dirlen, const char *name, char *out,
-                       size_t size)
-{
-	if (dirlen == 0)
-		return -ENOENT;
-	int n = snprintf(out, size, "%.*s/%s.so", (int)dirlen, dir, name);
-	if (n > 0 && (size_t)n < size && is_file(out))
-		return 0;
-	n = snprintf(out, size, "%.*s/%s/%s.so", (int)dirlen, dir, name, name);
-	if (n > 0 && (size_t)n < size && is_file(out))
-		return 0;
-	return -ENOENT;
-}
-
-/* Names what there is to choose from: a typo is then plain to see. */
-static void not_found(const char *name, bvhlab_error *err)
-{
-	char list[300] = "";
-	char **names = NULL;
-	size_t used = 0;
-	if (bvhlab_plugin_names(&names, NULL) == 0) {
-		for (char **p = names; *p && used < sizeof(list); p++)
-			used += (size_t)snprintf(list + used, sizeof(list) - used, "%s%s",
-			                         p == names ? "" : ", ", *p);
-		if (used >= sizeof(list)) /* a long list: say it goes on */
-			memcpy(list + sizeof(list) - 4, "...", 4);
-		bvhlab_plugin_names_free(names);
-	}
-	error_set(err, "plugin '%s' not found on the search path %s (available: %s)", name,
-	          bvhlab_plugin_search_path(), used ? list : "none");
-}
-
-static int resolve(const char *name, char *out, size_t size, bvhlab_error *err)
-{
-	if (looks_like_path(name)) {
-		if ((size_t)snprintf(out, size, "%s", name) >= size) {
-			error_set(err, "plugin '%s': path too long", name);
-			return -ENAMETOOLONG;
-		}
-		return 0;
-	}
-	const char *sp = bvhlab_plugin_search_path();
-	for (const char *p = sp; *p;) {
-		const char *colon = strchr(p, ':');
-		size_t len = colon ? (size_t)(colon - p) : strlen(p);
-		if (find_in_dir(p, len, name, out, size) == 0)
-			return 0;
-		p += len + (colon ? 1 : 0);
-	}
-	not_found(name, err);
-	return -ENOENT;
-}
 
 static int check_options(const bvhlab_builder *b, const char *path, bvhlab_error *err)
 {
@@ -187,7 +104,7 @@ int bvhlab_plugin_open(const char *name_or_path, bvhlab_plugin **out, bvhlab_err
 {
 	char path[4096];
 	*out = NULL;
-	int r = resolve(name_or_path, path, sizeof(path), err);
+	int r = plugin_resolve(name_or_path, path, sizeof(path), err);
 	if (r < 0)
 		return r;
 	bvhlab_plugin *p = calloc(1, sizeof(*p));

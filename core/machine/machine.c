@@ -1,20 +1,9 @@
-/* The machine: CPU model, version, and the topology the results record. */
+/* The machine the results record: CPU model, core count and topology. */
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
-#include <bvhlab/bvhlab.h>
-
 #include "machine/machine.h"
-
-#ifndef BVHLAB_VERSION
-#define BVHLAB_VERSION "unknown"
-#endif
-
-const char *bvhlab_version(void)
-{
-	return BVHLAB_VERSION;
-}
 
 static void read_cpu_name(char *out, size_t size)
 {

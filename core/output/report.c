@@ -11,7 +11,6 @@
 #include <cJSON.h>
 
 #include "output/report.h"
-#include "output/results.h"
 #include "util/util.h"
 
 /* The number at a dotted path ("build_ms.median"), or NULL. */
@@ -141,7 +140,7 @@ static void csv_row(struct strbuf *sb, const cJSON *run)
 	csv_field(sb, str(run, "error"), true);
 }
 
-char *results_csv(const cJSON *doc)
+char *report_csv(const cJSON *doc)
 {
 	struct strbuf sb = {0};
 	sb_printf(&sb, "scene,builder,plugin,status");

@@ -1,6 +1,7 @@
 /*
- * Pieces shared by the report renderings (report.c, report_html.c,
- * report_svg.c): document access and the inline SVG charts.
+ * The renderings of a results document (results.csv, report.md,
+ * report.html; results.c writes them) and the pieces they share: document
+ * access and the inline SVG charts.
  */
 #ifndef BVHLAB_CORE_REPORT_H
 #define BVHLAB_CORE_REPORT_H
@@ -10,6 +11,18 @@
 #include <cJSON.h>
 
 #include "util/util.h"
+
+/* The CSV and Markdown renderings of a results document (malloc'd text). */
+char *report_csv(const struct cJSON *doc);
+char *report_markdown(const struct cJSON *doc);
+/* report.html: self-contained but for the PNGs it names (images/...). */
+char *report_html(const struct cJSON *doc);
+
+/* Appends the thesis-style speedup tables (parallel builders against
+ * sah_seq on 1 thread, per thread count > 1) to a report; nothing when the
+ * document has no such runs. report_thesis.c. */
+void report_thesis(struct strbuf *sb, const struct cJSON *doc);
+
 
 /* The member at a dotted path ("build_ms.median"), or NULL. */
 const cJSON *report_at(const cJSON *o, const char *path);

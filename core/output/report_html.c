@@ -11,7 +11,6 @@
 #include <string.h>
 
 #include "output/report.h"
-#include "output/results.h"
 
 static const char css[] =
 	"body{font-family:sans-serif;margin:2em;max-width:1400px;color:#222}"

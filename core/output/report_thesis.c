@@ -12,7 +12,7 @@
 
 #include <cJSON.h>
 
-#include "output/results.h"
+#include "output/report.h"
 #include "util/util.h"
 
 #define SEQ_PLUGIN "sah_seq"

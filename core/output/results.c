@@ -1,5 +1,5 @@
 /*
- * results.json: the document (schema in DESIGN.md) and its atomic writing.
+ * results.json: the document (schema in docs/design.md) and its atomic writing.
  */
 #include <errno.h>
 #include <stdio.h>
@@ -11,7 +11,7 @@
 
 #include <cJSON.h>
 
-#include "harness/harness.h"
+#include "output/report.h"
 #include "output/results.h"
 #include "util/util.h"
 
@@ -157,7 +157,7 @@ static cJSON *options_json(const bvhlab_options *opts)
 static cJSON *timing_json(const struct run_record *run)
 {
 	double med, mn, mx;
-	harness_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
+	util_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddNumberToObject(o, "median", med);
 	cJSON_AddNumberToObject(o, "min", mn);
@@ -267,7 +267,7 @@ int results_write(const struct results *res, bvhlab_error *err)
 {
 	int r = write_rendering(res, "results.json", cJSON_Print(res->doc), err);
 	if (r == 0)
-		r = write_rendering(res, "results.csv", results_csv(res->doc), err);
+		r = write_rendering(res, "results.csv", report_csv(res->doc), err);
 	if (r == 0)
 		r = write_rendering(res, "report.md", report_markdown(res->doc), err);
 	if (r == 0)
@@ -470,7 +470,7 @@ int results_render_saved(const char *json_path, const char *dir, bvhlab_error *e
 	if (r == 0)
 		r = make_dirs(dir, err);
 	if (r == 0)
-		r = write_rendering(&res, "results.csv", results_csv(res.doc), err);
+		r = write_rendering(&res, "results.csv", report_csv(res.doc), err);
 	if (r == 0)
 		r = write_rendering(&res, "report.md", report_markdown(res.doc), err);
 	if (r == 0)

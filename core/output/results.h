@@ -1,5 +1,5 @@
 /*
- * results.json (DESIGN.md schema), results.csv and report.md of one output
+ * results.json (docs/design.md, "results.json"), results.csv and report.md of one output
  * folder. The document lives in memory as cJSON and every file is rewritten
  * through a temporary file and rename after each run, so an interrupted
  * sweep always leaves complete files with every finished run.
@@ -24,7 +24,13 @@ struct results {
 	char *dir;
 };
 
-struct ray_metrics;
+/* Traversal counters of one run's primary and diffuse rays. */
+struct ray_metrics {
+	bool measured;
+	uint32_t threads; /* the threads that traced them: all hardware threads */
+	bvhlab_trace_stats primary, diffuse;
+	double primary_s, diffuse_s;
+};
 
 /* Everything known about one run; fields beyond status are optional. */
 struct run_record {
@@ -57,7 +63,7 @@ int results_add_scene(struct results *res, const char *name, const char *source,
                       uint32_t triangles, const char *error);
 int results_add_run(struct results *res, const struct run_record *run);
 
-/* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of DESIGN.md. */
+/* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of docs/design.md. */
 struct cJSON *results_rays_json(const struct ray_metrics *m);
 
 struct stage_metrics;
@@ -72,7 +78,7 @@ int results_set_run_image(struct results *res, const char *scene, const char *bu
                           uint32_t threads, const char *name);
 
 /*
- * Takes over the finished runs (any status of DESIGN.md's list) and the
+ * Takes over the finished runs (any status of docs/design.md's list) and the
  * scenes of dir/results.json, for `bvhlab run --resume`. *kept counts the
  * runs, *not_ok those whose status is not "ok". -ENOENT when there is no
  * file; another negative errno, with err naming the file, when it cannot be
@@ -89,20 +95,8 @@ int results_write(const struct results *res, bvhlab_error *err);
 /* Writes `text` to dir/name through dir/.name.tmp and rename. */
 int results_write_file(const char *dir, const char *name, const char *text, bvhlab_error *err);
 
-/* The CSV and Markdown renderings of a results document (malloc'd text). */
-char *results_csv(const struct cJSON *doc);
-char *report_markdown(const struct cJSON *doc);
-/* report.html: self-contained but for the PNGs it names (images/...). */
-char *report_html(const struct cJSON *doc);
-
 /* Regenerates results.csv, report.md and report.html in dir from a saved
  * results.json (bvhlab report). */
 int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err);
-
-struct strbuf;
-/* Appends the thesis-style speedup tables (parallel builders against
- * sah_seq on 1 thread, per thread count > 1) to a report; nothing when the
- * document has no such runs. report_thesis.c. */
-void report_thesis(struct strbuf *sb, const struct cJSON *doc);
 
 #endif

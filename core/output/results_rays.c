@@ -5,7 +5,6 @@
  */
 #include <cJSON.h>
 
-#include "harness/harness.h"
 #include "output/results.h"
 
 static cJSON *kind_json(const bvhlab_trace_stats *st, double seconds)

@@ -1,4 +1,4 @@
-/* Error text and clock helpers shared by the core's modules. */
+/* Error text, strings, the clock and sample statistics shared by the core's modules. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -88,4 +88,21 @@ char *sb_take(struct strbuf *sb)
 	text[sb->len] = '\0';
 	*sb = (struct strbuf){0};
 	return text;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+void util_summarise(const double *samples, uint32_t n, double *median, double *min,
+                       double *max)
+{
+	double sorted[n ? n : 1];
+	memcpy(sorted, samples, n * sizeof(double));
+	qsort(sorted, n, sizeof(double), cmp_double);
+	*min = n ? sorted[0] : 0;
+	*max = n ? sorted[n - 1] : 0;
+	*median = n == 0 ? 0 : n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
 }

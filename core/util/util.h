@@ -45,4 +45,14 @@ static inline uint64_t util_splitmix64(uint64_t *state)
 /* Monotonic clock in seconds. */
 double util_now(void);
 
+/* The same clock in milliseconds, for messages and test reports. */
+static inline double util_now_ms(void)
+{
+	return util_now() * 1e3;
+}
+
+/* Median, min and max of n samples (sorts a copy); all 0 when n is 0. */
+void util_summarise(const double *samples, uint32_t n, double *median, double *min,
+                    double *max);
+
 #endif

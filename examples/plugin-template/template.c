@@ -123,15 +123,6 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return 0;
 }
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
-	.name = "template",
+BVHLAB_PLUGIN(.name = "template", .flags = BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "template plugin: middle split of the centroid bounds",
-	.flags = BVHLAB_BUILDER_DETERMINISTIC,
-	.option_count = sizeof(options) / sizeof(options[0]),
-	.options = options,
-	.build = build,
-};
-
-BVHLAB_PLUGIN_EXPORT(descriptor)
+	.option_count = sizeof(options) / sizeof(options[0]), .options = options, .build = build)

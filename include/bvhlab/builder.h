@@ -14,8 +14,9 @@
  *
  *     const bvhlab_builder *bvhlab_plugin_entry(uint32_t host_abi_major);
  *
- * (write BVHLAB_PLUGIN_EXPORT(descriptor) after the descriptor, or declare it
- * with BVHLAB_PLUGIN_ENTRY). It returns a static descriptor owned by the
+ * (BVHLAB_PLUGIN(...) writes the descriptor and the entry point; or write
+ * BVHLAB_PLUGIN_EXPORT(descriptor) after a descriptor of your own, or declare
+ * the function with BVHLAB_PLUGIN_ENTRY). It returns a static descriptor owned by the
  * plugin, or NULL when it cannot serve that ABI major. C++ plugins include
  * this header as it is: its declarations are extern "C". The host refuses
  * a descriptor of another major and never reads past its struct_size; a
@@ -78,6 +79,23 @@ typedef const struct bvhlab_builder *(*bvhlab_plugin_entry_fn)(uint32_t host_abi
 	{                                                                     \
 		return host_abi_major == BVHLAB_ABI_MAJOR ? &(descriptor) : NULL; \
 	}
+
+/*
+ * A C plugin's descriptor and entry point in one, at file scope, from the
+ * descriptor's designated fields; abi_version and struct_size are filled in
+ * (the ones a hand-written descriptor most easily gets wrong):
+ *
+ *     BVHLAB_PLUGIN(.name = "mine", .summary = "...", .flags = 0,
+ *                   .option_count = 1, .options = options, .build = build)
+ *
+ * C++17 has no designated initializers: C++ plugins write the descriptor
+ * and BVHLAB_PLUGIN_EXPORT(descriptor) (examples/plugin-template-cpp/).
+ */
+#define BVHLAB_PLUGIN(...)                                                       \
+	static const bvhlab_builder bvhlab_plugin_descriptor = {                 \
+		.abi_version = BVHLAB_ABI_CURRENT, .struct_size = sizeof(bvhlab_builder), \
+		__VA_ARGS__};                                                    \
+	BVHLAB_PLUGIN_EXPORT(bvhlab_plugin_descriptor)
 
 /* ---- options -------------------------------------------------------- */
 

@@ -218,16 +218,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return rc;
 }
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
-	.name = "embree",
-	.summary = "Intel Embree 3 rtcBuildBVH: low (Morton), medium (binned SAH), "
-	           "high (spatial splits)",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_SPATIAL_SPLITS,
-	.option_count = OPTION_COUNT,
-	.options = options,
-	.build = build,
-};
-
-BVHLAB_PLUGIN_EXPORT(descriptor)
+BVHLAB_PLUGIN(.name = "embree", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_SPATIAL_SPLITS,
+	.summary = "Intel Embree 3 rtcBuildBVH: low (Morton), "
+	           "medium (binned SAH), high (spatial splits)",
+	.option_count = OPTION_COUNT, .options = options, .build = build)

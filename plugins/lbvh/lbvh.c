@@ -306,15 +306,6 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return build_team(host, ctx, &b, output);
 }
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
-	.name = "lbvh",
+BVHLAB_PLUGIN(.name = "lbvh", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "parallel LBVH: Morton codes, radix sort, Karras 2012 emission, SAH collapse",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.option_count = OPTION_COUNT,
-	.options = options,
-	.build = build,
-};
-
-BVHLAB_PLUGIN_EXPORT(descriptor)
+	.option_count = OPTION_COUNT, .options = options, .build = build)

@@ -331,15 +331,6 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return sah_run_build(host, ctx, input, output, schedule, &cfg);
 }
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
-	.name = "sah_queue",
+BVHLAB_PLUGIN(.name = "sah_queue", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "parallel SAH, thesis node queue: workers share a job queue, exact termination",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.option_count = OPTION_COUNT,
-	.options = options,
-	.build = build,
-};
-
-BVHLAB_PLUGIN_EXPORT(descriptor)
+	.option_count = OPTION_COUNT, .options = options, .build = build)

@@ -33,15 +33,6 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return sah_run_build(host, ctx, input, output, schedule, NULL);
 }
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
-	.name = "sah_seq",
+BVHLAB_PLUGIN(.name = "sah_seq", .flags = BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "sequential top-down SAH (exact sweep or binned), the reference",
-	.flags = BVHLAB_BUILDER_DETERMINISTIC,
-	.option_count = SAH_OPTION_COUNT,
-	.options = options,
-	.build = build,
-};
-
-BVHLAB_PLUGIN_EXPORT(descriptor)
+	.option_count = SAH_OPTION_COUNT, .options = options, .build = build)

@@ -310,15 +310,6 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return sah_run_build(host, ctx, input, output, schedule, &parallel_min);
 }
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
-	.name = "sah_tasks",
+BVHLAB_PLUGIN(.name = "sah_tasks", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "parallel binned SAH: large nodes split by all threads, small ones as tasks",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.option_count = OPTION_COUNT,
-	.options = options,
-	.build = build,
-};
-
-BVHLAB_PLUGIN_EXPORT(descriptor)
+	.option_count = OPTION_COUNT, .options = options, .build = build)
