@@ -329,16 +329,11 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return build_team(host, ctx, &p, output);
 }
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
+BVHLAB_PLUGIN(
 	.name = "ploc",
 	.summary = "parallel locally-ordered clustering (Meister & Bittner 2018) from Morton "
 	           "order, SAH collapse",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.option_count = OPTION_COUNT,
 	.options = options,
-	.build = build,
-};
-
-BVHLAB_PLUGIN_EXPORT(descriptor)
+	.build = build)

@@ -307,9 +307,7 @@ out:
 	return rc;
 }
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
+BVHLAB_PLUGIN(
 	.name = "reinsert",
 	.summary = "refinement: parallel search, exact one-thread application of subtree "
 	           "reinsertions (Bittner et al. 2013, Meister & Bittner 2018)",
@@ -317,7 +315,4 @@ static const bvhlab_builder descriptor = {
 	.option_count = OPTION_COUNT,
 	.options = options,
 	.build = NULL,
-	.refine = refine,
-};
-
-BVHLAB_PLUGIN_EXPORT(descriptor)
+	.refine = refine)
