@@ -23,23 +23,51 @@ static const char usage[] =
 	"                   is timed apart as the cold build)\n"
 	"  --subdivide K    split every scene triangle into 4, K times\n"
 	"  --rays N         rays for the brute-force check (default 256, 0 = none)\n"
+	"  --refine PLUGIN  a refinement stage after each build (repeatable, applied\n"
+	"                   in order; timed apart, SAH before and after printed)\n"
+	"  -R KEY=VALUE     an option of the last --refine stage (repeatable)\n"
 	"\n"
 	"exit status: 0 valid tree, 1 build failed or tree invalid, 2 bad arguments.\n";
+
+#define MAX_STAGES 8
 
 struct build_args {
 	unsigned long threads, repeat, subdivide, rays;
 	const char *options[MAX_OPTIONS];
 	int option_count;
+	const char *refine[MAX_STAGES];
+	int refine_count;
+	const char *refine_options[MAX_OPTIONS];
+	int refine_option_stage[MAX_OPTIONS]; /* which stage each -R is for */
+	int refine_option_count;
 };
+
+/* --refine and -R; -1 when there are too many or -R has no stage. */
+static int parse_refine(int c, struct build_args *a)
+{
+	if (c == 'f' && a->refine_count < MAX_STAGES) {
+		a->refine[a->refine_count++] = optarg;
+		return 0;
+	}
+	if (c == 'R' && a->refine_count > 0 && a->refine_option_count < MAX_OPTIONS) {
+		a->refine_option_stage[a->refine_option_count] = a->refine_count - 1;
+		a->refine_options[a->refine_option_count++] = optarg;
+		return 0;
+	}
+	fprintf(stderr, "bvhlab build: %s\n", c == 'f' ? "too many --refine stages"
+	                                                : "-R needs a --refine before it");
+	return -1;
+}
 
 static int parse(int argc, char **argv, struct build_args *a)
 {
 	static const struct option longopts[] = {
 		{"threads", required_argument, NULL, 't'},   {"repeat", required_argument, NULL, 'r'},
 		{"subdivide", required_argument, NULL, 's'}, {"rays", required_argument, NULL, 'y'},
+		{"refine", required_argument, NULL, 'f'},
 		{"help", no_argument, NULL, 'h'},            {NULL, 0, NULL, 0}};
 	int c, r = 0;
-	while (r == 0 && (c = getopt_long(argc, argv, "ho:", longopts, NULL)) != -1) {
+	while (r == 0 && (c = getopt_long(argc, argv, "ho:R:", longopts, NULL)) != -1) {
 		if (c == 'h')
 			exit((fputs(usage, stdout), 0));
 		else if (c == 't')
@@ -52,6 +80,8 @@ static int parse(int argc, char **argv, struct build_args *a)
 			r = cli_parse_uint("--rays", optarg, 1u << 20, &a->rays);
 		else if (c == 'o' && a->option_count < MAX_OPTIONS)
 			a->options[a->option_count++] = optarg;
+		else if (c == 'f' || c == 'R')
+			r = parse_refine(c, a);
 		else
 			r = -1;
 	}
@@ -99,16 +129,60 @@ static int check(const bvhlab_scene *scene, const bvhlab_prims *prims, const bvh
 	return mismatches ? EXIT_RUNS_FAILED : 0;
 }
 
+/* The refinement stages of --refine, with their -R options. */
+struct stages {
+	bvhlab_plugin *plugin[MAX_STAGES];
+	bvhlab_options opts[MAX_STAGES];
+	struct refine_stage stage[MAX_STAGES];
+	struct stage_metrics out[MAX_STAGES];
+	int count;
+};
+
+static void stages_close(struct stages *st)
+{
+	for (int k = 0; k < st->count; k++) {
+		if (st->opts[k].values)
+			bvhlab_options_finish(&st->opts[k]);
+		bvhlab_plugin_close(st->plugin[k]);
+	}
+}
+
+static int stages_open(struct stages *st, const struct build_args *a, bvhlab_error *err)
+{
+	for (int k = 0; k < a->refine_count; k++) {
+		st->count = k + 1;
+		if (bvhlab_plugin_open(a->refine[k], &st->plugin[k], err) < 0 ||
+		    bvhlab_options_init(&st->opts[k], bvhlab_plugin_builder(st->plugin[k])) < 0)
+			return -1;
+		for (int j = 0; j < a->refine_option_count; j++)
+			if (a->refine_option_stage[j] == k &&
+			    bvhlab_options_parse(&st->opts[k], a->refine_options[j], err) < 0)
+				return -1;
+		st->stage[k] = (struct refine_stage){.plugin = st->plugin[k], .opts = &st->opts[k]};
+	}
+	return 0;
+}
+
+static void print_stages(const struct stages *st)
+{
+	for (int k = 0; k < st->count; k++)
+		printf("refine:     %s %.3f ms median, SAH %.4f -> %.4f\n", st->out[k].plugin,
+		       st->out[k].ms, st->out[k].sah_before, st->out[k].sah_after);
+}
+
 static int build_and_check(bvhlab_plugin *p, const bvhlab_options *opts,
                            const bvhlab_scene *scene, const struct build_args *a)
 {
 	bvhlab_prims prims = {0};
 	bvhlab_error err = {{0}};
 	double samples[a->repeat];
+	struct stages st = {0};
 	struct build_series s = {.warmup = 1, .repeat = (uint32_t)a->repeat,
-	                         .threads = (uint32_t)a->threads, .samples_ms = samples};
+	                         .threads = (uint32_t)a->threads, .samples_ms = samples,
+	                         .stages = st.stage, .stage_count = (uint32_t)a->refine_count,
+	                         .stage_out = st.out};
 	int status = EXIT_RUNS_FAILED;
-	if (bvhlab_prims_init(&prims, scene, &err) < 0 ||
+	if (stages_open(&st, a, &err) < 0 || bvhlab_prims_init(&prims, scene, &err) < 0 ||
 	    harness_time_builds(p, opts, &prims.input, &s, &err) < 0) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
@@ -121,10 +195,12 @@ static int build_and_check(bvhlab_plugin *p, const bvhlab_options *opts,
 	       bvhlab_plugin_builder(p)->name, s.threads ? s.threads : bvhlab_hardware_threads(),
 	       scene->name, scene->triangle_count, med, mn, mx, s.repeat,
 	       scene->triangle_count / (med * 1e3), s.cold_ms);
+	print_stages(&st);
 	status = check(scene, &prims, bvhlab_plugin_builder(p), &s.tree, a->rays);
 out:
 	bvhlab_tree_finish(&s.tree);
 	bvhlab_prims_finish(&prims);
+	stages_close(&st);
 	return status;
 }
 

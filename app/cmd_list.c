@@ -55,6 +55,9 @@ static int list_one(const char *name)
 	printf("%s — %s%s\n  file: %s\n", b->name, b->summary ? b->summary : "",
 	       b->flags & BVHLAB_BUILDER_UNFINISHED ? " [UNFINISHED]" : "", bvhlab_plugin_path(p));
 	print_flags(b->flags);
+	if (bvhlab_builder_refine(b))
+		printf("  stage: %s\n", b->build ? "builds, and refines trees (\"refine\" lists)"
+		                                 : "refines trees only (\"refine\" lists, --refine)");
 	printf("  options:%s\n", b->option_count ? "" : " none");
 	for (uint32_t k = 0; k < b->option_count; k++)
 		print_option(&b->options[k]);

@@ -281,6 +281,7 @@ void config_finish(struct config *cfg)
 		free(cfg->builders[i].name);
 		free(cfg->builders[i].threads);
 		free(cfg->builders[i].picks);
+		config_refine_finish(&cfg->builders[i]);
 	}
 	free(cfg->scenes);
 	free(cfg->builders);

@@ -43,9 +43,19 @@ struct config_part {
 	bvhlab_transform xf;
 };
 
+/* One refinement stage of a builder (config_refine.c). */
+struct config_refine {
+	char *plugin;      /* "plugin": a refining plugin's name or a path to a .so */
+	const struct cJSON *options; /* "options" object (may be NULL), owned by root */
+	int line, column;  /* where the stage's object starts */
+};
+
+/* Most stages in one builder's "refine" list. */
+#define CONFIG_MAX_REFINE 8
+
 struct config_builder {
 	char *plugin;      /* "plugin": a name on the search path or a path to a .so */
-	char *name;        /* "name", default: plugin */
+	char *name;        /* "name", default: plugin, then "+stage" per refine stage */
 	uint32_t *threads; /* "threads" override, or NULL for the config's list */
 	size_t thread_count;
 	double timeout_s;  /* "timeout_s" override, or 0 for the config's */
@@ -54,6 +64,9 @@ struct config_builder {
 	bool optional;     /* "optional", default false: a plugin that is not there (not
 	                    * built, say) drops the builder from the sweep instead of
 	                    * failing its runs */
+	struct config_refine *refine; /* "refine": stages applied in order after the
+	                               * build, or NULL */
+	size_t refine_count;
 	int line, column;  /* where the builder's object starts */
 	/* An option grid's builder (config_grid.c): the value it takes of each grid. */
 	struct config_grid_pick *picks;
@@ -133,6 +146,9 @@ int config_apply_options(const struct config *cfg, const struct config_builder *
  */
 const struct cJSON *config_grid_value(const struct config_builder *b,
                                       const struct cJSON *member, size_t *index);
+/* Same for the options of stage k of the builder's "refine" list. */
+int config_apply_refine_options(const struct config *cfg, const struct config_builder *b,
+                                size_t k, bvhlab_options *opts, bvhlab_error *err);
 
 /* Replaces the thread list (command line --threads). */
 int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count);

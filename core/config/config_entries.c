@@ -221,6 +221,8 @@ static int parse_builder(struct config *cfg, const cJSON *obj, size_t index,
 		rc = builder_plugin(cfg, obj, prefix, b, err);
 	if (!rc)
 		rc = builder_options(cfg, obj, index, b, err);
+	if (!rc)
+		rc = config_parse_refine(cfg, obj, index, b, err);
 	return rc;
 }
 

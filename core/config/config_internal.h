@@ -74,6 +74,7 @@ extern const struct config_key config_scene_keys[]; /* struct config_scene */
 extern const struct config_key config_part_keys[];  /* struct config_part */
 extern const struct config_key config_builder_keys[]; /* struct config_builder */
 extern const struct config_key config_camera_keys[]; /* bvhlab_camera */
+extern const struct config_key config_refine_keys[]; /* struct config_refine */
 
 /* Reads every key of the table present in obj into base (the table's
  * struct), in table order; CONFIG_CUSTOM keys are left to the caller. */
@@ -139,5 +140,10 @@ int config_parse_builders(struct config *cfg, bvhlab_error *err);
  * combination, named "NAME[key=value,...]" (config_grid.c); `array` is the
  * config's "builders" array, one element per builder before expansion. */
 int config_expand_grids(struct config *cfg, const cJSON *array, bvhlab_error *err);
+/* builders[index]'s "refine" list (config_refine.c); without a "name",
+ * "+PLUGIN" of each stage is appended to the builder's name. */
+int config_parse_refine(struct config *cfg, const cJSON *obj, size_t index,
+                        struct config_builder *b, bvhlab_error *err);
+void config_refine_finish(struct config_builder *b);
 
 #endif /* BVHLAB_CORE_CONFIG_INTERNAL_H */

@@ -108,6 +108,14 @@ const struct config_key config_builder_keys[] = {
 	BUILDER("memory_limit_mb", CONFIG_U64, memory_limit_mb, 1, CONFIG_MAX_MEMORY_MB),
 	CUSTOM("options"),
 	BUILDER("optional", CONFIG_BOOL, optional, 0, 0),
+	CUSTOM("refine"), /* config_refine.c */
+	END,
+};
+
+#define STAGE(name, kind, field) KEY(struct config_refine, name, kind, field, 0, 0, 0)
+const struct config_key config_refine_keys[] = {
+	STAGE("plugin", CONFIG_STRING, plugin),
+	CUSTOM("options"),
 	END,
 };
 

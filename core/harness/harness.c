@@ -56,6 +56,8 @@ struct series_report {
 	struct build_memory memory;
 	struct ray_metrics rays;
 	bool heat_written, shade_written;
+	uint32_t stage_count;
+	struct stage_metrics stages[HARNESS_MAX_STAGES];
 	char error[sizeof(((bvhlab_error *)0)->message)];
 	double samples[];      /* [repeat] */
 };
@@ -224,7 +226,10 @@ static void series_work(void *arg, void *report, size_t size)
 	struct series_report *rep = report;
 	const struct config *cfg = job->h->cfg;
 	struct build_series s = {.warmup = cfg->warmup, .repeat = cfg->repeat,
-	                         .threads = job->threads, .samples_ms = rep->samples};
+	                         .threads = job->threads, .samples_ms = rep->samples,
+	                         .stages = job->hb->refine,
+	                         .stage_count = (uint32_t)job->hb->cb->refine_count,
+	                         .stage_out = rep->stages};
 	bvhlab_error err = {{0}};
 	(void)size;
 	rep->status = SERIES_OK;
@@ -236,6 +241,7 @@ static void series_work(void *arg, void *report, size_t size)
 	} else {
 		rep->sample_count = s.repeat;
 		rep->cold_ms = s.cold_ms;
+		rep->stage_count = s.stage_count;
 		validate(job, &s.tree, rep, &err);
 		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
 		if (rep->has_stats)
@@ -256,7 +262,8 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 {
 	static const char *const names[] = {"ok", "invalid", "failed"};
 	rep->error[sizeof(rep->error) - 1] = '\0';
-	if (rep->status > SERIES_FAILED || rep->sample_count > repeat) {
+	if (rep->status > SERIES_FAILED || rep->sample_count > repeat ||
+	    rep->stage_count > HARNESS_MAX_STAGES) {
 		run->status = "crashed";
 		run->error = "sent back a malformed report";
 		return;
@@ -274,6 +281,10 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->rays_checked = rep->rays_checked;
 	run->mismatches = rep->mismatches;
 	run->rays = rep->rays.measured ? &rep->rays : NULL;
+	for (uint32_t k = 0; k < rep->stage_count; k++)
+		rep->stages[k].plugin[sizeof(rep->stages[k].plugin) - 1] = '\0';
+	run->stages = rep->stages;
+	run->stage_count = rep->stage_count;
 }
 
 /* Runs the series in a child (or here, with "isolate": false) and records it. */

@@ -45,17 +45,36 @@ struct harness_options {
 int harness_run(const struct config *cfg, const struct harness_options *opts,
                 bvhlab_error *err);
 
+/* A refinement stage run after every build of a series. */
+struct refine_stage {
+	const bvhlab_plugin *plugin; /* one whose descriptor has refine (ABI 1.2) */
+	const bvhlab_options *opts;
+};
+
+#define HARNESS_MAX_STAGES CONFIG_MAX_REFINE
+
+/* What a series measured of one stage. */
+struct stage_metrics {
+	char plugin[64];       /* the descriptor's name */
+	double ms;             /* median over the timed repeats */
+	double sah_before, sah_after; /* SAH cost of the last repeat's tree */
+};
+
 /* One timed build series of a plugin on prepared primitives. */
 struct build_series {
 	uint32_t warmup, repeat;
 	uint32_t threads;      /* 0: all hardware threads */
-	double *samples_ms;    /* [repeat], filled */
+	double *samples_ms;    /* [repeat], filled: the build and every stage */
 	double cold_ms;        /* the first build (warm-up or not): fresh output
 	                        * and builder scratch, page faults included */
-	bvhlab_tree tree;      /* the last build's tree */
+	const struct refine_stage *stages; /* [stage_count], applied in order */
+	uint32_t stage_count;  /* at most HARNESS_MAX_STAGES */
+	struct stage_metrics *stage_out; /* [stage_count], filled */
+	bvhlab_tree tree;      /* the last build's tree, refined */
 };
 
-/* Runs warmup + repeat builds; stops at the first failure (err set). */
+/* Runs warmup + repeat builds, each followed by the stages; stops at the
+ * first failure (err set). */
 int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
                         const bvhlab_build_input *input, struct build_series *s,
                         bvhlab_error *err);

@@ -65,6 +65,31 @@ static int probe(const struct config *cfg, struct harness_builder *hb)
 	return -EINVAL;
 }
 
+/* Opens a builder's refinement stages; *ok false (hb->error set) when one
+ * cannot be used. -ENOMEM only for options that cannot be set up. */
+static int open_stages(const struct config *cfg, struct harness_builder *hb, bool *ok)
+{
+	*ok = true;
+	for (size_t k = 0; *ok && k < hb->cb->refine_count; k++) {
+		struct harness_stage *st = &hb->stages[k];
+		if (bvhlab_plugin_open(hb->cb->refine[k].plugin, &st->plugin, &hb->error) < 0) {
+			*ok = false;
+			break;
+		}
+		if (!bvhlab_builder_refine(bvhlab_plugin_builder(st->plugin))) {
+			error_set(&hb->error, "refine stage %zu: plugin '%s' has no refinement stage",
+			          k + 1, hb->cb->refine[k].plugin);
+			*ok = false;
+			break;
+		}
+		if (bvhlab_options_init(&st->opts, bvhlab_plugin_builder(st->plugin)) < 0)
+			return -ENOMEM;
+		*ok = config_apply_refine_options(cfg, hb->cb, k, &st->opts, &hb->error) == 0;
+		hb->refine[k] = (struct refine_stage){.plugin = st->plugin, .opts = &st->opts};
+	}
+	return 0;
+}
+
 /* 0, -EINVAL with hb's error set, or -ENOMEM. */
 static int open_one(const struct config *cfg, struct harness_builder *hb)
 {
@@ -76,6 +101,8 @@ static int open_one(const struct config *cfg, struct harness_builder *hb)
 	if (bvhlab_options_init(&hb->opts, bvhlab_plugin_builder(hb->plugin)) < 0)
 		return -ENOMEM;
 	hb->opts_ok = config_apply_options(cfg, hb->cb, &hb->opts, &hb->error) == 0;
+	if (hb->opts_ok && open_stages(cfg, hb, &hb->opts_ok) < 0)
+		return -ENOMEM;
 	return hb->opts_ok ? 0 : -EINVAL;
 }
 
@@ -108,6 +135,11 @@ void harness_close_builders(const struct config *cfg, struct harness_builder *bu
 		if (builders[b].opts.values)
 			bvhlab_options_finish(&builders[b].opts);
 		bvhlab_plugin_close(builders[b].plugin);
+		for (size_t k = 0; k < HARNESS_MAX_STAGES; k++) {
+			if (builders[b].stages[k].opts.values)
+				bvhlab_options_finish(&builders[b].stages[k].opts);
+			bvhlab_plugin_close(builders[b].stages[k].plugin);
+		}
 	}
 	free(builders);
 }

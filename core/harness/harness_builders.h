@@ -12,17 +12,23 @@
 #include <bvhlab/bvhlab.h>
 
 #include "config/config.h"
+#include "harness/harness.h"
 #include "harness/isolate.h"
 
 struct harness_builder {
 	const struct config_builder *cb;
 	bvhlab_plugin *plugin; /* NULL when it could not be loaded */
 	bvhlab_options opts;
-	bool opts_ok;
+	bool opts_ok;          /* and every refine stage's plugin and options too */
 	const char *status;    /* of its runs when unusable: "failed", "crashed", "timeout" */
 	bool skipped;          /* optional ("optional": true) and its plugin could not be
 	                        * loaded: it has no runs at all */
 	bvhlab_error error;
+	struct harness_stage {
+		bvhlab_plugin *plugin;
+		bvhlab_options opts;
+	} stages[HARNESS_MAX_STAGES];
+	struct refine_stage refine[HARNESS_MAX_STAGES]; /* views of stages[] */
 };
 
 /* The resource limits of a builder's children (its own or the config's). */

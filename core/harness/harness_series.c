@@ -1,26 +1,79 @@
 /*
  * Timing a build series: warm-up builds, then timed ones into the same
- * tree (so room grown once stays allocated); `bvhlab build` and the sweep
- * share it.
+ * tree (so room grown once stays allocated), each followed by the
+ * builder's refinement stages; `bvhlab build` and the sweep share it.
  */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+
 #include "harness/harness.h"
 #include "util/util.h"
+
+/* The stages after one build: their times into ms[stage * repeat + k]
+ * when k is a timed repeat, the SAH around each when `last`. */
+static int run_stages(struct build_series *s, const bvhlab_build_input *input, double *ms,
+                      int64_t k, bool last, bvhlab_error *err)
+{
+	bvhlab_tree_stats st;
+	for (uint32_t j = 0; j < s->stage_count; j++) {
+		struct stage_metrics *out = &s->stage_out[j];
+		if (last) {
+			bvhlab_tree_stats_compute(&s->tree, &st);
+			out->sah_before = st.sah_cost;
+		}
+		double t0 = util_now();
+		int r = bvhlab_refine(s->stages[j].plugin, s->stages[j].opts, input, s->threads,
+		                      &s->tree, err);
+		double t1 = util_now();
+		if (r < 0)
+			return r;
+		if (k >= 0)
+			ms[j * s->repeat + (uint64_t)k] = (t1 - t0) * 1e3;
+		if (last) {
+			bvhlab_tree_stats_compute(&s->tree, &st);
+			out->sah_after = st.sah_cost;
+		}
+	}
+	return 0;
+}
+
+static void stage_names(struct build_series *s, const double *ms)
+{
+	for (uint32_t j = 0; j < s->stage_count; j++) {
+		struct stage_metrics *out = &s->stage_out[j];
+		double mn, mx;
+		snprintf(out->plugin, sizeof(out->plugin), "%s",
+		         bvhlab_plugin_builder(s->stages[j].plugin)->name);
+		util_summarise(ms + (size_t)j * s->repeat, s->repeat, &out->ms, &mn, &mx);
+	}
+}
 
 int harness_time_builds(const bvhlab_plugin *plugin, const bvhlab_options *opts,
                         const bvhlab_build_input *input, struct build_series *s,
                         bvhlab_error *err)
 {
-	for (uint32_t k = 0; k < s->warmup + s->repeat; k++) {
+	double *ms = calloc((size_t)s->stage_count * s->repeat + 1, sizeof(*ms));
+	int r = ms ? 0 : -ENOMEM;
+	if (r < 0)
+		error_set(err, "out of memory for the stage times");
+	for (uint32_t k = 0; r == 0 && k < s->warmup + s->repeat; k++) {
 		double t0 = util_now();
-		int r = bvhlab_build(plugin, opts, input, s->threads, &s->tree, err);
-		double t1 = util_now();
-		if (r < 0)
-			return r;
-		if (k == 0)
+		r = bvhlab_build(plugin, opts, input, s->threads, &s->tree, err);
+		double t1 = util_now(), staged = 0;
+		bool last = k + 1 == s->warmup + s->repeat;
+		if (r == 0 && k == 0)
 			s->cold_ms = (t1 - t0) * 1e3;
-		if (k >= s->warmup)
-			s->samples_ms[k - s->warmup] = (t1 - t0) * 1e3;
+		if (r == 0 && s->stage_count) {
+			r = run_stages(s, input, ms, (int64_t)k - s->warmup, last, err);
+			for (uint32_t j = 0; r == 0 && k >= s->warmup && j < s->stage_count; j++)
+				staged += ms[j * s->repeat + (k - s->warmup)];
+		}
+		if (r == 0 && k >= s->warmup)
+			s->samples_ms[k - s->warmup] = (t1 - t0) * 1e3 + staged;
 	}
-	return 0;
+	if (r == 0)
+		stage_names(s, ms);
+	free(ms);
+	return r;
 }
-

@@ -214,16 +214,13 @@ static int explain(const struct bvhlab_build_ctx *ctx, int r)
 	return r;
 }
 
-int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
-                 const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
-                 bvhlab_error *err)
+/* The call into the plugin, with pinning around it and the counts back
+ * into the tree. */
+static int call_plugin(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                       const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
+                       bool refine, bvhlab_error *err)
 {
 	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
-	if (prepare_tree(tree, input->prim_count) < 0) {
-		error_set(err, "builder '%s': cannot allocate the output for %u primitives", b->name,
-		          input->prim_count);
-		return -ENOMEM;
-	}
 	bvhlab_build_input in = *input;
 	in.threads = threads ? threads : bvhlab_hardware_threads();
 	bvhlab_build_output out = {
@@ -232,14 +229,47 @@ int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		.nodes = tree->nodes,
 		.prim_index = tree->prim_index,
 		.index_capacity = tree->index_capacity,
+		.node_count = refine ? tree->node_count : 0,
+		.index_count = refine ? tree->index_count : 0,
 	};
 	struct bvhlab_build_ctx ctx = {.builder = b, .opts = opts, .tree = tree, .err = err};
 	int r = pinning_begin(&ctx);
 	if (r < 0)
 		return r;
-	r = b->build(&host_table, &ctx, &in, &out);
+	r = refine ? bvhlab_builder_refine(b)(&host_table, &ctx, &in, &out)
+	           : b->build(&host_table, &ctx, &in, &out);
 	pinning_end(&ctx);
 	tree->node_count = out.node_count;
 	tree->index_count = out.index_count;
 	return explain(&ctx, r);
+}
+
+int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                 const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
+                 bvhlab_error *err)
+{
+	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
+	if (!b->build) {
+		error_set(err, "plugin '%s' only refines trees; use it in a builder's \"refine\" list",
+		          b->name);
+		return -ENOTSUP;
+	}
+	if (prepare_tree(tree, input->prim_count) < 0) {
+		error_set(err, "builder '%s': cannot allocate the output for %u primitives", b->name,
+		          input->prim_count);
+		return -ENOMEM;
+	}
+	return call_plugin(plugin, opts, input, threads, tree, false, err);
+}
+
+int bvhlab_refine(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                  const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
+                  bvhlab_error *err)
+{
+	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
+	if (!bvhlab_builder_refine(b)) {
+		error_set(err, "plugin '%s' has no refinement stage (ABI 1.2 refine)", b->name);
+		return -ENOTSUP;
+	}
+	return call_plugin(plugin, opts, input, threads, tree, true, err);
 }

@@ -66,11 +66,16 @@ static int check_builder(const bvhlab_builder *b, const char *path, bvhlab_error
 		error_set(err, "plugin %s: descriptor has no name", path);
 		return -EINVAL;
 	}
-	if (!b->build) {
+	if (!b->build && !bvhlab_builder_refine(b)) {
 		error_set(err, "plugin %s ('%s'): descriptor has no build function", path, b->name);
 		return -EINVAL;
 	}
 	return check_options(b, path, err);
+}
+
+bvhlab_refine_fn bvhlab_builder_refine(const bvhlab_builder *b)
+{
+	return BVHLAB_BUILDER_HAS(b, refine) ? b->refine : NULL;
 }
 
 static int load(bvhlab_plugin *p, bvhlab_error *err)

@@ -67,6 +67,8 @@ struct run_record {
 	bool valid;
 	uint64_t rays_checked, mismatches;
 	const struct ray_metrics *rays; /* or NULL: not traced */
+	const struct stage_metrics *stages; /* [stage_count] refinement stages */
+	uint32_t stage_count;
 };
 
 
@@ -84,6 +86,10 @@ int results_add_run(struct results *res, const struct run_record *run);
 
 /* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of docs/design.md. */
 struct cJSON *results_rays_json(const struct ray_metrics *m);
+
+struct stage_metrics;
+/* "stages": [{"plugin", "ms", "sah_before", "sah_after"}, ...] (results_stages.c). */
+struct cJSON *results_stages_json(const struct stage_metrics *stages, uint32_t count);
 
 /* The scene's "images": {"<kind>": name}; a legend also sets "heat_min"/"heat_max". */
 int results_set_scene_image(struct results *res, const char *scene, const char *kind,

@@ -258,6 +258,7 @@ const bvhlab_builder descriptor = {
 	sizeof(options) / sizeof(options[0]),     // option_count
 	options,
 	build,
+	nullptr,                                  // refine (ABI 1.2): none
 };
 
 } // namespace

@@ -6,6 +6,9 @@
  *        bvhlab_build_output, bvhlab_option_decl.
  *   1.1  bvhlab_host.pin_thread (check BVHLAB_HOST_HAS(host, pin_thread));
  *        hardware_threads counts physical cores, not logical CPUs.
+ *   1.2  bvhlab_builder.refine: a plugin may improve a finished tree in
+ *        place (a refinement stage); a refinement-only plugin leaves
+ *        build NULL. Plugins of 1.0 and 1.1 load as before.
  *
  * A plugin is a shared object that exports exactly one symbol,
  *
@@ -36,7 +39,7 @@
 BVHLAB_BEGIN_DECLS
 
 #define BVHLAB_ABI_MAJOR 1
-#define BVHLAB_ABI_MINOR 1
+#define BVHLAB_ABI_MINOR 2
 #define BVHLAB_ABI_VERSION(major, minor) (((uint32_t)(major) << 16) | (uint32_t)(minor))
 #define BVHLAB_ABI_VERSION_MAJOR(v) ((uint32_t)(v) >> 16)
 #define BVHLAB_ABI_VERSION_MINOR(v) ((uint32_t)(v) & 0xffffu)
@@ -255,10 +258,31 @@ typedef struct bvhlab_builder {
 	const bvhlab_option_decl *options; /* [option_count] */
 
 	/* Builds one tree. Returns 0, or a negative errno after host->set_error.
-	 * May be called many times, from one thread at a time. */
+	 * May be called many times, from one thread at a time. NULL (since
+	 * 1.2) in a plugin that only refines. */
 	int (*build)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	             const bvhlab_build_input *input, bvhlab_build_output *output);
+
+	/*
+	 * since 1.2, may be NULL. Improves a finished tree in place: on entry
+	 * `tree` holds a valid tree in the standard layout (node_count,
+	 * index_count set, nodes[0] the root) over the primitives of `input`,
+	 * built by any builder; input->threads is the thread count to use.
+	 * On return it must hold a valid tree over the same primitives, with
+	 * the counts updated; the capacity past the counts is scratch, and
+	 * host->grow_output works as in build(). The harness times it as a
+	 * stage of its own and reports the SAH cost before and after.
+	 * Returns 0, or a negative errno after host->set_error (the tree is
+	 * then discarded). Same calling rules as build.
+	 */
+	int (*refine)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+	              const bvhlab_build_input *input, bvhlab_build_output *tree);
 } bvhlab_builder;
+
+/* True when descriptor `b` has `field`: one built against an older minor
+ * lacks the fields that came later, e.g. BVHLAB_BUILDER_HAS(b, refine). */
+#define BVHLAB_BUILDER_HAS(b, field) \
+	((b)->struct_size >= offsetof(bvhlab_builder, field) + sizeof((b)->field))
 
 BVHLAB_END_DECLS
 

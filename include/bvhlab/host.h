@@ -30,6 +30,11 @@ int bvhlab_plugin_open(const char *name_or_path, bvhlab_plugin **out, bvhlab_err
 void bvhlab_plugin_close(bvhlab_plugin *plugin);
 
 const bvhlab_builder *bvhlab_plugin_builder(const bvhlab_plugin *plugin);
+/* A descriptor's refine function (ABI 1.2), or NULL: NULL too for a
+ * plugin built against an older minor, whose descriptor has no such field. */
+typedef int (*bvhlab_refine_fn)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                                const bvhlab_build_input *input, bvhlab_build_output *tree);
+bvhlab_refine_fn bvhlab_builder_refine(const bvhlab_builder *b);
 /* The file the plugin was loaded from. */
 const char *bvhlab_plugin_path(const bvhlab_plugin *plugin);
 
@@ -94,6 +99,16 @@ void bvhlab_option_format(const bvhlab_option_value *v, char *buf, size_t size);
 int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
                  const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
                  bvhlab_error *err);
+
+/*
+ * Runs the plugin's refine function (ABI 1.2) once on `tree`, a valid tree
+ * over `input` (from bvhlab_build), with `threads` threads (0: all), in
+ * place. -ENOTSUP when the plugin does not refine. Returns 0, or the
+ * plugin's negative errno with its message in err. Does not validate.
+ */
+int bvhlab_refine(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                  const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
+                  bvhlab_error *err);
 
 BVHLAB_END_DECLS
 

@@ -129,9 +129,9 @@ static void place_sort(lbvh *b, char *p)
 {
 	size_t k8 = align64(8 * (size_t)b->n);
 
-	b->codes = (uint64_t *)(void *)p;
-	b->keys[0] = (uint64_t *)(void *)(p + k8);
-	b->keys[1] = (uint64_t *)(void *)(p + 2 * k8);
+	b->sort.codes = (uint64_t *)(void *)p;
+	b->sort.keys[0] = (uint64_t *)(void *)(p + k8);
+	b->sort.keys[1] = (uint64_t *)(void *)(p + 2 * k8);
 }
 
 /* The hierarchy's arrays; node_flags only with collapse. */
@@ -173,8 +173,8 @@ static void place_tree(lbvh *b, char *p)
 static int scratch_alloc(lbvh *b, const bvhlab_build_output *out, struct scratch *s)
 {
 	size_t sort = sort_size(b->n), tree = tree_size(b->n, b->collapse);
-	size_t hist = (size_t)b->threads * TOP_RADIX * sizeof(uint32_t) +
-	              (TOP_RADIX + 1) * sizeof(uint32_t);
+	size_t hist = (size_t)b->threads * MORTON_TOP_RADIX * sizeof(uint32_t) +
+	              (MORTON_TOP_RADIX + 1) * sizeof(uint32_t);
 	uint32_t nodes = 2 * b->n - 1, spare = spare_nodes(b->n, b->collapse);
 	bool sort_out = (size_t)out->node_capacity * sizeof(bvhlab_node) >= sort;
 	bool tree_out = spare && out->node_capacity >= nodes + spare;
@@ -191,9 +191,9 @@ static int scratch_alloc(lbvh *b, const bvhlab_build_output *out, struct scratch
 	b->scratch_dirty = tree_out;
 	place_tree(b, tree_out ? (char *)((past + 63) & ~(uintptr_t)63) : (char *)s->region);
 	place_sort(b, sort_out ? (char *)out->nodes : (char *)s->region + (tree_out ? 0 : tree));
-	b->hist = s->small;
-	b->bucket = (uint32_t *)(void *)(b->hist + b->threads);
-	b->count = b->bucket + TOP_RADIX + 1;
+	b->sort.hist = s->small;
+	b->sort.bucket = (uint32_t *)(void *)(b->sort.hist + b->threads);
+	b->count = b->sort.bucket + MORTON_TOP_RADIX + 1;
 	return 0;
 }
 
@@ -205,70 +205,12 @@ static void scratch_free(struct scratch *s)
 
 /* ---- the team ------------------------------------------------------------ */
 
-/* Polls of a waiting thread before it sleeps: some tens of microseconds,
- * more than the usual skew between threads at a phase end, less than the
- * cost of putting a thread to sleep and waking it again, which in a VM is
- * itself tens of microseconds, paid at each of some twenty barriers. */
-#define BARRIER_SPINS 1024
-
-static inline void cpu_relax(void)
-{
-#if defined(__x86_64__) || defined(__i386__)
-	__builtin_ia32_pause();
-#endif
-}
-
-/*
- * The last thread to arrive opens the next round. Its acq_rel fetch_add
- * reads the counter's release sequence, so it has acquired everyone's
- * writes; its release store of `round` passes them all on to every thread
- * that sees the new round. The others poll, then sleep on the condition
- * variable, whose mutex the last thread takes before it bumps the round,
- * so that no wake-up is lost.
- */
-void team_sync(lbvh *b)
-{
-	struct team_barrier *tb = &b->barrier;
-	unsigned round = atomic_load_explicit(&tb->round, memory_order_relaxed);
-
-	if (atomic_fetch_add_explicit(&tb->arrived, 1, memory_order_acq_rel) + 1 == b->threads) {
-		atomic_store_explicit(&tb->arrived, 0, memory_order_relaxed);
-		pthread_mutex_lock(&tb->lock);
-		atomic_store_explicit(&tb->round, round + 1, memory_order_release);
-		pthread_cond_broadcast(&tb->wake);
-		pthread_mutex_unlock(&tb->lock);
-		return;
-	}
-	for (unsigned k = 0; k < tb->spins; k++) {
-		if (atomic_load_explicit(&tb->round, memory_order_acquire) != round)
-			return;
-		cpu_relax();
-	}
-	pthread_mutex_lock(&tb->lock);
-	while (atomic_load_explicit(&tb->round, memory_order_acquire) == round)
-		pthread_cond_wait(&tb->wake, &tb->lock);
-	pthread_mutex_unlock(&tb->lock);
-}
-
-/* Holds the started threads until the team size is known. */
-struct gate {
-	pthread_mutex_t lock;
-	pthread_cond_t cond;
-	bool open;
-};
-
-struct member {
-	lbvh *b;
-	struct gate *gate;
-	unsigned t;
-	pthread_t tid;
-};
-
-static void run_phases(lbvh *b, unsigned t)
+static void run_phases(void *arg, unsigned t)
 {
 	static void (*const phase[])(lbvh *, unsigned) = {
 		lbvh_sort, lbvh_karras, lbvh_bounds, lbvh_compact,
 	};
+	lbvh *b = arg;
 
 	for (size_t k = 0; k < sizeof(phase) / sizeof(phase[0]); k++) {
 		phase[k](b, t);
@@ -277,68 +219,12 @@ static void run_phases(lbvh *b, unsigned t)
 	}
 }
 
-static void *member_main(void *arg)
-{
-	struct member *m = arg;
-
-	pthread_mutex_lock(&m->gate->lock);
-	while (!m->gate->open)
-		pthread_cond_wait(&m->gate->cond, &m->gate->lock);
-	pthread_mutex_unlock(&m->gate->lock);
-	run_phases(m->b, m->t);
-	return NULL;
-}
-
-static void open_gate(struct gate *gate)
-{
-	pthread_mutex_lock(&gate->lock);
-	gate->open = true;
-	pthread_cond_broadcast(&gate->cond);
-	pthread_mutex_unlock(&gate->lock);
-}
-
-/*
- * Runs every phase with up to `want` threads, the calling one included.
- * A thread that cannot be started only makes the team smaller: the tree
- * does not depend on its size. Joining the members is what makes their
- * writes visible to the caller. 0, or a negative errno.
- */
-static int run_team(lbvh *b, unsigned want, uint32_t cpus)
-{
-	struct member m[LBVH_MAX_THREADS];
-	struct gate gate = { PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, false };
-	unsigned size = 1;
-	int rc;
-
-	if ((rc = pthread_mutex_init(&b->barrier.lock, NULL)) != 0)
-		return -rc;
-	if ((rc = pthread_cond_init(&b->barrier.wake, NULL)) != 0) {
-		pthread_mutex_destroy(&b->barrier.lock);
-		return -rc;
-	}
-	for (; size < want; size++) {
-		m[size] = (struct member){ .b = b, .gate = &gate, .t = size };
-		if (pthread_create(&m[size].tid, NULL, member_main, &m[size]) != 0)
-			break;
-	}
-	b->threads = size;
-	/* Polling only pays while every thread has a CPU of its own. */
-	b->barrier.spins = size <= cpus ? BARRIER_SPINS : 0;
-	open_gate(&gate);
-	run_phases(b, 0);
-	for (unsigned t = 1; t < size; t++)
-		pthread_join(m[t].tid, NULL);
-	pthread_cond_destroy(&b->barrier.wake);
-	pthread_mutex_destroy(&b->barrier.lock);
-	return 0;
-}
-
 static unsigned team_size(const bvhlab_build_input *in)
 {
 	uint32_t most = in->prim_count / MIN_PRIMS_PER_THREAD;
 	uint32_t want = in->threads < most ? in->threads : most;
 
-	return want < 1 ? 1 : want > LBVH_MAX_THREADS ? LBVH_MAX_THREADS : want;
+	return want < 1 ? 1 : want > TEAM_MAX_THREADS ? TEAM_MAX_THREADS : want;
 }
 
 /* ---- build --------------------------------------------------------------- */
@@ -363,7 +249,7 @@ static void log_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx, const lbv
 {
 	host->log(ctx, BVHLAB_LOG_DEBUG,
 	          "%u prims, %u threads: setup %.2f, sort %.2f, karras %.2f, "
-	          "bounds %.2f, compact %.2f ms", b->n, b->threads, b->phase_ms[4] - start,
+	          "bounds %.2f, compact %.2f ms", b->n, b->team.threads, b->phase_ms[4] - start,
 	          b->phase_ms[0] - b->phase_ms[4], b->phase_ms[1] - b->phase_ms[0],
 	          b->phase_ms[2] - b->phase_ms[1], b->phase_ms[3] - b->phase_ms[2]);
 }
@@ -376,12 +262,17 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b,
 	int rc;
 
 	b->threads = team_size(b->in);
+	b->sort.n = b->n;
+	b->sort.bits = b->bits;
+	b->sort.centroids = b->in->centroids;
+	b->sort.centroid_bounds = b->in->centroid_bounds;
 	if ((rc = scratch_alloc(b, out, &s)) < 0) {
 		host->set_error(ctx, "out of memory for the scratch of %u primitives", b->n);
 		goto out;
 	}
 	b->phase_ms[4] = now_ms();
-	if ((rc = run_team(b, b->threads, host->hardware_threads(ctx))) < 0) {
+	if ((rc = team_run(&b->team, b->threads, host->hardware_threads(ctx), run_phases,
+	                   b)) < 0) {
 		host->set_error(ctx, "cannot set up the thread team");
 		goto out;
 	}

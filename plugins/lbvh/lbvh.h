@@ -43,13 +43,13 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include <bvhlab/aabb.h>
 #include <bvhlab/builder.h>
 
-/* The sort's first digit: the top bits of the codes (lbvh_sort.c). */
-#define TOP_BITS 11
-#define TOP_RADIX (1u << TOP_BITS)
+#include "morton.h"
+#include "team.h"
+
 #define NO_NODE UINT32_MAX
-#define LBVH_MAX_THREADS 256
 /* Zero bytes before and after lcp[], so that 16-byte scans never leave it. */
 #define LCP_PAD 32
 
@@ -57,7 +57,7 @@ typedef struct lbvh {
 	/* parameters */
 	const bvhlab_build_input *in;
 	uint32_t n;          /* primitives, >= 2 when the team runs */
-	uint32_t threads;    /* team size T */
+	uint32_t threads;    /* threads asked for; the team (team.threads) may be smaller */
 	unsigned bits;       /* Morton code bits: 30 or 63 */
 	bool collapse;
 	uint32_t max_leaf;
@@ -68,22 +68,12 @@ typedef struct lbvh {
 	uint32_t *prim_index;
 	uint32_t node_count;  /* set by the last phase */
 
-	/* sort: in the output node array, which the bounds phase is the first
-	 * to write (see lbvh.c), so the sorted words last through Karras */
-	uint64_t *codes;          /* [n] Morton code of each primitive, by id */
-	uint64_t *keys[2];        /* [n] packed (code, id) words: buckets, then
-	                           * sorted, in keys[0]; scratch in keys[1] */
-	uint32_t (*hist)[TOP_RADIX]; /* [T][TOP_RADIX] digit counts of each chunk */
-	uint32_t *bucket;         /* [TOP_RADIX + 1] first sorted position of
-	                           * each top digit, n at the end */
-
-	/* the sorted keys, set at the end of the sort: words[k] holds the code
-	 * of sorted position k from bit `base` up, shifted above `id_bits` of
-	 * primitive id (base 0 when the whole code fits) */
-	struct {
-		const uint64_t *words;
-		unsigned base, id_bits;
-	} sorted;
+	/* sort (plugins/common/morton): its buffers in the output node array,
+	 * which the bounds phase is the first to write (see lbvh.c), so the
+	 * sorted words last through Karras. keys[0][k] holds the code of
+	 * sorted position k from bit sort.base up, shifted above
+	 * sort.id_bits of primitive id (base 0 when the whole code fits). */
+	morton_sort sort;
 
 	/* hierarchy: past the tree in the output, or a fresh mapping */
 	uint8_t *lcp;             /* [n - 1] 1 + common prefix length of sorted
@@ -100,16 +90,9 @@ typedef struct lbvh {
 	bool scratch_dirty;       /* visits and node_flags left from a build
 	                           * before: the sort zeroes them */
 	uint32_t *count;          /* [3 T] per-chunk counts for the compaction */
-	atomic_uint blocks[3];    /* blocks handed out in karras, bounds and
-	                           * the sort's buckets */
+	atomic_uint blocks[2];    /* blocks handed out in karras and bounds */
 
-	struct team_barrier {
-		atomic_uint arrived;   /* threads at the barrier this round */
-		atomic_uint round;     /* rounds completed */
-		unsigned spins;        /* polls before sleeping; 0 when oversubscribed */
-		pthread_mutex_t lock;  /* guards the sleep on `wake` */
-		pthread_cond_t wake;
-	} barrier;
+	team team;                /* the threads (plugins/common/team) */
 	double phase_ms[5];       /* thread 0's phase end times, [4] the start */
 } lbvh;
 
@@ -117,32 +100,14 @@ typedef struct lbvh {
 static inline void chunk(const lbvh *b, unsigned t, uint32_t count, uint32_t *lo,
                          uint32_t *hi)
 {
-	*lo = (uint32_t)((uint64_t)count * t / b->threads);
-	*hi = (uint32_t)((uint64_t)count * (t + 1) / b->threads);
+	team_chunk(b->team.threads, t, count, lo, hi);
 }
 
-/*
- * Hands out the next block of `size` of `count` items, [lo, hi), to
- * whichever thread asks first; false when none is left. Used where the
- * result does not depend on who does which part: a thread that runs
- * slowly (another process on its CPU: this machine is shared) then holds
- * the team up at the next barrier by one block, not by a whole share.
- */
-static inline bool next_block(atomic_uint *next, uint32_t count, uint32_t size,
-                              uint32_t *lo, uint32_t *hi)
+/* Waits for the whole team: everything written before is visible after. */
+static inline void lbvh_sync(lbvh *b)
 {
-	uint64_t first = (uint64_t)atomic_fetch_add_explicit(next, 1, memory_order_relaxed) * size;
-
-	if (first >= count)
-		return false;
-	*lo = (uint32_t)first;
-	*hi = count - *lo < size ? count : *lo + size;
-	return true;
+	team_sync(&b->team);
 }
-
-/* Waits for the whole team: everything written before is visible after
- * (lbvh.c). */
-void team_sync(lbvh *b);
 
 /*
  * 1 + the common prefix length of the sorted keys at positions i < j,
@@ -152,14 +117,14 @@ void team_sync(lbvh *b);
  */
 static inline uint8_t common_prefix(const lbvh *b, uint32_t i, uint32_t j)
 {
-	uint64_t wi = b->sorted.words[i], wj = b->sorted.words[j];
-	uint64_t x = (wi ^ wj) >> b->sorted.id_bits;
-	uint64_t id_mask = (1ull << b->sorted.id_bits) - 1;
+	uint64_t wi = b->sort.keys[0][i], wj = b->sort.keys[0][j];
+	uint64_t x = (wi ^ wj) >> b->sort.id_bits;
+	uint64_t id_mask = (1ull << b->sort.id_bits) - 1;
 
 	if (x)
-		return (uint8_t)(1 + __builtin_clzll(x) - b->sorted.base);
-	if (b->sorted.base)
-		x = b->codes[wi & id_mask] ^ b->codes[wj & id_mask];
+		return (uint8_t)(1 + __builtin_clzll(x) - b->sort.base);
+	if (b->sort.base)
+		x = b->sort.codes[wi & id_mask] ^ b->sort.codes[wj & id_mask];
 	if (x)
 		return (uint8_t)(1 + __builtin_clzll(x));
 	return (uint8_t)(1 + 64 + __builtin_clz(i ^ j));
@@ -204,7 +169,7 @@ static inline float half_area(const float lo[3], const float hi[3])
 	return dx * dy + dy * dz + dz * dx;
 }
 
-/* Phases, run by every thread t of the team; each ends with team_sync
+/* Phases, run by every thread t of the team; each ends with lbvh_sync
  * except the last, which the caller's join ends. */
 void lbvh_sort(lbvh *b, unsigned t);      /* lbvh_sort.c */
 void lbvh_karras(lbvh *b, unsigned t);    /* lbvh_emit.c */

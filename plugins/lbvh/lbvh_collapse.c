@@ -145,7 +145,7 @@ static uint32_t prefix(const lbvh *b, unsigned t, unsigned base, uint32_t *total
 	uint32_t before = 0;
 
 	*total = 0;
-	for (unsigned u = 0; u < b->threads; u++) {
+	for (unsigned u = 0; u < b->team.threads; u++) {
 		before += u < t ? b->count[base + u] : 0;
 		*total += b->count[base + u];
 	}
@@ -160,7 +160,7 @@ static uint32_t count_inner(lbvh *b, unsigned t, uint32_t lo, uint32_t hi)
 	for (uint32_t i = lo; i < hi; i++)
 		count += inner(b, i);
 	b->count[t] = count;
-	team_sync(b);
+	lbvh_sync(b);
 	prefix(b, t, 0, &total);
 	return total;
 }
@@ -196,12 +196,12 @@ static uint32_t list_moves(lbvh *b, unsigned t, uint32_t lo, uint32_t hi, uint32
 		h += i < f && !inner(b, i);
 		m += i >= f && inner(b, i);
 	}
-	b->count[b->threads + t] = h;
-	b->count[2 * b->threads + t] = m;
-	team_sync(b);
-	list_where(b, holes, prefix(b, t, b->threads, &total), h, lo, mid, false);
-	list_where(b, movers, prefix(b, t, 2 * b->threads, &total), m, mid, hi, true);
-	team_sync(b);
+	b->count[b->team.threads + t] = h;
+	b->count[2 * b->team.threads + t] = m;
+	lbvh_sync(b);
+	list_where(b, holes, prefix(b, t, b->team.threads, &total), h, lo, mid, false);
+	list_where(b, movers, prefix(b, t, 2 * b->team.threads, &total), m, mid, hi, true);
+	lbvh_sync(b);
 	return total;
 }
 
@@ -225,7 +225,7 @@ void lbvh_compact(lbvh *b, unsigned t)
 	 * first point it at the new place of its children, then move. */
 	for (uint32_t r = lo; r < hi; r++)
 		slot_of(b, b->parent[movers[r]])->first = 1 + 2 * holes[r];
-	team_sync(b);
+	lbvh_sync(b);
 	for (uint32_t r = lo; r < hi; r++)
 		memcpy(kids_of(b, holes[r]), kids_of(b, movers[r]), 2 * sizeof(bvhlab_node));
 	if (t == 0)

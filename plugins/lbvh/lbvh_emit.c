@@ -136,12 +136,12 @@ void lbvh_karras(lbvh *b, unsigned t)
 {
 	uint32_t lo, hi;
 
-	while (next_block(&b->blocks[0], b->n - 1, KARRAS_BLOCK, &lo, &hi))
+	while (team_next_block(&b->blocks[0], b->n - 1, KARRAS_BLOCK, &lo, &hi))
 		for (uint32_t i = lo; i < hi; i++)
 			karras_node(b, i);
 	if (t == 0)
 		b->parent[0] = NO_NODE;
-	team_sync(b);
+	lbvh_sync(b);
 }
 
 /* Both children of internal node i are done: writes its slot and returns
@@ -160,8 +160,8 @@ static uint32_t finish_node(lbvh *b, uint32_t i, uint32_t size)
 #else
 	/* Plain compares, not fminf: boxes hold no NaN, and these inline. */
 	for (int k = 0; k < 3; k++) {
-		out->lo[k] = l->lo[k] < r->lo[k] ? l->lo[k] : r->lo[k];
-		out->hi[k] = l->hi[k] > r->hi[k] ? l->hi[k] : r->hi[k];
+		out->lo[k] = bvhlab_minf(l->lo[k], r->lo[k]);
+		out->hi[k] = bvhlab_maxf(l->hi[k], r->hi[k]);
 	}
 #endif
 	out->first = 1 + 2 * i;
@@ -228,7 +228,7 @@ void lbvh_bounds(lbvh *b, unsigned t)
 	uint32_t lo, hi;
 
 	(void)t;
-	while (next_block(&b->blocks[1], b->n, BOUNDS_BLOCK, &lo, &hi)) {
+	while (team_next_block(&b->blocks[1], b->n, BOUNDS_BLOCK, &lo, &hi)) {
 		for (uint32_t k = lo; k < hi; k++) {
 			if (k + LEAF_AHEAD < hi)
 				__builtin_prefetch(&b->in->prim_bounds[b->prim_index[k + LEAF_AHEAD]]);
@@ -237,5 +237,5 @@ void lbvh_bounds(lbvh *b, unsigned t)
 		for (uint32_t k = lo; k < hi; k++)
 			climb(b, b->parent[b->n - 1 + k], lo, hi);
 	}
-	team_sync(b);
+	lbvh_sync(b);
 }

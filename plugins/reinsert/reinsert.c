@@ -1,0 +1,318 @@
+/*
+ * reinsert: the refinement plugin (see reinsert.h). This file: options,
+ * scratch, the choice of candidates, the iterations, refine().
+ */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "reinsert.h"
+
+static const bvhlab_option_decl options[] = {
+	{ .name = "batch", .type = BVHLAB_OPTION_FLOAT,
+	  .help = "fraction of the nodes, those of largest cost, searched for a better "
+	          "place in each iteration",
+	  .def_float = 0.05, .min = 1e-6, .max = 1.0 },
+	{ .name = "iterations", .type = BVHLAB_OPTION_INT,
+	  .help = "most iterations (candidates chosen anew in each)",
+	  .def_int = 8, .min = 1, .max = 1000 },
+	{ .name = "min_gain", .type = BVHLAB_OPTION_FLOAT,
+	  .help = "stop after an iteration that lowers the SAH by less than this fraction "
+	          "of it (0: run every iteration)",
+	  .def_float = 0.001, .min = 0.0, .max = 1.0 },
+	{ .name = "leaves", .type = BVHLAB_OPTION_BOOL,
+	  .help = "split leaves of several primitives first, so that their primitives can "
+	          "move too, and cut the tree into leaves by the SAH afterwards (kept only "
+	          "if the SAH fell)",
+	  .def_bool = true },
+	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,
+	  .help = "most primitives in a leaf of that final cut (8, as the builders)",
+	  .def_int = 8, .min = 1, .max = 64 },
+	{ .name = "max_visits", .type = BVHLAB_OPTION_INT,
+	  .help = "most nodes one candidate's search may look at",
+	  .def_int = 4096, .min = 16, .max = 1 << 24 },
+};
+
+#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
+
+struct params {
+	double batch, min_gain;
+	int64_t iterations, max_visits, max_leaf;
+	bool leaves;
+};
+
+static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, struct params *o)
+{
+	int rc;
+
+	if ((rc = host->option_float(ctx, "batch", &o->batch)) < 0 ||
+	    (rc = host->option_int(ctx, "iterations", &o->iterations)) < 0 ||
+	    (rc = host->option_float(ctx, "min_gain", &o->min_gain)) < 0 ||
+	    (rc = host->option_int(ctx, "max_visits", &o->max_visits)) < 0 ||
+	    (rc = host->option_bool(ctx, "leaves", &o->leaves)) < 0 ||
+	    (rc = host->option_int(ctx, "max_leaf", &o->max_leaf)) < 0) {
+		host->set_error(ctx, "cannot read the options");
+		return rc;
+	}
+	if (!(o->batch > 0 && o->batch <= 1) || o->iterations < 1 || !(o->min_gain >= 0) ||
+	    o->max_visits < 16 || o->max_visits > (1 << 24) || o->max_leaf < 1 ||
+	    o->max_leaf > 64) {
+		host->set_error(ctx, "options out of range");
+		return -EINVAL;
+	}
+	return 0;
+}
+
+/* ---- candidates --------------------------------------------------------- */
+
+/* A node's cost: what it adds to the SAH, area times primitives for a leaf. */
+static double cost_of(const bvhlab_node *n)
+{
+	return node_area(n) * (n->count ? n->count : 1);
+}
+
+static int descending(const void *a, const void *b)
+{
+	uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+
+	return (x < y) - (x > y);
+}
+
+/*
+ * Puts the k largest of keys[0 .. n) first, in any order: a histogram of
+ * the top 16 bits finds the bucket where the k-th largest lies; keys of
+ * higher buckets are taken whole, that bucket's own are sorted to take
+ * what is left. Linear, and deterministic.
+ */
+static void select_largest(uint64_t *keys, uint32_t n, uint32_t k, uint32_t *hist)
+{
+	uint32_t at = 0, above = 0, split = 0, mid;
+
+	memset(hist, 0, 65536 * sizeof(*hist));
+	for (uint32_t j = 0; j < n; j++)
+		hist[keys[j] >> 48]++;
+	for (split = 65535; above + hist[split] < k; split--)
+		above += hist[split];
+	/* keys above the split bucket first, then the bucket's own */
+	for (uint32_t j = 0; j < n; j++)
+		if (keys[j] >> 48 > split) {
+			uint64_t t = keys[at];
+			keys[at++] = keys[j];
+			keys[j] = t;
+		}
+	mid = at;
+	for (uint32_t j = at; j < n; j++)
+		if (keys[j] >> 48 == split) {
+			uint64_t t = keys[at];
+			keys[at++] = keys[j];
+			keys[j] = t;
+		}
+	qsort(keys + mid, at - mid, sizeof(*keys), descending);
+}
+
+/* The batch: the nodes of largest cost, ties to the lower slot. Keys are
+ * the cost's float bits (non-negative floats order as integers) above the
+ * slot's complement. */
+static void choose(reinsert *r, double batch)
+{
+	uint32_t n = r->node_count - 1, k = (uint32_t)(batch * n);
+
+	k = k < 1 ? 1 : k > n ? n : k;
+	for (uint32_t x = 1; x < r->node_count; x++) {
+		float c = (float)cost_of(&r->nodes[x]);
+		uint32_t bits;
+
+		memcpy(&bits, &c, sizeof(bits));
+		r->keys[x - 1] = (uint64_t)bits << 32 | (UINT32_MAX - x);
+	}
+	select_largest(r->keys, n, k, r->hist);
+	for (uint32_t j = 0; j < k; j++)
+		r->cand[j] = UINT32_MAX - (uint32_t)r->keys[j];
+	r->cand_count = k;
+}
+
+/* ---- iterations ----------------------------------------------------------- */
+
+static void find_parents(reinsert *r)
+{
+	r->parent[0] = NO_NODE;
+	for (uint32_t x = 0; x < r->node_count; x++)
+		if (r->nodes[x].count == 0)
+			r->parent[r->nodes[x].first] = r->parent[r->nodes[x].first + 1] = x;
+}
+
+static double inner_area(const reinsert *r)
+{
+	double sum = 0;
+
+	for (uint32_t x = 0; x < r->node_count; x++)
+		sum += cost_of(&r->nodes[x]);
+	return sum;
+}
+
+static int by_gain(const void *a, const void *b)
+{
+	const struct move *x = a, *y = b;
+
+	if (x->gain != y->gain)
+		return x->gain < y->gain ? 1 : -1;
+	return (x->node > y->node) - (x->node < y->node);
+}
+
+/* The moves by decreasing predicted gain; returns the exact change. */
+static double apply(reinsert *r)
+{
+	uint32_t count = 0;
+	double change = 0;
+
+	for (uint32_t k = 0; k < r->cand_count; k++)
+		if (r->moves[k].dest != NO_NODE && r->moves[k].gain > 0)
+			r->moves[count++] = r->moves[k];
+	qsort(r->moves, count, sizeof(*r->moves), by_gain);
+	for (uint32_t k = 0; k < count; k++)
+		change += reinsert_try(r, r->moves[k].node, r->moves[k].dest);
+	return change;
+}
+
+static void search_member(void *arg, unsigned t)
+{
+	(void)t;
+	reinsert_search(arg);
+}
+
+static int iterate(reinsert *r, const struct params *o, uint32_t threads, uint32_t cpus)
+{
+	double total = inner_area(r);
+
+	for (int64_t it = 0; it < o->iterations; it++) {
+		double change;
+		int rc;
+
+		choose(r, o->batch);
+		atomic_store_explicit(&r->next, 0, memory_order_relaxed);
+		if ((rc = team_run(&r->team, threads, cpus, search_member, r)) < 0)
+			return rc;
+		change = apply(r);
+		if (-change < o->min_gain * total || change == 0)
+			break;
+		total += change;
+	}
+	return 0;
+}
+
+/* ---- refine ------------------------------------------------------------- */
+
+/* The tree as it came in, to put back if splitting leaves did not pay. */
+struct saved {
+	bvhlab_node *nodes;
+	uint32_t *index;
+	uint32_t node_count;
+	double sah;
+};
+
+static int save(struct saved *s, const bvhlab_build_output *t)
+{
+	s->node_count = t->node_count;
+	s->nodes = malloc((size_t)t->node_count * sizeof(*s->nodes));
+	s->index = malloc((size_t)t->index_count * sizeof(*s->index));
+	if (!s->nodes || !s->index)
+		return -ENOMEM;
+	memcpy(s->nodes, t->nodes, (size_t)t->node_count * sizeof(*s->nodes));
+	memcpy(s->index, t->prim_index, (size_t)t->index_count * sizeof(*s->index));
+	s->sah = reinsert_sah(t->nodes, t->node_count);
+	return 0;
+}
+
+/* Keeps the cut tree only when its SAH is lower than the saved one's. */
+static void keep_or_restore(const struct saved *s, bvhlab_build_output *t)
+{
+	if (reinsert_sah(t->nodes, t->node_count) < s->sah)
+		return;
+	memcpy(t->nodes, s->nodes, (size_t)s->node_count * sizeof(*s->nodes));
+	memcpy(t->prim_index, s->index, (size_t)t->index_count * sizeof(*s->index));
+	t->node_count = s->node_count;
+}
+
+/* Room for the split leaves; false (go on without splitting) if refused. */
+static bool split_leaves(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                         const bvhlab_build_input *in, bvhlab_build_output *t)
+{
+	uint32_t need = reinsert_split_room(t);
+
+	if (need > t->node_capacity &&
+	    (need == UINT32_MAX || host->grow_output(ctx, t, need, t->index_capacity) < 0))
+		return false;
+	reinsert_split_leaves(t, in);
+	return true;
+}
+
+static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct params *o,
+                    const bvhlab_build_input *input, bvhlab_build_output *tree)
+{
+	reinsert r = { .nodes = tree->nodes, .node_count = tree->node_count,
+	               .max_visits = (uint32_t)o->max_visits };
+	size_t n = tree->node_count;
+	int rc;
+
+	r.parent = malloc(n * sizeof(*r.parent));
+	r.cand = malloc(n * sizeof(*r.cand));
+	r.moves = malloc(n * sizeof(*r.moves));
+	r.keys = malloc(n * sizeof(*r.keys));
+	r.hist = malloc(65536 * sizeof(*r.hist));
+	if (!r.parent || !r.cand || !r.moves || !r.keys || !r.hist) {
+		host->set_error(ctx, "out of memory for %zu nodes", n);
+		rc = -ENOMEM;
+		goto out;
+	}
+	find_parents(&r);
+	if ((rc = iterate(&r, o, input->threads, host->hardware_threads(ctx))) < 0)
+		host->set_error(ctx, "cannot start the search threads");
+out:
+	free(r.parent);
+	free(r.cand);
+	free(r.moves);
+	free(r.keys);
+	free(r.hist);
+	return rc;
+}
+
+static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                  const bvhlab_build_input *input, bvhlab_build_output *tree)
+{
+	struct saved s = { 0 };
+	struct params o;
+	bool split = false;
+	int rc;
+
+	if ((rc = read_options(host, ctx, &o)) < 0)
+		return rc;
+	if (tree->node_count < 3 && !(o.leaves && tree->node_count == 1 && tree->nodes[0].count > 1))
+		return 0; /* nothing can move */
+	if (o.leaves) {
+		if ((rc = save(&s, tree)) < 0) {
+			host->set_error(ctx, "out of memory for a copy of the tree");
+			goto out;
+		}
+		split = split_leaves(host, ctx, input, tree);
+	}
+	if (tree->node_count >= 3 && (rc = optimise(host, ctx, &o, input, tree)) < 0)
+		goto out;
+	if (split && (rc = reinsert_collapse(tree, (uint32_t)o.max_leaf)) < 0)
+		host->set_error(ctx, "out of memory for the collapse");
+	if (split && rc == 0)
+		keep_or_restore(&s, tree);
+out:
+	free(s.nodes);
+	free(s.index);
+	return rc;
+}
+
+BVHLAB_PLUGIN(
+	.name = "reinsert",
+	.summary = "refinement: parallel search, exact one-thread application of subtree "
+	           "reinsertions (Bittner et al. 2013, Meister & Bittner 2018)",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	.option_count = OPTION_COUNT,
+	.options = options,
+	.build = NULL,
+	.refine = refine)

@@ -1,0 +1,104 @@
+/*
+ * reinsert: a refinement stage (ABI 1.2 refine) that improves a finished
+ * tree's SAH by moving subtrees to better places, after Bittner, Hapala &
+ * Havran 2013 (insertion-based optimisation) and the batched parallel form
+ * of Meister & Bittner 2018. Each iteration:
+ *
+ *   1. candidates  the `batch` fraction of nodes with the largest cost
+ *                  (surface area, times the primitive count for a leaf)
+ *                  (reinsert.c)
+ *   2. search      for every candidate, in parallel over the threads, the
+ *                  node beside which it would cost least: what taking it
+ *                  out saves (exactly) against what putting it back costs,
+ *                  by branch and bound from the root (reinsert_search.c)
+ *   3. apply       on one thread, the moves by decreasing predicted gain:
+ *                  each is carried out and refitted while the exact change
+ *                  of the inner nodes' summed area is added up, and taken
+ *                  back (the inverse move restores the same boxes) unless
+ *                  that change is negative (reinsert_move.c)
+ *
+ * So the SAH never rises, every kept move lowers it, the tree stays a
+ * valid tree in the standard layout (a move reuses the freed pair of
+ * slots) and the result depends on nothing but the tree and the options:
+ * the same for every thread count. The loop stops after `iterations`, or
+ * when an iteration lowers the SAH by less than `min_gain` of it.
+ */
+#ifndef BVHLAB_REINSERT_H
+#define BVHLAB_REINSERT_H
+
+#include <stdatomic.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <bvhlab/aabb.h>
+#include <bvhlab/builder.h>
+
+#include "team.h"
+
+#define NO_NODE UINT32_MAX
+
+/* A candidate's best move: beside `dest`, saving `gain` (area units). */
+struct move {
+	uint32_t node, dest;
+	double gain;
+};
+
+typedef struct reinsert {
+	bvhlab_node *nodes;
+	uint32_t node_count;
+	uint32_t *parent;       /* [node_count] parent slot, NO_NODE at the root */
+	uint32_t *cand;         /* [node_count] this iteration's candidates */
+	uint32_t cand_count;
+	struct move *moves;     /* [node_count] one per candidate */
+	uint64_t *keys;         /* [node_count] scratch of the selection */
+	uint32_t *hist;         /* [65536] scratch of the selection */
+	uint32_t max_visits;    /* nodes a search may take from its queue */
+	atomic_uint next;       /* candidates handed out in the search */
+	team team;
+} reinsert;
+
+/* The surface area as the core's SAH metric computes it, so that the
+ * bookkeeping adds up to the reported cost. */
+static inline double area_of(const float lo[3], const float hi[3])
+{
+	return bvhlab_box_area(lo, hi);
+}
+
+static inline double node_area(const bvhlab_node *n)
+{
+	return area_of(n->lo, n->hi);
+}
+
+static inline void box_union(const bvhlab_node *a, const bvhlab_node *b, float lo[3],
+                             float hi[3])
+{
+	for (int k = 0; k < 3; k++) {
+		lo[k] = bvhlab_minf(a->lo[k], b->lo[k]);
+		hi[k] = bvhlab_maxf(a->hi[k], b->hi[k]);
+	}
+}
+
+static inline uint32_t sibling_of(const reinsert *r, uint32_t x)
+{
+	uint32_t first = r->nodes[r->parent[x]].first;
+
+	return x == first ? first + 1 : first;
+}
+
+/* Member t's share of the candidates: their best moves (reinsert_search.c). */
+void reinsert_search(reinsert *r);
+
+/* Carries out the move if it lowers the summed area; the change (negative)
+ * or 0 when the move was refused or taken back (reinsert_move.c). */
+double reinsert_try(reinsert *r, uint32_t node, uint32_t dest);
+
+/* With option `leaves` (reinsert_leaves.c): the node count once every
+ * leaf is split; the split; the SAH cost as the core's metric; the SAH
+ * collapse that cuts the tree into leaves of at most max_leaf again
+ * (0 or -ENOMEM, the tree untouched then). */
+uint32_t reinsert_split_room(const bvhlab_build_output *t);
+void reinsert_split_leaves(bvhlab_build_output *t, const bvhlab_build_input *in);
+double reinsert_sah(const bvhlab_node *nodes, uint32_t count);
+int reinsert_collapse(bvhlab_build_output *t, uint32_t max_leaf);
+
+#endif /* BVHLAB_REINSERT_H */

@@ -1,0 +1,98 @@
+/*
+ * reinsert: carrying out one move with exact bookkeeping.
+ *
+ * A move takes node N (slot x) from its parent P (slot p), whose other
+ * child S (slot s) takes P's slot, and puts it beside node X (slot d): X
+ * moves into the pair N and S left, {x, s}, and a new inner node, their
+ * parent, takes slot d. No slot is allocated or freed, so the tree keeps
+ * its node count and layout rules. Then the boxes are refitted upwards
+ * from where P was and from d, while the change of every inner node's
+ * area is added up: that is the exact change of the SAH metric's inner
+ * sum (leaves keep their boxes), so a move is kept only when the sum
+ * falls. The inverse of a move is the move of N back beside S, which
+ * restores the same slots and, boxes being unions, the same boxes.
+ */
+#include "reinsert.h"
+
+static void adopt_children(reinsert *r, uint32_t slot)
+{
+	const bvhlab_node *n = &r->nodes[slot];
+
+	if (n->count == 0)
+		r->parent[n->first] = r->parent[n->first + 1] = slot;
+}
+
+/* Boxes from `slot` up to the root, as unions of the children; adds the
+ * area changes to *delta. Stops where a box comes out unchanged: nothing
+ * above can change then (the other path is refitted on its own). */
+static void refit_up(reinsert *r, uint32_t slot, double *delta)
+{
+	for (; slot != NO_NODE; slot = r->parent[slot]) {
+		bvhlab_node *n = &r->nodes[slot];
+		float lo[3], hi[3];
+		double before = node_area(n);
+
+		box_union(&r->nodes[n->first], &r->nodes[n->first + 1], lo, hi);
+		if (lo[0] == n->lo[0] && lo[1] == n->lo[1] && lo[2] == n->lo[2] &&
+		    hi[0] == n->hi[0] && hi[1] == n->hi[1] && hi[2] == n->hi[2])
+			return;
+		for (int k = 0; k < 3; k++) {
+			n->lo[k] = lo[k];
+			n->hi[k] = hi[k];
+		}
+		*delta += node_area(n) - before;
+	}
+}
+
+/* Whether slot d lies in the subtree of slot x (x itself included). */
+static bool below(const reinsert *r, uint32_t d, uint32_t x)
+{
+	for (; d != NO_NODE; d = r->parent[d])
+		if (d == x)
+			return true;
+	return false;
+}
+
+/* The move itself, valid by the caller's checks; returns the area change. */
+static double move(reinsert *r, uint32_t x, uint32_t d)
+{
+	uint32_t p = r->parent[x], s = sibling_of(r, x), pair = r->nodes[p].first;
+	double delta = -node_area(&r->nodes[p]);
+	bvhlab_node *parent;
+
+	/* out: S into P's slot */
+	r->nodes[p] = r->nodes[s];
+	adopt_children(r, p);
+	/* in: X into S's old slot, beside N; their new parent into X's slot */
+	r->nodes[s] = r->nodes[d];
+	adopt_children(r, s);
+	parent = &r->nodes[d];
+	box_union(&r->nodes[x], &r->nodes[s], parent->lo, parent->hi);
+	parent->first = pair;
+	parent->count = 0;
+	r->parent[x] = r->parent[s] = d;
+	delta += node_area(parent);
+	refit_up(r, r->parent[p], &delta);
+	refit_up(r, r->parent[d], &delta);
+	return delta;
+}
+
+double reinsert_try(reinsert *r, uint32_t x, uint32_t d)
+{
+	uint32_t p, s;
+	double delta;
+
+	if (x == 0 || x >= r->node_count || d >= r->node_count)
+		return 0;
+	p = r->parent[x];
+	s = sibling_of(r, x);
+	/* beside P or S would change nothing; inside N is no tree */
+	if (d == p || d == s || below(r, d, x))
+		return 0;
+	delta = move(r, x, d);
+	if (delta < 0)
+		return delta;
+	/* S now sits in P's old slot p; N goes back beside it */
+	(void)move(r, x, p);
+	return 0;
+}

@@ -1,0 +1,134 @@
+/*
+ * reinsert: the search for each candidate's best new place (read-only on
+ * the tree, so the threads share it without locks; each candidate's
+ * result goes to its own entry).
+ *
+ * Taking node N out of its parent P saves P's area and shrinks P's
+ * ancestors: computed exactly by refitting that path without N in a few
+ * local boxes. Putting N beside node X costs the new parent's area,
+ * SA(N u X), plus the growth of X's ancestors, SA(A u N) - SA(A) each (the
+ * induced cost). Branch and bound from the root (Bittner et al. 2013):
+ * nodes in a priority queue by induced cost; no placement below a node
+ * can cost less than its induced cost plus SA(N), which prunes. The
+ * induced costs use the boxes with N still in place, a small error on
+ * the paths through P that the exact bookkeeping of the move settles.
+ */
+#include "reinsert.h"
+
+/* The queue: a binary min-heap on induced cost, of bounded size (a full
+ * queue drops what it cannot take: the search then only sees less). */
+#define QUEUE_SIZE 1024
+
+struct entry {
+	double induced;
+	uint32_t node;
+};
+
+struct queue {
+	struct entry e[QUEUE_SIZE];
+	uint32_t size;
+};
+
+static void push(struct queue *q, double induced, uint32_t node)
+{
+	uint32_t k;
+
+	if (q->size == QUEUE_SIZE)
+		return;
+	for (k = q->size++; k > 0 && q->e[(k - 1) / 2].induced > induced; k = (k - 1) / 2)
+		q->e[k] = q->e[(k - 1) / 2];
+	q->e[k] = (struct entry){ induced, node };
+}
+
+static struct entry pop(struct queue *q)
+{
+	struct entry top = q->e[0], last = q->e[--q->size];
+	uint32_t k = 0;
+
+	for (;;) {
+		uint32_t c = 2 * k + 1;
+
+		if (c >= q->size)
+			break;
+		if (c + 1 < q->size && q->e[c + 1].induced < q->e[c].induced)
+			c++;
+		if (!(q->e[c].induced < last.induced))
+			break;
+		q->e[k] = q->e[c];
+		k = c;
+	}
+	q->e[k] = last;
+	return top;
+}
+
+/* What taking node x out saves: its parent's area and the shrinking of
+ * the parent's ancestors, refitted without it. */
+static double removal_gain(const reinsert *r, uint32_t x)
+{
+	uint32_t p = r->parent[x], from = p;
+	double gain = node_area(&r->nodes[p]);
+	bvhlab_node box = r->nodes[sibling_of(r, x)];
+
+	for (uint32_t a = r->parent[p]; a != NO_NODE; from = a, a = r->parent[a]) {
+		const bvhlab_node *n = &r->nodes[a];
+		const bvhlab_node *other = &r->nodes[n->first == from ? n->first + 1 : n->first];
+		double before = node_area(n), after;
+
+		box_union(&box, other, box.lo, box.hi);
+		after = area_of(box.lo, box.hi);
+		if (after == before)
+			break; /* the boxes above keep their areas too */
+		gain += before - after;
+	}
+	return gain;
+}
+
+/* The cheapest place beside which to put node x; NO_NODE if none. */
+static uint32_t best_place(const reinsert *r, uint32_t x, double *cost, struct queue *q)
+{
+	const bvhlab_node *n = &r->nodes[x];
+	uint32_t p = r->parent[x], s = sibling_of(r, x), best = NO_NODE, visits = 0;
+	double least = *cost, own = node_area(n);
+
+	q->size = 0;
+	push(q, 0, 0);
+	while (q->size && visits++ < r->max_visits) {
+		struct entry e = pop(q);
+		const bvhlab_node *at = &r->nodes[e.node];
+		float lo[3], hi[3];
+		double direct, grown;
+
+		if (e.induced + own >= least)
+			break; /* the rest of the queue costs at least as much */
+		if (e.node == x)
+			continue; /* nothing inside N */
+		box_union(n, at, lo, hi);
+		direct = area_of(lo, hi);
+		if (e.induced + direct < least && e.node != p && e.node != s) {
+			least = e.induced + direct;
+			best = e.node;
+		}
+		grown = e.induced + direct - node_area(at);
+		if (at->count == 0 && grown + own < least) {
+			push(q, grown, at->first);
+			push(q, grown, at->first + 1);
+		}
+	}
+	*cost = least;
+	return best;
+}
+
+void reinsert_search(reinsert *r)
+{
+	struct queue q;
+	uint32_t lo, hi;
+
+	while (team_next_block(&r->next, r->cand_count, 64, &lo, &hi))
+		for (uint32_t k = lo; k < hi; k++) {
+			uint32_t x = r->cand[k];
+			double gain = removal_gain(r, x), cost = gain;
+			uint32_t dest = best_place(r, x, &cost, &q);
+
+			r->moves[k] = (struct move){ x, dest, dest == NO_NODE ? 0 : gain - cost };
+		}
+}

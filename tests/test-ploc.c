@@ -1,0 +1,176 @@
+/*
+ * ploc: on generated scenes (coincident centroids, needles, duplicates,
+ * 1 to 3 triangles) and on the shared meshes, with radius 1, 4 and 16 and
+ * with and without collapse, every build is valid, traces like brute
+ * force, keeps leaves within max_leaf, and is the same tree, node for
+ * node, for 1, 2 and 8 threads and when repeated. Collapse never raises
+ * the SAH cost. Under ThreadSanitizer the scenes shrink.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "testutil.h"
+
+#define FIXTURE_SEED 15
+#include "scene_fixture.h"
+#include "refine_scenes.h"
+
+#define RAYS 256
+#define RAY_SEED 1515
+
+static const uint32_t thread_counts[] = { 1, 2, 8 };
+#define THREAD_COUNTS (sizeof(thread_counts) / sizeof(thread_counts[0]))
+
+static bvhlab_plugin *plugin;
+
+struct setup {
+	uint32_t radius;
+	bool collapse;
+};
+
+static int build_valid(const char *name, const bvhlab_build_input *in, const struct setup *s,
+                       uint32_t threads, bvhlab_tree *tree)
+{
+	bvhlab_options opts;
+	bvhlab_error err = { { 0 } };
+	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin));
+
+	if (rc == 0)
+		rc = bvhlab_options_set_int(&opts, "radius", s->radius, &err);
+	if (rc == 0)
+		rc = bvhlab_options_set_bool(&opts, "collapse", s->collapse, &err);
+	if (rc == 0)
+		rc = bvhlab_build(plugin, &opts, in, threads, tree, &err);
+	if (rc == 0)
+		rc = bvhlab_validate_tree(tree, in, false, &err);
+	if (rc != 0) {
+		fprintf(stderr, "%s radius=%u collapse=%d threads=%u: %s\n", name, s->radius,
+		        s->collapse, threads, err.message);
+		CHECK(!"valid build");
+	}
+	bvhlab_options_finish(&opts);
+	return rc;
+}
+
+static void check_same(const char *name, const bvhlab_tree *ref, const bvhlab_tree *tree,
+                       uint32_t threads)
+{
+	CHECK_INT(tree->node_count, ref->node_count);
+	CHECK_INT(tree->index_count, ref->index_count);
+	if (tree->node_count != ref->node_count || tree->index_count != ref->index_count)
+		return;
+	if (memcmp(tree->nodes, ref->nodes, ref->node_count * sizeof(bvhlab_node)) != 0 ||
+	    memcmp(tree->prim_index, ref->prim_index, ref->index_count * sizeof(uint32_t)) != 0) {
+		fprintf(stderr, "%s: %u threads built another tree than 1\n", name, threads);
+		CHECK(!"same tree for every thread count");
+	}
+}
+
+/* The 1-thread tree in full, every other thread count (twice for 2)
+ * against it; returns its SAH cost. */
+static double check_setup(const char *name, const bvhlab_scene *scene,
+                          const bvhlab_build_input *in, const struct setup *s, uint32_t rays)
+{
+	bvhlab_tree ref = { 0 }, tree = { 0 };
+	bvhlab_tree_stats stats = { 0 };
+	bvhlab_error err = { { 0 } };
+	uint64_t mismatches = 1;
+
+	if (build_valid(name, in, s, 1, &ref) != 0)
+		goto out;
+	CHECK_INT(ref.index_count, in->prim_count);
+	if (!s->collapse)
+		CHECK_INT(ref.node_count, 2 * in->prim_count - 1);
+	CHECK_INT(bvhlab_validate_rays(&ref, scene, rays, RAY_SEED, &mismatches, &err), 0);
+	CHECK_INT(mismatches, 0);
+	bvhlab_tree_stats_compute(&ref, &stats);
+	for (uint32_t i = 0; i < ref.node_count; i++)
+		CHECK(ref.nodes[i].count <= (s->collapse ? 8u : 1u));
+	for (size_t t = 0; t <= THREAD_COUNTS; t++) {
+		uint32_t threads = t < THREAD_COUNTS ? thread_counts[t] : 2;
+		if (build_valid(name, in, s, threads, &tree) == 0)
+			check_same(name, &ref, &tree, threads);
+	}
+out:
+	bvhlab_tree_finish(&ref);
+	bvhlab_tree_finish(&tree);
+	return stats.sah_cost;
+}
+
+static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
+{
+	static const uint32_t radii[] = { 1, 4, 16 };
+	bvhlab_prims prims;
+	bvhlab_error err = { { 0 } };
+
+	if (!scene)
+		return;
+	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
+	for (size_t k = 0; k < sizeof(radii) / sizeof(radii[0]); k++) {
+		struct setup on = { .radius = radii[k], .collapse = true };
+		struct setup off = { .radius = radii[k], .collapse = false };
+		double with = check_setup(name, scene, &prims.input, &on, rays);
+		double without = check_setup(name, scene, &prims.input, &off, rays);
+
+		printf("%-18s %8u triangles  radius %2u  SAH collapse %9.4f  single %9.4f\n", name,
+		       scene->triangle_count, radii[k], with, without);
+		CHECK(with <= without * (1 + 1e-6));
+	}
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+static void test_descriptor(void)
+{
+	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
+	bvhlab_options opts;
+	bvhlab_error err = { { 0 } };
+
+	CHECK(strcmp(b->name, "ploc") == 0);
+	CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
+	CHECK(b->build != NULL);
+	CHECK(bvhlab_builder_refine(b) == NULL);
+	CHECK_INT(bvhlab_options_init(&opts, b), 0);
+	CHECK_INT(opts.values[bvhlab_options_find(&opts, "radius")].i, 16);
+	CHECK(bvhlab_options_set_int(&opts, "radius", 0, &err) < 0);
+	CHECK(bvhlab_options_set_int(&opts, "radius", 65, &err) < 0);
+	bvhlab_options_finish(&opts);
+}
+
+int main(void)
+{
+	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "ogre.obj",
+	                                      "igea.ply" };
+	bvhlab_error err = { { 0 } };
+	struct stat st;
+
+	if (bvhlab_plugin_open("ploc", &plugin, &err) < 0) {
+		fprintf(stderr, "%s\n", err.message);
+		CHECK(!"ploc loads");
+		return test_finish();
+	}
+	test_descriptor();
+	test_scene("soup", generate("soup", SCALE(20000, 3000), 0, 0), RAYS);
+	test_scene("icosphere", generate("icosphere", 0, SCALE(30, 10), 0), RAYS);
+	test_scene("stadium", generate("stadium", SCALE(20000, 3000), 0, 0), RAYS);
+	test_scene("identical", identical_scene(SCALE(3000, 600)), RAYS);
+	test_scene("needles", needle_scene(SCALE(5000, 800)), RAYS);
+	test_scene("one", generate("soup", 1, 0, 0), RAYS);
+	test_scene("two", generate("soup", 2, 0, 0), RAYS);
+	test_scene("three", generate("soup", 3, 0, 0), RAYS);
+	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
+		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
+	} else {
+		for (size_t i = 0; i < (UNDER_TSAN ? 1 : sizeof(shared) / sizeof(shared[0])); i++) {
+			bvhlab_scene *scene = load_shared(shared[i]);
+			if (scene)
+				test_scene(shared[i], scene, 64);
+		}
+	}
+	bvhlab_plugin_close(plugin);
+	return test_finish();
+}

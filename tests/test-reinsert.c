@@ -1,0 +1,308 @@
+/*
+ * reinsert, the refinement stage (ABI 1.2 refine): after lbvh, sah_seq
+ * and ploc, on generated scenes (coincident centroids, needles, 2 and 3
+ * triangles) and shared meshes, the refined tree is valid, traces like
+ * brute force, keeps its index count, never has a higher SAH
+ * cost than the tree it started from (and lower where the builder left
+ * room), and is the same tree, node for node, for 1 and 2 threads. Also:
+ * the descriptor, the host's refusals, a config's "refine" list and the
+ * harness's timed series with stages. Both modes: leaves split and re-cut
+ * by the SAH (the node count may change), and subtree moves only.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "config/config.h"
+#include "harness/harness.h"
+#include "testutil.h"
+
+#define FIXTURE_SEED 18
+#include "scene_fixture.h"
+#include "refine_scenes.h"
+
+#define RAYS 256
+#define RAY_SEED 1818
+
+static bvhlab_plugin *refiner;
+
+static void tree_dup(bvhlab_tree *dst, const bvhlab_tree *src)
+{
+	CHECK_INT(bvhlab_tree_init(dst, src->node_count, src->index_count), 0);
+	memcpy(dst->nodes, src->nodes, src->node_count * sizeof(bvhlab_node));
+	memcpy(dst->prim_index, src->prim_index, src->index_count * sizeof(uint32_t));
+	dst->node_count = src->node_count;
+	dst->index_count = src->index_count;
+}
+
+static double sah(const bvhlab_tree *t)
+{
+	bvhlab_tree_stats st;
+
+	bvhlab_tree_stats_compute(t, &st);
+	return st.sah_cost;
+}
+
+/* Leaves split and re-cut (the default), or subtree moves only. */
+static bool split_leaves = true;
+
+/* Refines `tree` in place with the test's options; 0 or the failure. */
+static int refine(const bvhlab_build_input *in, uint32_t threads, bvhlab_tree *tree)
+{
+	bvhlab_options opts;
+	bvhlab_error err = { { 0 } };
+	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(refiner));
+
+	if (rc == 0)
+		rc = bvhlab_options_parse(&opts, "batch=0.25", &err);
+	if (rc == 0)
+		rc = bvhlab_options_parse(&opts, "iterations=3", &err);
+	if (rc == 0)
+		rc = bvhlab_options_set_bool(&opts, "leaves", split_leaves, &err);
+	if (rc == 0)
+		rc = bvhlab_refine(refiner, &opts, in, threads, tree, &err);
+	if (rc < 0)
+		fprintf(stderr, "refine: %s\n", err.message);
+	bvhlab_options_finish(&opts);
+	return rc;
+}
+
+/* One builder's tree, refined with 1 and 2 threads. */
+static void check_builder(const char *name, const char *builder, const bvhlab_scene *scene,
+                          const bvhlab_build_input *in, uint32_t rays)
+{
+	bvhlab_plugin *p = NULL;
+	bvhlab_options opts = { 0 };
+	bvhlab_tree built = { 0 }, one = { 0 }, two = { 0 };
+	bvhlab_error err = { { 0 } };
+	uint64_t mismatches = 1;
+	double before, after;
+
+	if (bvhlab_plugin_open(builder, &p, &err) < 0 || bvhlab_options_init(&opts,
+	    bvhlab_plugin_builder(p)) < 0 || bvhlab_build(p, &opts, in, 2, &built, &err) < 0) {
+		fprintf(stderr, "%s %s: %s\n", name, builder, err.message);
+		CHECK(!"builder builds");
+		goto out;
+	}
+	tree_dup(&one, &built);
+	tree_dup(&two, &built);
+	CHECK_INT(refine(in, 1, &one), 0);
+	CHECK_INT(refine(in, 2, &two), 0);
+	CHECK_INT(bvhlab_validate_tree(&one, in, false, &err), 0);
+	CHECK_INT(bvhlab_validate_rays(&one, scene, rays, RAY_SEED, &mismatches, &err), 0);
+	CHECK_INT(mismatches, 0);
+	if (!split_leaves) /* moves keep every node; a new cut of leaves does not */
+		CHECK_INT(one.node_count, built.node_count);
+	CHECK_INT(one.index_count, built.index_count);
+	before = sah(&built);
+	after = sah(&one);
+	printf("%-18s %-8s %8u triangles  leaves %d  SAH %9.4f -> %9.4f\n", name, builder,
+	       scene->triangle_count, split_leaves, before, after);
+	CHECK(after <= before * (1 + 1e-12));
+	CHECK(one.node_count == two.node_count &&
+	      memcmp(one.nodes, two.nodes, one.node_count * sizeof(bvhlab_node)) == 0 &&
+	      memcmp(one.prim_index, two.prim_index, one.index_count * sizeof(uint32_t)) == 0);
+	/* Again on the refined tree: still never higher. */
+	CHECK_INT(refine(in, 2, &two), 0);
+	CHECK_INT(bvhlab_validate_tree(&two, in, false, &err), 0);
+	CHECK(sah(&two) <= after * (1 + 1e-12));
+out:
+	bvhlab_tree_finish(&built);
+	bvhlab_tree_finish(&one);
+	bvhlab_tree_finish(&two);
+	if (opts.values)
+		bvhlab_options_finish(&opts);
+	bvhlab_plugin_close(p);
+}
+
+/* Every builder on one scene, in both modes. */
+static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
+{
+	static const char *const builders[] = { "lbvh", "sah_seq", "ploc" };
+	bvhlab_prims prims;
+	bvhlab_error err = { { 0 } };
+
+	if (!scene)
+		return;
+	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
+	for (int mode = 0; mode < 2; mode++) {
+		split_leaves = mode == 0;
+		for (size_t b = 0; b < sizeof(builders) / sizeof(builders[0]); b++)
+			check_builder(name, builders[b], scene, &prims.input, rays);
+	}
+	split_leaves = true;
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+/* On a real mesh lbvh leaves room: the refinement must find some. */
+static void test_improves(void)
+{
+	bvhlab_scene *scene = generate("icosphere", 0, SCALE(40, 12), 0);
+	bvhlab_plugin *lbvh = NULL;
+	bvhlab_options opts = { 0 };
+	bvhlab_prims prims = { 0 };
+	bvhlab_tree tree = { 0 };
+	bvhlab_error err = { { 0 } };
+
+	if (!scene || bvhlab_prims_init(&prims, scene, &err) < 0 ||
+	    bvhlab_plugin_open("lbvh", &lbvh, &err) < 0 ||
+	    bvhlab_options_init(&opts, bvhlab_plugin_builder(lbvh)) < 0 ||
+	    bvhlab_build(lbvh, &opts, &prims.input, 1, &tree, &err) < 0) {
+		CHECK(!"lbvh on an icosphere");
+	} else {
+		double before = sah(&tree);
+		CHECK_INT(refine(&prims.input, 2, &tree), 0);
+		CHECK(sah(&tree) < before * 0.99);
+	}
+	bvhlab_tree_finish(&tree);
+	if (opts.values)
+		bvhlab_options_finish(&opts);
+	bvhlab_plugin_close(lbvh);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+/* A refinement-only plugin cannot build; a builder cannot refine. */
+static void test_descriptor(void)
+{
+	const bvhlab_builder *b = bvhlab_plugin_builder(refiner);
+	bvhlab_scene *scene = generate("soup", 50, 0, 0);
+	bvhlab_plugin *lbvh = NULL;
+	bvhlab_options opts, lopts = { 0 };
+	bvhlab_prims prims = { 0 };
+	bvhlab_tree tree = { 0 };
+	bvhlab_error err = { { 0 } };
+
+	CHECK(strcmp(b->name, "reinsert") == 0);
+	CHECK(b->build == NULL && bvhlab_builder_refine(b) != NULL);
+	CHECK_INT(bvhlab_options_init(&opts, b), 0);
+	if (scene && bvhlab_prims_init(&prims, scene, &err) == 0) {
+		CHECK_INT(bvhlab_build(refiner, &opts, &prims.input, 1, &tree, &err), -ENOTSUP);
+		CHECK_CONTAINS(err.message, "refine");
+		CHECK_INT(bvhlab_plugin_open("lbvh", &lbvh, &err), 0);
+		CHECK_INT(bvhlab_options_init(&lopts, bvhlab_plugin_builder(lbvh)), 0);
+		CHECK_INT(bvhlab_build(lbvh, &lopts, &prims.input, 1, &tree, &err), 0);
+		CHECK_INT(bvhlab_refine(lbvh, &lopts, &prims.input, 1, &tree, &err), -ENOTSUP);
+	}
+	bvhlab_options_finish(&opts);
+	if (lopts.values)
+		bvhlab_options_finish(&lopts);
+	bvhlab_plugin_close(lbvh);
+	bvhlab_tree_finish(&tree);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+/* "refine" in a config: the default name, and errors naming the key. */
+static void test_config(void)
+{
+	static const char *const bad[][2] = {
+		{ "\"refine\": 3", "builders[0].refine" },
+		{ "\"refine\": []", "builders[0].refine" },
+		{ "\"refine\": [{\"options\": {}}]", "builders[0].refine[0]" },
+		{ "\"refine\": [{\"plugin\": \"reinsert\", \"batch\": 1}]", "batch" },
+	};
+	const char *head = "{\"format_version\": 1, \"scenes\": [{\"generator\": \"soup\"}], "
+	                   "\"builders\": [{\"plugin\": \"lbvh\", ";
+	char text[512];
+	struct config cfg;
+	bvhlab_error err = { { 0 } };
+
+	snprintf(text, sizeof(text), "%s\"refine\": [{\"plugin\": \"reinsert\", \"options\": "
+	         "{\"batch\": 0.1}}, {\"plugin\": \"reinsert\"}]}]}", head);
+	CHECK_INT(config_parse(&cfg, "t.json", text, &err), 0);
+	if (cfg.builder_count == 1) {
+		CHECK(strcmp(cfg.builders[0].name, "lbvh+reinsert+reinsert") == 0);
+		CHECK_INT(cfg.builders[0].refine_count, 2);
+	}
+	config_finish(&cfg);
+	for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
+		snprintf(text, sizeof(text), "%s%s}]}", head, bad[k][0]);
+		err.message[0] = '\0';
+		CHECK(config_parse(&cfg, "t.json", text, &err) < 0);
+		CHECK_CONTAINS(err.message, bad[k][1]);
+	}
+}
+
+/* The harness's series: the stages run after every build, their SAH is
+ * taken around them on the last repeat, and the tree it keeps is the
+ * refined one. */
+static void test_series(void)
+{
+	bvhlab_scene *scene = generate("icosphere", 0, SCALE(24, 8), 0);
+	bvhlab_plugin *lbvh = NULL;
+	bvhlab_options opts = { 0 }, ropts = { 0 };
+	bvhlab_prims prims = { 0 };
+	bvhlab_error err = { { 0 } };
+	double samples[3];
+	struct stage_metrics out[2];
+	struct refine_stage stages[2];
+	struct build_series s = { .warmup = 1, .repeat = 3, .threads = 2, .samples_ms = samples,
+	                          .stages = stages, .stage_count = 2, .stage_out = out };
+
+	if (!scene || bvhlab_prims_init(&prims, scene, &err) < 0 ||
+	    bvhlab_plugin_open("lbvh", &lbvh, &err) < 0 ||
+	    bvhlab_options_init(&opts, bvhlab_plugin_builder(lbvh)) < 0 ||
+	    bvhlab_options_init(&ropts, bvhlab_plugin_builder(refiner)) < 0) {
+		CHECK(!"series set-up");
+		goto out;
+	}
+	stages[0] = stages[1] = (struct refine_stage){ .plugin = refiner, .opts = &ropts };
+	CHECK_INT(harness_time_builds(lbvh, &opts, &prims.input, &s, &err), 0);
+	CHECK(strcmp(out[0].plugin, "reinsert") == 0 && strcmp(out[1].plugin, "reinsert") == 0);
+	CHECK(out[0].sah_after < out[0].sah_before);
+	CHECK(out[1].sah_before == out[0].sah_after);
+	CHECK(out[1].sah_after <= out[1].sah_before);
+	CHECK(sah(&s.tree) == out[1].sah_after);
+	for (int k = 0; k < 3; k++)
+		CHECK(samples[k] > 0);
+	CHECK_INT(bvhlab_validate_tree(&s.tree, &prims.input, false, &err), 0);
+out:
+	bvhlab_tree_finish(&s.tree);
+	if (opts.values)
+		bvhlab_options_finish(&opts);
+	if (ropts.values)
+		bvhlab_options_finish(&ropts);
+	bvhlab_plugin_close(lbvh);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+int main(void)
+{
+	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply" };
+	bvhlab_error err = { { 0 } };
+	struct stat st;
+
+	if (bvhlab_plugin_open("reinsert", &refiner, &err) < 0) {
+		fprintf(stderr, "%s\n", err.message);
+		CHECK(!"reinsert loads");
+		return test_finish();
+	}
+	test_descriptor();
+	test_config();
+	test_series();
+	test_improves();
+	test_scene("soup", generate("soup", SCALE(10000, 2000), 0, 0), RAYS);
+	test_scene("identical", identical_scene(SCALE(2000, 400)), RAYS);
+	test_scene("needles", needle_scene(SCALE(3000, 600)), RAYS);
+	test_scene("two", generate("soup", 2, 0, 0), RAYS);
+	test_scene("three", generate("soup", 3, 0, 0), RAYS);
+	test_scene("stadium", generate("stadium", SCALE(10000, 2000), 0, 0), RAYS);
+	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
+		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
+	} else {
+		for (size_t i = 0; i < (UNDER_TSAN ? 1 : sizeof(shared) / sizeof(shared[0])); i++) {
+			bvhlab_scene *scene = load_shared(shared[i]);
+			if (scene)
+				test_scene(shared[i], scene, 64);
+		}
+	}
+	bvhlab_plugin_close(refiner);
+	return test_finish();
+}
