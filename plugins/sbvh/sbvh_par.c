@@ -306,7 +306,8 @@ static int task_phase(sbvh_build *B, job_list *small)
 
 	if (!w)
 		return -ENOMEM;
-	qsort(small->jobs, small->n, sizeof(*small->jobs), by_size);
+	if (small->n > 1) /* qsort may not take the NULL of an empty list */
+		qsort(small->jobs, small->n, sizeof(*small->jobs), by_size);
 	for (uint32_t t = 0; t < T; t++)
 		w[t] = (worker){ .B = B, .small = small, .next = &next };
 	for (uint32_t t = 1; t < T; t++)
