@@ -65,7 +65,7 @@ struct build_series {
 	uint32_t warmup, repeat;
 	uint32_t threads;      /* 0: all hardware threads */
 	double *samples_ms;    /* [repeat], filled: the build and every stage */
-	double cold_ms;        /* the first build (warm-up or not): fresh output
+	double cold_ms;        /* the first build (warm-up or not) with its refine stages: fresh output
 	                        * and builder scratch, page faults included */
 	const struct refine_stage *stages; /* [stage_count], applied in order */
 	uint32_t stage_count;  /* at most HARNESS_MAX_STAGES */
