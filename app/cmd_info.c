@@ -15,7 +15,7 @@ static const char usage[] =
 	"Loads a scene and prints its triangle and vertex counts, degenerate\n"
 	"(zero-area) triangles and bounds. SCENE is an .obj or .ply file, or a\n"
 	"generator with parameters: icosphere:frequency=300, soup:count=100000,seed=2,\n"
-	"stadium:count=50000, terrain:size=512, needles:count=1000,width=0.001,\n"
+	"stadium:count=50000, terrain:size=512, needles:count=1000,width=0.001, room,\n"
 	"or a scene of an experiment config, CONFIG.json:NAME (composite scenes\n"
 	"print their part count).\n"
 	"\n"

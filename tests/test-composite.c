@@ -1,6 +1,6 @@
 /*
  * Composite scenes: "parts" in configs (parsing and its errors), placing
- * and merging parts into one scene, and the "needles" generator.
+ * and merging parts into one scene, and the "needles" and "room" generators.
  */
 #include <errno.h>
 #include <math.h>
@@ -178,6 +178,27 @@ static void test_needles(void)
 	CHECK_CONTAINS(err.message, "needles: width must be > 0");
 }
 
+/* The room fills the cube -1..1 with 12 whole, huge triangles. */
+static void test_room(void)
+{
+	bvhlab_scene *s = NULL;
+	bvhlab_error err = { "" };
+	CHECK_INT(bvhlab_scene_generate("room", NULL, &s, &err), 0);
+	if (!s)
+		return;
+	CHECK(s->triangle_count == 12 && s->vertex_count == 12 && s->degenerate_count == 0);
+	for (int k = 0; k < 3; k++)
+		CHECK(s->bounds.lo[k] == -1.0f && s->bounds.hi[k] == 1.0f);
+	for (uint32_t t = 0; t < s->triangle_count; t++) {
+		const uint32_t *v = s->indices + 3 * t;
+		const float *a = s->vertices + 3 * v[0], *b = s->vertices + 3 * v[1],
+		            *c = s->vertices + 3 * v[2];
+		CHECK(fmax(length(a, b), fmax(length(b, c), length(c, a))) >= 2.0);
+	}
+	CHECK_CONTAINS(s->source, "room");
+	bvhlab_scene_destroy(s);
+}
+
 int main(void)
 {
 	test_parse();
@@ -185,5 +206,6 @@ int main(void)
 	test_load();
 	test_part_error();
 	test_needles();
+	test_room();
 	return test_finish();
 }

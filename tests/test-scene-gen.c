@@ -354,7 +354,7 @@ static void test_unknown(void)
 	CHECK_INT(bvhlab_scene_generate("teapot", NULL, &s, &err), -EINVAL);
 	CHECK(s == NULL);
 	CHECK_CONTAINS(err.message, "unknown generator 'teapot'");
-	CHECK_CONTAINS(err.message, "icosphere, soup, stadium, terrain, needles");
+	CHECK_CONTAINS(err.message, "icosphere, soup, stadium, terrain, needles, room");
 	bvhlab_gen_params_init(&p);
 	CHECK_INT(p.frequency, 16);
 	CHECK_INT(p.count, 10000);

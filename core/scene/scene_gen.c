@@ -445,6 +445,12 @@ static int gen_needles(const bvhlab_gen_params *params, bvhlab_scene **out, char
 	return scene_gen_needles(params, out, source, SOURCE_SIZE, err);
 }
 
+static int gen_room(const bvhlab_gen_params *params, bvhlab_scene **out, char *source,
+                    bvhlab_error *err)
+{
+	return scene_gen_room(params, out, source, SOURCE_SIZE, err);
+}
+
 typedef int generate_fn(const bvhlab_gen_params *params, bvhlab_scene **out, char *source,
                         bvhlab_error *err);
 
@@ -457,6 +463,7 @@ static const struct {
 	{ "stadium", gen_stadium },
 	{ "terrain", gen_terrain },
 	{ "needles", gen_needles },
+	{ "room", gen_room },
 };
 
 int bvhlab_scene_generate(const char *generator, const bvhlab_gen_params *params,
@@ -487,7 +494,8 @@ int bvhlab_scene_generate(const char *generator, const bvhlab_gen_params *params
 		*out = scene;
 		return 0;
 	}
-	scene_error(err, "unknown generator '%s' (known: icosphere, soup, stadium, terrain, needles)",
+	scene_error(err,
+	            "unknown generator '%s' (known: icosphere, soup, stadium, terrain, needles, room)",
 	            generator ? generator : "(null)");
 	return -EINVAL;
 }

@@ -88,4 +88,8 @@ int scene_load_obj_stats(const char *path, bvhlab_scene **out,
 int scene_gen_needles(const bvhlab_gen_params *params, bvhlab_scene **out, char *source,
                       size_t source_size, bvhlab_error *err);
 
+/* The "room" generator (scene_room.c): 12 huge triangles, no parameters. */
+int scene_gen_room(const bvhlab_gen_params *params, bvhlab_scene **out, char *source,
+                   size_t source_size, bvhlab_error *err);
+
 #endif /* BVHLAB_CORE_SCENE_PRIVATE_H */

@@ -49,10 +49,11 @@ int bvhlab_scene_load_obj(const char *path, bvhlab_scene **out, bvhlab_error *er
 int bvhlab_scene_load_ply(const char *path, bvhlab_scene **out, bvhlab_error *err);
 
 /*
- * Generates "icosphere", "soup", "stadium", "terrain" or "needles" (count
+ * Generates "icosphere", "soup", "stadium", "terrain", "needles" (count
  * long thin triangles across the unit cube: each joins a random point of
  * one face to a random point of the opposite face, the face pair random,
- * the third vertex `width` from the first). An unknown
+ * the third vertex `width` from the first) or "room" (an open room of 12
+ * huge triangles in the cube -1..1, no parameters). An unknown
  * generator is -EINVAL with a message listing the known ones.
  */
 int bvhlab_scene_generate(const char *generator, const bvhlab_gen_params *params,
