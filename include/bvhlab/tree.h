@@ -15,7 +15,12 @@
 
 BVHLAB_BEGIN_DECLS
 
-/* A tree in the standard layout (see bvhlab_node). Owns its arrays. */
+/*
+ * A tree in the standard layout (see bvhlab_node). Owns its arrays, which
+ * only bvhlab_tree_init/reserve allocate and bvhlab_tree_finish frees (large
+ * ones are page mappings, not malloc blocks): a tree over arrays of your own
+ * is fine to read, validate and trace, but not to reserve or finish.
+ */
 typedef struct bvhlab_tree {
 	bvhlab_node *nodes;
 	uint32_t node_count;
