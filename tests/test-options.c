@@ -82,6 +82,14 @@ static void test_parse(bvhlab_options *o)
 	CHECK(strcmp(buf, "true") == 0);
 	bvhlab_option_format(&o->values[3], buf, sizeof(buf));
 	CHECK(strcmp(buf, "2.5") == 0);
+	/* Shortest form that reads back exactly: 0.05 as typed, and all 17
+	 * digits where fewer would lose the value. */
+	CHECK_INT(bvhlab_options_parse(o, "c_trav=0.05", &err), 0);
+	bvhlab_option_format(&o->values[3], buf, sizeof(buf));
+	CHECK(strcmp(buf, "0.05") == 0);
+	o->values[3].f = 0.1 + 0.2;
+	bvhlab_option_format(&o->values[3], buf, sizeof(buf));
+	CHECK(strcmp(buf, "0.30000000000000004") == 0);
 }
 
 int main(void)

@@ -254,6 +254,17 @@ int bvhlab_options_parse(bvhlab_options *opts, const char *assignment, bvhlab_er
 	return set_from_text(opts, key, k, eq + 1, err);
 }
 
+/* The shortest %g form that reads back as the same double: 0.05, not
+ * 0.050000000000000003 (what %.17g prints), and nothing lost. */
+static void format_double(double f, char *buf, size_t size)
+{
+	for (int digits = 15; digits <= 17; digits++) {
+		snprintf(buf, size, "%.*g", digits, f);
+		if (strtod(buf, NULL) == f)
+			return;
+	}
+}
+
 void bvhlab_option_format(const bvhlab_option_value *v, char *buf, size_t size)
 {
 	switch (v->type) {
@@ -264,7 +275,7 @@ void bvhlab_option_format(const bvhlab_option_value *v, char *buf, size_t size)
 		snprintf(buf, size, "%" PRId64, v->i);
 		break;
 	case BVHLAB_OPTION_FLOAT:
-		snprintf(buf, size, "%.17g", v->f);
+		format_double(v->f, buf, size);
 		break;
 	case BVHLAB_OPTION_STRING:
 		snprintf(buf, size, "\"%s\"", v->s ? v->s : "");
