@@ -11,7 +11,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <bvhlab/bvhlab.h>
 
@@ -194,12 +193,8 @@ static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
 	bvhlab_scene_destroy(scene);
 }
 
-static void test_shared(const char *file)
+static void test_shared(const char *file, bvhlab_scene *scene)
 {
-	bvhlab_scene *scene = load_shared(file);
-
-	if (!scene)
-		return;
 	/* Brute force costs a pass over every triangle per ray. */
 	test_scene(file, scene, 64);
 }
@@ -339,7 +334,6 @@ int main(void)
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "nefertiti.obj",
 	                                      "ogre.obj", "igea.ply" };
 	bvhlab_error err = { { 0 } };
-	struct stat st;
 
 	if (bvhlab_plugin_open("lbvh", &plugin, &err) < 0) {
 		fprintf(stderr, "%s\n", err.message);
@@ -360,13 +354,7 @@ int main(void)
 	test_scene("one", generate("soup", 1, 0, 0), RAYS);
 	test_scene("two", generate("soup", 2, 0, 0), RAYS);
 	test_scene("three", generate("soup", 3, 0, 0), RAYS);
-	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
-		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
-		shared_missing = true;
-	} else {
-		for (size_t i = 0; i < (UNDER_TSAN ? 1 : sizeof(shared) / sizeof(shared[0])); i++)
-			test_shared(shared[i]);
-	}
+	shared_missing = !for_shared(shared, sizeof(shared) / sizeof(shared[0]), 1, test_shared);
 	bvhlab_plugin_close(plugin);
 	return shared_missing && !test_failures ? TEST_SKIP : test_finish();
 }
