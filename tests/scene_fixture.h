@@ -41,6 +41,19 @@ static inline bvhlab_scene *generate(const char *generator, uint32_t count, uint
 	return scene;
 }
 
+/* Opens plugin `name` into *plugin; false, with a failed check and the
+ * reason, when it does not load. */
+static inline bool plugin_loads(const char *name, bvhlab_plugin **plugin)
+{
+	bvhlab_error err = { { 0 } };
+
+	if (bvhlab_plugin_open(name, plugin, &err) == 0)
+		return true;
+	fprintf(stderr, "%s: %s\n", name, err.message);
+	CHECK(!"plugin loads");
+	return false;
+}
+
 /* A scene with room for `vertices` vertices and `triangles` triangles, for
  * the caller to fill; NULL (a failed check) when out of memory. */
 static inline bvhlab_scene *blank_scene(uint32_t vertices, uint32_t triangles)

@@ -333,13 +333,9 @@ int main(void)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "nefertiti.obj",
 	                                      "ogre.obj", "igea.ply" };
-	bvhlab_error err = { { 0 } };
 
-	if (bvhlab_plugin_open("lbvh", &plugin, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"lbvh loads");
+	if (!plugin_loads("lbvh", &plugin))
 		return test_finish();
-	}
 	test_descriptor();
 	test_options();
 	test_max_leaf_binds();

@@ -149,13 +149,9 @@ int main(void)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "ogre.obj",
 	                                      "igea.ply" };
-	bvhlab_error err = { { 0 } };
 
-	if (bvhlab_plugin_open("ploc", &plugin, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"ploc loads");
+	if (!plugin_loads("ploc", &plugin))
 		return test_finish();
-	}
 	test_descriptor();
 	test_scene("soup", generate("soup", SCALE(20000, 3000), 0, 0), RAYS);
 	test_scene("icosphere", generate("icosphere", 0, SCALE(30, 10), 0), RAYS);

@@ -280,13 +280,9 @@ static void test_shared(const char *file, bvhlab_scene *scene)
 int main(void)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply" };
-	bvhlab_error err = { { 0 } };
 
-	if (bvhlab_plugin_open("reinsert", &refiner, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"reinsert loads");
+	if (!plugin_loads("reinsert", &refiner))
 		return test_finish();
-	}
 	test_descriptor();
 	test_config();
 	test_series();

@@ -356,13 +356,9 @@ static void test_quality(const bvhlab_plugin *plugin)
 int main(void)
 {
 	bvhlab_plugin *plugin = NULL;
-	bvhlab_error err = { { 0 } };
 
-	if (bvhlab_plugin_open("sah_seq", &plugin, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"sah_seq loads");
+	if (!plugin_loads("sah_seq", &plugin))
 		return test_finish();
-	}
 	test_descriptor(plugin);
 	test_options(plugin);
 	test_option_values(plugin);

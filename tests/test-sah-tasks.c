@@ -161,14 +161,9 @@ int main(void)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "ogre.obj",
 	                                      "nefertiti.obj", "igea.ply" };
-	bvhlab_error err = { { 0 } };
 
-	if (bvhlab_plugin_open("sah_seq", &seq, &err) < 0 ||
-	    bvhlab_plugin_open("sah_tasks", &tasks, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"plugins load");
+	if (!plugin_loads("sah_seq", &seq) || !plugin_loads("sah_tasks", &tasks))
 		goto out;
-	}
 	test_descriptor();
 	test_scene("soup", generate("soup", SCALE(20000, 3000), 0, 0), false);
 	test_scene("icosphere", generate("icosphere", 0, SCALE(24, 10), 0), false);
