@@ -34,6 +34,17 @@ static void path_in(char *buf, size_t size, const char *name)
 	snprintf(buf, size, "%s/%s", tmpdir, name);
 }
 
+/* `bvhlab run --quiet` on config `text`, written as `name`, which must exit
+ * with `status`; the results of its output folder `out`, which goes into
+ * dir (room for 512). */
+static cJSON *run_config(const char *name, const char *text, int status, const char *out,
+                         char *dir)
+{
+	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", write_config(name, text))), status);
+	path_in(dir, 512, out);
+	return load_results(dir);
+}
+
 static const cJSON *find_run(const cJSON *doc, const char *scene, const char *builder,
                              int threads)
 {
@@ -67,13 +78,10 @@ static void test_fifo(void)
 	CHECK_INT(mkfifo(fifo, 0644), 0);
 	CHECK_INT(run_in(NULL, ARGS("info", fifo)), 2);
 	CHECK_CONTAINS(err_text, "f.obj: not a regular file");
-	const char *cfg = write_config("fifo.json",
+	cJSON *doc = run_config("fifo.json",
 		"{ \"output\": \"out-fifo\", \"repeat\": 1,\n"
 		"  \"scenes\": [ { \"path\": \"f.obj\" }, { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", cfg)), 1);
-	path_in(dir, sizeof(dir), "out-fifo");
-	cJSON *doc = load_results(dir);
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", 1, "out-fifo", dir);
 	check_run(doc, "f", "fake_good", 1, "failed", "f.obj: not a regular file");
 	check_run(doc, "soup", "fake_good", 1, "ok", NULL);
 	cJSON_Delete(doc);
@@ -101,9 +109,7 @@ static void test_loadcrash(void)
 	         "    { \"plugin\": \"%s/hang_entry.so\", \"timeout_s\": 1 },\n"
 	         "    { \"plugin\": \"fake_good\" } ] }\n",
 	         LOADCRASH_DIR, LOADCRASH_DIR, LOADCRASH_DIR);
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", write_config("load.json", text))), 1);
-	path_in(dir, sizeof(dir), "out-load");
-	cJSON *doc = load_results(dir);
+	cJSON *doc = run_config("load.json", text, 1, "out-load", dir);
 	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 8);
 	for (int t = 1; t <= 2; t++) {
 		check_run(doc, "soup", "crash_ctor", t, "crashed", "killed by SIGSEGV");
@@ -218,9 +224,7 @@ static void test_images(void)
 	snprintf(text + n, sizeof(text) - (size_t)n,
 	         " ],\n  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"x y\" },\n"
 	         "    { \"plugin\": \"fake_good\", \"name\": \"x_y\" } ] }\n");
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", write_config("img.json", text))), 0);
-	path_in(dir, sizeof(dir), "out-img");
-	cJSON *doc = load_results(dir);
+	cJSON *doc = run_config("img.json", text, 0, "out-img", dir);
 	const char *seen[64];
 	int count = 0;
 	const cJSON *s, *r;
@@ -376,13 +380,10 @@ static void test_limits(void)
 	/* Sanitizers reserve terabytes of address space: no limit can apply. */
 #else
 	char dir[512];
-	const char *cfg = write_config("mem.json",
+	cJSON *doc = run_config("mem.json",
 		"{ \"output\": \"out-mem\", \"repeat\": 1, \"memory_limit_mb\": 64,\n"
 		"  \"scenes\": [ { \"generator\": \"icosphere\", \"frequency\": 300 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", cfg)), 1);
-	path_in(dir, sizeof(dir), "out-mem");
-	cJSON *doc = load_results(dir);
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", 1, "out-mem", dir);
 	check_run(doc, "icosphere", "fake_good", 1, "failed", "memory_limit_mb = 64");
 	cJSON_Delete(doc);
 #endif
