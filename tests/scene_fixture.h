@@ -107,6 +107,36 @@ static inline bvhlab_scene *load_shared(const char *file)
 	return scene;
 }
 
+/* The SAH cost of the builds of one setup (option value, collapse) on a
+ * scene, after the test's checks of them. */
+typedef double (*collapse_check_fn)(const char *name, const bvhlab_scene *scene,
+                                    const bvhlab_build_input *in, uint32_t value,
+                                    bool collapse, uint32_t rays);
+
+/* For each value of `option`: the builds with and without collapse, whose
+ * SAH costs are printed; collapse never raises it. Destroys scene. */
+static inline void compare_collapse(const char *name, bvhlab_scene *scene, uint32_t rays,
+                                    const char *option, const uint32_t *values,
+                                    size_t count, collapse_check_fn check)
+{
+	bvhlab_prims prims;
+	bvhlab_error err = { { 0 } };
+
+	if (!scene)
+		return;
+	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
+	for (size_t k = 0; k < count; k++) {
+		double with = check(name, scene, &prims.input, values[k], true, rays);
+		double without = check(name, scene, &prims.input, values[k], false, rays);
+
+		printf("%-18s %8u triangles  %s %2u  SAH collapse %9.4f  single %9.4f\n", name,
+		       scene->triangle_count, option, values[k], with, without);
+		CHECK(with <= without * (1 + 1e-6));
+	}
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
 /*
  * test(file, scene) on the first `count` shared meshes of files (the first
  * `tsan_count` under TSan, where the rest are too slow), scene NULL for one

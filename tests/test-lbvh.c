@@ -26,7 +26,7 @@ static bool shared_missing;
 #define RAYS 256
 #define RAY_SEED 4242
 
-static const unsigned bit_counts[] = { 30, 63 };
+static const uint32_t bit_counts[] = { 30, 63 };
 static const uint32_t thread_counts[] = { 1, 2, 8 };
 #define THREAD_COUNTS (sizeof(thread_counts) / sizeof(thread_counts[0]))
 
@@ -171,26 +171,19 @@ out:
 	return stats.sah_cost;
 }
 
+static double check_bits(const char *name, const bvhlab_scene *scene,
+                         const bvhlab_build_input *in, uint32_t bits, bool collapse,
+                         uint32_t rays)
+{
+	struct setup s = { .bits = bits, .collapse = collapse };
+
+	return check_setup(name, scene, in, &s, rays);
+}
+
 static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
 {
-	bvhlab_prims prims;
-	bvhlab_error err = { { 0 } };
-
-	if (!scene)
-		return;
-	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
-	for (size_t k = 0; k < sizeof(bit_counts) / sizeof(bit_counts[0]); k++) {
-		struct setup on = { .bits = bit_counts[k], .collapse = true };
-		struct setup off = { .bits = bit_counts[k], .collapse = false };
-		double with = check_setup(name, scene, &prims.input, &on, rays);
-		double without = check_setup(name, scene, &prims.input, &off, rays);
-
-		printf("%-18s %8u triangles  bits %2u  SAH collapse %9.4f  single %9.4f\n", name,
-		       scene->triangle_count, bit_counts[k], with, without);
-		CHECK(with <= without * (1 + 1e-6));
-	}
-	bvhlab_prims_finish(&prims);
-	bvhlab_scene_destroy(scene);
+	compare_collapse(name, scene, rays, "bits", bit_counts,
+	                 sizeof(bit_counts) / sizeof(bit_counts[0]), check_bits);
 }
 
 static void test_shared(const char *file, bvhlab_scene *scene)

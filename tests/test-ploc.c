@@ -100,27 +100,21 @@ out:
 	return stats.sah_cost;
 }
 
+static double check_radius(const char *name, const bvhlab_scene *scene,
+                           const bvhlab_build_input *in, uint32_t radius, bool collapse,
+                           uint32_t rays)
+{
+	struct setup s = { .radius = radius, .collapse = collapse };
+
+	return check_setup(name, scene, in, &s, rays);
+}
+
 static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
 {
 	static const uint32_t radii[] = { 1, 4, 16 };
-	bvhlab_prims prims;
-	bvhlab_error err = { { 0 } };
 
-	if (!scene)
-		return;
-	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
-	for (size_t k = 0; k < sizeof(radii) / sizeof(radii[0]); k++) {
-		struct setup on = { .radius = radii[k], .collapse = true };
-		struct setup off = { .radius = radii[k], .collapse = false };
-		double with = check_setup(name, scene, &prims.input, &on, rays);
-		double without = check_setup(name, scene, &prims.input, &off, rays);
-
-		printf("%-18s %8u triangles  radius %2u  SAH collapse %9.4f  single %9.4f\n", name,
-		       scene->triangle_count, radii[k], with, without);
-		CHECK(with <= without * (1 + 1e-6));
-	}
-	bvhlab_prims_finish(&prims);
-	bvhlab_scene_destroy(scene);
+	compare_collapse(name, scene, rays, "radius", radii, sizeof(radii) / sizeof(radii[0]),
+	                 check_radius);
 }
 
 static void test_descriptor(void)

@@ -280,6 +280,18 @@ static void test_search(void)
 	exe = built;
 }
 
+/* Writes `text` as dir/results.json, then resumes the sweep of cfg from it:
+ * bvhlab's exit status. */
+static int resume_from(const char *dir, const char *cfg, const char *text)
+{
+	char path[600];
+	snprintf(path, sizeof(path), "%s/results.json", dir);
+	FILE *f = fopen(path, "w");
+	fputs(text, f);
+	fclose(f);
+	return run_in(NULL, ARGS("run", "--quiet", "--resume", cfg));
+}
+
 /* Runs --resume on a results.json edited by `edit`: refused, file as it was. */
 static void refused(const char *dir, const char *cfg, const char *good, void (*edit)(cJSON *),
                     const char *message)
@@ -287,12 +299,7 @@ static void refused(const char *dir, const char *cfg, const char *good, void (*e
 	cJSON *doc = cJSON_Parse(good);
 	edit(cJSON_GetObjectItem(doc, "runs"));
 	char *text = cJSON_Print(doc);
-	char path[600];
-	snprintf(path, sizeof(path), "%s/results.json", dir);
-	FILE *f = fopen(path, "w");
-	fputs(text, f);
-	fclose(f);
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", "--resume", cfg)), 2);
+	CHECK_INT(resume_from(dir, cfg, text), 2);
 	CHECK_CONTAINS(err_text, message);
 	char *after = read_file(dir, "results.json");
 	CHECK(after && !strcmp(after, text));
@@ -362,12 +369,7 @@ static void test_resume(void)
 	refused(dir, cfg, good, wrong_type, "\"build_ms\" has the wrong type");
 	refused(dir, cfg, good, odd_status, "\"status\" is none of");
 	/* The untouched document still resumes. */
-	char path[600];
-	snprintf(path, sizeof(path), "%s/results.json", dir);
-	FILE *f = fopen(path, "w");
-	fputs(good, f);
-	fclose(f);
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", "--resume", cfg)), 0);
+	CHECK_INT(resume_from(dir, cfg, good), 0);
 	free(good);
 }
 
