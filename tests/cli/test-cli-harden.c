@@ -34,14 +34,20 @@ static void path_in(char *buf, size_t size, const char *name)
 	snprintf(buf, size, "%s/%s", tmpdir, name);
 }
 
-/* `bvhlab run --quiet` on config `text`, written as `name`, which must exit
- * with `status`; the results of its output folder `out`, which goes into
- * dir (room for 512). */
+/* Config `text` written as `name`; its output folder `out` into dir (room
+ * for 512). */
+static const char *config_out(const char *name, const char *text, const char *out, char *dir)
+{
+	path_in(dir, 512, out);
+	return write_config(name, text);
+}
+
+/* `bvhlab run --quiet` on config_out(name, text, out, dir), which must exit
+ * with `status`: the results it wrote. */
 static cJSON *run_config(const char *name, const char *text, int status, const char *out,
                          char *dir)
 {
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", write_config(name, text))), status);
-	path_in(dir, 512, out);
+	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", config_out(name, text, out, dir))), status);
 	return load_results(dir);
 }
 
@@ -351,11 +357,10 @@ static void odd_status(cJSON *runs)
 static void test_resume(void)
 {
 	char dir[512];
-	const char *cfg = write_config("res.json",
+	const char *cfg = config_out("res.json",
 		"{ \"output\": \"out-res\", \"repeat\": 1, \"threads\": [1, 2],\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
-	path_in(dir, sizeof(dir), "out-res");
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", "out-res", dir);
 	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", cfg)), 0);
 	char *good = read_file(dir, "results.json");
 	if (!good)
@@ -415,11 +420,10 @@ static int killed_at_rename(const char *cfg, const char *n, bool resume)
 static void test_crashsafe(void)
 {
 	char dir[512];
-	const char *cfg = write_config("crash.json",
+	const char *cfg = config_out("crash.json",
 		"{ \"output\": \"out-crash\", \"repeat\": 1, \"threads\": [1, 2, 3],\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
-	path_in(dir, sizeof(dir), "out-crash");
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", "out-crash", dir);
 	/* Renames: 1 the empty document, 2 after the first run, 3 after the second. */
 	CHECK_INT(killed_at_rename(cfg, "3", false), 128 + SIGKILL);
 	CHECK_INT(runs_written(dir), 1);
