@@ -160,18 +160,28 @@ struct emit {
 	size_t count;        /* how many want */
 };
 
+/* The command of a run of the plan's, in *line (caller frees; NULL when
+ * out of memory); false for a run not wanted. */
+static bool wanted_command(const struct emit *e, const cJSON *run, char **line)
+{
+	int id = cJSON_GetObjectItemCaseSensitive(run, "id")->valueint;
+	char idtext[16];
+	struct strbuf sb = {0};
+	if (!e->want[id])
+		return false;
+	snprintf(idtext, sizeof(idtext), "%d", id);
+	run_command(&sb, e->command, e->dir, idtext);
+	*line = sb_take(&sb);
+	return true;
+}
+
 static void emit_lines(const struct emit *e)
 {
 	const cJSON *run;
+	char *line;
 	cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(e->plan->doc, "runs")) {
-		int id = cJSON_GetObjectItemCaseSensitive(run, "id")->valueint;
-		char idtext[16];
-		struct strbuf sb = {0};
-		if (!e->want[id])
+		if (!wanted_command(e, run, &line))
 			continue;
-		snprintf(idtext, sizeof(idtext), "%d", id);
-		run_command(&sb, e->command, e->dir, idtext);
-		char *line = sb_take(&sb);
 		if (line)
 			puts(line);
 		free(line);
@@ -182,15 +192,10 @@ static int emit_json(const struct emit *e)
 {
 	cJSON *out = cJSON_CreateArray();
 	const cJSON *run;
+	char *line;
 	cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(e->plan->doc, "runs")) {
-		int id = cJSON_GetObjectItemCaseSensitive(run, "id")->valueint;
-		char idtext[16];
-		struct strbuf sb = {0};
-		if (!e->want[id])
+		if (!wanted_command(e, run, &line))
 			continue;
-		snprintf(idtext, sizeof(idtext), "%d", id);
-		run_command(&sb, e->command, e->dir, idtext);
-		char *line = sb_take(&sb);
 		cJSON *o = cJSON_Duplicate(run, 1);
 		cJSON_AddStringToObject(o, "command", line ? line : "");
 		cJSON_AddItemToArray(out, o);

@@ -15,18 +15,10 @@
 /* n needles: triangle i spans x in [i/4, i/4 + 10], a hair's width in y. */
 static inline bvhlab_scene *needle_scene(uint32_t n)
 {
-	bvhlab_scene *scene = calloc(1, sizeof(*scene));
+	bvhlab_scene *scene = blank_scene(3 * n, n);
 
-	CHECK(scene != NULL);
 	if (!scene)
 		return NULL;
-	scene->vertices = malloc(9 * (size_t)n * sizeof(float));
-	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
-	CHECK(scene->vertices && scene->indices);
-	if (!scene->vertices || !scene->indices) {
-		bvhlab_scene_destroy(scene);
-		return NULL;
-	}
 	for (uint32_t i = 0; i < n; i++) {
 		float x = 0.25f * (float)i, *v = scene->vertices + 9 * (size_t)i;
 
@@ -36,8 +28,6 @@ static inline bvhlab_scene *needle_scene(uint32_t n)
 		for (int k = 0; k < 3; k++)
 			scene->indices[3 * (size_t)i + k] = 3 * i + (uint32_t)k;
 	}
-	scene->vertex_count = 3 * n;
-	scene->triangle_count = n;
 	bvhlab_scene_update(scene);
 	return scene;
 }

@@ -86,6 +86,32 @@ static inline bool triangle_is(const bvhlab_scene *s, uint32_t t, uint32_t a, ui
 	return i[0] == a && i[1] == b && i[2] == c;
 }
 
+/* The scene at path, which must load (NULL, a failed check, if not). */
+static inline bvhlab_scene *load_ok(const char *path)
+{
+	bvhlab_scene *s = NULL;
+	bvhlab_error err = { "" };
+	int ret = bvhlab_scene_load(path, &s, &err);
+
+	CHECK_INT(ret, 0);
+	if (ret)
+		fprintf(stderr, "  %s\n", err.message);
+	return s;
+}
+
+/* The degenerate mesh every loader test writes: 3 triangles, 2 of zero
+ * area, all kept (a builder must cope) and counted. */
+static inline void expect_degenerate(const char *path)
+{
+	bvhlab_scene *s = load_ok(path);
+
+	if (!s)
+		return;
+	CHECK_INT(s->triangle_count, 3);
+	CHECK_INT(s->degenerate_count, 2);
+	bvhlab_scene_destroy(s);
+}
+
 /* Loading fails with `code` and a message holding the path, then `needle`. */
 static inline void expect_scene_error(const char *path, int code, const char *needle)
 {

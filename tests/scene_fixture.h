@@ -5,9 +5,11 @@
 #ifndef BVHLAB_SCENE_FIXTURE_H
 #define BVHLAB_SCENE_FIXTURE_H
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include <bvhlab/bvhlab.h>
 
@@ -39,24 +41,52 @@ static inline bvhlab_scene *generate(const char *generator, uint32_t count, uint
 	return scene;
 }
 
-/* n copies of one triangle: every centroid equal, so no split separates
- * any two of them (and every Morton code is the same). */
-static inline bvhlab_scene *identical_scene(uint32_t n)
+/* Opens plugin `name` into *plugin; false, with a failed check and the
+ * reason, when it does not load. */
+static inline bool plugin_loads(const char *name, bvhlab_plugin **plugin)
 {
-	static const float tri[9] = { 0, 0, 0, 1, 0.5f, 0, 0.25f, 1, 0.75f };
+	bvhlab_error err = { { 0 } };
+
+	if (bvhlab_plugin_open(name, plugin, &err) == 0)
+		return true;
+	fprintf(stderr, "%s: %s\n", name, err.message);
+	CHECK(!"plugin loads");
+	return false;
+}
+
+/* A scene with room for `vertices` vertices and `triangles` triangles, for
+ * the caller to fill; NULL (a failed check) when out of memory. */
+static inline bvhlab_scene *blank_scene(uint32_t vertices, uint32_t triangles)
+{
 	bvhlab_scene *scene = calloc(1, sizeof(*scene));
 
 	CHECK(scene != NULL);
 	if (!scene)
 		return NULL;
-	scene->vertices = malloc(sizeof(tri));
-	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
+	scene->vertices = malloc(3 * (size_t)vertices * sizeof(float));
+	scene->indices = malloc(3 * (size_t)triangles * sizeof(uint32_t));
 	CHECK(scene->vertices && scene->indices);
+	if (!scene->vertices || !scene->indices) {
+		bvhlab_scene_destroy(scene);
+		return NULL;
+	}
+	scene->vertex_count = vertices;
+	scene->triangle_count = triangles;
+	return scene;
+}
+
+/* n copies of one triangle: every centroid equal, so no split separates
+ * any two of them (and every Morton code is the same). */
+static inline bvhlab_scene *identical_scene(uint32_t n)
+{
+	static const float tri[9] = { 0, 0, 0, 1, 0.5f, 0, 0.25f, 1, 0.75f };
+	bvhlab_scene *scene = blank_scene(3, n);
+
+	if (!scene)
+		return NULL;
 	memcpy(scene->vertices, tri, sizeof(tri));
 	for (uint32_t i = 0; i < 3 * n; i++)
 		scene->indices[i] = i % 3;
-	scene->vertex_count = 3;
-	scene->triangle_count = n;
 	bvhlab_scene_update(scene);
 	return scene;
 }
@@ -75,6 +105,56 @@ static inline bvhlab_scene *load_shared(const char *file)
 		CHECK(!"shared mesh loads");
 	}
 	return scene;
+}
+
+/* The SAH cost of the builds of one setup (option value, collapse) on a
+ * scene, after the test's checks of them. */
+typedef double (*collapse_check_fn)(const char *name, const bvhlab_scene *scene,
+                                    const bvhlab_build_input *in, uint32_t value,
+                                    bool collapse, uint32_t rays);
+
+/* For each value of `option`: the builds with and without collapse, whose
+ * SAH costs are printed; collapse never raises it. Destroys scene. */
+static inline void compare_collapse(const char *name, bvhlab_scene *scene, uint32_t rays,
+                                    const char *option, const uint32_t *values,
+                                    size_t count, collapse_check_fn check)
+{
+	bvhlab_prims prims;
+	bvhlab_error err = { { 0 } };
+
+	if (!scene)
+		return;
+	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
+	for (size_t k = 0; k < count; k++) {
+		double with = check(name, scene, &prims.input, values[k], true, rays);
+		double without = check(name, scene, &prims.input, values[k], false, rays);
+
+		printf("%-18s %8u triangles  %s %2u  SAH collapse %9.4f  single %9.4f\n", name,
+		       scene->triangle_count, option, values[k], with, without);
+		CHECK(with <= without * (1 + 1e-6));
+	}
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+/*
+ * test(file, scene) on the first `count` shared meshes of files (the first
+ * `tsan_count` under TSan, where the rest are too slow), scene NULL for one
+ * that does not load. False, and a line saying so, when the shared meshes
+ * are not there, so the test can report itself skipped.
+ */
+static inline bool for_shared(const char *const *files, size_t count, size_t tsan_count,
+                              void (*test)(const char *file, bvhlab_scene *scene))
+{
+	struct stat st;
+
+	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
+		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
+		return false;
+	}
+	for (size_t i = 0; i < (UNDER_TSAN ? tsan_count : count); i++)
+		test(files[i], load_shared(files[i]));
+	return true;
 }
 
 #endif

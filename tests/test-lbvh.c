@@ -11,7 +11,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <bvhlab/bvhlab.h>
 
@@ -27,7 +26,7 @@ static bool shared_missing;
 #define RAYS 256
 #define RAY_SEED 4242
 
-static const unsigned bit_counts[] = { 30, 63 };
+static const uint32_t bit_counts[] = { 30, 63 };
 static const uint32_t thread_counts[] = { 1, 2, 8 };
 #define THREAD_COUNTS (sizeof(thread_counts) / sizeof(thread_counts[0]))
 
@@ -172,34 +171,23 @@ out:
 	return stats.sah_cost;
 }
 
-static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
+static double check_bits(const char *name, const bvhlab_scene *scene,
+                         const bvhlab_build_input *in, uint32_t bits, bool collapse,
+                         uint32_t rays)
 {
-	bvhlab_prims prims;
-	bvhlab_error err = { { 0 } };
+	struct setup s = { .bits = bits, .collapse = collapse };
 
-	if (!scene)
-		return;
-	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
-	for (size_t k = 0; k < sizeof(bit_counts) / sizeof(bit_counts[0]); k++) {
-		struct setup on = { .bits = bit_counts[k], .collapse = true };
-		struct setup off = { .bits = bit_counts[k], .collapse = false };
-		double with = check_setup(name, scene, &prims.input, &on, rays);
-		double without = check_setup(name, scene, &prims.input, &off, rays);
-
-		printf("%-18s %8u triangles  bits %2u  SAH collapse %9.4f  single %9.4f\n", name,
-		       scene->triangle_count, bit_counts[k], with, without);
-		CHECK(with <= without * (1 + 1e-6));
-	}
-	bvhlab_prims_finish(&prims);
-	bvhlab_scene_destroy(scene);
+	return check_setup(name, scene, in, &s, rays);
 }
 
-static void test_shared(const char *file)
+static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
 {
-	bvhlab_scene *scene = load_shared(file);
+	compare_collapse(name, scene, rays, "bits", bit_counts,
+	                 sizeof(bit_counts) / sizeof(bit_counts[0]), check_bits);
+}
 
-	if (!scene)
-		return;
+static void test_shared(const char *file, bvhlab_scene *scene)
+{
 	/* Brute force costs a pass over every triangle per ray. */
 	test_scene(file, scene, 64);
 }
@@ -338,14 +326,9 @@ int main(void)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "nefertiti.obj",
 	                                      "ogre.obj", "igea.ply" };
-	bvhlab_error err = { { 0 } };
-	struct stat st;
 
-	if (bvhlab_plugin_open("lbvh", &plugin, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"lbvh loads");
+	if (!plugin_loads("lbvh", &plugin))
 		return test_finish();
-	}
 	test_descriptor();
 	test_options();
 	test_max_leaf_binds();
@@ -360,13 +343,7 @@ int main(void)
 	test_scene("one", generate("soup", 1, 0, 0), RAYS);
 	test_scene("two", generate("soup", 2, 0, 0), RAYS);
 	test_scene("three", generate("soup", 3, 0, 0), RAYS);
-	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
-		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
-		shared_missing = true;
-	} else {
-		for (size_t i = 0; i < (UNDER_TSAN ? 1 : sizeof(shared) / sizeof(shared[0])); i++)
-			test_shared(shared[i]);
-	}
+	shared_missing = !for_shared(shared, sizeof(shared) / sizeof(shared[0]), 1, test_shared);
 	bvhlab_plugin_close(plugin);
 	return shared_missing && !test_failures ? TEST_SKIP : test_finish();
 }

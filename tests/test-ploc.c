@@ -9,7 +9,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <bvhlab/bvhlab.h>
 
@@ -101,27 +100,21 @@ out:
 	return stats.sah_cost;
 }
 
+static double check_radius(const char *name, const bvhlab_scene *scene,
+                           const bvhlab_build_input *in, uint32_t radius, bool collapse,
+                           uint32_t rays)
+{
+	struct setup s = { .radius = radius, .collapse = collapse };
+
+	return check_setup(name, scene, in, &s, rays);
+}
+
 static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
 {
 	static const uint32_t radii[] = { 1, 4, 16 };
-	bvhlab_prims prims;
-	bvhlab_error err = { { 0 } };
 
-	if (!scene)
-		return;
-	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
-	for (size_t k = 0; k < sizeof(radii) / sizeof(radii[0]); k++) {
-		struct setup on = { .radius = radii[k], .collapse = true };
-		struct setup off = { .radius = radii[k], .collapse = false };
-		double with = check_setup(name, scene, &prims.input, &on, rays);
-		double without = check_setup(name, scene, &prims.input, &off, rays);
-
-		printf("%-18s %8u triangles  radius %2u  SAH collapse %9.4f  single %9.4f\n", name,
-		       scene->triangle_count, radii[k], with, without);
-		CHECK(with <= without * (1 + 1e-6));
-	}
-	bvhlab_prims_finish(&prims);
-	bvhlab_scene_destroy(scene);
+	compare_collapse(name, scene, rays, "radius", radii, sizeof(radii) / sizeof(radii[0]),
+	                 check_radius);
 }
 
 static void test_descriptor(void)
@@ -141,18 +134,18 @@ static void test_descriptor(void)
 	bvhlab_options_finish(&opts);
 }
 
+static void test_shared(const char *file, bvhlab_scene *scene)
+{
+	test_scene(file, scene, 64);
+}
+
 int main(void)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "ogre.obj",
 	                                      "igea.ply" };
-	bvhlab_error err = { { 0 } };
-	struct stat st;
 
-	if (bvhlab_plugin_open("ploc", &plugin, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"ploc loads");
+	if (!plugin_loads("ploc", &plugin))
 		return test_finish();
-	}
 	test_descriptor();
 	test_scene("soup", generate("soup", SCALE(20000, 3000), 0, 0), RAYS);
 	test_scene("icosphere", generate("icosphere", 0, SCALE(30, 10), 0), RAYS);
@@ -162,15 +155,7 @@ int main(void)
 	test_scene("one", generate("soup", 1, 0, 0), RAYS);
 	test_scene("two", generate("soup", 2, 0, 0), RAYS);
 	test_scene("three", generate("soup", 3, 0, 0), RAYS);
-	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
-		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
-	} else {
-		for (size_t i = 0; i < (UNDER_TSAN ? 1 : sizeof(shared) / sizeof(shared[0])); i++) {
-			bvhlab_scene *scene = load_shared(shared[i]);
-			if (scene)
-				test_scene(shared[i], scene, 64);
-		}
-	}
+	(void)for_shared(shared, sizeof(shared) / sizeof(shared[0]), 1, test_shared);
 	bvhlab_plugin_close(plugin);
 	return test_finish();
 }

@@ -13,7 +13,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <bvhlab/bvhlab.h>
 
@@ -273,17 +272,17 @@ out:
 	bvhlab_scene_destroy(scene);
 }
 
+static void test_shared(const char *file, bvhlab_scene *scene)
+{
+	test_scene(file, scene, 64);
+}
+
 int main(void)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply" };
-	bvhlab_error err = { { 0 } };
-	struct stat st;
 
-	if (bvhlab_plugin_open("reinsert", &refiner, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"reinsert loads");
+	if (!plugin_loads("reinsert", &refiner))
 		return test_finish();
-	}
 	test_descriptor();
 	test_config();
 	test_series();
@@ -294,15 +293,7 @@ int main(void)
 	test_scene("two", generate("soup", 2, 0, 0), RAYS);
 	test_scene("three", generate("soup", 3, 0, 0), RAYS);
 	test_scene("stadium", generate("stadium", SCALE(10000, 2000), 0, 0), RAYS);
-	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
-		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
-	} else {
-		for (size_t i = 0; i < (UNDER_TSAN ? 1 : sizeof(shared) / sizeof(shared[0])); i++) {
-			bvhlab_scene *scene = load_shared(shared[i]);
-			if (scene)
-				test_scene(shared[i], scene, 64);
-		}
-	}
+	(void)for_shared(shared, sizeof(shared) / sizeof(shared[0]), 1, test_shared);
 	bvhlab_plugin_close(refiner);
 	return test_finish();
 }

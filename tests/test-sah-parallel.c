@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <cJSON.h>
 
@@ -184,12 +183,8 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool generated)
 	bvhlab_scene_destroy(scene);
 }
 
-static void test_shared(const char *file)
+static void test_shared(const char *file, bvhlab_scene *scene)
 {
-	bvhlab_scene *scene = load_shared(file);
-
-	if (!scene)
-		return;
 	test_scene(file, scene, false);
 }
 
@@ -332,7 +327,7 @@ static void close_plugins(void)
 
 int main(void)
 {
-	struct stat st;
+	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply" };
 
 	if (open_plugins() < 0) {
 		CHECK(!"plugins load");
@@ -350,13 +345,7 @@ int main(void)
 	test_scene("identical", identical_scene(SCALE(1000, 300)), true);
 	test_scene("one", generate("soup", 1, 0, 0), true);
 	test_scene("two", generate("soup", 2, 0, 0), true);
-	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
-		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
-		shared_missing = true;
-	} else {
-		test_shared("stanford-bunny.obj");
-		test_shared("horse.ply");
-	}
+	shared_missing = !for_shared(shared, 2, 2, test_shared);
 	close_plugins();
 	return shared_missing && !test_failures ? TEST_SKIP : test_finish();
 }

@@ -292,15 +292,11 @@ static void test_simd(const bvhlab_plugin *plugin)
  * fast does. */
 static bvhlab_scene *row_scene(uint32_t n)
 {
-	bvhlab_scene *scene = calloc(1, sizeof(*scene));
+	bvhlab_scene *scene = blank_scene(3 * n, n);
 	uint32_t h = 12345;
 
-	CHECK(scene != NULL);
 	if (!scene)
 		return NULL;
-	scene->vertices = malloc(9 * (size_t)n * sizeof(float));
-	scene->indices = malloc(3 * (size_t)n * sizeof(uint32_t));
-	CHECK(scene->vertices && scene->indices);
 	for (uint32_t k = 0; k < n; k++) {
 		h = h * 1664525u + 1013904223u;
 		float x = (float)((k * 7919u) % n), s = 0.1f + (float)(h >> 24) / 64.0f;
@@ -310,8 +306,6 @@ static bvhlab_scene *row_scene(uint32_t n)
 		for (int i = 0; i < 3; i++)
 			scene->indices[3 * k + i] = 3 * k + i;
 	}
-	scene->vertex_count = 3 * n;
-	scene->triangle_count = n;
 	bvhlab_scene_update(scene);
 	return scene;
 }
@@ -362,13 +356,9 @@ static void test_quality(const bvhlab_plugin *plugin)
 int main(void)
 {
 	bvhlab_plugin *plugin = NULL;
-	bvhlab_error err = { { 0 } };
 
-	if (bvhlab_plugin_open("sah_seq", &plugin, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"sah_seq loads");
+	if (!plugin_loads("sah_seq", &plugin))
 		return test_finish();
-	}
 	test_descriptor(plugin);
 	test_options(plugin);
 	test_option_values(plugin);

@@ -14,7 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include <bvhlab/bvhlab.h>
 
@@ -136,12 +135,8 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool mesh)
 	bvhlab_scene_destroy(scene);
 }
 
-static void test_shared(const char *file)
+static void test_shared(const char *file, bvhlab_scene *scene)
 {
-	bvhlab_scene *scene = load_shared(file);
-
-	if (!scene)
-		return;
 	test_scene(file, scene, true);
 }
 
@@ -164,15 +159,11 @@ static void test_descriptor(void)
 
 int main(void)
 {
-	struct stat st;
-	bvhlab_error err = { { 0 } };
+	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "ogre.obj",
+	                                      "nefertiti.obj", "igea.ply" };
 
-	if (bvhlab_plugin_open("sah_seq", &seq, &err) < 0 ||
-	    bvhlab_plugin_open("sah_tasks", &tasks, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"plugins load");
+	if (!plugin_loads("sah_seq", &seq) || !plugin_loads("sah_tasks", &tasks))
 		goto out;
-	}
 	test_descriptor();
 	test_scene("soup", generate("soup", SCALE(20000, 3000), 0, 0), false);
 	test_scene("icosphere", generate("icosphere", 0, SCALE(24, 10), 0), false);
@@ -181,20 +172,9 @@ int main(void)
 	test_scene("identical", identical_scene(SCALE(1000, 300)), false);
 	test_scene("one", generate("soup", 1, 0, 0), false);
 	test_scene("two", generate("soup", 2, 0, 0), false);
-	if (stat(BVHLAB_SHARED_SCENES, &st) != 0 || !S_ISDIR(st.st_mode)) {
-		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
-		shared_missing = true;
-	} else {
-		test_shared("stanford-bunny.obj");
-		test_shared("horse.ply");
-		/* The rest of the shared meshes; too slow under TSan, which
-		 * the two above and the generated scenes cover. */
-		if (!UNDER_TSAN) {
-			test_shared("ogre.obj");
-			test_shared("nefertiti.obj");
-			test_shared("igea.ply");
-		}
-	}
+	/* Under TSan the first two: the rest are too slow there, and the
+	 * generated scenes cover what they would. */
+	shared_missing = !for_shared(shared, 5, 2, test_shared);
 out:
 	if (tasks)
 		bvhlab_plugin_close(tasks);

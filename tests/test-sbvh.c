@@ -205,13 +205,8 @@ static void test_descriptor(void)
 
 int main(void)
 {
-	bvhlab_error err = { { 0 } };
-
-	if (bvhlab_plugin_open("sbvh", &sbvh, &err) < 0) {
-		fprintf(stderr, "%s\n", err.message);
-		CHECK(!"plugin loads");
+	if (!plugin_loads("sbvh", &sbvh))
 		return test_finish();
-	}
 	test_descriptor();
 	test_scene("soup", generate("soup", SCALE(8000, 2000), 0, 0), true);
 	test_scene("needles", needles(SCALE(3000, 800)), false);

@@ -88,15 +88,8 @@ static void test_degenerate(void)
 		"f 1 2 3\n"  /* collinear */
 		"f 1 1 4\n"  /* repeated vertex */
 		"f 1 2 4\n");
-	bvhlab_scene *s = NULL;
-	bvhlab_error err = { "" };
 
-	CHECK_INT(bvhlab_scene_load(path, &s, &err), 0);
-	if (!s)
-		return;
-	CHECK_INT(s->triangle_count, 3);
-	CHECK_INT(s->degenerate_count, 2);
-	bvhlab_scene_destroy(s);
+	expect_degenerate(path);
 }
 
 /* Loading `text` fails with -EINVAL and a message containing PATH:`needle`. */

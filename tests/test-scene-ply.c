@@ -48,18 +48,6 @@ static const char *write_buf(const char *name, const struct buf *b)
 	return write_file(name, b->data, b->len);
 }
 
-static bvhlab_scene *load_ok(const char *path)
-{
-	bvhlab_scene *s = NULL;
-	bvhlab_error err = { "" };
-	int ret = bvhlab_scene_load(path, &s, &err);
-
-	CHECK_INT(ret, 0);
-	if (ret)
-		fprintf(stderr, "  %s\n", err.message);
-	return s;
-}
-
 static const char ascii_ply[] =
 	"ply\n"
 	"format ascii 1.0\n"

@@ -166,6 +166,28 @@ static void md_cell(struct strbuf *sb, const char *s)
 	sb_printf(sb, " |");
 }
 
+/* The Markdown run table's number columns (key, format), before the
+ * speedup and after it. */
+static const char *const md_times[][2] = {
+	{"build_ms.median", "%.2f"}, {"build_ms.min", "%.2f"}, {"build_ms.max", "%.2f"},
+	{"build_ms.cold", "%.2f"}, {"mtris_per_s", "%.2f"},
+};
+static const char *const md_figures[][2] = {
+	{"tree.sah_cost", "%.3f"}, {"tree.epo", "%.3f"}, {"memory.peak_bytes", "%.0f"},
+	{"rays.primary.mrays_per_s", "%.2f"}, {"rays.primary.nodes_per_ray", "%.1f"},
+	{"rays.diffuse.mrays_per_s", "%.2f"}, {"rays.diffuse.nodes_per_ray", "%.1f"},
+	{"tree.nodes", "%.0f"}, {"tree.max_depth", "%.0f"}, {"tree.avg_leaf_size", "%.2f"},
+	{"tree.refs", "%.0f"}, {"tree.dup_ratio", "%.3f"},
+};
+
+static void md_numbers(struct strbuf *sb, const cJSON *run, const char *const (*cols)[2],
+                       size_t count)
+{
+	char buf[64];
+	for (size_t k = 0; k < count; k++)
+		md_cell(sb, num(buf, sizeof(buf), run, cols[k][0], cols[k][1]));
+}
+
 static void md_run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run)
 {
 	char buf[64];
@@ -173,26 +195,11 @@ static void md_run_row(struct strbuf *sb, const struct report_index *ix, const c
 	md_cell(sb, str(run, "builder"));
 	md_cell(sb, num(buf, sizeof(buf), run, "threads", "%.0f"));
 	md_cell(sb, str(run, "status"));
-	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.median", "%.2f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.min", "%.2f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.max", "%.2f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "build_ms.cold", "%.2f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "mtris_per_s", "%.2f"));
+	md_numbers(sb, run, md_times, sizeof(md_times) / sizeof(md_times[0]));
 	double speedup = report_speedup(ix, run);
 	snprintf(buf, sizeof(buf), "%.2f", speedup);
 	md_cell(sb, isnan(speedup) ? "" : buf);
-	md_cell(sb, num(buf, sizeof(buf), run, "tree.sah_cost", "%.3f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "tree.epo", "%.3f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "memory.peak_bytes", "%.0f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.mrays_per_s", "%.2f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "rays.primary.nodes_per_ray", "%.1f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "rays.diffuse.mrays_per_s", "%.2f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "rays.diffuse.nodes_per_ray", "%.1f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "tree.nodes", "%.0f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "tree.max_depth", "%.0f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "tree.avg_leaf_size", "%.2f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "tree.refs", "%.0f"));
-	md_cell(sb, num(buf, sizeof(buf), run, "tree.dup_ratio", "%.3f"));
+	md_numbers(sb, run, md_figures, sizeof(md_figures) / sizeof(md_figures[0]));
 	md_cell(sb, str(run, "error"));
 	sb_printf(sb, "\n");
 }

@@ -317,27 +317,11 @@ bool results_has_run(const struct results *res, const char *scene, const char *b
 /* The file's text; -ENOENT quietly when there is none. */
 static int read_text(const char *path, char **out, bvhlab_error *err)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		int e = errno;
-		if (e != ENOENT)
-			error_set(err, "cannot resume from %s: %s", path, strerror(e));
-		return -e;
-	}
-	struct strbuf sb = {0};
-	char chunk[65536];
-	size_t n;
-	while ((n = fread(chunk, 1, sizeof(chunk), f)) > 0)
-		sb_printf(&sb, "%.*s", (int)n, chunk);
-	bool failed = ferror(f);
-	fclose(f);
-	*out = sb_take(&sb);
-	if (failed || !*out) {
-		free(*out);
-		error_set(err, "cannot resume from %s: %s", path, failed ? "read error" : "out of memory");
-		return failed ? -EIO : -ENOMEM;
-	}
-	return 0;
+	const char *why;
+	int r = util_read_text(path, out, &why);
+	if (r < 0 && r != -ENOENT)
+		error_set(err, "cannot resume from %s: %s", path, why);
+	return r;
 }
 
 /* Moves the old document's finished runs and named scenes into ours. */

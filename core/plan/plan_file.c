@@ -21,27 +21,11 @@
 
 int plan_read_file(const char *path, char **out, bvhlab_error *err)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		int e = errno;
-		error_set(err, "cannot read %s: %s", path, strerror(e));
-		return -e;
-	}
-	struct strbuf sb = {0};
-	char chunk[65536];
-	size_t n;
-	while ((n = fread(chunk, 1, sizeof(chunk), f)) > 0)
-		sb_printf(&sb, "%.*s", (int)n, chunk);
-	bool failed = ferror(f);
-	fclose(f);
-	*out = sb_take(&sb);
-	if (failed || !*out) {
-		free(*out);
-		*out = NULL;
-		error_set(err, "cannot read %s: %s", path, failed ? "read error" : "out of memory");
-		return failed ? -EIO : -ENOMEM;
-	}
-	return 0;
+	const char *why;
+	int r = util_read_text(path, out, &why);
+	if (r < 0)
+		error_set(err, "cannot read %s: %s", path, why);
+	return r;
 }
 
 /* path, relative to folder dir (NULL: the working folder), made absolute; the

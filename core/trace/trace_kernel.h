@@ -121,6 +121,20 @@ static inline bool isect(const ray_prep *p, const float *v0, const float *v1,
 	return true;
 }
 
+/* Triangle prim's hit out (t, u, v) from isect() into hit, unless it
+ * only ties with hit's: an exact tie in t goes to the smaller id, so every
+ * visiting order (stack, stackless, brute force) picks the same triangle. */
+static inline bool take_hit(bvhlab_hit *hit, uint32_t prim, const float out[3])
+{
+	if (out[0] == hit->t && (hit->prim == BVHLAB_NO_HIT || prim >= hit->prim))
+		return false;
+	hit->t = out[0];
+	hit->u = out[1];
+	hit->v = out[2];
+	hit->prim = prim;
+	return true;
+}
+
 static inline bool isect_prim(const ray_prep *p, const bvhlab_scene *scene, uint32_t prim,
                               bvhlab_hit *hit)
 {
@@ -131,15 +145,7 @@ static inline bool isect_prim(const ray_prep *p, const bvhlab_scene *scene, uint
 	if (!isect(p, vtx + 3 * (size_t)idx[0], vtx + 3 * (size_t)idx[1],
 	           vtx + 3 * (size_t)idx[2], hit->t, out))
 		return false;
-	/* An exact tie in t goes to the smaller id, so every visiting order
-	 * (stack, stackless, brute force) picks the same triangle. */
-	if (out[0] == hit->t && (hit->prim == BVHLAB_NO_HIT || prim >= hit->prim))
-		return false;
-	hit->t = out[0];
-	hit->u = out[1];
-	hit->v = out[2];
-	hit->prim = prim;
-	return true;
+	return take_hit(hit, prim, out);
 }
 
 /*
@@ -187,13 +193,7 @@ static inline bool isect_slot(const ray_prep *p, const bvhlab_tree *tree,
 	const float *v = tris + 9 * (size_t)slot;
 	if (!isect(p, v, v + 3, v + 6, hit->t, out))
 		return false;
-	if (out[0] == hit->t && (hit->prim == BVHLAB_NO_HIT || prim >= hit->prim))
-		return false;
-	hit->t = out[0];
-	hit->u = out[1];
-	hit->v = out[2];
-	hit->prim = prim;
-	return true;
+	return take_hit(hit, prim, out);
 }
 
 /*

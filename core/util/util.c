@@ -1,4 +1,5 @@
 /* Error text, strings, the clock and sample statistics shared by the core's modules. */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,6 +36,32 @@ void error_prefix(bvhlab_error *err, const char *fmt, ...)
 	va_end(ap);
 	memcpy(old, err->message, sizeof(old));
 	error_set(err, "%s: %s", prefix, old);
+}
+
+int util_read_text(const char *path, char **out, const char **why)
+{
+	FILE *f = fopen(path, "rb");
+	*out = NULL;
+	if (!f) {
+		int e = errno;
+		*why = strerror(e);
+		return -e;
+	}
+	struct strbuf sb = {0};
+	char chunk[65536];
+	size_t n;
+	while ((n = fread(chunk, 1, sizeof(chunk), f)) > 0)
+		sb_printf(&sb, "%.*s", (int)n, chunk);
+	bool failed = ferror(f);
+	fclose(f);
+	*out = sb_take(&sb);
+	if (failed || !*out) {
+		free(*out);
+		*out = NULL;
+		*why = failed ? "read error" : "out of memory";
+		return failed ? -EIO : -ENOMEM;
+	}
+	return 0;
 }
 
 double util_now(void)

@@ -32,6 +32,11 @@ void sb_printf(struct strbuf *sb, const char *fmt, ...) UTIL_PRINTF(2, 3);
 /* Returns the text (caller frees), or NULL if any append failed. */
 char *sb_take(struct strbuf *sb);
 
+/* The whole file at path into *out (caller frees; NULL on failure): 0, or
+ * -errno with *why saying what went wrong ("read error", "out of memory",
+ * or fopen's strerror). */
+int util_read_text(const char *path, char **out, const char **why);
+
 /* splitmix64: the core's one seeded generator, so every random choice
  * (generators, sampled rays) is reproducible from a seed. */
 static inline uint64_t util_splitmix64(uint64_t *state)

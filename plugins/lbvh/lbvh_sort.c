@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "lbvh.h"
+#include "morton_front.h"
 
 /* Zeroes the arrival counters and flags of thread t's chunk (of n; n - 1
  * flags), which are left from the build before when the scratch is in the
@@ -59,17 +60,8 @@ static void border_prefixes(lbvh *b, unsigned t)
 
 void lbvh_sort(lbvh *b, unsigned t)
 {
-	/* Every thread computes the same packing; it is read only after the
-	 * barriers below. */
-	if (t == 0)
-		morton_sort_init(&b->sort);
 	clear_counters(b, t);
-	morton_codes(&b->sort, b->team.threads, t);
-	lbvh_sync(b);
-	morton_scatter(&b->sort, b->team.threads, t);
-	lbvh_sync(b);
-	morton_sort_buckets(&b->sort, bucket_done, b);
-	lbvh_sync(b);
+	morton_sort_team(&b->sort, &b->team, t, bucket_done, b);
 	border_prefixes(b, t);
 	lbvh_sync(b);
 }

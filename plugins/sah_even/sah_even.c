@@ -18,11 +18,6 @@
 #include "sah_kernel.h"
 #include "sah_threads.h"
 
-static const bvhlab_option_decl options[] = { SAH_OPTION_DECLS };
-
-_Static_assert(sizeof(options) / sizeof(options[0]) == SAH_OPTION_COUNT,
-               "SAH_OPTION_COUNT matches SAH_OPTION_DECLS");
-
 /* One subtree with its share of the threads; lives in its starter's frame
  * until the join, so the thread can use it throughout. */
 struct even_task {
@@ -75,12 +70,6 @@ static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder 
 	return 0;
 }
 
-static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *input, bvhlab_build_output *output)
-{
-	return sah_run_build(host, ctx, input, output, schedule, NULL);
-}
-
-BVHLAB_PLUGIN(.name = "sah_even", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.summary = "parallel SAH, thesis \"symmetric\": a thread per split, budget halved",
-	.option_count = SAH_OPTION_COUNT, .options = options, .build = build)
+SAH_PLAIN_PLUGIN("sah_even", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	"parallel SAH, thesis \"symmetric\": a thread per split, budget halved",
+	schedule)

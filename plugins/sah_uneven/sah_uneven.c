@@ -20,11 +20,6 @@
 #include "sah_kernel.h"
 #include "sah_threads.h"
 
-static const bvhlab_option_decl options[] = { SAH_OPTION_DECLS };
-
-_Static_assert(sizeof(options) / sizeof(options[0]) == SAH_OPTION_COUNT,
-               "SAH_OPTION_COUNT matches SAH_OPTION_DECLS");
-
 /* Splits along the larger child, handing each smaller one to a new thread,
  * until `spare` threads are started; returns how many tasks it used. */
 static uint32_t spawn_path(sah_builder *b, const sah_job *root, sah_subtree_task *tasks,
@@ -69,12 +64,6 @@ static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder 
 	return 0;
 }
 
-static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *input, bvhlab_build_output *output)
-{
-	return sah_run_build(host, ctx, input, output, schedule, NULL);
-}
-
-BVHLAB_PLUGIN(.name = "sah_uneven", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.summary = "parallel SAH, thesis \"asymmetric\": only the larger child spawns threads",
-	.option_count = SAH_OPTION_COUNT, .options = options, .build = build)
+SAH_PLAIN_PLUGIN("sah_uneven", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	"parallel SAH, thesis \"asymmetric\": only the larger child spawns threads",
+	schedule)

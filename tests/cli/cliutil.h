@@ -50,8 +50,9 @@ static char *read_file(const char *dir, const char *name)
 	return text;
 }
 
-/* Starts bvhlab with args (NULL-terminated); stdout/stderr into files. */
-static pid_t start(const char *const *args)
+/* Starts bvhlab with args (NULL-terminated) in `cwd` (NULL: here), killed
+ * by SIGALRM after `limit` s (0: never); stdout/stderr into files. */
+static pid_t start_in(const char *cwd, unsigned limit, const char *const *args)
 {
 	char out_path[256], err_path[256];
 	snprintf(out_path, sizeof(out_path), "%s/stdout", tmpdir);
@@ -62,13 +63,23 @@ static pid_t start(const char *const *args)
 		int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
 		dup2(o, 1);
 		dup2(e, 2);
+		if (cwd && chdir(cwd) != 0)
+			_exit(126);
 		char *argv[32] = {(char *)exe};
 		for (int k = 0; args[k] && k < 30; k++)
 			argv[k + 1] = (char *)args[k];
+		if (limit)
+			alarm(limit); /* survives exec: a hung bvhlab dies of SIGALRM */
 		execv(exe, argv);
 		_exit(127);
 	}
 	return pid;
+}
+
+/* Starts bvhlab with args (NULL-terminated), here, with no time limit. */
+static pid_t start(const char *const *args)
+{
+	return start_in(NULL, 0, args);
 }
 
 /* Waits for a started bvhlab; its output into the buffers. */
@@ -98,6 +109,17 @@ static char *write_config(const char *name, const char *text)
 	fputs(text, f);
 	fclose(f);
 	return path;
+}
+
+/* The number of runs in dir/results.json, or -1 while there is none to read. */
+static inline int runs_written(const char *dir)
+{
+	char *text = read_file(dir, "results.json");
+	cJSON *doc = text ? cJSON_Parse(text) : NULL;
+	int n = doc ? cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")) : -1;
+	cJSON_Delete(doc);
+	free(text);
+	return n;
 }
 
 static cJSON *load_results(const char *dir)

@@ -24,30 +24,6 @@
 /* Long enough for any of these runs on a loaded machine; a hang ends here. */
 #define LIMIT_S 60
 
-/* Like start(), in `cwd` (NULL: here), killed by SIGALRM after `limit` s. */
-static pid_t start_in(const char *cwd, unsigned limit, const char *const *args)
-{
-	char out_path[256], err_path[256];
-	snprintf(out_path, sizeof(out_path), "%s/stdout", tmpdir);
-	snprintf(err_path, sizeof(err_path), "%s/stderr", tmpdir);
-	pid_t pid = fork();
-	if (pid == 0) {
-		int o = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-		int e = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-		dup2(o, 1);
-		dup2(e, 2);
-		if (cwd && chdir(cwd) != 0)
-			_exit(126);
-		char *argv[32] = {(char *)exe};
-		for (int k = 0; args[k] && k < 30; k++)
-			argv[k + 1] = (char *)args[k];
-		alarm(limit); /* survives exec: a hung bvhlab dies of SIGALRM */
-		execv(exe, argv);
-		_exit(127);
-	}
-	return pid;
-}
-
 static int run_in(const char *cwd, const char *const *args)
 {
 	return finish(start_in(cwd, LIMIT_S, args));
@@ -56,6 +32,23 @@ static int run_in(const char *cwd, const char *const *args)
 static void path_in(char *buf, size_t size, const char *name)
 {
 	snprintf(buf, size, "%s/%s", tmpdir, name);
+}
+
+/* Config `text` written as `name`; its output folder `out` into dir (room
+ * for 512). */
+static const char *config_out(const char *name, const char *text, const char *out, char *dir)
+{
+	path_in(dir, 512, out);
+	return write_config(name, text);
+}
+
+/* `bvhlab run --quiet` on config_out(name, text, out, dir), which must exit
+ * with `status`: the results it wrote. */
+static cJSON *run_config(const char *name, const char *text, int status, const char *out,
+                         char *dir)
+{
+	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", config_out(name, text, out, dir))), status);
+	return load_results(dir);
 }
 
 static const cJSON *find_run(const cJSON *doc, const char *scene, const char *builder,
@@ -91,13 +84,10 @@ static void test_fifo(void)
 	CHECK_INT(mkfifo(fifo, 0644), 0);
 	CHECK_INT(run_in(NULL, ARGS("info", fifo)), 2);
 	CHECK_CONTAINS(err_text, "f.obj: not a regular file");
-	const char *cfg = write_config("fifo.json",
+	cJSON *doc = run_config("fifo.json",
 		"{ \"output\": \"out-fifo\", \"repeat\": 1,\n"
 		"  \"scenes\": [ { \"path\": \"f.obj\" }, { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", cfg)), 1);
-	path_in(dir, sizeof(dir), "out-fifo");
-	cJSON *doc = load_results(dir);
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", 1, "out-fifo", dir);
 	check_run(doc, "f", "fake_good", 1, "failed", "f.obj: not a regular file");
 	check_run(doc, "soup", "fake_good", 1, "ok", NULL);
 	cJSON_Delete(doc);
@@ -125,9 +115,7 @@ static void test_loadcrash(void)
 	         "    { \"plugin\": \"%s/hang_entry.so\", \"timeout_s\": 1 },\n"
 	         "    { \"plugin\": \"fake_good\" } ] }\n",
 	         LOADCRASH_DIR, LOADCRASH_DIR, LOADCRASH_DIR);
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", write_config("load.json", text))), 1);
-	path_in(dir, sizeof(dir), "out-load");
-	cJSON *doc = load_results(dir);
+	cJSON *doc = run_config("load.json", text, 1, "out-load", dir);
 	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 8);
 	for (int t = 1; t <= 2; t++) {
 		check_run(doc, "soup", "crash_ctor", t, "crashed", "killed by SIGSEGV");
@@ -242,9 +230,7 @@ static void test_images(void)
 	snprintf(text + n, sizeof(text) - (size_t)n,
 	         " ],\n  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"x y\" },\n"
 	         "    { \"plugin\": \"fake_good\", \"name\": \"x_y\" } ] }\n");
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", write_config("img.json", text))), 0);
-	path_in(dir, sizeof(dir), "out-img");
-	cJSON *doc = load_results(dir);
+	cJSON *doc = run_config("img.json", text, 0, "out-img", dir);
 	const char *seen[64];
 	int count = 0;
 	const cJSON *s, *r;
@@ -300,6 +286,18 @@ static void test_search(void)
 	exe = built;
 }
 
+/* Writes `text` as dir/results.json, then resumes the sweep of cfg from it:
+ * bvhlab's exit status. */
+static int resume_from(const char *dir, const char *cfg, const char *text)
+{
+	char path[600];
+	snprintf(path, sizeof(path), "%s/results.json", dir);
+	FILE *f = fopen(path, "w");
+	fputs(text, f);
+	fclose(f);
+	return run_in(NULL, ARGS("run", "--quiet", "--resume", cfg));
+}
+
 /* Runs --resume on a results.json edited by `edit`: refused, file as it was. */
 static void refused(const char *dir, const char *cfg, const char *good, void (*edit)(cJSON *),
                     const char *message)
@@ -307,12 +305,7 @@ static void refused(const char *dir, const char *cfg, const char *good, void (*e
 	cJSON *doc = cJSON_Parse(good);
 	edit(cJSON_GetObjectItem(doc, "runs"));
 	char *text = cJSON_Print(doc);
-	char path[600];
-	snprintf(path, sizeof(path), "%s/results.json", dir);
-	FILE *f = fopen(path, "w");
-	fputs(text, f);
-	fclose(f);
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", "--resume", cfg)), 2);
+	CHECK_INT(resume_from(dir, cfg, text), 2);
 	CHECK_CONTAINS(err_text, message);
 	char *after = read_file(dir, "results.json");
 	CHECK(after && !strcmp(after, text));
@@ -364,11 +357,10 @@ static void odd_status(cJSON *runs)
 static void test_resume(void)
 {
 	char dir[512];
-	const char *cfg = write_config("res.json",
+	const char *cfg = config_out("res.json",
 		"{ \"output\": \"out-res\", \"repeat\": 1, \"threads\": [1, 2],\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
-	path_in(dir, sizeof(dir), "out-res");
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", "out-res", dir);
 	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", cfg)), 0);
 	char *good = read_file(dir, "results.json");
 	if (!good)
@@ -382,12 +374,7 @@ static void test_resume(void)
 	refused(dir, cfg, good, wrong_type, "\"build_ms\" has the wrong type");
 	refused(dir, cfg, good, odd_status, "\"status\" is none of");
 	/* The untouched document still resumes. */
-	char path[600];
-	snprintf(path, sizeof(path), "%s/results.json", dir);
-	FILE *f = fopen(path, "w");
-	fputs(good, f);
-	fclose(f);
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", "--resume", cfg)), 0);
+	CHECK_INT(resume_from(dir, cfg, good), 0);
 	free(good);
 }
 
@@ -400,13 +387,10 @@ static void test_limits(void)
 	/* Sanitizers reserve terabytes of address space: no limit can apply. */
 #else
 	char dir[512];
-	const char *cfg = write_config("mem.json",
+	cJSON *doc = run_config("mem.json",
 		"{ \"output\": \"out-mem\", \"repeat\": 1, \"memory_limit_mb\": 64,\n"
 		"  \"scenes\": [ { \"generator\": \"icosphere\", \"frequency\": 300 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
-	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", cfg)), 1);
-	path_in(dir, sizeof(dir), "out-mem");
-	cJSON *doc = load_results(dir);
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", 1, "out-mem", dir);
 	check_run(doc, "icosphere", "fake_good", 1, "failed", "memory_limit_mb = 64");
 	cJSON_Delete(doc);
 #endif
@@ -432,33 +416,22 @@ static int killed_at_rename(const char *cfg, const char *n, bool resume)
 	return status;
 }
 
-static int runs_in(const char *dir)
-{
-	char *text = read_file(dir, "results.json");
-	cJSON *doc = text ? cJSON_Parse(text) : NULL;
-	int n = doc ? cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")) : -1;
-	cJSON_Delete(doc);
-	free(text);
-	return n;
-}
-
 /* 10. results.json is replaced whole or not at all. */
 static void test_crashsafe(void)
 {
 	char dir[512];
-	const char *cfg = write_config("crash.json",
+	const char *cfg = config_out("crash.json",
 		"{ \"output\": \"out-crash\", \"repeat\": 1, \"threads\": [1, 2, 3],\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
-	path_in(dir, sizeof(dir), "out-crash");
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", "out-crash", dir);
 	/* Renames: 1 the empty document, 2 after the first run, 3 after the second. */
 	CHECK_INT(killed_at_rename(cfg, "3", false), 128 + SIGKILL);
-	CHECK_INT(runs_in(dir), 1);
+	CHECK_INT(runs_written(dir), 1);
 	/* Killed again while resuming, before its first new run lands. */
 	CHECK_INT(killed_at_rename(cfg, "2", true), 128 + SIGKILL);
-	CHECK_INT(runs_in(dir), 1);
+	CHECK_INT(runs_written(dir), 1);
 	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", "--resume", cfg)), 0);
-	CHECK_INT(runs_in(dir), 3);
+	CHECK_INT(runs_written(dir), 3);
 }
 
 int main(int argc, char **argv)

@@ -132,17 +132,6 @@ static void test_in_process(void)
 	cJSON_Delete(doc);
 }
 
-/* The number of runs in dir/results.json, or -1 while there is none to read. */
-static int runs_written(const char *dir)
-{
-	char *text = read_file(dir, "results.json");
-	cJSON *doc = text ? cJSON_Parse(text) : NULL;
-	int n = doc ? cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")) : -1;
-	cJSON_Delete(doc);
-	free(text);
-	return n;
-}
-
 /* Polls (bounded) until the sweep has written at least one run. */
 static int wait_for_runs(const char *dir)
 {

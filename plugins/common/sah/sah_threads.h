@@ -41,6 +41,23 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                        sah_scheduler_fn schedule, void *arg);
 
 /*
+ * The options, build() and entry point of a SAH plugin with the shared
+ * options only, whose build is sah_run_build(schedule) without an argument;
+ * at file scope, after schedule.
+ */
+#define SAH_PLAIN_PLUGIN(plugin_name, plugin_flags, plugin_summary, schedule)            \
+	static const bvhlab_option_decl options[] = { SAH_OPTION_DECLS };                  \
+	_Static_assert(sizeof(options) / sizeof(options[0]) == SAH_OPTION_COUNT,           \
+	               "SAH_OPTION_COUNT matches SAH_OPTION_DECLS");                       \
+	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,                   \
+	                 const bvhlab_build_input *input, bvhlab_build_output *output)     \
+	{                                                                                  \
+		return sah_run_build(host, ctx, input, output, schedule, NULL);            \
+	}                                                                                  \
+	BVHLAB_PLUGIN(.name = plugin_name, .flags = plugin_flags, .summary = plugin_summary, \
+	              .option_count = SAH_OPTION_COUNT, .options = options, .build = build)
+
+/*
  * pthread_create with a SAH_THREAD_STACK stack. 0, or a negative errno
  * (the caller then does the work itself: every scheduler stays correct
  * with fewer threads than it asked for).

@@ -1,0 +1,128 @@
+/* The Morton builders' shared front end (see morton_front.h). */
+#include <errno.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "big_alloc.h"
+#include "morton_front.h"
+
+/* Below this many primitives per thread, more threads cost more than they
+ * save (thread start and barriers are tens of microseconds). */
+#define MIN_PRIMS_PER_THREAD 512
+
+int morton_read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, morton_options *o)
+{
+	int rc;
+
+	if ((rc = host->option_int(ctx, "bits", &o->bits)) < 0 ||
+	    (rc = host->option_bool(ctx, "collapse", &o->collapse)) < 0 ||
+	    (rc = host->option_int(ctx, "max_leaf", &o->max_leaf)) < 0 ||
+	    (rc = host->option_float(ctx, "c_trav", &o->c_trav)) < 0 ||
+	    (rc = host->option_float(ctx, "c_isect", &o->c_isect)) < 0) {
+		host->set_error(ctx, "cannot read the options");
+		return rc;
+	}
+	return 0;
+}
+
+double morton_now_ms(void)
+{
+	struct timespec ts;
+
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
+unsigned morton_team_size(const bvhlab_build_input *in)
+{
+	uint32_t most = in->prim_count / MIN_PRIMS_PER_THREAD;
+	uint32_t want = in->threads < most ? in->threads : most;
+
+	return want < 1 ? 1 : want > TEAM_MAX_THREADS ? TEAM_MAX_THREADS : want;
+}
+
+uint32_t morton_spare_nodes(uint32_t n, size_t bytes)
+{
+	uint64_t spare = (bytes + 64 + sizeof(bvhlab_node) - 1) / sizeof(bvhlab_node);
+
+	return 2 * (uint64_t)n - 1 + spare > UINT32_MAX ? 0 : (uint32_t)spare;
+}
+
+int morton_ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx, uint32_t n,
+                           uint32_t spare, bvhlab_build_output *out)
+{
+	uint32_t nodes = 2 * n - 1;
+
+	if (spare && out->node_capacity < nodes + spare)
+		(void)host->grow_output(ctx, out, nodes + spare, n); /* fine if refused */
+	if (out->node_capacity >= nodes && out->index_capacity >= n)
+		return 0;
+	if (host->grow_output(ctx, out, nodes, n) < 0) {
+		host->set_error(ctx, "cannot grow the output to %u nodes", nodes);
+		return -ENOMEM;
+	}
+	return 0;
+}
+
+void morton_place_sort(morton_sort *s, char *at)
+{
+	size_t k8 = morton_align64(8 * (size_t)s->n);
+
+	s->codes = (uint64_t *)(void *)at;
+	s->keys[0] = (uint64_t *)(void *)(at + k8);
+	s->keys[1] = (uint64_t *)(void *)(at + 2 * k8);
+}
+
+uint32_t *morton_scratch_alloc(morton_scratch *scratch, size_t region, morton_sort *sort,
+                               unsigned threads, unsigned extra)
+{
+	size_t hist = (size_t)threads * MORTON_TOP_RADIX * sizeof(uint32_t) +
+	              (MORTON_TOP_RADIX + 1) * sizeof(uint32_t);
+
+	/* Zero-filled, which lbvh's arrival counters rely on when they live
+	 * here; the threads touch it first, each its own chunk, sharing the
+	 * faults. */
+	scratch->region = region ? big_alloc(region) : NULL;
+	scratch->small = malloc(hist + (size_t)threads * extra * sizeof(uint32_t));
+	if ((region && !scratch->region) || !scratch->small)
+		return NULL;
+	sort->hist = scratch->small;
+	sort->bucket = (uint32_t *)(void *)(sort->hist + threads);
+	return sort->bucket + MORTON_TOP_RADIX + 1;
+}
+
+void morton_scratch_free(morton_scratch *scratch)
+{
+	big_free(scratch->region);
+	free(scratch->small);
+}
+
+void morton_sort_team(morton_sort *s, team *tm, unsigned t,
+                      void (*done)(void *arg, uint32_t first, uint32_t end), void *arg)
+{
+	/* Only member 0 sets the packing; the others read it after the
+	 * barriers below. */
+	if (t == 0)
+		morton_sort_init(s);
+	morton_codes(s, tm->threads, t);
+	team_sync(tm);
+	morton_scatter(s, tm->threads, t);
+	team_sync(tm);
+	morton_sort_buckets(s, done, arg);
+	team_sync(tm);
+}
+
+void morton_single_leaf(const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	bvhlab_node *root = &out->nodes[0];
+
+	for (int k = 0; k < 3; k++) {
+		root->lo[k] = in->prim_bounds[0].lo[k];
+		root->hi[k] = in->prim_bounds[0].hi[k];
+	}
+	root->first = 0;
+	root->count = 1;
+	out->prim_index[0] = 0;
+	out->node_count = 1;
+	out->index_count = 1;
+}

@@ -1,0 +1,102 @@
+/*
+ * What lbvh and ploc share around the Morton sort (a part of the same
+ * static library): their common options, the team's size, the output's
+ * room with scratch past the tree, the scratch mappings, the sort run by
+ * a team, and the tree of a single primitive.
+ */
+#ifndef BVHLAB_MORTON_FRONT_H
+#define BVHLAB_MORTON_FRONT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <bvhlab/builder.h>
+
+#include "morton.h"
+#include "team.h"
+
+/* The options of the code length and the SAH collapse, in an option array. */
+#define MORTON_OPTION_DECLS                                                                  \
+	{ .name = "bits", .type = BVHLAB_OPTION_INT,                                         \
+	  .help = "Morton code length: 30 (10 bits per axis) or 63 (21 bits per axis)",      \
+	  .def_int = 63, .min = 30, .max = 63 },                                             \
+	{ .name = "collapse", .type = BVHLAB_OPTION_BOOL,                                    \
+	  .help = "turn subtrees of at most max_leaf primitives into leaves where the SAH "  \
+	          "says a leaf is cheaper (off: one primitive per leaf)",                    \
+	  .def_bool = true },                                                                \
+	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,                                     \
+	  .help = "most primitives in a collapsed leaf (8, as the SAH builders)",            \
+	  .def_int = 8, .min = 1, .max = 64 },                                               \
+	{ .name = "c_trav", .type = BVHLAB_OPTION_FLOAT,                                     \
+	  .help = "SAH cost of traversing an inner node (> 0), for collapse",                \
+	  .def_float = 1.0, .min = 1e-6, .max = 1e6 },                                       \
+	{ .name = "c_isect", .type = BVHLAB_OPTION_FLOAT,                                    \
+	  .help = "SAH cost of intersecting one primitive (> 0), for collapse",              \
+	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }
+
+/* MORTON_OPTION_DECLS as read, before the builder checks their ranges. */
+typedef struct morton_options {
+	int64_t bits, max_leaf;
+	bool collapse;
+	double c_trav, c_isect;
+} morton_options;
+
+/* Reads MORTON_OPTION_DECLS: 0, or a negative errno after host->set_error. */
+int morton_read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, morton_options *o);
+
+/* Monotonic clock in milliseconds, for the phase times in the debug log. */
+double morton_now_ms(void);
+
+static inline size_t morton_align64(size_t x)
+{
+	return (x + 63) & ~(size_t)63;
+}
+
+/* Threads for a build of in: in->threads, fewer on a small input. */
+unsigned morton_team_size(const bvhlab_build_input *in);
+
+/*
+ * Nodes for `bytes` of scratch past a tree of n primitives (2n - 1 nodes),
+ * which the host keeps between builds: a fresh mapping would be paged in
+ * (and zeroed by the kernel) at every build. 0 when the count would not
+ * fit a uint32_t.
+ */
+uint32_t morton_spare_nodes(uint32_t n, size_t bytes);
+
+/* Room for the tree of n primitives, asking for `spare` nodes more (fine
+ * if refused): 0, or -ENOMEM after host->set_error. */
+int morton_ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx, uint32_t n,
+                           uint32_t spare, bvhlab_build_output *out);
+
+/* The sort's three buffers of n words, one after another at `at`. */
+static inline size_t morton_sort_bytes(size_t n)
+{
+	return 3 * morton_align64(8 * n);
+}
+
+void morton_place_sort(morton_sort *s, char *at);
+
+/* What morton_scratch_alloc() mapped or allocated. */
+typedef struct morton_scratch {
+	void *region; /* one huge-page mapping (big_alloc), or NULL */
+	void *small;  /* the sort's digit counts, then the builder's words */
+} morton_scratch;
+
+/*
+ * A zero-filled mapping of `region` bytes (none for 0), and the digit
+ * counts of s->sort for `threads` threads followed by `extra` uint32_t per
+ * thread, which it returns; NULL when out of memory.
+ */
+uint32_t *morton_scratch_alloc(morton_scratch *scratch, size_t region, morton_sort *sort,
+                               unsigned threads, unsigned extra);
+void morton_scratch_free(morton_scratch *scratch);
+
+/* By every member t of tm: the sort of morton.h, barriers included. */
+void morton_sort_team(morton_sort *s, team *tm, unsigned t,
+                      void (*done)(void *arg, uint32_t first, uint32_t end), void *arg);
+
+/* The whole tree of a single primitive: one leaf. */
+void morton_single_leaf(const bvhlab_build_input *in, bvhlab_build_output *out);
+
+#endif /* BVHLAB_MORTON_FRONT_H */
