@@ -24,60 +24,22 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/clip.h>
+
 #include "tree/validate_clip.h"
 
-#define MAX_VERTS 16   /* a triangle clipped by 6 planes has at most 9 */
 #define MAX_PIECES (1 << 18) /* uncovered pieces kept per triangle */
 #define PAD_ULPS 0x1p-20 /* 8 float ulps of a coordinate's magnitude */
 #define PAD_EXTENT 1e-6
 #define AREA_TOLERANCE 1e-5
 
-typedef struct poly {
-	int n;
-	double v[MAX_VERTS][3];
-} poly;
+typedef bvhlab_poly poly; /* the clipper shared with the builders (bvhlab/clip.h) */
 
 /* The uncovered pieces before and after one box's subtraction. */
 typedef struct cover {
 	poly *pieces[2];
 	int count[2], cap[2];
 } cover;
-
-/* The part of p with sign * (x[axis] - at) >= 0 (Sutherland-Hodgman). */
-static void clip(const poly *p, int axis, double at, double sign, poly *out)
-{
-	out->n = 0;
-	for (int i = 0; i < p->n; i++) {
-		const double *a = p->v[i], *b = p->v[(i + 1) % p->n];
-		double da = sign * (a[axis] - at), db = sign * (b[axis] - at);
-
-		if (da >= 0.0 && out->n < MAX_VERTS)
-			memcpy(out->v[out->n++], a, sizeof(out->v[0]));
-		if (((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) && out->n < MAX_VERTS) {
-			double t = da / (da - db), *c = out->v[out->n++];
-
-			for (int k = 0; k < 3; k++)
-				c[k] = a[k] + t * (b[k] - a[k]);
-			c[axis] = at;
-		}
-	}
-}
-
-static double area(const poly *p)
-{
-	double s[3] = { 0.0, 0.0, 0.0 };
-
-	for (int i = 1; i + 1 < p->n; i++) {
-		const double *a = p->v[0], *b = p->v[i], *c = p->v[i + 1];
-		double e[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
-		double f[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
-
-		s[0] += e[1] * f[2] - e[2] * f[1];
-		s[1] += e[2] * f[0] - e[0] * f[2];
-		s[2] += e[0] * f[1] - e[1] * f[0];
-	}
-	return 0.5 * sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-}
 
 /* The leaf's box widened for float rounding (see the top of the file). */
 static void padded_box(const bvhlab_node *n, double lo[3], double hi[3])
@@ -102,8 +64,8 @@ static void clip_box(const poly *p, const double lo[3], const double hi[3], poly
 	const poly *cur = p;
 
 	for (int k = 0; k < 3; k++) {
-		clip(cur, k, lo[k], 1.0, &tmp[0]);
-		clip(&tmp[0], k, hi[k], -1.0, &tmp[1]);
+		bvhlab_poly_clip(cur, k, lo[k], 1.0, &tmp[0]);
+		bvhlab_poly_clip(&tmp[0], k, hi[k], -1.0, &tmp[1]);
 		cur = &tmp[1];
 		if (cur->n == 0)
 			break;
@@ -164,13 +126,13 @@ static bool subtract(const poly *p, const double lo[3], const double hi[3], cove
 		for (int side = 0; side < 2; side++) {
 			double at = side ? hi[k] : lo[k], sign = side ? 1.0 : -1.0;
 
-			clip(&rest, k, at, sign, &out);
-			if (out.n >= 3 && area(&out) > min_area) {
+			bvhlab_poly_clip(&rest, k, at, sign, &out);
+			if (out.n >= 3 && bvhlab_poly_area(&out) > min_area) {
 				if (!room(c, to))
 					return false;
 				c->pieces[to][c->count[to]++] = out;
 			}
-			clip(&rest, k, at, -sign, &next);
+			bvhlab_poly_clip(&rest, k, at, -sign, &next);
 			rest = next;
 		}
 	}
@@ -225,7 +187,7 @@ static int check_prim(const bvhlab_tree *t, const bvhlab_build_input *in, const 
 	poly tri, part;
 
 	triangle(in, prim, &tri);
-	full = area(&tri);
+	full = bvhlab_poly_area(&tri);
 	if (!(full > 0.0))
 		return check_degenerate(t, &tri, leaves, count, prim, err);
 	c->count[0] = c->count[1] = 0;
@@ -251,7 +213,7 @@ static int check_prim(const bvhlab_tree *t, const bvhlab_build_input *in, const 
 		cur = !cur;
 	}
 	for (int j = 0; j < c->count[cur]; j++)
-		left += area(&c->pieces[cur][j]);
+		left += bvhlab_poly_area(&c->pieces[cur][j]);
 	if (left > AREA_TOLERANCE * full)
 		return FAIL(err, "primitive %" PRIu32 ": its %" PRIu32 " reference(s)' leaf boxes "
 		            "leave %.3g%% of its area uncovered (leaf %" PRIu32 " among them)", prim,

@@ -6,6 +6,7 @@
  * tools) include this. Each header holds one concept:
  *   types.h    boxes, nodes, rays, hits, errors (plain data, fixed layouts)
  *   aabb.h     box helpers (header-only)
+ *   clip.h     clipping polygons by axis planes (header-only; spatial splits)
  *   builder.h  the plugin ABI
  *   scene.h    triangle scenes: loading, generators, per-primitive data
  *   tree.h     the tree, validation, metrics, canonical compare
@@ -21,6 +22,7 @@
 
 #include "aabb.h"
 #include "builder.h"
+#include "clip.h"
 #include "epo.h"
 #include "host.h"
 #include "machine.h"

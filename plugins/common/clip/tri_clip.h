@@ -9,17 +9,12 @@
 #ifndef BVHLAB_TRI_CLIP_H
 #define BVHLAB_TRI_CLIP_H
 
+#include <bvhlab/clip.h>
 #include <bvhlab/types.h>
 
-/* A triangle clipped by the 6 planes of a box has at most 9 corners, and
- * one more plane adds at most one. */
-#define TRI_POLY_MAX 12
-
-/* A convex polygon; n == 0 is empty. */
-typedef struct tri_poly {
-	int n;
-	double v[TRI_POLY_MAX][3];
-} tri_poly;
+/* A convex polygon (the clipper is <bvhlab/clip.h>, shared with the
+ * validator); n == 0 is empty. */
+typedef bvhlab_poly tri_poly;
 
 /* Triangle `tri` (vertex indices into vertices[3 * i]) as a polygon. */
 void tri_poly_triangle(tri_poly *p, const float *vertices, const uint32_t *tri);
