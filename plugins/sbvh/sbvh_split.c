@@ -215,30 +215,51 @@ void sbvh_bin_spatial(const sbvh_build *B, const sbvh_job *job, uint32_t begin,
 	}
 }
 
-/* Sweeps one axis's bins: the best boundary by SAH. enter/leave: counts of
- * the left side (bins <= j) and right side (bins > j). */
+/* Bins of axis k that hold anything: a box, an entry or an exit. */
+static uint32_t used_bins(const sbvh_bins *b, int k, uint32_t bins, const uint32_t *enter,
+                          const uint32_t *leave, uint32_t *used)
+{
+	uint32_t m = 0;
+
+	for (uint32_t j = 0; j < bins; j++)
+		if (b->lo[k][j][0] <= b->hi[k][j][0] || enter[j] || leave[j])
+			used[m++] = j;
+	return m;
+}
+
+/*
+ * Sweeps one axis's bins: the best boundary by SAH. enter/leave: counts of
+ * the left side (bins <= j) and right side (bins > j). Only bins that hold
+ * something are visited: past an unused bin both sides and the cost are
+ * those of the boundary before it, which the strict < already prefers, so
+ * the split is the same as over every bin, and small nodes (a few used
+ * bins of 32) sweep a few bins, not all.
+ */
 static void sweep(const sbvh_bins *b, int k, uint32_t bins, const uint32_t *enter,
                   const uint32_t *leave, double inv_area, sbvh_split *best, int kind)
 {
 	float rlo[SBVH_MAX_BINS][3], rhi[SBVH_MAX_BINS][3], lo[3], hi[3];
-	uint32_t rn[SBVH_MAX_BINS], n = 0;
+	uint32_t rn[SBVH_MAX_BINS], used[SBVH_MAX_BINS], n = 0;
+	uint32_t m = used_bins(b, k, bins, enter, leave, used);
 
+	/* rlo[u], rhi[u], rn[u]: the right side of the boundary before used[u]. */
 	empty(lo, hi);
-	for (uint32_t j = bins; j-- > 1;) {
-		grow(lo, hi, b->lo[k][j], b->hi[k][j]);
-		n += leave[j];
-		memcpy(rlo[j], lo, sizeof(lo));
-		memcpy(rhi[j], hi, sizeof(hi));
-		rn[j] = n;
+	for (uint32_t u = m; u-- > 1;) {
+		grow(lo, hi, b->lo[k][used[u]], b->hi[k][used[u]]);
+		n += leave[used[u]];
+		memcpy(rlo[u], lo, sizeof(lo));
+		memcpy(rhi[u], hi, sizeof(hi));
+		rn[u] = n;
 	}
 	empty(lo, hi);
 	n = 0;
-	for (uint32_t j = 0; j + 1 < bins; j++) {
+	for (uint32_t u = 0; u + 1 < m; u++) {
+		uint32_t j = used[u];
 		grow(lo, hi, b->lo[k][j], b->hi[k][j]);
 		n += enter[j];
-		if (n == 0 || rn[j + 1] == 0)
+		if (n == 0 || rn[u + 1] == 0)
 			continue;
-		double cost = 1.0 + (area(lo, hi) * n + area(rlo[j + 1], rhi[j + 1]) * rn[j + 1]) *
+		double cost = 1.0 + (area(lo, hi) * n + area(rlo[u + 1], rhi[u + 1]) * rn[u + 1]) *
 		                        inv_area;
 		if (cost < best->cost) {
 			best->cost = cost;
@@ -246,11 +267,11 @@ static void sweep(const sbvh_bins *b, int k, uint32_t bins, const uint32_t *ente
 			best->axis = k;
 			best->bin = j;
 			best->nl = n;
-			best->nr = rn[j + 1];
+			best->nr = rn[u + 1];
 			memcpy(best->llo, lo, sizeof(lo));
 			memcpy(best->lhi, hi, sizeof(hi));
-			memcpy(best->rlo, rlo[j + 1], sizeof(lo));
-			memcpy(best->rhi, rhi[j + 1], sizeof(hi));
+			memcpy(best->rlo, rlo[u + 1], sizeof(lo));
+			memcpy(best->rhi, rhi[u + 1], sizeof(hi));
 		}
 	}
 }
