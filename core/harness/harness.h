@@ -12,6 +12,7 @@
 #include <bvhlab/traversal.h>
 
 #include "config/config.h"
+#include "harness/refine_stage.h"
 #include "output/results.h"
 
 /* Loads or generates one config scene, subdivides it and names it. */
@@ -44,21 +45,6 @@ struct harness_options {
  */
 int harness_run(const struct config *cfg, const struct harness_options *opts,
                 bvhlab_error *err);
-
-/* A refinement stage run after every build of a series. */
-struct refine_stage {
-	const bvhlab_plugin *plugin; /* one whose descriptor has refine (ABI 1.2) */
-	const bvhlab_options *opts;
-};
-
-#define HARNESS_MAX_STAGES CONFIG_MAX_REFINE
-
-/* What a series measured of one stage. */
-struct stage_metrics {
-	char plugin[64];       /* the descriptor's name */
-	double ms;             /* median over the timed repeats */
-	double sah_before, sah_after; /* SAH cost of the last repeat's tree */
-};
 
 /* One timed build series of a plugin on prepared primitives. */
 struct build_series {

@@ -12,8 +12,8 @@
 #include <bvhlab/bvhlab.h>
 
 #include "config/config.h"
-#include "harness/harness.h"
 #include "harness/isolate.h"
+#include "harness/refine_stage.h"
 
 struct harness_builder {
 	const struct config_builder *cb;

@@ -46,6 +46,13 @@ struct build_memory {
 	uint64_t output_bytes;    /* the output buffers the host allocated, capacity */
 };
 
+/* What a build series measured of one refinement stage. */
+struct stage_metrics {
+	char plugin[64];       /* the descriptor's name */
+	double ms;             /* median over the timed repeats */
+	double sah_before, sah_after; /* SAH cost of the last repeat's tree */
+};
+
 /* Everything known about one run; fields beyond status are optional. */
 struct run_record {
 	uint32_t id;           /* position in the config's run order (plan.h) */
@@ -87,7 +94,6 @@ int results_add_run(struct results *res, const struct run_record *run);
 /* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of docs/design.md. */
 struct cJSON *results_rays_json(const struct ray_metrics *m);
 
-struct stage_metrics;
 /* "stages": [{"plugin", "ms", "sah_before", "sah_after"}, ...] (results_stages.c). */
 struct cJSON *results_stages_json(const struct stage_metrics *stages, uint32_t count);
 

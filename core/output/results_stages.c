@@ -6,7 +6,6 @@
  */
 #include <cJSON.h>
 
-#include "harness/harness.h"
 #include "output/results.h"
 
 cJSON *results_stages_json(const struct stage_metrics *stages, uint32_t count)
