@@ -164,20 +164,23 @@ static void clip_into_bins(const sbvh_build *B, const sbvh_job *job, const sbvh_
 {
 	const uint32_t *tri = &B->in->indices[3 * (size_t)r->prim];
 	uint32_t bins = B->opt.bins;
-	float v[3][3], below = -INFINITY;
+	float v[3][3], below = -INFINITY, clo[3], chi[3]; /* crossings of `below` */
 
 	for (int j = 0; j < 3; j++)
 		memcpy(v[j], &B->in->vertices[3 * (size_t)tri[j]], sizeof(v[j]));
+	empty(clo, chi);
 	for (uint32_t j = b0; j <= b1; j++) {
 		float above = j < b1 ? plane(job, k, j, bins) : INFINITY, lo[3], hi[3];
 		empty(lo, hi);
 		for (int m = 0; m < 3; m++)
 			if (below <= v[m][k] && v[m][k] <= above)
 				grow(lo, hi, v[m], v[m]);
-		if (j > b0)
-			add_crossings(v, k, below, lo, hi);
+		/* A plane's crossings bound both bins beside it: found once. */
+		grow(lo, hi, clo, chi);
+		empty(clo, chi);
 		if (j < b1)
-			add_crossings(v, k, above, lo, hi);
+			add_crossings(v, k, above, clo, chi);
+		grow(lo, hi, clo, chi);
 		for (int m = 0; m < 3; m++) {
 			lo[m] = maxf(lo[m], r->lo[m]);
 			hi[m] = minf(hi[m], r->hi[m]);
