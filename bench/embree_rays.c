@@ -6,11 +6,17 @@
  *   build/bench/embree-rays SCENE [--subdivide K] [--size N] [--min-ms MS]
  *                           [--builder PLUGIN]
  *
- * Embree and both core traversals (stack, stackless) trace the whole batch
- * in turn, pass after pass, until --min-ms (default 1000) has passed and at
- * least 5 times each; the medians are printed with the ratios, once timed
- * by the thread's CPU time (what the harness reports) and once by the wall
- * clock.
+ * Embree and both core traversals (stack, stackless) take turns, a round
+ * at a time, until --min-ms (default 1000) has passed and at least 5
+ * rounds were run. In a round each traces the whole batch PASSES times in
+ * a row, timed on both clocks, the thread's CPU time (what the harness
+ * reports) and the wall clock; the core's passes go through
+ * bvhlab_trace_measure, as the harness's do. A round's figure is the median
+ * of its passes, so the first pass, cold after the other tracers ran (and,
+ * for the core, after its copy of the tree), is left out as the harness's
+ * median leaves it out; the medians over rounds are printed with the ratios.
+ * Both clocks' figures come from the same passes: a burst of load from
+ * elsewhere stretches the wall clock only.
  * Embree's BVH is its own (rtcCommitScene, default quality, 4- or 8-wide
  * nodes); ours is the plugin's tree in the 32-byte binary layout.
  */
@@ -29,7 +35,8 @@
 #include "util/util.h"
 
 #define MAX_SAMPLES 4096
-#define MIN_REPEATS 5
+#define MIN_ROUNDS 5
+#define PASSES 3
 
 struct args {
 	const char *scene, *builder;
@@ -129,24 +136,45 @@ static double cpu_now(void)
 	return (double)c.tv_sec + 1e-9 * (double)c.tv_nsec;
 }
 
-/* What one tracer measured. */
+/* What one tracer measured: a median per round, on each clock. */
 struct tracer {
-	double samples[MAX_SAMPLES];
-	double mrays;
+	double cpu[MAX_SAMPLES], wall[MAX_SAMPLES];
+	double mrays[2]; /* medians over rounds: thread CPU time, wall clock */
 	size_t hits;
 	double nodes; /* per ray; the core's traversals only */
 };
 
-/* One pass of the core's traversal k, timed by its own clocks. */
-static bool ours_pass(bool wall_clock, const bvhlab_tree *tree, const bvhlab_scene *s,
-                      const bvhlab_ray *rays, size_t n, int k, bvhlab_hit *h,
-                      struct tracer *t, size_t pass)
+static double rate(size_t n, double seconds)
 {
-	bvhlab_trace_options o = {.traversal = k, .threads = 1, .max_repeats = 1};
+	return (double)n / seconds * 1e-6;
+}
+
+/* PASSES passes of rtcIntersect1 in a row. */
+static void embree_round(RTCScene sc, const bvhlab_ray *rays, size_t n, struct tracer *t,
+                         size_t round)
+{
+	double cpu[PASSES], wall[PASSES];
+	for (int i = 0; i < PASSES; i++) {
+		double w0 = util_now(), c0 = cpu_now();
+		t->hits = embree_pass(sc, rays, n);
+		cpu[i] = rate(n, cpu_now() - c0);
+		wall[i] = rate(n, util_now() - w0);
+	}
+	t->cpu[round] = median(cpu, PASSES);
+	t->wall[round] = median(wall, PASSES);
+}
+
+/* PASSES passes of the core's traversal k, timed by bvhlab_trace_measure. */
+static bool ours_round(const bvhlab_tree *tree, const bvhlab_scene *s, const bvhlab_ray *rays,
+                       size_t n, int k, bvhlab_hit *h, struct tracer *t, size_t round)
+{
+	bvhlab_trace_options o = {.traversal = k, .threads = 1, .min_repeats = PASSES,
+	                          .max_repeats = PASSES};
 	bvhlab_trace_timing tm;
 	if (bvhlab_trace_measure(tree, s, rays, n, &o, h, NULL, &tm) < 0)
 		return false;
-	t->samples[pass] = wall_clock ? tm.wall_mrays_median : tm.mrays_median;
+	t->cpu[round] = tm.mrays_median;
+	t->wall[round] = tm.wall_mrays_median;
 	t->nodes = (double)tm.stats.nodes_visited / (double)tm.stats.rays;
 	t->hits = 0;
 	for (size_t i = 0; i < n; i++)
@@ -154,42 +182,40 @@ static bool ours_pass(bool wall_clock, const bvhlab_tree *tree, const bvhlab_sce
 	return true;
 }
 
-/* Passes of Embree and of both core traversals in turn, so a burst of
+/* Rounds of Embree and of both core traversals in turn, so a burst of
  * load from elsewhere on the machine falls on all three alike; medians. */
-static void time_all(bool wall_clock, RTCScene sc, const bvhlab_tree *tree,
-                     const bvhlab_scene *s, const bvhlab_ray *rays, size_t n,
-                     const struct args *a, struct tracer t[3])
+static void time_all(RTCScene sc, const bvhlab_tree *tree, const bvhlab_scene *s,
+                     const bvhlab_ray *rays, size_t n, const struct args *a, struct tracer t[3])
 {
 	bvhlab_hit *h = malloc(n * sizeof(*h));
 	double start = util_now();
 	size_t k = 0;
-	while (h && k < MAX_SAMPLES && (k < MIN_REPEATS || util_now() - start < a->min_ms * 1e-3)) {
-		double w0 = util_now(), c0 = cpu_now();
-		t[0].hits = embree_pass(sc, rays, n);
-		double secs = wall_clock ? util_now() - w0 : cpu_now() - c0;
-		t[0].samples[k] = (double)n / secs * 1e-6;
-		if (!ours_pass(wall_clock, tree, s, rays, n, BVHLAB_TRAVERSAL_STACK, h, &t[1], k) ||
-		    !ours_pass(wall_clock, tree, s, rays, n, BVHLAB_TRAVERSAL_STACKLESS, h, &t[2], k))
+	while (h && k < MAX_SAMPLES && (k < MIN_ROUNDS || util_now() - start < a->min_ms * 1e-3)) {
+		embree_round(sc, rays, n, &t[0], k);
+		if (!ours_round(tree, s, rays, n, BVHLAB_TRAVERSAL_STACK, h, &t[1], k) ||
+		    !ours_round(tree, s, rays, n, BVHLAB_TRAVERSAL_STACKLESS, h, &t[2], k))
 			break;
 		k++;
 	}
-	for (int i = 0; i < 3; i++)
-		t[i].mrays = k ? median(t[i].samples, k) : 0;
+	for (int i = 0; i < 3; i++) {
+		t[i].mrays[0] = k ? median(t[i].cpu, k) : 0;
+		t[i].mrays[1] = k ? median(t[i].wall, k) : 0;
+	}
 	free(h);
 }
 
-static void report(const struct args *a, const bvhlab_scene *s, bool wall_clock,
+static void report(const struct args *a, const bvhlab_scene *s, int clock,
                    const struct tracer t[3])
 {
 	printf("scene %s (%u triangles), %ux%u primary rays, 1 thread, %s\n", s->name,
 	       s->triangle_count, a->size, a->size,
-	       wall_clock ? "wall clock" : "thread CPU time");
-	printf("  embree rtcIntersect1: %.2f Mrays/s (%zu hits)\n", t[0].mrays, t[0].hits);
+	       clock ? "wall clock" : "thread CPU time");
+	printf("  embree rtcIntersect1: %.2f Mrays/s (%zu hits)\n", t[0].mrays[clock], t[0].hits);
 	for (int k = 1; k < 3; k++)
 		printf("  bvhlab %s tree, %s traversal: %.2f Mrays/s (%zu hits, %.2f nodes/ray), "
 		       "ratio to embree %.2f\n",
-		       a->builder, bvhlab_traversal_name(k - 1), t[k].mrays, t[k].hits, t[k].nodes,
-		       t[0].mrays > 0 ? t[k].mrays / t[0].mrays : 0);
+		       a->builder, bvhlab_traversal_name(k - 1), t[k].mrays[clock], t[k].hits,
+		       t[k].nodes, t[0].mrays[clock] > 0 ? t[k].mrays[clock] / t[0].mrays[clock] : 0);
 }
 
 static int build(const struct args *a, const bvhlab_scene *s, bvhlab_tree *tree,
@@ -239,10 +265,9 @@ int main(int argc, char **argv)
 		return 1;
 	RTCDevice dev = rtcNewDevice("threads=1");
 	RTCScene sc = embree_scene(dev, s);
-	for (int clock = 0; clock < 2; clock++) {
-		time_all(clock == 1, sc, &tree, s, rays, n, &a, t);
-		report(&a, s, clock == 1, t);
-	}
+	time_all(sc, &tree, s, rays, n, &a, t);
+	for (int clock = 0; clock < 2; clock++)
+		report(&a, s, clock, t);
 	rtcReleaseScene(sc);
 	rtcReleaseDevice(dev);
 	free(rays);
