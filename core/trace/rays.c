@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
 #include <bvhlab/trace.h>
 
 #include "util/util.h"
@@ -46,18 +47,13 @@ static bool normalize3(float v[3])
 	return true;
 }
 
-static bool box_empty(const bvhlab_aabb *b)
-{
-	return !(b->lo[0] <= b->hi[0] && b->lo[1] <= b->hi[1] && b->lo[2] <= b->hi[2]);
-}
-
 void bvhlab_camera_frame(const bvhlab_aabb *bounds, bvhlab_camera *camera)
 {
 	float dir[3] = {1.0f, 0.6f, 1.4f}, centre[3] = {0, 0, 0}, radius = 1.0f;
 	memset(camera, 0, sizeof(*camera));
 	camera->up[1] = 1.0f;
 	camera->fov_deg = 45.0f;
-	if (box_empty(bounds)) {
+	if (bvhlab_aabb_is_empty(bounds)) {
 		camera->position[2] = 1.0f;
 		return;
 	}
@@ -174,7 +170,7 @@ static void cosine_dir(const float n[3], uint64_t *state, float dir[3])
 static float scene_offset(const bvhlab_scene *scene)
 {
 	float diag[3];
-	if (box_empty(&scene->bounds))
+	if (bvhlab_aabb_is_empty(&scene->bounds))
 		return OFFSET_SCALE;
 	sub3(scene->bounds.hi, scene->bounds.lo, diag);
 	float len = sqrtf(dot3(diag, diag));

@@ -33,19 +33,39 @@ static inline float bvhlab_maxf(float a, float b)
 	return a > b ? a : b;
 }
 
+/*
+ * Each helper comes in two forms: on a bvhlab_aabb, and on a box given by
+ * its corners lo[3], hi[3] (a node's box, a builder's bins, any layout that
+ * is not a bvhlab_aabb). The bvhlab_aabb forms call the corner forms.
+ */
+
 /* lo = +inf, hi = -inf: growing it by anything gives that thing's box. */
-static inline void bvhlab_aabb_empty(bvhlab_aabb *b)
+static inline void bvhlab_box_empty(float *lo, float *hi)
 {
 	for (int k = 0; k < 3; k++) {
-		b->lo[k] = INFINITY;
-		b->hi[k] = -INFINITY;
+		lo[k] = INFINITY;
+		hi[k] = -INFINITY;
 	}
 }
 
-/* True for a box that contains nothing (lo > hi on some axis). */
+static inline void bvhlab_aabb_empty(bvhlab_aabb *b)
+{
+	bvhlab_box_empty(b->lo, b->hi);
+}
+
+/* True for a box that contains nothing: lo > hi on some axis, or a NaN. */
 static inline bool bvhlab_aabb_is_empty(const bvhlab_aabb *b)
 {
-	return b->lo[0] > b->hi[0] || b->lo[1] > b->hi[1] || b->lo[2] > b->hi[2];
+	return !(b->lo[0] <= b->hi[0] && b->lo[1] <= b->hi[1] && b->lo[2] <= b->hi[2]);
+}
+
+/* Grows the box lo[3], hi[3] to contain the box blo[3], bhi[3]. */
+static inline void bvhlab_box_grow(float *lo, float *hi, const float *blo, const float *bhi)
+{
+	for (int k = 0; k < 3; k++) {
+		lo[k] = bvhlab_minf(lo[k], blo[k]);
+		hi[k] = bvhlab_maxf(hi[k], bhi[k]);
+	}
 }
 
 /* Grows b to contain the point p[3]. */
@@ -61,10 +81,7 @@ static inline void bvhlab_aabb_grow_point(bvhlab_aabb *b, const float *p)
  * box, or any other layout that is not a bvhlab_aabb). */
 static inline void bvhlab_aabb_grow_corners(bvhlab_aabb *b, const float *lo, const float *hi)
 {
-	for (int k = 0; k < 3; k++) {
-		b->lo[k] = bvhlab_minf(b->lo[k], lo[k]);
-		b->hi[k] = bvhlab_maxf(b->hi[k], hi[k]);
-	}
+	bvhlab_box_grow(b->lo, b->hi, lo, hi);
 }
 
 /* Grows b to contain the box p. */
@@ -81,10 +98,15 @@ static inline float bvhlab_aabb_center(const bvhlab_aabb *b, int axis)
 
 /* Half the surface area, in float: the factor 2 cancels in every SAH ratio.
  * Not for empty boxes. */
+static inline float bvhlab_half_area(const float *lo, const float *hi)
+{
+	float dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+	return dx * dy + dy * dz + dz * dx;
+}
+
 static inline float bvhlab_aabb_half_area(const bvhlab_aabb *b)
 {
-	float dx = b->hi[0] - b->lo[0], dy = b->hi[1] - b->lo[1], dz = b->hi[2] - b->lo[2];
-	return dx * dy + dy * dz + dz * dx;
+	return bvhlab_half_area(b->lo, b->hi);
 }
 
 /* The full surface area 2(xy + yz + zx) of the box with corners lo[3],

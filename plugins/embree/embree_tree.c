@@ -51,8 +51,7 @@ static void *create_leaf(RTCThreadLocalAllocator alloc, const struct RTCBuildPri
 	tleaf *l = rtcThreadLocalAlloc(alloc, sizeof(tleaf) + count * sizeof(uint32_t), 16);
 	l->head.count = (uint32_t)count;
 	l->head.arity = 0;
-	for (int k = 0; k < 3; k++)
-		l->lo[k] = INFINITY, l->hi[k] = -INFINITY;
+	bvhlab_box_empty(l->lo, l->hi);
 	for (size_t k = 0; k < count; k++) {
 		const struct RTCBuildPrimitive *p = &prims[k];
 		l->prim[k] = p->primID;

@@ -162,13 +162,6 @@ static inline uint32_t internal_index(const bvhlab_node *node)
 	return (node->first - 1) / 2;
 }
 
-static inline float half_area(const float lo[3], const float hi[3])
-{
-	float dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
-
-	return dx * dy + dy * dz + dz * dx;
-}
-
 /* Phases, run by every thread t of the team; each ends with lbvh_sync
  * except the last, which the caller's join ends. */
 void lbvh_sort(lbvh *b, unsigned t);      /* lbvh_sort.c */

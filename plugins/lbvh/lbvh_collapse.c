@@ -32,6 +32,8 @@
  */
 #include <string.h>
 
+#include <bvhlab/aabb.h>
+
 #include "lbvh.h"
 
 #define COST_TAG 0x80000000u
@@ -99,7 +101,7 @@ static void settle_kids(lbvh *b, uint32_t i)
 static inline float child_cost(const lbvh *b, const bvhlab_node *child)
 {
 	uint32_t leaf = float_bits(b->c_isect * (float)child->count *
-	                           half_area(child->lo, child->hi));
+	                           bvhlab_half_area(child->lo, child->hi));
 	uint32_t tagged = -(child->count >> 31);
 
 	return bits_float((child->count & ~COST_TAG & tagged) | (leaf & ~tagged));
@@ -119,7 +121,7 @@ void lbvh_collapse(lbvh *b, uint32_t i, uint32_t size, bvhlab_node *out)
 		settle_kids(b, i);
 		return;
 	}
-	area = half_area(out->lo, out->hi);
+	area = bvhlab_half_area(out->lo, out->hi);
 	split_cost = b->c_trav * area + child_cost(b, &kids[0]) + child_cost(b, &kids[1]);
 	leaf_cost = b->c_isect * (float)size * area;
 	if (leaf_cost <= split_cost) {

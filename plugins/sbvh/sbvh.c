@@ -20,6 +20,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
+
 #include "sbvh.h"
 
 static const bvhlab_option_decl options[] = {
@@ -104,10 +106,7 @@ static void init_refs(sbvh_build *B)
 static void init_root(const sbvh_build *B, uint32_t count, sbvh_job *root)
 {
 	*root = (sbvh_job){ .end = count, .rend = B->capacity };
-	for (int k = 0; k < 3; k++) {
-		root->lo[k] = root->clo[k] = INFINITY;
-		root->hi[k] = root->chi[k] = -INFINITY;
-	}
+	sbvh_job_empty(root);
 	for (uint32_t i = 0; i < count; i++) {
 		const sbvh_ref *r = &B->refs[0][i];
 		for (int k = 0; k < 3; k++) {
@@ -118,15 +117,6 @@ static void init_root(const sbvh_build *B, uint32_t count, sbvh_job *root)
 			root->chi[k] = c > root->chi[k] ? c : root->chi[k];
 		}
 	}
-}
-
-static double box_area(const float lo[3], const float hi[3])
-{
-	double d[3];
-
-	for (int k = 0; k < 3; k++)
-		d[k] = hi[k] > lo[k] ? (double)hi[k] - lo[k] : 0.0;
-	return 2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
 }
 
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
@@ -165,7 +155,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		}
 	}
 	init_root(&B, count, &root);
-	B.root_area = box_area(root.lo, root.hi);
+	B.root_area = bvhlab_box_area(root.lo, root.hi);
 	atomic_init(&B.next_node, 1);
 	atomic_init(&B.next_slot, 0);
 	atomic_init(&B.spatial, 0);

@@ -29,6 +29,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include <bvhlab/aabb.h>
 #include <bvhlab/builder.h>
 
 #define SBVH_MAX_BINS 64
@@ -60,6 +61,13 @@ typedef struct sbvh_job {
 	float lo[3], hi[3];    /* box of the references */
 	float clo[3], chi[3];  /* bounds of their box centres */
 } sbvh_job;
+
+/* No references yet: empty box and centre bounds. */
+static inline void sbvh_job_empty(sbvh_job *j)
+{
+	bvhlab_box_empty(j->lo, j->hi);
+	bvhlab_box_empty(j->clo, j->chi);
+}
 
 /* What a build shares between its threads. */
 typedef struct sbvh_build {

@@ -9,17 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
+
 #include "sbvh.h"
-
-static inline float minf(float a, float b)
-{
-	return a < b ? a : b;
-}
-
-static inline float maxf(float a, float b)
-{
-	return a > b ? a : b;
-}
 
 void sbvh_choose_object(const sbvh_build *B, const sbvh_job *job, const sbvh_bins *bins,
                         sbvh_split *obj)
@@ -94,10 +86,8 @@ void sbvh_make_children(sbvh_build *B, const sbvh_job *job, uint32_t nl, uint32_
 	*right = (sbvh_job){ .begin = job->rend - nr, .end = job->rend,
 	                     .rbegin = job->rbegin + nl + spare_l, .rend = job->rend,
 	                     .node = first + 1, .buf = !job->buf };
-	for (int k = 0; k < 3; k++) {
-		left->lo[k] = right->lo[k] = left->clo[k] = right->clo[k] = INFINITY;
-		left->hi[k] = right->hi[k] = left->chi[k] = right->chi[k] = -INFINITY;
-	}
+	sbvh_job_empty(left);
+	sbvh_job_empty(right);
 }
 
 /* Adds a reference to a child job's box and centre bounds. */
@@ -105,20 +95,17 @@ static inline void grow_job(sbvh_job *j, const sbvh_ref *r)
 {
 	for (int k = 0; k < 3; k++) {
 		float c = 0.5f * (r->lo[k] + r->hi[k]);
-		j->lo[k] = minf(j->lo[k], r->lo[k]);
-		j->hi[k] = maxf(j->hi[k], r->hi[k]);
-		j->clo[k] = minf(j->clo[k], c);
-		j->chi[k] = maxf(j->chi[k], c);
+		j->lo[k] = bvhlab_minf(j->lo[k], r->lo[k]);
+		j->hi[k] = bvhlab_maxf(j->hi[k], r->hi[k]);
+		j->clo[k] = bvhlab_minf(j->clo[k], c);
+		j->chi[k] = bvhlab_maxf(j->chi[k], c);
 	}
 }
 
 /* Empty box and centre bounds, no references yet. */
 static void child_init(sbvh_job *j)
 {
-	for (int k = 0; k < 3; k++) {
-		j->lo[k] = j->clo[k] = INFINITY;
-		j->hi[k] = j->chi[k] = -INFINITY;
-	}
+	sbvh_job_empty(j);
 	j->begin = j->end = 0;
 }
 

@@ -37,14 +37,6 @@ typedef struct team {
 	member *m;             /* [B->threads] */
 } team;
 
-static void child_empty(sbvh_job *j)
-{
-	for (int k = 0; k < 3; k++) {
-		j->lo[k] = j->clo[k] = INFINITY;
-		j->hi[k] = j->chi[k] = -INFINITY;
-	}
-}
-
 static void grow_job(sbvh_job *j, const sbvh_ref *r)
 {
 	for (int k = 0; k < 3; k++) {
@@ -84,8 +76,8 @@ static void write_share(member *m)
 	sbvh_ref *out = m->team->B->refs[!m->team->job->buf], l, r;
 	uint32_t li = m->lout, ri = m->rout;
 
-	child_empty(&m->l);
-	child_empty(&m->r);
+	sbvh_job_empty(&m->l);
+	sbvh_job_empty(&m->r);
 	for (uint32_t i = m->begin; i < m->end; i++) {
 		unsigned side = side_of(m->team, i, &l, &r);
 		if (side & 1) {

@@ -11,47 +11,16 @@
 #include <math.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
+
 #include "sbvh.h"
 #include "tri_clip.h"
-
-static inline float minf(float a, float b)
-{
-	return a < b ? a : b;
-}
-
-static inline float maxf(float a, float b)
-{
-	return a > b ? a : b;
-}
-
-static double area(const float lo[3], const float hi[3])
-{
-	double d[3];
-
-	for (int k = 0; k < 3; k++)
-		d[k] = hi[k] > lo[k] ? (double)hi[k] - lo[k] : 0.0;
-	return 2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]);
-}
-
-static void grow(float lo[3], float hi[3], const float *blo, const float *bhi)
-{
-	for (int k = 0; k < 3; k++) {
-		lo[k] = minf(lo[k], blo[k]);
-		hi[k] = maxf(hi[k], bhi[k]);
-	}
-}
-
-static void empty(float lo[3], float hi[3])
-{
-	for (int k = 0; k < 3; k++)
-		lo[k] = INFINITY, hi[k] = -INFINITY;
-}
 
 void sbvh_bins_clear(sbvh_bins *b, uint32_t bins)
 {
 	for (int a = 0; a < 3; a++)
 		for (uint32_t i = 0; i < bins; i++) {
-			empty(b->lo[a][i], b->hi[a][i]);
+			bvhlab_box_empty(b->lo[a][i], b->hi[a][i]);
 			b->count[a][i] = b->exits[a][i] = 0;
 		}
 }
@@ -60,7 +29,7 @@ void sbvh_bins_merge(sbvh_bins *to, const sbvh_bins *from, uint32_t bins)
 {
 	for (int a = 0; a < 3; a++)
 		for (uint32_t i = 0; i < bins; i++) {
-			grow(to->lo[a][i], to->hi[a][i], from->lo[a][i], from->hi[a][i]);
+			bvhlab_box_grow(to->lo[a][i], to->hi[a][i], from->lo[a][i], from->hi[a][i]);
 			to->count[a][i] += from->count[a][i];
 			to->exits[a][i] += from->exits[a][i];
 		}
@@ -71,12 +40,12 @@ void sbvh_centroid_bounds(const sbvh_build *B, const sbvh_job *job, uint32_t beg
 {
 	const sbvh_ref *refs = B->refs[job->buf];
 
-	empty(clo, chi);
+	bvhlab_box_empty(clo, chi);
 	for (uint32_t i = begin; i < end; i++)
 		for (int k = 0; k < 3; k++) {
 			float c = 0.5f * (refs[i].lo[k] + refs[i].hi[k]);
-			clo[k] = minf(clo[k], c);
-			chi[k] = maxf(chi[k], c);
+			clo[k] = bvhlab_minf(clo[k], c);
+			chi[k] = bvhlab_maxf(chi[k], c);
 		}
 }
 
@@ -109,7 +78,7 @@ void sbvh_bin_object(const sbvh_build *B, const sbvh_job *job, const float clo[3
 		for (uint32_t i = begin; i < end; i++) {
 			uint32_t j = object_bin(&refs[i], k, clo[k], scale, bins);
 
-			grow(b->lo[k][j], b->hi[k][j], refs[i].lo, refs[i].hi);
+			bvhlab_box_grow(b->lo[k][j], b->hi[k][j], refs[i].lo, refs[i].hi);
 			b->count[k][j]++;
 		}
 	}
@@ -146,7 +115,7 @@ static void add_crossings(const float v[3][3], int k, float at, float lo[3], flo
 		for (int m = 0; m < 3; m++)
 			p[m] = a[m] + t * (b[m] - a[m]);
 		p[k] = at;
-		grow(lo, hi, p, p);
+		bvhlab_box_grow(lo, hi, p, p);
 	}
 }
 
@@ -168,25 +137,25 @@ static void clip_into_bins(const sbvh_build *B, const sbvh_job *job, const sbvh_
 
 	for (int j = 0; j < 3; j++)
 		memcpy(v[j], &B->in->vertices[3 * (size_t)tri[j]], sizeof(v[j]));
-	empty(clo, chi);
+	bvhlab_box_empty(clo, chi);
 	for (uint32_t j = b0; j <= b1; j++) {
 		float above = j < b1 ? plane(job, k, j, bins) : INFINITY, lo[3], hi[3];
-		empty(lo, hi);
+		bvhlab_box_empty(lo, hi);
 		for (int m = 0; m < 3; m++)
 			if (below <= v[m][k] && v[m][k] <= above)
-				grow(lo, hi, v[m], v[m]);
+				bvhlab_box_grow(lo, hi, v[m], v[m]);
 		/* A plane's crossings bound both bins beside it: found once. */
-		grow(lo, hi, clo, chi);
-		empty(clo, chi);
+		bvhlab_box_grow(lo, hi, clo, chi);
+		bvhlab_box_empty(clo, chi);
 		if (j < b1)
 			add_crossings(v, k, above, clo, chi);
-		grow(lo, hi, clo, chi);
+		bvhlab_box_grow(lo, hi, clo, chi);
 		for (int m = 0; m < 3; m++) {
-			lo[m] = maxf(lo[m], r->lo[m]);
-			hi[m] = minf(hi[m], r->hi[m]);
+			lo[m] = bvhlab_maxf(lo[m], r->lo[m]);
+			hi[m] = bvhlab_minf(hi[m], r->hi[m]);
 		}
 		if (lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2])
-			grow(b->lo[k][j], b->hi[k][j], lo, hi);
+			bvhlab_box_grow(b->lo[k][j], b->hi[k][j], lo, hi);
 		below = above;
 	}
 	b->count[k][b0]++;
@@ -208,7 +177,7 @@ void sbvh_bin_spatial(const sbvh_build *B, const sbvh_job *job, uint32_t begin,
 			uint32_t b1 = spatial_bin(job, k, refs[i].hi[k], bins);
 
 			if (b0 == b1) {
-				grow(b->lo[k][b0], b->hi[k][b0], refs[i].lo, refs[i].hi);
+				bvhlab_box_grow(b->lo[k][b0], b->hi[k][b0], refs[i].lo, refs[i].hi);
 				b->count[k][b0]++;
 				b->exits[k][b0]++;
 			} else {
@@ -246,23 +215,23 @@ static void sweep(const sbvh_bins *b, int k, uint32_t bins, const uint32_t *ente
 	uint32_t m = used_bins(b, k, bins, enter, leave, used);
 
 	/* rlo[u], rhi[u], rn[u]: the right side of the boundary before used[u]. */
-	empty(lo, hi);
+	bvhlab_box_empty(lo, hi);
 	for (uint32_t u = m; u-- > 1;) {
-		grow(lo, hi, b->lo[k][used[u]], b->hi[k][used[u]]);
+		bvhlab_box_grow(lo, hi, b->lo[k][used[u]], b->hi[k][used[u]]);
 		n += leave[used[u]];
 		memcpy(rlo[u], lo, sizeof(lo));
 		memcpy(rhi[u], hi, sizeof(hi));
 		rn[u] = n;
 	}
-	empty(lo, hi);
+	bvhlab_box_empty(lo, hi);
 	n = 0;
 	for (uint32_t u = 0; u + 1 < m; u++) {
 		uint32_t j = used[u];
-		grow(lo, hi, b->lo[k][j], b->hi[k][j]);
+		bvhlab_box_grow(lo, hi, b->lo[k][j], b->hi[k][j]);
 		n += enter[j];
 		if (n == 0 || rn[u + 1] == 0)
 			continue;
-		double cost = 1.0 + (area(lo, hi) * n + area(rlo[u + 1], rhi[u + 1]) * rn[u + 1]) *
+		double cost = 1.0 + (bvhlab_box_area(lo, hi) * n + bvhlab_box_area(rlo[u + 1], rhi[u + 1]) * rn[u + 1]) *
 		                        inv_area;
 		if (cost < best->cost) {
 			best->cost = cost;
@@ -282,7 +251,7 @@ static void sweep(const sbvh_bins *b, int k, uint32_t bins, const uint32_t *ente
 void sbvh_best_object(const sbvh_build *B, const sbvh_job *job, const sbvh_bins *b,
                       const float clo[3], const float chi[3], sbvh_split *s)
 {
-	double a = area(job->lo, job->hi), inv = a > 0.0 ? 1.0 / a : 0.0;
+	double a = bvhlab_box_area(job->lo, job->hi), inv = a > 0.0 ? 1.0 / a : 0.0;
 
 	for (int k = 0; k < 3; k++)
 		if (chi[k] > clo[k])
@@ -294,7 +263,7 @@ void sbvh_best_object(const sbvh_build *B, const sbvh_job *job, const sbvh_bins 
 void sbvh_best_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_bins *b,
                        sbvh_split *s)
 {
-	double a = area(job->lo, job->hi), inv = a > 0.0 ? 1.0 / a : 0.0;
+	double a = bvhlab_box_area(job->lo, job->hi), inv = a > 0.0 ? 1.0 / a : 0.0;
 	int kind = s->kind;
 
 	for (int k = 0; k < 3; k++)
@@ -311,29 +280,29 @@ bool sbvh_try_spatial(const sbvh_build *B, const sbvh_split *s)
 	if (s->kind != SPLIT_OBJECT)
 		return true; /* no object split at all: maybe a spatial one */
 	for (int k = 0; k < 3; k++) {
-		lo[k] = maxf(s->llo[k], s->rlo[k]);
-		hi[k] = minf(s->lhi[k], s->rhi[k]);
+		lo[k] = bvhlab_maxf(s->llo[k], s->rlo[k]);
+		hi[k] = bvhlab_minf(s->lhi[k], s->rhi[k]);
 		if (!(hi[k] >= lo[k]))
 			return false;
 	}
-	return area(lo, hi) > B->opt.alpha * B->root_area;
+	return bvhlab_box_area(lo, hi) > B->opt.alpha * B->root_area;
 }
 
 /* Stich's reference unsplitting: 1 (all left), 2 (all right) or 3 (cut). */
 static unsigned unsplit(const sbvh_split *s, const sbvh_ref *r)
 {
 	float lo[3], hi[3];
-	double al = area(s->llo, s->lhi), ar = area(s->rlo, s->rhi);
+	double al = bvhlab_box_area(s->llo, s->lhi), ar = bvhlab_box_area(s->rlo, s->rhi);
 	double cut = al * s->nl + ar * s->nr, to_left, to_right;
 
 	memcpy(lo, s->llo, sizeof(lo));
 	memcpy(hi, s->lhi, sizeof(hi));
-	grow(lo, hi, r->lo, r->hi);
-	to_left = area(lo, hi) * s->nl + ar * (s->nr - 1);
+	bvhlab_box_grow(lo, hi, r->lo, r->hi);
+	to_left = bvhlab_box_area(lo, hi) * s->nl + ar * (s->nr - 1);
 	memcpy(lo, s->rlo, sizeof(lo));
 	memcpy(hi, s->rhi, sizeof(hi));
-	grow(lo, hi, r->lo, r->hi);
-	to_right = al * (s->nl - 1) + area(lo, hi) * s->nr;
+	bvhlab_box_grow(lo, hi, r->lo, r->hi);
+	to_right = al * (s->nl - 1) + bvhlab_box_area(lo, hi) * s->nr;
 	if (to_left < cut && to_left <= to_right)
 		return 1;
 	return to_right < cut ? 2 : 3;
