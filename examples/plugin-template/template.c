@@ -8,8 +8,8 @@
  * then run it:  bvhlab build ./build/template.so icosphere:frequency=64
  */
 #include <errno.h>
-#include <math.h> /* INFINITY only */
 
+#include <bvhlab/aabb.h> /* box helpers, header-only */
 #include <bvhlab/builder.h>
 
 static const bvhlab_option_decl options[] = {
@@ -23,35 +23,18 @@ typedef struct job {
 	uint32_t max_leaf;
 } job;
 
-/* Local min/max keep the module free of libm. */
-static float min(float a, float b)
-{
-	return a < b ? a : b;
-}
-
-static float max(float a, float b)
-{
-	return a > b ? a : b;
-}
-
 /* The node's box, and the bounds of its primitives' centroids. */
 static void bounds(const job *j, bvhlab_node *n, uint32_t begin, uint32_t end, float *clo,
                    float *chi)
 {
-	for (int k = 0; k < 3; k++) {
-		n->lo[k] = clo[k] = INFINITY;
-		n->hi[k] = chi[k] = -INFINITY;
-	}
+	bvhlab_box_empty(n->lo, n->hi);
+	bvhlab_box_empty(clo, chi);
 	for (uint32_t i = begin; i < end; i++) {
 		uint32_t p = j->out->prim_index[i];
 		const bvhlab_aabb *b = &j->in->prim_bounds[p];
-		for (int k = 0; k < 3; k++) {
-			float c = j->in->centroids[3 * (size_t)p + k];
-			n->lo[k] = min(n->lo[k], b->lo[k]);
-			n->hi[k] = max(n->hi[k], b->hi[k]);
-			clo[k] = min(clo[k], c);
-			chi[k] = max(chi[k], c);
-		}
+		const float *c = &j->in->centroids[3 * (size_t)p];
+		bvhlab_box_grow(n->lo, n->hi, b->lo, b->hi);
+		bvhlab_box_grow(clo, chi, c, c);
 	}
 }
 
