@@ -19,6 +19,15 @@
 #error "define FIXTURE_SEED before including scene_fixture.h"
 #endif
 
+/* Node for node the same tree: the counts, the nodes and the leaf slots,
+ * byte for byte (what "the same tree for every thread count" means). */
+static inline bool trees_identical(const bvhlab_tree *a, const bvhlab_tree *b)
+{
+	return a->node_count == b->node_count && a->index_count == b->index_count &&
+	       memcmp(a->nodes, b->nodes, a->node_count * sizeof(bvhlab_node)) == 0 &&
+	       memcmp(a->prim_index, b->prim_index, a->index_count * sizeof(uint32_t)) == 0;
+}
+
 /* A generated scene; 0 keeps a parameter's default. */
 static inline bvhlab_scene *generate(const char *generator, uint32_t count, uint32_t frequency,
                                      uint32_t size)

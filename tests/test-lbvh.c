@@ -130,11 +130,7 @@ static void check_same(const char *name, const bvhlab_tree *ref, const bvhlab_tr
 	}
 	CHECK_INT(tree->node_count, ref->node_count);
 	CHECK_INT(tree->index_count, ref->index_count);
-	if (tree->node_count == ref->node_count && tree->index_count == ref->index_count) {
-		CHECK(memcmp(tree->nodes, ref->nodes, ref->node_count * sizeof(bvhlab_node)) == 0);
-		CHECK(memcmp(tree->prim_index, ref->prim_index,
-		             ref->index_count * sizeof(uint32_t)) == 0);
-	}
+	CHECK(trees_identical(ref, tree));
 }
 
 /*

@@ -62,8 +62,7 @@ static void check_same(const char *name, const bvhlab_tree *ref, const bvhlab_tr
 	CHECK_INT(tree->index_count, ref->index_count);
 	if (tree->node_count != ref->node_count || tree->index_count != ref->index_count)
 		return;
-	if (memcmp(tree->nodes, ref->nodes, ref->node_count * sizeof(bvhlab_node)) != 0 ||
-	    memcmp(tree->prim_index, ref->prim_index, ref->index_count * sizeof(uint32_t)) != 0) {
+	if (!trees_identical(ref, tree)) {
 		fprintf(stderr, "%s: %u threads built another tree than 1\n", name, threads);
 		CHECK(!"same tree for every thread count");
 	}
