@@ -57,22 +57,6 @@ static void padded_box(const bvhlab_node *n, double lo[3], double hi[3])
 	}
 }
 
-/* The part of p inside the box. */
-static void clip_box(const poly *p, const double lo[3], const double hi[3], poly *out)
-{
-	poly tmp[2];
-	const poly *cur = p;
-
-	for (int k = 0; k < 3; k++) {
-		bvhlab_poly_clip(cur, k, lo[k], 1.0, &tmp[0]);
-		bvhlab_poly_clip(&tmp[0], k, hi[k], -1.0, &tmp[1]);
-		cur = &tmp[1];
-		if (cur->n == 0)
-			break;
-	}
-	*out = *cur;
-}
-
 static bool disjoint(const poly *p, const double lo[3], const double hi[3])
 {
 	for (int k = 0; k < 3; k++) {
@@ -144,14 +128,6 @@ typedef struct refs {
 	uint32_t *leaf;   /* [index_count] leaves referencing each primitive */
 } refs;
 
-static void triangle(const bvhlab_build_input *in, uint32_t prim, poly *p)
-{
-	p->n = 3;
-	for (int j = 0; j < 3; j++)
-		for (int k = 0; k < 3; k++)
-			p->v[j][k] = in->vertices[3 * (size_t)in->indices[3 * (size_t)prim + j] + k];
-}
-
 #define FAIL(err, ...) (snprintf((err)->message, sizeof((err)->message), __VA_ARGS__), -EINVAL)
 
 /* A zero-area triangle cannot be measured by area: each vertex in some box. */
@@ -186,7 +162,7 @@ static int check_prim(const bvhlab_tree *t, const bvhlab_build_input *in, const 
 	int cur = 0;
 	poly tri, part;
 
-	triangle(in, prim, &tri);
+	bvhlab_poly_triangle(&tri, in->vertices, &in->indices[3 * (size_t)prim]);
 	full = bvhlab_poly_area(&tri);
 	if (!(full > 0.0))
 		return check_degenerate(t, &tri, leaves, count, prim, err);
@@ -197,7 +173,8 @@ static int check_prim(const bvhlab_tree *t, const bvhlab_build_input *in, const 
 	c->count[0] = 1;
 	for (uint32_t i = 0; i < count; i++) {
 		padded_box(&t->nodes[leaves[i]], lo, hi);
-		clip_box(&tri, lo, hi, &part);
+		part = tri;
+		bvhlab_poly_clip_box(&part, lo, hi);
 		if (part.n == 0) {
 			const bvhlab_node *n = &t->nodes[leaves[i]];
 			return FAIL(err, "node %" PRIu32 ": box (%g, %g, %g) - (%g, %g, %g) misses "

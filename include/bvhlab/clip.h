@@ -12,6 +12,8 @@
 #define BVHLAB_CLIP_H
 
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "types.h"
@@ -48,6 +50,27 @@ static inline void bvhlab_poly_clip(const bvhlab_poly *p, int axis, double at, d
 				c[k] = a[k] + t * (b[k] - a[k]);
 			c[axis] = at;
 		}
+	}
+}
+
+/* Triangle `tri` (three vertex indices into vertices[3 * i]) as a polygon. */
+static inline void bvhlab_poly_triangle(bvhlab_poly *p, const float *vertices,
+                                        const uint32_t *tri)
+{
+	p->n = 3;
+	for (int j = 0; j < 3; j++)
+		for (int k = 0; k < 3; k++)
+			p->v[j][k] = vertices[3 * (size_t)tri[j] + k];
+}
+
+/* Keeps the part of p inside the closed box lo[3], hi[3], in place. */
+static inline void bvhlab_poly_clip_box(bvhlab_poly *p, const double lo[3], const double hi[3])
+{
+	bvhlab_poly tmp;
+
+	for (int k = 0; k < 3 && p->n > 0; k++) {
+		bvhlab_poly_clip(p, k, lo[k], 1.0, &tmp);
+		bvhlab_poly_clip(&tmp, k, hi[k], -1.0, p);
 	}
 }
 

@@ -95,9 +95,9 @@ static double piece(const sbvh_build *B, const sbvh_ref *r, tri_poly *p)
 	const bvhlab_aabb box = { { r->lo[0], r->lo[1], r->lo[2] },
 		                  { r->hi[0], r->hi[1], r->hi[2] } };
 
-	tri_poly_triangle(p, B->in->vertices, &B->in->indices[3 * (size_t)r->prim]);
+	bvhlab_poly_triangle(p, B->in->vertices, &B->in->indices[3 * (size_t)r->prim]);
 	tri_poly_clip_box(p, &box);
-	return tri_poly_area(p);
+	return bvhlab_poly_area(p);
 }
 
 /* Cuts refs[i] at the middle of its longest side into refs[i] and
@@ -131,8 +131,8 @@ static bool cut(const sbvh_build *B, sbvh_ref *refs, uint32_t i, uint32_t j, dou
 	memcpy(r->hi, lb.hi, sizeof(r->hi));
 	memcpy(refs[j].lo, hb.lo, sizeof(r->lo));
 	memcpy(refs[j].hi, hb.hi, sizeof(r->hi));
-	*ai = tri_poly_area(&l);
-	*aj = tri_poly_area(&h);
+	*ai = bvhlab_poly_area(&l);
+	*aj = bvhlab_poly_area(&h);
 	return true;
 }
 

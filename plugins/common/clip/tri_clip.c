@@ -6,22 +6,15 @@
 
 #include "tri_clip.h"
 
-void tri_poly_triangle(tri_poly *p, const float *vertices, const uint32_t *tri)
-{
-	p->n = 3;
-	for (int j = 0; j < 3; j++)
-		for (int k = 0; k < 3; k++)
-			p->v[j][k] = vertices[3 * (size_t)tri[j] + k];
-}
-
 void tri_poly_clip_box(tri_poly *p, const bvhlab_aabb *box)
 {
-	tri_poly tmp;
+	double lo[3], hi[3];
 
-	for (int k = 0; k < 3 && p->n > 0; k++) {
-		bvhlab_poly_clip(p, k, box->lo[k], 1.0, &tmp);
-		bvhlab_poly_clip(&tmp, k, box->hi[k], -1.0, p);
+	for (int k = 0; k < 3; k++) {
+		lo[k] = box->lo[k];
+		hi[k] = box->hi[k];
 	}
+	bvhlab_poly_clip_box(p, lo, hi);
 }
 
 void tri_poly_split(const tri_poly *p, int axis, double pos, tri_poly *left,
@@ -64,17 +57,12 @@ void tri_poly_bounds(const tri_poly *p, const bvhlab_aabb *within, bvhlab_aabb *
 	}
 }
 
-double tri_poly_area(const tri_poly *p)
-{
-	return bvhlab_poly_area(p);
-}
-
 void tri_clip_split(const float *vertices, const uint32_t *tri, const bvhlab_aabb *box,
                     int axis, float pos, bvhlab_aabb *left, bvhlab_aabb *right)
 {
 	tri_poly p, l, r;
 
-	tri_poly_triangle(&p, vertices, tri);
+	bvhlab_poly_triangle(&p, vertices, tri);
 	tri_poly_clip_box(&p, box);
 	tri_poly_split(&p, axis, pos, &l, &r);
 	tri_poly_bounds(&l, box, left);

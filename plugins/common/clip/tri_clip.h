@@ -16,9 +16,6 @@
  * validator); n == 0 is empty. */
 typedef bvhlab_poly tri_poly;
 
-/* Triangle `tri` (vertex indices into vertices[3 * i]) as a polygon. */
-void tri_poly_triangle(tri_poly *p, const float *vertices, const uint32_t *tri);
-
 /* Keeps the part of p inside box (closed). */
 void tri_poly_clip_box(tri_poly *p, const bvhlab_aabb *box);
 
@@ -30,9 +27,6 @@ void tri_poly_split(const tri_poly *p, int axis, double pos, tri_poly *left,
 /* The box of p rounded outwards to float, intersected with `within`; an
  * empty polygon gives an empty box (lo = +inf, hi = -inf). */
 void tri_poly_bounds(const tri_poly *p, const bvhlab_aabb *within, bvhlab_aabb *out);
-
-/* Area of p (one side). */
-double tri_poly_area(const tri_poly *p);
 
 /*
  * The boxes of the part of triangle `tri` inside `box` on either side of
