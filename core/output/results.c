@@ -80,9 +80,6 @@ int results_init(struct results *res, const struct config *cfg, const char *dir,
                  bvhlab_error *err)
 {
 	memset(res, 0, sizeof(*res));
-	int r = results_make_dirs(dir, err);
-	if (r < 0)
-		return r;
 	res->dir = strdup(dir);
 	res->doc = cJSON_CreateObject();
 	if (!res->dir || !res->doc)
@@ -266,16 +263,76 @@ static int write_rendering(const struct results *res, const char *name, char *te
 	return r;
 }
 
+static const char *const renderings[] = {"results.json", "results.csv", "report.md",
+                                         "report.html"};
+
+static int write_renderings(const struct results *res, bvhlab_error *err)
+{
+	int r = write_rendering(res, renderings[0], cJSON_Print(res->doc), err);
+	if (r == 0)
+		r = write_rendering(res, renderings[1], report_csv(res->doc), err);
+	if (r == 0)
+		r = write_rendering(res, renderings[2], report_markdown(res->doc), err);
+	if (r == 0)
+		r = write_rendering(res, renderings[3], report_html(res->doc), err);
+	return r;
+}
+
+/* Removes dir/name if it is there (cleaning up a folder that failed). */
+static void remove_in(const char *dir, const char *name)
+{
+	char path[4096];
+	if ((size_t)snprintf(path, sizeof(path), "%s/%s", dir, name) < sizeof(path))
+		unlink(path);
+}
+
+/*
+ * A new results folder appears whole: written as a temporary sibling and
+ * renamed into place (over an empty folder too). A sweep killed while it
+ * starts (GNU parallel stopping its jobs) leaves no folder, or one with a
+ * results.json that says which plan it belongs to, never a bare folder
+ * that `bvhlab merge` must refuse.
+ */
+static int write_fresh(const struct results *res, bvhlab_error *err)
+{
+	char tmp[4096], *slash;
+	if ((size_t)snprintf(tmp, sizeof(tmp), "%s.new-XXXXXX", res->dir) >= sizeof(tmp)) {
+		error_set(err, "output folder name too long: %s", res->dir);
+		return -ENAMETOOLONG;
+	}
+	int r = 0;
+	if ((slash = strrchr(tmp, '/')) && slash != tmp) {
+		*slash = '\0';
+		r = results_make_dirs(tmp, err);
+		*slash = '/';
+	}
+	if (r == 0 && !mkdtemp(tmp)) {
+		r = -errno;
+		error_set(err, "cannot create output folder %s: %s", res->dir, strerror(-r));
+	}
+	if (r < 0)
+		return r;
+	struct results t = *res;
+	t.dir = tmp;
+	r = write_renderings(&t, err);
+	if (r == 0 && rename(tmp, res->dir) < 0) {
+		r = -errno;
+		error_set(err, "cannot create output folder %s: %s", res->dir, strerror(-r));
+	}
+	if (r < 0) {
+		for (size_t k = 0; k < sizeof(renderings) / sizeof(renderings[0]); k++)
+			remove_in(tmp, renderings[k]);
+		rmdir(tmp);
+	}
+	return r;
+}
+
 int results_write(const struct results *res, bvhlab_error *err)
 {
-	int r = write_rendering(res, "results.json", cJSON_Print(res->doc), err);
-	if (r == 0)
-		r = write_rendering(res, "results.csv", report_csv(res->doc), err);
-	if (r == 0)
-		r = write_rendering(res, "report.md", report_markdown(res->doc), err);
-	if (r == 0)
-		r = write_rendering(res, "report.html", report_html(res->doc), err);
-	return r;
+	struct stat st;
+	if (stat(res->dir, &st) < 0 && errno == ENOENT)
+		return write_fresh(res, err);
+	return write_renderings(res, err);
 }
 
 /* ---- resuming ---------------------------------------------------------------- */

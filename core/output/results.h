@@ -82,7 +82,7 @@ struct run_record {
 /* mkdir -p: creates every missing folder of `path`; err names the one that failed. */
 int results_make_dirs(const char *path, bvhlab_error *err);
 
-/* Creates the folder (and parents) and the document. */
+/* The document for folder dir; results_write creates the folder. */
 int results_init(struct results *res, const struct config *cfg, const char *dir,
                  bvhlab_error *err);
 void results_finish(struct results *res);
@@ -127,7 +127,9 @@ int results_check_runs(const struct cJSON *runs, const struct config *cfg, const
 bool results_has_run(const struct results *res, const char *scene, const char *builder,
                      uint32_t threads);
 
-/* Rewrites results.json, results.csv and report.md atomically. */
+/* Rewrites results.json, results.csv, report.md and report.html, each
+ * atomically; a folder that does not exist yet is made with all four in it
+ * at once (a temporary sibling renamed into place), parents as needed. */
 int results_write(const struct results *res, bvhlab_error *err);
 
 /* Writes `text` to dir/name through dir/.name.tmp and rename. */
