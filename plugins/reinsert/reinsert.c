@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "leaves.h"
 #include "reinsert.h"
 
 static const bvhlab_option_decl options[] = {
@@ -20,14 +21,7 @@ static const bvhlab_option_decl options[] = {
 	  .help = "stop after an iteration that lowers the SAH by less than this fraction "
 	          "of it (0: run every iteration)",
 	  .def_float = 0.001, .min = 0.0, .max = 1.0 },
-	{ .name = "leaves", .type = BVHLAB_OPTION_BOOL,
-	  .help = "split leaves of several primitives first, so that their primitives can "
-	          "move too, and cut the tree into leaves by the SAH afterwards (kept only "
-	          "if the SAH fell)",
-	  .def_bool = true },
-	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,
-	  .help = "most primitives in a leaf of that final cut (8, as the builders)",
-	  .def_int = 8, .min = 1, .max = 64 },
+	LEAVES_OPTION_DECLS,
 	{ .name = "max_visits", .type = BVHLAB_OPTION_INT,
 	  .help = "most nodes one candidate's search may look at",
 	  .def_int = 4096, .min = 16, .max = 1 << 24 },
@@ -202,50 +196,6 @@ static int iterate(reinsert *r, const struct params *o, uint32_t threads, uint32
 
 /* ---- refine ------------------------------------------------------------- */
 
-/* The tree as it came in, to put back if splitting leaves did not pay. */
-struct saved {
-	bvhlab_node *nodes;
-	uint32_t *index;
-	uint32_t node_count;
-	double sah;
-};
-
-static int save(struct saved *s, const bvhlab_build_output *t)
-{
-	s->node_count = t->node_count;
-	s->nodes = malloc((size_t)t->node_count * sizeof(*s->nodes));
-	s->index = malloc((size_t)t->index_count * sizeof(*s->index));
-	if (!s->nodes || !s->index)
-		return -ENOMEM;
-	memcpy(s->nodes, t->nodes, (size_t)t->node_count * sizeof(*s->nodes));
-	memcpy(s->index, t->prim_index, (size_t)t->index_count * sizeof(*s->index));
-	s->sah = reinsert_sah(t->nodes, t->node_count);
-	return 0;
-}
-
-/* Keeps the cut tree only when its SAH is lower than the saved one's. */
-static void keep_or_restore(const struct saved *s, bvhlab_build_output *t)
-{
-	if (reinsert_sah(t->nodes, t->node_count) < s->sah)
-		return;
-	memcpy(t->nodes, s->nodes, (size_t)s->node_count * sizeof(*s->nodes));
-	memcpy(t->prim_index, s->index, (size_t)t->index_count * sizeof(*s->index));
-	t->node_count = s->node_count;
-}
-
-/* Room for the split leaves; false (go on without splitting) if refused. */
-static bool split_leaves(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                         const bvhlab_build_input *in, bvhlab_build_output *t)
-{
-	uint32_t need = reinsert_split_room(t);
-
-	if (need > t->node_capacity &&
-	    (need == UINT32_MAX || host->grow_output(ctx, t, need, t->index_capacity) < 0))
-		return false;
-	reinsert_split_leaves(t, in);
-	return true;
-}
-
 static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct params *o,
                     const bvhlab_build_input *input, bvhlab_build_output *tree)
 {
@@ -279,7 +229,7 @@ out:
 static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *tree)
 {
-	struct saved s = { 0 };
+	leaves_saved s = { 0 };
 	struct params o;
 	bool split = false;
 	int rc;
@@ -289,21 +239,18 @@ static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	if (tree->node_count < 3 && !(o.leaves && tree->node_count == 1 && tree->nodes[0].count > 1))
 		return 0; /* nothing can move */
 	if (o.leaves) {
-		if ((rc = save(&s, tree)) < 0) {
+		if ((rc = leaves_save(&s, tree)) < 0) {
 			host->set_error(ctx, "out of memory for a copy of the tree");
 			goto out;
 		}
-		split = split_leaves(host, ctx, input, tree);
+		split = leaves_split(host, ctx, input, tree);
 	}
 	if (tree->node_count >= 3 && (rc = optimise(host, ctx, &o, input, tree)) < 0)
 		goto out;
-	if (split && (rc = reinsert_collapse(tree, (uint32_t)o.max_leaf)) < 0)
+	if (split && (rc = leaves_collapse_or_restore(&s, tree, (uint32_t)o.max_leaf)) < 0)
 		host->set_error(ctx, "out of memory for the collapse");
-	if (split && rc == 0)
-		keep_or_restore(&s, tree);
 out:
-	free(s.nodes);
-	free(s.index);
+	leaves_finish(&s);
 	return rc;
 }
 

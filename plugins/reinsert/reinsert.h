@@ -92,13 +92,4 @@ void reinsert_search(reinsert *r);
  * or 0 when the move was refused or taken back (reinsert_move.c). */
 double reinsert_try(reinsert *r, uint32_t node, uint32_t dest);
 
-/* With option `leaves` (reinsert_leaves.c): the node count once every
- * leaf is split; the split; the SAH cost as the core's metric; the SAH
- * collapse that cuts the tree into leaves of at most max_leaf again
- * (0 or -ENOMEM, the tree untouched then). */
-uint32_t reinsert_split_room(const bvhlab_build_output *t);
-void reinsert_split_leaves(bvhlab_build_output *t, const bvhlab_build_input *in);
-double reinsert_sah(const bvhlab_node *nodes, uint32_t count);
-int reinsert_collapse(bvhlab_build_output *t, uint32_t max_leaf);
-
 #endif /* BVHLAB_REINSERT_H */

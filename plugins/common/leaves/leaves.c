@@ -1,26 +1,30 @@
 /*
- * reinsert with `leaves` on: a leaf of several primitives cannot be taken
- * apart by moving subtrees, and the SAH builders' trees keep most of their
- * primitives in such leaves. So before the iterations every leaf of k > 1
+ * Splitting leaves before a refinement stage and cutting the tree into
+ * leaves again after it (see leaves.h). The split: every leaf of k > 1
  * primitives becomes a balanced subtree of k one-primitive leaves (new
- * pairs appended past the tree), and after them the tree is cut into
- * leaves again by the SAH as lbvh's collapse does (a subtree of at most
- * max_leaf primitives becomes one leaf where c_isect * N * A is no more
- * than its best inner cost, c_trav = c_isect = 1 as in the reported
- * metric) and written out afresh in depth-first order. The original
- * leaves are among the cuts the collapse can choose, but the moves in
- * between may still leave a worse tree: the result is kept only when its
- * SAH, computed as the core's metric does, is lower; otherwise the tree
- * as it came in is put back.
+ * pairs appended past the tree). The cut: as lbvh's collapse, a subtree
+ * of at most max_leaf primitives becomes one leaf where c_isect * N * A is
+ * no more than its best inner cost (c_trav = c_isect = 1 as in the
+ * reported metric), written out afresh in breadth-first order. The
+ * original leaves are among the cuts the collapse can choose, but the
+ * stage in between may still leave a worse tree: hence the comparison
+ * with the saved tree.
  */
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "reinsert.h"
+#include <bvhlab/aabb.h>
+
+#include "leaves.h"
+
+static double area_of(const float lo[3], const float hi[3])
+{
+	return bvhlab_box_area(lo, hi);
+}
 
 /* Nodes past the tree that splitting every leaf takes. */
-uint32_t reinsert_split_room(const bvhlab_build_output *t)
+static uint32_t split_room(const bvhlab_build_output *t)
 {
 	uint64_t extra = 0;
 
@@ -30,18 +34,25 @@ uint32_t reinsert_split_room(const bvhlab_build_output *t)
 	return extra > UINT32_MAX - t->node_count ? UINT32_MAX : t->node_count + (uint32_t)extra;
 }
 
-/* Node x becomes the root of a balanced subtree over prim_index slots
- * [first, first + k); its box is kept (it contains them all). */
+/*
+ * Node x becomes the root of a balanced subtree over prim_index slots
+ * [first, first + k). A primitive's leaf gets its box cut to the box of the
+ * leaf it came from (lo, hi): a builder with spatial splits may have given
+ * that leaf only part of the triangle, and the new nodes must stay inside
+ * their parents.
+ */
 static void split_range(bvhlab_build_output *t, const bvhlab_build_input *in, uint32_t x,
-                        uint32_t first, uint32_t k)
+                        uint32_t first, uint32_t k, const float lo[3], const float hi[3])
 {
 	bvhlab_node *n = &t->nodes[x];
 	uint32_t pair = t->node_count, half = k / 2;
 
 	if (k == 1) {
 		const bvhlab_aabb *box = &in->prim_bounds[t->prim_index[first]];
-		memcpy(n->lo, box->lo, sizeof(n->lo));
-		memcpy(n->hi, box->hi, sizeof(n->hi));
+		for (int a = 0; a < 3; a++) {
+			n->lo[a] = bvhlab_maxf(box->lo[a], lo[a]);
+			n->hi[a] = bvhlab_minf(box->hi[a], hi[a]);
+		}
 		n->first = first;
 		n->count = 1;
 		return;
@@ -49,23 +60,29 @@ static void split_range(bvhlab_build_output *t, const bvhlab_build_input *in, ui
 	t->node_count += 2;
 	n->first = pair;
 	n->count = 0;
-	split_range(t, in, pair, first, half);
-	split_range(t, in, pair + 1, first + half, k - half);
-	box_union(&t->nodes[pair], &t->nodes[pair + 1], t->nodes[x].lo, t->nodes[x].hi);
+	split_range(t, in, pair, first, half, lo, hi);
+	split_range(t, in, pair + 1, first + half, k - half, lo, hi);
+	memcpy(n->lo, t->nodes[pair].lo, sizeof(n->lo));
+	memcpy(n->hi, t->nodes[pair].hi, sizeof(n->hi));
+	bvhlab_box_grow(n->lo, n->hi, t->nodes[pair + 1].lo, t->nodes[pair + 1].hi);
 }
 
-void reinsert_split_leaves(bvhlab_build_output *t, const bvhlab_build_input *in)
+static void split_all(bvhlab_build_output *t, const bvhlab_build_input *in)
 {
 	uint32_t count = t->node_count;
 
 	for (uint32_t x = 0; x < count; x++)
-		if (t->nodes[x].count > 1)
-			split_range(t, in, x, t->nodes[x].first, t->nodes[x].count);
+		if (t->nodes[x].count > 1) {
+			float lo[3], hi[3];
+			memcpy(lo, t->nodes[x].lo, sizeof(lo));
+			memcpy(hi, t->nodes[x].hi, sizeof(hi));
+			split_range(t, in, x, t->nodes[x].first, t->nodes[x].count, lo, hi);
+		}
 }
 
 /* ---- the SAH metric, as the core computes it --------------------------------- */
 
-double reinsert_sah(const bvhlab_node *nodes, uint32_t count)
+double leaves_sah(const bvhlab_node *nodes, uint32_t count)
 {
 	double root = area_of(nodes[0].lo, nodes[0].hi), sum = 0, refs = 0;
 
@@ -172,7 +189,7 @@ static uint32_t emit(struct collapse *c)
 	return used;
 }
 
-int reinsert_collapse(bvhlab_build_output *t, uint32_t max_leaf)
+static int collapse(bvhlab_build_output *t, uint32_t max_leaf)
 {
 	size_t n = t->node_count;
 	struct collapse c = { .t = t, .max_leaf = max_leaf };
@@ -199,5 +216,57 @@ out:
 	free(c.stack);
 	free(c.out);
 	free(c.index);
+	return rc;
+}
+
+/* ---- the flow around a stage ------------------------------------------------------- */
+
+int leaves_save(leaves_saved *s, const bvhlab_build_output *t)
+{
+	s->node_count = t->node_count;
+	s->nodes = malloc((size_t)t->node_count * sizeof(*s->nodes));
+	s->index = malloc((size_t)t->index_count * sizeof(*s->index));
+	if (!s->nodes || !s->index)
+		return -ENOMEM;
+	memcpy(s->nodes, t->nodes, (size_t)t->node_count * sizeof(*s->nodes));
+	memcpy(s->index, t->prim_index, (size_t)t->index_count * sizeof(*s->index));
+	s->sah = leaves_sah(t->nodes, t->node_count);
+	return 0;
+}
+
+void leaves_finish(leaves_saved *s)
+{
+	free(s->nodes);
+	free(s->index);
+	s->nodes = NULL;
+	s->index = NULL;
+}
+
+bool leaves_split(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                  const bvhlab_build_input *in, bvhlab_build_output *t)
+{
+	uint32_t need = split_room(t);
+
+	if (need > t->node_capacity &&
+	    (need == UINT32_MAX || host->grow_output(ctx, t, need, t->index_capacity) < 0))
+		return false;
+	split_all(t, in);
+	return true;
+}
+
+static void restore(const leaves_saved *s, bvhlab_build_output *t)
+{
+	memcpy(t->nodes, s->nodes, (size_t)s->node_count * sizeof(*s->nodes));
+	memcpy(t->prim_index, s->index, (size_t)t->index_count * sizeof(*s->index));
+	t->node_count = s->node_count;
+}
+
+int leaves_collapse_or_restore(const leaves_saved *s, bvhlab_build_output *t,
+                               uint32_t max_leaf)
+{
+	int rc = collapse(t, max_leaf);
+
+	if (rc < 0 || leaves_sah(t->nodes, t->node_count) >= s->sah)
+		restore(s, t);
 	return rc;
 }

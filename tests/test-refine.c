@@ -1,19 +1,24 @@
 /*
- * reinsert, the refinement stage (ABI 1.2 refine): after lbvh, sah_seq
- * and ploc, on generated scenes (coincident centroids, needles, 2 and 3
- * triangles) and shared meshes, the refined tree is valid, traces like
- * brute force, keeps its index count, never has a higher SAH
- * cost than the tree it started from (and lower where the builder left
- * room), and is the same tree, node for node, for 1 and 2 threads. Also:
- * the descriptor, the host's refusals, a config's "refine" list and the
- * harness's timed series with stages. Both modes: leaves split and re-cut
- * by the SAH (the node count may change), and subtree moves only.
+ * The refinement stages (ABI 1.2 refine), reinsert and treelet: after
+ * lbvh, sah_seq and ploc, on generated scenes (coincident centroids,
+ * needles, 2 and 3 triangles) and shared meshes, the refined tree is
+ * valid, traces like brute force, keeps its index count, never has a
+ * higher SAH cost than the tree it started from (and lower where the
+ * builder left room), and is the same tree, node for node, for 1 and 2
+ * threads. Also: the descriptors, the host's refusals, a config's
+ * "refine" list and the harness's timed series with stages. Both modes:
+ * leaves split and re-cut by the SAH (the node count may change), and
+ * leaves kept. treelet on scenes of at most 8 triangles, where one
+ * treelet holds them all, must find the least SAH of every binary tree
+ * over them, found here by enumerating the trees.
  */
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
 #include <bvhlab/bvhlab.h>
 
 #include "config/config.h"
@@ -27,7 +32,9 @@
 #define RAYS 256
 #define RAY_SEED 1818
 
+/* The stage under test and the options the tests give it. */
 static bvhlab_plugin *refiner;
+static const char *refiner_options;
 
 static void tree_dup(bvhlab_tree *dst, const bvhlab_tree *src)
 {
@@ -46,6 +53,11 @@ static double sah(const bvhlab_tree *t)
 	return st.sah_cost;
 }
 
+static const char *b_name(void)
+{
+	return bvhlab_plugin_builder(refiner)->name;
+}
+
 /* Leaves split and re-cut (the default), or subtree moves only. */
 static bool split_leaves = true;
 
@@ -56,10 +68,8 @@ static int refine(const bvhlab_build_input *in, uint32_t threads, bvhlab_tree *t
 	bvhlab_error err = { { 0 } };
 	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(refiner));
 
-	if (rc == 0)
-		rc = bvhlab_options_parse(&opts, "batch=0.25", &err);
-	if (rc == 0)
-		rc = bvhlab_options_parse(&opts, "iterations=3", &err);
+	for (const char *o = refiner_options; rc == 0 && *o; o += strlen(o) + 1)
+		rc = bvhlab_options_parse(&opts, o, &err);
 	if (rc == 0)
 		rc = bvhlab_options_set_bool(&opts, "leaves", split_leaves, &err);
 	if (rc == 0)
@@ -94,13 +104,15 @@ static void check_builder(const char *name, const char *builder, const bvhlab_sc
 	CHECK_INT(bvhlab_validate_tree(&one, in, false, &err), 0);
 	CHECK_INT(bvhlab_validate_rays(&one, scene, rays, RAY_SEED, &mismatches, &err), 0);
 	CHECK_INT(mismatches, 0);
-	if (!split_leaves) /* moves keep every node; a new cut of leaves does not */
+	/* reinsert's moves keep every node; a new cut of leaves does not */
+	if (!split_leaves && strcmp(b_name(), "reinsert") == 0)
 		CHECK_INT(one.node_count, built.node_count);
 	CHECK_INT(one.index_count, built.index_count);
 	before = sah(&built);
 	after = sah(&one);
-	printf("%-18s %-8s %8u triangles  leaves %d  SAH %9.4f -> %9.4f\n", name, builder,
-	       scene->triangle_count, split_leaves, before, after);
+	printf("%-8s %-18s %-8s %8u triangles  leaves %d  SAH %9.4f -> %9.4f\n",
+	       bvhlab_plugin_builder(refiner)->name, name, builder, scene->triangle_count,
+	       split_leaves, before, after);
 	CHECK(after <= before * (1 + 1e-12));
 	CHECK(trees_identical(&one, &two));
 	/* Again on the refined tree: still never higher. */
@@ -175,7 +187,6 @@ static void test_descriptor(void)
 	bvhlab_tree tree = { 0 };
 	bvhlab_error err = { { 0 } };
 
-	CHECK(strcmp(b->name, "reinsert") == 0);
 	CHECK(b->build == NULL && bvhlab_builder_refine(b) != NULL);
 	CHECK_INT(bvhlab_options_init(&opts, b), 0);
 	if (scene && bvhlab_prims_init(&prims, scene, &err) == 0) {
@@ -251,7 +262,7 @@ static void test_series(void)
 	}
 	stages[0] = stages[1] = (struct refine_stage){ .plugin = refiner, .opts = &ropts };
 	CHECK_INT(harness_time_builds(lbvh, &opts, &prims.input, &s, &err), 0);
-	CHECK(strcmp(out[0].plugin, "reinsert") == 0 && strcmp(out[1].plugin, "reinsert") == 0);
+	CHECK(strcmp(out[0].plugin, b_name()) == 0 && strcmp(out[1].plugin, b_name()) == 0);
 	CHECK(out[0].sah_after < out[0].sah_before);
 	CHECK(out[1].sah_before == out[0].sah_after);
 	CHECK(out[1].sah_after <= out[1].sah_before);
@@ -275,14 +286,74 @@ static void test_shared(const char *file, bvhlab_scene *scene)
 	test_scene(file, scene, 64);
 }
 
-int main(void)
+/* Least SAH (area units) of any binary tree over the boxes in `set`, one
+ * primitive a leaf, by trying every split of every subset: no memo. */
+static double best_tree(const bvhlab_aabb *box, uint32_t set)
+{
+	bvhlab_aabb u;
+	double best = INFINITY;
+
+	bvhlab_aabb_empty(&u);
+	for (uint32_t i = 0; i < 32; i++)
+		if (set >> i & 1)
+			bvhlab_aabb_grow(&u, &box[i]);
+	if (!(set & (set - 1)))
+		return bvhlab_box_area(u.lo, u.hi);
+	for (uint32_t l = (set - 1) & set; l; l = (l - 1) & set) {
+		double c = best_tree(box, l) + best_tree(box, set ^ l);
+		best = c < best ? c : best;
+	}
+	return bvhlab_box_area(u.lo, u.hi) + best;
+}
+
+/* treelet on n <= 8 triangles, one a leaf: the least SAH there is. */
+static void test_optimal(uint32_t n)
+{
+	bvhlab_scene *scene = generate("soup", n, 0, 0);
+	bvhlab_plugin *seq = NULL;
+	bvhlab_options opts = { 0 };
+	bvhlab_prims prims = { 0 };
+	bvhlab_tree tree = { 0 };
+	bvhlab_error err = { { 0 } };
+	const char *saved = refiner_options;
+
+	if (!scene || bvhlab_prims_init(&prims, scene, &err) < 0 ||
+	    bvhlab_plugin_open("sah_seq", &seq, &err) < 0 ||
+	    bvhlab_options_init(&opts, bvhlab_plugin_builder(seq)) < 0 ||
+	    bvhlab_options_parse(&opts, "max_leaf=1", &err) < 0 ||
+	    bvhlab_build(seq, &opts, &prims.input, 1, &tree, &err) < 0) {
+		CHECK(!"sah_seq on a small soup");
+	} else {
+		const bvhlab_aabb *b = prims.input.prim_bounds;
+		double root = bvhlab_box_area(tree.nodes[0].lo, tree.nodes[0].hi);
+		double least = best_tree(b, (1u << n) - 1) / root, before = sah(&tree);
+
+		refiner_options = "size=8\0max_leaf=1\0";
+		CHECK_INT(refine(&prims.input, 2, &tree), 0);
+		printf("treelet optimal: %u triangles, SAH %.6f -> %.6f, least %.6f\n", n, before,
+		       sah(&tree), least);
+		CHECK(fabs(sah(&tree) - least) <= 1e-9 * least);
+		CHECK_INT(bvhlab_validate_tree(&tree, &prims.input, false, &err), 0);
+	}
+	refiner_options = saved;
+	bvhlab_tree_finish(&tree);
+	if (opts.values)
+		bvhlab_options_finish(&opts);
+	bvhlab_plugin_close(seq);
+	bvhlab_prims_finish(&prims);
+	bvhlab_scene_destroy(scene);
+}
+
+/* Every test of one stage, with the options it is tested with. */
+static void test_stage(const char *name, const char *options)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply" };
 
-	if (!plugin_loads("reinsert", &refiner))
-		return test_finish();
+	if (!plugin_loads(name, &refiner))
+		return;
+	refiner_options = options;
+	CHECK(strcmp(b_name(), name) == 0);
 	test_descriptor();
-	test_config();
 	test_series();
 	test_improves();
 	test_scene("soup", generate("soup", SCALE(10000, 2000), 0, 0), RAYS);
@@ -292,6 +363,17 @@ int main(void)
 	test_scene("three", generate("soup", 3, 0, 0), RAYS);
 	test_scene("stadium", generate("stadium", SCALE(10000, 2000), 0, 0), RAYS);
 	(void)for_shared(shared, sizeof(shared) / sizeof(shared[0]), 1, test_shared);
+	if (strcmp(name, "treelet") == 0)
+		for (uint32_t n = 3; n <= 8; n++)
+			test_optimal(n);
 	bvhlab_plugin_close(refiner);
+	refiner = NULL;
+}
+
+int main(void)
+{
+	test_config();
+	test_stage("reinsert", "batch=0.25\0iterations=3\0");
+	test_stage("treelet", "rounds=2\0");
 	return test_finish();
 }
