@@ -226,32 +226,33 @@ out:
 	return rc;
 }
 
+/* What optimise needs, as the leaves_run stage. */
+struct stage {
+	const bvhlab_host *host;
+	bvhlab_build_ctx *ctx;
+	const struct params *o;
+	const bvhlab_build_input *input;
+};
+
+static int stage(void *arg, bvhlab_build_output *tree)
+{
+	const struct stage *st = arg;
+
+	return tree->node_count < 3 ? 0 : optimise(st->host, st->ctx, st->o, st->input, tree);
+}
+
 static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *tree)
 {
-	leaves_saved s = { 0 };
 	struct params o;
-	bool split = false;
+	struct stage st = { .host = host, .ctx = ctx, .o = &o, .input = input };
 	int rc;
 
 	if ((rc = read_options(host, ctx, &o)) < 0)
 		return rc;
 	if (tree->node_count < 3 && !(o.leaves && tree->node_count == 1 && tree->nodes[0].count > 1))
 		return 0; /* nothing can move */
-	if (o.leaves) {
-		if ((rc = leaves_save(&s, tree)) < 0) {
-			host->set_error(ctx, "out of memory for a copy of the tree");
-			goto out;
-		}
-		split = leaves_split(host, ctx, input, tree);
-	}
-	if (tree->node_count >= 3 && (rc = optimise(host, ctx, &o, input, tree)) < 0)
-		goto out;
-	if (split && (rc = leaves_collapse_or_restore(&s, tree, (uint32_t)o.max_leaf)) < 0)
-		host->set_error(ctx, "out of memory for the collapse");
-out:
-	leaves_finish(&s);
-	return rc;
+	return leaves_run(host, ctx, input, tree, o.leaves, false, (uint32_t)o.max_leaf, stage, &st);
 }
 
 BVHLAB_PLUGIN(

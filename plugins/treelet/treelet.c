@@ -63,29 +63,41 @@ static int rounds(treelet *t, int64_t count, uint32_t *scratch, unsigned threads
 	return 0;
 }
 
-/* The rounds over the tree as it is now, with their scratch. */
-static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, uint32_t size,
-                    uint32_t max_leaf, int64_t count, const bvhlab_build_input *input,
-                    bvhlab_build_output *tree)
+/* The options as read, and what the rounds need. */
+struct params {
+	const bvhlab_host *host;
+	bvhlab_build_ctx *ctx;
+	const bvhlab_build_input *input;
+	int64_t size, rounds, max_leaf;
+	bool leaves;
+};
+
+/* The rounds over the tree as it is now, with their scratch: the
+ * leaves_run stage. */
+static int optimise(void *arg, bvhlab_build_output *tree)
 {
-	treelet t = { .nodes = tree->nodes, .node_count = tree->node_count, .size = size,
-	              .max_leaf = max_leaf };
+	const struct params *o = arg;
+	treelet t = { .nodes = tree->nodes, .node_count = tree->node_count,
+	              .size = (uint32_t)o->size, .max_leaf = (uint32_t)o->max_leaf };
 	size_t n = tree->node_count;
-	uint32_t *scratch = malloc(2 * n * sizeof(*scratch));
+	uint32_t *scratch;
 	int rc;
 
+	if (n < 5)
+		return 0; /* no treelet of three leaves */
+	scratch = malloc(2 * n * sizeof(*scratch));
 	t.order = malloc(n * sizeof(*t.order));
 	t.task_end = malloc(n * sizeof(*t.task_end));
 	t.cost = malloc(n * sizeof(*t.cost));
 	t.prims = malloc(n * sizeof(*t.prims));
 	if (!t.order || !t.task_end || !t.cost || !t.prims || !scratch) {
-		host->set_error(ctx, "out of memory for %zu nodes", n);
+		o->host->set_error(o->ctx, "out of memory for %zu nodes", n);
 		rc = -ENOMEM;
 		goto out;
 	}
-	rc = rounds(&t, count, scratch, input->threads, host->hardware_threads(ctx));
+	rc = rounds(&t, o->rounds, scratch, o->input->threads, o->host->hardware_threads(o->ctx));
 	if (rc < 0)
-		host->set_error(ctx, "cannot start the threads");
+		o->host->set_error(o->ctx, "cannot start the threads");
 out:
 	free(t.order);
 	free(t.task_end);
@@ -98,38 +110,24 @@ out:
 static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *tree)
 {
-	leaves_saved s = { 0 };
-	int64_t size, count, max_leaf;
-	bool leaves;
+	struct params o = { .host = host, .ctx = ctx, .input = input };
 	int rc;
 
-	if ((rc = host->option_int(ctx, "size", &size)) < 0 ||
-	    (rc = host->option_int(ctx, "rounds", &count)) < 0 ||
-	    (rc = host->option_bool(ctx, "leaves", &leaves)) < 0 ||
-	    (rc = host->option_int(ctx, "max_leaf", &max_leaf)) < 0) {
+	if ((rc = host->option_int(ctx, "size", &o.size)) < 0 ||
+	    (rc = host->option_int(ctx, "rounds", &o.rounds)) < 0 ||
+	    (rc = host->option_bool(ctx, "leaves", &o.leaves)) < 0 ||
+	    (rc = host->option_int(ctx, "max_leaf", &o.max_leaf)) < 0) {
 		host->set_error(ctx, "cannot read the options");
 		return rc;
 	}
-	if (size < 3 || size > TREELET_MAX || count < 1 || max_leaf < 1 || max_leaf > 64) {
+	if (o.size < 3 || o.size > TREELET_MAX || o.rounds < 1 || o.max_leaf < 1 ||
+	    o.max_leaf > 64) {
 		host->set_error(ctx, "options out of range");
 		return -EINVAL;
 	}
 	/* the costs assume the final cut, so it is made with or without splitting */
-	if ((rc = leaves_save(&s, tree)) < 0) {
-		host->set_error(ctx, "out of memory for a copy of the tree");
-		goto out;
-	}
-	if (leaves)
-		leaves_split(host, ctx, input, tree);
-	/* fewer than 5 nodes: no treelet of three leaves */
-	if (tree->node_count >= 5 &&
-	    (rc = optimise(host, ctx, (uint32_t)size, (uint32_t)max_leaf, count, input, tree)) < 0)
-		goto out;
-	if ((rc = leaves_collapse_or_restore(&s, tree, (uint32_t)max_leaf)) < 0)
-		host->set_error(ctx, "out of memory for the collapse");
-out:
-	leaves_finish(&s);
-	return rc;
+	return leaves_run(host, ctx, input, tree, o.leaves, true, (uint32_t)o.max_leaf, optimise,
+	                  &o);
 }
 
 BVHLAB_PLUGIN(

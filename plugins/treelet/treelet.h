@@ -54,7 +54,8 @@ typedef struct treelet {
 	uint32_t node_count;
 	uint32_t size;       /* treelet leaves wanted, 3 .. TREELET_MAX */
 	uint32_t max_leaf;   /* most primitives the final SAH cut puts in a leaf */
-	double *cost;        /* [node_count] by slot: the subtree's SAH cost once cut (below) */
+	double *cost;        /* [node_count] by slot: the subtree's SAH cost once cut (below);
+	                      * an inner node's is valid once the round has visited it */
 	uint32_t *prims;     /* [node_count] by slot: primitives below */
 	uint32_t *order;     /* [node_count] inner nodes: tasks' post-orders, then the top's */
 	uint32_t *task_end;  /* [tasks] end of each task's run in `order` */
@@ -88,7 +89,7 @@ static inline double treelet_cost(double area, uint32_t prims, uint32_t max_leaf
 bool treelet_optimise(treelet *t, uint32_t v);
 
 /* Fills order, task_end, tasks and the top's run for the tree as it is
- * now, and every node's cost and prims; scratch has room for
+ * now, every node's prims and every leaf's cost; scratch has room for
  * 2 * node_count words (treelet_order.c). */
 void treelet_plan(treelet *t, uint32_t task_nodes, uint32_t *scratch);
 

@@ -8,8 +8,9 @@
 
 #include "treelet.h"
 
-/* size[x]: nodes in x's subtree, and t's cost[x] and prims[x]; `pre`
- * gets a pre-order of the tree. */
+/* size[x]: nodes in x's subtree, and t's prims[x], and cost[x] of the
+ * leaves (an inner node's is taken from its children when the round
+ * reaches it: treelet_optimise); `pre` gets a pre-order of the tree. */
 static void subtree_sizes(treelet *t, uint32_t *stack, uint32_t *pre, uint32_t *size)
 {
 	const bvhlab_node *nodes = t->nodes;
@@ -26,25 +27,22 @@ static void subtree_sizes(treelet *t, uint32_t *stack, uint32_t *pre, uint32_t *
 	}
 	while (m-- > 0) {
 		uint32_t x = pre[m], l = nodes[x].first;
-		double area = bvhlab_box_area(nodes[x].lo, nodes[x].hi);
 
 		if (nodes[x].count) {
 			size[x] = 1;
 			t->prims[x] = nodes[x].count;
-			t->cost[x] = area * nodes[x].count;
+			t->cost[x] = bvhlab_box_area(nodes[x].lo, nodes[x].hi) * nodes[x].count;
 			continue;
 		}
 		size[x] = 1 + size[l] + size[l + 1];
 		t->prims[x] = t->prims[l] + t->prims[l + 1];
-		t->cost[x] = treelet_cost(area, t->prims[x], t->max_leaf,
-		                          area + t->cost[l] + t->cost[l + 1]);
 	}
 }
 
 /*
- * Appends the inner nodes of x's subtree to out in post-order, stopping
- * at nodes for which `stop` holds (a task's root, seen from the top): a
- * pre-order that visits the right child first, reversed. `stack` has room
+ * Appends the inner nodes of x's subtree to out in post-order; with `top`,
+ * stopping at subtrees of at most task_nodes (the tasks'): a pre-order
+ * that visits the right child first, reversed. `stack` has room
  * for the subtree.
  */
 static uint32_t post_order(const bvhlab_node *nodes, uint32_t x, const uint32_t *size,

@@ -82,7 +82,8 @@ static void split_all(bvhlab_build_output *t, const bvhlab_build_input *in)
 
 /* ---- the SAH metric, as the core computes it --------------------------------- */
 
-double leaves_sah(const bvhlab_node *nodes, uint32_t count)
+/* The SAH cost as the core's metric computes it (c_trav = c_isect = 1). */
+static double sah(const bvhlab_node *nodes, uint32_t count)
 {
 	double root = area_of(nodes[0].lo, nodes[0].hi), sum = 0, refs = 0;
 
@@ -221,7 +222,15 @@ out:
 
 /* ---- the flow around a stage ------------------------------------------------------- */
 
-int leaves_save(leaves_saved *s, const bvhlab_build_output *t)
+/* The tree as it came in, to put back if the cut tree is no better. */
+struct saved {
+	bvhlab_node *nodes;
+	uint32_t *index;
+	uint32_t node_count;
+	double sah;
+};
+
+static int save(struct saved *s, const bvhlab_build_output *t)
 {
 	s->node_count = t->node_count;
 	s->nodes = malloc((size_t)t->node_count * sizeof(*s->nodes));
@@ -230,20 +239,14 @@ int leaves_save(leaves_saved *s, const bvhlab_build_output *t)
 		return -ENOMEM;
 	memcpy(s->nodes, t->nodes, (size_t)t->node_count * sizeof(*s->nodes));
 	memcpy(s->index, t->prim_index, (size_t)t->index_count * sizeof(*s->index));
-	s->sah = leaves_sah(t->nodes, t->node_count);
+	s->sah = sah(t->nodes, t->node_count);
 	return 0;
 }
 
-void leaves_finish(leaves_saved *s)
-{
-	free(s->nodes);
-	free(s->index);
-	s->nodes = NULL;
-	s->index = NULL;
-}
-
-bool leaves_split(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                  const bvhlab_build_input *in, bvhlab_build_output *t)
+/* Splits every leaf of t, growing the output for the new nodes; false
+ * (t untouched) when the host refuses the room. */
+static bool split_leaves(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                         const bvhlab_build_input *in, bvhlab_build_output *t)
 {
 	uint32_t need = split_room(t);
 
@@ -254,19 +257,33 @@ bool leaves_split(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return true;
 }
 
-static void restore(const leaves_saved *s, bvhlab_build_output *t)
+static void restore(const struct saved *s, bvhlab_build_output *t)
 {
 	memcpy(t->nodes, s->nodes, (size_t)s->node_count * sizeof(*s->nodes));
 	memcpy(t->prim_index, s->index, (size_t)t->index_count * sizeof(*s->index));
 	t->node_count = s->node_count;
 }
 
-int leaves_collapse_or_restore(const leaves_saved *s, bvhlab_build_output *t,
-                               uint32_t max_leaf)
+int leaves_run(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+               bvhlab_build_output *tree, bool split, bool cut, uint32_t max_leaf,
+               leaves_stage_fn stage, void *arg)
 {
-	int rc = collapse(t, max_leaf);
+	struct saved s = { 0 };
+	int rc = 0;
 
-	if (rc < 0 || leaves_sah(t->nodes, t->node_count) >= s->sah)
-		restore(s, t);
+	if ((split || cut) && (rc = save(&s, tree)) < 0) {
+		host->set_error(ctx, "out of memory for a copy of the tree");
+		goto out;
+	}
+	cut = (split && split_leaves(host, ctx, in, tree)) || cut;
+	if ((rc = stage(arg, tree)) < 0 || !cut)
+		goto out;
+	if ((rc = collapse(tree, max_leaf)) < 0)
+		host->set_error(ctx, "out of memory for the collapse");
+	if (rc < 0 || sah(tree->nodes, tree->node_count) >= s.sah)
+		restore(&s, tree);
+out:
+	free(s.nodes);
+	free(s.index);
 	return rc;
 }

@@ -26,30 +26,19 @@
 	  .help = "most primitives in a leaf of that final cut (8, as the builders)",       \
 	  .def_int = 8, .min = 1, .max = 64 }
 
-/* The tree as it came in, to put back if splitting leaves did not pay. */
-typedef struct leaves_saved {
-	bvhlab_node *nodes;
-	uint32_t *index;
-	uint32_t node_count;
-	double sah;
-} leaves_saved;
+/* A stage's own work between the split and the cut: 0, or a negative
+ * errno after host->set_error. */
+typedef int (*leaves_stage_fn)(void *arg, bvhlab_build_output *tree);
 
-/* A copy of t: 0 or -ENOMEM (leaves_finish frees what was taken). */
-int leaves_save(leaves_saved *s, const bvhlab_build_output *t);
-void leaves_finish(leaves_saved *s);
-
-/* Splits every leaf of t, growing the output for the new nodes; false
- * (t untouched) when the host refuses the room. */
-bool leaves_split(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                  const bvhlab_build_input *in, bvhlab_build_output *t);
-
-/* Cuts the split tree into leaves of at most max_leaf by the SAH and
- * keeps it only when its SAH is below s's; else puts s back. 0 or
- * -ENOMEM (t is then s's tree again). */
-int leaves_collapse_or_restore(const leaves_saved *s, bvhlab_build_output *t,
-                               uint32_t max_leaf);
-
-/* The SAH cost as the core's metric computes it (c_trav = c_isect = 1). */
-double leaves_sah(const bvhlab_node *nodes, uint32_t count);
+/*
+ * Runs stage(arg, tree) with leaves split first when `split` (and the host
+ * gives the room for the new nodes), then cuts the tree into leaves of at
+ * most max_leaf by the SAH when it was split or `cut` asks for it, keeping
+ * the cut tree only when its SAH is below the tree's as it came in (else
+ * that tree is put back). 0, or a negative errno after host->set_error.
+ */
+int leaves_run(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+               bvhlab_build_output *tree, bool split, bool cut, uint32_t max_leaf,
+               leaves_stage_fn stage, void *arg);
 
 #endif /* BVHLAB_LEAVES_H */
