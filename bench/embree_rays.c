@@ -6,7 +6,7 @@
  *   build/bench/embree-rays SCENE [--subdivide K] [--size N] [--min-ms MS]
  *                           [--builder PLUGIN]
  *
- * Embree and both core traversals (stack, stackless) take turns, a round
+ * Embree and the core traversals (stack, stackless, wide) take turns, a round
  * at a time, until --min-ms (default 1000) has passed and at least 5
  * rounds were run. In a round each traces the whole batch PASSES times in
  * a row, timed on both clocks, the thread's CPU time (what the harness
@@ -37,6 +37,7 @@
 #define MAX_SAMPLES 4096
 #define MIN_ROUNDS 5
 #define PASSES 3
+#define TRACERS (1 + BVHLAB_TRAVERSAL_COUNT) /* embree, then ours by enum bvhlab_traversal */
 
 struct args {
 	const char *scene, *builder;
@@ -182,22 +183,24 @@ static bool ours_round(const bvhlab_tree *tree, const bvhlab_scene *s, const bvh
 	return true;
 }
 
-/* Rounds of Embree and of both core traversals in turn, so a burst of
- * load from elsewhere on the machine falls on all three alike; medians. */
+/* Rounds of Embree and of every core traversal in turn, so a burst of
+ * load from elsewhere on the machine falls on all alike; medians. */
 static void time_all(RTCScene sc, const bvhlab_tree *tree, const bvhlab_scene *s,
-                     const bvhlab_ray *rays, size_t n, const struct args *a, struct tracer t[3])
+                     const bvhlab_ray *rays, size_t n, const struct args *a, struct tracer *t)
 {
 	bvhlab_hit *h = malloc(n * sizeof(*h));
 	double start = util_now();
 	size_t k = 0;
 	while (h && k < MAX_SAMPLES && (k < MIN_ROUNDS || util_now() - start < a->min_ms * 1e-3)) {
 		embree_round(sc, rays, n, &t[0], k);
-		if (!ours_round(tree, s, rays, n, BVHLAB_TRAVERSAL_STACK, h, &t[1], k) ||
-		    !ours_round(tree, s, rays, n, BVHLAB_TRAVERSAL_STACKLESS, h, &t[2], k))
+		int j = 0;
+		while (j < BVHLAB_TRAVERSAL_COUNT && ours_round(tree, s, rays, n, j, h, &t[1 + j], k))
+			j++;
+		if (j < BVHLAB_TRAVERSAL_COUNT)
 			break;
 		k++;
 	}
-	for (int i = 0; i < 3; i++) {
+	for (int i = 0; i < TRACERS; i++) {
 		t[i].mrays[0] = k ? median(t[i].cpu, k) : 0;
 		t[i].mrays[1] = k ? median(t[i].wall, k) : 0;
 	}
@@ -205,13 +208,13 @@ static void time_all(RTCScene sc, const bvhlab_tree *tree, const bvhlab_scene *s
 }
 
 static void report(const struct args *a, const bvhlab_scene *s, int clock,
-                   const struct tracer t[3])
+                   const struct tracer *t)
 {
 	printf("scene %s (%u triangles), %ux%u primary rays, 1 thread, %s\n", s->name,
 	       s->triangle_count, a->size, a->size,
 	       clock ? "wall clock" : "thread CPU time");
 	printf("  embree rtcIntersect1: %.2f Mrays/s (%zu hits)\n", t[0].mrays[clock], t[0].hits);
-	for (int k = 1; k < 3; k++)
+	for (int k = 1; k < TRACERS; k++)
 		printf("  bvhlab %s tree, %s traversal: %.2f Mrays/s (%zu hits, %.2f nodes/ray), "
 		       "ratio to embree %.2f\n",
 		       a->builder, bvhlab_traversal_name(k - 1), t[k].mrays[clock], t[k].hits,
@@ -260,7 +263,7 @@ int main(int argc, char **argv)
 	}
 	bvhlab_camera_frame(&s->bounds, &cam);
 	size_t n = (size_t)a.size * a.size;
-	static struct tracer t[3];
+	static struct tracer t[TRACERS];
 	if (bvhlab_rays_primary(&cam, a.size, a.size, &rays) < 0)
 		return 1;
 	RTCDevice dev = rtcNewDevice("threads=1");

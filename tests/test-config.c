@@ -12,6 +12,8 @@
 
 #include <cJSON.h>
 
+#include <bvhlab/traversal.h>
+
 #include "config/config.h"
 #include "config/json_locate.h"
 #include "testutil.h"
@@ -183,6 +185,8 @@ static void test_defaults(void)
 	CHECK(strcmp(cfg.scenes[0].name, "icosphere") == 0 && cfg.scenes[0].subdivide == 0);
 	CHECK(memcmp(&cfg.scenes[0].gen, &gen, sizeof(gen)) == 0);
 	CHECK(strcmp(cfg.builders[0].name, "sah_seq") == 0 && !cfg.builders[0].threads);
+	CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_WIDE &&
+	      cfg.ray_traversals == 1u << BVHLAB_TRAVERSAL_WIDE);
 	config_finish(&cfg);
 
 	/* Whole numbers in any spelling; a config in the current folder. */
@@ -206,6 +210,43 @@ static void test_defaults(void)
 	struct config zero;
 	memset(&zero, 0, sizeof(zero));
 	config_finish(&zero);
+}
+
+/* "traversal": a name, "both" or an array of names, the first the main one. */
+static void test_traversal(void)
+{
+	static const struct {
+		const char *value;
+		int main;
+		unsigned all;
+	} ok[] = {
+		{"\"stack\"", BVHLAB_TRAVERSAL_STACK, 1u << BVHLAB_TRAVERSAL_STACK},
+		{"\"both\"", BVHLAB_TRAVERSAL_STACK, 3u},
+		{"[\"stackless\", \"wide\"]", BVHLAB_TRAVERSAL_STACKLESS, 6u},
+		{"[\"wide\", \"stack\", \"stackless\"]", BVHLAB_TRAVERSAL_WIDE, 7u},
+	};
+	for (size_t i = 0; i < sizeof(ok) / sizeof(ok[0]); i++) {
+		char text[256];
+		struct config cfg;
+		bvhlab_error err = {""};
+		snprintf(text, sizeof(text),
+		         "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": %s } }", ok[i].value);
+		int rc = load(&cfg, text, &err);
+		CHECK_INT(rc, 0);
+		if (rc == 0)
+			CHECK(cfg.ray_traversal == ok[i].main && cfg.ray_traversals == ok[i].all);
+		config_finish(&cfg);
+	}
+	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"wid\" } }";
+	EXPECT_ERROR_AT(t, "\"wid\"", 0, "'rays.traversal' must be \"wide\", \"stack\", "
+	                "\"stackless\", \"both\" (stack and stackless) or an array of those "
+	                "names, not \"wid\"");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", 2] } }";
+	EXPECT_ERROR_AT(t, "2]", 0, "an array of those names, not 2");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", \"wide\"] } }";
+	EXPECT_ERROR_AT(t, "\"wide\"", 1, "'rays.traversal' names \"wide\" twice");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [] } }";
+	EXPECT_ERROR_AT(t, "[]", 0, "not an array");
 }
 
 static void test_syntax(void)
@@ -567,6 +608,7 @@ int main(void)
 	test_full();
 	test_defaults();
 	test_syntax();
+	test_traversal();
 	test_unknown_keys();
 	test_types();
 	test_structure();

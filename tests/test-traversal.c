@@ -1,9 +1,10 @@
 /*
- * The stackless traversal against the stack traversal and brute force:
- * the same closest hit (triangle, and t, u, v bit for bit) on hand-made
- * trees with shared edges, coincident triangles (ties) and a deep chain,
- * and on every shared mesh with trees of two builders. The timed batch
- * tracer: exact counters of one pass, its repeats and its errors.
+ * The stackless and wide traversals against the stack traversal and brute
+ * force: the same closest hit (triangle, and t, u, v bit for bit) on
+ * hand-made trees with shared edges, coincident triangles (ties) and a
+ * deep chain, and on every shared mesh with trees of two builders. The
+ * timed batch tracer: exact counters of one pass (the binary tree's for
+ * every traversal), its repeats and its errors.
  */
 #include <errno.h>
 #include <math.h>
@@ -49,30 +50,63 @@ static int agree(const fixture *f, const uint32_t *parents, const bvhlab_ray *r)
 	return same_hit(&a, &b) && same_hit(&a, &c) && any == (a.prim != BVHLAB_NO_HIT);
 }
 
+/* The wide traversal (batches only) on n rays: closest hits as the stack
+ * traversal's, any-hit rays hit exactly when those have a hit. Rays that
+ * disagree. */
+static int wide_disagrees(const fixture *f, const bvhlab_ray *rays, int n)
+{
+	bvhlab_hit *wide = calloc((size_t)n, sizeof(*wide));
+	bvhlab_hit *any = calloc((size_t)n, sizeof(*any));
+	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_WIDE, .threads = 2};
+	bvhlab_trace_timing tm;
+	int bad = 0;
+	CHECK(wide && any);
+	if (!wide || !any)
+		goto out;
+	CHECK_INT(bvhlab_trace_measure(&f->tree, &f->scene, rays, (size_t)n, &o, wide, NULL, &tm), 0);
+	o.any_hit = true;
+	CHECK_INT(bvhlab_trace_measure(&f->tree, &f->scene, rays, (size_t)n, &o, any, NULL, &tm), 0);
+	for (int i = 0; i < n; i++) {
+		bvhlab_hit h;
+		bvhlab_trace_closest(&f->tree, &f->scene, &rays[i], &h, NULL);
+		bad += !same_hit(&h, &wide[i]) ||
+		       (any[i].prim != BVHLAB_NO_HIT) != (h.prim != BVHLAB_NO_HIT);
+	}
+out:
+	free(wide);
+	free(any);
+	return bad;
+}
+
 static void check_tree(fixture *f, uint64_t seed, float size, int rays, const char *what)
 {
 	uint32_t *parents = NULL;
+	bvhlab_ray *batch = calloc((size_t)rays, sizeof(*batch));
 	int bad = 0;
 	CHECK_INT(bvhlab_tree_parents(&f->tree, &parents), 0);
-	if (!parents)
-		return;
+	if (!parents || !batch)
+		goto out;
 	CHECK(parents[0] == UINT32_MAX);
 	for (int i = 0; i < rays; i++) {
-		bvhlab_ray r = grid_ray(&seed, size);
-		bad += !agree(f, parents, &r);
+		batch[i] = grid_ray(&seed, size);
+		bad += !agree(f, parents, &batch[i]);
 	}
+	bad += wide_disagrees(f, batch, rays);
 	if (bad)
 		fprintf(stderr, "%s: %d of %d rays disagree\n", what, bad, rays);
 	CHECK_INT(bad, 0);
+out:
+	free(batch);
 	free(parents);
 }
 
 /* A grid with shared edges (rays through edges and corners tie between
- * neighbours), leaves of 1 and 4, and the same trees with nodes and
- * leaves shuffled: the visiting order changes, the hits must not. */
+ * neighbours), leaves of 1, 4 and 7 (two triangle groups of the wide
+ * traversal), and the same trees with nodes and leaves shuffled: the
+ * visiting order changes, the hits must not. */
 static void test_grid(void)
 {
-	for (uint32_t leaf = 1; leaf <= 4; leaf += 3) {
+	for (uint32_t leaf = 1; leaf <= 7; leaf += 3) {
 		fixture f;
 		bvhlab_tree shuffled;
 		fixture_grid(&f, 12, 9, 0.0f);
@@ -136,10 +170,16 @@ static void test_chain(void)
 	bvhlab_trace_stackless(&f.tree, parents, &f.scene, &up, false, &h, NULL);
 	CHECK(h.prim == 0 && h.t == 5.0f);
 	free(parents);
+	/* Too deep for a wide ray's stack: the stack traversal takes over. */
+	bvhlab_ray both[2] = {down, up};
+	CHECK_INT(wide_disagrees(&f, both, 2), 0);
 	/* Links that are not a tree: a child shared by two parents. */
 	f.tree.nodes[2].first = 1;
 	CHECK_INT(bvhlab_tree_parents(&f.tree, &parents), -EINVAL);
 	CHECK(parents == NULL);
+	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_WIDE};
+	bvhlab_trace_timing tm;
+	CHECK_INT(bvhlab_trace_measure(&f.tree, &f.scene, both, 2, &o, NULL, NULL, &tm), -EINVAL);
 	fixture_free(&f);
 }
 
@@ -157,7 +197,7 @@ static void test_measure(void)
 	fixture_build(&f, 2);
 	for (int i = 0; i < N; i++)
 		rays[i] = grid_ray(&seed, 20);
-	for (int t = 0; t < 2; t++) {
+	for (int t = 0; t < BVHLAB_TRAVERSAL_COUNT; t++) {
 		bvhlab_trace_options o = {.traversal = t, .threads = 2, .min_repeats = 4, .min_ms = 20};
 		bvhlab_trace_timing tm;
 		CHECK_INT(bvhlab_trace_measure(&f.tree, &f.scene, rays, N, &o, hits, nodes, &tm), 0);
@@ -175,8 +215,9 @@ static void test_measure(void)
 			node_sum += nodes[i];
 		}
 		CHECK_INT(node_sum, tm.stats.nodes_visited);
-		if (t == 0) {
+		if (t == 0)
 			ref = st;
+		if (t != BVHLAB_TRAVERSAL_STACKLESS) { /* wide counts the binary tree too */
 			CHECK_INT(tm.stats.nodes_visited, ref.nodes_visited);
 			CHECK_INT(tm.stats.tris_tested, ref.tris_tested);
 		}
@@ -185,11 +226,29 @@ static void test_measure(void)
 	bvhlab_trace_timing tm;
 	CHECK_INT(bvhlab_trace_measure(&f.tree, &f.scene, rays, N, &bad, NULL, NULL, &tm), -EINVAL);
 	CHECK(bvhlab_traversal_name(0) && !strcmp(bvhlab_traversal_name(1), "stackless"));
+	CHECK(!strcmp(bvhlab_traversal_name(BVHLAB_TRAVERSAL_WIDE), "wide"));
+	CHECK(!bvhlab_traversal_name(BVHLAB_TRAVERSAL_COUNT));
 	fixture_free(&f);
 }
 
-/* Stack and stackless on a builder's tree of a shared mesh: primary and
- * diffuse rays, hits compared bit for bit. */
+/* Rays of traversal t whose hits differ from a's (n primary, nd diffuse). */
+static size_t differ_from(const bvhlab_tree *tree, const bvhlab_scene *s, int t,
+                          const bvhlab_ray *rays, size_t n, const bvhlab_ray *diffuse,
+                          size_t nd, const bvhlab_hit *a, bvhlab_hit *b)
+{
+	bvhlab_trace_options o = {.traversal = t, .threads = 2};
+	bvhlab_trace_timing tm;
+	size_t differ = 0;
+	CHECK_INT(bvhlab_trace_measure(tree, s, rays, n, &o, b, NULL, &tm), 0);
+	if (nd)
+		CHECK_INT(bvhlab_trace_measure(tree, s, diffuse, nd, &o, b + n, NULL, &tm), 0);
+	for (size_t i = 0; i < n + nd; i++)
+		differ += !same_hit(&a[i], &b[i]);
+	return differ;
+}
+
+/* Stack, stackless and wide on a builder's tree of a shared mesh: primary
+ * and diffuse rays, hits compared bit for bit. */
 static void shared_mesh(const char *file, const char *plugin)
 {
 	bvhlab_scene *s = load_shared(file);
@@ -201,7 +260,7 @@ static void shared_mesh(const char *file, const char *plugin)
 	bvhlab_camera cam;
 	bvhlab_ray *rays = NULL, *diffuse = NULL;
 	uint32_t side = SCALE(160, 48);
-	size_t n = (size_t)side * side, nd = 0, differ = 0;
+	size_t n = (size_t)side * side, nd = 0;
 	bvhlab_hit *a = calloc(n * 2, sizeof(*a)), *b = calloc(n * 2, sizeof(*b));
 	if (!s || !a || !b || bvhlab_prims_init(&prims, s, &err) < 0 ||
 	    bvhlab_plugin_open(plugin, &p, &err) < 0 ||
@@ -220,17 +279,13 @@ static void shared_mesh(const char *file, const char *plugin)
 	CHECK(nd > 0 && nd <= n);
 	if (nd)
 		CHECK_INT(bvhlab_trace_measure(&tree, s, diffuse, nd, &o, a + n, NULL, &tm), 0);
-	o.traversal = BVHLAB_TRAVERSAL_STACKLESS;
-	CHECK_INT(bvhlab_trace_measure(&tree, s, rays, n, &o, b, NULL, &tm), 0);
-	if (nd)
-		CHECK_INT(bvhlab_trace_measure(&tree, s, diffuse, nd, &o, b + n, NULL, &tm), 0);
-	for (size_t i = 0; i < n; i++)
-		differ += !same_hit(&a[i], &b[i]);
-	for (size_t i = 0; i < nd; i++)
-		differ += !same_hit(&a[n + i], &b[n + i]);
-	printf("%s, %s: %zu primary and %zu diffuse rays, %zu differ\n", file, plugin, n, nd,
-	       differ);
-	CHECK_INT(differ, 0);
+	size_t stackless = differ_from(&tree, s, BVHLAB_TRAVERSAL_STACKLESS, rays, n, diffuse, nd,
+	                               a, b);
+	size_t wide = differ_from(&tree, s, BVHLAB_TRAVERSAL_WIDE, rays, n, diffuse, nd, a, b);
+	printf("%s, %s: %zu primary and %zu diffuse rays, %zu differ stackless, %zu wide\n",
+	       file, plugin, n, nd, stackless, wide);
+	CHECK_INT(stackless, 0);
+	CHECK_INT(wide, 0);
 out:
 	free(rays);
 	free(diffuse);

@@ -36,8 +36,8 @@ static int set_defaults(struct config *cfg)
 	cfg->ray_diffuse = 1;
 	cfg->ray_threads = 1;
 	cfg->ray_min_ms = DEFAULT_RAY_MIN_MS;
-	cfg->ray_traversals = 1u << BVHLAB_TRAVERSAL_STACK;
-	cfg->ray_traversal = BVHLAB_TRAVERSAL_STACK;
+	cfg->ray_traversals = 1u << BVHLAB_TRAVERSAL_WIDE;
+	cfg->ray_traversal = BVHLAB_TRAVERSAL_WIDE;
 	cfg->report_reference = strdup("sah_seq");
 	if (!cfg->report_reference)
 		return -ENOMEM;
@@ -89,25 +89,68 @@ static int resolve_output(struct config *cfg, bvhlab_error *err)
 	return rc ? out_of_memory(cfg->path, err) : 0;
 }
 
-/* "traversal": "stack", "stackless" or "both" (stack is then the main one). */
+/* enum bvhlab_traversal of a name; -1 for none. */
+static int traversal_of(const char *name)
+{
+	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++)
+		if (strcmp(name, bvhlab_traversal_name(k)) == 0)
+			return k;
+	return -1;
+}
+
+static int bad_traversal(struct config *cfg, const cJSON *item, bvhlab_error *err)
+{
+	char got[48];
+	if (cJSON_IsString(item))
+		snprintf(got, sizeof(got), "\"%.40s\"", item->valuestring);
+	return config_error(cfg, item, false, err,
+	                    "'rays.traversal' must be \"wide\", \"stack\", \"stackless\", "
+	                    "\"both\" (stack and stackless) or an array of those names, not %s",
+	                    cJSON_IsString(item) ? got
+	                                         : config_describe(cfg, item, got, sizeof(got)));
+}
+
+/* One name of the array form: the first is the main traversal. */
+static int add_traversal(struct config *cfg, const cJSON *item, bool first, bvhlab_error *err)
+{
+	int k = cJSON_IsString(item) ? traversal_of(item->valuestring) : -1;
+	if (k < 0)
+		return bad_traversal(cfg, item, err);
+	if (cfg->ray_traversals & (1u << k))
+		return config_error(cfg, item, false, err, "'rays.traversal' names \"%s\" twice",
+		                    item->valuestring);
+	cfg->ray_traversals |= 1u << k;
+	if (first)
+		cfg->ray_traversal = k;
+	return 0;
+}
+
+/* "traversal": a name, "both" (stack, then stackless) or an array of
+ * names, the first the main one. */
 static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *err)
 {
-	char *name = NULL;
-	int rc = config_get_string(cfg, rays, "traversal", "rays.", &name, err);
-	if (rc || !name)
-		return rc;
-	if (strcmp(name, "both") == 0) {
+	const cJSON *t = config_member(rays, "traversal");
+	if (!t)
+		return 0;
+	if (cJSON_IsString(t) && strcmp(t->valuestring, "both") == 0) {
 		cfg->ray_traversals = 1u << BVHLAB_TRAVERSAL_STACK | 1u << BVHLAB_TRAVERSAL_STACKLESS;
 		cfg->ray_traversal = BVHLAB_TRAVERSAL_STACK;
-	} else if (strcmp(name, "stack") == 0 || strcmp(name, "stackless") == 0) {
-		cfg->ray_traversal = name[5] ? BVHLAB_TRAVERSAL_STACKLESS : BVHLAB_TRAVERSAL_STACK;
-		cfg->ray_traversals = 1u << cfg->ray_traversal;
-	} else {
-		rc = config_error(cfg, config_member(rays, "traversal"), false, err,
-		                  "'rays.traversal' must be \"stack\", \"stackless\" or \"both\", "
-		                  "not \"%s\"", name);
+		return 0;
 	}
-	free(name);
+	if (cJSON_IsString(t) && traversal_of(t->valuestring) >= 0) {
+		cfg->ray_traversal = traversal_of(t->valuestring);
+		cfg->ray_traversals = 1u << cfg->ray_traversal;
+		return 0;
+	}
+	if (!cJSON_IsArray(t) || cJSON_GetArraySize(t) == 0)
+		return bad_traversal(cfg, t, err);
+	cfg->ray_traversals = 0;
+	int rc = 0;
+	const cJSON *item;
+	cJSON_ArrayForEach(item, t) {
+		if (rc == 0)
+			rc = add_traversal(cfg, item, item == t->child, err);
+	}
 	return rc;
 }
 

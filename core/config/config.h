@@ -99,9 +99,10 @@ struct config {
 	                                              * default 256, 256, 1 */
 	uint32_t ray_threads; /* "rays": "threads", default 1; 0 = all hardware threads */
 	double ray_min_ms; /* "rays": "min_ms", default 200: each batch repeated this long */
-	unsigned ray_traversals; /* "rays": "traversal" stack|stackless|both, default stack:
-	                          * bit (1 << enum bvhlab_traversal) per traversal */
-	int ray_traversal; /* the main one (stack for "both") */
+	unsigned ray_traversals; /* "rays": "traversal" wide|stack|stackless|both or an array
+	                          * of names, default wide: bit (1 << enum
+	                          * bvhlab_traversal) per traversal */
+	int ray_traversal; /* the main one (stack for "both", the first of an array) */
 	char *report_reference; /* "report": {"reference"}, default "sah_seq": a builder
 	                         * name or, failing that, a plugin name */
 	bool has_camera;   /* "rays": {"camera": ...} given; else framed per scene */

@@ -55,7 +55,7 @@ const struct config_key config_ray_keys[] = {
 	CUSTOM("camera"),
 	TOP("threads", CONFIG_U32, ray_threads, 0, MAX_RAY_THREADS),
 	TOP("min_ms", CONFIG_POSITIVE, ray_min_ms, 0, 0),
-	CUSTOM("traversal"), /* "stack" | "stackless" | "both": config.c */
+	CUSTOM("traversal"), /* a name, "both" or an array of names: config.c */
 	END,
 };
 

@@ -63,7 +63,7 @@ static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	                          .min_ms = rs->min_ms, .min_repeats = MIN_REPEATS};
 	int r = bvhlab_trace_measure(tree, scene, rays, n, &o, hits, nodes, &out[rs->main]);
 	m->threads = out[rs->main].threads;
-	for (int k = 0; r == 0 && k < 2; k++) {
+	for (int k = 0; r == 0 && k < BVHLAB_TRAVERSAL_COUNT; k++) {
 		if (k == rs->main || !(rs->traversals & (1u << k)))
 			continue;
 		bvhlab_hit *other = malloc(n * sizeof(*other));

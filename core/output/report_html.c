@@ -49,8 +49,19 @@ static void range_cell(struct strbuf *sb, const cJSON *run, const char *kind)
 	sb_printf(sb, "</td>");
 }
 
+/* Traversals a scene's table may show beside the main one, by name. */
+static const char *const other_traversals[] = {"wide", "stack", "stackless"};
+#define OTHERS (sizeof(other_traversals) / sizeof(other_traversals[0]))
+
+static double other_num(const cJSON *run, const char *traversal, const char *what)
+{
+	char key[96];
+	snprintf(key, sizeof(key), "rays.%s.%s", traversal, what);
+	return report_num(run, key);
+}
+
 static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
-                    bool stackless)
+                    const bool *others, bool any_other)
 {
 	bool ok = strcmp(report_str(run, "status"), "ok") == 0;
 	sb_printf(sb, "<tr><td class=\"l\">");
@@ -77,31 +88,44 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 	num_cell(sb, report_num(run, "rays.diffuse.nodes_per_ray"), "%.1f");
 	num_cell(sb, report_num(run, "tree.refs"), "%.0f");
 	num_cell(sb, report_num(run, "tree.dup_ratio"), "%.3f");
-	if (stackless) {
-		num_cell(sb, report_num(run, "rays.stackless.primary.mrays_per_s"), "%.2f");
-		num_cell(sb, report_num(run, "rays.stackless.primary.nodes_per_ray"), "%.1f");
-		num_cell(sb, report_num(run, "rays.stackless.diffuse.mrays_per_s"), "%.2f");
-		num_cell(sb, report_num(run, "rays.traversal_disagreements"), "%.0f");
+	for (size_t t = 0; t < OTHERS; t++) {
+		if (!others[t])
+			continue;
+		num_cell(sb, other_num(run, other_traversals[t], "primary.mrays_per_s"), "%.2f");
+		num_cell(sb, other_num(run, other_traversals[t], "diffuse.mrays_per_s"), "%.2f");
+		if (strcmp(other_traversals[t], "stackless") == 0) /* it counts its own nodes */
+			num_cell(sb, other_num(run, other_traversals[t], "primary.nodes_per_ray"),
+			         "%.1f");
 	}
+	if (any_other)
+		num_cell(sb, report_num(run, "rays.traversal_disagreements"), "%.0f");
 	sb_printf(sb, "<td class=\"l\">");
 	esc(sb, report_str(run, "error"));
 	sb_printf(sb, "</td></tr>\n");
 }
 
-/* Whether some run of the scene was also traced stacklessly. */
-static bool has_stackless(const cJSON *const *runs, size_t n)
+/* Which other traversals some run of the scene was also traced with;
+ * whether any. */
+static bool find_others(const cJSON *const *runs, size_t n, bool *others)
 {
-	for (size_t k = 0; k < n; k++)
-		if (report_at(runs[k], "rays.stackless"))
-			return true;
-	return false;
+	bool any = false;
+	for (size_t t = 0; t < OTHERS; t++) {
+		char key[64];
+		snprintf(key, sizeof(key), "rays.%s", other_traversals[t]);
+		others[t] = false;
+		for (size_t k = 0; k < n && !others[t]; k++)
+			others[t] = report_at(runs[k], key) != NULL;
+		any |= others[t];
+	}
+	return any;
 }
 
 static void table(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
 	size_t n;
+	bool others[OTHERS];
 	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
-	bool stackless = has_stackless(runs, n);
+	bool any_other = find_others(runs, n, others);
 	sb_printf(sb, "<table><tr><th class=\"l\">builder</th><th>threads</th>"
 	              "<th class=\"l\">status</th><th>median ms</th><th>min ms</th><th>max ms</th>"
 	              "<th>cold ms</th>"
@@ -109,12 +133,19 @@ static void table(struct strbuf *sb, const struct report_index *ix, const char *
 	              "<th>peak MiB</th><th>primary Mrays/s</th><th>min–max</th>"
 	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s</th>"
 	              "<th>diffuse nodes/ray</th><th>refs</th><th>refs/tri</th>");
-	if (stackless)
-		sb_printf(sb, "<th>stackless primary Mrays/s</th><th>stackless primary nodes/ray</th>"
-		              "<th>stackless diffuse Mrays/s</th><th>hits differing</th>");
+	for (size_t t = 0; t < OTHERS; t++) {
+		const char *name = other_traversals[t];
+		if (!others[t])
+			continue;
+		sb_printf(sb, "<th>%s primary Mrays/s</th><th>%s diffuse Mrays/s</th>", name, name);
+		if (strcmp(name, "stackless") == 0)
+			sb_printf(sb, "<th>%s primary nodes/ray</th>", name);
+	}
+	if (any_other)
+		sb_printf(sb, "<th>hits differing</th>");
 	sb_printf(sb, "<th class=\"l\">error</th></tr>\n");
 	for (size_t k = 0; k < n; k++)
-		run_row(sb, ix, runs[k], stackless);
+		run_row(sb, ix, runs[k], others, any_other);
 	sb_printf(sb, "</table>\n");
 }
 
@@ -243,7 +274,10 @@ char *report_html(const cJSON *doc)
 	               "Rays are traced with the same threads for every run, so traversal "
 	               "numbers compare trees, not thread counts; Mrays/s: rays per CPU "
 	               "second of the tracing threads times their number, each tile of rays "
-	               "at its best of the repeated passes (min–max: whole passes).</p>\n",
+	               "at its best of the repeated passes (min–max: whole passes), by the "
+	               "run's traversal (default wide: the tree collapsed into 4-child "
+	               "nodes); nodes and triangles per ray are the binary tree's, counted "
+	               "by the stack traversal, whichever is timed.</p>\n",
 	          report_num(doc, "machine.cores"));
 	report_summary_html(&sb, doc);
 	report_machines_html(&sb, doc);

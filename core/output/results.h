@@ -31,8 +31,9 @@ struct ray_metrics {
 	uint32_t threads;      /* the threads that traced them */
 	unsigned traversals;   /* bit (1 << enum bvhlab_traversal) for each one measured */
 	int main;              /* the traversal "primary"/"diffuse" report */
-	bvhlab_trace_timing primary[2], diffuse[2]; /* by enum bvhlab_traversal */
-	uint64_t disagreements; /* rays whose hits differ between the two traversals */
+	/* by enum bvhlab_traversal */
+	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
+	uint64_t disagreements; /* rays whose hits differ from the main traversal's */
 };
 
 /* Peak memory of one run's builds (harness/harness_memory.c measures it). */

@@ -39,14 +39,18 @@ cJSON *results_rays_json(const struct ray_metrics *m)
 	cJSON_AddNumberToObject(o, "threads", m->threads);
 	cJSON_AddStringToObject(o, "traversal", bvhlab_traversal_name(m->main));
 	add_kinds(o, m, m->main);
-	for (int k = 0; k < 2; k++) {
+	bool others = false;
+	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
 		if (k == m->main || !(m->traversals & (1u << k)))
 			continue;
 		cJSON *other = cJSON_CreateObject();
 		add_kinds(other, m, k);
 		cJSON_AddItemToObject(o, bvhlab_traversal_name(k), other);
-		/* Rays (primary and diffuse) whose hit differs between the two. */
-		cJSON_AddNumberToObject(o, "traversal_disagreements", (double)m->disagreements);
+		others = true;
 	}
+	/* Rays (primary and diffuse) whose hit differs from the main traversal's,
+	 * summed over the others. */
+	if (others)
+		cJSON_AddNumberToObject(o, "traversal_disagreements", (double)m->disagreements);
 	return o;
 }

@@ -24,7 +24,9 @@ static void trace_tile(struct batch *b, size_t begin, size_t end, bvhlab_trace_s
 	for (size_t i = begin; i < end; i++) {
 		bvhlab_hit hit;
 		uint64_t before = st->nodes_visited;
-		if (b->traversal == BVHLAB_TRAVERSAL_STACKLESS)
+		if (b->traversal == BVHLAB_TRAVERSAL_WIDE)
+			trace_ray_wide(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
+		else if (b->traversal == BVHLAB_TRAVERSAL_STACKLESS)
 			trace_ray_stackless(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
 		else
 			trace_ray_stack(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);

@@ -50,15 +50,34 @@ typedef struct ray_prep {
 } ray_prep;
 
 
-/* False for a zero, infinite or NaN direction: such a ray hits nothing. */
-static inline bool prep_ray(const bvhlab_ray *ray, ray_prep *p)
+/* The slab test's constants. False for a zero, infinite or NaN direction:
+ * such a ray hits nothing. */
+static inline bool prep_box(const bvhlab_ray *ray, ray_prep *p)
 {
 	const float *d = ray->dir;
 	float ax = fabsf(d[0]), ay = fabsf(d[1]), az = fabsf(d[2]);
-	int k;
 
 	if (!isfinite(ax) || !isfinite(ay) || !isfinite(az) || ax + ay + az == 0.0f)
 		return false;
+	for (int k = 0; k < 3; k++) {
+		p->org[k] = ray->org[k];
+		p->dir[k] = d[k];
+		p->inv[k] = 1.0f / d[k];
+		p->near[k] = signbit(p->inv[k]) ? 4 + k : k;
+		p->far[k] = signbit(p->inv[k]) ? k : 4 + k;
+	}
+	p->tmin = ray->tmin;
+	return true;
+}
+
+/* The triangle test's constants, after prep_box(): a traversal may leave
+ * them until its first leaf. */
+static inline void prep_shear(ray_prep *p)
+{
+	const float *d = p->dir;
+	float ax = fabsf(d[0]), ay = fabsf(d[1]), az = fabsf(d[2]);
+	int k;
+
 	p->kz = ax >= ay ? (ax >= az ? 0 : 2) : (ay >= az ? 1 : 2);
 	p->kx = (p->kz + 1) % 3;
 	p->ky = (p->kx + 1) % 3;
@@ -70,14 +89,14 @@ static inline bool prep_ray(const bvhlab_ray *ray, ray_prep *p)
 	p->sx = d[p->kx] / d[p->kz];
 	p->sy = d[p->ky] / d[p->kz];
 	p->sz = 1.0f / d[p->kz];
-	for (k = 0; k < 3; k++) {
-		p->org[k] = ray->org[k];
-		p->dir[k] = d[k];
-		p->inv[k] = 1.0f / d[k];
-		p->near[k] = signbit(p->inv[k]) ? 4 + k : k;
-		p->far[k] = signbit(p->inv[k]) ? k : 4 + k;
-	}
-	p->tmin = ray->tmin;
+}
+
+/* Both. */
+static inline bool prep_ray(const bvhlab_ray *ray, ray_prep *p)
+{
+	if (!prep_box(ray, p))
+		return false;
+	prep_shear(p);
 	return true;
 }
 
@@ -202,21 +221,38 @@ static inline bool isect_slot(const ray_prep *p, const bvhlab_tree *tree,
  * parent links (parents, stackless only). trace_view_init makes the plain
  * view of a tree; trace_view_copy the batch tracer's copies.
  */
+struct wide_bvh; /* trace_wide.h */
+
 struct trace_view {
 	const bvhlab_node *nodes;
 	const float *tris;
 	const uint32_t *parents;
+	const struct wide_bvh *wide; /* the wide traversal's nodes */
 	void *owned; /* what trace_view_free releases */
 	float *owned_tris;
+	struct wide_bvh *owned_wide;
 };
 
 static inline struct trace_view trace_view_plain(const bvhlab_tree *tree)
 {
-	return (struct trace_view){tree->nodes, NULL, NULL, NULL, NULL};
+	return (struct trace_view){tree->nodes, NULL, NULL, NULL, NULL, NULL, NULL};
 }
+
+/*
+ * Memory for a traversal's copies, released with free(): line-aligned, and
+ * from 2 MiB up on huge pages where the kernel grants them (transparent huge
+ * pages, "madvise" mode), as Embree's allocator does. A ray's walk touches
+ * a new 4 KiB page at almost every step; with 4 KiB pages the TLB misses
+ * and the physical placement of the pages, which differs from one process to
+ * the next, made the same batch trace at different speeds in two runs.
+ */
+void *trace_alloc(size_t bytes);
 
 /* Node copy aligned for sibling pairs, plus the vertex copy. 0 or -ENOMEM. */
 int trace_view_copy(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v);
+/* Adds the wide nodes to a view: 0, -EINVAL (links that do not make a
+ * tree), -ENOMEM. */
+int trace_view_wide(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v);
 void trace_view_free(struct trace_view *v);
 
 /* The stack traversal of trace.c through a view: what bvhlab_trace_closest
@@ -224,6 +260,11 @@ void trace_view_free(struct trace_view *v);
 void trace_ray_stack(const bvhlab_tree *tree, const bvhlab_scene *scene,
                      const struct trace_view *view, const bvhlab_ray *ray, bool any,
                      bvhlab_hit *hit, bvhlab_trace_stats *stats);
+
+/* The wide traversal of trace_wide.c, likewise (view->wide set). */
+void trace_ray_wide(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                    const struct trace_view *view, const bvhlab_ray *ray, bool any,
+                    bvhlab_hit *hit, bvhlab_trace_stats *stats);
 
 /* The stackless traversal of trace_stackless.c, likewise. */
 void trace_ray_stackless(const bvhlab_tree *tree, const bvhlab_scene *scene,

@@ -28,6 +28,8 @@ const char *bvhlab_traversal_name(int traversal)
 		return "stack";
 	case BVHLAB_TRAVERSAL_STACKLESS:
 		return "stackless";
+	case BVHLAB_TRAVERSAL_WIDE:
+		return "wide";
 	default:
 		return NULL;
 	}
@@ -126,7 +128,8 @@ static int run_passes(struct batch *b, struct worker *w, uint32_t threads,
 		bvhlab_trace_stats st;
 		double c, s = pass(b, w, threads, &st, &c);
 		if (n == 0) {
-			t->stats = st;
+			if (b->traversal != BVHLAB_TRAVERSAL_WIDE)
+				t->stats = st;
 			b->hits = NULL; /* filled once; later passes only time */
 			b->nodes = NULL;
 		}
@@ -157,6 +160,22 @@ static int run_passes(struct batch *b, struct worker *w, uint32_t threads,
 	return r;
 }
 
+/* The wide traversal's untimed pass of the stack traversal, for counters
+ * of the binary tree; then the wide nodes for the timed passes. */
+static int count_binary(const bvhlab_tree *tree, const bvhlab_scene *scene, struct batch *b,
+                        struct worker *w, uint32_t threads, bvhlab_trace_timing *t)
+{
+	bvhlab_hit *hits = b->hits;
+	double cpu;
+	b->traversal = BVHLAB_TRAVERSAL_STACK;
+	b->hits = NULL;
+	pass(b, w, threads, &t->stats, &cpu);
+	b->traversal = BVHLAB_TRAVERSAL_WIDE;
+	b->hits = hits;
+	b->nodes = NULL;
+	return trace_view_wide(tree, scene, &b->view);
+}
+
 int bvhlab_trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene,
                          const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
                          bvhlab_hit *hits, uint32_t *nodes, bvhlab_trace_timing *timing)
@@ -180,6 +199,8 @@ int bvhlab_trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	int r = w ? trace_view_copy(tree, scene, &b.view) : -ENOMEM;
 	b.view.parents = parents;
 	atomic_init(&b.next, 0);
+	if (r == 0 && opts->traversal == BVHLAB_TRAVERSAL_WIDE)
+		r = count_binary(tree, scene, &b, w, threads, timing);
 	if (r == 0)
 		r = run_passes(&b, w, threads, opts, timing);
 	timing->threads = threads;

@@ -9,10 +9,26 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 
 #include "trace/trace_kernel.h"
+#include "trace/trace_wide.h"
 
 #define LINE 64
+#define HUGE_PAGE ((size_t)2 << 20)
+
+void *trace_alloc(size_t bytes)
+{
+	size_t align = bytes >= HUGE_PAGE ? HUGE_PAGE : LINE;
+	void *mem = NULL;
+	if (posix_memalign(&mem, align, bytes ? bytes : 1) != 0)
+		return NULL;
+#ifdef MADV_HUGEPAGE
+	if (align == HUGE_PAGE)
+		madvise(mem, bytes, MADV_HUGEPAGE); /* advice: failing changes nothing */
+#endif
+	return mem;
+}
 
 /*
  * Builders write the children of a node side by side, nodes[first] and
@@ -36,8 +52,8 @@ static size_t pair_offset(const bvhlab_tree *tree)
 static int copy_nodes(const bvhlab_tree *tree, struct trace_view *v)
 {
 	size_t off = pair_offset(tree), bytes = (size_t)tree->node_count * sizeof(bvhlab_node);
-	void *mem = NULL;
-	if (posix_memalign(&mem, LINE, bytes + off + LINE) != 0)
+	void *mem = trace_alloc(bytes + off + LINE);
+	if (!mem)
 		return -ENOMEM;
 	bvhlab_node *nodes = (bvhlab_node *)(void *)((char *)mem + off);
 	memcpy(nodes, tree->nodes, bytes);
@@ -49,7 +65,7 @@ static int copy_nodes(const bvhlab_tree *tree, struct trace_view *v)
 static int copy_tris(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v)
 {
 	size_t n = tree->index_count;
-	float *t = malloc((n ? n : 1) * 9 * sizeof(*t));
+	float *t = trace_alloc((n ? n : 1) * 9 * sizeof(*t));
 	if (!t)
 		return -ENOMEM;
 	for (size_t i = 0; i < n; i++) {
@@ -78,10 +94,27 @@ int trace_view_copy(const bvhlab_tree *tree, const bvhlab_scene *scene, struct t
 	return r;
 }
 
+int trace_view_wide(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v)
+{
+	struct wide_bvh *w = malloc(sizeof(*w));
+	int r = w ? wide_bvh_init(w, tree, scene) : -ENOMEM;
+	if (r < 0) {
+		free(w);
+		return r;
+	}
+	v->wide = v->owned_wide = w;
+	return 0;
+}
+
 void trace_view_free(struct trace_view *v)
 {
 	free(v->owned);
 	free(v->owned_tris);
+	if (v->owned_wide)
+		wide_bvh_finish(v->owned_wide);
+	free(v->owned_wide);
 	v->owned = NULL;
 	v->owned_tris = NULL;
+	v->owned_wide = NULL;
+	v->wide = NULL;
 }

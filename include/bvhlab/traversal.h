@@ -29,9 +29,12 @@ BVHLAB_BEGIN_DECLS
 enum bvhlab_traversal {
 	BVHLAB_TRAVERSAL_STACK = 0,     /* bvhlab_trace_closest: near child first, stack of far ones */
 	BVHLAB_TRAVERSAL_STACKLESS = 1, /* bvhlab_trace_stackless: parent links, no stack */
+	BVHLAB_TRAVERSAL_WIDE = 2,      /* the tree collapsed into 4-child nodes, four box
+	                                 * tests at once, nearest child first (batches only) */
+	BVHLAB_TRAVERSAL_COUNT = 3      /* how many there are */
 };
 
-/* "stack" / "stackless"; NULL for another value. */
+/* "stack" / "stackless" / "wide"; NULL for another value. */
 const char *bvhlab_traversal_name(int traversal);
 
 /*
@@ -106,8 +109,11 @@ typedef struct bvhlab_trace_timing {
  * own, on both clocks, and the figures are over passes. Threads take tiles of rays
  * from a shared counter; per ray nothing is allocated or locked. hits and
  * nodes (may be NULL) get each ray's hit and count of nodes entered, from
- * the first pass. 0, -EINVAL (bad traversal, tree links for stackless),
- * -ENOMEM; then nothing was measured.
+ * the first pass. For BVHLAB_TRAVERSAL_WIDE the counters and nodes still
+ * count the binary tree's nodes, from an extra untimed pass of the stack
+ * traversal, so they mean the same whatever traversal is timed; hits come
+ * from the first wide pass. 0, -EINVAL (bad traversal, tree links for
+ * stackless or wide), -ENOMEM; then nothing was measured.
  */
 int bvhlab_trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene,
                          const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,

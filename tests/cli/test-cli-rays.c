@@ -13,7 +13,7 @@
 static const char config[] =
 	"{ \"format_version\": 1, \"output\": \"out-rays\", \"repeat\": 1, \"threads\": [1, 2],\n"
 	"  \"images\": true, \"rays\": { \"width\": 40, \"height\": 30, \"diffuse\": 2,\n"
-	"    \"min_ms\": 1, \"traversal\": \"both\" },\n"
+	"    \"min_ms\": 1, \"traversal\": [\"wide\", \"stack\", \"stackless\"] },\n"
 	"  \"scenes\": [ { \"name\": \"ico<1>\", \"generator\": \"icosphere\", \"frequency\": 10 },\n"
 	"              { \"name\": \"terrain\", \"generator\": \"terrain\", \"size\": 16 } ],\n"
 	"  \"builders\": [ { \"plugin\": \"sah_seq\", \"name\": \"sweep\" },\n"
@@ -81,8 +81,8 @@ static void check_html(const char *dir)
 	free(html);
 }
 
-/* Every run: both traversals with the same hits, repeated passes, EPO and
- * peak memory; the summary at the top of both reports. */
+/* Every run: the three traversals with the same hits, the same node counts
+ * for wide (main) and stack, repeated passes, EPO and peak memory. */
 static void check_measures(const cJSON *doc)
 {
 	const cJSON *run;
@@ -90,6 +90,10 @@ static void check_measures(const cJSON *doc)
 		const cJSON *rays = cJSON_GetObjectItem(run, "rays");
 		const cJSON *sl = cJSON_GetObjectItem(cJSON_GetObjectItem(rays, "stackless"), "primary");
 		const cJSON *st = cJSON_GetObjectItem(rays, "primary");
+		const cJSON *sk = cJSON_GetObjectItem(cJSON_GetObjectItem(rays, "stack"), "primary");
+		CHECK(!strcmp(cJSON_GetObjectItem(rays, "traversal")->valuestring, "wide"));
+		CHECK(sk && cJSON_GetObjectItem(sk, "nodes_per_ray")->valuedouble ==
+		                    cJSON_GetObjectItem(st, "nodes_per_ray")->valuedouble);
 		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(rays, "traversal_disagreements")) &&
 		      cJSON_GetObjectItem(rays, "traversal_disagreements")->valuedouble == 0);
 		CHECK(sl && cJSON_GetObjectItem(sl, "rays")->valueint == 40 * 30);
@@ -144,6 +148,7 @@ static void test_run(void)
 	char *html = read_file(regen, "report.html");
 	CHECK_CONTAINS(html, "<h2 id=\"summary\">Summary</h2>");
 	CHECK_CONTAINS(html, "stackless primary Mrays/s");
+	CHECK_CONTAINS(html, "stack primary Mrays/s");
 	free(html);
 	CHECK_INT(run(ARGS("report", "/nonexistent/results.json")), 2);
 }

@@ -1,0 +1,66 @@
+/*
+ * The wide traversal's copy of a tree: the binary tree collapsed into
+ * nodes of up to four children whose boxes sit side by side, one float
+ * lane each, so one node visit tests four boxes with 4-wide vector
+ * arithmetic and a ray descends about half as many levels as in the binary
+ * tree (each level one dependent memory read: the traversal of a large
+ * scene waits on memory, not on arithmetic). The boxes and triangles are
+ * the binary tree's own, so the hits are the same.
+ */
+#ifndef BVHLAB_CORE_TRACE_WIDE_H
+#define BVHLAB_CORE_TRACE_WIDE_H
+
+#include <stdint.h>
+
+#include <bvhlab/scene.h>
+#include <bvhlab/tree.h>
+
+#define WIDE 4      /* children per wide node */
+#define TRI_LANES 4 /* triangles per group */
+
+/*
+ * 128 bytes, two cache lines. box[k] for k < 3 is the low bound on axis k,
+ * box[3 + k] the high bound, for all four lanes. A lane with count 0 is an
+ * inner child (child: its wide node), 0 < count < WIDE_EMPTY a leaf
+ * (child: its first group of wide_bvh.tris, count its triangles), and
+ * count WIDE_EMPTY an empty lane: its box is inverted, +inf to -inf, and
+ * the traversal masks it out besides, since a ray with a NaN origin enters
+ * every box.
+ */
+#define WIDE_EMPTY UINT32_MAX
+
+struct wide_node {
+	float box[6][WIDE];
+	uint32_t child[WIDE];
+	uint32_t count[WIDE];
+};
+
+/*
+ * Up to four triangles of a leaf, one lane each, so the sign test of the
+ * triangle test runs on all four at once: v[3 * j + k] is coordinate k of
+ * vertex j. prim holds the primitive ids of the lanes. A leaf's triangles
+ * take consecutive groups in slot order; lanes past the leaf's count and
+ * ids outside the scene have NaN vertices, which no ray hits.
+ */
+struct wide_tris {
+	float v[9][TRI_LANES];
+	uint32_t prim[TRI_LANES];
+};
+
+struct wide_bvh {
+	struct wide_node *nodes; /* [0] is the root */
+	struct wide_tris *tris;
+	uint32_t node_count, tri_groups;
+	uint32_t depth; /* wide levels on the longest root-to-leaf path */
+};
+
+/*
+ * Collapses tree into *w: each wide node takes a binary inner node's two
+ * children and keeps opening the inner child of largest surface area until
+ * it has four. 0; -EINVAL for links that leave the node array or reach a
+ * node twice (validate first); -ENOMEM.
+ */
+int wide_bvh_init(struct wide_bvh *w, const bvhlab_tree *tree, const bvhlab_scene *scene);
+void wide_bvh_finish(struct wide_bvh *w);
+
+#endif
