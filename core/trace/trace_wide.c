@@ -3,12 +3,13 @@
  * (trace_wide_build.c), four slab tests per node in one vector pass, the
  * children entered nearest first and the others kept on a stack with their
  * entry distances. Each slab test performs box_enter()'s float operations
- * lane by lane, and leaves are tested with the same triangle test on the
- * same vertex copy, so the hits are those of the stack traversal; only the
- * order of the visits differs, which take_hit() makes irrelevant.
+ * lane by lane, and a leaf's triangles go through isect()'s shear and sign
+ * test four at a time, then isect() itself for the lanes that pass, so the
+ * hits are those of the stack traversal; only the order of the visits
+ * differs, which take_hit() makes irrelevant.
  *
  * GCC's vector extensions rather than intrinsics: the same source gives
- * SSE on x86-64 and NEON on arm64.
+ * SSE on x86-64 and NEON on arm64 (x86 gets three SSE builtins besides).
  */
 #include "trace/trace_kernel.h"
 #include "trace/trace_wide.h"
@@ -291,7 +292,9 @@ void trace_ray_wide(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	hit->t = ray->tmax;
 	hit->u = hit->v = 0.0f;
 	hit->prim = BVHLAB_NO_HIT;
-	if (prep_box(ray, &p)) {
+	/* The root's box first, as the stack traversal does: a ray that misses
+	 * the scene then costs one scalar box test, not a wide node. */
+	if (prep_box(ray, &p) && box_enter(&p, &view->nodes[0], hit->t) != INFINITY) {
 		wide_ray_init(&r, &p);
 		wide_walk(&w, &r);
 	}

@@ -3,9 +3,9 @@
  * nodes of up to four children whose boxes sit side by side, one float
  * lane each, so one node visit tests four boxes with 4-wide vector
  * arithmetic and a ray descends about half as many levels as in the binary
- * tree (each level one dependent memory read: the traversal of a large
- * scene waits on memory, not on arithmetic). The boxes and triangles are
- * the binary tree's own, so the hits are the same.
+ * tree. Subtrees of at most 8 triangles become one leaf whose triangles are
+ * tested four at a time, as Embree's leaves of Triangle4 blocks are. The
+ * boxes and triangles are the binary tree's own, so the hits are the same.
  */
 #ifndef BVHLAB_CORE_TRACE_WIDE_H
 #define BVHLAB_CORE_TRACE_WIDE_H

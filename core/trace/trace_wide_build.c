@@ -15,6 +15,11 @@
 #include "trace/trace_wide.h"
 
 #define LINE 64
+/* Subtrees of at most this many triangles become one leaf lane (two
+ * groups): on igea subdivided once, 4 gave 0.65 of Embree's speed, 8 gave
+ * 0.74; 16 and 32 gave more (0.79, 0.83) but flatten so much of the
+ * builder's tree that its lower levels would no longer count. */
+#define SMALL (2 * TRI_LANES)
 
 /* A binary node waiting to become the wide node `wide`, at wide level `level`. */
 struct pending {
@@ -93,26 +98,26 @@ static int leaf_lane(struct collapse *c, struct wide_node *w, uint32_t i, const 
 
 /*
  * The slots of the triangles under inner node `node` when there are at
- * most TRI_LANES of them: such a subtree becomes one leaf lane, one group whose
- * four triangle tests cost about what its boxes would. 0 when there are
- * more (or links a tree cannot have).
+ * most SMALL of them: such a subtree becomes one leaf lane, whose groups'
+ * vector triangle tests cost less than walking its nodes. 0 when there
+ * are more (or links a tree cannot have).
  */
-static uint32_t small_subtree(const struct collapse *c, uint32_t node, uint32_t slots[TRI_LANES])
+static uint32_t small_subtree(const struct collapse *c, uint32_t node, uint32_t slots[SMALL])
 {
 	const bvhlab_tree *t = c->tree;
-	uint32_t stack[2 * TRI_LANES], sp = 0, n = 0, visits = 0;
+	uint32_t stack[2 * SMALL], sp = 0, n = 0, visits = 0;
 	stack[sp++] = node;
 	while (sp > 0) {
 		const bvhlab_node *b = &t->nodes[stack[--sp]];
-		if (++visits > 2 * TRI_LANES)
+		if (++visits > 2 * SMALL)
 			return 0;
 		if (b->count) {
-			if (b->count > TRI_LANES - n || b->first > t->index_count - b->count)
+			if (b->count > SMALL - n || b->first > t->index_count - b->count)
 				return 0;
 			for (uint32_t i = 0; i < b->count; i++)
 				slots[n++] = b->first + i;
 		} else {
-			if (b->first == 0 || b->first >= t->node_count - 1 || sp + 2 > 2 * TRI_LANES)
+			if (b->first == 0 || b->first >= t->node_count - 1 || sp + 2 > 2 * SMALL)
 				return 0;
 			stack[sp++] = b->first;
 			stack[sp++] = b->first + 1;
@@ -123,7 +128,7 @@ static uint32_t small_subtree(const struct collapse *c, uint32_t node, uint32_t 
 
 static bool opens(const struct collapse *c, uint32_t node)
 {
-	uint32_t slots[TRI_LANES];
+	uint32_t slots[SMALL];
 	return c->tree->nodes[node].count == 0 && small_subtree(c, node, slots) == 0;
 }
 
@@ -182,7 +187,7 @@ static int fill(struct collapse *c, const struct pending *p)
 {
 	const bvhlab_node *nodes = c->tree->nodes;
 	struct wide_node *w = &c->w->nodes[p->wide];
-	uint32_t lane[WIDE], slots[TRI_LANES], n = 1, m;
+	uint32_t lane[WIDE], slots[SMALL], n = 1, m;
 	int r = 0;
 	lane[0] = p->node;
 	if (nodes[p->node].count == 0)
@@ -198,7 +203,8 @@ static int fill(struct collapse *c, const struct pending *p)
 		} else if ((m = small_subtree(c, lane[i], slots)) > 0) {
 			w->child[i] = c->w->tri_groups;
 			w->count[i] = m;
-			r = add_group(c, slots, m);
+			for (uint32_t k = 0; r == 0 && k < m; k += TRI_LANES)
+				r = add_group(c, slots + k, m - k < TRI_LANES ? m - k : TRI_LANES);
 		} else {
 			r = inner_lane(c, w, i, lane[i], p->level + 1);
 		}
