@@ -238,14 +238,9 @@ static inline struct trace_view trace_view_plain(const bvhlab_tree *tree)
 	return (struct trace_view){tree->nodes, NULL, NULL, NULL, NULL, NULL, NULL};
 }
 
-/*
- * Memory for a traversal's copies, released with free(): line-aligned, and
- * from 2 MiB up on huge pages where the kernel grants them (transparent huge
- * pages, "madvise" mode), as Embree's allocator does. A ray's walk touches
- * a new 4 KiB page at almost every step; with 4 KiB pages the TLB misses
- * and the physical placement of the pages, which differs from one process to
- * the next, made the same batch trace at different speeds in two runs.
- */
+/* Line-aligned memory for a traversal's copies, released with free().
+ * (Huge pages through madvise were tried: no faster on igea subdivided
+ * once.) */
 void *trace_alloc(size_t bytes);
 
 /* Node copy aligned for sibling pairs, plus the vertex copy. 0 or -ENOMEM. */

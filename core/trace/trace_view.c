@@ -9,25 +9,15 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 
 #include "trace/trace_kernel.h"
 #include "trace/trace_wide.h"
 
 #define LINE 64
-#define HUGE_PAGE ((size_t)2 << 20)
-
 void *trace_alloc(size_t bytes)
 {
-	size_t align = bytes >= HUGE_PAGE ? HUGE_PAGE : LINE;
 	void *mem = NULL;
-	if (posix_memalign(&mem, align, bytes ? bytes : 1) != 0)
-		return NULL;
-#ifdef MADV_HUGEPAGE
-	if (align == HUGE_PAGE)
-		madvise(mem, bytes, MADV_HUGEPAGE); /* advice: failing changes nothing */
-#endif
-	return mem;
+	return posix_memalign(&mem, LINE, bytes ? bytes : 1) == 0 ? mem : NULL;
 }
 
 /*
