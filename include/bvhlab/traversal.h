@@ -1,12 +1,13 @@
 /*
- * bvhlab — the core's two traversals and timed ray batches (issue 17).
+ * bvhlab — the core's other traversals and timed ray batches (issue 17).
  *
- * A second, stackless traversal beside the stack-based one of trace.h, and
- * a batch tracer that repeats a batch until enough time has passed, so a
- * throughput figure is a median of many passes rather than one short
- * interval. Kept apart from trace.h so it can move into it as one block.
+ * A stackless traversal beside the stack-based one of trace.h, a wide one
+ * for batches (the tree collapsed into 4-child nodes), and a batch tracer
+ * that repeats a batch until enough time has passed, so a throughput
+ * figure is a median of many passes rather than one short interval. Kept
+ * apart from trace.h so it can move into it as one block.
  *
- * Both traversals return the same closest hit for any ray on a valid tree:
+ * Every traversal returns the same closest hit for any ray on a valid tree:
  * the closest (t, prim) pair, ties in t broken by the smaller primitive id
  * (as bvhlab_trace_closest and bvhlab_trace_brute do), whatever order the
  * nodes are visited in.
