@@ -85,13 +85,57 @@ struct member {
 	pthread_t tid;
 };
 
+/*
+ * Copies a task's nodes from its scratch (slot 0 its root, then its nodes
+ * in allocation order) into the tree: the root into the slot the top
+ * phase gave it, the others into one range claimed at the end, child
+ * links moved with them. Pairs stay adjacent, and with one thread the
+ * slots are those the shared counter would have handed out.
+ */
+static void place_task(sah_builder *b, const sah_job *task, const bvhlab_node *scratch,
+                       uint32_t used)
+{
+	uint32_t base = atomic_fetch_add_explicit(&b->node_counter, used - 1,
+	                                          memory_order_relaxed) - 1;
+	for (uint32_t i = 0; i < used; i++) {
+		bvhlab_node n = scratch[i];
+		if (n.count == 0)
+			n.first += base;
+		b->nodes[i ? base + i : task->node] = n;
+	}
+}
+
+/*
+ * Each task builds into a scratch array of its own, with a counter of its
+ * own, and is copied into the tree when done: the shared counter is then
+ * touched once per task instead of once per split, and two threads never
+ * write nodes into the same cache line. With the shared counter, the
+ * atomic's cache line and the interleaved node writes bounced between the
+ * cores at every split (on igea subdivided once: 148 to 150 ms for the
+ * tasks at 2 threads, 137 to 140 without).
+ */
 static void run_tasks(struct team *tm)
 {
-	uint32_t i;
+	sah_builder local;
+	uint32_t i, cap = tm->task_count ? 2 * sah_job_size(&tm->tasks[0]) : 0;
+	bvhlab_node *scratch = cap ? malloc(cap * sizeof(*scratch)) : NULL;
 
+	memcpy(&local, tm->b, sizeof(local));
+	local.nodes = scratch;
 	while ((i = atomic_fetch_add_explicit(&tm->next, 1, memory_order_relaxed)) <
-	       tm->task_count)
-		sah_build_subtree(tm->b, &tm->tasks[i]);
+	       tm->task_count) {
+		sah_job job = tm->tasks[i];
+		if (!scratch) { /* no memory for it: the shared counter still works */
+			sah_build_subtree(tm->b, &job);
+			continue;
+		}
+		job.node = 0;
+		atomic_init(&local.node_counter, 1);
+		sah_build_subtree(&local, &job);
+		place_task(tm->b, &tm->tasks[i], scratch,
+		           atomic_load_explicit(&local.node_counter, memory_order_relaxed));
+	}
+	free(scratch);
 }
 
 static void run_part(struct team *tm, uint32_t part)
