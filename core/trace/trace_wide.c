@@ -18,25 +18,19 @@
  * the stack traversal, so no ray allocates. */
 #define WIDE_STACK 256
 
-/* The 8-lane vectors pass between static functions only, so GCC's note
- * that their ABI differs with and without AVX concerns nothing here. */
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
-
 /* SSE's MAXPS/MINPS are exactly the selects below and MOVMSKPS gathers
  * lane signs; GCC does not find them from the generic code. */
-#if defined(__SSE__) && WIDE == 4 && TRI_LANES == 4 && defined(__GNUC__) && !defined(__clang__)
+#if defined(__SSE__) && WIDE == 4 && defined(__GNUC__) && !defined(__clang__)
 #define X86_LANES 1
 #else
 #define X86_LANES 0
 #endif
 
-/* Node lanes (WIDE) and triangle lanes (TRI_LANES). */
-typedef float vnf __attribute__((vector_size(4 * WIDE)));
-typedef int32_t vni __attribute__((vector_size(4 * WIDE)));
-typedef float v4f __attribute__((vector_size(4 * TRI_LANES)));
-typedef int32_t v4i __attribute__((vector_size(4 * TRI_LANES)));
+/* One lane per child box and per triangle of a group. (8 lanes were
+ * tried: no faster, see README.) */
+_Static_assert(WIDE == TRI_LANES, "node and triangle lanes share one vector type");
+typedef float vf __attribute__((vector_size(4 * WIDE)));
+typedef int32_t vi __attribute__((vector_size(4 * WIDE)));
 
 struct wide_entry {
 	uint32_t child, count; /* a lane: count 0 inner, else a leaf */
@@ -45,46 +39,40 @@ struct wide_entry {
 
 struct wide_ray {
 	ray_prep *p;
-	bool sheared; /* p's triangle constants and torg, sx, sy are set */
-	vnf org[3], inv[3];
-	v4f torg[3], sx, sy; /* for the triangle lanes; sx, sy: the shear of ray_prep */
+	bool sheared; /* p's triangle constants and sx, sy are set */
+	vf org[3], inv[3];
+	vf sx, sy; /* the shear of ray_prep, for the triangle lanes */
 	int near[3], far[3]; /* rows of wide_node.box */
 };
 
-static inline vnf splat(float x)
+static inline vf splat(float x)
 {
-	vnf v;
+	vf v;
 	for (int i = 0; i < WIDE; i++)
-		v[i] = x;
-	return v;
-}
-
-static inline v4f splat4(float x)
-{
-	v4f v;
-	for (int i = 0; i < TRI_LANES; i++)
 		v[i] = x;
 	return v;
 }
 
 /* a > b ? a : b and a < b ? a : b lane by lane, as box_enter() writes
  * them: a NaN in a leaves b. */
-static inline vnf pick_max(vnf a, vnf b)
+static inline vf pick_max(vf a, vf b)
 {
 #if X86_LANES
 	return __builtin_ia32_maxps(a, b); /* the same select, one instruction */
+#else
+	vi m = a > b;
+	return (vf)((m & (vi)a) | (~m & (vi)b));
 #endif
-	vni m = a > b;
-	return (vnf)((m & (vni)a) | (~m & (vni)b));
 }
 
-static inline vnf pick_min(vnf a, vnf b)
+static inline vf pick_min(vf a, vf b)
 {
 #if X86_LANES
 	return __builtin_ia32_minps(a, b);
+#else
+	vi m = a < b;
+	return (vf)((m & (vi)a) | (~m & (vi)b));
 #endif
-	vni m = a < b;
-	return (vnf)((m & (vni)a) | (~m & (vni)b));
 }
 
 static void wide_ray_init(struct wide_ray *r, ray_prep *p)
@@ -105,50 +93,38 @@ static void wide_ray_init(struct wide_ray *r, ray_prep *p)
 static void wide_ray_shear(struct wide_ray *r)
 {
 	prep_shear(r->p);
-	for (int k = 0; k < 3; k++)
-		r->torg[k] = splat4(r->p->org[k]);
-	r->sx = splat4(r->p->sx);
-	r->sy = splat4(r->p->sy);
+	r->sx = splat(r->p->sx);
+	r->sy = splat(r->p->sy);
 	r->sheared = true;
 }
 
-static inline unsigned node_bits(vni m)
+static inline unsigned lane_bits(vi m)
 {
 #if X86_LANES
-	return (unsigned)__builtin_ia32_movmskps((vnf)m);
-#endif
+	return (unsigned)__builtin_ia32_movmskps((vf)m);
+#else
 	unsigned bits = 0;
 	for (int i = 0; i < WIDE; i++)
 		bits |= (unsigned)(m[i] & 1) << i;
 	return bits;
-}
-
-static inline unsigned tri_bits(v4i m)
-{
-#if X86_LANES
-	return (unsigned)__builtin_ia32_movmskps((v4f)m);
 #endif
-	unsigned bits = 0;
-	for (int i = 0; i < TRI_LANES; i++)
-		bits |= (unsigned)(m[i] & 1) << i;
-	return bits;
 }
 
 /* Bit i set when the ray enters lane i's box before tmax; *t the entries. */
 static inline unsigned enter_lanes(const struct wide_ray *r, const struct wide_node *n,
-                                   float tmax, vnf *t)
+                                   float tmax, vf *t)
 {
-	vnf t0 = splat(r->p->tmin), t1 = splat(tmax);
+	vf t0 = splat(r->p->tmin), t1 = splat(tmax);
 	for (int k = 0; k < 3; k++) {
-		vnf tn = (*(const vnf *)n->box[r->near[k]] - r->org[k]) * r->inv[k];
-		vnf tf = (*(const vnf *)n->box[r->far[k]] - r->org[k]) * r->inv[k];
+		vf tn = (*(const vf *)n->box[r->near[k]] - r->org[k]) * r->inv[k];
+		vf tf = (*(const vf *)n->box[r->far[k]] - r->org[k]) * r->inv[k];
 		t0 = pick_max(tn, t0);
 		t1 = pick_min(tf, t1);
 	}
-	vni empty = (vni)splat(0.0f) - 1; /* WIDE_EMPTY in every lane */
-	vni in = (t0 <= t1 * splat(FAR_SCALE)) & (*(const vni *)n->count != empty);
+	vi empty = (vi)splat(0.0f) - 1; /* WIDE_EMPTY in every lane */
+	vi in = (t0 <= t1 * splat(FAR_SCALE)) & (*(const vi *)n->count != empty);
 	*t = t0;
-	return node_bits(in);
+	return lane_bits(in);
 }
 
 /*
@@ -160,19 +136,19 @@ static inline unsigned enter_lanes(const struct wide_ray *r, const struct wide_n
 static inline unsigned sign4(const struct wide_ray *r, const struct wide_tris *g)
 {
 	const ray_prep *p = r->p;
-	v4f x[3], y[3], zero = splat4(0.0f);
+	vf x[3], y[3], zero = splat(0.0f);
 	for (int j = 0; j < 3; j++) {
-		v4f z = *(const v4f *)g->v[3 * j + p->kz] - r->torg[p->kz];
-		x[j] = (*(const v4f *)g->v[3 * j + p->kx] - r->torg[p->kx]) - r->sx * z;
-		y[j] = (*(const v4f *)g->v[3 * j + p->ky] - r->torg[p->ky]) - r->sy * z;
+		vf z = *(const vf *)g->v[3 * j + p->kz] - r->org[p->kz];
+		x[j] = (*(const vf *)g->v[3 * j + p->kx] - r->org[p->kx]) - r->sx * z;
+		y[j] = (*(const vf *)g->v[3 * j + p->ky] - r->org[p->ky]) - r->sy * z;
 	}
-	v4f e0 = x[2] * y[1] - y[2] * x[1];
-	v4f e1 = x[0] * y[2] - y[0] * x[2];
-	v4f e2 = x[1] * y[0] - y[1] * x[0];
-	v4i on_edge = (e0 == zero) | (e1 == zero) | (e2 == zero);
-	v4i neg = (e0 < zero) | (e1 < zero) | (e2 < zero);
-	v4i pos = (e0 > zero) | (e1 > zero) | (e2 > zero);
-	return tri_bits(on_edge | ~(neg & pos));
+	vf e0 = x[2] * y[1] - y[2] * x[1];
+	vf e1 = x[0] * y[2] - y[0] * x[2];
+	vf e2 = x[1] * y[0] - y[1] * x[0];
+	vi on_edge = (e0 == zero) | (e1 == zero) | (e2 == zero);
+	vi neg = (e0 < zero) | (e1 < zero) | (e2 < zero);
+	vi pos = (e0 > zero) | (e1 > zero) | (e2 > zero);
+	return lane_bits(on_edge | ~(neg & pos));
 }
 
 /* isect() and take_hit() on lane i of a group. */
@@ -187,7 +163,7 @@ static bool isect_lane(const ray_prep *p, const struct wide_tris *g, uint32_t i,
 
 /* The entered lanes, nearest first, in e; how many. (A version without a
  * loop for one or two lanes measured slower.) */
-static uint32_t sort_lanes(const struct wide_node *n, unsigned mask, vnf t,
+static uint32_t sort_lanes(const struct wide_node *n, unsigned mask, vf t,
                            struct wide_entry e[WIDE])
 {
 	uint32_t m = 0;
@@ -252,7 +228,7 @@ static void wide_walk(struct wide_walk *w, struct wide_ray *r)
 		if (cur.count == 0) {
 			const struct wide_node *n = &nodes[cur.child];
 			struct wide_entry e[WIDE];
-			vnf t;
+			vf t;
 			w->nodes++;
 			unsigned mask = enter_lanes(r, n, w->hit->t, &t);
 			uint32_t m = sort_lanes(n, mask, t, e);
