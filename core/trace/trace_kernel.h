@@ -238,11 +238,6 @@ static inline struct trace_view trace_view_plain(const bvhlab_tree *tree)
 	return (struct trace_view){tree->nodes, NULL, NULL, NULL, NULL, NULL, NULL};
 }
 
-/* Line-aligned memory for a traversal's copies, released with free().
- * (Huge pages through madvise were tried: no faster on igea subdivided
- * once.) */
-void *trace_alloc(size_t bytes);
-
 /* Node copy aligned for sibling pairs, plus the vertex copy. 0 or -ENOMEM. */
 int trace_view_copy(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v);
 /* Adds the wide nodes to a view: 0, -EINVAL (links that do not make a

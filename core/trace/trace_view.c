@@ -14,11 +14,6 @@
 #include "trace/trace_wide.h"
 
 #define LINE 64
-void *trace_alloc(size_t bytes)
-{
-	void *mem = NULL;
-	return posix_memalign(&mem, LINE, bytes ? bytes : 1) == 0 ? mem : NULL;
-}
 
 /*
  * Builders write the children of a node side by side, nodes[first] and
@@ -42,8 +37,8 @@ static size_t pair_offset(const bvhlab_tree *tree)
 static int copy_nodes(const bvhlab_tree *tree, struct trace_view *v)
 {
 	size_t off = pair_offset(tree), bytes = (size_t)tree->node_count * sizeof(bvhlab_node);
-	void *mem = trace_alloc(bytes + off + LINE);
-	if (!mem)
+	void *mem = NULL;
+	if (posix_memalign(&mem, LINE, bytes + off + LINE) != 0)
 		return -ENOMEM;
 	bvhlab_node *nodes = (bvhlab_node *)(void *)((char *)mem + off);
 	memcpy(nodes, tree->nodes, bytes);
@@ -55,7 +50,7 @@ static int copy_nodes(const bvhlab_tree *tree, struct trace_view *v)
 static int copy_tris(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v)
 {
 	size_t n = tree->index_count;
-	float *t = trace_alloc((n ? n : 1) * 9 * sizeof(*t));
+	float *t = malloc((n ? n : 1) * 9 * sizeof(*t));
 	if (!t)
 		return -ENOMEM;
 	for (size_t i = 0; i < n; i++) {

@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "trace/trace_kernel.h"
 #include "trace/trace_wide.h"
 
 #define LINE 64
@@ -230,7 +229,10 @@ static void count_nodes(const bvhlab_tree *tree, uint32_t *inner, uint32_t *grou
 
 static void *aligned(size_t count, size_t size)
 {
-	return count <= SIZE_MAX / size ? trace_alloc(count * size) : NULL;
+	void *mem = NULL;
+	if (count > SIZE_MAX / size || posix_memalign(&mem, LINE, count * size) != 0)
+		return NULL;
+	return mem;
 }
 
 int wide_bvh_init(struct wide_bvh *w, const bvhlab_tree *tree, const bvhlab_scene *scene)
