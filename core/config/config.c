@@ -101,8 +101,9 @@ static int traversal_of(const char *name)
 static int bad_traversal(struct config *cfg, const cJSON *item, bvhlab_error *err)
 {
 	char got[48];
-	if (cJSON_IsString(item))
-		snprintf(got, sizeof(got), "\"%.40s\"", item->valuestring);
+	if (cJSON_IsString(item)) /* a long name shown cut, and said to be */
+		snprintf(got, sizeof(got), "\"%.36s%s\"", item->valuestring,
+		         strlen(item->valuestring) > 36 ? "..." : "");
 	return config_error(cfg, item, false, err,
 	                    "'rays.traversal' must be \"wide\", \"stack\", \"stackless\", "
 	                    "\"both\" (stack and stackless) or an array of those names, not %s",

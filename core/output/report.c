@@ -123,6 +123,8 @@ static const char *const csv_numbers[][2] = {
 	{"rays.primary.repeats", "%.0f"},
 	{"rays.diffuse.mrays_min", "%.4f"},
 	{"rays.diffuse.mrays_max", "%.4f"},
+	{"rays.wide.primary.mrays_per_s", "%.4f"},
+	{"rays.wide.diffuse.mrays_per_s", "%.4f"},
 	{"rays.stack.primary.mrays_per_s", "%.4f"},
 	{"rays.stack.diffuse.mrays_per_s", "%.4f"},
 	{"rays.stackless.primary.mrays_per_s", "%.4f"},
