@@ -138,9 +138,10 @@ static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *
 		cfg->ray_traversal = BVHLAB_TRAVERSAL_STACK;
 		return 0;
 	}
-	if (cJSON_IsString(t) && traversal_of(t->valuestring) >= 0) {
-		cfg->ray_traversal = traversal_of(t->valuestring);
-		cfg->ray_traversals = 1u << cfg->ray_traversal;
+	int k = cJSON_IsString(t) ? traversal_of(t->valuestring) : -1;
+	if (k >= 0) {
+		cfg->ray_traversal = k;
+		cfg->ray_traversals = 1u << k;
 		return 0;
 	}
 	if (!cJSON_IsArray(t) || cJSON_GetArraySize(t) == 0)

@@ -193,8 +193,6 @@ static inline void prefetch_entry(const struct trace_view *v, const struct wide_
 }
 
 struct wide_walk {
-	const bvhlab_tree *tree;
-	const bvhlab_scene *scene;
 	const struct trace_view *v;
 	bvhlab_hit *hit;
 	uint64_t nodes, tris;
@@ -262,7 +260,7 @@ void trace_ray_wide(const bvhlab_tree *tree, const bvhlab_scene *scene,
 		trace_ray_stack(tree, scene, view, ray, any, hit, stats);
 		return;
 	}
-	struct wide_walk w = {tree, scene, view, hit, 0, 0, any};
+	struct wide_walk w = {view, hit, 0, 0, any};
 	ray_prep p;
 	struct wide_ray r;
 	hit->t = ray->tmax;

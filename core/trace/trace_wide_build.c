@@ -11,6 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/aabb.h>
+
 #include "trace/trace_wide.h"
 
 #define LINE 64
@@ -35,11 +37,13 @@ struct collapse {
 	uint32_t todo_count, cap;
 };
 
-static float half_area(const bvhlab_node *n)
-{
-	float dx = n->hi[0] - n->lo[0], dy = n->hi[1] - n->lo[1], dz = n->hi[2] - n->lo[2];
-	return dx * dy + dy * dz + dz * dx;
-}
+/* A lane being gathered: a binary node, and when it is an inner node with
+ * at most SMALL triangles below it, their slots (it becomes a leaf lane). */
+struct lane {
+	uint32_t node;
+	uint32_t small; /* how many slots; 0: a leaf, or an inner node to open */
+	uint32_t slots[SMALL];
+};
 
 static void set_lane(struct wide_node *w, uint32_t i, const bvhlab_node *n)
 {
@@ -65,34 +69,27 @@ static void group_lane(struct collapse *c, struct wide_tris *g, uint32_t lane, u
 	}
 }
 
-/* One group from up to TRI_LANES slots. */
-static int add_group(struct collapse *c, const uint32_t *slots, uint32_t n)
+/*
+ * Wide lane i as a leaf of n triangles copied into groups: those of slots
+ * (a small subtree's), or with slots NULL those of slots first..first+n-1
+ * (a binary leaf, of any size).
+ */
+static int leaf_lane(struct collapse *c, struct wide_node *w, uint32_t i,
+                     const uint32_t *slots, uint32_t first, uint32_t n)
 {
-	if (c->w->tri_groups == c->group_cap)
-		return -EINVAL;
-	struct wide_tris *g = &c->w->tris[c->w->tri_groups++];
-	for (uint32_t lane = 0; lane < TRI_LANES; lane++)
-		group_lane(c, g, lane, lane < n ? slots[lane] : 0, lane < n);
-	return 0;
-}
-
-/* A binary leaf as a leaf lane: its triangles copied into groups, checked
- * against the index array so the traversal need not. */
-static int leaf_lane(struct collapse *c, struct wide_node *w, uint32_t i, const bvhlab_node *n)
-{
-	if (n->first > c->tree->index_count || n->count > c->tree->index_count - n->first ||
-	    n->count == WIDE_EMPTY)
+	uint64_t groups = ((uint64_t)n + TRI_LANES - 1) / TRI_LANES;
+	if (groups > c->group_cap - c->w->tri_groups)
 		return -EINVAL;
 	w->child[i] = c->w->tri_groups;
-	w->count[i] = n->count;
-	int r = 0;
-	for (uint32_t k = 0; r == 0 && k < n->count; k += TRI_LANES) {
-		uint32_t slots[TRI_LANES], m = n->count - k < TRI_LANES ? n->count - k : TRI_LANES;
-		for (uint32_t j = 0; j < m; j++)
-			slots[j] = n->first + k + j;
-		r = add_group(c, slots, m);
+	w->count[i] = n;
+	for (uint32_t k = 0; k < n; k += TRI_LANES) {
+		struct wide_tris *g = &c->w->tris[c->w->tri_groups++];
+		for (uint32_t lane = 0; lane < TRI_LANES; lane++) {
+			uint32_t at = k + lane;
+			group_lane(c, g, lane, slots ? (at < n ? slots[at] : 0) : first + at, at < n);
+		}
 	}
-	return r;
+	return 0;
 }
 
 /*
@@ -125,14 +122,15 @@ static uint32_t small_subtree(const struct collapse *c, uint32_t node, uint32_t 
 	return n;
 }
 
-static bool opens(const struct collapse *c, uint32_t node)
+/* Lane l for binary node `node`, its small subtree found once here. */
+static void take_lane(const struct collapse *c, struct lane *l, uint32_t node)
 {
-	uint32_t slots[SMALL];
-	return c->tree->nodes[node].count == 0 && small_subtree(c, node, slots) == 0;
+	l->node = node;
+	l->small = c->tree->nodes[node].count ? 0 : small_subtree(c, node, l->slots);
 }
 
 /* Takes both children of inner node `node` as lanes at lane[at] and lane[n]. */
-static int open_node(struct collapse *c, uint32_t node, uint32_t *lane, uint32_t at,
+static int open_node(struct collapse *c, uint32_t node, struct lane *lane, uint32_t at,
                      uint32_t n)
 {
 	const bvhlab_tree *t = c->tree;
@@ -140,13 +138,15 @@ static int open_node(struct collapse *c, uint32_t node, uint32_t *lane, uint32_t
 	if (first == 0 || first >= t->node_count - 1 || c->seen[first] || c->seen[first + 1])
 		return -EINVAL;
 	c->seen[first] = c->seen[first + 1] = 1;
-	lane[at] = first;
-	lane[n] = first + 1;
+	take_lane(c, &lane[at], first);
+	take_lane(c, &lane[n], first + 1);
 	return 0;
 }
 
-/* The binary nodes under `node` that become one wide node's lanes. */
-static int gather(struct collapse *c, uint32_t node, uint32_t lane[WIDE], uint32_t *lanes)
+/* The binary nodes under `node` that become one wide node's lanes: the
+ * inner lane of largest area that is not a small subtree is opened until
+ * there are WIDE. */
+static int gather(struct collapse *c, uint32_t node, struct lane lane[WIDE], uint32_t *lanes)
 {
 	const bvhlab_node *nodes = c->tree->nodes;
 	uint32_t n = 2;
@@ -155,15 +155,16 @@ static int gather(struct collapse *c, uint32_t node, uint32_t lane[WIDE], uint32
 		int best = -1;
 		float best_area = -1.0f;
 		for (uint32_t i = 0; i < n; i++) {
-			float a = half_area(&nodes[lane[i]]);
-			if (!(a <= best_area) && opens(c, lane[i])) {
+			const bvhlab_node *b = &nodes[lane[i].node];
+			float a = bvhlab_half_area(b->lo, b->hi);
+			if (!(a <= best_area) && b->count == 0 && lane[i].small == 0) {
 				best = (int)i;
 				best_area = a;
 			}
 		}
 		if (best < 0)
 			break;
-		r = open_node(c, lane[best], lane, (uint32_t)best, n++);
+		r = open_node(c, lane[best].node, lane, (uint32_t)best, n++);
 	}
 	*lanes = n;
 	return r;
@@ -182,30 +183,40 @@ static int inner_lane(struct collapse *c, struct wide_node *w, uint32_t i, uint3
 	return 0;
 }
 
+/* A binary leaf as a leaf lane, checked against the index array so the
+ * traversal need not. */
+static int binary_leaf(struct collapse *c, struct wide_node *w, uint32_t i,
+                       const bvhlab_node *b)
+{
+	if (b->first > c->tree->index_count || b->count > c->tree->index_count - b->first ||
+	    b->count == WIDE_EMPTY)
+		return -EINVAL;
+	return leaf_lane(c, w, i, NULL, b->first, b->count);
+}
+
 static int fill(struct collapse *c, const struct pending *p)
 {
 	const bvhlab_node *nodes = c->tree->nodes;
 	struct wide_node *w = &c->w->nodes[p->wide];
-	uint32_t lane[WIDE], slots[SMALL], n = 1, m;
+	struct lane lane[WIDE];
+	uint32_t n = 1;
 	int r = 0;
-	lane[0] = p->node;
 	if (nodes[p->node].count == 0)
 		r = gather(c, p->node, lane, &n);
+	else
+		lane[0] = (struct lane){.node = p->node}; /* a leaf root */
 	for (uint32_t i = 0; r == 0 && i < WIDE; i++) {
-		const bvhlab_node *b = i < n ? &nodes[lane[i]] : NULL;
+		const bvhlab_node *b = i < n ? &nodes[lane[i].node] : NULL;
 		set_lane(w, i, b);
 		if (!b) {
 			w->child[i] = 0;
 			w->count[i] = WIDE_EMPTY;
 		} else if (b->count) {
-			r = leaf_lane(c, w, i, b);
-		} else if ((m = small_subtree(c, lane[i], slots)) > 0) {
-			w->child[i] = c->w->tri_groups;
-			w->count[i] = m;
-			for (uint32_t k = 0; r == 0 && k < m; k += TRI_LANES)
-				r = add_group(c, slots + k, m - k < TRI_LANES ? m - k : TRI_LANES);
+			r = binary_leaf(c, w, i, b);
+		} else if (lane[i].small) {
+			r = leaf_lane(c, w, i, lane[i].slots, 0, lane[i].small);
 		} else {
-			r = inner_lane(c, w, i, lane[i], p->level + 1);
+			r = inner_lane(c, w, i, lane[i].node, p->level + 1);
 		}
 	}
 	if (c->w->depth < p->level)
