@@ -31,6 +31,7 @@
 #include "sah_kernel.h"
 #include "sah_threads.h"
 #include "tasks_split.h"
+#include "team.h"
 
 /* SAH_OPTION_DECLS in the same order, but binned by default: the team
  * split exists for binned only. */
@@ -66,8 +67,9 @@ _Static_assert(128 > 64, "parallel_min's minimum exceeds max_leaf's maximum");
 
 enum command { CMD_BIN, CMD_SCATTER, CMD_TASKS, CMD_EXIT };
 
-struct team {
-	pthread_barrier_t bar;
+/* The threads of one build (the name "team" is team.h's barrier). */
+struct crew {
+	team bar;             /* polls, then sleeps: see team.h */
 	pthread_mutex_t gate; /* held while threads start: size is not final yet */
 	uint32_t size;
 	bool failed;          /* under gate: no barrier, members leave at once */
@@ -80,7 +82,7 @@ struct team {
 };
 
 struct member {
-	struct team *team;
+	struct crew *crew;
 	uint32_t index;
 	pthread_t tid;
 };
@@ -114,7 +116,7 @@ static void place_task(sah_builder *b, const sah_job *task, const bvhlab_node *s
  * bounced between the cores at every split (on igea subdivided once: 148 to 150 ms for the
  * tasks at 2 threads, 137 to 140 without).
  */
-static void run_tasks(struct team *tm)
+static void run_tasks(struct crew *tm)
 {
 	sah_builder local;
 	uint32_t i, cap = tm->task_count ? 2 * sah_job_size(&tm->tasks[0]) : 0;
@@ -138,7 +140,7 @@ static void run_tasks(struct team *tm)
 	free(scratch);
 }
 
-static void run_part(struct team *tm, uint32_t part)
+static void run_part(struct crew *tm, uint32_t part)
 {
 	switch (tm->cmd) {
 	case CMD_BIN: tasks_bin(&tm->split, part); break;
@@ -151,7 +153,7 @@ static void run_part(struct team *tm, uint32_t part)
 static void *member_main(void *arg)
 {
 	struct member *m = arg;
-	struct team *tm = m->team;
+	struct crew *tm = m->crew;
 
 	pthread_mutex_lock(&tm->gate);
 	bool failed = tm->failed;
@@ -159,27 +161,27 @@ static void *member_main(void *arg)
 	if (failed)
 		return NULL;
 	for (;;) {
-		pthread_barrier_wait(&tm->bar);
+		team_sync(&tm->bar);
 		if (tm->cmd == CMD_EXIT)
 			return NULL;
 		run_part(tm, m->index);
-		pthread_barrier_wait(&tm->bar);
+		team_sync(&tm->bar);
 	}
 }
 
 /* One step by every member; the barriers publish the caller's settings
  * before it and every member's results after it. */
-static void team_run(struct team *tm, int cmd)
+static void crew_run(struct crew *tm, int cmd)
 {
 	tm->cmd = cmd;
 	if (tm->size > 1)
-		pthread_barrier_wait(&tm->bar);
+		team_sync(&tm->bar);
 	run_part(tm, 0);
 	if (tm->size > 1)
-		pthread_barrier_wait(&tm->bar);
+		team_sync(&tm->bar);
 }
 
-static int add_task(struct team *tm, const sah_job *job)
+static int add_task(struct crew *tm, const sah_job *job)
 {
 	if (tm->task_count == tm->task_cap) {
 		uint32_t cap = tm->task_cap ? 2 * tm->task_cap : 64;
@@ -194,16 +196,16 @@ static int add_task(struct team *tm, const sah_job *job)
 }
 
 /* Splits one large node: by the team for binned, else by the kernel. */
-static unsigned split_large(struct team *tm, const sah_job *job, sah_job child[2])
+static unsigned split_large(struct crew *tm, const sah_job *job, sah_job child[2])
 {
 	if (tm->b->opt.method != SAH_BINNED)
 		return sah_split_job(tm->b, job, child);
 	tasks_split_begin(&tm->split, job);
-	team_run(tm, CMD_BIN);
+	crew_run(tm, CMD_BIN);
 	/* No candidate: every centroid coincides; the kernel's median. */
 	if (!tasks_choose(&tm->split))
 		return sah_split_job(tm->b, job, child);
-	team_run(tm, CMD_SCATTER);
+	crew_run(tm, CMD_SCATTER);
 	tasks_split_end(&tm->split, child);
 	return 2;
 }
@@ -213,7 +215,7 @@ static unsigned split_large(struct team *tm, const sah_job *job, sah_job child[2
  * commands). Larger child pushed first, smaller processed first: the stack
  * stays within log2(N) + 1 entries.
  */
-static int split_top(struct team *tm, uint32_t parallel_min, const sah_job *root)
+static int split_top(struct crew *tm, uint32_t parallel_min, const sah_job *root)
 {
 	sah_job stack[64], child[2];
 	unsigned sp = 0;
@@ -249,20 +251,20 @@ static int by_size_desc(const void *pa, const void *pb)
 /* Starts up to threads - 1 members; the team is as large as what started
  * (every step is correct for any size). The number started, or a negative
  * errno with every started member joined. */
-static int team_start(struct team *tm, struct member *m, uint32_t threads)
+static int crew_start(struct crew *tm, struct member *m, uint32_t threads, uint32_t cpus)
 {
 	uint32_t started = 0;
 	int rc;
 
 	pthread_mutex_lock(&tm->gate);
 	for (uint32_t i = 1; i < threads; i++) {
-		m[started].team = tm;
+		m[started].crew = tm;
 		m[started].index = started + 1;
 		started += sah_thread_start(&m[started].tid, member_main, &m[started]) == 0;
 	}
 	tm->size = started + 1;
 	tm->split.parts = tm->size;
-	rc = -pthread_barrier_init(&tm->bar, NULL, tm->size);
+	rc = team_barrier_init(&tm->bar, tm->size, cpus);
 	tm->failed = rc < 0;
 	pthread_mutex_unlock(&tm->gate);
 	if (rc == 0)
@@ -272,18 +274,18 @@ static int team_start(struct team *tm, struct member *m, uint32_t threads)
 	return rc;
 }
 
-static void team_stop(struct team *tm, struct member *m, uint32_t started)
+static void crew_stop(struct crew *tm, struct member *m, uint32_t started)
 {
 	/* Members leave after the first barrier: no second one to meet. */
 	tm->cmd = CMD_EXIT;
 	if (tm->size > 1)
-		pthread_barrier_wait(&tm->bar);
+		team_sync(&tm->bar);
 	for (uint32_t i = 0; i < started; i++)
 		pthread_join(m[i].tid, NULL);
-	pthread_barrier_destroy(&tm->bar);
+	team_barrier_finish(&tm->bar);
 }
 
-static int team_init(struct team *tm, sah_builder *b, uint32_t threads)
+static int crew_init(struct crew *tm, sah_builder *b, uint32_t threads)
 {
 	int rc;
 
@@ -299,7 +301,7 @@ static int team_init(struct team *tm, sah_builder *b, uint32_t threads)
 	return rc;
 }
 
-static void team_destroy(struct team *tm)
+static void crew_destroy(struct crew *tm)
 {
 	tasks_split_free(&tm->split);
 	pthread_mutex_destroy(&tm->gate);
@@ -307,14 +309,14 @@ static void team_destroy(struct team *tm)
 }
 
 /* Top splits, then the tasks, largest first. */
-static int run_build(struct team *tm, uint32_t parallel_min, const sah_job *root)
+static int run_build(struct crew *tm, uint32_t parallel_min, const sah_job *root)
 {
 	int rc = split_top(tm, parallel_min, root);
 
 	if (rc < 0)
 		return rc;
 	qsort(tm->tasks, tm->task_count, sizeof(*tm->tasks), by_size_desc);
-	team_run(tm, CMD_TASKS);
+	crew_run(tm, CMD_TASKS);
 	return 0;
 }
 
@@ -325,17 +327,17 @@ static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder 
 	uint32_t threads = sah_useful_threads(asked, root);
 	const uint32_t *parallel_min = arg;
 	struct member *m = calloc(threads, sizeof(*m));
-	struct team tm;
-	int rc = m ? team_init(&tm, b, threads) : -ENOMEM;
+	struct crew tm;
+	int rc = m ? crew_init(&tm, b, threads) : -ENOMEM;
 	int started;
 
 	if (rc < 0)
 		goto out;
-	started = team_start(&tm, m, threads);
+	started = crew_start(&tm, m, threads, host->hardware_threads(ctx));
 	rc = started < 0 ? started : run_build(&tm, *parallel_min, root);
 	if (started >= 0)
-		team_stop(&tm, m, (uint32_t)started);
-	team_destroy(&tm);
+		crew_stop(&tm, m, (uint32_t)started);
+	crew_destroy(&tm);
 out:
 	if (rc < 0)
 		host->set_error(ctx, "sah_tasks: cannot set up the build (%d)", rc);

@@ -82,6 +82,35 @@ static void open_gate(struct gate *gate)
 	pthread_mutex_unlock(&gate->lock);
 }
 
+static void set_size(team *tm, unsigned threads, uint32_t cpus)
+{
+	tm->threads = threads;
+	/* Polling only pays while every thread has a CPU of its own. */
+	tm->spins = threads <= cpus ? BARRIER_SPINS : 0;
+}
+
+int team_barrier_init(team *tm, unsigned threads, uint32_t cpus)
+{
+	int rc;
+
+	atomic_init(&tm->arrived, 0);
+	atomic_init(&tm->round, 0);
+	set_size(tm, threads, cpus);
+	if ((rc = pthread_mutex_init(&tm->lock, NULL)) != 0)
+		return -rc;
+	if ((rc = pthread_cond_init(&tm->wake, NULL)) != 0) {
+		pthread_mutex_destroy(&tm->lock);
+		return -rc;
+	}
+	return 0;
+}
+
+void team_barrier_finish(team *tm)
+{
+	pthread_cond_destroy(&tm->wake);
+	pthread_mutex_destroy(&tm->lock);
+}
+
 /* Joining the members is what makes their writes visible to the caller. */
 int team_run(team *tm, unsigned want, uint32_t cpus, void (*fn)(void *arg, unsigned t),
              void *arg)
@@ -92,27 +121,19 @@ int team_run(team *tm, unsigned want, uint32_t cpus, void (*fn)(void *arg, unsig
 	int rc;
 
 	want = want > TEAM_MAX_THREADS ? TEAM_MAX_THREADS : want;
-	atomic_init(&tm->arrived, 0);
-	atomic_init(&tm->round, 0);
-	if ((rc = pthread_mutex_init(&tm->lock, NULL)) != 0)
-		return -rc;
-	if ((rc = pthread_cond_init(&tm->wake, NULL)) != 0) {
-		pthread_mutex_destroy(&tm->lock);
-		return -rc;
-	}
+	/* The size is set again below, once it is known. */
+	if ((rc = team_barrier_init(tm, want, cpus)) < 0)
+		return rc;
 	for (; size < want; size++) {
 		m[size] = (struct member){ .gate = &gate, .fn = fn, .arg = arg, .t = size };
 		if (pthread_create(&m[size].tid, NULL, member_main, &m[size]) != 0)
 			break;
 	}
-	tm->threads = size;
-	/* Polling only pays while every thread has a CPU of its own. */
-	tm->spins = size <= cpus ? BARRIER_SPINS : 0;
+	set_size(tm, size, cpus);
 	open_gate(&gate);
 	fn(arg, 0);
 	for (unsigned t = 1; t < size; t++)
 		pthread_join(m[t].tid, NULL);
-	pthread_cond_destroy(&tm->wake);
-	pthread_mutex_destroy(&tm->lock);
+	team_barrier_finish(tm);
 	return 0;
 }

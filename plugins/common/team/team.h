@@ -28,6 +28,14 @@ typedef struct team {
 void team_sync(team *tm);
 
 /*
+ * Sets up the barrier alone, for a caller that starts and joins its own
+ * threads (sah_tasks): `threads` members meet at team_sync; they poll
+ * before sleeping only while threads <= cpus. 0 or a negative errno.
+ */
+int team_barrier_init(team *tm, unsigned threads, uint32_t cpus);
+void team_barrier_finish(team *tm);
+
+/*
  * Runs fn(arg, t) on up to `want` threads, t = 0 .. threads - 1, the
  * calling thread as 0, and returns when all have returned. A thread that
  * cannot be started only makes the team smaller, so fn must not depend
