@@ -4,7 +4,8 @@
  *
  * At every node the builder bins the references' centroids (object
  * split); when the two children of the best object split overlap by more
- * than alpha times the root's area, it also bins the node's box with each
+ * than alpha times the root's area and by at least `overlap` of the
+ * node's own area, it also bins the node's box with each
  * reference clipped exactly into the bins it crosses (spatial split), and
  * takes the cheaper. A spatial split cuts the references it crosses into
  * two, unless leaving one whole on one side is cheaper (reference
@@ -32,6 +33,10 @@ static const bvhlab_option_decl options[] = {
 	  .help = "try spatial splits where the object split's children overlap by more "
 	          "than alpha * root area (Stich's alpha; 1 turns them off)",
 	  .def_float = 1e-5, .min = 0.0, .max = 1.0 },
+	{ .name = "overlap", .type = BVHLAB_OPTION_FLOAT,
+	  .help = "and by at least this share of the node's own area (0 turns the test off: "
+	          "Stich's alpha alone)",
+	  .def_float = 0.1, .min = 0.0, .max = 1.0 },
 	{ .name = "bins", .type = BVHLAB_OPTION_INT,
 	  .help = "object and spatial bins per axis",
 	  .def_int = 32, .min = 2, .max = SBVH_MAX_BINS },
@@ -56,6 +61,7 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, sbvh_opt
 
 	if ((rc = host->option_float(ctx, "split_factor", &o->split_factor)) < 0 ||
 	    (rc = host->option_float(ctx, "alpha", &o->alpha)) < 0 ||
+	    (rc = host->option_float(ctx, "overlap", &o->overlap)) < 0 ||
 	    (rc = host->option_int(ctx, "bins", &bins)) < 0 ||
 	    (rc = host->option_int(ctx, "max_leaf", &max_leaf)) < 0 ||
 	    (rc = host->option_int(ctx, "parallel_min", &parallel_min)) < 0 ||

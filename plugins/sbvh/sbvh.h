@@ -46,6 +46,7 @@ typedef struct sbvh_ref {
 typedef struct sbvh_options {
 	double split_factor; /* reference budget, in triangles */
 	double alpha;        /* try spatial splits when children overlap > alpha * SA(root) */
+	double overlap;      /* ... and >= overlap * SA(node) */
 	uint32_t bins;       /* object and spatial bins per axis */
 	uint32_t max_leaf;
 	uint32_t parallel_min; /* jobs of at least this many references use every thread */
@@ -97,9 +98,11 @@ typedef struct sbvh_split {
 
 enum { SPLIT_LEAF = 0, SPLIT_OBJECT = 1, SPLIT_SPATIAL = 2, SPLIT_MEDIAN = 3 };
 
-/* Per-thread scratch for binning (bins of one chunk). */
+/* Per-thread scratch for binning (bins of one chunk). A bin's box takes
+ * four floats, of which the first three count, so that it is grown with
+ * one vector min and max (sah_simd.h); the fourth is never read. */
 typedef struct sbvh_bins {
-	float lo[3][SBVH_MAX_BINS][3], hi[3][SBVH_MAX_BINS][3];
+	float lo[3][SBVH_MAX_BINS][4], hi[3][SBVH_MAX_BINS][4];
 	uint32_t count[3][SBVH_MAX_BINS];  /* object: refs; spatial: entries */
 	uint32_t exits[3][SBVH_MAX_BINS];  /* spatial: refs ending in the bin */
 } sbvh_bins;
@@ -126,7 +129,7 @@ void sbvh_best_object(const sbvh_build *B, const sbvh_job *job, const sbvh_bins 
 void sbvh_best_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_bins *b,
                        sbvh_split *s);
 /* Whether the object split's children overlap enough to try spatial splits. */
-bool sbvh_try_spatial(const sbvh_build *B, const sbvh_split *s);
+bool sbvh_try_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_split *s);
 
 /*
  * Where reference i of the job goes under split s: bit 0 left, bit 1

@@ -26,7 +26,7 @@ bool sbvh_want_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_spli
 {
 	uint32_t n = job->end - job->begin;
 
-	return n > 1 && job->rend - job->rbegin > n && sbvh_try_spatial(B, obj);
+	return n > 1 && job->rend - job->rbegin > n && sbvh_try_spatial(B, job, obj);
 }
 
 void sbvh_choose_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_bins *bins,

@@ -13,6 +13,7 @@
 
 #include <bvhlab/aabb.h>
 
+#include "sah_simd.h"
 #include "sbvh.h"
 #include "tri_clip.h"
 
@@ -65,20 +66,28 @@ static float object_scale(const float clo[3], const float chi[3], int k, uint32_
 	return ext > 0.0f ? (float)bins * 0.99999f / ext : 0.0f;
 }
 
+/* One pass for the three axes: a reference is read once, and its box
+ * grows each axis's bin with one vector min and max (a reference's lo and
+ * hi are each followed by a 32-bit field, so four floats are readable). */
 void sbvh_bin_object(const sbvh_build *B, const sbvh_job *job, const float clo[3],
                      const float chi[3], uint32_t begin, uint32_t end, sbvh_bins *b)
 {
 	const sbvh_ref *refs = B->refs[job->buf];
 	uint32_t bins = B->opt.bins;
+	float scale[3];
 
 	sbvh_bins_clear(b, bins);
-	for (int k = 0; k < 3; k++) {
-		float scale = object_scale(clo, chi, k, bins);
+	for (int k = 0; k < 3; k++)
+		scale[k] = object_scale(clo, chi, k, bins);
+	for (uint32_t i = begin; i < end; i++) {
+		const sbvh_ref *r = &refs[i];
+		v4 lo = v4_load(r->lo), hi = v4_load(r->hi);
 
-		for (uint32_t i = begin; i < end; i++) {
-			uint32_t j = object_bin(&refs[i], k, clo[k], scale, bins);
+		for (int k = 0; k < 3; k++) {
+			uint32_t j = object_bin(r, k, clo[k], scale[k], bins);
 
-			bvhlab_box_grow(b->lo[k][j], b->hi[k][j], refs[i].lo, refs[i].hi);
+			v4_store(b->lo[k][j], v4_min(v4_load(b->lo[k][j]), lo));
+			v4_store(b->hi[k][j], v4_max(v4_load(b->hi[k][j]), hi));
 			b->count[k][j]++;
 		}
 	}
@@ -177,7 +186,8 @@ void sbvh_bin_spatial(const sbvh_build *B, const sbvh_job *job, uint32_t begin,
 			uint32_t b1 = spatial_bin(job, k, refs[i].hi[k], bins);
 
 			if (b0 == b1) {
-				bvhlab_box_grow(b->lo[k][b0], b->hi[k][b0], refs[i].lo, refs[i].hi);
+				v4_store(b->lo[k][b0], v4_min(v4_load(b->lo[k][b0]), v4_load(refs[i].lo)));
+				v4_store(b->hi[k][b0], v4_max(v4_load(b->hi[k][b0]), v4_load(refs[i].hi)));
 				b->count[k][b0]++;
 				b->exits[k][b0]++;
 			} else {
@@ -210,29 +220,34 @@ static uint32_t used_bins(const sbvh_bins *b, int k, uint32_t bins, const uint32
 static void sweep(const sbvh_bins *b, int k, uint32_t bins, const uint32_t *enter,
                   const uint32_t *leave, double inv_area, sbvh_split *best, int kind)
 {
-	float rlo[SBVH_MAX_BINS][3], rhi[SBVH_MAX_BINS][3], lo[3], hi[3];
+	float rlo[SBVH_MAX_BINS][4], rhi[SBVH_MAX_BINS][4], llo[4], lhi[4];
 	uint32_t rn[SBVH_MAX_BINS], used[SBVH_MAX_BINS], n = 0;
 	uint32_t m = used_bins(b, k, bins, enter, leave, used);
+	v4 lo = v4_set1(INFINITY), hi = v4_set1(-INFINITY);
 
 	/* rlo[u], rhi[u], rn[u]: the right side of the boundary before used[u]. */
-	bvhlab_box_empty(lo, hi);
 	for (uint32_t u = m; u-- > 1;) {
-		bvhlab_box_grow(lo, hi, b->lo[k][used[u]], b->hi[k][used[u]]);
+		lo = v4_min(lo, v4_load(b->lo[k][used[u]]));
+		hi = v4_max(hi, v4_load(b->hi[k][used[u]]));
 		n += leave[used[u]];
-		memcpy(rlo[u], lo, sizeof(lo));
-		memcpy(rhi[u], hi, sizeof(hi));
+		v4_store(rlo[u], lo);
+		v4_store(rhi[u], hi);
 		rn[u] = n;
 	}
-	bvhlab_box_empty(lo, hi);
+	lo = v4_set1(INFINITY);
+	hi = v4_set1(-INFINITY);
 	n = 0;
 	for (uint32_t u = 0; u + 1 < m; u++) {
 		uint32_t j = used[u];
-		bvhlab_box_grow(lo, hi, b->lo[k][j], b->hi[k][j]);
+		lo = v4_min(lo, v4_load(b->lo[k][j]));
+		hi = v4_max(hi, v4_load(b->hi[k][j]));
 		n += enter[j];
 		if (n == 0 || rn[u + 1] == 0)
 			continue;
-		double cost = 1.0 + (bvhlab_box_area(lo, hi) * n + bvhlab_box_area(rlo[u + 1], rhi[u + 1]) * rn[u + 1]) *
-		                        inv_area;
+		v4_store(llo, lo);
+		v4_store(lhi, hi);
+		double cost = 1.0 + (bvhlab_box_area(llo, lhi) * n +
+		                     bvhlab_box_area(rlo[u + 1], rhi[u + 1]) * rn[u + 1]) * inv_area;
 		if (cost < best->cost) {
 			best->cost = cost;
 			best->kind = kind;
@@ -240,10 +255,10 @@ static void sweep(const sbvh_bins *b, int k, uint32_t bins, const uint32_t *ente
 			best->bin = j;
 			best->nl = n;
 			best->nr = rn[u + 1];
-			memcpy(best->llo, lo, sizeof(lo));
-			memcpy(best->lhi, hi, sizeof(hi));
-			memcpy(best->rlo, rlo[u + 1], sizeof(lo));
-			memcpy(best->rhi, rhi[u + 1], sizeof(hi));
+			memcpy(best->llo, llo, sizeof(best->llo));
+			memcpy(best->lhi, lhi, sizeof(best->lhi));
+			memcpy(best->rlo, rlo[u + 1], sizeof(best->rlo));
+			memcpy(best->rhi, rhi[u + 1], sizeof(best->rhi));
 		}
 	}
 }
@@ -273,9 +288,17 @@ void sbvh_best_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_bins
 		s->pos = plane(job, s->axis, s->bin, B->opt.bins);
 }
 
-bool sbvh_try_spatial(const sbvh_build *B, const sbvh_split *s)
+/*
+ * Stich's alpha against the root's area, and (as Embree's builder does) a
+ * share of the node's own area: deep down, where nodes are small, an
+ * overlap above alpha of the root can still be a sliver of the node, and
+ * spatial binning there costs far more than the rare split it finds
+ * (courtyard: 38 % of the build in spatial binning, 240 spatial splits).
+ */
+bool sbvh_try_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_split *s)
 {
 	float lo[3], hi[3];
+	double overlap;
 
 	if (s->kind != SPLIT_OBJECT)
 		return true; /* no object split at all: maybe a spatial one */
@@ -285,7 +308,9 @@ bool sbvh_try_spatial(const sbvh_build *B, const sbvh_split *s)
 		if (!(hi[k] >= lo[k]))
 			return false;
 	}
-	return bvhlab_box_area(lo, hi) > B->opt.alpha * B->root_area;
+	overlap = bvhlab_box_area(lo, hi);
+	return overlap > B->opt.alpha * B->root_area &&
+	       overlap >= B->opt.overlap * bvhlab_box_area(job->lo, job->hi);
 }
 
 /* Stich's reference unsplitting: 1 (all left), 2 (all right) or 3 (cut). */
