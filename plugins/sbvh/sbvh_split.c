@@ -99,18 +99,44 @@ static float plane(const sbvh_job *job, int k, uint32_t j, uint32_t bins)
 	return job->lo[k] + (job->hi[k] - job->lo[k]) * ((float)(j + 1) / (float)bins);
 }
 
-/* Spatial bin of coordinate x along k, made consistent with plane(). */
-static uint32_t spatial_bin(const sbvh_job *job, int k, float x, uint32_t bins)
+/* A node's spatial planes and bin scale per axis, computed once per node
+ * (binning asked plane() for them a few times per reference, each a
+ * division): plane[k][j] is plane(job, k, j, bins), the same float. */
+typedef struct spatial_grid {
+	float plane[3][SBVH_MAX_BINS];
+	float scale[3];
+} spatial_grid;
+
+static void grid_init(spatial_grid *g, const sbvh_job *job, uint32_t bins)
 {
-	float ext = job->hi[k] - job->lo[k];
-	int64_t i = (int64_t)((x - job->lo[k]) * ((float)bins / ext));
+	for (int k = 0; k < 3; k++) {
+		float ext = job->hi[k] - job->lo[k];
+		g->scale[k] = ext > 0.0f ? (float)bins / ext : 0.0f;
+		for (uint32_t j = 0; j < bins; j++)
+			g->plane[k][j] = plane(job, k, j, bins);
+	}
+}
+
+/* Spatial bin of coordinate x along k, made consistent with the planes. */
+static uint32_t spatial_bin(const spatial_grid *g, const sbvh_job *job, int k, float x,
+                            uint32_t bins)
+{
+	int64_t i = (int64_t)((x - job->lo[k]) * g->scale[k]);
 	uint32_t j = i < 0 ? 0 : i >= (int64_t)bins ? bins - 1 : (uint32_t)i;
 
-	while (j > 0 && x < plane(job, k, j - 1, bins))
+	while (j > 0 && x < g->plane[k][j - 1])
 		j--;
-	while (j + 1 < bins && x > plane(job, k, j, bins))
+	while (j + 1 < bins && x > g->plane[k][j])
 		j++;
 	return j;
+}
+
+static void load_triangle(const sbvh_build *B, uint32_t prim, float v[3][3])
+{
+	const uint32_t *tri = &B->in->indices[3 * (size_t)prim];
+
+	for (int j = 0; j < 3; j++)
+		memcpy(v[j], &B->in->vertices[3 * (size_t)tri[j]], sizeof(v[j]));
 }
 
 /* Adds the points where the triangle's edges cross x[k] = at. */
@@ -137,18 +163,14 @@ static void add_crossings(const float v[3][3], int k, float at, float lo[3], flo
  * actually cuts are clipped exactly (sbvh_place). Float rounding here
  * only moves an estimate.
  */
-static void clip_into_bins(const sbvh_build *B, const sbvh_job *job, const sbvh_ref *r,
+static void clip_into_bins(const spatial_grid *g, const float v[3][3], const sbvh_ref *r,
                            int k, uint32_t b0, uint32_t b1, sbvh_bins *b)
 {
-	const uint32_t *tri = &B->in->indices[3 * (size_t)r->prim];
-	uint32_t bins = B->opt.bins;
-	float v[3][3], below = -INFINITY, clo[3], chi[3]; /* crossings of `below` */
+	float below = -INFINITY, clo[3], chi[3]; /* crossings of `below` */
 
-	for (int j = 0; j < 3; j++)
-		memcpy(v[j], &B->in->vertices[3 * (size_t)tri[j]], sizeof(v[j]));
 	bvhlab_box_empty(clo, chi);
 	for (uint32_t j = b0; j <= b1; j++) {
-		float above = j < b1 ? plane(job, k, j, bins) : INFINITY, lo[3], hi[3];
+		float above = j < b1 ? g->plane[k][j] : INFINITY, lo[3], hi[3];
 		bvhlab_box_empty(lo, hi);
 		for (int m = 0; m < 3; m++)
 			if (below <= v[m][k] && v[m][k] <= above)
@@ -176,22 +198,33 @@ void sbvh_bin_spatial(const sbvh_build *B, const sbvh_job *job, uint32_t begin,
 {
 	const sbvh_ref *refs = B->refs[job->buf];
 	uint32_t bins = B->opt.bins;
+	spatial_grid g;
 
 	sbvh_bins_clear(b, bins);
-	for (int k = 0; k < 3; k++) {
-		if (!(job->hi[k] > job->lo[k]))
-			continue;
-		for (uint32_t i = begin; i < end; i++) {
-			uint32_t b0 = spatial_bin(job, k, refs[i].lo[k], bins);
-			uint32_t b1 = spatial_bin(job, k, refs[i].hi[k], bins);
+	grid_init(&g, job, bins);
+	/* One pass: a reference, and its triangle if an axis clips it, are
+	 * read once for the three axes. */
+	for (uint32_t i = begin; i < end; i++) {
+		const sbvh_ref *r = &refs[i];
+		float v[3][3];
+		bool have_v = false;
+
+		for (int k = 0; k < 3; k++) {
+			if (!(g.scale[k] > 0.0f))
+				continue;
+			uint32_t b0 = spatial_bin(&g, job, k, r->lo[k], bins);
+			uint32_t b1 = spatial_bin(&g, job, k, r->hi[k], bins);
 
 			if (b0 == b1) {
-				v4_store(b->lo[k][b0], v4_min(v4_load(b->lo[k][b0]), v4_load(refs[i].lo)));
-				v4_store(b->hi[k][b0], v4_max(v4_load(b->hi[k][b0]), v4_load(refs[i].hi)));
+				v4_store(b->lo[k][b0], v4_min(v4_load(b->lo[k][b0]), v4_load(r->lo)));
+				v4_store(b->hi[k][b0], v4_max(v4_load(b->hi[k][b0]), v4_load(r->hi)));
 				b->count[k][b0]++;
 				b->exits[k][b0]++;
 			} else {
-				clip_into_bins(B, job, &refs[i], k, b0, b1, b);
+				if (!have_v)
+					load_triangle(B, r->prim, v);
+				have_v = true;
+				clip_into_bins(&g, (const float(*)[3])v, r, k, b0, b1, b);
 			}
 		}
 	}
