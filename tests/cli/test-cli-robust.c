@@ -132,6 +132,31 @@ static void test_in_process(void)
 	cJSON_Delete(doc);
 }
 
+/* "validate": false skips the rays against brute force, not the structure
+ * check: a tree whose links are not a tree is still judged invalid, with
+ * the node named, and gets no ray figures. */
+static void test_unvalidated_dag(void)
+{
+	const char *cfg = write_config("dag.json",
+		"{ \"output\": \"out-dag\", \"repeat\": 1, \"validate\": false,\n"
+		"  \"rays\": { \"min_ms\": 1, \"width\": 16, \"height\": 16 },\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
+		"    { \"plugin\": \"fake_good\", \"name\": \"dag\", \"options\": { \"fail\": \"shared\" } } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 1);
+	char dir[512];
+	snprintf(dir, sizeof(dir), "%s/out-dag", tmpdir);
+	cJSON *doc = load_results(dir);
+	if (!doc)
+		return;
+	const cJSON *dag = find_run(doc, "soup", "dag", 1);
+	CHECK(dag && !strcmp(run_str(dag, "status"), "invalid"));
+	CHECK_CONTAINS(run_str(dag, "error"), "node 3 reachable twice");
+	CHECK(dag && !cJSON_GetObjectItem(dag, "rays"));
+	CHECK(run_valid(find_run(doc, "soup", "fake_good", 1)));
+	cJSON_Delete(doc);
+}
+
 /* Polls (bounded) until the sweep has written at least one run. */
 static int wait_for_runs(const char *dir)
 {
@@ -299,6 +324,7 @@ int main(int argc, char **argv)
 	plain_crashes();
 	test_misbehaving();
 	test_in_process();
+	test_unvalidated_dag();
 	test_kill_and_resume();
 	test_resume_errors();
 	test_bad_input();

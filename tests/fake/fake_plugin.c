@@ -26,7 +26,7 @@ static const bvhlab_option_decl options[] = {
 	 .def_float = 0.5, .min = 0.0, .max = 100.0},
 	{.name = "fail", .type = BVHLAB_OPTION_STRING, .help = "how build() fails or misbehaves",
 	 .def_string = "no",
-	 .choices = "no|error|silent|positive|segfault|abort|loop|exit|invalid|alloc"},
+	 .choices = "no|error|silent|positive|segfault|abort|loop|exit|invalid|alloc|shared"},
 #ifdef FAKE_BAD_OPTION
 	{.name = "broken", .type = 0, .help = "an option of no type"},
 #endif
@@ -125,6 +125,30 @@ static bool fail_is(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *
 	return host->option_string(ctx, "fail", &fail) == 0 && strcmp(fail, how) == 0;
 }
 
+/* "shared": two inner nodes share their pair of leaves, so the links form
+ * a DAG and not a tree (each primitive still lies in one leaf). */
+static int build_shared(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                        const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	static const uint32_t first[5] = { 1, 3, 3, 0, 0 };
+	uint32_t half = in->prim_count / 2;
+
+	if (in->prim_count < 2 || (out->node_capacity < 5 &&
+	                           host->grow_output(ctx, out, 5, in->prim_count) < 0))
+		return -EINVAL;
+	for (uint32_t i = 0; i < 5; i++) {
+		memcpy(out->nodes[i].lo, in->bounds.lo, sizeof(out->nodes[i].lo));
+		memcpy(out->nodes[i].hi, in->bounds.hi, sizeof(out->nodes[i].hi));
+		out->nodes[i].first = i == 4 ? half : first[i];
+		out->nodes[i].count = i == 3 ? half : i == 4 ? in->prim_count - half : 0;
+	}
+	for (uint32_t k = 0; k < in->prim_count; k++)
+		out->prim_index[k] = k;
+	out->node_count = 5;
+	out->index_count = in->prim_count;
+	return 0;
+}
+
 /* unused in the variant without a build function */
 __attribute__((unused)) static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *in, bvhlab_build_output *out)
@@ -132,6 +156,8 @@ __attribute__((unused)) static int build(const bvhlab_host *host, bvhlab_build_c
 	int r = maybe_fail(host, ctx);
 	if (r != 0)
 		return r;
+	if (fail_is(host, ctx, "shared"))
+		return build_shared(host, ctx, in, out);
 	bvhlab_node *root = &out->nodes[0];
 	memcpy(root->lo, in->bounds.lo, sizeof(root->lo));
 	memcpy(root->hi, in->bounds.hi, sizeof(root->hi));
