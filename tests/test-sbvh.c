@@ -112,6 +112,7 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool gain)
 	static const char *const none[] = { "split_factor=1", NULL };
 	static const char *const pre[] = { "parallel_min=64", "presplit=0.5", "split_factor=2",
 		                           NULL };
+	static const char *const ahead[] = { "parallel_min=64", "lookahead=256", NULL };
 	bvhlab_prims prims;
 	bvhlab_error err = { { 0 } };
 
@@ -123,6 +124,7 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool gain)
 	check_threads(name, budget, scene, &prims.input, 2.0);
 	check_threads(name, none, scene, &prims.input, 1.0);
 	check_threads(name, pre, scene, &prims.input, 2.0);
+	check_threads(name, ahead, scene, &prims.input, 1.3);
 	if (gain)
 		check_spatial_gain(name, scene, &prims.input);
 	printf("%-10s %8u triangles: done\n", name, scene->triangle_count);

@@ -51,12 +51,17 @@ static const bvhlab_option_decl options[] = {
 	          "with the largest boxes in two (early split clipping); the rest is left "
 	          "to spatial splits",
 	  .def_float = 0.0, .min = 0.0, .max = 1.0 },
+	{ .name = "lookahead", .type = BVHLAB_OPTION_INT,
+	  .help = "nodes of at least this many references (and split by all threads "
+	          "together) also take a spatial split that the greedy SAH turns down when "
+	          "its children, split once more, cost less than the object split's",
+	  .def_int = 65536, .min = 2, .max = UINT32_MAX },
 };
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, sbvh_options *o)
 {
-	int64_t bins, max_leaf, parallel_min;
+	int64_t bins, max_leaf, parallel_min, lookahead;
 	int rc;
 
 	if ((rc = host->option_float(ctx, "split_factor", &o->split_factor)) < 0 ||
@@ -65,13 +70,15 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, sbvh_opt
 	    (rc = host->option_int(ctx, "bins", &bins)) < 0 ||
 	    (rc = host->option_int(ctx, "max_leaf", &max_leaf)) < 0 ||
 	    (rc = host->option_int(ctx, "parallel_min", &parallel_min)) < 0 ||
-	    (rc = host->option_float(ctx, "presplit", &o->presplit)) < 0) {
+	    (rc = host->option_float(ctx, "presplit", &o->presplit)) < 0 ||
+	    (rc = host->option_int(ctx, "lookahead", &lookahead)) < 0) {
 		host->set_error(ctx, "cannot read the options (%d)", rc);
 		return rc;
 	}
 	o->bins = (uint32_t)bins;
 	o->max_leaf = (uint32_t)max_leaf;
 	o->parallel_min = (uint32_t)parallel_min;
+	o->lookahead = (uint32_t)lookahead;
 	return 0;
 }
 

@@ -51,6 +51,7 @@ typedef struct sbvh_options {
 	uint32_t max_leaf;
 	uint32_t parallel_min; /* jobs of at least this many references use every thread */
 	double presplit;     /* share of the budget's room spent on pre-splitting */
+	uint32_t lookahead;  /* jobs of at least this many references: sbvh_lookahead */
 } sbvh_options;
 
 /* A node to build: its references and region (see the top). */
@@ -112,6 +113,9 @@ typedef struct sbvh_bins {
 /* Bins refs [begin, end) of the job's buffer into b (cleared first). */
 void sbvh_bin_object(const sbvh_build *B, const sbvh_job *job, const float clo[3],
                      const float chi[3], uint32_t begin, uint32_t end, sbvh_bins *b);
+/* The same over refs[begin, end) of any array. */
+void sbvh_bin_object_refs(const sbvh_ref *refs, uint32_t bins, const float clo[3],
+                          const float chi[3], uint32_t begin, uint32_t end, sbvh_bins *b);
 void sbvh_bin_spatial(const sbvh_build *B, const sbvh_job *job, uint32_t begin,
                       uint32_t end, sbvh_bins *b);
 /* Adds `from` into `to` (box unions and count sums: order does not matter). */
@@ -162,6 +166,16 @@ void sbvh_make_children(sbvh_build *B, const sbvh_job *job, uint32_t nl, uint32_
                         sbvh_job *left, sbvh_job *right);
 /* Builds the whole subtree of job on the calling thread. 0 or -ENOMEM. */
 int sbvh_build_subtree(sbvh_build *B, const sbvh_job *job, sbvh_bins *scratch);
+
+/* ---- sbvh_lookahead.c ----------------------------------------------------- */
+
+/*
+ * Of an object split obj and a spatial split sp of a large job, the one
+ * whose children split best in turn (see the file). bins is scratch.
+ * Returns obj or sp; -ENOMEM leaves the choice to the greedy cost.
+ */
+const sbvh_split *sbvh_lookahead(const sbvh_build *B, const sbvh_job *job,
+                                 const sbvh_split *obj, const sbvh_split *sp, sbvh_bins *bins);
 
 /* ---- sbvh_presplit.c ------------------------------------------------------ */
 

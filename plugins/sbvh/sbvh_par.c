@@ -11,6 +11,7 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -172,7 +173,20 @@ static void decide(team *tm, sbvh_split *obj, sbvh_split *best)
 	merge_bins(tm);
 	sbvh_choose_object(tm->B, tm->job, &tm->m[0].bins, obj);
 	*best = *obj;
-	if (sbvh_want_spatial(tm->B, tm->job, obj)) {
+	uint32_t n = tm->job->end - tm->job->begin;
+	if (n >= tm->B->opt.lookahead && obj->kind == SPLIT_OBJECT &&
+	    tm->job->rend - tm->job->rbegin > n) {
+		/* The best spatial split whatever the object split's overlap
+		 * and cost, for sbvh_lookahead to weigh. */
+		sbvh_split sp = *obj;
+		sp.kind = SPLIT_LEAF;
+		sp.cost = INFINITY;
+		run_phase(tm, PH_SPATIAL);
+		merge_bins(tm);
+		sbvh_choose_spatial(tm->B, tm->job, &tm->m[0].bins, &sp);
+		if (sp.kind == SPLIT_SPATIAL)
+			*best = *sbvh_lookahead(tm->B, tm->job, obj, &sp, &tm->m[0].bins);
+	} else if (sbvh_want_spatial(tm->B, tm->job, obj)) {
 		run_phase(tm, PH_SPATIAL);
 		merge_bins(tm);
 		sbvh_choose_spatial(tm->B, tm->job, &tm->m[0].bins, best);

@@ -72,8 +72,12 @@ static float object_scale(const float clo[3], const float chi[3], int k, uint32_
 void sbvh_bin_object(const sbvh_build *B, const sbvh_job *job, const float clo[3],
                      const float chi[3], uint32_t begin, uint32_t end, sbvh_bins *b)
 {
-	const sbvh_ref *refs = B->refs[job->buf];
-	uint32_t bins = B->opt.bins;
+	sbvh_bin_object_refs(B->refs[job->buf], B->opt.bins, clo, chi, begin, end, b);
+}
+
+void sbvh_bin_object_refs(const sbvh_ref *refs, uint32_t bins, const float clo[3],
+                          const float chi[3], uint32_t begin, uint32_t end, sbvh_bins *b)
+{
 	float scale[3];
 
 	sbvh_bins_clear(b, bins);
