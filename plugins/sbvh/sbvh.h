@@ -170,9 +170,10 @@ int sbvh_build_subtree(sbvh_build *B, const sbvh_job *job, sbvh_bins *scratch);
 /* ---- sbvh_lookahead.c ----------------------------------------------------- */
 
 /*
- * Of an object split obj and a spatial split sp of a large job, the one
- * whose children split best in turn (see the file). bins is scratch.
- * Returns obj or sp; -ENOMEM leaves the choice to the greedy cost.
+ * Of an object split obj and a spatial split sp of a large job: sp when
+ * its greedy cost is lower, or when its children, split once more, cost
+ * less than obj's (see the file); else obj. bins is scratch. Without
+ * memory for the sample, the greedy cost alone decides.
  */
 const sbvh_split *sbvh_lookahead(const sbvh_build *B, const sbvh_job *job,
                                  const sbvh_split *obj, const sbvh_split *sp, sbvh_bins *bins);

@@ -26,7 +26,6 @@
  * overrule the greedy choice both ways gave the courtyard 17.15, adding
  * only gives 16.60.
  */
-#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 

@@ -11,7 +11,6 @@
  */
 #include <errno.h>
 #include <math.h>
-#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
