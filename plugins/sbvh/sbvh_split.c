@@ -330,7 +330,9 @@ void sbvh_best_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_bins
  * share of the node's own area: deep down, where nodes are small, an
  * overlap above alpha of the root can still be a sliver of the node, and
  * spatial binning there costs far more than the rare split it finds
- * (courtyard: 38 % of the build in spatial binning, 240 spatial splits).
+ * (courtyard, without this test: 38 % of a 1-thread build in spatial
+ * binning; with it, 620 against 804 ms at 2 threads, SAH 17.8503 against
+ * 17.8481).
  */
 bool sbvh_try_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_split *s)
 {
