@@ -34,8 +34,8 @@ static const bvhlab_option_decl options[] = {
 	          "than alpha * root area (Stich's alpha; 1 turns them off)",
 	  .def_float = 1e-5, .min = 0.0, .max = 1.0 },
 	{ .name = "overlap", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "and by at least this share of the node's own area (0 turns the test off: "
-	          "Stich's alpha alone)",
+	  .help = "try spatial splits only where those children also overlap by at least "
+	          "this share of the node's own area (0: alpha alone)",
 	  .def_float = 0.1, .min = 0.0, .max = 1.0 },
 	{ .name = "bins", .type = BVHLAB_OPTION_INT,
 	  .help = "object and spatial bins per axis",
