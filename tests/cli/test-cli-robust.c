@@ -70,14 +70,21 @@ static const char misbehaving_config[] =
 	"    { \"plugin\": \"sah_seq\" },\n"
 	"    { \"plugin\": \"fake_good\" } ] }\n";
 
+/* Writes the config as `name`, runs it (every test here has a failing
+ * run: exit status 1) and loads the results.json of its output `out`. */
+static cJSON *run_failing(const char *name, const char *text, const char *out)
+{
+	char dir[512];
+
+	CHECK_INT(run(ARGS("run", "--quiet", write_config(name, text))), 1);
+	snprintf(dir, sizeof(dir), "%s/%s", tmpdir, out);
+	return load_results(dir);
+}
+
 /* Every misbehaving plugin is reported as such; the others still run, valid. */
 static void test_misbehaving(void)
 {
-	const char *cfg = write_config("mis.json", misbehaving_config);
-	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 1);
-	char dir[512];
-	snprintf(dir, sizeof(dir), "%s/out-mis", tmpdir);
-	cJSON *doc = load_results(dir);
+	cJSON *doc = run_failing("mis.json", misbehaving_config, "out-mis");
 	if (!doc)
 		return;
 	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 18);
@@ -112,18 +119,14 @@ static void test_misbehaving(void)
 /* "isolate": false runs in this process, with the same statuses. */
 static void test_in_process(void)
 {
-	const char *cfg = write_config("inproc.json",
+	cJSON *doc = run_failing("inproc.json",
 		"{ \"output\": \"out-inproc\", \"repeat\": 1, \"isolate\": false,\n"
 		"  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64 },\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
 		"    { \"plugin\": \"fake_good\", \"name\": \"bad\", \"options\": { \"fail\": \"invalid\" } },\n"
 		"    { \"plugin\": \"fake_good\", \"name\": \"err\",\n"
-		"      \"options\": { \"fail\": \"error\" } } ] }\n");
-	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 1);
-	char dir[512];
-	snprintf(dir, sizeof(dir), "%s/out-inproc", tmpdir);
-	cJSON *doc = load_results(dir);
+		"      \"options\": { \"fail\": \"error\" } } ] }\n", "out-inproc");
 	if (!doc)
 		return;
 	CHECK(run_valid(find_run(doc, "soup", "fake_good", 1)));
@@ -137,16 +140,13 @@ static void test_in_process(void)
  * the node named, and gets no ray figures. */
 static void test_unvalidated_dag(void)
 {
-	const char *cfg = write_config("dag.json",
+	cJSON *doc = run_failing("dag.json",
 		"{ \"output\": \"out-dag\", \"repeat\": 1, \"validate\": false,\n"
 		"  \"rays\": { \"min_ms\": 1, \"width\": 16, \"height\": 16 },\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
-		"    { \"plugin\": \"fake_good\", \"name\": \"dag\", \"options\": { \"fail\": \"shared\" } } ] }\n");
-	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 1);
-	char dir[512];
-	snprintf(dir, sizeof(dir), "%s/out-dag", tmpdir);
-	cJSON *doc = load_results(dir);
+		"    { \"plugin\": \"fake_good\", \"name\": \"dag\", \"options\": { \"fail\": \"shared\" } } ] }\n",
+		"out-dag");
 	if (!doc)
 		return;
 	const cJSON *dag = find_run(doc, "soup", "dag", 1);
