@@ -120,16 +120,8 @@ static void init_root(const sbvh_build *B, uint32_t count, sbvh_job *root)
 {
 	*root = (sbvh_job){ .end = count, .rend = B->capacity };
 	sbvh_job_empty(root);
-	for (uint32_t i = 0; i < count; i++) {
-		const sbvh_ref *r = &B->refs[0][i];
-		for (int k = 0; k < 3; k++) {
-			float c = 0.5f * (r->lo[k] + r->hi[k]);
-			root->lo[k] = r->lo[k] < root->lo[k] ? r->lo[k] : root->lo[k];
-			root->hi[k] = r->hi[k] > root->hi[k] ? r->hi[k] : root->hi[k];
-			root->clo[k] = c < root->clo[k] ? c : root->clo[k];
-			root->chi[k] = c > root->chi[k] ? c : root->chi[k];
-		}
-	}
+	for (uint32_t i = 0; i < count; i++)
+		sbvh_job_grow(root, &B->refs[0][i]);
 }
 
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,

@@ -71,6 +71,18 @@ static inline void sbvh_job_empty(sbvh_job *j)
 	bvhlab_box_empty(j->clo, j->chi);
 }
 
+/* Adds a reference to a job's box and centre bounds. */
+static inline void sbvh_job_grow(sbvh_job *j, const sbvh_ref *r)
+{
+	for (int k = 0; k < 3; k++) {
+		float c = 0.5f * (r->lo[k] + r->hi[k]);
+		j->lo[k] = bvhlab_minf(j->lo[k], r->lo[k]);
+		j->hi[k] = bvhlab_maxf(j->hi[k], r->hi[k]);
+		j->clo[k] = bvhlab_minf(j->clo[k], c);
+		j->chi[k] = bvhlab_maxf(j->chi[k], c);
+	}
+}
+
 /* What a build shares between its threads. */
 typedef struct sbvh_build {
 	const bvhlab_build_input *in;

@@ -90,18 +90,6 @@ void sbvh_make_children(sbvh_build *B, const sbvh_job *job, uint32_t nl, uint32_
 	sbvh_job_empty(right);
 }
 
-/* Adds a reference to a child job's box and centre bounds. */
-static inline void grow_job(sbvh_job *j, const sbvh_ref *r)
-{
-	for (int k = 0; k < 3; k++) {
-		float c = 0.5f * (r->lo[k] + r->hi[k]);
-		j->lo[k] = bvhlab_minf(j->lo[k], r->lo[k]);
-		j->hi[k] = bvhlab_maxf(j->hi[k], r->hi[k]);
-		j->clo[k] = bvhlab_minf(j->clo[k], c);
-		j->chi[k] = bvhlab_maxf(j->chi[k], c);
-	}
-}
-
 /* Empty box and centre bounds, no references yet. */
 static void child_init(sbvh_job *j)
 {
@@ -137,11 +125,11 @@ static bool partition(const sbvh_build *B, const sbvh_job *job, const sbvh_split
 			return false;
 		if (side & 1) {
 			out[li++] = lref;
-			grow_job(l, &lref);
+			sbvh_job_grow(l, &lref);
 		}
 		if (side & 2) {
 			out[--ri] = rref;
-			grow_job(r, &rref);
+			sbvh_job_grow(r, &rref);
 		}
 	}
 	l->end = li - job->rbegin;

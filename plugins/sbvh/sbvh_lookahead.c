@@ -46,13 +46,7 @@ struct sample {
 static void add(struct sample *c, const sbvh_ref *r)
 {
 	c->refs[c->n++] = *r;
-	for (int k = 0; k < 3; k++) {
-		float m = 0.5f * (r->lo[k] + r->hi[k]);
-		c->box.lo[k] = bvhlab_minf(c->box.lo[k], r->lo[k]);
-		c->box.hi[k] = bvhlab_maxf(c->box.hi[k], r->hi[k]);
-		c->box.clo[k] = bvhlab_minf(c->box.clo[k], m);
-		c->box.chi[k] = bvhlab_maxf(c->box.chi[k], m);
-	}
+	sbvh_job_grow(&c->box, r);
 }
 
 /* A child's best object split cost, in units of its own area (a leaf's

@@ -37,17 +37,6 @@ typedef struct team {
 	member *m;             /* [B->threads] */
 } team;
 
-static void grow_job(sbvh_job *j, const sbvh_ref *r)
-{
-	for (int k = 0; k < 3; k++) {
-		float c = 0.5f * (r->lo[k] + r->hi[k]);
-		j->lo[k] = r->lo[k] < j->lo[k] ? r->lo[k] : j->lo[k];
-		j->hi[k] = r->hi[k] > j->hi[k] ? r->hi[k] : j->hi[k];
-		j->clo[k] = c < j->clo[k] ? c : j->clo[k];
-		j->chi[k] = c > j->chi[k] ? c : j->chi[k];
-	}
-}
-
 static unsigned side_of(const team *tm, uint32_t i, sbvh_ref *l, sbvh_ref *r)
 {
 	const sbvh_ref *ref = &tm->B->refs[tm->job->buf][i];
@@ -82,11 +71,11 @@ static void write_share(member *m)
 		unsigned side = side_of(m->team, i, &l, &r);
 		if (side & 1) {
 			out[li++] = l;
-			grow_job(&m->l, &l);
+			sbvh_job_grow(&m->l, &l);
 		}
 		if (side & 2) {
 			out[ri++] = r;
-			grow_job(&m->r, &r);
+			sbvh_job_grow(&m->r, &r);
 		}
 	}
 }
