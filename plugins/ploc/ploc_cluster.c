@@ -39,13 +39,22 @@
 #define TIE_BITS 8u
 #define TIE_MASK ((1u << TIE_BITS) - 1)
 
+/* The row loops are inlined into nearest_block so that its AVX2 clone
+ * compiles them 8 lanes wide: called, they ran at the default target's 4
+ * lanes (igea subdivided once, one thread: 199 ms a build, 163 inlined). */
+#if defined(__GNUC__)
+#define ROW_INLINE static inline __attribute__((always_inline))
+#else
+#define ROW_INLINE static inline
+#endif
+
 /*
  * key[k]: the pair of cluster i and cluster i + 1 + k, k < count, as its
  * later cluster sees it (the earlier one adds 1): one row, in loops the
  * compiler vectorises. The distance is half the surface area of the
  * union of the two boxes.
  */
-static void key_row(const struct clusters *c, uint32_t i, uint32_t count, uint32_t *key)
+ROW_INLINE void key_row(const struct clusters *c, uint32_t i, uint32_t count, uint32_t *key)
 {
 	const float *l0 = c->lo[0] + i + 1, *l1 = c->lo[1] + i + 1, *l2 = c->lo[2] + i + 1;
 	const float *h0 = c->hi[0] + i + 1, *h1 = c->hi[1] + i + 1, *h2 = c->hi[2] + i + 1;
@@ -67,7 +76,7 @@ static void key_row(const struct clusters *c, uint32_t i, uint32_t count, uint32
 }
 
 /* The least of the row's keys, and each offered to its later cluster. */
-static uint32_t offer_row(const uint32_t *key, uint32_t count, uint32_t *best)
+ROW_INLINE uint32_t offer_row(const uint32_t *key, uint32_t count, uint32_t *best)
 {
 	uint32_t least = UINT32_MAX;
 
