@@ -10,7 +10,8 @@
  * leaves split and re-cut by the SAH (the node count may change), and
  * leaves kept. treelet on scenes of at most 8 triangles, where one
  * treelet holds them all, must find the least SAH of every binary tree
- * over them, found here by enumerating the trees.
+ * over them, found here by enumerating the trees. reinsert runs with
+ * its children moves (Bittner et al.) and, on a few scenes, without.
  */
 #include <errno.h>
 #include <math.h>
@@ -345,6 +346,19 @@ static void test_optimal(uint32_t n)
 }
 
 /* Every test of one stage, with the options it is tested with. */
+/* reinsert with its first move only (children off): the same checks on
+ * the scenes where moves are many (the stage's own run has both moves). */
+static void test_subtree_moves(void)
+{
+	const char *saved = refiner_options;
+
+	refiner_options = "batch=0.25\0iterations=3\0children=false\0";
+	test_improves();
+	test_scene("soup", generate("soup", SCALE(10000, 2000), 0, 0), RAYS);
+	test_scene("needles", needle_scene(SCALE(3000, 600)), RAYS);
+	refiner_options = saved;
+}
+
 static void test_stage(const char *name, const char *options)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply" };
@@ -366,6 +380,8 @@ static void test_stage(const char *name, const char *options)
 	if (strcmp(name, "treelet") == 0)
 		for (uint32_t n = 3; n <= 8; n++)
 			test_optimal(n);
+	if (strcmp(name, "reinsert") == 0)
+		test_subtree_moves();
 	bvhlab_plugin_close(refiner);
 	refiner = NULL;
 }

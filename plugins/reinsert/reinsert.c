@@ -21,6 +21,10 @@ static const bvhlab_option_decl options[] = {
 	  .help = "stop after an iteration that lowers the SAH by less than this fraction "
 	          "of it (0: run every iteration)",
 	  .def_float = 0.001, .min = 0.0, .max = 1.0 },
+	{ .name = "children", .type = BVHLAB_OPTION_BOOL,
+	  .help = "also try Bittner et al.'s move for each inner candidate: take it and its "
+	          "parent out and put its two children back apart, where each costs least",
+	  .def_bool = true },
 	LEAVES_OPTION_DECLS,
 	{ .name = "max_visits", .type = BVHLAB_OPTION_INT,
 	  .help = "most nodes one candidate's search may look at",
@@ -32,7 +36,7 @@ static const bvhlab_option_decl options[] = {
 struct params {
 	double batch, min_gain;
 	int64_t iterations, max_visits, max_leaf;
-	bool leaves;
+	bool leaves, children;
 };
 
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, struct params *o)
@@ -44,6 +48,7 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, struct p
 	    (rc = host->option_float(ctx, "min_gain", &o->min_gain)) < 0 ||
 	    (rc = host->option_int(ctx, "max_visits", &o->max_visits)) < 0 ||
 	    (rc = host->option_bool(ctx, "leaves", &o->leaves)) < 0 ||
+	    (rc = host->option_bool(ctx, "children", &o->children)) < 0 ||
 	    (rc = host->option_int(ctx, "max_leaf", &o->max_leaf)) < 0) {
 		host->set_error(ctx, "cannot read the options");
 		return rc;
@@ -163,8 +168,11 @@ static double apply(reinsert *r)
 		if (r->moves[k].dest != NO_NODE && r->moves[k].gain > 0)
 			r->moves[count++] = r->moves[k];
 	qsort(r->moves, count, sizeof(*r->moves), by_gain);
-	for (uint32_t k = 0; k < count; k++)
-		change += reinsert_try(r, r->moves[k].node, r->moves[k].dest);
+	for (uint32_t k = 0; k < count; k++) {
+		const struct move *m = &r->moves[k];
+		change += m->dest2 == NO_NODE ? reinsert_try(r, m->node, m->dest)
+		                              : reinsert_try_children(r, m->node, m->dest, m->dest2);
+	}
 	return change;
 }
 
@@ -200,7 +208,7 @@ static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct
                     const bvhlab_build_input *input, bvhlab_build_output *tree)
 {
 	reinsert r = { .nodes = tree->nodes, .node_count = tree->node_count,
-	               .max_visits = (uint32_t)o->max_visits };
+	               .max_visits = (uint32_t)o->max_visits, .children = o->children };
 	size_t n = tree->node_count;
 	int rc;
 

@@ -10,7 +10,11 @@
  *   2. search      for every candidate, in parallel over the threads, the
  *                  node beside which it would cost least: what taking it
  *                  out saves (exactly) against what putting it back costs,
- *                  by branch and bound from the root (reinsert_search.c)
+ *                  by branch and bound from the root (reinsert_search.c);
+ *                  with `children`, also what taking it and its parent
+ *                  out and putting its two children back apart would
+ *                  save, as Bittner et al. move nodes, and the better of
+ *                  the two
  *   3. apply       on one thread, the moves by decreasing predicted gain:
  *                  each is carried out and refitted while the exact change
  *                  of the inner nodes' summed area is added up, and taken
@@ -37,10 +41,22 @@
 
 #define NO_NODE UINT32_MAX
 
-/* A candidate's best move: beside `dest`, saving `gain` (area units). */
+/* A candidate's best move, saving `gain` (area units): the node beside
+ * `dest`; or, when dest2 is a node, the node out and its children put
+ * back apart, the one of larger area beside dest, the other beside dest2. */
 struct move {
-	uint32_t node, dest;
+	uint32_t node, dest, dest2;
 	double gain;
+};
+
+/* A slot's node and parent as they were before a move wrote them; a
+ * children move writes fewer than UNDO_MAX (boxes refitted above are not
+ * logged: refitting again after the undo restores them). */
+#define UNDO_MAX 32
+
+struct undo {
+	uint32_t slot, parent;
+	bvhlab_node node;
 };
 
 typedef struct reinsert {
@@ -53,6 +69,9 @@ typedef struct reinsert {
 	uint64_t *keys;         /* [node_count] scratch of the selection */
 	uint32_t *hist;         /* [65536] scratch of the selection */
 	uint32_t max_visits;    /* nodes a search may take from its queue */
+	bool children;          /* children moves searched too */
+	struct undo log[UNDO_MAX]; /* what a children move wrote, to take it back */
+	uint32_t log_count;
 	atomic_uint next;       /* candidates handed out in the search */
 	team team;
 } reinsert;
@@ -78,6 +97,15 @@ static inline void box_union(const bvhlab_node *a, const bvhlab_node *b, float l
 	}
 }
 
+/* Whether slot d lies in the subtree of slot x (x itself included). */
+static inline bool in_subtree(const reinsert *r, uint32_t d, uint32_t x)
+{
+	for (; d != NO_NODE; d = r->parent[d])
+		if (d == x)
+			return true;
+	return false;
+}
+
 static inline uint32_t sibling_of(const reinsert *r, uint32_t x)
 {
 	uint32_t first = r->nodes[r->parent[x]].first;
@@ -91,5 +119,7 @@ void reinsert_search(reinsert *r);
 /* Carries out the move if it lowers the summed area; the change (negative)
  * or 0 when the move was refused or taken back (reinsert_move.c). */
 double reinsert_try(reinsert *r, uint32_t node, uint32_t dest);
+/* The same for a children move (see struct move). */
+double reinsert_try_children(reinsert *r, uint32_t node, uint32_t dest, uint32_t dest2);
 
 #endif /* BVHLAB_REINSERT_H */

@@ -44,15 +44,6 @@ static void refit_up(reinsert *r, uint32_t slot, double *delta)
 	}
 }
 
-/* Whether slot d lies in the subtree of slot x (x itself included). */
-static bool below(const reinsert *r, uint32_t d, uint32_t x)
-{
-	for (; d != NO_NODE; d = r->parent[d])
-		if (d == x)
-			return true;
-	return false;
-}
-
 /* The move itself, valid by the caller's checks; returns the area change. */
 static double move(reinsert *r, uint32_t x, uint32_t d)
 {
@@ -87,12 +78,100 @@ double reinsert_try(reinsert *r, uint32_t x, uint32_t d)
 	p = r->parent[x];
 	s = sibling_of(r, x);
 	/* beside P or S would change nothing; inside N is no tree */
-	if (d == p || d == s || below(r, d, x))
+	if (d == p || d == s || in_subtree(r, d, x))
 		return 0;
 	delta = move(r, x, d);
 	if (delta < 0)
 		return delta;
 	/* S now sits in P's old slot p; N goes back beside it */
 	(void)move(r, x, p);
+	return 0;
+}
+
+/*
+ * The children move. Node N (slot x) leaves with its parent P (slot p):
+ * P's other child S takes P's slot, which frees the pair {x, s}. N's
+ * children go back one by one, the one of larger area (A, slot a) first:
+ * beside X (slot d), A into slot x and X into slot s, their new parent
+ * into slot d; then the other (B) beside Y (slot e), Y into A's old slot
+ * and their parent into slot e. A place given as s means S, now at p.
+ * Every slot written is logged first; taking the move back restores them
+ * and refits the same paths, which restores the boxes above.
+ */
+static void log_slot(reinsert *r, uint32_t slot)
+{
+	r->log[r->log_count++] = (struct undo){ slot, r->parent[slot], r->nodes[slot] };
+}
+
+static void put_node(reinsert *r, uint32_t slot, const bvhlab_node *n)
+{
+	log_slot(r, slot);
+	r->nodes[slot] = *n;
+	if (n->count == 0) {
+		log_slot(r, n->first);
+		log_slot(r, n->first + 1);
+		r->parent[n->first] = r->parent[n->first + 1] = slot;
+	}
+}
+
+/* Node c's content into slot `into`, beside what slot d held (moved to
+ * slot `other`, the other of the pair); their parent into slot d. */
+static void insert_beside(reinsert *r, uint32_t c, uint32_t into, uint32_t d, uint32_t other,
+                          double *delta)
+{
+	bvhlab_node moved = r->nodes[c], old = r->nodes[d], parent;
+
+	put_node(r, into, &moved);
+	put_node(r, other, &old);
+	box_union(&moved, &old, parent.lo, parent.hi);
+	parent.first = into < other ? into : other;
+	parent.count = 0;
+	log_slot(r, d);
+	r->nodes[d] = parent;
+	r->parent[into] = r->parent[other] = d;
+	*delta += node_area(&parent);
+	refit_up(r, r->parent[d], delta);
+}
+
+static void undo_all(reinsert *r, const uint32_t *from, unsigned count)
+{
+	double ignored = 0;
+
+	while (r->log_count) {
+		const struct undo *u = &r->log[--r->log_count];
+		r->nodes[u->slot] = u->node;
+		r->parent[u->slot] = u->parent;
+	}
+	for (unsigned k = 0; k < count; k++)
+		refit_up(r, r->parent[from[k]], &ignored);
+}
+
+double reinsert_try_children(reinsert *r, uint32_t x, uint32_t d, uint32_t e)
+{
+	uint32_t p, s, a, b;
+	double delta;
+
+	if (x == 0 || x >= r->node_count || d >= r->node_count || e >= r->node_count ||
+	    r->nodes[x].count != 0 || in_subtree(r, d, x) || in_subtree(r, e, x))
+		return 0;
+	p = r->parent[x];
+	s = sibling_of(r, x);
+	a = r->nodes[x].first;
+	b = a + 1;
+	if (node_area(&r->nodes[b]) > node_area(&r->nodes[a])) {
+		a = b;
+		b = a - 1;
+	}
+	d = d == s ? p : d;
+	e = e == s ? p : e;
+	delta = -node_area(&r->nodes[p]) - node_area(&r->nodes[x]);
+	r->log_count = 0;
+	put_node(r, p, &r->nodes[s]);
+	refit_up(r, r->parent[p], &delta);
+	insert_beside(r, a, x, d, s, &delta);
+	insert_beside(r, b, b, e, a, &delta);
+	if (delta < 0)
+		return delta;
+	undo_all(r, (const uint32_t[]){ p, d, e, x, s, a, b }, 7);
 	return 0;
 }

@@ -83,11 +83,16 @@ static double removal_gain(const reinsert *r, uint32_t x)
 	return gain;
 }
 
-/* The cheapest place beside which to put node x; NO_NODE if none. */
-static uint32_t best_place(const reinsert *r, uint32_t x, double *cost, struct queue *q)
+/*
+ * The cheapest place beside which to put node c, below *cost (which gets
+ * the cost found); NO_NODE if none. The subtree of `skip` is not searched
+ * (c's own, or the node c comes out of), and no1, no2 are no places.
+ */
+static uint32_t best_place(const reinsert *r, uint32_t c, uint32_t skip, uint32_t no1,
+                           uint32_t no2, double *cost, struct queue *q)
 {
-	const bvhlab_node *n = &r->nodes[x];
-	uint32_t p = r->parent[x], s = sibling_of(r, x), best = NO_NODE, visits = 0;
+	const bvhlab_node *n = &r->nodes[c];
+	uint32_t best = NO_NODE, visits = 0;
 	double least = *cost, own = node_area(n);
 
 	q->size = 0;
@@ -100,11 +105,11 @@ static uint32_t best_place(const reinsert *r, uint32_t x, double *cost, struct q
 
 		if (e.induced + own >= least)
 			break; /* the rest of the queue costs at least as much */
-		if (e.node == x)
-			continue; /* nothing inside N */
+		if (e.node == skip)
+			continue;
 		box_union(n, at, lo, hi);
 		direct = area_of(lo, hi);
-		if (e.induced + direct < least && e.node != p && e.node != s) {
+		if (e.induced + direct < least && e.node != no1 && e.node != no2) {
 			least = e.induced + direct;
 			best = e.node;
 		}
@@ -118,6 +123,31 @@ static uint32_t best_place(const reinsert *r, uint32_t x, double *cost, struct q
 	return best;
 }
 
+/* Node x (an inner node) out with its parent, its children put back
+ * apart, the larger first (Bittner et al. 2013): the move that can
+ * rebuild x's top where moving x whole keeps it. Predicted like the
+ * subtree move, both children's places searched with x still in place. */
+static struct move children_move(const reinsert *r, uint32_t x, double gain, struct queue *q)
+{
+	const bvhlab_node *n = &r->nodes[x];
+	uint32_t p = r->parent[x], a = n->first, b = n->first + 1;
+	double saved = gain + node_area(n), cost_a = saved, cost_b;
+	struct move m = { x, NO_NODE, NO_NODE, 0 };
+
+	if (node_area(&r->nodes[b]) > node_area(&r->nodes[a])) {
+		a = b;
+		b = n->first;
+	}
+	m.dest = best_place(r, a, x, p, NO_NODE, &cost_a, q);
+	if (m.dest == NO_NODE)
+		return m;
+	cost_b = saved - cost_a;
+	m.dest2 = best_place(r, b, x, p, NO_NODE, &cost_b, q);
+	if (m.dest2 != NO_NODE)
+		m.gain = saved - cost_a - cost_b;
+	return m;
+}
+
 void reinsert_search(reinsert *r)
 {
 	struct queue q;
@@ -125,10 +155,15 @@ void reinsert_search(reinsert *r)
 
 	while (team_next_block(&r->next, r->cand_count, 64, &lo, &hi))
 		for (uint32_t k = lo; k < hi; k++) {
-			uint32_t x = r->cand[k];
+			uint32_t x = r->cand[k], p = r->parent[x];
 			double gain = removal_gain(r, x), cost = gain;
-			uint32_t dest = best_place(r, x, &cost, &q);
+			uint32_t dest = best_place(r, x, x, p, sibling_of(r, x), &cost, &q);
+			struct move m = { x, dest, NO_NODE, dest == NO_NODE ? 0 : gain - cost };
 
-			r->moves[k] = (struct move){ x, dest, dest == NO_NODE ? 0 : gain - cost };
+			if (r->children && r->nodes[x].count == 0) {
+				struct move c = children_move(r, x, gain, &q);
+				m = c.dest2 != NO_NODE && c.gain > m.gain ? c : m;
+			}
+			r->moves[k] = m;
 		}
 }
