@@ -51,15 +51,14 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p)
 
 /* ---- scratch ------------------------------------------------------------ */
 
-/* Clusters (two sets of ten arrays), nn, the merge tree, desc, place and
- * iter_first: past the tree in the output when the host gives the room,
+/* Clusters (two sets of ten arrays), nn, the merge tree, desc and the
+ * emit phase's tasks: past the tree in the output when the host gives the room,
  * which it keeps between builds (fresh pages cost more than a phase). */
 static size_t work_size(size_t n)
 {
 	return 20 * morton_align64(4 * n) + morton_align64(4 * n) +
 	       morton_align64(sizeof(bvhlab_node) * (2 * n)) +
-	       morton_align64(4 * 2 * n) + morton_align64(sizeof(struct place) * 2 * n) +
-	       morton_align64(4 * n);
+	       morton_align64(4 * 2 * n) + morton_align64(sizeof(struct place) * n);
 }
 
 static uint32_t spare_nodes(uint32_t n)
@@ -96,8 +95,7 @@ static void place_work(ploc *p, char *at)
 	p->nn = (uint32_t *)(void *)take(&at, 4 * n);
 	p->tree = (bvhlab_node *)(void *)take(&at, sizeof(bvhlab_node) * 2 * n);
 	p->desc = (uint32_t *)(void *)take(&at, 4 * 2 * n);
-	p->place = (struct place *)(void *)take(&at, sizeof(struct place) * 2 * n);
-	p->iter_first = (uint32_t *)(void *)take(&at, 4 * n);
+	p->tasks = (struct place *)(void *)take(&at, sizeof(struct place) * n);
 }
 
 /* The sort's buffers: in the output's first nodes, which only the emit
@@ -172,6 +170,8 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p,
 	int rc;
 
 	p->threads = morton_team_size(p->in);
+	p->emit_cut = p->n / (PLOC_EMIT_TASKS * p->threads);
+	p->emit_cut = p->emit_cut ? p->emit_cut : 1;
 	p->sort.n = p->n;
 	p->sort.centroids = p->in->centroids;
 	p->sort.centroid_bounds = p->in->centroid_bounds;

@@ -16,7 +16,8 @@
  *   2. cluster   the iterations (ploc_cluster.c): nearest neighbours by
  *                blocks, then counts, prefix and writes by chunks
  *   3. emit      the SAH collapse, decided as clusters merge, applied top
- *                down into the output (ploc_emit.c)
+ *                down into the output: thread 0 the top, the team the
+ *                subtrees below it (ploc_emit.c)
  *
  * Ties: a cluster picks, among candidates at the same distance, the
  * nearest in the order, then the one whose pair starts at an even
@@ -38,9 +39,11 @@
 #include "team.h"
 
 #define PLOC_MAX_RADIUS 64
-/* Iterations over fewer clusters, and the emit phase's ranges of those
- * iterations, are run by thread 0 alone. */
-#define PLOC_SOLO_BELOW 32768
+/* Iterations over fewer clusters are run by thread 0 alone. */
+#define PLOC_SOLO_BELOW 4096
+/* Emit tasks per thread: subtrees of at most n / (this x T) primitives,
+ * so that a slow thread holds the others up by a small share. */
+#define PLOC_EMIT_TASKS 32
 /* Record flags in the count field of the merge tree (below). */
 #define REC_PRIM 0x80000000u      /* one primitive; first: its sorted position */
 #define REC_COLLAPSED 0x40000000u /* the SAH made this subtree one leaf */
@@ -56,10 +59,10 @@ struct clusters {
 	uint32_t *desc;       /* [n] output nodes below the cluster's own */
 };
 
-/* Where a node of the merge tree goes in the output: set by its parent
- * in the emit phase. */
+/* A record of the merge tree and where it goes in the output (emit). */
 struct place {
-	uint32_t slot;  /* output node, or DEAD inside a collapsed leaf */
+	uint32_t x;     /* the record */
+	uint32_t slot;  /* its output node */
 	uint32_t kids;  /* output slot of its children's pair */
 	uint32_t first; /* first prim_index slot of its primitives */
 };
@@ -86,15 +89,15 @@ typedef struct ploc {
 	 * The merge tree, 2n - 1 records in the output's node layout: the
 	 * root at 0, the two clusters of every merge as a pair, allocated
 	 * downwards from the end, so children always lie above their parent
-	 * and each iteration's pairs form one range (iter_first[]). first:
-	 * the pair of an inner record, the sorted position of a primitive.
+	 * and each iteration's pairs form one range. first: the pair of an
+	 * inner record, the sorted position of a primitive.
 	 */
 	bvhlab_node *tree;
 	uint32_t *desc;         /* [2n - 1] output nodes below each record */
-	struct place *place;    /* [2n - 1] */
-	uint32_t *iter_first;   /* [n] first record of iteration k's pairs */
+	struct place *tasks;    /* [n] the emit phase's subtrees, for the team */
+	uint32_t task_count;
+	uint32_t emit_cut;      /* most primitives of a task's subtree */
 	uint32_t iterations;
-	uint32_t solo_from;     /* first iteration that thread 0 ran alone */
 	uint32_t *count;        /* [2 T] per-chunk counts of merges, survivors */
 	atomic_uint blocks[2];  /* blocks handed out, by iteration parity */
 	team team;

@@ -272,8 +272,6 @@ static void iteration(ploc *p, unsigned t, unsigned chunks, uint32_t it, uint32_
 		atomic_store_explicit(&p->blocks[(it + 1) & 1], 0, memory_order_relaxed);
 	*m = write_chunk(p, chunks, t, c, to, lo, hi, *base, &merges);
 	*base -= 2 * merges;
-	if (t == 0)
-		p->iter_first[it] = *base;
 	sync_if(p, team);
 }
 
@@ -290,7 +288,6 @@ void ploc_cluster(ploc *p, unsigned t)
 	for (; m > PLOC_SOLO_BELOW; it++)
 		iteration(p, t, p->team.threads, it, &m, &base);
 	if (t == 0) {
-		p->solo_from = it;
 		for (; m > 1; it++)
 			iteration(p, 0, 1, it, &m, &base);
 		put_record(p, &p->cl[it & 1], 0, 0);

@@ -8,26 +8,25 @@
  * q + 2 on and the right child's after the desc[] nodes of the left one;
  * primitives likewise, the left child's first. A record that became a
  * leaf (a primitive, or a collapsed subtree whose primitives it gathers
- * in one short walk) marks its children DEAD, and the dead pass that on.
+ * in one short walk) ends its branch.
  *
- * Each record's place is written by its parent, which lies below it in
- * the merge tree's array, in the range of a later iteration: the ranges
- * are taken from the last iteration's to the first's, each shared out in
- * chunks and closed by a barrier.
+ * A node's slot is above its parent's, and a subtree's nodes below its
+ * root are the desc[] slots from its children's pair on. So a subtree is
+ * written by one pass over its slots in order, with no stack: each inner
+ * node leaves its children's records and places in their own slots (a
+ * stub, see stub_put), which the pass reaches later. Thread 0 writes the
+ * nodes above subtrees of at most `emit_cut` primitives, which become
+ * tasks that the team takes in turn. Only live records are read (most of
+ * the merge tree lies inside collapsed leaves) and the output is written
+ * in the order it is laid out in.
  */
+#include <string.h>
+
 #include "ploc.h"
 
 /* At most 64 primitives below a collapsed record: a walk of its subtree
  * holds at most one pending sibling per level, fewer than 2 * 64. */
 #define GATHER_STACK 128
-
-static void kill_children(ploc *p, const bvhlab_node *rec)
-{
-	if (rec->count & REC_PRIM)
-		return;
-	p->place[rec->first].slot = DEAD;
-	p->place[rec->first + 1].slot = DEAD;
-}
 
 /* The primitives below a collapsed record, left to right, from `first`. */
 static void gather(ploc *p, const bvhlab_node *rec, uint32_t first)
@@ -48,18 +47,34 @@ static void gather(ploc *p, const bvhlab_node *rec, uint32_t first)
 	}
 }
 
-static void emit_record(ploc *p, uint32_t x)
+/* A stub in an output slot not yet written: the record that goes there,
+ * its children's slot and its first primitive slot (in the box's bits).
+ * A stub with record DEAD tells the top pass to go on at slot `kids`. */
+static void stub_put(ploc *p, uint32_t slot, struct place pl)
 {
-	const bvhlab_node *rec = &p->tree[x];
-	struct place pl = p->place[x];
-	bvhlab_node *out;
-	uint32_t left;
+	bvhlab_node *n = &p->nodes[slot];
 
-	if (pl.slot == DEAD) {
-		kill_children(p, rec);
-		return;
-	}
-	out = &p->nodes[pl.slot];
+	n->first = pl.x;
+	n->count = pl.kids;
+	memcpy(&n->lo[0], &pl.first, sizeof(pl.first));
+}
+
+static struct place stub_get(const ploc *p, uint32_t slot)
+{
+	const bvhlab_node *n = &p->nodes[slot];
+	struct place pl = { .x = n->first, .slot = slot, .kids = n->count };
+
+	memcpy(&pl.first, &n->lo[0], sizeof(pl.first));
+	return pl;
+}
+
+/* The node of pl's record into its slot, and stubs for its children. */
+static void emit_place(ploc *p, struct place pl)
+{
+	const bvhlab_node *rec = &p->tree[pl.x];
+	bvhlab_node *out = &p->nodes[pl.slot];
+	uint32_t left = rec->first;
+
 	*out = *rec;
 	if (rec->count & (REC_PRIM | REC_COLLAPSED)) {
 		out->first = pl.first;
@@ -68,42 +83,68 @@ static void emit_record(ploc *p, uint32_t x)
 			p->prim_index[pl.first] = rec->first;
 		else
 			gather(p, rec, pl.first);
-		kill_children(p, rec);
 		return;
 	}
 	out->first = pl.kids;
 	out->count = 0;
-	left = rec->first;
-	p->place[left] = (struct place){ pl.kids, pl.kids + 2, pl.first };
-	p->place[left + 1] = (struct place){ pl.kids + 1, pl.kids + 2 + p->desc[left],
-	                                     pl.first + (p->tree[left].count & REC_PRIMS) };
+	stub_put(p, pl.kids, (struct place){ left, pl.kids, pl.kids + 2, pl.first });
+	stub_put(p, pl.kids + 1,
+	         (struct place){ left + 1, pl.kids + 1, pl.kids + 2 + p->desc[left],
+	                         pl.first + (p->tree[left].count & REC_PRIMS) });
 }
 
-/* The records of iteration it's pairs, chunk t of `chunks`. */
-static void emit_range(ploc *p, uint32_t it, unsigned chunks, unsigned t)
+static uint32_t below(const ploc *p, uint32_t x)
 {
-	uint32_t first = p->iter_first[it], lo, hi;
-	uint32_t size = (it ? p->iter_first[it - 1] : 2 * p->n - 1) - first;
-
-	team_chunk(chunks, t, size, &lo, &hi);
-	for (uint32_t x = first + lo; x < first + hi; x++)
-		emit_record(p, x);
+	return p->tree[x].count & (REC_PRIM | REC_COLLAPSED) ? 0 : p->desc[x];
 }
 
-/* The root and the small late iterations' ranges by thread 0 alone (as
- * they were clustered), then the large ones by the team. */
+/* A task: its root, then its other slots in order. */
+static void emit_task(ploc *p, struct place root)
+{
+	uint32_t end = root.kids + below(p, root.x);
+
+	emit_place(p, root);
+	for (uint32_t slot = root.kids; slot < end; slot++)
+		emit_place(p, stub_get(p, slot));
+}
+
+/* Thread 0: the nodes above the tasks, in slot order; a task's slots
+ * below its root are skipped (the stub at the first says how far). */
+static void emit_top(ploc *p)
+{
+	struct place pl = { 0, 0, 1, 0 };
+
+	p->task_count = 0;
+	for (uint32_t slot = 0; slot < p->node_count;) {
+		if (slot > 0)
+			pl = stub_get(p, slot);
+		if (pl.x == DEAD) {
+			slot = pl.kids;
+			continue;
+		}
+		if ((p->tree[pl.x].count & REC_PRIMS) <= p->emit_cut) {
+			p->tasks[p->task_count++] = pl;
+			if (below(p, pl.x))
+				stub_put(p, pl.kids, (struct place){ DEAD, 0,
+				                                   pl.kids + below(p, pl.x), 0 });
+		} else {
+			emit_place(p, pl);
+		}
+		slot++;
+	}
+}
+
 void ploc_emit(ploc *p, unsigned t)
 {
+	uint32_t lo, hi;
+
 	if (t == 0) {
-		p->place[0] = (struct place){ 0, 1, 0 };
-		emit_record(p, 0);
-		p->node_count = 1 + p->desc[0];
-		for (uint32_t it = p->iterations; it-- > p->solo_from;)
-			emit_range(p, it, 1, 0);
+		p->node_count = 1 + below(p, 0);
+		emit_top(p);
+		atomic_store_explicit(&p->blocks[0], 0, memory_order_relaxed);
 	}
 	team_sync(&p->team);
-	for (uint32_t it = p->solo_from; it-- > 0;) {
-		emit_range(p, it, p->team.threads, t);
-		team_sync(&p->team);
-	}
+	while (team_next_block(&p->blocks[0], p->task_count, 1, &lo, &hi))
+		emit_task(p, p->tasks[lo]);
+	team_sync(&p->team);
 }
