@@ -11,8 +11,8 @@
 
 static const bvhlab_option_decl options[] = {
 	{ .name = "batch", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "fraction of the nodes, those of largest cost, searched for a better "
-	          "place in each iteration",
+	  .help = "fraction of the nodes, those that hold their children worst (Bittner et "
+	          "al.'s measure), searched for a better place in each iteration",
 	  .def_float = 0.05, .min = 1e-6, .max = 1.0 },
 	{ .name = "iterations", .type = BVHLAB_OPTION_INT,
 	  .help = "most iterations (candidates chosen anew in each)",
@@ -70,6 +70,27 @@ static double cost_of(const bvhlab_node *n)
 	return node_area(n) * (n->count ? n->count : 1);
 }
 
+/*
+ * Bittner et al.'s measure of how badly a node holds its children: its
+ * area, times its area over their mean and over the least of theirs; a
+ * leaf's is its cost. As the batch's key it beat the cost alone (lbvh on
+ * igea subdivided once, 2 threads, batch 0.02 / 0.05 / 0.1 over 30 / 20 /
+ * 10 iterations: SAH 47.66 / 46.91 / 46.33 against 48.38 / 47.57 / 46.83
+ * in about the same time). A full batch takes every node either way.
+ */
+static double inefficiency(const reinsert *r, uint32_t x)
+{
+	const bvhlab_node *n = &r->nodes[x];
+	double a, l, h;
+
+	if (n->count)
+		return cost_of(n);
+	a = node_area(n);
+	l = node_area(&r->nodes[n->first]);
+	h = node_area(&r->nodes[n->first + 1]);
+	return a * (a / (0.5 * (l + h) + 1e-30)) * (a / ((l < h ? l : h) + 1e-30));
+}
+
 static int descending(const void *a, const void *b)
 {
 	uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -109,16 +130,16 @@ static void select_largest(uint64_t *keys, uint32_t n, uint32_t k, uint32_t *his
 	qsort(keys + mid, at - mid, sizeof(*keys), descending);
 }
 
-/* The batch: the nodes of largest cost, ties to the lower slot. Keys are
- * the cost's float bits (non-negative floats order as integers) above the
- * slot's complement. */
+/* The batch: the nodes of largest inefficiency, ties to the lower slot.
+ * Keys are its float bits (non-negative floats order as integers) above
+ * the slot's complement. */
 static void choose(reinsert *r, double batch)
 {
 	uint32_t n = r->node_count - 1, k = (uint32_t)(batch * n);
 
 	k = k < 1 ? 1 : k > n ? n : k;
 	for (uint32_t x = 1; x < r->node_count; x++) {
-		float c = (float)cost_of(&r->nodes[x]);
+		float c = (float)inefficiency(r, x);
 		uint32_t bits;
 
 		memcpy(&bits, &c, sizeof(bits));

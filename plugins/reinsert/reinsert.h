@@ -4,8 +4,9 @@
  * Havran 2013 (insertion-based optimisation) and the batched parallel form
  * of Meister & Bittner 2018. Each iteration:
  *
- *   1. candidates  the `batch` fraction of nodes with the largest cost
- *                  (surface area, times the primitive count for a leaf)
+ *   1. candidates  the `batch` fraction of nodes that hold their children
+ *                  worst: area x area / mean child area x area / least
+ *                  child area (Bittner et al.), a leaf's cost for a leaf
  *                  (reinsert.c)
  *   2. search      for every candidate, in parallel over the threads, the
  *                  node beside which it would cost least: what taking it
