@@ -133,11 +133,10 @@ static void first_clusters(ploc *p, unsigned t)
 	team_chunk(p->team.threads, t, p->n, &lo, &hi);
 	for (uint32_t k = lo; k < hi; k++) {
 		uint32_t id = morton_id(&p->sort, k);
+		const bvhlab_aabb *box = &p->in->prim_bounds[id];
 
 		if (k + GATHER_AHEAD < hi)
 			__builtin_prefetch(&p->in->prim_bounds[morton_id(&p->sort, k + GATHER_AHEAD)]);
-		const bvhlab_aabb *box = &p->in->prim_bounds[id];
-
 		for (int a = 0; a < 3; a++) {
 			c->lo[a][k] = box->lo[a];
 			c->hi[a][k] = box->hi[a];

@@ -93,15 +93,10 @@ static void emit_place(ploc *p, struct place pl)
 	                         pl.first + (p->tree[left].count & REC_PRIMS) });
 }
 
-static uint32_t below(const ploc *p, uint32_t x)
-{
-	return p->tree[x].count & (REC_PRIM | REC_COLLAPSED) ? 0 : p->desc[x];
-}
-
 /* A task: its root, then its other slots in order. */
 static void emit_task(ploc *p, struct place root)
 {
-	uint32_t end = root.kids + below(p, root.x);
+	uint32_t end = root.kids + p->desc[root.x];
 
 	emit_place(p, root);
 	for (uint32_t slot = root.kids; slot < end; slot++)
@@ -124,9 +119,8 @@ static void emit_top(ploc *p)
 		}
 		if ((p->tree[pl.x].count & REC_PRIMS) <= p->emit_cut) {
 			p->tasks[p->task_count++] = pl;
-			if (below(p, pl.x))
-				stub_put(p, pl.kids, (struct place){ DEAD, 0,
-				                                   pl.kids + below(p, pl.x), 0 });
+			if (p->desc[pl.x])
+				stub_put(p, pl.kids, (struct place){ DEAD, 0, pl.kids + p->desc[pl.x], 0 });
 		} else {
 			emit_place(p, pl);
 		}
@@ -139,7 +133,7 @@ void ploc_emit(ploc *p, unsigned t)
 	uint32_t lo, hi;
 
 	if (t == 0) {
-		p->node_count = 1 + below(p, 0);
+		p->node_count = 1 + p->desc[0];
 		emit_top(p);
 		atomic_store_explicit(&p->blocks[0], 0, memory_order_relaxed);
 	}
