@@ -345,7 +345,6 @@ static void test_optimal(uint32_t n)
 	bvhlab_scene_destroy(scene);
 }
 
-/* Every test of one stage, with the options it is tested with. */
 /* reinsert with its first move only (children off): the same checks on
  * a scene where moves are many (the stage's own run has both moves).
  * Not the soup under TSan: the threads share the same search code with
@@ -361,6 +360,7 @@ static void test_subtree_moves(void)
 	refiner_options = saved;
 }
 
+/* Every test of one stage, with the options it is tested with. */
 static void test_stage(const char *name, const char *options)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply" };

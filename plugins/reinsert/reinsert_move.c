@@ -110,8 +110,8 @@ static void put_node(reinsert *r, uint32_t slot, const bvhlab_node *n)
 	if (n->count == 0) {
 		log_slot(r, n->first);
 		log_slot(r, n->first + 1);
-		r->parent[n->first] = r->parent[n->first + 1] = slot;
 	}
+	adopt_children(r, slot);
 }
 
 /* Node c's content into slot `into`, beside what slot d held (moved to
