@@ -71,6 +71,13 @@ static inline void sbvh_job_empty(sbvh_job *j)
 	bvhlab_box_empty(j->clo, j->chi);
 }
 
+/* Whether a job's region has room for a reference more than it holds:
+ * the room a spatial split needs. */
+static inline bool sbvh_job_has_room(const sbvh_job *j)
+{
+	return j->rend - j->rbegin > j->end - j->begin;
+}
+
 /* Adds a reference to a job's box and centre bounds. */
 static inline void sbvh_job_grow(sbvh_job *j, const sbvh_ref *r)
 {

@@ -24,9 +24,7 @@ void sbvh_choose_object(const sbvh_build *B, const sbvh_job *job, const sbvh_bin
 
 bool sbvh_want_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_split *obj)
 {
-	uint32_t n = job->end - job->begin;
-
-	return n > 1 && job->rend - job->rbegin > n && sbvh_try_spatial(B, job, obj);
+	return job->end - job->begin > 1 && sbvh_job_has_room(job) && sbvh_try_spatial(B, job, obj);
 }
 
 void sbvh_choose_spatial(const sbvh_build *B, const sbvh_job *job, const sbvh_bins *bins,

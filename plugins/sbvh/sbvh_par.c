@@ -161,23 +161,22 @@ static void decide(team *tm, sbvh_split *obj, sbvh_split *best)
 	merge_bins(tm);
 	sbvh_choose_object(tm->B, tm->job, &tm->m[0].bins, obj);
 	*best = *obj;
-	uint32_t n = tm->job->end - tm->job->begin;
-	if (n >= tm->B->opt.lookahead && obj->kind == SPLIT_OBJECT &&
-	    tm->job->rend - tm->job->rbegin > n) {
-		/* The best spatial split whatever the object split's overlap
-		 * and cost, for sbvh_lookahead to weigh. */
+	bool ahead = tm->job->end - tm->job->begin >= tm->B->opt.lookahead &&
+	             obj->kind == SPLIT_OBJECT && sbvh_job_has_room(tm->job);
+	if (ahead || sbvh_want_spatial(tm->B, tm->job, obj)) {
 		sbvh_split sp = *obj;
-		sp.kind = SPLIT_LEAF;
-		sp.cost = INFINITY;
+		if (ahead) { /* the best spatial split whatever the object split's
+		              * overlap and cost, for sbvh_lookahead to weigh */
+			sp.kind = SPLIT_LEAF;
+			sp.cost = INFINITY;
+		}
 		run_phase(tm, PH_SPATIAL);
 		merge_bins(tm);
 		sbvh_choose_spatial(tm->B, tm->job, &tm->m[0].bins, &sp);
-		if (sp.kind == SPLIT_SPATIAL)
+		if (!ahead)
+			*best = sp;
+		else if (sp.kind == SPLIT_SPATIAL)
 			*best = *sbvh_lookahead(tm->B, tm->job, obj, &sp, &tm->m[0].bins);
-	} else if (sbvh_want_spatial(tm->B, tm->job, obj)) {
-		run_phase(tm, PH_SPATIAL);
-		merge_bins(tm);
-		sbvh_choose_spatial(tm->B, tm->job, &tm->m[0].bins, best);
 	}
 	sbvh_choose_final(tm->B, tm->job, best);
 	sbvh_choose_final(tm->B, tm->job, obj);

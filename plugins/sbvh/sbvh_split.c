@@ -66,6 +66,13 @@ static float object_scale(const float clo[3], const float chi[3], int k, uint32_
 	return ext > 0.0f ? (float)bins * 0.99999f / ext : 0.0f;
 }
 
+/* Grows bin j of axis k by a reference's box, loaded as two vectors. */
+static inline void bin_grow(sbvh_bins *b, int k, uint32_t j, v4 lo, v4 hi)
+{
+	v4_store(b->lo[k][j], v4_min(v4_load(b->lo[k][j]), lo));
+	v4_store(b->hi[k][j], v4_max(v4_load(b->hi[k][j]), hi));
+}
+
 /* One pass for the three axes: a reference is read once, and its box
  * grows each axis's bin with one vector min and max (a reference's lo and
  * hi are each followed by a 32-bit field, so four floats are readable). */
@@ -90,8 +97,7 @@ void sbvh_bin_object_refs(const sbvh_ref *refs, uint32_t bins, const float clo[3
 		for (int k = 0; k < 3; k++) {
 			uint32_t j = object_bin(r, k, clo[k], scale[k], bins);
 
-			v4_store(b->lo[k][j], v4_min(v4_load(b->lo[k][j]), lo));
-			v4_store(b->hi[k][j], v4_max(v4_load(b->hi[k][j]), hi));
+			bin_grow(b, k, j, lo, hi);
 			b->count[k][j]++;
 		}
 	}
@@ -220,8 +226,7 @@ void sbvh_bin_spatial(const sbvh_build *B, const sbvh_job *job, uint32_t begin,
 			uint32_t b1 = spatial_bin(&g, job, k, r->hi[k], bins);
 
 			if (b0 == b1) {
-				v4_store(b->lo[k][b0], v4_min(v4_load(b->lo[k][b0]), v4_load(r->lo)));
-				v4_store(b->hi[k][b0], v4_max(v4_load(b->hi[k][b0]), v4_load(r->hi)));
+				bin_grow(b, k, b0, v4_load(r->lo), v4_load(r->hi));
 				b->count[k][b0]++;
 				b->exits[k][b0]++;
 			} else {
