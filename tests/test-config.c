@@ -107,7 +107,8 @@ static void test_full(void)
 		"  \"repeat\": 7, \"warmup\": 0,\n"
 		"  \"threads\": [0, 2, 4],\n"
 		"  \"validate\": false, \"validate_rays\": 100,\n"
-		"  \"rays\": { \"width\": 64, \"height\": 32, \"diffuse\": 3, \"camera\": {"
+		"  \"rays\": { \"width\": 64, \"height\": 32, \"diffuse\": 3, \"rounds\": 3,"
+		" \"camera\": {"
 		" \"position\": [1, 2, 3], \"target\": [0, 0.5, 0], \"up\": [0, 0, 1], \"fov\": 30 } },\n"
 		"  \"images\": true,\n"
 		"  \"scenes\": [\n"
@@ -134,6 +135,7 @@ static void test_full(void)
 	CHECK(cfg.threads[0] == 0 && cfg.threads[1] == 2 && cfg.threads[2] == 4);
 	CHECK(!cfg.validate && cfg.images && cfg.validate_rays == 100);
 	CHECK(cfg.ray_width == 64 && cfg.ray_height == 32 && cfg.ray_diffuse == 3);
+	CHECK(cfg.ray_rounds == 3);
 	const bvhlab_camera *cam = &cfg.camera;
 	CHECK(cfg.has_camera && cam->fov_deg == 30.0f && cam->position[2] == 3.0f);
 	CHECK(cam->target[1] == 0.5f && cam->up[1] == 0.0f && cam->up[2] == 1.0f);
@@ -182,6 +184,7 @@ static void test_defaults(void)
 	CHECK(cfg.repeat == 5 && cfg.warmup == 1 && cfg.thread_count == 1 && cfg.threads[0] == 1);
 	CHECK(cfg.validate && !cfg.images && cfg.validate_rays == 256);
 	CHECK(cfg.ray_width == 256 && cfg.ray_height == 256 && cfg.ray_diffuse == 1);
+	CHECK(cfg.ray_min_ms == 200 && cfg.ray_rounds == 8);
 	CHECK(strcmp(cfg.scenes[0].name, "icosphere") == 0 && cfg.scenes[0].subdivide == 0);
 	CHECK(memcmp(&cfg.scenes[0].gen, &gen, sizeof(gen)) == 0);
 	CHECK(strcmp(cfg.builders[0].name, "sah_seq") == 0 && !cfg.builders[0].threads);
@@ -304,7 +307,7 @@ static void test_unknown_keys(void)
 	             "timeout_s, memory_limit_mb, options, optional, refine); did you mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
-	                "diffuse, camera, threads, min_ms, traversal); did you mean 'width'?");
+	                "diffuse, camera, threads, min_ms, rounds, traversal); did you mean 'width'?");
 }
 
 static void test_types(void)
@@ -338,6 +341,10 @@ static void test_types(void)
 	EXPECT_ERROR_AT(t, "0 }", 0, "'rays.width' must be a positive integer, not 0");
 	t = TOP("\"rays\": { \"height\": 16385 }");
 	EXPECT_ERROR_AT(t, "16385", 0, "'rays.height' must be a positive integer up to 16384");
+	t = TOP("\"rays\": { \"rounds\": 0 }");
+	EXPECT_ERROR_AT(t, "0 }", 0, "'rays.rounds' must be a positive integer, not 0");
+	t = TOP("\"rays\": { \"rounds\": 1001 }");
+	EXPECT_ERROR_AT(t, "1001", 0, "'rays.rounds' must be a positive integer up to 1000");
 	t = TOP("\"rays\": [1]");
 	EXPECT_ERROR_AT(t, "[1]", 0, "'rays' must be an object");
 	t = "{ \"builders\": [ { \"plugin\": \"a\", \"threads\": [true] } ], " SCENES " }";

@@ -17,6 +17,7 @@
 #define DEFAULT_TIMEOUT_S 600
 /* Long enough that a pass of a few ms is repeated dozens of times. */
 #define DEFAULT_RAY_MIN_MS 200.0
+#define DEFAULT_RAY_ROUNDS 8
 
 static int out_of_memory(const char *path, bvhlab_error *err)
 {
@@ -36,6 +37,7 @@ static int set_defaults(struct config *cfg)
 	cfg->ray_diffuse = 1;
 	cfg->ray_threads = 1;
 	cfg->ray_min_ms = DEFAULT_RAY_MIN_MS;
+	cfg->ray_rounds = DEFAULT_RAY_ROUNDS;
 	cfg->ray_traversals = 1u << BVHLAB_TRAVERSAL_WIDE;
 	cfg->ray_traversal = BVHLAB_TRAVERSAL_WIDE;
 	cfg->report_reference = strdup("sah_seq");

@@ -99,6 +99,9 @@ struct config {
 	                                              * default 256, 256, 1 */
 	uint32_t ray_threads; /* "rays": "threads", default 1; 0 = all hardware threads */
 	double ray_min_ms; /* "rays": "min_ms", default 200: each batch repeated this long */
+	uint32_t ray_rounds; /* "rays": "rounds", default 8: min_ms is spread over this many
+	                      * slices, interleaved over a scene's trees (1: each run's
+	                      * batches timed in one stretch in its own child) */
 	unsigned ray_traversals; /* "rays": "traversal" wide|stack|stackless|both or an array
 	                          * of names, default wide: bit (1 << enum
 	                          * bvhlab_traversal) per traversal */

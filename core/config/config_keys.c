@@ -17,6 +17,7 @@
 #define MAX_RAY_SIDE 16384
 #define MAX_DIFFUSE 1024
 #define MAX_RAY_THREADS 1024
+#define MAX_RAY_ROUNDS 1000
 /* 16 subdivisions turn one triangle into 4^16 = 2^32, past a uint32_t count. */
 #define MAX_SUBDIVIDE 15
 
@@ -55,6 +56,7 @@ const struct config_key config_ray_keys[] = {
 	CUSTOM("camera"),
 	TOP("threads", CONFIG_U32, ray_threads, 0, MAX_RAY_THREADS),
 	TOP("min_ms", CONFIG_POSITIVE, ray_min_ms, 0, 0),
+	TOP("rounds", CONFIG_U32, ray_rounds, 1, MAX_RAY_ROUNDS),
 	CUSTOM("traversal"), /* a name, "both" or an array of names: config.c */
 	END,
 };

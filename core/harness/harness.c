@@ -14,6 +14,7 @@
 
 #include "harness/harness.h"
 #include "harness/harness_builders.h"
+#include "harness/harness_rounds.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
 #include "output/results.h"
@@ -36,6 +37,8 @@ struct harness {
 	struct progress progress;
 	bool all_ok;
 	bool shade_done; /* this scene's shaded render is on its way */
+	bool rounds_on;  /* this scene's rays are timed in interleaved rounds */
+	struct harness_rounds rounds; /* this scene's trees waiting for them */
 };
 
 enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };
@@ -56,6 +59,7 @@ struct series_report {
 	struct build_memory memory;
 	struct ray_metrics rays;
 	bool heat_written, shade_written;
+	bool tree_written; /* the tree is in the job's tree_path */
 	uint32_t stage_count;
 	struct stage_metrics stages[HARNESS_MAX_STAGES];
 	char error[sizeof(((bvhlab_error *)0)->message)];
@@ -71,6 +75,7 @@ struct series_job {
 	uint32_t threads;
 	const char *heat_path;  /* where the child leaves nodes per pixel, or NULL */
 	const char *shade_path; /* where it leaves the shaded render, or NULL */
+	const char *tree_path;  /* where it leaves its tree for the rounds, or NULL */
 };
 
 static uint32_t resolve_threads(uint32_t t)
@@ -206,6 +211,10 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		return;
 	harness_camera(cfg, job->scene, &cam);
 	harness_ray_settings(cfg, &rs);
+	if (job->tree_path) { /* a provisional timing: the rounds measure again */
+		rs.min_ms /= rs.rounds;
+		rs.min_repeats = 1;
+	}
 	int r = image_buffers(job, n, &nodes, &shade);
 	if (r == 0)
 		r = harness_trace_rays(tree, job->scene, &cam, &rs, &rep->rays, nodes, shade);
@@ -213,6 +222,8 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)
 		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
+	if (r == 0 && job->tree_path)
+		rep->tree_written = harness_rounds_write_tree(job->tree_path, tree) == 0;
 	if (r < 0)
 		error_set(err, "tracing rays: %s", strerror(-r));
 	free(nodes);
@@ -330,6 +341,20 @@ static void image_paths(struct harness *h, struct series_job *job, size_t scene_
 		job->shade_path = paths[1];
 }
 
+/* A tree the child left for the rounds joins them if its run is ok. */
+static void queue_tree(struct harness *h, const struct series_job *job,
+                       const struct run_record *run, const struct series_report *rep)
+{
+	const bvhlab_builder *desc = bvhlab_plugin_builder(job->hb->plugin);
+	bool dup = desc->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
+	if (!job->tree_path)
+		return;
+	if (!rep->tree_written || strcmp(run->status, "ok") != 0 || !run->rays ||
+	    harness_rounds_add(&h->rounds, job->tree_path, run->builder, run->threads, dup,
+	                       &rep->rays) < 0)
+		unlink(job->tree_path);
+}
+
 static void run_one(struct harness *h, struct series_job *job, size_t scene_index,
                     size_t builder_index, size_t thread_index)
 {
@@ -340,7 +365,7 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 	                         .plugin = desc->name, .threads = resolve_threads(job->threads),
 	                         .opts = &job->hb->opts, .status = "failed",
 	                         .triangles = job->scene->triangle_count};
-	char paths[2][4096];
+	char paths[2][4096], tree_path[4096];
 	if (skip_run(h, run.id, run.scene, run.builder, run.threads))
 		return;
 	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double);
@@ -351,8 +376,12 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 		return;
 	}
 	image_paths(h, job, scene_index, builder_index, first, paths);
+	if (h->rounds_on && harness_rounds_path(tree_path, sizeof(tree_path), h->cfg->output,
+	                                        scene_index, run.id) == 0)
+		job->tree_path = tree_path;
 	progress_start(&h->progress, &run);
 	run_series(h, job, &run, rep, size);
+	queue_tree(h, job, &run, rep);
 	h->shade_done = h->shade_done || (job->shade_path && rep->shade_written);
 	free(rep);
 }
@@ -375,6 +404,51 @@ static void run_builders(struct harness *h, const bvhlab_scene *scene,
 			run_one(h, &job, scene_index, b, t);
 		}
 	}
+}
+
+/* The runs of a scene still to do here. */
+static size_t scene_runs(const struct harness *h, size_t scene_index)
+{
+	size_t runs = 0;
+	for (size_t b = 0; b < h->cfg->builder_count; b++) {
+		size_t n;
+		builder_threads(h, &h->cfg->builders[b], &n);
+		for (size_t t = 0; t < n; t++)
+			runs += !h->only || h->only[plan_run_id(h->cfg, scene_index, b, t)];
+	}
+	return runs;
+}
+
+static void rounds_start(struct harness *h, const bvhlab_scene *scene, size_t scene_index)
+{
+	size_t runs = scene_runs(h, scene_index);
+	h->rounds_on = harness_rounds_fit(h->cfg, scene->triangle_count, runs);
+	if (!h->rounds_on && h->cfg->ray_rounds > 1 && h->cfg->ray_width && h->cfg->ray_height)
+		fprintf(stderr, "%sbvhlab: scene '%s': %zu trees of %u triangles would not fit in half "
+		        "of this machine's memory for interleaved ray rounds; each run times its "
+		        "rays alone (rays.rounds 1)\n", h->progress.tty ? "\n" : "", scene->name, runs,
+		        scene->triangle_count);
+}
+
+/* The interleaved rounds over the scene's trees; their timings replace the
+ * runs' provisional ones in the results. */
+static void rounds_end(struct harness *h, const bvhlab_scene *scene, const bvhlab_prims *prims)
+{
+	bvhlab_error err = {{0}};
+	int r = harness_rounds_run(&h->rounds, h->cfg, scene, prims, &err);
+	for (size_t i = 0; r == 0 && i < h->rounds.count; i++) {
+		const struct rounds_entry *e = &h->rounds.entries[i];
+		if (e->timed)
+			r = results_set_run_rays(&h->res, scene->name, e->builder, e->threads, &e->rays);
+	}
+	if (r == 0 && h->rounds.count)
+		r = results_write(&h->res, &err);
+	if (r < 0)
+		fprintf(stderr, "%sbvhlab: scene '%s': interleaved ray rounds: %s; its runs keep "
+		        "their provisional ray timings (rays.rounds 1)\n", h->progress.tty ? "\n" : "",
+		        scene->name, err.message[0] ? err.message : strerror(-r));
+	harness_rounds_clear(&h->rounds);
+	h->rounds_on = false;
 }
 
 /* Turns the children's raw files into the scene's PNGs. */
@@ -429,7 +503,9 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	                  scene->triangle_count, NULL);
 	free(shown);
 	h->shade_done = false;
+	rounds_start(h, scene, scene_index);
 	run_builders(h, scene, &prims, scene_index);
+	rounds_end(h, scene, &prims);
 	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)
 		scene_images(h, scene, scene_index);
 out:
@@ -495,6 +571,7 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 		run_scene(&h, &cfg->scenes[s], s);
 	progress_finish(&h.progress);
 	harness_close_builders(cfg, h.builders);
+	harness_rounds_finish(&h.rounds);
 	results_finish(&h.res);
 	return r < 0 ? r : h.all_ok ? 0 : 1;
 }

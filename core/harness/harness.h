@@ -78,12 +78,20 @@ void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree);
 
 struct ray_metrics; /* output/results.h */
 
+/* Each tile keeps its best of at least this many passes (see
+ * bvhlab_trace_timing): enough chances to run undisturbed. */
+#define HARNESS_MIN_REPEATS 10
+/* Diffuse rays: the same for every builder of a scene. */
+#define HARNESS_DIFFUSE_SEED 0xd1ff05eULL
+
 /* What rays a run is measured with: the config's "rays". */
 struct ray_settings {
 	uint32_t width, height; /* primary rays: one per pixel */
 	uint32_t diffuse;       /* bounces per primary hit */
 	uint32_t threads;       /* tracing threads; 0: all hardware threads */
 	double min_ms;          /* each batch is repeated for at least this long */
+	uint32_t min_repeats;   /* ... and at least this many passes */
+	uint32_t rounds;        /* slices min_ms is spread over (harness_rounds.c) */
 	unsigned traversals;    /* bit (1 << enum bvhlab_traversal) for each one measured */
 	int main;               /* the traversal whose hits feed images and diffuse rays */
 };

@@ -16,10 +16,6 @@
 #include "output/results.h"
 #include "util/util.h"
 
-#define DIFFUSE_SEED 0xd1ff05eULL
-/* Each tile keeps its best of at least this many passes (see
- * bvhlab_trace_timing): enough chances to run undisturbed. */
-#define MIN_REPEATS 10
 
 void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam)
 {
@@ -33,12 +29,13 @@ void harness_ray_settings(const struct config *cfg, struct ray_settings *rs)
 {
 	if (!cfg) {
 		*rs = (struct ray_settings){.traversals = 1u << BVHLAB_TRAVERSAL_STACK,
-		                            .main = BVHLAB_TRAVERSAL_STACK};
+		                            .main = BVHLAB_TRAVERSAL_STACK, .rounds = 1};
 		return;
 	}
 	*rs = (struct ray_settings){.width = cfg->ray_width, .height = cfg->ray_height,
 	                            .diffuse = cfg->ray_diffuse, .threads = cfg->ray_threads,
-	                            .min_ms = cfg->ray_min_ms, .traversals = cfg->ray_traversals,
+	                            .min_ms = cfg->ray_min_ms, .min_repeats = HARNESS_MIN_REPEATS,
+	                            .rounds = cfg->ray_rounds, .traversals = cfg->ray_traversals,
 	                            .main = cfg->ray_traversal};
 }
 
@@ -60,7 +57,7 @@ static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
                       struct ray_metrics *m)
 {
 	bvhlab_trace_options o = {.traversal = rs->main, .threads = rs->threads,
-	                          .min_ms = rs->min_ms, .min_repeats = MIN_REPEATS};
+	                          .min_ms = rs->min_ms, .min_repeats = rs->min_repeats};
 	int r = bvhlab_trace_measure(tree, scene, rays, n, &o, hits, nodes, &out[rs->main]);
 	m->threads = out[rs->main].threads;
 	for (int k = 0; r == 0 && k < BVHLAB_TRAVERSAL_COUNT; k++) {
@@ -83,7 +80,7 @@ static int trace_diffuse(const bvhlab_tree *tree, const bvhlab_scene *scene,
 {
 	bvhlab_ray *rays = NULL;
 	size_t count = 0;
-	int r = bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, DIFFUSE_SEED, &rays,
+	int r = bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, HARNESS_DIFFUSE_SEED, &rays,
 	                            &count);
 	bvhlab_hit *dh = r == 0 && count ? malloc(count * sizeof(*dh)) : NULL;
 	if (r == 0 && count)
@@ -102,6 +99,7 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	memset(m, 0, sizeof(*m));
 	m->traversals = rs->traversals;
 	m->main = rs->main;
+	m->rounds = 1;
 	int r = bvhlab_rays_primary(cam, rs->width, rs->height, &rays);
 	if (r < 0)
 		return r;

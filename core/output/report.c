@@ -262,7 +262,8 @@ char *report_markdown(const cJSON *doc)
 	               "threads for every run, whatever its build thread count, so traversal "
 	               "numbers compare trees; Mrays/s: rays per CPU second of the tracing "
 	               "threads times their number, each tile of rays at its best of the "
-	               "repeated passes, by the run's rays.traversal (default wide: the tree "
+	               "repeated passes (spread over rays.rounds rounds taken in turn by the "
+	               "scene's trees), by the run's rays.traversal (default wide: the tree "
 	               "collapsed into 4-child nodes); nodes and triangles per ray are the "
 	               "binary tree's, counted by the stack traversal, whichever is timed.\n",
 	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),

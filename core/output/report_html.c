@@ -274,7 +274,8 @@ char *report_html(const cJSON *doc)
 	               "Rays are traced with the same threads for every run, so traversal "
 	               "numbers compare trees, not thread counts; Mrays/s: rays per CPU "
 	               "second of the tracing threads times their number, each tile of rays "
-	               "at its best of the repeated passes (min–max: whole passes), by the "
+	               "at its best of the repeated passes (spread over rounds taken in turn "
+	               "by the scene's trees; min–max: whole passes), by the "
 	               "run's traversal (default wide: the tree collapsed into 4-child "
 	               "nodes); nodes and triangles per ray are the binary tree's, counted "
 	               "by the stack traversal, whichever is timed.</p>\n",

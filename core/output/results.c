@@ -474,6 +474,25 @@ int results_set_run_image(struct results *res, const char *scene, const char *bu
 	return -ENOENT;
 }
 
+int results_set_run_rays(struct results *res, const char *scene, const char *builder,
+                         uint32_t threads, const struct ray_metrics *m)
+{
+	cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
+		if (!run_matches(run, scene, builder, threads))
+			continue;
+		cJSON *rays = results_rays_json(m);
+		if (!rays)
+			return -ENOMEM;
+		if (!cJSON_ReplaceItemInObjectCaseSensitive(run, "rays", rays)) {
+			cJSON_Delete(rays);
+			return -ENOENT;
+		}
+		return 0;
+	}
+	return -ENOENT;
+}
+
 int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err)
 {
 	char *text = NULL;

@@ -31,6 +31,8 @@ struct ray_metrics {
 	uint32_t threads;      /* the threads that traced them */
 	unsigned traversals;   /* bit (1 << enum bvhlab_traversal) for each one measured */
 	int main;              /* the traversal "primary"/"diffuse" report */
+	uint32_t rounds;       /* interleaved rounds the timings are spread over
+	                        * (harness_rounds.c); 1: one stretch in the run's child */
 	/* by enum bvhlab_traversal */
 	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
 	uint64_t disagreements; /* rays whose hits differ from the main traversal's */
@@ -104,6 +106,11 @@ int results_set_scene_image(struct results *res, const char *scene, const char *
 /* The run's "heat_image": name. */
 int results_set_run_image(struct results *res, const char *scene, const char *builder,
                           uint32_t threads, const char *name);
+
+/* Replaces the run's "rays" (the interleaved rounds' timings come after
+ * the run was recorded). -ENOENT when there is no such run. */
+int results_set_run_rays(struct results *res, const char *scene, const char *builder,
+                         uint32_t threads, const struct ray_metrics *m);
 
 /*
  * Takes over the finished runs (any status of docs/design.md's list) and the

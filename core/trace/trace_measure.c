@@ -5,17 +5,21 @@
  * milliseconds, short enough for a scheduler hiccup or another process to
  * decide the figure; the median of many passes is what stays put between
  * runs on a shared machine. The counters come from one pass, so per-ray
- * averages stay exact.
+ * averages stay exact. A measurement is a series of slices
+ * (trace_series.h): one for bvhlab_trace_measure, one per round for the
+ * harness's interleaved rounds.
  */
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <bvhlab/machine.h>
 #include <bvhlab/traversal.h>
 
 #include "trace/trace_batch.h"
 #include "trace/trace_kernel.h"
+#include "trace/trace_series.h"
 #include "util/util.h"
 
 #define DEFAULT_MAX_REPEATS 10000
@@ -63,14 +67,11 @@ static double pass(struct batch *b, struct worker *w, uint32_t threads,
 	return seconds;
 }
 
-/* seconds: the tracing threads' CPU time so far (per thread), so a busy
+/* seconds: the slice's tracing CPU time so far (per thread), so a busy
  * machine stretches the wall time of a measurement, not shrinks it. */
 static bool more(const bvhlab_trace_options *o, uint32_t done, double seconds, uint64_t rays)
 {
-	uint32_t max = o->max_repeats ? o->max_repeats : DEFAULT_MAX_REPEATS;
 	uint32_t min = o->min_repeats ? o->min_repeats : 1;
-	if (done >= max)
-		return false;
 	if (seconds * 1e3 < o->min_ms || rays < o->min_rays)
 		return true;
 	/* min_repeats gives way once passes are so slow that they took ten
@@ -78,13 +79,20 @@ static bool more(const bvhlab_trace_options *o, uint32_t done, double seconds, u
 	return done < min && seconds * 1e3 < MIN_REPEATS_CAP * o->min_ms;
 }
 
-/* Median, min and max of n samples (sorts them). */
-static void summarise(double *x, uint32_t n, double *median, double *min, double *max)
+/* Median, min and max of n samples (sorts a copy). */
+static void summarise(const double *x, uint32_t n, double *median, double *min, double *max)
 {
-	qsort(x, n, sizeof(*x), cmp_double);
-	*min = x[0];
-	*max = x[n - 1];
-	*median = n % 2 ? x[n / 2] : 0.5 * (x[n / 2 - 1] + x[n / 2]);
+	double *y = malloc(n * sizeof(*y));
+	if (!y || n == 0) {
+		free(y);
+		return;
+	}
+	memcpy(y, x, n * sizeof(*y));
+	qsort(y, n, sizeof(*y), cmp_double);
+	*min = y[0];
+	*max = y[n - 1];
+	*median = n % 2 ? y[n / 2] : 0.5 * (y[n / 2 - 1] + y[n / 2]);
+	free(y);
 }
 
 static double mrays(size_t rays, double seconds)
@@ -92,16 +100,31 @@ static double mrays(size_t rays, double seconds)
 	return seconds > 0 ? (double)rays / seconds * 1e-6 : 0;
 }
 
-static int grow(double **a, double **b, uint32_t *cap)
+struct trace_series {
+	struct batch b;
+	struct worker *w;
+	uint32_t threads;
+	uint32_t max_repeats;
+	uint32_t *parents;      /* stackless: the tree's parent links */
+	double *best;           /* [tiles] least CPU seconds of each tile so far */
+	double *cpu, *wall;     /* [cap] Mrays/s of each pass on either clock */
+	uint32_t n, cap;
+	bool counted;           /* stats hold the counters of one pass */
+	bvhlab_trace_stats stats;
+	double seconds_total;
+};
+
+static int grow(struct trace_series *s)
 {
-	double *ga = realloc(*a, 2 * *cap * sizeof(**a));
-	if (ga)
-		*a = ga;
-	double *gb = ga ? realloc(*b, 2 * *cap * sizeof(**b)) : NULL;
-	if (!gb)
+	uint32_t cap = s->cap ? 2 * s->cap : 64;
+	double *cpu = realloc(s->cpu, cap * sizeof(*cpu));
+	if (cpu)
+		s->cpu = cpu;
+	double *wall = cpu ? realloc(s->wall, cap * sizeof(*wall)) : NULL;
+	if (!wall)
 		return -ENOMEM;
-	*b = gb;
-	*cap *= 2;
+	s->wall = wall;
+	s->cap = cap;
 	return 0;
 }
 
@@ -112,100 +135,176 @@ static void keep_best(const double *tile, double *best, size_t tiles)
 		best[i] = tile[i] < best[i] ? tile[i] : best[i];
 }
 
-static int run_passes(struct batch *b, struct worker *w, uint32_t threads,
-                      const bvhlab_trace_options *o, bvhlab_trace_timing *t)
+/* One timed pass into the series' samples; its CPU seconds per thread. */
+static double timed_pass(struct trace_series *s)
 {
-	uint32_t cap = 64, n = 0;
-	double cpu_total = 0;
-	size_t tiles = trace_tiles(b->count);
-	double *cpu = malloc(cap * sizeof(*cpu)), *wall = malloc(cap * sizeof(*wall));
-	double *best = malloc(tiles * sizeof(*best));
-	b->tile_cpu = malloc(tiles * sizeof(*b->tile_cpu));
-	int r = cpu && wall && best && b->tile_cpu ? 0 : -ENOMEM;
-	for (size_t i = 0; r == 0 && i < tiles; i++)
-		best[i] = INFINITY;
-	while (r == 0) {
-		bvhlab_trace_stats st;
-		double c, s = pass(b, w, threads, &st, &c);
-		if (n == 0) {
-			if (b->traversal != BVHLAB_TRAVERSAL_WIDE)
-				t->stats = st;
-			b->hits = NULL; /* filled once; later passes only time */
-			b->nodes = NULL;
-		}
-		keep_best(b->tile_cpu, best, tiles);
-		cpu[n] = mrays(b->count, c / threads);
-		wall[n++] = mrays(b->count, s);
-		t->seconds_total += s;
-		cpu_total += c / threads;
-		if (!more(o, n, cpu_total, (uint64_t)n * b->count))
+	bvhlab_trace_stats st;
+	double c, w = pass(&s->b, s->w, s->threads, &st, &c);
+	if (!s->counted) {
+		if (s->b.traversal != BVHLAB_TRAVERSAL_WIDE)
+			s->stats = st;
+		s->counted = true;
+		s->b.hits = NULL; /* filled once; later passes only time */
+		s->b.nodes = NULL;
+	}
+	keep_best(s->b.tile_cpu, s->best, trace_tiles(s->b.count));
+	s->cpu[s->n] = mrays(s->b.count, c / s->threads);
+	s->wall[s->n++] = mrays(s->b.count, w);
+	s->seconds_total += w;
+	return c / s->threads;
+}
+
+int trace_series_slice(struct trace_series *s, const bvhlab_trace_options *o)
+{
+	double cpu_s = 0;
+	uint32_t done = 0;
+	if (s->b.count == 0)
+		return 0;
+	while (s->n < s->max_repeats) {
+		if (s->n == s->cap && grow(s) < 0)
+			return s->n ? 0 : -ENOMEM; /* the passes so far still make a median */
+		cpu_s += timed_pass(s);
+		done++;
+		if (!more(o, done, cpu_s, (uint64_t)done * s->b.count))
 			break;
-		if (n == cap && grow(&cpu, &wall, &cap) < 0)
-			break; /* the passes so far still make a median */
 	}
-	if (r == 0) {
-		double sum = 0;
-		for (size_t i = 0; i < tiles; i++)
-			sum += best[i];
-		t->repeats = n;
-		t->mrays_best = mrays(b->count, sum / threads);
-		summarise(cpu, n, &t->mrays_median, &t->mrays_min, &t->mrays_max);
-		summarise(wall, n, &t->wall_mrays_median, &t->wall_mrays_min, &t->wall_mrays_max);
-	}
-	free(cpu);
-	free(wall);
-	free(best);
-	free(b->tile_cpu);
-	b->tile_cpu = NULL;
-	return r;
+	return 0;
+}
+
+void trace_series_timing(const struct trace_series *s, bvhlab_trace_timing *t)
+{
+	*t = (bvhlab_trace_timing){.stats = s->stats, .threads = s->threads, .repeats = s->n,
+	                           .seconds_total = s->seconds_total};
+	if (s->n == 0)
+		return;
+	double sum = 0;
+	for (size_t i = 0; i < trace_tiles(s->b.count); i++)
+		sum += s->best[i];
+	t->mrays_best = mrays(s->b.count, sum / s->threads);
+	summarise(s->cpu, s->n, &t->mrays_median, &t->mrays_min, &t->mrays_max);
+	summarise(s->wall, s->n, &t->wall_mrays_median, &t->wall_mrays_min, &t->wall_mrays_max);
 }
 
 /* The wide traversal's untimed pass of the stack traversal, for counters
  * of the binary tree; then the wide nodes for the timed passes. */
-static int count_binary(const bvhlab_tree *tree, const bvhlab_scene *scene, struct batch *b,
-                        struct worker *w, uint32_t threads, bvhlab_trace_timing *t)
+static int count_binary(struct trace_series *s)
 {
+	struct batch *b = &s->b;
 	bvhlab_hit *hits = b->hits;
 	double cpu;
 	b->traversal = BVHLAB_TRAVERSAL_STACK;
 	b->hits = NULL;
-	pass(b, w, threads, &t->stats, &cpu);
+	pass(b, s->w, s->threads, &s->stats, &cpu);
 	b->traversal = BVHLAB_TRAVERSAL_WIDE;
 	b->hits = hits;
 	b->nodes = NULL;
-	return trace_view_wide(tree, scene, &b->view);
+	return trace_view_wide(b->tree, b->scene, &b->view);
+}
+
+void trace_series_destroy(struct trace_series *s)
+{
+	if (!s)
+		return;
+	trace_view_free(&s->b.view);
+	free(s->parents);
+	free(s->w);
+	free(s->best);
+	free(s->b.tile_cpu);
+	free(s->cpu);
+	free(s->wall);
+	free(s);
+}
+
+static int series_views(struct trace_series *s, int traversal)
+{
+	if (traversal == BVHLAB_TRAVERSAL_STACKLESS) {
+		int r = bvhlab_tree_parents(s->b.tree, &s->parents);
+		if (r < 0)
+			return r;
+	}
+	int r = trace_view_copy(s->b.tree, s->b.scene, &s->b.view);
+	s->b.view.parents = s->parents;
+	if (r == 0 && traversal == BVHLAB_TRAVERSAL_WIDE && s->b.count)
+		r = count_binary(s);
+	return r;
+}
+
+/* A series with its buffers but no tracing copies yet. */
+static struct trace_series *series_alloc(const struct batch *b, uint32_t threads,
+                                         uint32_t max_repeats)
+{
+	struct trace_series *s = calloc(1, sizeof(*s));
+	if (!s)
+		return NULL;
+	s->b = *b;
+	atomic_init(&s->b.next, 0);
+	s->threads = trace_thread_count(threads, b->count);
+	s->max_repeats = max_repeats ? max_repeats : DEFAULT_MAX_REPEATS;
+	size_t tiles = trace_tiles(b->count);
+	s->w = calloc(s->threads, sizeof(*s->w));
+	s->best = malloc((tiles ? tiles : 1) * sizeof(*s->best));
+	s->b.tile_cpu = malloc((tiles ? tiles : 1) * sizeof(*s->b.tile_cpu));
+	if (!s->w || !s->best || !s->b.tile_cpu) {
+		trace_series_destroy(s);
+		return NULL;
+	}
+	for (size_t i = 0; i < tiles; i++)
+		s->best[i] = INFINITY;
+	return s;
+}
+
+int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                        const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
+                        bvhlab_hit *hits, uint32_t *nodes, struct trace_series **out)
+{
+	*out = NULL;
+	if (!bvhlab_traversal_name(opts->traversal))
+		return -EINVAL;
+	struct batch b = {.tree = tree, .scene = scene, .rays = rays, .count = count,
+	                  .any = opts->any_hit, .traversal = opts->traversal, .hits = hits,
+	                  .nodes = nodes};
+	struct trace_series *s = series_alloc(&b, opts->threads, opts->max_repeats);
+	if (!s)
+		return -ENOMEM;
+	int r = series_views(s, opts->traversal);
+	if (r < 0) {
+		trace_series_destroy(s);
+		return r;
+	}
+	*out = s;
+	return 0;
+}
+
+int trace_series_create_like(const struct trace_series *base, const bvhlab_ray *rays,
+                             size_t count, struct trace_series **out)
+{
+	struct batch b = base->b;
+	b.rays = rays;
+	b.count = count;
+	b.hits = NULL;
+	b.nodes = NULL;
+	b.view.owned = NULL; /* borrowed: base frees them */
+	b.view.owned_tris = NULL;
+	b.view.owned_wide = NULL;
+	*out = series_alloc(&b, base->threads, base->max_repeats);
+	return *out ? 0 : -ENOMEM;
 }
 
 int bvhlab_trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene,
                          const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
                          bvhlab_hit *hits, uint32_t *nodes, bvhlab_trace_timing *timing)
 {
-	struct batch b = {.tree = tree, .scene = scene, .rays = rays, .count = count,
-	                  .any = opts->any_hit, .traversal = opts->traversal, .hits = hits,
-	                  .nodes = nodes};
-	uint32_t *parents = NULL;
+	struct trace_series *s;
 	*timing = (bvhlab_trace_timing){0};
 	if (!bvhlab_traversal_name(opts->traversal))
 		return -EINVAL;
 	if (count == 0)
 		return 0;
-	if (opts->traversal == BVHLAB_TRAVERSAL_STACKLESS) {
-		int r = bvhlab_tree_parents(tree, &parents);
-		if (r < 0)
-			return r;
-	}
-	uint32_t threads = trace_thread_count(opts->threads, count);
-	struct worker *w = calloc(threads, sizeof(*w));
-	int r = w ? trace_view_copy(tree, scene, &b.view) : -ENOMEM;
-	b.view.parents = parents;
-	atomic_init(&b.next, 0);
-	if (r == 0 && opts->traversal == BVHLAB_TRAVERSAL_WIDE)
-		r = count_binary(tree, scene, &b, w, threads, timing);
+	int r = trace_series_create(tree, scene, rays, count, opts, hits, nodes, &s);
 	if (r == 0)
-		r = run_passes(&b, w, threads, opts, timing);
-	timing->threads = threads;
-	free(w);
-	trace_view_free(&b.view);
-	free(parents);
+		r = trace_series_slice(s, opts);
+	if (r == 0)
+		trace_series_timing(s, timing);
+	trace_series_destroy(s);
 	return r;
 }

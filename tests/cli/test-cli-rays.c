@@ -2,9 +2,12 @@
  * Rays, images and reports through the bvhlab command: a run with images
  * writes report.html naming every run, with charts and PNGs of the asked
  * size that are not blank; `bvhlab report` regenerates it; `bvhlab render`
- * writes one image; a bad camera is an error with its position.
+ * writes one image; a bad camera is an error with its position; ray
+ * timings come from the interleaved rounds (rays.rounds), isolated or not,
+ * and leave no tree file behind.
  * Usage: test-cli-rays BVHLAB_EXE all
  */
+#include <dirent.h>
 #include <stdint.h>
 
 #include "cliutil.h"
@@ -97,7 +100,12 @@ static void check_measures(const cJSON *doc)
 		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(rays, "traversal_disagreements")) &&
 		      cJSON_GetObjectItem(rays, "traversal_disagreements")->valuedouble == 0);
 		CHECK(sl && cJSON_GetObjectItem(sl, "rays")->valueint == 40 * 30);
-		CHECK(cJSON_GetObjectItem(st, "repeats")->valueint >= 1);
+		/* The default 8 rounds, each a slice of at least 2 passes (10
+		 * passes over 8 rounds): more than the run's own provisional
+		 * timing (1 pass of min_ms / 8) could have made. */
+		CHECK_INT(cJSON_GetObjectItem(rays, "rounds")->valueint, 8);
+		CHECK(cJSON_GetObjectItem(st, "repeats")->valueint >= 16);
+		CHECK(cJSON_GetObjectItem(sl, "repeats")->valueint >= 16);
 		CHECK(cJSON_GetObjectItem(st, "mrays_min")->valuedouble <=
 		      cJSON_GetObjectItem(st, "mrays_max")->valuedouble);
 		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(cJSON_GetObjectItem(run, "tree"), "epo")));
@@ -106,6 +114,21 @@ static void check_measures(const cJSON *doc)
 		CHECK(cJSON_GetObjectItem(mem, "peak_rss_bytes")->valuedouble > 0);
 		CHECK(cJSON_GetObjectItem(mem, "output_bytes")->valuedouble > 0);
 	}
+}
+
+/* No ".tree-" file of the rounds is left in the output folder. */
+static void check_no_trees(const char *dir)
+{
+	DIR *d = opendir(dir);
+	struct dirent *e;
+	CHECK(d != NULL);
+	while (d && (e = readdir(d)) != NULL) {
+		if (!strncmp(e->d_name, ".tree-", 6))
+			fprintf(stderr, "left behind: %s/%s\n", dir, e->d_name);
+		CHECK(strncmp(e->d_name, ".tree-", 6) != 0);
+	}
+	if (d)
+		closedir(d);
 }
 
 static void test_run(void)
@@ -130,6 +153,7 @@ static void test_run(void)
 	check_image(dir, "images/terrain--binned--heat.png", 40, 30);
 	check_image(dir, "images/terrain--legend.png", 256, 16);
 	check_html(dir);
+	check_no_trees(dir);
 	char *csv = read_file(dir, "results.csv");
 	CHECK_CONTAINS(csv, "rays.primary.mrays_per_s");
 	free(csv);
@@ -151,6 +175,42 @@ static void test_run(void)
 	CHECK_CONTAINS(html, "stack primary Mrays/s");
 	free(html);
 	CHECK_INT(run(ARGS("report", "/nonexistent/results.json")), 2);
+}
+
+/* Every run's primary timing: `rounds` rounds of at least `passes` passes
+ * in all; in process (isolate false) the same as in children. */
+static void check_rounds(const char *name, const char *isolate, int rounds, int passes)
+{
+	char text[1024], dir[600];
+	snprintf(text, sizeof(text),
+	         "{ \"output\": \"out-%s\", \"repeat\": 1, \"isolate\": %s,\n"
+	         "  \"rays\": { \"width\": 16, \"height\": 16, \"min_ms\": 1, \"rounds\": %d },\n"
+	         "  \"scenes\": [ { \"generator\": \"icosphere\", \"frequency\": 6 } ],\n"
+	         "  \"builders\": [ { \"plugin\": \"sah_seq\" }, { \"plugin\": \"lbvh\" } ] }\n",
+	         name, isolate, rounds);
+	const char *cfg = write_config(name, text);
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 0);
+	snprintf(dir, sizeof(dir), "%s/out-%s", tmpdir, name);
+	cJSON *doc = load_results(dir);
+	const cJSON *r;
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 2);
+	cJSON_ArrayForEach(r, cJSON_GetObjectItem(doc, "runs")) {
+		const cJSON *rays = cJSON_GetObjectItem(r, "rays");
+		const cJSON *prim = cJSON_GetObjectItem(rays, "primary");
+		CHECK_INT(cJSON_GetObjectItem(rays, "rounds")->valueint, rounds);
+		CHECK(cJSON_GetObjectItem(prim, "repeats")->valueint >= passes);
+		CHECK(cJSON_GetObjectItem(prim, "mrays_per_s")->valuedouble > 0);
+		CHECK_INT(cJSON_GetObjectItem(prim, "rays")->valueint, 16 * 16);
+	}
+	cJSON_Delete(doc);
+	check_no_trees(dir);
+}
+
+static void test_rounds(void)
+{
+	check_rounds("rounds3.json", "true", 3, 12); /* 3 x ceil(10 / 3) */
+	check_rounds("rounds3-here.json", "false", 3, 12);
+	check_rounds("rounds1.json", "true", 1, 10);
 }
 
 static void test_render(void)
@@ -187,6 +247,7 @@ int main(int argc, char **argv)
 	if (!cli_begin(argc, argv))
 		return 2;
 	test_run();
+	test_rounds();
 	test_render();
 	test_bad_camera();
 	return cli_end();

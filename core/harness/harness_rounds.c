@@ -1,0 +1,320 @@
+/*
+ * Interleaved ray timing rounds over a scene's trees (harness_rounds.h).
+ * The parent keeps the list of trees; the rounds run in one child that
+ * reads them back, checks them again (the file passed through the disk),
+ * makes each batch's tracing copies once and then only times slices.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <bvhlab/trace.h>
+
+#include "harness/harness.h"
+#include "harness/harness_rounds.h"
+#include "harness/isolate.h"
+#include "output/safe_file.h"
+#include "trace/trace_series.h"
+#include "util/util.h"
+
+static const char TREE_MAGIC[8] = "bvhltree";
+
+struct tree_header {
+	char magic[8];
+	uint32_t node_count, index_count;
+};
+
+/* Bytes a run's tree of n triangles holds in the rounds' child, per
+ * traversal: the tree itself (about 2n nodes of 32 bytes, n indices), the
+ * node copy, the triangles in leaf order and the wide view, shared by the
+ * primary and diffuse batches. Measured: about 160 MB a tree on igea
+ * subdivided once (1.07M triangles, lbvh, wide), 150 bytes a triangle;
+ * this leaves room for spatial splits' extra references. */
+#define BYTES_PER_TRIANGLE 400.0
+
+bool harness_rounds_fit(const struct config *cfg, uint32_t triangles, size_t runs)
+{
+	if (cfg->ray_rounds <= 1 || cfg->ray_width == 0 || cfg->ray_height == 0)
+		return false;
+	unsigned traversals = (unsigned)__builtin_popcount(cfg->ray_traversals);
+	double need = BYTES_PER_TRIANGLE * traversals * triangles * (double)runs;
+	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+	return pages <= 0 || page <= 0 || need <= 0.5 * (double)pages * (double)page;
+}
+
+int harness_rounds_path(char *buf, size_t size, const char *dir, size_t scene, uint32_t run)
+{
+	int n = snprintf(buf, size, "%s/.tree-%zu-%u.raw", dir, scene, run);
+	return n < 0 || (size_t)n >= size ? -ENAMETOOLONG : 0;
+}
+
+int harness_rounds_write_tree(const char *path, const bvhlab_tree *tree)
+{
+	struct tree_header h = {.node_count = tree->node_count, .index_count = tree->index_count};
+	memcpy(h.magic, TREE_MAGIC, sizeof(h.magic));
+	int fd = safe_create(path);
+	if (fd < 0)
+		return fd;
+	int r = safe_write_all(fd, &h, sizeof(h));
+	if (r == 0)
+		r = safe_write_all(fd, tree->nodes, (size_t)h.node_count * sizeof(*tree->nodes));
+	if (r == 0)
+		r = safe_write_all(fd, tree->prim_index, (size_t)h.index_count * sizeof(uint32_t));
+	if (close(fd) < 0 && r == 0)
+		r = -errno;
+	if (r < 0)
+		unlink(path);
+	return r;
+}
+
+int harness_rounds_add(struct harness_rounds *r, const char *path, const char *builder,
+                       uint32_t threads, bool duplicates, const struct ray_metrics *rays)
+{
+	if (r->count == r->cap) {
+		size_t cap = r->cap ? 2 * r->cap : 16;
+		struct rounds_entry *e = realloc(r->entries, cap * sizeof(*e));
+		if (!e)
+			return -ENOMEM;
+		r->entries = e;
+		r->cap = cap;
+	}
+	char *copy = strdup(path);
+	if (!copy)
+		return -ENOMEM;
+	r->entries[r->count++] = (struct rounds_entry){.path = copy, .builder = builder,
+	                                               .threads = threads,
+	                                               .duplicates = duplicates, .rays = *rays};
+	return 0;
+}
+
+void harness_rounds_clear(struct harness_rounds *r)
+{
+	for (size_t i = 0; i < r->count; i++) {
+		unlink(r->entries[i].path);
+		free(r->entries[i].path);
+	}
+	r->count = 0;
+}
+
+void harness_rounds_finish(struct harness_rounds *r)
+{
+	harness_rounds_clear(r);
+	free(r->entries);
+	*r = (struct harness_rounds){0};
+}
+
+/* ---- in the rounds' child ------------------------------------------------ */
+
+/* One tree and its batches' series, by traversal. */
+struct timed_tree {
+	bvhlab_tree tree;
+	bvhlab_ray *diffuse;
+	size_t diffuse_count;
+	struct trace_series *primary[BVHLAB_TRAVERSAL_COUNT], *bounce[BVHLAB_TRAVERSAL_COUNT];
+};
+
+/* What comes back per entry. */
+struct rounds_slot {
+	uint32_t ok;
+	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
+};
+
+struct rounds_job {
+	const struct harness_rounds *r;
+	const struct config *cfg;
+	const bvhlab_scene *scene;
+	const bvhlab_prims *prims;
+};
+
+static int read_exact(FILE *f, void *p, size_t bytes)
+{
+	return fread(p, 1, bytes, f) == bytes ? 0 : -EIO;
+}
+
+/* The tree of a file, over arrays of its own (freed with free()). */
+static int load_tree(const char *path, bvhlab_tree *t)
+{
+	struct tree_header h;
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return -errno;
+	int r = read_exact(f, &h, sizeof(h));
+	if (r == 0 && memcmp(h.magic, TREE_MAGIC, sizeof(h.magic)) != 0)
+		r = -EINVAL;
+	if (r == 0) {
+		t->nodes = malloc(((size_t)h.node_count + 1) * sizeof(*t->nodes));
+		t->prim_index = malloc(((size_t)h.index_count + 1) * sizeof(uint32_t));
+		r = t->nodes && t->prim_index ? 0 : -ENOMEM;
+	}
+	if (r == 0)
+		r = read_exact(f, t->nodes, (size_t)h.node_count * sizeof(*t->nodes));
+	if (r == 0)
+		r = read_exact(f, t->prim_index, (size_t)h.index_count * sizeof(uint32_t));
+	if (r == 0 && fgetc(f) != EOF)
+		r = -EINVAL;
+	t->node_count = t->node_capacity = h.node_count;
+	t->index_count = t->index_capacity = h.index_count;
+	fclose(f);
+	return r;
+}
+
+static void free_timed(struct timed_tree *tt)
+{
+	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
+		trace_series_destroy(tt->bounce[k]); /* borrows primary[k]'s copies */
+		trace_series_destroy(tt->primary[k]);
+	}
+	free(tt->diffuse);
+	free(tt->tree.nodes);
+	free(tt->tree.prim_index);
+	*tt = (struct timed_tree){0};
+}
+
+/* Diffuse rays from the tree's own closest hits, as the run's child made
+ * them (every traversal gives the same hits). */
+static int make_diffuse(struct timed_tree *tt, const bvhlab_scene *scene,
+                        const bvhlab_ray *primary, size_t n, const struct ray_settings *rs)
+{
+	bvhlab_hit *hits = malloc(n * sizeof(*hits));
+	int r = hits ? bvhlab_trace_batch(&tt->tree, scene, primary, n, false, rs->threads, hits,
+	                                  NULL, NULL, NULL)
+	             : -ENOMEM;
+	if (r == 0 && rs->diffuse)
+		r = bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, HARNESS_DIFFUSE_SEED,
+		                        &tt->diffuse, &tt->diffuse_count);
+	free(hits);
+	return r;
+}
+
+static int prepare(const struct rounds_job *job, const struct rounds_entry *e,
+                   const bvhlab_ray *primary, size_t n, const struct ray_settings *rs,
+                   struct timed_tree *tt)
+{
+	bvhlab_error err = {{0}};
+	int r = load_tree(e->path, &tt->tree);
+	if (r == 0)
+		r = bvhlab_validate_tree(&tt->tree, &job->prims->input, e->duplicates, &err);
+	if (r == 0)
+		r = make_diffuse(tt, job->scene, primary, n, rs);
+	for (int k = 0; r == 0 && k < BVHLAB_TRAVERSAL_COUNT; k++) {
+		if (!(rs->traversals & (1u << k)))
+			continue;
+		bvhlab_trace_options o = {.traversal = k, .threads = rs->threads};
+		r = trace_series_create(&tt->tree, job->scene, primary, n, &o, NULL, NULL,
+		                        &tt->primary[k]);
+		if (r == 0 && tt->diffuse_count)
+			r = trace_series_create_like(tt->primary[k], tt->diffuse, tt->diffuse_count,
+			                             &tt->bounce[k]);
+	}
+	return r;
+}
+
+/* One round: a slice of every batch of every tree, the trees in turn. */
+static void one_round(struct timed_tree *tt, const struct rounds_slot *slots, size_t count,
+                      const struct ray_settings *rs)
+{
+	uint32_t rounds = rs->rounds;
+	bvhlab_trace_options o = {.min_ms = rs->min_ms / rounds,
+	                          .min_repeats = (rs->min_repeats + rounds - 1) / rounds};
+	for (size_t i = 0; i < count; i++) {
+		for (int k = 0; slots[i].ok && k < BVHLAB_TRAVERSAL_COUNT; k++) {
+			if (tt[i].primary[k])
+				trace_series_slice(tt[i].primary[k], &o);
+			if (tt[i].bounce[k])
+				trace_series_slice(tt[i].bounce[k], &o);
+		}
+	}
+}
+
+static void collect(struct timed_tree *tt, struct rounds_slot *slot)
+{
+	for (int k = 0; slot->ok && k < BVHLAB_TRAVERSAL_COUNT; k++) {
+		if (tt->primary[k])
+			trace_series_timing(tt->primary[k], &slot->primary[k]);
+		if (tt->bounce[k])
+			trace_series_timing(tt->bounce[k], &slot->diffuse[k]);
+	}
+}
+
+static void rounds_work(void *arg, void *report, size_t size)
+{
+	const struct rounds_job *job = arg;
+	struct rounds_slot *slots = report;
+	size_t count = job->r->count, n = (size_t)job->cfg->ray_width * job->cfg->ray_height;
+	struct ray_settings rs;
+	bvhlab_camera cam;
+	bvhlab_ray *primary = NULL;
+	(void)size;
+	harness_ray_settings(job->cfg, &rs);
+	harness_camera(job->cfg, job->scene, &cam);
+	struct timed_tree *tt = calloc(count, sizeof(*tt));
+	if (!tt || bvhlab_rays_primary(&cam, job->cfg->ray_width, job->cfg->ray_height, &primary))
+		goto out;
+	for (size_t i = 0; i < count; i++) {
+		slots[i].ok = prepare(job, &job->r->entries[i], primary, n, &rs, &tt[i]) == 0;
+		if (!slots[i].ok)
+			free_timed(&tt[i]);
+	}
+	for (uint32_t k = 0; k < rs.rounds; k++)
+		one_round(tt, slots, count, &rs);
+	for (size_t i = 0; i < count; i++)
+		collect(&tt[i], &slots[i]);
+out:
+	for (size_t i = 0; tt && i < count; i++)
+		free_timed(&tt[i]);
+	free(tt);
+	free(primary);
+}
+
+/* Long enough for every slice at ten times its time (see
+ * bvhlab_trace_options.min_repeats), plus the config's own limit. */
+static double rounds_timeout(const struct config *cfg, size_t count)
+{
+	unsigned traversals = (unsigned)__builtin_popcount(cfg->ray_traversals);
+	return cfg->timeout_s + 20.0 * cfg->ray_min_ms * 1e-3 * traversals * (double)count;
+}
+
+static void take(struct harness_rounds *r, const struct rounds_slot *slots, uint32_t rounds)
+{
+	for (size_t i = 0; i < r->count; i++) {
+		struct ray_metrics *m = &r->entries[i].rays;
+		if (!slots[i].ok)
+			continue;
+		for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
+			bvhlab_trace_stats p = m->primary[k].stats, d = m->diffuse[k].stats;
+			m->primary[k] = slots[i].primary[k];
+			m->diffuse[k] = slots[i].diffuse[k];
+			m->primary[k].stats = p; /* the run's exact counters stay */
+			m->diffuse[k].stats = d;
+		}
+		m->rounds = rounds;
+		r->entries[i].timed = true;
+	}
+}
+
+int harness_rounds_run(struct harness_rounds *r, const struct config *cfg,
+                       const bvhlab_scene *scene, const bvhlab_prims *prims, bvhlab_error *err)
+{
+	struct rounds_job job = {.r = r, .cfg = cfg, .scene = scene, .prims = prims};
+	struct isolate_limits limits = {.timeout_s = rounds_timeout(cfg, r->count)};
+	size_t size = r->count * sizeof(struct rounds_slot);
+	char why[256] = "";
+	if (r->count == 0)
+		return 0;
+	struct rounds_slot *slots = calloc(r->count, sizeof(*slots));
+	if (!slots)
+		return -ENOMEM;
+	int outcome = ISOLATE_REPORTED;
+	if (cfg->isolate)
+		outcome = isolate_call(rounds_work, &job, slots, size, &limits, why, sizeof(why));
+	else
+		rounds_work(&job, slots, size);
+	if (outcome == ISOLATE_REPORTED)
+		take(r, slots, cfg->ray_rounds);
+	else
+		error_set(err, "%s", outcome < 0 ? why : outcome == ISOLATE_TIMEOUT ? "timed out" : why);
+	free(slots);
+	return outcome == ISOLATE_REPORTED ? 0 : outcome < 0 ? outcome : -EIO;
+}

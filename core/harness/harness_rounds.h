@@ -1,0 +1,72 @@
+/*
+ * Ray timings in interleaved rounds. A shared machine has stretches, from a
+ * fraction of a second to a few seconds, in which everything traced runs
+ * 25-45 % slower (measured on the project's VM); a run whose batches were
+ * timed inside one got a low figure in one run of a config and not in the
+ * next. So with "rays.rounds" > 1 each run's child leaves its validated
+ * tree in a temporary file, and once every run of the scene is done one
+ * child loads them all and gives each tree's batches a slice of min_ms /
+ * rounds per round, the trees in turn: each tree's passes are spread over
+ * the whole phase, and a slow stretch costs every tree a few slices rather
+ * than one tree its figure. The figures over all slices replace the short
+ * provisional ones each run's child measured (those keep their counters,
+ * images and hits).
+ */
+#ifndef BVHLAB_CORE_HARNESS_ROUNDS_H
+#define BVHLAB_CORE_HARNESS_ROUNDS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <bvhlab/scene.h>
+#include <bvhlab/tree.h>
+
+#include "config/config.h"
+#include "output/results.h"
+
+/* One run waiting for the rounds. */
+struct rounds_entry {
+	char *path;            /* its tree file */
+	const char *builder;   /* the config's label */
+	uint32_t threads;      /* resolved build thread count */
+	bool duplicates;       /* spatial splits: validated as such */
+	struct ray_metrics rays; /* the run's own; timings replaced by the rounds */
+	bool timed;            /* rays now hold the rounds' timings */
+};
+
+struct harness_rounds {
+	struct rounds_entry *entries;
+	size_t count, cap;
+};
+
+/* Whether a scene of `triangles` with `runs` runs gets interleaved rounds:
+ * cfg->ray_rounds > 1 and their trees and tracing copies fit in half of
+ * this machine's memory. */
+bool harness_rounds_fit(const struct config *cfg, uint32_t triangles, size_t runs);
+
+/* The temporary tree file of a run (a dot file in the output folder). */
+int harness_rounds_path(char *buf, size_t size, const char *dir, size_t scene, uint32_t run);
+
+/* In the run's child: the tree to path. 0 or a negative errno. */
+int harness_rounds_write_tree(const char *path, const bvhlab_tree *tree);
+
+/* A run whose tree is in path; its rays were measured in its child. */
+int harness_rounds_add(struct harness_rounds *r, const char *path, const char *builder,
+                       uint32_t threads, bool duplicates, const struct ray_metrics *rays);
+
+/*
+ * Times every entry's batches in cfg->ray_rounds interleaved rounds, in a
+ * forked child unless cfg->isolate is false. Entries whose tree loaded
+ * and traced get timed = true and the new timings. 0, or a negative errno
+ * with err saying why no entry was timed.
+ */
+int harness_rounds_run(struct harness_rounds *r, const struct config *cfg,
+                       const bvhlab_scene *scene, const bvhlab_prims *prims, bvhlab_error *err);
+
+/* Deletes the tree files and forgets the entries (keeps the array). */
+void harness_rounds_clear(struct harness_rounds *r);
+
+void harness_rounds_finish(struct harness_rounds *r);
+
+#endif

@@ -1,0 +1,47 @@
+/*
+ * A ray batch timed in slices (trace_measure.c). bvhlab_trace_measure is
+ * one slice of a series; the harness's interleaved rounds
+ * (harness/harness_rounds.c) give each of a scene's trees one slice per
+ * round, so that a stretch in which a shared machine runs slow lands on a
+ * few slices of every tree instead of on the whole measurement of one.
+ * The figures (best per tile, median, min and max over passes) are over
+ * all passes of all slices.
+ */
+#ifndef BVHLAB_CORE_TRACE_SERIES_H
+#define BVHLAB_CORE_TRACE_SERIES_H
+
+#include <stddef.h>
+
+#include <bvhlab/traversal.h>
+
+struct trace_series;
+
+/*
+ * Copies what the traversal reads (opts->traversal, opts->threads and
+ * opts->any_hit are kept for every slice). hits and nodes (may be NULL)
+ * get each ray's hit and node count from the series' first pass, with the
+ * meaning bvhlab_trace_measure gives them; they must live until then.
+ * 0, -EINVAL (bad traversal or tree links), -ENOMEM.
+ */
+int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                        const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
+                        bvhlab_hit *hits, uint32_t *nodes, struct trace_series **out);
+
+/* A series of other rays through base's tree with base's traversal,
+ * threads and tracing copies (base must outlive it). Its timing's
+ * counters are those of its first pass for the stack and stackless
+ * traversals and zero for the wide one (no counting pass). 0 or -ENOMEM. */
+int trace_series_create_like(const struct trace_series *base, const bvhlab_ray *rays,
+                             size_t count, struct trace_series **out);
+
+/* Timed passes until this slice meets opts' min_ms, min_rays and
+ * min_repeats (counted within the slice); max_repeats bounds the series'
+ * passes in all. 0 or -ENOMEM (the passes so far still count). */
+int trace_series_slice(struct trace_series *s, const bvhlab_trace_options *opts);
+
+/* The figures over every pass so far (zeros before the first slice). */
+void trace_series_timing(const struct trace_series *s, bvhlab_trace_timing *t);
+
+void trace_series_destroy(struct trace_series *s);
+
+#endif
