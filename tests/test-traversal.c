@@ -16,6 +16,7 @@
 #include <bvhlab/traversal.h>
 
 #include "testutil.h"
+#include "trace/trace_series.h"
 #define FIXTURE_SEED 17 /* scene_fixture.h's generators are not used here */
 #include "scene_fixture.h"
 #include "tree_fixture.h"
@@ -231,6 +232,52 @@ static void test_measure(void)
 	fixture_free(&f);
 }
 
+/* A series adds up the passes of its slices; one "like" it borrows its
+ * copies, times other rays and frees only its own (ASan checks). */
+static void test_series(void)
+{
+	fixture f;
+	enum { N = 2000 };
+	bvhlab_ray rays[N];
+	bvhlab_hit hits[N], h;
+	uint64_t seed = 7;
+	fixture_grid(&f, 16, 16, 0.05f);
+	fixture_build(&f, 2);
+	for (int i = 0; i < N; i++)
+		rays[i] = grid_ray(&seed, 16);
+	for (int t = 0; t < BVHLAB_TRAVERSAL_COUNT; t++) {
+		/* min_repeats holds until a slice took 10 x min_ms: 200 ms, far
+		 * more than 3 passes of 2000 rays take. */
+		bvhlab_trace_options o = {.traversal = t, .threads = 2, .min_repeats = 3, .min_ms = 20};
+		struct trace_series *s = NULL, *like = NULL;
+		bvhlab_trace_timing tm;
+		CHECK_INT(trace_series_create(&f.tree, &f.scene, rays, N, &o, hits, NULL, &s), 0);
+		trace_series_timing(s, &tm);
+		CHECK_INT(tm.repeats, 0);
+		CHECK_INT(trace_series_slice(s, &o), 0);
+		trace_series_timing(s, &tm);
+		uint32_t first = tm.repeats;
+		CHECK(first >= 3);
+		CHECK_INT(trace_series_slice(s, &o), 0);
+		trace_series_timing(s, &tm);
+		CHECK(tm.repeats >= first + 3);
+		CHECK_INT(tm.stats.rays, N);
+		CHECK(tm.mrays_best >= tm.mrays_max * (1 - 1e-9) && tm.mrays_median > 0);
+		for (int i = 0; i < N; i++) {
+			bvhlab_trace_closest(&f.tree, &f.scene, &rays[i], &h, NULL);
+			CHECK(same_hit(&h, &hits[i]));
+		}
+		CHECK_INT(trace_series_create_like(s, rays + N / 2, N / 2, &like), 0);
+		CHECK_INT(trace_series_slice(like, &o), 0);
+		trace_series_timing(like, &tm);
+		CHECK(tm.repeats >= 3 && tm.mrays_median > 0);
+		CHECK_INT(tm.stats.rays, t == BVHLAB_TRAVERSAL_WIDE ? 0 : N / 2);
+		trace_series_destroy(like);
+		trace_series_destroy(s);
+	}
+	fixture_free(&f);
+}
+
 /* Rays of traversal t whose hits differ from a's (n primary, nd diffuse). */
 static size_t differ_from(const bvhlab_tree *tree, const bvhlab_scene *s, int t,
                           const bvhlab_ray *rays, size_t n, const bvhlab_ray *diffuse,
@@ -320,6 +367,7 @@ int main(void)
 	test_ties();
 	test_chain();
 	test_measure();
+	test_series();
 	test_shared_meshes();
 	return test_finish();
 }
