@@ -406,51 +406,6 @@ static void run_builders(struct harness *h, const bvhlab_scene *scene,
 	}
 }
 
-/* The runs of a scene still to do here. */
-static size_t scene_runs(const struct harness *h, size_t scene_index)
-{
-	size_t runs = 0;
-	for (size_t b = 0; b < h->cfg->builder_count; b++) {
-		size_t n;
-		builder_threads(h, &h->cfg->builders[b], &n);
-		for (size_t t = 0; t < n; t++)
-			runs += !h->only || h->only[plan_run_id(h->cfg, scene_index, b, t)];
-	}
-	return runs;
-}
-
-static void rounds_start(struct harness *h, const bvhlab_scene *scene, size_t scene_index)
-{
-	size_t runs = scene_runs(h, scene_index);
-	h->rounds_on = harness_rounds_fit(h->cfg, scene->triangle_count, runs);
-	if (!h->rounds_on && h->cfg->ray_rounds > 1 && h->cfg->ray_width && h->cfg->ray_height)
-		fprintf(stderr, "%sbvhlab: scene '%s': %zu trees of %u triangles would not fit in half "
-		        "of this machine's memory for interleaved ray rounds; each run times its "
-		        "rays alone (rays.rounds 1)\n", h->progress.tty ? "\n" : "", scene->name, runs,
-		        scene->triangle_count);
-}
-
-/* The interleaved rounds over the scene's trees; their timings replace the
- * runs' provisional ones in the results. */
-static void rounds_end(struct harness *h, const bvhlab_scene *scene, const bvhlab_prims *prims)
-{
-	bvhlab_error err = {{0}};
-	int r = harness_rounds_run(&h->rounds, h->cfg, scene, prims, &err);
-	for (size_t i = 0; r == 0 && i < h->rounds.count; i++) {
-		const struct rounds_entry *e = &h->rounds.entries[i];
-		if (e->timed)
-			r = results_set_run_rays(&h->res, scene->name, e->builder, e->threads, &e->rays);
-	}
-	if (r == 0 && h->rounds.count)
-		r = results_write(&h->res, &err);
-	if (r < 0)
-		fprintf(stderr, "%sbvhlab: scene '%s': interleaved ray rounds: %s; its runs keep "
-		        "their provisional ray timings (rays.rounds 1)\n", h->progress.tty ? "\n" : "",
-		        scene->name, err.message[0] ? err.message : strerror(-r));
-	harness_rounds_clear(&h->rounds);
-	h->rounds_on = false;
-}
-
 /* Turns the children's raw files into the scene's PNGs. */
 static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t scene_index)
 {
@@ -503,9 +458,10 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	                  scene->triangle_count, NULL);
 	free(shown);
 	h->shade_done = false;
-	rounds_start(h, scene, scene_index);
+	h->rounds_on = harness_rounds_start(h->cfg, scene, h->progress.tty);
 	run_builders(h, scene, &prims, scene_index);
-	rounds_end(h, scene, &prims);
+	harness_rounds_end(&h->rounds, &h->res, h->cfg, scene, &prims, h->progress.tty);
+	h->rounds_on = false;
 	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)
 		scene_images(h, scene, scene_index);
 out:

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <bvhlab/trace.h>
@@ -26,22 +27,43 @@ struct tree_header {
 	uint32_t node_count, index_count;
 };
 
-/* Bytes a run's tree of n triangles holds in the rounds' child, per
- * traversal: the tree itself (about 2n nodes of 32 bytes, n indices), the
- * node copy, the triangles in leaf order and the wide view, shared by the
- * primary and diffuse batches. Measured: about 160 MB a tree on igea
- * subdivided once (1.07M triangles, lbvh, wide), 150 bytes a triangle;
- * this leaves room for spatial splits' extra references. */
+/*
+ * What a tree holds in the rounds' child: the tree itself, and per
+ * traversal the node copy, the triangles in leaf order and the wide view,
+ * shared by the primary and diffuse batches. Measured on igea subdivided
+ * once (1.07M triangles, lbvh, wide): about 160 MB a tree, 150 bytes a
+ * triangle, its file 68 MB. Before the runs only the triangle count is
+ * known, and spatial splits may add references: 400 bytes a triangle.
+ * After them, the file's size: itself plus 1.5 times it per traversal.
+ */
 #define BYTES_PER_TRIANGLE 400.0
+#define COPIES_PER_FILE_BYTE 1.5
 
-bool harness_rounds_fit(const struct config *cfg, uint32_t triangles, size_t runs)
+/* Half of this machine's memory: what the rounds' child may hold. */
+static double memory_budget(void)
+{
+	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+	return pages > 0 && page > 0 ? 0.5 * (double)pages * (double)page : 1e300;
+}
+
+static unsigned traversal_count(const struct config *cfg)
+{
+	return (unsigned)__builtin_popcount(cfg->ray_traversals);
+}
+
+bool harness_rounds_fit(const struct config *cfg, uint32_t triangles)
 {
 	if (cfg->ray_rounds <= 1 || cfg->ray_width == 0 || cfg->ray_height == 0)
 		return false;
-	unsigned traversals = (unsigned)__builtin_popcount(cfg->ray_traversals);
-	double need = BYTES_PER_TRIANGLE * traversals * triangles * (double)runs;
-	long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-	return pages <= 0 || page <= 0 || need <= 0.5 * (double)pages * (double)page;
+	return BYTES_PER_TRIANGLE * traversal_count(cfg) * triangles <= memory_budget();
+}
+
+/* What the entry's tree will hold in the rounds' child. */
+static double entry_bytes(const struct config *cfg, const struct rounds_entry *e)
+{
+	struct stat st;
+	double file = stat(e->path, &st) == 0 ? (double)st.st_size : 0;
+	return file * (1 + COPIES_PER_FILE_BYTE * traversal_count(cfg));
 }
 
 int harness_rounds_path(char *buf, size_t size, const char *dir, size_t scene, uint32_t run)
@@ -122,7 +144,8 @@ struct rounds_slot {
 };
 
 struct rounds_job {
-	const struct harness_rounds *r;
+	const struct rounds_entry *entries; /* [count] */
+	size_t count;
 	const struct config *cfg;
 	const bvhlab_scene *scene;
 	const bvhlab_prims *prims;
@@ -242,7 +265,7 @@ static void rounds_work(void *arg, void *report, size_t size)
 {
 	const struct rounds_job *job = arg;
 	struct rounds_slot *slots = report;
-	size_t count = job->r->count, n = (size_t)job->cfg->ray_width * job->cfg->ray_height;
+	size_t count = job->count, n = (size_t)job->cfg->ray_width * job->cfg->ray_height;
 	struct ray_settings rs;
 	bvhlab_camera cam;
 	bvhlab_ray *primary = NULL;
@@ -253,7 +276,7 @@ static void rounds_work(void *arg, void *report, size_t size)
 	if (!tt || bvhlab_rays_primary(&cam, job->cfg->ray_width, job->cfg->ray_height, &primary))
 		goto out;
 	for (size_t i = 0; i < count; i++) {
-		slots[i].ok = prepare(job, &job->r->entries[i], primary, n, &rs, &tt[i]) == 0;
+		slots[i].ok = prepare(job, &job->entries[i], primary, n, &rs, &tt[i]) == 0;
 		if (!slots[i].ok)
 			free_timed(&tt[i]);
 	}
@@ -272,14 +295,14 @@ out:
  * bvhlab_trace_options.min_repeats), plus the config's own limit. */
 static double rounds_timeout(const struct config *cfg, size_t count)
 {
-	unsigned traversals = (unsigned)__builtin_popcount(cfg->ray_traversals);
-	return cfg->timeout_s + 20.0 * cfg->ray_min_ms * 1e-3 * traversals * (double)count;
+	return cfg->timeout_s + 20.0 * cfg->ray_min_ms * 1e-3 * traversal_count(cfg) * (double)count;
 }
 
-static void take(struct harness_rounds *r, const struct rounds_slot *slots, uint32_t rounds)
+static void take(struct rounds_entry *entries, size_t count, const struct rounds_slot *slots,
+                 uint32_t rounds)
 {
-	for (size_t i = 0; i < r->count; i++) {
-		struct ray_metrics *m = &r->entries[i].rays;
+	for (size_t i = 0; i < count; i++) {
+		struct ray_metrics *m = &entries[i].rays;
 		if (!slots[i].ok)
 			continue;
 		for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
@@ -290,20 +313,20 @@ static void take(struct harness_rounds *r, const struct rounds_slot *slots, uint
 			m->diffuse[k].stats = d;
 		}
 		m->rounds = rounds;
-		r->entries[i].timed = true;
+		entries[i].timed = true;
 	}
 }
 
-int harness_rounds_run(struct harness_rounds *r, const struct config *cfg,
-                       const bvhlab_scene *scene, const bvhlab_prims *prims, bvhlab_error *err)
+/* The rounds over count entries, in one child (or here). */
+static int run_group(struct rounds_entry *entries, size_t count, const struct config *cfg,
+                     const bvhlab_scene *scene, const bvhlab_prims *prims, bvhlab_error *err)
 {
-	struct rounds_job job = {.r = r, .cfg = cfg, .scene = scene, .prims = prims};
-	struct isolate_limits limits = {.timeout_s = rounds_timeout(cfg, r->count)};
-	size_t size = r->count * sizeof(struct rounds_slot);
+	struct rounds_job job = {.entries = entries, .count = count, .cfg = cfg, .scene = scene,
+	                         .prims = prims};
+	struct isolate_limits limits = {.timeout_s = rounds_timeout(cfg, count)};
+	size_t size = count * sizeof(struct rounds_slot);
 	char why[256] = "";
-	if (r->count == 0)
-		return 0;
-	struct rounds_slot *slots = calloc(r->count, sizeof(*slots));
+	struct rounds_slot *slots = calloc(count, sizeof(*slots));
 	if (!slots)
 		return -ENOMEM;
 	int outcome = ISOLATE_REPORTED;
@@ -312,9 +335,63 @@ int harness_rounds_run(struct harness_rounds *r, const struct config *cfg,
 	else
 		rounds_work(&job, slots, size);
 	if (outcome == ISOLATE_REPORTED)
-		take(r, slots, cfg->ray_rounds);
+		take(entries, count, slots, cfg->ray_rounds);
 	else
-		error_set(err, "%s", outcome < 0 ? why : outcome == ISOLATE_TIMEOUT ? "timed out" : why);
+		error_set(err, "%s", why);
 	free(slots);
 	return outcome == ISOLATE_REPORTED ? 0 : outcome < 0 ? outcome : -EIO;
+}
+
+/* Trees that fit the memory budget together are timed together: the
+ * scene's runs in one group on most configs, in a few on big scenes. */
+int harness_rounds_run(struct harness_rounds *r, const struct config *cfg,
+                       const bvhlab_scene *scene, const bvhlab_prims *prims, bvhlab_error *err)
+{
+	double budget = memory_budget();
+	int rc = 0;
+	for (size_t i = 0, j; i < r->count; i = j) {
+		double bytes = entry_bytes(cfg, &r->entries[i]);
+		for (j = i + 1; j < r->count; j++) {
+			bytes += entry_bytes(cfg, &r->entries[j]);
+			if (bytes > budget)
+				break;
+		}
+		int g = run_group(r->entries + i, j - i, cfg, scene, prims, err);
+		rc = rc < 0 ? rc : g;
+	}
+	return rc;
+}
+
+bool harness_rounds_start(const struct config *cfg, const bvhlab_scene *scene, bool tty)
+{
+	bool on = harness_rounds_fit(cfg, scene->triangle_count);
+	if (!on && cfg->ray_rounds > 1 && cfg->ray_width && cfg->ray_height)
+		fprintf(stderr, "%sbvhlab: scene '%s': a tree of %u triangles would not fit in half of "
+		        "this machine's memory for interleaved ray rounds; each run times its rays "
+		        "alone (rays.rounds 1)\n", tty ? "\n" : "", scene->name, scene->triangle_count);
+	return on;
+}
+
+void harness_rounds_end(struct harness_rounds *r, struct results *res,
+                        const struct config *cfg, const bvhlab_scene *scene,
+                        const bvhlab_prims *prims, bool tty)
+{
+	bvhlab_error err = {{0}};
+	int rc = harness_rounds_run(r, cfg, scene, prims, &err);
+	bool some = false;
+	for (size_t i = 0; i < r->count; i++) {
+		const struct rounds_entry *e = &r->entries[i];
+		int u = e->timed ? results_set_run_rays(res, scene->name, e->builder, e->threads,
+		                                        &e->rays)
+		                 : 0;
+		some = some || e->timed;
+		rc = rc < 0 ? rc : u;
+	}
+	int w = some ? results_write(res, &err) : 0;
+	rc = rc < 0 ? rc : w;
+	if (rc < 0)
+		fprintf(stderr, "%sbvhlab: scene '%s': interleaved ray rounds: %s; runs not timed "
+		        "there keep their provisional ray timings (rays.rounds 1)\n", tty ? "\n" : "",
+		        scene->name, err.message[0] ? err.message : strerror(-rc));
+	harness_rounds_clear(r);
 }

@@ -40,10 +40,20 @@ struct harness_rounds {
 	size_t count, cap;
 };
 
-/* Whether a scene of `triangles` with `runs` runs gets interleaved rounds:
- * cfg->ray_rounds > 1 and their trees and tracing copies fit in half of
- * this machine's memory. */
-bool harness_rounds_fit(const struct config *cfg, uint32_t triangles, size_t runs);
+/* Whether a scene of `triangles` gets interleaved rounds: cfg->ray_rounds
+ * > 1 and one tree with its tracing copies fits in half of this machine's
+ * memory (the rounds take as many trees at once as fit). */
+bool harness_rounds_fit(const struct config *cfg, uint32_t triangles);
+
+/* harness_rounds_fit, saying on stderr when it is not (tty: after the
+ * progress line). */
+bool harness_rounds_start(const struct config *cfg, const bvhlab_scene *scene, bool tty);
+
+/* After the scene's runs: harness_rounds_run, the timings into res (its
+ * files rewritten), a failure said on stderr, and the entries cleared. */
+void harness_rounds_end(struct harness_rounds *r, struct results *res,
+                        const struct config *cfg, const bvhlab_scene *scene,
+                        const bvhlab_prims *prims, bool tty);
 
 /* The temporary tree file of a run (a dot file in the output folder). */
 int harness_rounds_path(char *buf, size_t size, const char *dir, size_t scene, uint32_t run);
@@ -57,9 +67,11 @@ int harness_rounds_add(struct harness_rounds *r, const char *path, const char *b
 
 /*
  * Times every entry's batches in cfg->ray_rounds interleaved rounds, in a
- * forked child unless cfg->isolate is false. Entries whose tree loaded
- * and traced get timed = true and the new timings. 0, or a negative errno
- * with err saying why no entry was timed.
+ * forked child unless cfg->isolate is false; trees that would not fit in
+ * half of the machine's memory together are split into groups, a child
+ * each. Entries whose tree loaded and traced get timed = true and the new
+ * timings. 0, or a negative errno with err saying why a group was not
+ * timed.
  */
 int harness_rounds_run(struct harness_rounds *r, const struct config *cfg,
                        const bvhlab_scene *scene, const bvhlab_prims *prims, bvhlab_error *err);
