@@ -16,7 +16,6 @@
 #include "output/results.h"
 #include "util/util.h"
 
-
 void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam)
 {
 	if (cfg && cfg->has_camera)
@@ -80,8 +79,8 @@ static int trace_diffuse(const bvhlab_tree *tree, const bvhlab_scene *scene,
 {
 	bvhlab_ray *rays = NULL;
 	size_t count = 0;
-	int r = bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, HARNESS_DIFFUSE_SEED, &rays,
-	                            &count);
+	int r = bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, HARNESS_DIFFUSE_SEED,
+	                            &rays, &count);
 	bvhlab_hit *dh = r == 0 && count ? malloc(count * sizeof(*dh)) : NULL;
 	if (r == 0 && count)
 		r = dh ? trace_kind(tree, scene, rays, count, rs, m->diffuse, dh, NULL, m) : -ENOMEM;

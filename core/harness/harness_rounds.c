@@ -177,8 +177,10 @@ static int load_tree(const char *path, bvhlab_tree *t)
 		r = read_exact(f, t->prim_index, (size_t)h.index_count * sizeof(uint32_t));
 	if (r == 0 && fgetc(f) != EOF)
 		r = -EINVAL;
-	t->node_count = t->node_capacity = h.node_count;
-	t->index_count = t->index_capacity = h.index_count;
+	if (r == 0) {
+		t->node_count = t->node_capacity = h.node_count;
+		t->index_count = t->index_capacity = h.index_count;
+	}
 	fclose(f);
 	return r;
 }
@@ -251,6 +253,8 @@ static void one_round(struct timed_tree *tt, const struct rounds_slot *slots, si
 	}
 }
 
+/* A series that could not time one pass (no memory for its samples)
+ * leaves the run its own figures. */
 static void collect(struct timed_tree *tt, struct rounds_slot *slot)
 {
 	for (int k = 0; slot->ok && k < BVHLAB_TRAVERSAL_COUNT; k++) {
@@ -258,6 +262,8 @@ static void collect(struct timed_tree *tt, struct rounds_slot *slot)
 			trace_series_timing(tt->primary[k], &slot->primary[k]);
 		if (tt->bounce[k])
 			trace_series_timing(tt->bounce[k], &slot->diffuse[k]);
+		slot->ok = (!tt->primary[k] || slot->primary[k].repeats) &&
+		           (!tt->bounce[k] || slot->diffuse[k].repeats);
 	}
 }
 
