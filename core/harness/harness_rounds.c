@@ -4,6 +4,7 @@
  * reads them back, checks them again (the file passed through the disk),
  * makes each batch's tracing copies once and then only times slices.
  */
+#include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -70,6 +71,23 @@ int harness_rounds_path(char *buf, size_t size, const char *dir, size_t scene, u
 {
 	int n = snprintf(buf, size, "%s/.tree-%zu-%u.raw", dir, scene, run);
 	return n < 0 || (size_t)n >= size ? -ENAMETOOLONG : 0;
+}
+
+void harness_rounds_sweep(const char *dir)
+{
+	char path[4096];
+	DIR *d = opendir(dir);
+	struct dirent *e;
+	while (d && (e = readdir(d)) != NULL) {
+		size_t len = strlen(e->d_name);
+		if (strncmp(e->d_name, ".tree-", 6) != 0 || len < 10 ||
+		    strcmp(e->d_name + len - 4, ".raw") != 0)
+			continue;
+		if (snprintf(path, sizeof(path), "%s/%s", dir, e->d_name) < (int)sizeof(path))
+			unlink(path);
+	}
+	if (d)
+		closedir(d);
 }
 
 int harness_rounds_write_tree(const char *path, const bvhlab_tree *tree)

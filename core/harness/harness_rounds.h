@@ -58,6 +58,10 @@ void harness_rounds_end(struct harness_rounds *r, struct results *res,
 /* The temporary tree file of a run (a dot file in the output folder). */
 int harness_rounds_path(char *buf, size_t size, const char *dir, size_t scene, uint32_t run);
 
+/* Deletes the tree files an interrupted sweep left in dir (they can be
+ * large: a tree of a 1M-triangle scene takes about 70 MB). */
+void harness_rounds_sweep(const char *dir);
+
 /* In the run's child: the tree to path. 0 or a negative errno. */
 int harness_rounds_write_tree(const char *path, const bvhlab_tree *tree);
 
