@@ -251,10 +251,14 @@ static void test_series(void)
 		bvhlab_trace_options o = {.traversal = t, .threads = 2, .min_repeats = 3, .min_ms = 20};
 		struct trace_series *s = NULL, *like = NULL;
 		bvhlab_trace_timing tm;
-		CHECK_INT(trace_series_create(&f.tree, &f.scene, rays, N, &o, hits, NULL, &s), 0);
+		CHECK_INT(trace_series_create(&f.tree, &f.scene, rays, N, &o, hits, NULL, true, &s), 0);
 		trace_series_timing(s, &tm);
 		CHECK_INT(tm.repeats, 0);
+		bvhlab_trace_options few = {.min_repeats = 2, .min_ms = 1e-6};
+		bvhlab_trace_options many = {.min_repeats = 1000, .min_ms = 1e9};
+		CHECK(!trace_series_done(s, &few));
 		CHECK_INT(trace_series_slice(s, &o), 0);
+		CHECK(trace_series_done(s, &few) && !trace_series_done(s, &many));
 		trace_series_timing(s, &tm);
 		uint32_t first = tm.repeats;
 		CHECK(first >= 3);

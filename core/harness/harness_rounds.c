@@ -150,6 +150,8 @@ void harness_rounds_finish(struct harness_rounds *r)
 /* One tree and its batches' series, by traversal. */
 struct timed_tree {
 	bvhlab_tree tree;
+	bvhlab_hit *hits; /* the main primary series' first pass, until the
+	                   * diffuse rays are made from it */
 	bvhlab_ray *diffuse;
 	size_t diffuse_count;
 	struct trace_series *primary[BVHLAB_TRAVERSAL_COUNT], *bounce[BVHLAB_TRAVERSAL_COUNT];
@@ -158,6 +160,7 @@ struct timed_tree {
 /* What comes back per entry. */
 struct rounds_slot {
 	uint32_t ok;
+	uint64_t diffuse_rays; /* the rounds' diffuse batch: the run's, or none is taken */
 	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
 };
 
@@ -167,6 +170,10 @@ struct rounds_job {
 	const struct config *cfg;
 	const bvhlab_scene *scene;
 	const bvhlab_prims *prims;
+	/* in the child */
+	struct ray_settings rs;
+	const bvhlab_ray *primary; /* [n] */
+	size_t n;
 };
 
 static int read_exact(FILE *f, void *p, size_t bytes)
@@ -209,64 +216,88 @@ static void free_timed(struct timed_tree *tt)
 		trace_series_destroy(tt->bounce[k]); /* borrows primary[k]'s copies */
 		trace_series_destroy(tt->primary[k]);
 	}
+	free(tt->hits);
 	free(tt->diffuse);
 	free(tt->tree.nodes);
 	free(tt->tree.prim_index);
 	*tt = (struct timed_tree){0};
 }
 
-/* Diffuse rays from the tree's own closest hits, as the run's child made
- * them (every traversal gives the same hits). */
-static int make_diffuse(struct timed_tree *tt, const bvhlab_scene *scene,
-                        const bvhlab_ray *primary, size_t n, const struct ray_settings *rs)
-{
-	bvhlab_hit *hits = malloc(n * sizeof(*hits));
-	int r = hits ? bvhlab_trace_batch(&tt->tree, scene, primary, n, false, rs->threads, hits,
-	                                  NULL, NULL, NULL)
-	             : -ENOMEM;
-	if (r == 0 && rs->diffuse)
-		r = bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, HARNESS_DIFFUSE_SEED,
-		                        &tt->diffuse, &tt->diffuse_count);
-	free(hits);
-	return r;
-}
-
+/* A series per traversal for the primary rays; the main one keeps its
+ * first pass's hits for the diffuse rays. No counting pass: the run's
+ * counters stay. */
 static int prepare(const struct rounds_job *job, const struct rounds_entry *e,
-                   const bvhlab_ray *primary, size_t n, const struct ray_settings *rs,
                    struct timed_tree *tt)
 {
 	bvhlab_error err = {{0}};
+	const struct ray_settings *rs = &job->rs;
 	int r = load_tree(e->path, &tt->tree);
 	if (r == 0)
 		r = bvhlab_validate_tree(&tt->tree, &job->prims->input, e->duplicates, &err);
-	if (r == 0)
-		r = make_diffuse(tt, job->scene, primary, n, rs);
+	if (r == 0 && !(tt->hits = malloc(job->n * sizeof(*tt->hits))))
+		r = -ENOMEM;
 	for (int k = 0; r == 0 && k < BVHLAB_TRAVERSAL_COUNT; k++) {
 		if (!(rs->traversals & (1u << k)))
 			continue;
 		bvhlab_trace_options o = {.traversal = k, .threads = rs->threads};
-		r = trace_series_create(&tt->tree, job->scene, primary, n, &o, NULL, NULL,
+		r = trace_series_create(&tt->tree, job->scene, job->primary, job->n, &o,
+		                        k == rs->main ? tt->hits : NULL, NULL, false,
 		                        &tt->primary[k]);
-		if (r == 0 && tt->diffuse_count)
+	}
+	return r;
+}
+
+/* After the main primary series' first slice: the diffuse rays from its
+ * hits, as the run's child made them, and a series for them beside each
+ * primary one, on its copies. */
+static int make_bounces(const struct rounds_job *job, struct timed_tree *tt)
+{
+	const struct ray_settings *rs = &job->rs;
+	int r = 0;
+	if (rs->diffuse)
+		r = bvhlab_rays_diffuse(job->scene, job->primary, tt->hits, job->n, rs->diffuse,
+		                        HARNESS_DIFFUSE_SEED, &tt->diffuse, &tt->diffuse_count);
+	free(tt->hits);
+	tt->hits = NULL;
+	for (int k = 0; r == 0 && tt->diffuse_count && k < BVHLAB_TRAVERSAL_COUNT; k++) {
+		if (tt->primary[k])
 			r = trace_series_create_like(tt->primary[k], tt->diffuse, tt->diffuse_count,
 			                             &tt->bounce[k]);
 	}
 	return r;
 }
 
-/* One round: a slice of every batch of every tree, the trees in turn. */
-static void one_round(struct timed_tree *tt, const struct rounds_slot *slots, size_t count,
-                      const struct ray_settings *rs)
+static void slice(struct trace_series *s, const bvhlab_trace_options *all,
+                  const bvhlab_trace_options *o)
 {
+	if (s && !trace_series_done(s, all))
+		trace_series_slice(s, o);
+}
+
+/* One round: a slice of every batch of every tree, the trees in turn. A
+ * batch whose passes already meet the whole measurement's minimums (slow
+ * batches: min_repeats gives way at 10 x min_ms) takes no more slices, so
+ * the rounds cost no more time than one stretch would. */
+static void one_round(const struct rounds_job *job, struct timed_tree *tt,
+                      struct rounds_slot *slots)
+{
+	const struct ray_settings *rs = &job->rs;
 	uint32_t rounds = rs->rounds;
+	bvhlab_trace_options all = {.min_ms = rs->min_ms, .min_repeats = rs->min_repeats};
 	bvhlab_trace_options o = {.min_ms = rs->min_ms / rounds,
 	                          .min_repeats = (rs->min_repeats + rounds - 1) / rounds};
-	for (size_t i = 0; i < count; i++) {
-		for (int k = 0; slots[i].ok && k < BVHLAB_TRAVERSAL_COUNT; k++) {
-			if (tt[i].primary[k])
-				trace_series_slice(tt[i].primary[k], &o);
-			if (tt[i].bounce[k])
-				trace_series_slice(tt[i].bounce[k], &o);
+	for (size_t i = 0; i < job->count; i++) {
+		if (!slots[i].ok)
+			continue;
+		slice(tt[i].primary[rs->main], &all, &o);
+		if (tt[i].hits && make_bounces(job, &tt[i]) < 0) {
+			slots[i].ok = 0;
+			continue;
+		}
+		for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
+			if (k != rs->main)
+				slice(tt[i].primary[k], &all, &o);
+			slice(tt[i].bounce[k], &all, &o);
 		}
 	}
 }
@@ -275,6 +306,7 @@ static void one_round(struct timed_tree *tt, const struct rounds_slot *slots, si
  * leaves the run its own figures. */
 static void collect(struct timed_tree *tt, struct rounds_slot *slot)
 {
+	slot->diffuse_rays = tt->diffuse_count;
 	for (int k = 0; slot->ok && k < BVHLAB_TRAVERSAL_COUNT; k++) {
 		if (tt->primary[k])
 			trace_series_timing(tt->primary[k], &slot->primary[k]);
@@ -287,25 +319,26 @@ static void collect(struct timed_tree *tt, struct rounds_slot *slot)
 
 static void rounds_work(void *arg, void *report, size_t size)
 {
-	const struct rounds_job *job = arg;
+	struct rounds_job *job = arg;
 	struct rounds_slot *slots = report;
-	size_t count = job->count, n = (size_t)job->cfg->ray_width * job->cfg->ray_height;
-	struct ray_settings rs;
+	size_t count = job->count;
 	bvhlab_camera cam;
 	bvhlab_ray *primary = NULL;
 	(void)size;
-	harness_ray_settings(job->cfg, &rs);
+	harness_ray_settings(job->cfg, &job->rs);
 	harness_camera(job->cfg, job->scene, &cam);
+	job->n = (size_t)job->cfg->ray_width * job->cfg->ray_height;
 	struct timed_tree *tt = calloc(count, sizeof(*tt));
 	if (!tt || bvhlab_rays_primary(&cam, job->cfg->ray_width, job->cfg->ray_height, &primary))
 		goto out;
+	job->primary = primary;
 	for (size_t i = 0; i < count; i++) {
-		slots[i].ok = prepare(job, &job->entries[i], primary, n, &rs, &tt[i]) == 0;
+		slots[i].ok = prepare(job, &job->entries[i], &tt[i]) == 0;
 		if (!slots[i].ok)
 			free_timed(&tt[i]);
 	}
-	for (uint32_t k = 0; k < rs.rounds; k++)
-		one_round(tt, slots, count, &rs);
+	for (uint32_t k = 0; k < job->rs.rounds; k++)
+		one_round(job, tt, slots);
 	for (size_t i = 0; i < count; i++)
 		collect(&tt[i], &slots[i]);
 out:
@@ -327,7 +360,8 @@ static void take(struct rounds_entry *entries, size_t count, const struct rounds
 {
 	for (size_t i = 0; i < count; i++) {
 		struct ray_metrics *m = &entries[i].rays;
-		if (!slots[i].ok)
+		if (!slots[i].ok || m->main < 0 || m->main >= BVHLAB_TRAVERSAL_COUNT ||
+		    slots[i].diffuse_rays != m->diffuse[m->main].stats.rays)
 			continue;
 		for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
 			bvhlab_trace_stats p = m->primary[k].stats, d = m->diffuse[k].stats;

@@ -112,6 +112,7 @@ struct trace_series {
 	bool counted;           /* stats hold the counters of one pass */
 	bvhlab_trace_stats stats;
 	double seconds_total;
+	double cpu_total;       /* CPU seconds per thread of all passes */
 };
 
 static int grow(struct trace_series *s)
@@ -151,6 +152,7 @@ static double timed_pass(struct trace_series *s)
 	s->cpu[s->n] = mrays(s->b.count, c / s->threads);
 	s->wall[s->n++] = mrays(s->b.count, w);
 	s->seconds_total += w;
+	s->cpu_total += c / s->threads;
 	return c / s->threads;
 }
 
@@ -169,6 +171,12 @@ int trace_series_slice(struct trace_series *s, const bvhlab_trace_options *o)
 			break;
 	}
 	return 0;
+}
+
+bool trace_series_done(const struct trace_series *s, const bvhlab_trace_options *o)
+{
+	return s->b.count == 0 || s->n >= s->max_repeats ||
+	       (s->n && !more(o, s->n, s->cpu_total, (uint64_t)s->n * s->b.count));
 }
 
 void trace_series_timing(const struct trace_series *s, bvhlab_trace_timing *t)
@@ -215,7 +223,7 @@ void trace_series_destroy(struct trace_series *s)
 	free(s);
 }
 
-static int series_views(struct trace_series *s, int traversal)
+static int series_views(struct trace_series *s, int traversal, bool counters)
 {
 	if (traversal == BVHLAB_TRAVERSAL_STACKLESS) {
 		int r = bvhlab_tree_parents(s->b.tree, &s->parents);
@@ -225,7 +233,7 @@ static int series_views(struct trace_series *s, int traversal)
 	int r = trace_view_copy(s->b.tree, s->b.scene, &s->b.view);
 	s->b.view.parents = s->parents;
 	if (r == 0 && traversal == BVHLAB_TRAVERSAL_WIDE && s->b.count)
-		r = count_binary(s);
+		r = counters ? count_binary(s) : trace_view_wide(s->b.tree, s->b.scene, &s->b.view);
 	return r;
 }
 
@@ -255,7 +263,8 @@ static struct trace_series *series_alloc(const struct batch *b, uint32_t threads
 
 int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
                         const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
-                        bvhlab_hit *hits, uint32_t *nodes, struct trace_series **out)
+                        bvhlab_hit *hits, uint32_t *nodes, bool counters,
+                        struct trace_series **out)
 {
 	*out = NULL;
 	if (!bvhlab_traversal_name(opts->traversal))
@@ -266,7 +275,7 @@ int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	struct trace_series *s = series_alloc(&b, opts->threads, opts->max_repeats);
 	if (!s)
 		return -ENOMEM;
-	int r = series_views(s, opts->traversal);
+	int r = series_views(s, opts->traversal, counters);
 	if (r < 0) {
 		trace_series_destroy(s);
 		return r;
@@ -300,7 +309,7 @@ int bvhlab_trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene,
 		return -EINVAL;
 	if (count == 0)
 		return 0;
-	int r = trace_series_create(tree, scene, rays, count, opts, hits, nodes, &s);
+	int r = trace_series_create(tree, scene, rays, count, opts, hits, nodes, true, &s);
 	if (r == 0)
 		r = trace_series_slice(s, opts);
 	if (r == 0)

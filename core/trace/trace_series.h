@@ -10,6 +10,7 @@
 #ifndef BVHLAB_CORE_TRACE_SERIES_H
 #define BVHLAB_CORE_TRACE_SERIES_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include <bvhlab/traversal.h>
@@ -21,11 +22,14 @@ struct trace_series;
  * opts->any_hit are kept for every slice). hits and nodes (may be NULL)
  * get each ray's hit and node count from the series' first pass, with the
  * meaning bvhlab_trace_measure gives them; they must live until then.
- * 0, -EINVAL (bad traversal or tree links), -ENOMEM.
+ * counters false spares the wide traversal its counting pass: its
+ * timing's counters and nodes then stay zero. 0, -EINVAL (bad traversal
+ * or tree links), -ENOMEM.
  */
 int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
                         const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
-                        bvhlab_hit *hits, uint32_t *nodes, struct trace_series **out);
+                        bvhlab_hit *hits, uint32_t *nodes, bool counters,
+                        struct trace_series **out);
 
 /* A series of other rays through base's tree with base's traversal,
  * threads and tracing copies (base must outlive it). Its timing's
@@ -38,6 +42,10 @@ int trace_series_create_like(const struct trace_series *base, const bvhlab_ray *
  * min_repeats (counted within the slice); max_repeats bounds the series'
  * passes in all. 0 or -ENOMEM (the passes so far still count). */
 int trace_series_slice(struct trace_series *s, const bvhlab_trace_options *opts);
+
+/* Whether the series' passes in all meet opts' minimums (as one slice
+ * would have to), or its max_repeats: then more slices add only time. */
+bool trace_series_done(const struct trace_series *s, const bvhlab_trace_options *opts);
 
 /* The figures over every pass so far (zeros before the first slice). */
 void trace_series_timing(const struct trace_series *s, bvhlab_trace_timing *t);
