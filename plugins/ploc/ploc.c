@@ -51,12 +51,13 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p)
 
 /* ---- scratch ------------------------------------------------------------ */
 
-/* Clusters (two sets of ten arrays), nn, the merge tree, desc and the
+/* Clusters (two sets of six arrays and a record array), nn, the merge tree, desc and the
  * emit phase's tasks: past the tree in the output when the host gives the room,
  * which it keeps between builds (fresh pages cost more than a phase). */
 static size_t work_size(size_t n)
 {
-	return 20 * morton_align64(4 * n) + morton_align64(4 * n) +
+	return 2 * (6 * morton_align64(4 * n) + morton_align64(sizeof(struct cluster_meta) * n)) +
+	       morton_align64(4 * n) +
 	       morton_align64(sizeof(bvhlab_node) * (2 * n)) +
 	       morton_align64(4 * 2 * n) + morton_align64(sizeof(struct place) * n);
 }
@@ -80,10 +81,7 @@ static void place_clusters(struct clusters *c, char **at, size_t n)
 		c->lo[a] = (float *)(void *)take(at, 4 * n);
 		c->hi[a] = (float *)(void *)take(at, 4 * n);
 	}
-	c->first = (uint32_t *)(void *)take(at, 4 * n);
-	c->info = (uint32_t *)(void *)take(at, 4 * n);
-	c->cost = (float *)(void *)take(at, 4 * n);
-	c->desc = (uint32_t *)(void *)take(at, 4 * n);
+	c->meta = (struct cluster_meta *)(void *)take(at, sizeof(*c->meta) * n);
 }
 
 static void place_work(ploc *p, char *at)
@@ -141,10 +139,8 @@ static void first_clusters(ploc *p, unsigned t)
 			c->lo[a][k] = box->lo[a];
 			c->hi[a][k] = box->hi[a];
 		}
-		c->first[k] = id;
-		c->info[k] = 1 | REC_PRIM;
-		c->cost[k] = p->c_isect * bvhlab_aabb_half_area(box);
-		c->desc[k] = 0;
+		c->meta[k] = (struct cluster_meta){id, 1 | REC_PRIM,
+		                                   p->c_isect * bvhlab_aabb_half_area(box), 0};
 	}
 }
 

@@ -51,12 +51,18 @@
 #define DEAD UINT32_MAX
 
 /* Clusters of one iteration, by position in the Morton order. */
+/* What a merge reads of a cluster besides its box: one 16-byte record, so
+ * that compacting the clusters streams seven arrays, not ten. */
+struct cluster_meta {
+	uint32_t first; /* the record's first (see `tree`) */
+	uint32_t info;  /* the record's count field: REC_* | primitives */
+	float cost;     /* the subtree's SAH cost, area-weighted */
+	uint32_t desc;  /* output nodes below the cluster's own */
+};
+
 struct clusters {
-	float *lo[3], *hi[3]; /* [n] boxes, by axis, for vector distance rows */
-	uint32_t *first;      /* [n] the record's first (see `tree`) */
-	uint32_t *info;       /* [n] the record's count field: REC_* | primitives */
-	float *cost;          /* [n] the subtree's SAH cost, area-weighted */
-	uint32_t *desc;       /* [n] output nodes below the cluster's own */
+	float *lo[3], *hi[3];      /* [n] boxes, by axis, for vector distance rows */
+	struct cluster_meta *meta; /* [n] */
 };
 
 /* A record of the merge tree and where it goes in the output (emit). */

@@ -164,10 +164,7 @@ static void copy_cluster(const struct clusters *c, uint32_t i, struct clusters *
 		to->lo[a][k] = c->lo[a][i];
 		to->hi[a][k] = c->hi[a][i];
 	}
-	to->first[k] = c->first[i];
-	to->info[k] = c->info[i];
-	to->cost[k] = c->cost[i];
-	to->desc[k] = c->desc[i];
+	to->meta[k] = c->meta[i];
 }
 
 /* Cluster i of c as record x of the merge tree. */
@@ -179,9 +176,9 @@ static void put_record(ploc *p, const struct clusters *c, uint32_t i, uint32_t x
 		rec->lo[a] = c->lo[a][i];
 		rec->hi[a] = c->hi[a][i];
 	}
-	rec->first = c->first[i];
-	rec->count = c->info[i];
-	p->desc[x] = c->desc[i];
+	rec->first = c->meta[i].first;
+	rec->count = c->meta[i].info;
+	p->desc[x] = c->meta[i].desc;
 }
 
 /*
@@ -192,21 +189,23 @@ static void put_record(ploc *p, const struct clusters *c, uint32_t i, uint32_t x
 static void merge_cost(const ploc *p, const struct clusters *c, uint32_t i, uint32_t j,
                        struct clusters *to, uint32_t k)
 {
-	uint32_t prims = (c->info[i] & REC_PRIMS) + (c->info[j] & REC_PRIMS);
+	const struct cluster_meta *a = &c->meta[i], *b = &c->meta[j];
+	uint32_t prims = (a->info & REC_PRIMS) + (b->info & REC_PRIMS);
 	float area = half_area3(to->hi[0][k] - to->lo[0][k], to->hi[1][k] - to->lo[1][k],
 	                        to->hi[2][k] - to->lo[2][k]);
-	float split = p->c_trav * area + c->cost[i] + c->cost[j];
+	float split = p->c_trav * area + a->cost + b->cost;
 	float leaf = p->c_isect * (float)prims * area;
+	struct cluster_meta *m = &to->meta[k];
 
 	if (p->collapse && prims <= p->max_leaf && leaf <= split) {
-		to->info[k] = prims | REC_COLLAPSED;
-		to->cost[k] = leaf;
-		to->desc[k] = 0;
+		m->info = prims | REC_COLLAPSED;
+		m->cost = leaf;
+		m->desc = 0;
 		return;
 	}
-	to->info[k] = prims;
-	to->cost[k] = split;
-	to->desc[k] = 2 + c->desc[i] + c->desc[j];
+	m->info = prims;
+	m->cost = split;
+	m->desc = 2 + a->desc + b->desc;
 }
 
 /* Clusters i < j merge: their records at x and x + 1, the union at k. */
@@ -219,7 +218,7 @@ static void merge(ploc *p, const struct clusters *c, uint32_t i, uint32_t j, uin
 		to->lo[a][k] = bvhlab_minf(c->lo[a][i], c->lo[a][j]);
 		to->hi[a][k] = bvhlab_maxf(c->hi[a][i], c->hi[a][j]);
 	}
-	to->first[k] = x;
+	to->meta[k].first = x;
 	merge_cost(p, c, i, j, to, k);
 }
 
