@@ -211,7 +211,11 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		return;
 	harness_camera(cfg, job->scene, &cam);
 	harness_ray_settings(cfg, &rs);
-	if (job->tree_path) { /* a provisional timing: the rounds measure again */
+	/* With its tree kept for the rounds, which measure again, the run times
+	 * one provisional slice; without (a full disk), all of min_ms here. */
+	if (job->tree_path)
+		rep->tree_written = harness_rounds_write_tree(job->tree_path, tree) == 0;
+	if (rep->tree_written) {
 		rs.min_ms /= rs.rounds;
 		rs.min_repeats = 1;
 	}
@@ -222,8 +226,6 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)
 		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
-	if (r == 0 && job->tree_path)
-		rep->tree_written = harness_rounds_write_tree(job->tree_path, tree) == 0;
 	if (r < 0)
 		error_set(err, "tracing rays: %s", strerror(-r));
 	free(nodes);

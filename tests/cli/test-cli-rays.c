@@ -213,11 +213,42 @@ static void check_rounds(const char *name, const char *isolate, int rounds, int 
 	check_no_trees(dir);
 }
 
+/* A run whose tree cannot be kept for the rounds (here a folder in the
+ * way of its file) times all of min_ms itself, with its 10 passes, not
+ * one provisional slice (a pass of 4096 rays takes a good part of that
+ * slice's millisecond), and says rounds 1; the other run still gets the
+ * rounds. */
+static void check_tree_refused(void)
+{
+	char dir[600], blocker[700];
+	const char *cfg = write_config("refused.json",
+		"{ \"output\": \"out-refused\", \"repeat\": 1,\n"
+		"  \"rays\": { \"width\": 64, \"height\": 64, \"min_ms\": 5, \"rounds\": 5 },\n"
+		"  \"scenes\": [ { \"generator\": \"icosphere\", \"frequency\": 6 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"sah_seq\" }, { \"plugin\": \"lbvh\" } ] }\n");
+	snprintf(dir, sizeof(dir), "%s/out-refused", tmpdir);
+	snprintf(blocker, sizeof(blocker), "%s/.tree-0-0.raw", dir);
+	CHECK(mkdir(dir, 0755) == 0 && mkdir(blocker, 0755) == 0);
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 0);
+	cJSON *doc = load_results(dir);
+	const cJSON *runs = cJSON_GetObjectItem(doc, "runs");
+	for (int k = 0; k < 2; k++) {
+		const cJSON *rays = cJSON_GetObjectItem(cJSON_GetArrayItem(runs, k), "rays");
+		CHECK_INT(cJSON_GetObjectItem(rays, "rounds")->valueint, k == 0 ? 1 : 5);
+		CHECK(cJSON_GetObjectItem(cJSON_GetObjectItem(rays, "primary"), "repeats")->valueint >=
+		      10);
+	}
+	cJSON_Delete(doc);
+	CHECK(rmdir(blocker) == 0);
+	check_no_trees(dir);
+}
+
 static void test_rounds(void)
 {
 	check_rounds("rounds3.json", "true", 3, 10);
 	check_rounds("rounds3-here.json", "false", 3, 10);
 	check_rounds("rounds1.json", "true", 1, 10);
+	check_tree_refused();
 }
 
 static void test_render(void)
