@@ -234,7 +234,8 @@ static int prepare(const struct rounds_job *job, const struct rounds_entry *e,
 	int r = load_tree(e->path, &tt->tree);
 	if (r == 0)
 		r = bvhlab_validate_tree(&tt->tree, &job->prims->input, e->duplicates, &err);
-	if (r == 0 && !(tt->hits = malloc(job->n * sizeof(*tt->hits))))
+	/* Zeroed: make_bounces reads them even if no pass could run. */
+	if (r == 0 && !(tt->hits = calloc(job->n, sizeof(*tt->hits))))
 		r = -ENOMEM;
 	for (int k = 0; r == 0 && k < BVHLAB_TRAVERSAL_COUNT; k++) {
 		if (!(rs->traversals & (1u << k)))
