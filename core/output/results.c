@@ -361,14 +361,21 @@ static bool run_matches(const cJSON *run, const char *scene, const char *builder
 	       strcmp(b, builder) == 0;
 }
 
+/* The document's run of scene x builder x threads, or NULL. */
+static cJSON *find_run(const struct results *res, const char *scene, const char *builder,
+                       uint32_t threads)
+{
+	cJSON *run;
+	cJSON_ArrayForEach(run, res->runs)
+		if (run_matches(run, scene, builder, threads))
+			return run;
+	return NULL;
+}
+
 bool results_has_run(const struct results *res, const char *scene, const char *builder,
                      uint32_t threads)
 {
-	const cJSON *run;
-	cJSON_ArrayForEach(run, res->runs)
-		if (run_matches(run, scene, builder, threads))
-			return true;
-	return false;
+	return find_run(res, scene, builder, threads) != NULL;
 }
 
 /* The file's text; -ENOENT quietly when there is none. */
@@ -464,33 +471,27 @@ int results_set_scene_image(struct results *res, const char *scene, const char *
 int results_set_run_image(struct results *res, const char *scene, const char *builder,
                           uint32_t threads, const char *name)
 {
-	cJSON *run;
-	cJSON_ArrayForEach(run, res->runs) {
-		if (!run_matches(run, scene, builder, threads))
-			continue;
-		cJSON_DeleteItemFromObjectCaseSensitive(run, "heat_image");
-		return cJSON_AddStringToObject(run, "heat_image", name) ? 0 : -ENOMEM;
-	}
-	return -ENOENT;
+	cJSON *run = find_run(res, scene, builder, threads);
+	if (!run)
+		return -ENOENT;
+	cJSON_DeleteItemFromObjectCaseSensitive(run, "heat_image");
+	return cJSON_AddStringToObject(run, "heat_image", name) ? 0 : -ENOMEM;
 }
 
 int results_set_run_rays(struct results *res, const char *scene, const char *builder,
                          uint32_t threads, const struct ray_metrics *m)
 {
-	cJSON *run;
-	cJSON_ArrayForEach(run, res->runs) {
-		if (!run_matches(run, scene, builder, threads))
-			continue;
-		cJSON *rays = results_rays_json(m);
-		if (!rays)
-			return -ENOMEM;
-		if (!cJSON_ReplaceItemInObjectCaseSensitive(run, "rays", rays)) {
-			cJSON_Delete(rays);
-			return -ENOENT;
-		}
-		return 0;
+	cJSON *run = find_run(res, scene, builder, threads);
+	cJSON *rays = run ? results_rays_json(m) : NULL;
+	if (!run)
+		return -ENOENT;
+	if (!rays)
+		return -ENOMEM;
+	if (!cJSON_ReplaceItemInObjectCaseSensitive(run, "rays", rays)) {
+		cJSON_Delete(rays);
+		return -ENOENT;
 	}
-	return -ENOENT;
+	return 0;
 }
 
 int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err)
