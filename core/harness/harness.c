@@ -156,6 +156,13 @@ static bool scene_done(struct harness *h, const struct config_scene *cs, size_t 
 	return true;
 }
 
+/* Whether the job's builder may duplicate references (spatial splits):
+ * its trees are validated, here and in the rounds, as such. */
+static bool spatial_splits(const struct series_job *job)
+{
+	return bvhlab_plugin_builder(job->hb->plugin)->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
+}
+
 /*
  * Structure is always checked: the metrics are meaningless (and a cyclic tree
  * unsafe to walk) otherwise. The brute-force ray check is what "validate"
@@ -165,10 +172,8 @@ static void validate(const struct series_job *job, const bvhlab_tree *tree,
                      struct series_report *rep, bvhlab_error *err)
 {
 	const struct config *cfg = job->h->cfg;
-	const bvhlab_builder *desc = bvhlab_plugin_builder(job->hb->plugin);
-	bool dup = desc->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
 	rep->validated = true;
-	rep->valid = bvhlab_validate_tree(tree, &job->prims->input, dup, err) == 0;
+	rep->valid = bvhlab_validate_tree(tree, &job->prims->input, spatial_splits(job), err) == 0;
 	if (!rep->valid) {
 		rep->status = SERIES_INVALID;
 		return;
@@ -347,13 +352,11 @@ static void image_paths(struct harness *h, struct series_job *job, size_t scene_
 static void queue_tree(struct harness *h, const struct series_job *job,
                        const struct run_record *run, const struct series_report *rep)
 {
-	const bvhlab_builder *desc = bvhlab_plugin_builder(job->hb->plugin);
-	bool dup = desc->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
 	if (!job->tree_path)
 		return;
 	if (!rep->tree_written || strcmp(run->status, "ok") != 0 || !run->rays ||
-	    harness_rounds_add(&h->rounds, job->tree_path, run->builder, run->threads, dup,
-	                       &rep->rays) < 0)
+	    harness_rounds_add(&h->rounds, job->tree_path, run->builder, run->threads,
+	                       spatial_splits(job), &rep->rays) < 0)
 		unlink(job->tree_path);
 }
 
