@@ -1,7 +1,8 @@
 /*
  * core/output/safe_file.c: files created anew (a planted symlink is
  * replaced, never followed), atomic replacement, moving old results aside
- * without overwriting, and the output folders a fresh sweep may claim.
+ * without overwriting, the output folders a fresh sweep may claim, and
+ * temporary files written in parts (replaced whole, none left on failure).
  */
 #include <errno.h>
 #include <stdio.h>
@@ -82,12 +83,26 @@ static void test_claim(void)
 	CHECK_INT(safe_claim_output("/tmp/..", true, &err), -EINVAL);
 }
 
+static void test_parts(void)
+{
+	char path[256];
+	const struct safe_part parts[] = {{"bvh", 3}, {"", 0}, {"lab", 3}};
+	put("parts", "an older and longer text");
+	snprintf(path, sizeof(path), "%s/parts", dir);
+	CHECK_INT(safe_write_parts(path, parts, 3), 0);
+	CHECK(get("parts") && strcmp(get("parts"), "bvhlab") == 0);
+	snprintf(path, sizeof(path), "%s/no-such-folder/parts", dir);
+	CHECK_INT(safe_write_parts(path, parts, 3), -ENOENT);
+	CHECK(!get("no-such-folder/parts"));
+}
+
 int main(void)
 {
 	if (!mkdtemp(dir))
 		return 1;
 	test_no_follow();
 	test_claim();
+	test_parts();
 	char cmd[128];
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
 	if (!test_failures && system(cmd) != 0)

@@ -94,19 +94,12 @@ int harness_rounds_write_tree(const char *path, const bvhlab_tree *tree)
 {
 	struct tree_header h = {.node_count = tree->node_count, .index_count = tree->index_count};
 	memcpy(h.magic, TREE_MAGIC, sizeof(h.magic));
-	int fd = safe_create(path);
-	if (fd < 0)
-		return fd;
-	int r = safe_write_all(fd, &h, sizeof(h));
-	if (r == 0)
-		r = safe_write_all(fd, tree->nodes, (size_t)h.node_count * sizeof(*tree->nodes));
-	if (r == 0)
-		r = safe_write_all(fd, tree->prim_index, (size_t)h.index_count * sizeof(uint32_t));
-	if (close(fd) < 0 && r == 0)
-		r = -errno;
-	if (r < 0)
-		unlink(path);
-	return r;
+	const struct safe_part parts[] = {
+		{&h, sizeof(h)},
+		{tree->nodes, (size_t)h.node_count * sizeof(*tree->nodes)},
+		{tree->prim_index, (size_t)h.index_count * sizeof(uint32_t)},
+	};
+	return safe_write_parts(path, parts, 3);
 }
 
 int harness_rounds_add(struct harness_rounds *r, const char *path, const char *builder,

@@ -50,6 +50,21 @@ int safe_write_all(int fd, const void *data, size_t len)
 	return 0;
 }
 
+int safe_write_parts(const char *path, const struct safe_part *parts, size_t count)
+{
+	int fd = safe_create(path);
+	if (fd < 0)
+		return fd;
+	int r = 0;
+	for (size_t k = 0; r == 0 && k < count; k++)
+		r = safe_write_all(fd, parts[k].data, parts[k].len);
+	if (close(fd) < 0 && r == 0)
+		r = -errno;
+	if (r < 0)
+		unlink(path);
+	return r;
+}
+
 /* Data, then fsync: on disk before the rename makes it visible. */
 static int fill(const char *tmp, const void *data, size_t len)
 {

@@ -24,6 +24,19 @@ int safe_create(const char *path);
 /* All of `len` bytes to fd (EINTR and short writes retried); 0 or -errno. */
 int safe_write_all(int fd, const void *data, size_t len);
 
+/* One piece of a file written by safe_write_parts. */
+struct safe_part {
+	const void *data;
+	size_t len;
+};
+
+/*
+ * `path` made anew (safe_create) holding the parts in order, for a
+ * temporary file another process reads: not synced, and removed again
+ * when any write fails. 0 or a negative errno.
+ */
+int safe_write_parts(const char *path, const struct safe_part *parts, size_t count);
+
 /*
  * dir/name = data: written to dir/.name.tmp (safe_create), synced to disk,
  * then renamed over dir/name, so a crash at any moment leaves the old

@@ -30,15 +30,7 @@ int images_temp_path(char *buf, size_t size, const char *dir, const char *kind, 
 
 int images_write_raw(const char *path, const void *data, size_t bytes)
 {
-	int fd = safe_create(path);
-	if (fd < 0)
-		return fd;
-	int r = safe_write_all(fd, data, bytes);
-	if (close(fd) < 0 && r == 0)
-		r = -errno;
-	if (r < 0)
-		unlink(path);
-	return r;
+	return safe_write_parts(path, &(struct safe_part){data, bytes}, 1);
 }
 
 /* Exactly `bytes` bytes of the file, or an error (a short file is one). */
