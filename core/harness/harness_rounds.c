@@ -52,7 +52,7 @@ static unsigned traversal_count(const struct config *cfg)
 	return (unsigned)__builtin_popcount(cfg->ray_traversals);
 }
 
-bool harness_rounds_fit(const struct config *cfg, uint32_t triangles)
+static bool rounds_fit(const struct config *cfg, uint32_t triangles)
 {
 	if (cfg->ray_rounds <= 1 || cfg->ray_width == 0 || cfg->ray_height == 0)
 		return false;
@@ -122,7 +122,8 @@ int harness_rounds_add(struct harness_rounds *r, const char *path, const char *b
 	return 0;
 }
 
-void harness_rounds_clear(struct harness_rounds *r)
+/* Deletes the tree files and forgets the entries (keeps the array). */
+static void rounds_clear(struct harness_rounds *r)
 {
 	for (size_t i = 0; i < r->count; i++) {
 		unlink(r->entries[i].path);
@@ -133,7 +134,7 @@ void harness_rounds_clear(struct harness_rounds *r)
 
 void harness_rounds_finish(struct harness_rounds *r)
 {
-	harness_rounds_clear(r);
+	rounds_clear(r);
 	free(r->entries);
 	*r = (struct harness_rounds){0};
 }
@@ -395,9 +396,11 @@ static int run_group(struct rounds_entry *entries, size_t count, const struct co
 }
 
 /* Trees that fit the memory budget together are timed together: the
- * scene's runs in one group on most configs, in a few on big scenes. */
-int harness_rounds_run(struct harness_rounds *r, const struct config *cfg,
-                       const bvhlab_scene *scene, const bvhlab_prims *prims, bvhlab_error *err)
+ * scene's runs in one group on most configs, in a few on big scenes.
+ * Entries whose tree loaded and traced get timed = true and the new
+ * timings. 0, or a negative errno with err saying why a group was not. */
+static int rounds_run(struct harness_rounds *r, const struct config *cfg,
+                      const bvhlab_scene *scene, const bvhlab_prims *prims, bvhlab_error *err)
 {
 	double budget = memory_budget();
 	int rc = 0;
@@ -416,7 +419,7 @@ int harness_rounds_run(struct harness_rounds *r, const struct config *cfg,
 
 bool harness_rounds_start(const struct config *cfg, const bvhlab_scene *scene, bool tty)
 {
-	bool on = harness_rounds_fit(cfg, scene->triangle_count);
+	bool on = rounds_fit(cfg, scene->triangle_count);
 	if (!on && cfg->ray_rounds > 1 && cfg->ray_width && cfg->ray_height)
 		fprintf(stderr, "%sbvhlab: scene '%s': a tree of %u triangles would not fit in half of "
 		        "this machine's memory for interleaved ray rounds; each run times its rays "
@@ -429,7 +432,7 @@ void harness_rounds_end(struct harness_rounds *r, struct results *res,
                         const bvhlab_prims *prims, bool tty)
 {
 	bvhlab_error err = {{0}};
-	int rc = harness_rounds_run(r, cfg, scene, prims, &err);
+	int rc = rounds_run(r, cfg, scene, prims, &err);
 	bool some = false;
 	for (size_t i = 0; i < r->count; i++) {
 		const struct rounds_entry *e = &r->entries[i];
@@ -445,5 +448,5 @@ void harness_rounds_end(struct harness_rounds *r, struct results *res,
 		fprintf(stderr, "%sbvhlab: scene '%s': interleaved ray rounds: %s; runs not timed "
 		        "there keep their provisional ray timings (rays.rounds 1)\n", tty ? "\n" : "",
 		        scene->name, err.message[0] ? err.message : strerror(-rc));
-	harness_rounds_clear(r);
+	rounds_clear(r);
 }

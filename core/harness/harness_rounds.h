@@ -40,17 +40,17 @@ struct harness_rounds {
 	size_t count, cap;
 };
 
-/* Whether a scene of `triangles` gets interleaved rounds: cfg->ray_rounds
- * > 1 and one tree with its tracing copies fits in half of this machine's
- * memory (the rounds take as many trees at once as fit). */
-bool harness_rounds_fit(const struct config *cfg, uint32_t triangles);
-
-/* harness_rounds_fit, saying on stderr when it is not (tty: after the
- * progress line). */
+/* Whether a scene gets interleaved rounds: cfg->ray_rounds > 1 and one
+ * of its trees with its tracing copies fits in half of this machine's
+ * memory (the rounds take as many trees at once as fit); when it does
+ * not, says so on stderr (tty: after the progress line). */
 bool harness_rounds_start(const struct config *cfg, const bvhlab_scene *scene, bool tty);
 
-/* After the scene's runs: harness_rounds_run, the timings into res (its
- * files rewritten), a failure said on stderr, and the entries cleared. */
+/* After the scene's runs: the rounds (in a forked child unless
+ * cfg->isolate is false; trees that would not fit in half of the
+ * machine's memory together go in groups, a child each), the timings of
+ * the trees timed into res (its files rewritten), a failure said on
+ * stderr, and the entries and their tree files cleared. */
 void harness_rounds_end(struct harness_rounds *r, struct results *res,
                         const struct config *cfg, const bvhlab_scene *scene,
                         const bvhlab_prims *prims, bool tty);
@@ -68,20 +68,6 @@ int harness_rounds_write_tree(const char *path, const bvhlab_tree *tree);
 /* A run whose tree is in path; its rays were measured in its child. */
 int harness_rounds_add(struct harness_rounds *r, const char *path, const char *builder,
                        uint32_t threads, bool duplicates, const struct ray_metrics *rays);
-
-/*
- * Times every entry's batches in cfg->ray_rounds interleaved rounds, in a
- * forked child unless cfg->isolate is false; trees that would not fit in
- * half of the machine's memory together are split into groups, a child
- * each. Entries whose tree loaded and traced get timed = true and the new
- * timings. 0, or a negative errno with err saying why a group was not
- * timed.
- */
-int harness_rounds_run(struct harness_rounds *r, const struct config *cfg,
-                       const bvhlab_scene *scene, const bvhlab_prims *prims, bvhlab_error *err);
-
-/* Deletes the tree files and forgets the entries (keeps the array). */
-void harness_rounds_clear(struct harness_rounds *r);
 
 void harness_rounds_finish(struct harness_rounds *r);
 
