@@ -51,9 +51,10 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p)
 
 /* ---- scratch ------------------------------------------------------------ */
 
-/* Clusters (two sets of six arrays and a record array), nn, the merge tree, desc and the
- * emit phase's tasks: past the tree in the output when the host gives the room,
- * which it keeps between builds (fresh pages cost more than a phase). */
+/* Clusters (two sets of six arrays and a record array), nn, the merge
+ * tree, desc and the emit phase's tasks: past the tree in the output when
+ * the host gives the room, which it keeps between builds (fresh pages
+ * cost more than a phase). */
 static size_t work_size(size_t n)
 {
 	return 2 * (6 * morton_align64(4 * n) + morton_align64(sizeof(struct cluster_meta) * n)) +

@@ -50,7 +50,6 @@
 #define REC_PRIMS 0x3fffffffu     /* primitives below */
 #define DEAD UINT32_MAX
 
-/* Clusters of one iteration, by position in the Morton order. */
 /* What a merge reads of a cluster besides its box: one 16-byte record, so
  * that compacting the clusters streams seven arrays, not ten. */
 struct cluster_meta {
@@ -60,6 +59,7 @@ struct cluster_meta {
 	uint32_t desc;  /* output nodes below the cluster's own */
 };
 
+/* Clusters of one iteration, by position in the Morton order. */
 struct clusters {
 	float *lo[3], *hi[3];      /* [n] boxes, by axis, for vector distance rows */
 	struct cluster_meta *meta; /* [n] */
