@@ -21,6 +21,7 @@ struct bvhlab_build_ctx {
 	bvhlab_tree *tree;
 	bvhlab_error *err;
 	bool error_set;
+	char bad_phase[96];    /* the first phase report host_phase refused, or "" */
 	bool pinning;          /* plan is set: pin_thread binds */
 	struct pin_plan plan;
 	cpu_set_t caller_mask; /* restored after build(): the caller may be a worker */
@@ -146,6 +147,46 @@ static int host_pin_thread(bvhlab_build_ctx *ctx, uint32_t worker)
 	return ctx->pinning ? pin_plan_apply(&ctx->plan, worker) : 0;
 }
 
+static bool phase_name_ok(const char *name)
+{
+	size_t n = name ? strlen(name) : 0;
+	if (n == 0 || n >= BVHLAB_PHASE_NAME_MAX)
+		return false;
+	for (size_t k = 0; k < n; k++)
+		if (!((name[k] >= 'a' && name[k] <= 'z') || (name[k] >= '0' && name[k] <= '9') ||
+		      name[k] == '_'))
+			return false;
+	return true;
+}
+
+/* A refused report is kept for explain(): the build then fails naming it,
+ * rather than its figures going missing without a word. */
+static void host_phase(bvhlab_build_ctx *ctx, const char *name, double ms)
+{
+	bvhlab_tree *t = ctx->tree;
+	uint32_t k = 0;
+	if (ctx->bad_phase[0])
+		return;
+	if (!phase_name_ok(name) || !(ms >= 0 && ms <= 1e12)) {
+		snprintf(ctx->bad_phase, sizeof(ctx->bad_phase), "'%.40s' (%g ms)",
+		         name ? name : "(null)", ms);
+		return;
+	}
+	while (k < t->phase_count && strcmp(t->phases[k].name, name) != 0)
+		k++;
+	if (k == BVHLAB_MAX_PHASES) {
+		snprintf(ctx->bad_phase, sizeof(ctx->bad_phase), "'%s' (more than %d phases)",
+		         name, BVHLAB_MAX_PHASES);
+		return;
+	}
+	if (k == t->phase_count) {
+		snprintf(t->phases[k].name, sizeof(t->phases[k].name), "%s", name);
+		t->phases[k].ms = 0;
+		t->phase_count++;
+	}
+	t->phases[k].ms += ms;
+}
+
 static const bvhlab_host host_table = {
 	.abi_version = BVHLAB_ABI_CURRENT,
 	.struct_size = sizeof(bvhlab_host),
@@ -159,6 +200,7 @@ static const bvhlab_host host_table = {
 	.progress = host_progress,
 	.hardware_threads = host_hardware_threads,
 	.pin_thread = host_pin_thread,
+	.phase = host_phase,
 };
 
 static int prepare_tree(bvhlab_tree *tree, uint32_t prims)
@@ -201,6 +243,13 @@ static void pinning_end(struct bvhlab_build_ctx *ctx)
 static int explain(const struct bvhlab_build_ctx *ctx, int r)
 {
 	const char *name = ctx->builder->name;
+	if (r == 0 && ctx->bad_phase[0]) {
+		error_set(ctx->err,
+		          "builder '%s' reported phase %s: names are [a-z0-9_], 1 to %d "
+		          "characters, at most %d per build, times finite and >= 0",
+		          name, ctx->bad_phase, BVHLAB_PHASE_NAME_MAX - 1, BVHLAB_MAX_PHASES);
+		return -EPROTO;
+	}
 	if (r < 0 && !ctx->error_set)
 		error_set(ctx->err, "builder '%s' failed (%s) without saying why", name,
 		          strerror(-r));
@@ -233,6 +282,7 @@ static int call_plugin(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		.index_count = refine ? tree->index_count : 0,
 	};
 	struct bvhlab_build_ctx ctx = {.builder = b, .opts = opts, .tree = tree, .err = err};
+	tree->phase_count = 0;
 	int r = pinning_begin(&ctx);
 	if (r < 0)
 		return r;

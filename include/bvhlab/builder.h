@@ -9,6 +9,10 @@
  *   1.2  bvhlab_builder.refine: a plugin may improve a finished tree in
  *        place (a refinement stage); a refinement-only plugin leaves
  *        build NULL. Plugins of 1.0 and 1.1 load as before.
+ *   1.3  bvhlab_host.phase: a builder may report named phases of a build
+ *        (upload, device, download, convert, ...) in milliseconds; the
+ *        harness records them per run as build_phases. Older plugins load
+ *        as before and report none.
  *
  * A plugin is a shared object that exports exactly one symbol,
  *
@@ -39,7 +43,7 @@
 BVHLAB_BEGIN_DECLS
 
 #define BVHLAB_ABI_MAJOR 1
-#define BVHLAB_ABI_MINOR 2
+#define BVHLAB_ABI_MINOR 3
 #define BVHLAB_ABI_VERSION(major, minor) (((uint32_t)(major) << 16) | (uint32_t)(minor))
 #define BVHLAB_ABI_VERSION_MAJOR(v) ((uint32_t)(v) >> 16)
 #define BVHLAB_ABI_VERSION_MINOR(v) ((uint32_t)(v) & 0xffffu)
@@ -185,7 +189,24 @@ typedef struct bvhlab_host {
 	 * thread that called build() afterwards. 0, or a negative errno (the
 	 * thread then keeps running unpinned). */
 	int (*pin_thread)(bvhlab_build_ctx *ctx, uint32_t worker);
+
+	/* since 1.3. Adds `ms` milliseconds to the named phase of this build
+	 * or refinement (a call with a name already reported adds to it), so
+	 * a builder can say where its time went: e.g. "upload", "device" (a
+	 * device's own kernel time, from its events), "download", "convert"
+	 * (a peer library's tree turned into the standard layout). Names are
+	 * [a-z0-9_], 1 to BVHLAB_PHASE_NAME_MAX - 1 characters, at most
+	 * BVHLAB_MAX_PHASES distinct ones per call of build(); anything else,
+	 * or a negative or non-finite ms, fails the build with a message
+	 * naming the phase. The phases need not add up to the whole call,
+	 * which the host times itself (build_ms). Call it from the thread
+	 * that called build(). Check BVHLAB_HOST_HAS(host, phase) first. */
+	void (*phase)(bvhlab_build_ctx *ctx, const char *name, double ms);
 } bvhlab_host;
+
+/* Limits of host->phase (ABI 1.3). */
+#define BVHLAB_MAX_PHASES 8
+#define BVHLAB_PHASE_NAME_MAX 32
 
 /* True when `host` has `field`: a host older than the plugin lacks fields
  * that came in later minors, e.g. BVHLAB_HOST_HAS(host, pin_thread). */

@@ -10,6 +10,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "builder.h"
 #include "scene.h"
 #include "types.h"
 
@@ -21,6 +22,12 @@ BVHLAB_BEGIN_DECLS
  * ones are page mappings, not malloc blocks): a tree over arrays of your own
  * is fine to read, validate and trace, but not to reserve or finish.
  */
+/* One named phase of a build, as the builder reported it (host->phase). */
+typedef struct bvhlab_phase {
+	char name[BVHLAB_PHASE_NAME_MAX]; /* [a-z0-9_]+ */
+	double ms;                        /* milliseconds, summed over the calls */
+} bvhlab_phase;
+
 typedef struct bvhlab_tree {
 	bvhlab_node *nodes;
 	uint32_t node_count;
@@ -28,6 +35,10 @@ typedef struct bvhlab_tree {
 	uint32_t *prim_index;
 	uint32_t index_count;
 	uint32_t index_capacity;
+	/* The phases the last bvhlab_build or bvhlab_refine into this tree
+	 * reported (ABI 1.3), in the order first reported; 0 when none. */
+	uint32_t phase_count;
+	bvhlab_phase phases[BVHLAB_MAX_PHASES];
 } bvhlab_tree;
 
 /* Allocates capacities (2n - 1 nodes, n indices for n primitives). */
