@@ -46,6 +46,7 @@ static int set_defaults(struct config *cfg)
 	cfg->images = false;
 	cfg->isolate = true;
 	cfg->timeout_s = DEFAULT_TIMEOUT_S;
+	cfg->rays_per_frame = 1000000;
 	cfg->threads = malloc(sizeof(*cfg->threads));
 	if (!cfg->threads)
 		return -ENOMEM;
@@ -321,6 +322,7 @@ void config_finish(struct config *cfg)
 		free(cfg->scenes[i].name);
 		free(cfg->scenes[i].path);
 		free(cfg->scenes[i].generator);
+		free(cfg->scenes[i].frame_pattern);
 		config_parts_free(&cfg->scenes[i]);
 	}
 	for (size_t i = 0; cfg->builders && i < cfg->builder_count; i++) {
@@ -330,6 +332,7 @@ void config_finish(struct config *cfg)
 		free(cfg->builders[i].picks);
 		config_refine_finish(&cfg->builders[i]);
 	}
+	config_anim_finish(cfg);
 	free(cfg->scenes);
 	free(cfg->builders);
 	free(cfg->threads);

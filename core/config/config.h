@@ -25,6 +25,20 @@ struct json_locations;
 
 struct config_part;
 
+/* What a scene's or part's "deform" names (config_anim.c). */
+enum config_deform { CONFIG_DEFORM_NONE, CONFIG_DEFORM_WAVE, CONFIG_DEFORM_EXPLODE };
+
+/* How a scene or a composite's part moves over the scene's frames
+ * (config_anim.c; docs/animation.md). */
+struct config_motion {
+	bool animate;          /* "animate" given: a rigid motion */
+	double rotate[3];      /* "animate.rotate": degrees added by the last frame */
+	double translate[3];   /* "animate.translate": offset reached by the last frame */
+	double scale;          /* "animate.scale": factor reached by the last frame (1) */
+	int deform;            /* "deform": enum config_deform */
+	double amplitude;      /* "amplitude": a fraction of the mesh's extent; 0: default */
+};
+
 struct config_scene {
 	char *name;        /* "name", default: file stem, generator name or "composite" */
 	char *path;        /* "path" resolved against the config's folder, or NULL */
@@ -34,6 +48,11 @@ struct config_scene {
 	int line, column;  /* where the scene's object starts */
 	struct config_part *parts; /* "parts" of a composite scene, or NULL */
 	size_t part_count;
+	/* Animation (config_anim.c): "frames": N, or {"pattern", "count", "first"}. */
+	uint32_t frames;     /* frames of the animation; 0: a static scene */
+	char *frame_pattern; /* frame files, one %d conversion (resolved), or NULL */
+	uint32_t frame_first; /* the number frame 0's file carries */
+	struct config_motion motion; /* the whole scene's motion ("animate", "deform") */
 };
 
 /* One entry of a composite scene's "parts": a mesh or generator (src, whose
@@ -41,6 +60,7 @@ struct config_scene {
 struct config_part {
 	struct config_scene src;
 	bvhlab_transform xf;
+	struct config_motion motion; /* "animate", "deform", "amplitude" */
 };
 
 /* One refinement stage of a builder (config_refine.c). */
@@ -52,6 +72,18 @@ struct config_refine {
 
 /* Most stages in one builder's "refine" list. */
 #define CONFIG_MAX_REFINE 8
+
+/* A builder's strategy on an animated scene, "animation" (config_anim.c):
+ * frames after the first are updated by `update` (then refined by the
+ * stages), and rebuilt every rebuild_every frames; no "animation": every
+ * frame is rebuilt. Owned by the config (shared by a grid's builders). */
+struct config_animation {
+	char *update;      /* "update": a plugin with an update function (ABI 1.4) */
+	uint32_t rebuild_every; /* "rebuild_every": K > 0 rebuilds frames K, 2K, ...; 0: never */
+	struct config_refine *refine; /* "refine": stages after each update, or NULL */
+	size_t refine_count;
+	struct config_animation *next_owned; /* the config's list, for freeing */
+};
 
 struct config_builder {
 	char *plugin;      /* "plugin": a name on the search path or a path to a .so */
@@ -68,6 +100,7 @@ struct config_builder {
 	                               * build, or NULL */
 	size_t refine_count;
 	int line, column;  /* where the builder's object starts */
+	const struct config_animation *animation; /* "animation", or NULL: rebuild */
 	/* An option grid's builder (config_grid.c): the value it takes of each grid. */
 	struct config_grid_pick *picks;
 	size_t pick_count;
@@ -116,6 +149,9 @@ struct config {
 	                    * to distinct physical cores */
 	double timeout_s;  /* "timeout_s", default 600: an isolated run is killed after it */
 	uint64_t memory_limit_mb; /* "memory_limit_mb", default 0 = none: the child's RLIMIT_AS */
+	uint64_t rays_per_frame; /* "rays_per_frame", default 1000000: the rays an animated
+	                          * scene's frame is costed for (cost_ms) */
+	struct config_animation *animations; /* the builders' "animation"s, owned */
 
 	struct config_scene *scenes;
 	size_t scene_count;
@@ -153,6 +189,11 @@ const struct cJSON *config_grid_value(const struct config_builder *b,
 /* Same for the options of stage k of the builder's "refine" list. */
 int config_apply_refine_options(const struct config *cfg, const struct config_builder *b,
                                 size_t k, bvhlab_options *opts, bvhlab_error *err);
+
+/* Stage k of a builder's "animation.refine" (config_anim.c), like
+ * config_apply_refine_options. */
+int config_apply_anim_refine_options(const struct config *cfg, const struct config_builder *b,
+                                     size_t k, bvhlab_options *opts, bvhlab_error *err);
 
 /* Replaces the thread list (command line --threads). */
 int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count);

@@ -122,12 +122,16 @@ static int parse_scene(struct config *cfg, const cJSON *obj, size_t index,
 	int rc = config_check_keys(cfg, obj, config_scene_keys, where, err);
 	if (!rc)
 		rc = config_read_keys(cfg, obj, config_scene_keys, prefix, sc, err);
+	if (!rc) /* animation: frames, motion (config_anim.c) */
+		rc = config_parse_frames(cfg, obj, prefix, sc, err);
 	if (!rc && config_member(obj, "parts"))
 		rc = config_parse_parts(cfg, obj, prefix, sc, err);
 	else if (!rc)
 		rc = config_scene_source(cfg, obj, prefix, config_scene_keys, sc, err);
 	if (!rc)
 		rc = scene_name_and_path(cfg, sc, err);
+	if (!rc)
+		rc = config_check_scene_anim(cfg, obj, prefix, sc, err);
 	return rc;
 }
 
@@ -223,6 +227,8 @@ static int parse_builder(struct config *cfg, const cJSON *obj, size_t index,
 		rc = builder_options(cfg, obj, index, b, err);
 	if (!rc)
 		rc = config_parse_refine(cfg, obj, index, b, err);
+	if (!rc)
+		rc = config_parse_animation(cfg, obj, index, b, err);
 	return rc;
 }
 

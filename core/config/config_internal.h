@@ -145,5 +145,17 @@ int config_expand_grids(struct config *cfg, const cJSON *array, bvhlab_error *er
 int config_parse_refine(struct config *cfg, const cJSON *obj, size_t index,
                         struct config_builder *b, bvhlab_error *err);
 void config_refine_finish(struct config_builder *b);
+/* Animation (config_anim.c): a scene's "frames" (before its source is
+ * checked: a frame pattern gives the path), the motion keys of a scene or
+ * part, a builder's "animation"; freed in config_finish. */
+int config_parse_frames(struct config *cfg, const cJSON *obj, const char *prefix,
+                        struct config_scene *sc, bvhlab_error *err);
+int config_parse_motion(struct config *cfg, const cJSON *obj, const char *prefix,
+                        struct config_motion *m, bvhlab_error *err);
+int config_check_scene_anim(struct config *cfg, const cJSON *obj, const char *prefix,
+                            const struct config_scene *sc, bvhlab_error *err);
+int config_parse_animation(struct config *cfg, const cJSON *obj, size_t index,
+                           struct config_builder *b, bvhlab_error *err);
+void config_anim_finish(struct config *cfg);
 
 #endif /* BVHLAB_CORE_CONFIG_INTERNAL_H */

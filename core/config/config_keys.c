@@ -43,6 +43,7 @@ const struct config_key config_top_keys[] = {
 	TOP("timeout_s", CONFIG_POSITIVE, timeout_s, 0, 0),
 	TOP("memory_limit_mb", CONFIG_U64, memory_limit_mb, 1, CONFIG_MAX_MEMORY_MB),
 	TOP("pin", CONFIG_BOOL, pin, 0, 0),
+	TOP("rays_per_frame", CONFIG_U64, rays_per_frame, 1, UINT64_C(1000000000000)),
 	CUSTOM("report"),
 	CUSTOM("scenes"),
 	CUSTOM("builders"),
@@ -79,6 +80,10 @@ const struct config_key config_scene_keys[] = {
 	SCENE("seed", CONFIG_U64, gen.seed, 0, UINT64_MAX, CONFIG_GENERATED),
 	SCENE("width", CONFIG_POSITIVE, gen.width, 0, 0, CONFIG_GENERATED),
 	SCENE("subdivide", CONFIG_U32, subdivide, 0, MAX_SUBDIVIDE, 0),
+	CUSTOM("frames"),  /* animation: config_anim.c */
+	CUSTOM("animate"),
+	CUSTOM("deform"),
+	SCENE("amplitude", CONFIG_POSITIVE, motion.amplitude, 0, 0, 0),
 	END,
 };
 
@@ -97,6 +102,9 @@ const struct config_key config_part_keys[] = {
 	PART("scale", CONFIG_POSITIVE, xf.scale, 0, 0, 0),
 	CUSTOM("rotate"),    /* degrees, doubles: config_parts.c */
 	CUSTOM("translate"),
+	CUSTOM("animate"), /* animation: config_anim.c */
+	CUSTOM("deform"),
+	PART("amplitude", CONFIG_POSITIVE, motion.amplitude, 0, 0, 0),
 	END,
 };
 
@@ -111,6 +119,7 @@ const struct config_key config_builder_keys[] = {
 	CUSTOM("options"),
 	BUILDER("optional", CONFIG_BOOL, optional, 0, 0),
 	CUSTOM("refine"), /* config_refine.c */
+	CUSTOM("animation"), /* config_anim.c */
 	END,
 };
 

@@ -77,6 +77,8 @@ static int parse_part(struct config *cfg, const cJSON *obj, const char *scene_pr
 		rc = get_vec3(cfg, obj, "rotate", prefix, part->xf.rotate, err);
 	if (!rc)
 		rc = get_vec3(cfg, obj, "translate", prefix, part->xf.translate, err);
+	if (!rc)
+		rc = config_parse_motion(cfg, obj, prefix, &part->motion, err);
 	return rc ? rc : part_path(cfg, &part->src, err);
 }
 

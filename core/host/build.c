@@ -264,10 +264,11 @@ static int explain(const struct bvhlab_build_ctx *ctx, int r)
 }
 
 /* The call into the plugin, with pinning around it and the counts back
- * into the tree. */
+ * into the tree; `in_place` is its refine or update function (the tree's
+ * counts go in), NULL for build. */
 static int call_plugin(const bvhlab_plugin *plugin, const bvhlab_options *opts,
                        const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
-                       bool refine, bvhlab_error *err)
+                       bvhlab_refine_fn in_place, bvhlab_error *err)
 {
 	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
 	bvhlab_build_input in = *input;
@@ -278,16 +279,16 @@ static int call_plugin(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		.nodes = tree->nodes,
 		.prim_index = tree->prim_index,
 		.index_capacity = tree->index_capacity,
-		.node_count = refine ? tree->node_count : 0,
-		.index_count = refine ? tree->index_count : 0,
+		.node_count = in_place ? tree->node_count : 0,
+		.index_count = in_place ? tree->index_count : 0,
 	};
 	struct bvhlab_build_ctx ctx = {.builder = b, .opts = opts, .tree = tree, .err = err};
 	tree->phase_count = 0;
 	int r = pinning_begin(&ctx);
 	if (r < 0)
 		return r;
-	r = refine ? bvhlab_builder_refine(b)(&host_table, &ctx, &in, &out)
-	           : b->build(&host_table, &ctx, &in, &out);
+	r = in_place ? in_place(&host_table, &ctx, &in, &out)
+	             : b->build(&host_table, &ctx, &in, &out);
 	pinning_end(&ctx);
 	tree->node_count = out.node_count;
 	tree->index_count = out.index_count;
@@ -300,8 +301,8 @@ int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 {
 	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
 	if (!b->build) {
-		error_set(err, "plugin '%s' only refines trees; use it in a builder's \"refine\" list",
-		          b->name);
+		error_set(err, "plugin '%s' builds no trees (it refines or updates them); use it in "
+		          "a builder's \"refine\" list or \"animation\"", b->name);
 		return -ENOTSUP;
 	}
 	if (prepare_tree(tree, input->prim_count) < 0) {
@@ -309,7 +310,7 @@ int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		          input->prim_count);
 		return -ENOMEM;
 	}
-	return call_plugin(plugin, opts, input, threads, tree, false, err);
+	return call_plugin(plugin, opts, input, threads, tree, NULL, err);
 }
 
 int bvhlab_refine(const bvhlab_plugin *plugin, const bvhlab_options *opts,
@@ -321,5 +322,38 @@ int bvhlab_refine(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		error_set(err, "plugin '%s' has no refinement stage (ABI 1.2 refine)", b->name);
 		return -ENOTSUP;
 	}
-	return call_plugin(plugin, opts, input, threads, tree, true, err);
+	return call_plugin(plugin, opts, input, threads, tree, bvhlab_builder_refine(b), err);
+}
+
+/* The references a tree over another primitive count would have: fewer
+ * slots than primitives (some could not be referenced), or one past the
+ * last primitive. Cheap next to any update: one read of prim_index. */
+static int check_update_counts(const bvhlab_builder *b, const bvhlab_build_input *input,
+                               const bvhlab_tree *tree, bvhlab_error *err)
+{
+	uint32_t most = 0;
+	for (uint32_t k = 0; k < tree->index_count; k++)
+		most = tree->prim_index[k] > most ? tree->prim_index[k] : most;
+	if (tree->node_count && tree->index_count >= input->prim_count &&
+	    most < input->prim_count)
+		return 0;
+	error_set(err, "update '%s': the tree holds %u references (primitives up to %u), the frame "
+	          "has %u triangles: an update keeps the topology (same triangles, same order); "
+	          "rebuild instead", b->name, tree->index_count, most, input->prim_count);
+	return -EINVAL;
+}
+
+int bvhlab_update(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                  const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
+                  bvhlab_error *err)
+{
+	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
+	if (!bvhlab_builder_update(b)) {
+		error_set(err, "plugin '%s' has no update function (ABI 1.4 update)", b->name);
+		return -ENOTSUP;
+	}
+	int r = check_update_counts(b, input, tree, err);
+	if (r == 0)
+		r = call_plugin(plugin, opts, input, threads, tree, bvhlab_builder_update(b), err);
+	return r;
 }

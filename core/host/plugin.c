@@ -66,7 +66,7 @@ static int check_builder(const bvhlab_builder *b, const char *path, bvhlab_error
 		error_set(err, "plugin %s: descriptor has no name", path);
 		return -EINVAL;
 	}
-	if (!b->build && !bvhlab_builder_refine(b)) {
+	if (!b->build && !bvhlab_builder_refine(b) && !bvhlab_builder_update(b)) {
 		error_set(err, "plugin %s ('%s'): descriptor has no build function", path, b->name);
 		return -EINVAL;
 	}
@@ -76,6 +76,11 @@ static int check_builder(const bvhlab_builder *b, const char *path, bvhlab_error
 bvhlab_refine_fn bvhlab_builder_refine(const bvhlab_builder *b)
 {
 	return BVHLAB_BUILDER_HAS(b, refine) ? b->refine : NULL;
+}
+
+bvhlab_refine_fn bvhlab_builder_update(const bvhlab_builder *b)
+{
+	return BVHLAB_BUILDER_HAS(b, update) ? b->update : NULL;
 }
 
 static int load(bvhlab_plugin *p, bvhlab_error *err)

@@ -13,6 +13,10 @@
  *        (upload, device, download, convert, ...) in milliseconds; the
  *        harness records them per run as build_phases. Older plugins load
  *        as before and report none.
+ *   1.4  bvhlab_builder.update: a plugin may update a finished tree in
+ *        place for primitives that moved (same count and order), e.g. a
+ *        refit; an update-only plugin leaves build and refine NULL.
+ *        Older plugins load as before and have none.
  *
  * A plugin is a shared object that exports exactly one symbol,
  *
@@ -43,7 +47,7 @@
 BVHLAB_BEGIN_DECLS
 
 #define BVHLAB_ABI_MAJOR 1
-#define BVHLAB_ABI_MINOR 3
+#define BVHLAB_ABI_MINOR 4
 #define BVHLAB_ABI_VERSION(major, minor) (((uint32_t)(major) << 16) | (uint32_t)(minor))
 #define BVHLAB_ABI_VERSION_MAJOR(v) ((uint32_t)(v) >> 16)
 #define BVHLAB_ABI_VERSION_MINOR(v) ((uint32_t)(v) & 0xffffu)
@@ -297,6 +301,24 @@ typedef struct bvhlab_builder {
 	 * then discarded). Same calling rules as build.
 	 */
 	int (*refine)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+	              const bvhlab_build_input *input, bvhlab_build_output *tree);
+
+	/*
+	 * since 1.4, may be NULL. Updates a finished tree in place after its
+	 * primitives moved: on entry `tree` holds a valid tree in the standard
+	 * layout (any builder's, counts set) over primitives of the same count
+	 * and order as `input`'s, which gives their new boxes and vertices
+	 * (the topology is kept; only positions changed). On return it must
+	 * hold a valid tree over `input`, with the counts updated; the
+	 * capacity past the counts is scratch, and host->grow_output works as
+	 * in build(). A tree whose references do not fit input (another
+	 * triangle count) must be refused with host->set_error, not walked
+	 * out of bounds; the host refuses the plainest mismatches before the
+	 * call. The harness times it per frame of an animated scene in place
+	 * of a rebuild. Returns 0, or a negative errno after host->set_error.
+	 * Same calling rules as build.
+	 */
+	int (*update)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	              const bvhlab_build_input *input, bvhlab_build_output *tree);
 } bvhlab_builder;
 

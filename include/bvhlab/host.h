@@ -35,6 +35,9 @@ const bvhlab_builder *bvhlab_plugin_builder(const bvhlab_plugin *plugin);
 typedef int (*bvhlab_refine_fn)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                                 const bvhlab_build_input *input, bvhlab_build_output *tree);
 bvhlab_refine_fn bvhlab_builder_refine(const bvhlab_builder *b);
+/* A descriptor's update function (ABI 1.4), or NULL: NULL too for a
+ * plugin built against an older minor. Same signature as refine. */
+bvhlab_refine_fn bvhlab_builder_update(const bvhlab_builder *b);
 /* The file the plugin was loaded from. */
 const char *bvhlab_plugin_path(const bvhlab_plugin *plugin);
 
@@ -107,6 +110,18 @@ int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
  * plugin's negative errno with its message in err. Does not validate.
  */
 int bvhlab_refine(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                  const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
+                  bvhlab_error *err);
+
+/*
+ * Runs the plugin's update function (ABI 1.4) once on `tree`, a valid tree
+ * over primitives of the same count and order as `input`'s, which moved.
+ * -ENOTSUP when the plugin has no update; -EINVAL, with a message naming
+ * both counts, when the tree's references cannot be `input`'s primitives
+ * (fewer references than primitives, or one past the last). Returns 0, or
+ * the plugin's negative errno with its message in err. Does not validate.
+ */
+int bvhlab_update(const bvhlab_plugin *plugin, const bvhlab_options *opts,
                   const bvhlab_build_input *input, uint32_t threads, bvhlab_tree *tree,
                   bvhlab_error *err);
 
