@@ -14,6 +14,7 @@
 
 #include "harness/harness.h"
 #include "harness/harness_builders.h"
+#include "harness/harness_frames.h"
 #include "harness/harness_rounds.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
@@ -39,6 +40,8 @@ struct harness {
 	bool shade_done; /* this scene's shaded render is on its way */
 	bool rounds_on;  /* this scene's rays are timed in interleaved rounds */
 	struct harness_rounds rounds; /* this scene's trees waiting for them */
+	struct harness_anim anim; /* this scene's animation (harness_frames.c) */
+	bool animated;
 };
 
 enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };
@@ -62,8 +65,9 @@ struct series_report {
 	bool tree_written; /* the tree is in the job's tree_path */
 	uint32_t stage_count;
 	struct stage_metrics stages[HARNESS_MAX_STAGES];
+	uint32_t frame_count;  /* frames done, after samples[] (an animated scene) */
 	char error[sizeof(((bvhlab_error *)0)->message)];
-	double samples[];      /* [repeat] */
+	double samples[];      /* [repeat], then struct frame_metrics [frames] */
 };
 
 /* One run's build series, as handed to the child. */
@@ -237,6 +241,23 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 	free(shade);
 }
 
+/* An animated scene's frames, on the series' tree (harness_frames.c). */
+static void run_frames(const struct series_job *job, struct build_series *s,
+                       struct series_report *rep, bvhlab_error *err)
+{
+	double mn, mx, median;
+	util_summarise(rep->samples, s->repeat, &median, &mn, &mx);
+	struct frames_job fj = {.cfg = job->h->cfg, .cb = job->hb->cb, .anim = &job->h->anim,
+	                        .first = job->scene, .plugin = job->hb->plugin,
+	                        .opts = &job->hb->opts, .stages = job->hb->refine,
+	                        .stage_count = s->stage_count, .threads = job->threads,
+	                        .spatial_splits = spatial_splits(job), .first_ms = median};
+	int r = harness_frames_run(&fj, &s->tree, (struct frame_metrics *)(rep->samples + s->repeat),
+	                           &rep->frame_count, err);
+	if (r != 0)
+		rep->status = r > 0 ? SERIES_INVALID : SERIES_FAILED;
+}
+
 /* Warm-up, timed builds, validation and metrics: what runs in the child. */
 static void series_work(void *arg, void *report, size_t size)
 {
@@ -269,6 +290,8 @@ static void series_work(void *arg, void *report, size_t size)
 			                               &rep->epo) == 0;
 		if (rep->status == SERIES_OK)
 			trace_rays(job, &s.tree, rep, &err);
+		if (rep->status == SERIES_OK && job->h->animated)
+			run_frames(job, &s, rep, &err);
 	}
 	if (rep->status != SERIES_OK)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
@@ -276,12 +299,13 @@ static void series_work(void *arg, void *report, size_t size)
 }
 
 /* A report from a child is checked before use: the child ran foreign code. */
-static void report_to_run(struct series_report *rep, uint32_t repeat, struct run_record *run)
+static void report_to_run(struct series_report *rep, uint32_t repeat, uint32_t frames,
+                          struct run_record *run)
 {
 	static const char *const names[] = {"ok", "invalid", "failed"};
 	rep->error[sizeof(rep->error) - 1] = '\0';
 	if (rep->status > SERIES_FAILED || rep->sample_count > repeat ||
-	    rep->stage_count > HARNESS_MAX_STAGES) {
+	    rep->stage_count > HARNESS_MAX_STAGES || rep->frame_count > frames) {
 		run->status = "crashed";
 		run->error = "sent back a malformed report";
 		return;
@@ -303,6 +327,8 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 		rep->stages[k].plugin[sizeof(rep->stages[k].plugin) - 1] = '\0';
 	run->stages = rep->stages;
 	run->stage_count = rep->stage_count;
+	run->frames = (const struct frame_metrics *)(rep->samples + repeat);
+	run->frame_count = rep->frame_count;
 }
 
 /* Runs the series in a child (or here, with "isolate": false) and records it. */
@@ -318,7 +344,7 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	else
 		series_work(job, rep, size);
 	if (outcome == ISOLATE_REPORTED) {
-		report_to_run(rep, h->cfg->repeat, run);
+		report_to_run(rep, h->cfg->repeat, h->animated ? h->anim.frames : 0, run);
 	} else {
 		run->status = outcome < 0 ? "failed" : outcomes[outcome];
 		run->error = why;
@@ -373,7 +399,8 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 	char paths[2][4096], tree_path[4096];
 	if (skip_run(h, run.id, run.scene, run.builder, run.threads))
 		return;
-	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double);
+	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double) +
+	              harness_frames_size(h->animated ? &h->anim : NULL);
 	struct series_report *rep = calloc(1, size);
 	if (!rep) {
 		run.error = "out of memory for the run's samples";
@@ -447,7 +474,10 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (scene_done(h, cs, scene_index))
 		return;
 	int r = h->cfg->isolate ? harness_probe_scene(h->cfg, cs, &err) : 0;
-	if (r == 0)
+	h->animated = r == 0 && harness_anim_on(cs); /* frame 0 is the scene: harness_anim.c */
+	if (r == 0 && h->animated && (r = harness_anim_open(cs, &h->anim, &err)) == 0)
+		r = harness_anim_frame(&h->anim, 0, &scene, &err);
+	else if (r == 0)
 		r = harness_load_scene(cs, &scene, &err);
 	if (r == 0)
 		r = bvhlab_prims_init(&prims, scene, &err);
@@ -470,6 +500,9 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)
 		scene_images(h, scene, scene_index);
 out:
+	if (h->animated)
+		harness_anim_close(&h->anim);
+	h->animated = false;
 	bvhlab_prims_finish(&prims);
 	bvhlab_scene_destroy(scene);
 }

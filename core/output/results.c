@@ -241,6 +241,8 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddItemToObject(o, "validation", validation_json(run));
 	if (run->rays)
 		cJSON_AddItemToObject(o, "rays", results_rays_json(run->rays));
+	if (run->frame_count) /* an animated scene: results_frames.c */
+		cJSON_AddItemToObject(o, "frames", results_frames_json(run->frames, run->frame_count));
 	cJSON_AddItemToArray(res->runs, o);
 	return 0;
 }
@@ -275,6 +277,8 @@ static int write_renderings(const struct results *res, bvhlab_error *err)
 		r = write_rendering(res, renderings[2], report_markdown(res->doc), err);
 	if (r == 0)
 		r = write_rendering(res, renderings[3], report_html(res->doc), err);
+	if (r == 0) /* animated scenes' frames, long form: results_frames.c */
+		r = results_frames_csv(res->doc, res->dir, err);
 	return r;
 }
 
@@ -517,6 +521,8 @@ int results_render_saved(const char *json_path, const char *dir, bvhlab_error *e
 		r = write_rendering(&res, "report.md", report_markdown(res.doc), err);
 	if (r == 0)
 		r = write_rendering(&res, "report.html", report_html(res.doc), err);
+	if (r == 0)
+		r = results_frames_csv(res.doc, dir, err);
 	cJSON_Delete(res.doc);
 	return r;
 }

@@ -56,6 +56,20 @@ struct stage_metrics {
 	double sah_before, sah_after; /* SAH cost of the last repeat's tree */
 };
 
+/* One frame of an animated scene as a run's strategy handled it
+ * (harness/harness_frames.c; results_frames.c writes it). */
+struct frame_metrics {
+	uint32_t frame;
+	bool rebuilt;          /* built anew, not updated */
+	bool valid;            /* structure (and brute-force rays where checked) */
+	bool rays_checked;     /* brute-force rays checked: first, middle, last frame */
+	double update_ms;      /* the rebuild or update and its stages */
+	double sah;            /* SAH cost of the frame's tree */
+	double nodes_per_ray;  /* primary rays of the frame's camera */
+	double mrays_per_s;
+	double cost_ms;        /* update_ms + rays_per_frame / rays per second */
+};
+
 /* Everything known about one run; fields beyond status are optional. */
 struct run_record {
 	uint32_t id;           /* position in the config's run order (plan.h) */
@@ -79,6 +93,8 @@ struct run_record {
 	const struct ray_metrics *rays; /* or NULL: not traced */
 	const struct stage_metrics *stages; /* [stage_count] refinement stages */
 	uint32_t stage_count;
+	const struct frame_metrics *frames; /* [frame_count] an animated scene's frames */
+	uint32_t frame_count;
 };
 
 
@@ -99,6 +115,13 @@ struct cJSON *results_rays_json(const struct ray_metrics *m);
 
 /* "stages": [{"plugin", "ms", "sah_before", "sah_after"}, ...] (results_stages.c). */
 struct cJSON *results_stages_json(const struct stage_metrics *stages, uint32_t count);
+
+/* "frames": [{frame, update_ms, sah, valid, nodes_per_ray, mrays_per_s,
+ * cost_ms, rebuilt}, ...] (results_frames.c). */
+struct cJSON *results_frames_json(const struct frame_metrics *frames, uint32_t count);
+/* frames.csv in dir, one line per run and frame, when some run of the
+ * document has frames (results_frames.c). */
+int results_frames_csv(const struct cJSON *doc, const char *dir, bvhlab_error *err);
 
 /* The scene's "images": {"<kind>": name}; a legend also sets "heat_min"/"heat_max". */
 int results_set_scene_image(struct results *res, const char *scene, const char *kind,

@@ -1,0 +1,45 @@
+/*
+ * An animated config scene (docs/animation.md): its meshes loaded once, at
+ * rest, and any frame made from them on demand, or read from its frame
+ * file and checked against the first frame's topology.
+ */
+#ifndef BVHLAB_CORE_HARNESS_ANIM_H
+#define BVHLAB_CORE_HARNESS_ANIM_H
+
+#include <stdint.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "config/config.h"
+#include "scene/scene_anim.h"
+
+struct harness_anim {
+	const struct config_scene *cs;
+	uint32_t frames;
+	bvhlab_scene **meshes;        /* [mesh_count] at rest, in their own frame */
+	struct scene_motion *motions; /* [mesh_count] */
+	uint32_t mesh_count;          /* parts, or 1; 0 for frame files */
+	const bvhlab_scene *first;    /* frame 0, which frame files must match */
+};
+
+/* Whether the config scene is animated ("frames"). */
+static inline bool harness_anim_on(const struct config_scene *cs)
+{
+	return cs->frames > 0;
+}
+
+/* Loads the scene's meshes (a frame-file scene loads none). 0 or a negative
+ * errno with err naming the scene (and the part). */
+int harness_anim_open(const struct config_scene *cs, struct harness_anim *a, bvhlab_error *err);
+void harness_anim_close(struct harness_anim *a);
+
+/*
+ * Frame f (< a->frames) as a new scene, named as the config says. A frame
+ * file whose triangles differ from the first frame's (count, or the
+ * vertices they join) is -EINVAL with err naming the file; a->first must be
+ * set for that check (frame 0 itself needs none).
+ */
+int harness_anim_frame(const struct harness_anim *a, uint32_t f, bvhlab_scene **out,
+                       bvhlab_error *err);
+
+#endif

@@ -1,0 +1,51 @@
+/*
+ * A run's strategy over an animated scene's frames (docs/animation.md):
+ * per frame, the builder's rebuild or the animation's update and stages,
+ * timed; the tree validated (structure every frame, brute-force rays on
+ * the first, middle and last); its SAH and primary rays measured; the
+ * frame's modelled cost.
+ */
+#ifndef BVHLAB_CORE_HARNESS_FRAMES_H
+#define BVHLAB_CORE_HARNESS_FRAMES_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "config/config.h"
+#include "harness/harness_anim.h"
+#include "harness/refine_stage.h"
+#include "output/results.h"
+
+struct frames_job {
+	const struct config *cfg;
+	const struct config_builder *cb; /* its "animation", or none: rebuild */
+	const struct harness_anim *anim;
+	const bvhlab_scene *first;       /* frame 0, the run's scene */
+	const bvhlab_plugin *plugin;     /* the builder, for rebuilds */
+	const bvhlab_options *opts;
+	const struct refine_stage *stages; /* the builder's own, after each rebuild */
+	uint32_t stage_count;
+	uint32_t threads;
+	bool spatial_splits;
+	double first_ms;                 /* frame 0's build (the series' median) */
+};
+
+/* Room a run's report needs for the frames of scene a (0 for none). */
+static inline size_t harness_frames_size(const struct harness_anim *a)
+{
+	return a ? a->frames * sizeof(struct frame_metrics) : 0;
+}
+
+/*
+ * Runs frames 0 .. frames - 1 on `tree` (frame 0's, from the run's build
+ * series; updated or rebuilt in place) into out[], *count the frames done.
+ * 0 when all were done and valid; 1 when a frame's tree was invalid (err
+ * names the frame; the frames before it stay); a negative errno when a
+ * frame could not be made, built or updated (err says why).
+ */
+int harness_frames_run(const struct frames_job *job, bvhlab_tree *tree,
+                       struct frame_metrics *out, uint32_t *count, bvhlab_error *err);
+
+#endif
