@@ -242,6 +242,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cJS
 	for (size_t k = 0; k < n; k++)
 		md_run_row(sb, ix, runs[k]);
 	md_images(sb, scene);
+	report_frames_md(sb, ix, scene); /* an animated scene's frames */
 }
 
 char *report_markdown(const cJSON *doc)

@@ -55,6 +55,12 @@ void report_thesis(struct strbuf *sb, const struct cJSON *doc, const struct repo
 void report_machines_md(struct strbuf *sb, const cJSON *doc);
 void report_machines_html(struct strbuf *sb, const cJSON *doc);
 
+/* A scene's animation section (report_frames.c): its runs' frames summed
+ * up, the cheapest strategy, and in HTML SAH and cumulative cost over the
+ * frames as charts; nothing for a scene without frames. */
+void report_frames_md(struct strbuf *sb, const struct report_index *ix, const cJSON *scene);
+void report_frames_html(struct strbuf *sb, const struct report_index *ix, const cJSON *scene);
+
 /* Text with & < > " ' escaped for HTML and SVG. */
 void report_escape(struct strbuf *sb, const char *text);
 

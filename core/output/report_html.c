@@ -250,6 +250,7 @@ static void scene_section(struct strbuf *sb, const struct report_index *ix, cons
 	table(sb, ix, name);
 	charts(sb, ix, name);
 	images(sb, ix, scene);
+	report_frames_html(sb, ix, scene); /* an animated scene's frames */
 }
 
 char *report_html(const cJSON *doc)

@@ -1,0 +1,251 @@
+/*
+ * The animated scenes' part of report.md and report.html: per scene, each
+ * run's strategy over the frames (update time, SAH, modelled cost), the
+ * frame from which rebuilding would have paid off for the runs that
+ * update, the cheapest strategy over the whole animation, and in HTML the
+ * SAH and the cumulative cost over the frames as SVG charts (one pair per
+ * thread count, so each chart compares strategies on equal threads).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "output/report.h"
+
+/* One run's frames, summed up. */
+struct strategy {
+	const cJSON *run, *frames;
+	int count;          /* frames recorded */
+	bool all_valid, updates; /* every frame valid; some frame updated, not rebuilt */
+	double update_ms, cost_ms, sah_mean, sah_last;
+	int pays_off;       /* first frame where the rebuild run's cost was lower; -1 */
+};
+
+static const cJSON *frame_list(const cJSON *run)
+{
+	const cJSON *f = cJSON_GetObjectItemCaseSensitive(run, "frames");
+	return cJSON_IsArray(f) && cJSON_GetArraySize(f) > 0 ? f : NULL;
+}
+
+static bool is_true(const cJSON *o, const char *key)
+{
+	return cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(o, key));
+}
+
+static void sum_up(const cJSON *run, struct strategy *s)
+{
+	const cJSON *f;
+	*s = (struct strategy){.run = run, .frames = frame_list(run), .all_valid = true,
+	                       .pays_off = -1};
+	cJSON_ArrayForEach(f, s->frames) {
+		double sah = report_num(f, "sah");
+		s->count++;
+		s->all_valid = s->all_valid && is_true(f, "valid");
+		s->updates = s->updates || !is_true(f, "rebuilt");
+		s->update_ms += report_num(f, "update_ms");
+		s->cost_ms += report_num(f, "cost_ms");
+		s->sah_mean += isfinite(sah) ? sah : 0;
+		s->sah_last = sah;
+	}
+	s->sah_mean /= s->count ? s->count : 1;
+}
+
+/* The run that rebuilds every frame with the same plugin and threads. */
+static const struct strategy *rebuild_of(const struct strategy *s, size_t n,
+                                         const struct strategy *u)
+{
+	for (size_t k = 0; k < n; k++)
+		if (!s[k].updates && s[k].all_valid && s[k].count == u->count &&
+		    strcmp(report_str(s[k].run, "plugin"), report_str(u->run, "plugin")) == 0 &&
+		    report_num(s[k].run, "threads") == report_num(u->run, "threads"))
+			return &s[k];
+	return NULL;
+}
+
+static void pays_off(struct strategy *s, size_t n)
+{
+	for (size_t k = 0; k < n; k++) {
+		const struct strategy *r = s[k].updates ? rebuild_of(s, n, &s[k]) : NULL;
+		const cJSON *a = r ? s[k].frames->child : NULL, *b = r ? r->frames->child : NULL;
+		for (int f = 0; a && b; a = a->next, b = b->next, f++)
+			if (!is_true(a, "rebuilt") && report_num(a, "cost_ms") > report_num(b, "cost_ms")) {
+				s[k].pays_off = f;
+				break;
+			}
+	}
+}
+
+/* The scene's runs with frames, summed up; NULL when there are none. */
+static struct strategy *strategies(const struct report_index *ix, const char *scene, size_t *n)
+{
+	size_t count, m = 0;
+	const cJSON *const *runs = report_scene_runs(ix, scene, &count);
+	struct strategy *s = count ? calloc(count, sizeof(*s)) : NULL;
+	for (size_t k = 0; s && k < count; k++)
+		if (frame_list(runs[k]))
+			sum_up(runs[k], &s[m++]);
+	*n = m;
+	if (m == 0) {
+		free(s);
+		return NULL;
+	}
+	pays_off(s, m);
+	return s;
+}
+
+/* The cheapest complete run, over all thread counts (threads < 0) or one. */
+static const struct strategy *cheapest(const struct strategy *s, size_t n, double threads)
+{
+	const struct strategy *best = NULL;
+	int most = 0;
+	for (size_t k = 0; k < n; k++)
+		most = s[k].count > most ? s[k].count : most;
+	for (size_t k = 0; k < n; k++)
+		if (s[k].all_valid && s[k].count == most &&
+		    (threads < 0 || report_num(s[k].run, "threads") == threads) &&
+		    (!best || s[k].cost_ms < best->cost_ms))
+			best = &s[k];
+	return best;
+}
+
+static void cheapest_line(struct strbuf *sb, const struct strategy *s, size_t n, bool html)
+{
+	const struct strategy *best = cheapest(s, n, -1);
+	if (!best) {
+		sb_printf(sb, "%sNo strategy has every frame valid.%s\n", html ? "<p>" : "",
+		          html ? "</p>" : "\n");
+		return;
+	}
+	sb_printf(sb, html ? "<p><b>Cheapest over the animation: " : "**Cheapest over the "
+	                                                             "animation: ");
+	if (html)
+		report_escape(sb, report_str(best->run, "builder"));
+	else
+		sb_printf(sb, "%s", report_str(best->run, "builder"));
+	sb_printf(sb, " at %.0f thread%s%s, %.1f ms modelled over %d frames (%.1f ms of "
+	              "updates, mean SAH %.3f).", report_num(best->run, "threads"),
+	          report_num(best->run, "threads") == 1 ? "" : "s", html ? "</b>" : "**",
+	          best->cost_ms, best->count, best->update_ms, best->sah_mean);
+	sb_printf(sb, html ? "</p>\n" : "\n\n");
+}
+
+static const char *const head[] = {"strategy", "threads", "frames", "valid", "update ms",
+                                   "mean SAH", "last SAH", "cost ms", "rebuild pays off"};
+
+static void md_row(struct strbuf *sb, const struct strategy *s)
+{
+	char off[32] = "";
+	if (s->pays_off >= 0)
+		snprintf(off, sizeof(off), "frame %d", s->pays_off);
+	sb_printf(sb, "| %s | %.0f | %d | %s | %.2f | %.3f | %.3f | %.2f | %s |\n",
+	          report_str(s->run, "builder"), report_num(s->run, "threads"), s->count,
+	          s->all_valid ? "yes" : "**no**", s->update_ms, s->sah_mean, s->sah_last,
+	          s->cost_ms, off);
+}
+
+void report_frames_md(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
+{
+	size_t n;
+	struct strategy *s = strategies(ix, report_str(scene, "name"), &n);
+	if (!s)
+		return;
+	sb_printf(sb, "\n### Animation\n\nPer run, over the frames: update ms sums each "
+	              "frame's rebuild or update with its stages (frame 0: the build), cost ms "
+	              "sums each frame's update and rays_per_frame rays at its measured rate; "
+	              "\"rebuild pays off\": the first updated frame that cost more than the same "
+	              "plugin's rebuild of it. frames.csv has every frame.\n\n|");
+	for (size_t k = 0; k < sizeof(head) / sizeof(head[0]); k++)
+		sb_printf(sb, " %s |", head[k]);
+	sb_printf(sb, "\n|---|---:|---:|---|---:|---:|---:|---:|---|\n");
+	for (size_t k = 0; k < n; k++)
+		md_row(sb, &s[k]);
+	sb_printf(sb, "\n");
+	cheapest_line(sb, s, n, false);
+	free(s);
+}
+
+/* ---- HTML ----------------------------------------------------------------- */
+
+static void html_row(struct strbuf *sb, const struct strategy *s)
+{
+	sb_printf(sb, "<tr><td>");
+	report_escape(sb, report_str(s->run, "builder"));
+	sb_printf(sb, "</td><td>%.0f</td><td>%d</td><td>%s</td><td>%.2f</td><td>%.3f</td>"
+	              "<td>%.3f</td><td>%.2f</td><td>", report_num(s->run, "threads"), s->count,
+	          s->all_valid ? "yes" : "<b class=\"bad\">no</b>", s->update_ms, s->sah_mean,
+	          s->sah_last, s->cost_ms);
+	if (s->pays_off >= 0)
+		sb_printf(sb, "frame %d", s->pays_off);
+	sb_printf(sb, "</td></tr>\n");
+}
+
+/* SAH and cumulative cost per frame of the runs at `threads`. */
+static void charts(struct strbuf *sb, const struct strategy *s, size_t n, double threads)
+{
+	size_t total = 0, m = 0, c = 0;
+	for (size_t k = 0; k < n; k++)
+		total += (size_t)s[k].count;
+	struct svg_point *sah = calloc(total ? total : 1, sizeof(*sah));
+	struct svg_point *cost = calloc(total ? total : 1, sizeof(*cost));
+	char title[2][96];
+	for (size_t k = 0; sah && cost && k < n; k++) {
+		const cJSON *f;
+		double sum = 0;
+		if (report_num(s[k].run, "threads") != threads)
+			continue;
+		cJSON_ArrayForEach(f, s[k].frames) {
+			const char *g = report_str(s[k].run, "builder");
+			sum += report_num(f, "cost_ms");
+			sah[m++] = (struct svg_point){"", g, report_num(f, "frame"), report_num(f, "sah")};
+			cost[c++] = (struct svg_point){"", g, report_num(f, "frame"), sum};
+		}
+	}
+	snprintf(title[0], sizeof(title[0]), "SAH over the frames, %.0f thread%s", threads,
+	         threads == 1 ? "" : "s");
+	snprintf(title[1], sizeof(title[1]), "Cumulative modelled cost, %.0f thread%s", threads,
+	         threads == 1 ? "" : "s");
+	if (m)
+		svg_lines(sb, title[0], "frame", "SAH cost", sah, m);
+	if (c)
+		svg_lines(sb, title[1], "frame", "ms", cost, c);
+	if (!sah || !cost)
+		sb->failed = true;
+	free(sah);
+	free(cost);
+}
+
+/* One pair of charts per thread count, in the order the runs have them. */
+static void all_charts(struct strbuf *sb, const struct strategy *s, size_t n)
+{
+	for (size_t k = 0; k < n; k++) {
+		double t = report_num(s[k].run, "threads");
+		bool seen = false;
+		for (size_t j = 0; j < k && !seen; j++)
+			seen = report_num(s[j].run, "threads") == t;
+		if (!seen)
+			charts(sb, s, n, t);
+	}
+}
+
+void report_frames_html(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
+{
+	size_t n;
+	struct strategy *s = strategies(ix, report_str(scene, "name"), &n);
+	if (!s)
+		return;
+	sb_printf(sb, "<h3>Animation</h3>\n<p>Per run, over the frames: update ms sums each "
+	              "frame's rebuild or update with its stages (frame 0: the build); cost ms "
+	              "sums each frame's update and rays_per_frame rays at its measured rate; "
+	              "\"rebuild pays off\": the first updated frame that cost more than the same "
+	              "plugin's rebuild of it. frames.csv has every frame.</p>\n<table><tr>");
+	for (size_t k = 0; k < sizeof(head) / sizeof(head[0]); k++)
+		sb_printf(sb, "<th>%s</th>", head[k]);
+	sb_printf(sb, "</tr>\n");
+	for (size_t k = 0; k < n; k++)
+		html_row(sb, &s[k]);
+	sb_printf(sb, "</table>\n");
+	cheapest_line(sb, s, n, true);
+	all_charts(sb, s, n);
+	free(s);
+}
