@@ -1,0 +1,235 @@
+/*
+ * The refit plugin and the host's update (ABI 1.4). After the vertices
+ * of a scene move, refitting a tree (lbvh's, sah_seq's) keeps its
+ * topology (node count, every node's children or leaf range, prim_index,
+ * all unchanged), gives every node exactly the union of its children's
+ * (a leaf: its primitives') new boxes, passes validation and brute-force
+ * rays on the moved scene, and is the same tree bit for bit for 1, 2 and
+ * 3 threads. The host refuses an update over another triangle count
+ * (fewer or more) naming both counts, refit refuses a tree with a cycle,
+ * a refit-only plugin builds nothing and a builder has no update.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <bvhlab/aabb.h>
+#include <bvhlab/bvhlab.h>
+
+#include "testutil.h"
+
+static bvhlab_plugin *refit;
+
+static void tree_dup(bvhlab_tree *dst, const bvhlab_tree *src)
+{
+	CHECK_INT(bvhlab_tree_init(dst, src->node_capacity, src->index_capacity), 0);
+	memcpy(dst->nodes, src->nodes, src->node_count * sizeof(bvhlab_node));
+	memcpy(dst->prim_index, src->prim_index, src->index_count * sizeof(uint32_t));
+	dst->node_count = src->node_count;
+	dst->index_count = src->index_count;
+}
+
+/* A smooth, non-rigid motion: every vertex displaced by its own amount. */
+static void move(bvhlab_scene *s)
+{
+	for (uint32_t v = 0; v < s->vertex_count; v++) {
+		float *p = s->vertices + 3 * (size_t)v;
+		float x = p[0], y = p[1], z = p[2];
+		p[0] = x + 0.3f * sinf(4 * y) + 0.1f;
+		p[1] = y + 0.2f * cosf(5 * z);
+		p[2] = z * 1.5f + 0.1f * sinf(7 * x);
+	}
+	bvhlab_scene_update(s);
+}
+
+/* The box a node must get: the union of its subtree's primitives' boxes. */
+static void reference(const bvhlab_tree *t, const bvhlab_aabb *boxes, uint32_t i, float lo[3],
+                      float hi[3])
+{
+	const bvhlab_node *n = &t->nodes[i];
+	bvhlab_box_empty(lo, hi);
+	if (n->count) {
+		for (uint32_t k = n->first; k < n->first + n->count; k++)
+			for (int a = 0; a < 3; a++) {
+				lo[a] = bvhlab_minf(boxes[t->prim_index[k]].lo[a], lo[a]);
+				hi[a] = bvhlab_maxf(boxes[t->prim_index[k]].hi[a], hi[a]);
+			}
+		return;
+	}
+	float l[2][3], h[2][3];
+	reference(t, boxes, n->first, l[0], h[0]);
+	reference(t, boxes, n->first + 1, l[1], h[1]);
+	for (int a = 0; a < 3; a++) {
+		lo[a] = bvhlab_minf(l[0][a], l[1][a]);
+		hi[a] = bvhlab_maxf(h[0][a], h[1][a]);
+	}
+}
+
+static int update(const bvhlab_build_input *in, uint32_t threads, bvhlab_tree *t,
+                  bvhlab_error *err)
+{
+	bvhlab_options opts;
+	int r = bvhlab_options_init(&opts, bvhlab_plugin_builder(refit));
+	if (r == 0)
+		r = bvhlab_update(refit, &opts, in, threads, t, err);
+	bvhlab_options_finish(&opts);
+	return r;
+}
+
+/* Topology and boxes of a refitted tree against the tree it came from. */
+static void check_refitted(const bvhlab_tree *before, const bvhlab_tree *t,
+                           const bvhlab_build_input *in)
+{
+	CHECK_INT(t->node_count, before->node_count);
+	CHECK_INT(t->index_count, before->index_count);
+	CHECK(!memcmp(t->prim_index, before->prim_index, t->index_count * sizeof(uint32_t)));
+	int shape = 0, boxes = 0;
+	for (uint32_t i = 0; i < t->node_count; i++) {
+		float lo[3], hi[3];
+		shape += t->nodes[i].first != before->nodes[i].first ||
+		         t->nodes[i].count != before->nodes[i].count;
+		reference(t, in->prim_bounds, i, lo, hi);
+		boxes += memcmp(lo, t->nodes[i].lo, sizeof(lo)) || memcmp(hi, t->nodes[i].hi, sizeof(hi));
+	}
+	CHECK_INT(shape, 0);
+	CHECK_INT(boxes, 0);
+}
+
+static void check_scene(const char *builder, const char *gen, const bvhlab_gen_params *gp)
+{
+	bvhlab_scene *s = NULL;
+	bvhlab_plugin *b = NULL;
+	bvhlab_options opts;
+	bvhlab_prims prims = {0}, moved = {0};
+	bvhlab_tree t0 = {0}, first = {0};
+	bvhlab_error err = {{0}};
+	CHECK_INT(bvhlab_scene_generate(gen, gp, &s, &err), 0);
+	CHECK_INT(bvhlab_plugin_open(builder, &b, &err), 0);
+	if (!s || !b)
+		return;
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(b)), 0);
+	CHECK_INT(bvhlab_prims_init(&prims, s, &err), 0);
+	CHECK_INT(bvhlab_build(b, &opts, &prims.input, 1, &t0, &err), 0);
+	move(s);
+	CHECK_INT(bvhlab_prims_init(&moved, s, &err), 0);
+	/* The old tree no longer holds the moved triangles: the point of it. */
+	CHECK(bvhlab_validate_tree(&t0, &moved.input, false, &err) < 0);
+	for (uint32_t threads = 1; threads <= 3; threads++) {
+		bvhlab_tree t = {0};
+		uint64_t mismatches = 1;
+		tree_dup(&t, &t0);
+		CHECK_INT(update(&moved.input, threads, &t, &err), 0);
+		CHECK_INT(bvhlab_validate_tree(&t, &moved.input, false, &err), 0);
+		check_refitted(&t0, &t, &moved.input);
+		CHECK_INT(bvhlab_validate_rays(&t, s, 256, 33, &mismatches, &err), 0);
+		CHECK_INT(mismatches, 0);
+		if (threads == 1)
+			tree_dup(&first, &t);
+		else
+			CHECK(!memcmp(first.nodes, t.nodes, t.node_count * sizeof(bvhlab_node)));
+		bvhlab_tree_finish(&t);
+	}
+	bvhlab_tree_finish(&first);
+	bvhlab_tree_finish(&t0);
+	bvhlab_prims_finish(&moved);
+	bvhlab_prims_finish(&prims);
+	bvhlab_options_finish(&opts);
+	bvhlab_plugin_close(b);
+	bvhlab_scene_destroy(s);
+}
+
+/* An update over fewer or more triangles than the tree's is refused. */
+static void test_counts(void)
+{
+	bvhlab_gen_params gp;
+	bvhlab_scene *a = NULL, *fewer = NULL, *more = NULL;
+	bvhlab_prims pa = {0}, pf = {0}, pm = {0};
+	bvhlab_plugin *lbvh = NULL;
+	bvhlab_options opts;
+	bvhlab_tree t = {0};
+	bvhlab_error err = {{0}};
+	bvhlab_gen_params_init(&gp);
+	gp.count = 500;
+	CHECK_INT(bvhlab_scene_generate("soup", &gp, &a, &err), 0);
+	gp.count = 499;
+	CHECK_INT(bvhlab_scene_generate("soup", &gp, &fewer, &err), 0);
+	gp.count = 501;
+	CHECK_INT(bvhlab_scene_generate("soup", &gp, &more, &err), 0);
+	CHECK_INT(bvhlab_plugin_open("lbvh", &lbvh, &err), 0);
+	if (!a || !fewer || !more || !lbvh)
+		return;
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(lbvh)), 0);
+	CHECK_INT(bvhlab_prims_init(&pa, a, &err), 0);
+	CHECK_INT(bvhlab_prims_init(&pf, fewer, &err), 0);
+	CHECK_INT(bvhlab_prims_init(&pm, more, &err), 0);
+	CHECK_INT(bvhlab_build(lbvh, &opts, &pa.input, 1, &t, &err), 0);
+	CHECK_INT(update(&pf.input, 2, &t, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "update 'refit': the tree holds 500 references");
+	CHECK_CONTAINS(err.message, "the frame has 499 triangles");
+	CHECK_INT(update(&pm.input, 2, &t, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "the frame has 501 triangles");
+	/* lbvh updates nothing; refit builds nothing. */
+	CHECK_INT(bvhlab_update(lbvh, &opts, &pa.input, 1, &t, &err), -ENOTSUP);
+	CHECK_CONTAINS(err.message, "plugin 'lbvh' has no update function (ABI 1.4 update)");
+	bvhlab_options_finish(&opts);
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(refit)), 0);
+	CHECK_INT(bvhlab_build(refit, &opts, &pa.input, 1, &t, &err), -ENOTSUP);
+	CHECK_CONTAINS(err.message, "plugin 'refit' builds no trees");
+	bvhlab_options_finish(&opts);
+	bvhlab_tree_finish(&t);
+	bvhlab_prims_finish(&pa);
+	bvhlab_prims_finish(&pf);
+	bvhlab_prims_finish(&pm);
+	bvhlab_plugin_close(lbvh);
+	bvhlab_scene_destroy(a);
+	bvhlab_scene_destroy(fewer);
+	bvhlab_scene_destroy(more);
+}
+
+/* A tree whose inner node points back up is refused, not walked forever. */
+static void test_cycle(void)
+{
+	bvhlab_aabb boxes[2] = {{{0, 0, 0}, {1, 1, 1}}, {{1, 1, 1}, {2, 2, 2}}};
+	float centroids[6] = {0.5f, 0.5f, 0.5f, 1.5f, 1.5f, 1.5f};
+	bvhlab_build_input in = {.struct_size = sizeof(in), .prim_count = 2, .prim_bounds = boxes,
+	                         .centroids = centroids, .threads = 1};
+	bvhlab_tree t = {0};
+	bvhlab_error err = {{0}};
+	CHECK_INT(bvhlab_tree_init(&t, 3, 2), 0);
+	t.nodes[0] = (bvhlab_node){.first = 1};
+	t.nodes[1] = (bvhlab_node){.first = 0}; /* its children: the root and itself */
+	t.nodes[2] = (bvhlab_node){.first = 0, .count = 2};
+	t.prim_index[0] = 0;
+	t.prim_index[1] = 1;
+	t.node_count = 3;
+	t.index_count = 2;
+	CHECK_INT(update(&in, 1, &t, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "cycle");
+	bvhlab_tree_finish(&t);
+}
+
+int main(void)
+{
+	bvhlab_gen_params gp;
+	bvhlab_error err = {{0}};
+	CHECK_INT(bvhlab_plugin_open("refit", &refit, &err), 0);
+	if (!refit)
+		return test_finish();
+	CHECK(bvhlab_plugin_builder(refit)->flags & BVHLAB_BUILDER_DETERMINISTIC);
+	bvhlab_gen_params_init(&gp);
+	/* 40,500 triangles: about 81,000 nodes, enough for 3 threads' cut. */
+	gp.frequency = 45;
+	check_scene("lbvh", "icosphere", &gp);
+	gp.frequency = 20;
+	check_scene("sah_seq", "icosphere", &gp);
+	gp.count = 3000;
+	check_scene("lbvh", "soup", &gp);
+	gp.size = 12;
+	check_scene("lbvh", "terrain", &gp);
+	test_counts();
+	test_cycle();
+	bvhlab_plugin_close(refit);
+	return test_finish();
+}
