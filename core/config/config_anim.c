@@ -178,6 +178,9 @@ int config_parse_motion(struct config *cfg, const cJSON *obj, const char *prefix
 		m->deform = CONFIG_DEFORM_WAVE;
 	else if (deform && cJSON_IsString(deform) && strcmp(deform->valuestring, "explode") == 0)
 		m->deform = CONFIG_DEFORM_EXPLODE;
+	else if (deform && cJSON_IsString(deform))
+		return config_error(cfg, deform, false, err, "'%sdeform' must be \"wave\" or "
+		                    "\"explode\", not \"%.40s\"", prefix, deform->valuestring);
 	else if (deform)
 		return config_error(cfg, deform, false, err, "'%sdeform' must be \"wave\" or "
 		                    "\"explode\", not %s", prefix,
