@@ -97,11 +97,13 @@ static const char sweep_config[] =
 	"    { \"plugin\": \"lbvh\", \"threads\": [1, 2], \"animation\": { \"update\": \"refit\" } },\n"
 	"    { \"plugin\": \"lbvh\", \"animation\": { \"update\": \"refit\",\n"
 	"        \"refine\": [ { \"plugin\": \"reinsert\" } ] } },\n"
-	"    { \"plugin\": \"lbvh\", \"animation\": { \"update\": \"refit\", \"rebuild_every\": 2 } } ] }\n";
+	"    { \"plugin\": \"lbvh\",\n"
+	"      \"animation\": { \"update\": \"refit\", \"rebuild_every\": 2 } } ] }\n";
 
 static void check_scene(const cJSON *doc, const char *scene)
 {
-	const cJSON *lbvh = find_run(doc, scene, "lbvh", 1), *refit = find_run(doc, scene, "lbvh+refit", 1);
+	const cJSON *lbvh = find_run(doc, scene, "lbvh", 1);
+	const cJSON *refit = find_run(doc, scene, "lbvh+refit", 1);
 	const cJSON *refit2 = find_run(doc, scene, "lbvh+refit", 2);
 	const cJSON *every = find_run(doc, scene, "lbvh+refit[rebuild_every=2]", 1);
 	check_frames_for(lbvh, "1111", 1000);
@@ -133,7 +135,8 @@ static void test_sweep(void)
 	check_scene(doc, "yard");
 	check_scene(doc, "boom");
 	/* Triangles flying apart: refit's boxes grow, a rebuild's do not. */
-	const cJSON *lbvh = find_run(doc, "boom", "lbvh", 1), *refit = find_run(doc, "boom", "lbvh+refit", 1);
+	const cJSON *lbvh = find_run(doc, "boom", "lbvh", 1);
+	const cJSON *refit = find_run(doc, "boom", "lbvh+refit", 1);
 	CHECK(fnum(refit, 3, "sah") > 2 * fnum(refit, 0, "sah"));
 	CHECK(fnum(refit, 3, "sah") > 2 * fnum(lbvh, 3, "sah"));
 	cJSON_Delete(doc);
