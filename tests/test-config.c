@@ -289,7 +289,8 @@ static void test_unknown_keys(void)
 	EXPECT_ERROR_AT(t, "\"repet\"", 0,
 	                "unknown key 'repet' at the top level (known: format_version, output, "
 	                "repeat, warmup, threads, validate, validate_rays, rays, images, isolate, "
-	                "timeout_s, memory_limit_mb, pin, report, scenes, builders); did you mean "
+	                "timeout_s, memory_limit_mb, pin, rays_per_frame, report, scenes, builders); "
+	                "did you mean "
 	                "'repeat'?");
 	t = "{ " SCENES ", " BUILDERS ", \"zzzzzz\": 3 }";
 	EXPECT_ERROR_AT(t, "\"zzzzzz\"", 0, "unknown key 'zzzzzz' at the top level");
@@ -297,14 +298,16 @@ static void test_unknown_keys(void)
 	t = "{ \"scenes\": [ { \"generator\": \"icosphere\", \"frequncy\": 4 } ], " BUILDERS " }";
 	EXPECT_ERROR_AT(t, "\"frequncy\"", 0,
 	                "unknown key 'frequncy' in scenes[0] (known: name, path, generator, parts, "
-	                "frequency, count, size, seed, width, subdivide); did you mean "
+	                "frequency, count, size, seed, width, subdivide, frames, animate, deform, "
+	                "amplitude); did you mean "
 	                "'frequency'?");
 	EXPECT_ERROR("{ " SCENES ",\n"
 	             "  \"builders\": [ { \"plugin\": \"a\" },\n"
 	             "    { \"plugin\": \"b\", \"threds\": [2] } ] }",
 	             3, 22,
 	             "unknown key 'threds' in builders[1] (known: plugin, name, threads, "
-	             "timeout_s, memory_limit_mb, options, optional, refine); did you mean 'threads'?");
+	             "timeout_s, memory_limit_mb, options, optional, refine, animation); did you "
+	             "mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
 	                "diffuse, camera, threads, min_ms, rounds, traversal); did you mean 'width'?");
@@ -604,6 +607,49 @@ static void test_isolation_keys(void)
 #undef TOP
 }
 
+/* An animated scene's and a strategy's keys land in their fields
+ * (config_anim.c); the strategy names itself. */
+static void test_animation(void)
+{
+	struct config cfg;
+	bvhlab_error err = { "" };
+	const char *t =
+		"{ \"rays_per_frame\": 5000, \"scenes\": [\n"
+		"  { \"name\": \"y\", \"frames\": 12, \"parts\": [\n"
+		"    { \"generator\": \"room\", \"animate\": { \"rotate\": [0, 90, 0],\n"
+		"      \"translate\": [1, 2, 3], \"scale\": 2 } },\n"
+		"    { \"generator\": \"icosphere\", \"deform\": \"explode\", \"amplitude\": 0.25 } ] },\n"
+		"  { \"name\": \"f\", \"frames\": { \"pattern\": \"w/f%03d.ply\", \"count\": 5,\n"
+		"    \"first\": 7 } } ],\n"
+		"  \"builders\": [ { \"plugin\": \"lbvh\", \"animation\": { \"update\": \"refit\",\n"
+		"    \"rebuild_every\": 8, \"refine\": [ { \"plugin\": \"reinsert\" } ] } } ] }";
+	CHECK_INT(load(&cfg, t, &err), 0);
+	if (err.message[0])
+		fprintf(stderr, "%s\n", err.message);
+	CHECK_INT(cfg.rays_per_frame, 5000);
+	CHECK_INT(cfg.scenes[0].frames, 12);
+	const struct config_motion *m = &cfg.scenes[0].parts[0].motion;
+	CHECK(m->animate && m->rotate[1] == 90 && m->translate[2] == 3 && m->scale == 2);
+	CHECK_INT(m->deform, CONFIG_DEFORM_NONE);
+	m = &cfg.scenes[0].parts[1].motion;
+	CHECK(!m->animate && m->deform == CONFIG_DEFORM_EXPLODE && m->amplitude == 0.25);
+	CHECK_INT(cfg.scenes[1].frames, 5);
+	CHECK_INT(cfg.scenes[1].frame_first, 7);
+	CHECK_CONTAINS(cfg.scenes[1].frame_pattern, "/w/f%03d.ply");
+	CHECK_CONTAINS(cfg.scenes[1].path, "/w/f007.ply"); /* frame 0's file */
+	const struct config_animation *a = cfg.builders[0].animation;
+	CHECK(a && !strcmp(a->update, "refit") && a->rebuild_every == 8 && a->refine_count == 1);
+	CHECK_CONTAINS(cfg.builders[0].name, "lbvh+refit+reinsert[rebuild_every=8]");
+	config_finish(&cfg);
+	t = "{ \"scenes\": [ { \"generator\": \"icosphere\" } ],\n"
+	    "  \"builders\": [ { \"plugin\": \"a\" } ] }";
+	CHECK_INT(load(&cfg, t, &err), 0);
+	CHECK_INT(cfg.rays_per_frame, 1000000);
+	CHECK_INT(cfg.scenes[0].frames, 0);
+	CHECK(cfg.builders[0].animation == NULL);
+	config_finish(&cfg);
+}
+
 int main(void)
 {
 	snprintf(tmp_dir, sizeof(tmp_dir), "/tmp/bvhlab-test-config-XXXXXX");
@@ -622,6 +668,7 @@ int main(void)
 	test_options();
 	test_isolation_keys();
 	test_locate();
+	test_animation();
 	unlink(cfg_path);
 	rmdir(tmp_dir);
 	return test_finish();
