@@ -58,6 +58,9 @@ static int list_one(const char *name)
 	if (bvhlab_builder_refine(b))
 		printf("  stage: %s\n", b->build ? "builds, and refines trees (\"refine\" lists)"
 		                                 : "refines trees only (\"refine\" lists, --refine)");
+	if (bvhlab_builder_update(b)) /* ABI 1.4 */
+		printf("  update: updates trees whose primitives moved (\"animation\": "
+		       "{\"update\": \"%s\"})\n", b->name);
 	printf("  options:%s\n", b->option_count ? "" : " none");
 	for (uint32_t k = 0; k < b->option_count; k++)
 		print_option(&b->options[k]);
