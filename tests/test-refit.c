@@ -1,6 +1,7 @@
 /*
  * The refit plugin and the host's update (ABI 1.4). After the vertices
- * of a scene move, refitting a tree (lbvh's, sah_seq's) keeps its
+ * of a scene move, refitting a tree (lbvh's, walked by subtrees;
+ * sah_seq's and sah_tasks', swept in array order) keeps its
  * topology (node count, every node's children or leaf range, prim_index,
  * all unchanged), gives every node exactly the union of its children's
  * (a leaf: its primitives') new boxes, passes validation and brute-force
@@ -97,7 +98,18 @@ static void check_refitted(const bvhlab_tree *before, const bvhlab_tree *t,
 	CHECK_INT(boxes, 0);
 }
 
-static void check_scene(const char *builder, const char *gen, const bvhlab_gen_params *gp)
+/* Whether every inner node's children come after it: refit then sweeps
+ * the array, else walks subtrees. Both ways are tested. */
+static bool children_after(const bvhlab_tree *t)
+{
+	for (uint32_t i = 0; i < t->node_count; i++)
+		if (!t->nodes[i].count && t->nodes[i].first <= i)
+			return false;
+	return true;
+}
+
+static void check_scene(const char *builder, const char *gen, const bvhlab_gen_params *gp,
+                        bool swept)
 {
 	bvhlab_scene *s = NULL;
 	bvhlab_plugin *b = NULL;
@@ -112,6 +124,7 @@ static void check_scene(const char *builder, const char *gen, const bvhlab_gen_p
 	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(b)), 0);
 	CHECK_INT(bvhlab_prims_init(&prims, s, &err), 0);
 	CHECK_INT(bvhlab_build(b, &opts, &prims.input, 1, &t0, &err), 0);
+	CHECK_INT(children_after(&t0), swept);
 	move(s);
 	CHECK_INT(bvhlab_prims_init(&moved, s, &err), 0);
 	/* The old tree no longer holds the moved triangles: the point of it. */
@@ -221,13 +234,14 @@ int main(void)
 	bvhlab_gen_params_init(&gp);
 	/* 40,500 triangles: about 81,000 nodes, enough for 3 threads' cut. */
 	gp.frequency = 45;
-	check_scene("lbvh", "icosphere", &gp);
+	check_scene("lbvh", "icosphere", &gp, false);
+	check_scene("sah_tasks", "icosphere", &gp, true);
 	gp.frequency = 20;
-	check_scene("sah_seq", "icosphere", &gp);
+	check_scene("sah_seq", "icosphere", &gp, true);
 	gp.count = 3000;
-	check_scene("lbvh", "soup", &gp);
+	check_scene("lbvh", "soup", &gp, false);
 	gp.size = 12;
-	check_scene("lbvh", "terrain", &gp);
+	check_scene("lbvh", "terrain", &gp, false);
 	test_counts();
 	test_cycle();
 	bvhlab_plugin_close(refit);
