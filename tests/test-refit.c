@@ -1,14 +1,15 @@
 /*
  * The refit plugin and the host's update (ABI 1.4). After the vertices
  * of a scene move, refitting a tree (lbvh's, walked by subtrees;
- * sah_seq's and sah_tasks', swept in array order) keeps its
- * topology (node count, every node's children or leaf range, prim_index,
- * all unchanged), gives every node exactly the union of its children's
- * (a leaf: its primitives') new boxes, passes validation and brute-force
+ * sah_seq's and sah_tasks', swept in array order) keeps its topology
+ * (node count, every node's children or leaf range, prim_index, all
+ * unchanged), gives every node exactly the union of its children's (a
+ * leaf: its primitives') new boxes, passes validation and brute-force
  * rays on the moved scene, and is the same tree bit for bit for 1, 2 and
- * 3 threads. The host refuses an update over another triangle count
- * (fewer or more) naming both counts, refit refuses a tree with a cycle,
- * a refit-only plugin builds nothing and a builder has no update.
+ * 3 threads asked for (2 started on the larger trees). The host refuses
+ * an update over another triangle count (fewer or more) naming both
+ * counts, refit refuses a tree with a cycle, a refit-only plugin builds
+ * nothing and a builder has no update.
  */
 #include <errno.h>
 #include <math.h>
@@ -136,7 +137,7 @@ static void check_scene(const char *builder, const char *gen, const bvhlab_gen_p
 		CHECK_INT(update(&moved.input, threads, &t, &err), 0);
 		CHECK_INT(bvhlab_validate_tree(&t, &moved.input, false, &err), 0);
 		check_refitted(&t0, &t, &moved.input);
-		CHECK_INT(bvhlab_validate_rays(&t, s, 256, 33, &mismatches, &err), 0);
+		CHECK_INT(bvhlab_validate_rays(&t, s, 64, 33, &mismatches, &err), 0);
 		CHECK_INT(mismatches, 0);
 		if (threads == 1)
 			tree_dup(&first, &t);
@@ -232,11 +233,12 @@ int main(void)
 		return test_finish();
 	CHECK(bvhlab_plugin_builder(refit)->flags & BVHLAB_BUILDER_DETERMINISTIC);
 	bvhlab_gen_params_init(&gp);
-	/* 40,500 triangles: about 81,000 nodes, enough for 3 threads' cut. */
-	gp.frequency = 45;
+	/* 20,480 triangles: about 41,000 nodes, enough for 2 threads (refit
+	 * starts one per 32,768 nodes; 3 asked for). */
+	gp.frequency = 32;
 	check_scene("lbvh", "icosphere", &gp, false);
 	check_scene("sah_tasks", "icosphere", &gp, true);
-	gp.frequency = 20;
+	gp.frequency = 12;
 	check_scene("sah_seq", "icosphere", &gp, true);
 	gp.count = 3000;
 	check_scene("lbvh", "soup", &gp, false);
