@@ -18,7 +18,7 @@ struct strategy {
 	const cJSON *run, *frames;
 	int count;          /* frames recorded */
 	bool all_valid, updates; /* every frame valid; some frame updated, not rebuilt */
-	double update_ms, cost_ms, sah_mean, sah_last;
+	double update_ms, cost_ms, sah_mean, sah_last; /* SAH of the valid frames */
 	int pays_off;       /* first frame where the rebuild run's cost was lower; -1 */
 };
 
@@ -33,22 +33,29 @@ static bool is_true(const cJSON *o, const char *key)
 	return cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(o, key));
 }
 
+/* Sums of the frames; SAH over the valid frames only. */
 static void sum_up(const cJSON *run, struct strategy *s)
 {
 	const cJSON *f;
 	*s = (struct strategy){.run = run, .frames = frame_list(run), .all_valid = true,
 	                       .pays_off = -1};
+	int measured = 0;
 	cJSON_ArrayForEach(f, s->frames) {
 		double sah = report_num(f, "sah");
+		bool valid = is_true(f, "valid");
 		s->count++;
-		s->all_valid = s->all_valid && is_true(f, "valid");
+		s->all_valid = s->all_valid && valid;
 		s->updates = s->updates || !is_true(f, "rebuilt");
 		s->update_ms += report_num(f, "update_ms");
 		s->cost_ms += report_num(f, "cost_ms");
-		s->sah_mean += isfinite(sah) ? sah : 0;
+		if (!valid || !isfinite(sah))
+			continue; /* an invalid frame's tree has no SAH worth the name */
+		s->sah_mean += sah;
 		s->sah_last = sah;
+		measured++;
 	}
-	s->sah_mean /= s->count ? s->count : 1;
+	s->sah_mean = measured ? s->sah_mean / measured : NAN;
+	s->sah_last = measured ? s->sah_last : NAN;
 }
 
 /* The run that rebuilds every frame with the same plugin and threads. */
