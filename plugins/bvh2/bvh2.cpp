@@ -176,8 +176,10 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 		centers[i] = Vec3(c[0], c[1], c[2]);
 	}
 	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
+	// sweep and binned are single-threaded: a pool only for what uses one.
+	bool top_down = std::strcmp(s.builder, "sweep") == 0 || std::strcmp(s.builder, "binned") == 0;
 	std::optional<bvh::v2::ThreadPool> pool;
-	if (in->threads > 1 || s.pool_at_one)
+	if ((in->threads > 1 || s.pool_at_one) && (!top_down || s.reinsertion))
 		pool.emplace(in->threads);
 	Bvh bvh = run_builder(s, pool ? &*pool : nullptr, boxes, centers);
 	pool.reset(); // joins the workers inside the call
