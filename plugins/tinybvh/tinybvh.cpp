@@ -115,9 +115,13 @@ void run_builder(BVH &bvh, const Settings &s, const bvhvec4 *v, uint32_t n)
 }
 
 // BVH::Optimize does exactly this, but with a BVH_Verbose it never frees
-// (tinybvh 1.6.7 leaks one per call); this one lives on the stack.
+// (tinybvh 1.6.7 leaks one per call); this one lives on the stack. Optimize
+// visits nodes by index, and a threaded build numbers them in the order
+// its threads happened to take them: Compact renumbers them depth first
+// first, so the same tree gives the same result at any thread count.
 void optimize(BVH &bvh, const Settings &s)
 {
+	bvh.Compact();
 	tinybvh::BVH_Verbose verbose;
 	verbose.ConvertFrom(bvh);
 	verbose.Optimize(static_cast<uint32_t>(s.optimize), s.extreme, false);
