@@ -21,6 +21,7 @@
 #define TINYBVH_IMPLEMENTATION
 #include <tiny_bvh.h>
 
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -102,6 +103,23 @@ std::unique_ptr<bvhvec4[]> soup(const bvhlab_build_input *in)
 	return v;
 }
 
+// tinybvh 1.6.7's Build, BuildAVX and full sweep allocate their node
+// counter (BVH::atomicNewNodePtr, private) on 50,000 triangles or more even
+// with threadedBuild off, and free it only when it is on: 4 bytes leak per
+// one-thread build. An explicit instantiation may name a private member
+// ([temp.spec]), which is how the plugin reaches it to free it.
+struct CounterTag {
+	using type = std::atomic<uint32_t> *BVH::*;
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wnon-template-friend"
+	friend type counter_member(CounterTag);
+#pragma GCC diagnostic pop
+};
+template <typename Tag, typename Tag::type M> struct Reach {
+	friend typename Tag::type counter_member(Tag) { return M; }
+};
+template struct Reach<CounterTag, &BVH::atomicNewNodePtr>;
+
 // The library's call for `s`, on the calling thread (which may spawn more).
 void run_builder(BVH &bvh, const Settings &s, const bvhvec4 *v, uint32_t n)
 {
@@ -111,6 +129,11 @@ void run_builder(BVH &bvh, const Settings &s, const bvhvec4 *v, uint32_t n)
 	case Method::avx: bvh.BuildAVX(v, n); break;
 	case Method::sweep: bvh.useFullSweep = true; bvh.Build(v, n); break;
 	case Method::hq: bvh.BuildHQ(v, n); break;
+	}
+	if (!bvh.threadedBuild) {
+		std::atomic<uint32_t> *&counter = bvh.*counter_member(CounterTag{});
+		delete counter;
+		counter = nullptr;
 	}
 }
 
