@@ -108,9 +108,26 @@ static int bad_traversal(struct config *cfg, const cJSON *item, bvhlab_error *er
 		         strlen(item->valuestring) > 36 ? "..." : "");
 	return config_error(cfg, item, false, err,
 	                    "'rays.traversal' must be \"wide\", \"stack\", \"stackless\", "
-	                    "\"both\" (stack and stackless) or an array of those names, not %s",
+	                    "\"cl_stack\", \"cl_stackless\", \"both\" (stack and stackless) or an "
+	                    "array of those names, not %s",
 	                    cJSON_IsString(item) ? got
 	                                         : config_describe(cfg, item, got, sizeof(got)));
+}
+
+/* The device traversals exist only in a build with OpenCL. */
+static int traversal_built(struct config *cfg, const cJSON *item, int k, bvhlab_error *err)
+{
+#ifdef BVHLAB_HAVE_OPENCL
+	(void)cfg, (void)item, (void)k, (void)err;
+	return 0;
+#else
+	if (k != BVHLAB_TRAVERSAL_CL_STACK && k != BVHLAB_TRAVERSAL_CL_STACKLESS)
+		return 0;
+	return config_error(cfg, item, false, err,
+	                    "'rays.traversal' \"%s\" runs on an OpenCL device, and this bvhlab "
+	                    "was built without OpenCL (install ocl-icd-opencl-dev and "
+	                    "opencl-c-headers, then meson setup again)", bvhlab_traversal_name(k));
+#endif
 }
 
 /* One name of the array form: the first is the main traversal. */
@@ -119,6 +136,8 @@ static int add_traversal(struct config *cfg, const cJSON *item, bool first, bvhl
 	int k = cJSON_IsString(item) ? traversal_of(item->valuestring) : -1;
 	if (k < 0)
 		return bad_traversal(cfg, item, err);
+	if (traversal_built(cfg, item, k, err) < 0)
+		return -EINVAL;
 	if (cfg->ray_traversals & (1u << k))
 		return config_error(cfg, item, false, err, "'rays.traversal' names \"%s\" twice",
 		                    item->valuestring);
@@ -141,6 +160,8 @@ static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *
 		return 0;
 	}
 	int k = cJSON_IsString(t) ? traversal_of(t->valuestring) : -1;
+	if (k >= 0 && traversal_built(cfg, t, k, err) < 0)
+		return -EINVAL;
 	if (k >= 0) {
 		cfg->ray_traversal = k;
 		cfg->ray_traversals = 1u << k;
@@ -156,6 +177,23 @@ static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *
 			rc = add_traversal(cfg, item, item == t->child, err);
 	}
 	return rc;
+}
+
+/* "device": auto, gpu, cpu or P:D, checked here so a typo fails the
+ * config, not every run (which device exists is known only when tracing). */
+static int check_device(struct config *cfg, const cJSON *rays, bvhlab_error *err)
+{
+	const char *d = cfg->ray_device;
+	if (!d || !strcmp(d, "auto") || !strcmp(d, "gpu") || !strcmp(d, "cpu"))
+		return 0;
+	const char *p = d;
+	size_t a = strspn(p, "0123456789"), b = a && p[a] == ':' ? strspn(p + a + 1, "0123456789") : 0;
+	if (a && a <= 5 && b && b <= 5 && p[a + 1 + b] == '\0')
+		return 0;
+	return config_error(cfg, config_member(rays, "device"), false, err,
+	                    "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or \"P:D\" (OpenCL "
+	                    "platform and device indices, e.g. \"0:0\"; clinfo -l lists them), "
+	                    "not \"%.40s\"", d);
 }
 
 static int parse_rays(struct config *cfg, bvhlab_error *err)
@@ -174,6 +212,8 @@ static int parse_rays(struct config *cfg, bvhlab_error *err)
 		rc = config_read_keys(cfg, rays, config_ray_keys, "rays.", cfg, err);
 	if (!rc)
 		rc = parse_traversal(cfg, rays, err);
+	if (!rc)
+		rc = check_device(cfg, rays, err);
 	if (!rc)
 		rc = config_parse_camera(cfg, rays, err);
 	return rc;
@@ -334,6 +374,7 @@ void config_finish(struct config *cfg)
 	free(cfg->builders);
 	free(cfg->threads);
 	free(cfg->output);
+	free(cfg->ray_device);
 	free(cfg->report_reference);
 	json_locations_destroy(cfg->locations);
 	cJSON_Delete(cfg->root);

@@ -204,7 +204,7 @@ static int image_buffers(const struct series_job *job, size_t n, uint32_t **node
 /* Traversal statistics on the valid tree, and the raw image data. A
  * failure here costs the numbers, not the run: the tree itself is fine. */
 static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
-                       struct series_report *rep, bvhlab_error *err)
+                       struct series_report *rep)
 {
 	const struct config *cfg = job->h->cfg;
 	size_t n = (size_t)cfg->ray_width * cfg->ray_height;
@@ -231,8 +231,9 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)
 		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
-	if (r < 0)
-		error_set(err, "tracing rays: %s", strerror(-r));
+	/* The run stays ok (its tree is); its "rays" says why there are no figures. */
+	if (r < 0 && !rep->rays.error[0])
+		snprintf(rep->rays.error, sizeof(rep->rays.error), "%s", strerror(-r));
 	free(nodes);
 	free(shade);
 }
@@ -268,7 +269,7 @@ static void series_work(void *arg, void *report, size_t size)
 			rep->has_epo = bvhlab_tree_epo(&s.tree, job->scene, EPO_SAMPLES, EPO_SEED,
 			                               &rep->epo) == 0;
 		if (rep->status == SERIES_OK)
-			trace_rays(job, &s.tree, rep, &err);
+			trace_rays(job, &s.tree, rep);
 	}
 	if (rep->status != SERIES_OK)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
@@ -298,7 +299,9 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->valid = rep->valid;
 	run->rays_checked = rep->rays_checked;
 	run->mismatches = rep->mismatches;
-	run->rays = rep->rays.measured ? &rep->rays : NULL;
+	rep->rays.error[sizeof(rep->rays.error) - 1] = '\0';
+	rep->rays.device[sizeof(rep->rays.device) - 1] = '\0';
+	run->rays = rep->rays.measured || rep->rays.error[0] ? &rep->rays : NULL;
 	for (uint32_t k = 0; k < rep->stage_count; k++)
 		rep->stages[k].plugin[sizeof(rep->stages[k].plugin) - 1] = '\0';
 	run->stages = rep->stages;

@@ -132,6 +132,14 @@ static const char *const csv_numbers[][2] = {
 	{"rays.stackless.diffuse.mrays_per_s", "%.4f"},
 	{"rays.stackless.diffuse.nodes_per_ray", "%.4f"},
 	{"rays.traversal_disagreements", "%.0f"},
+	{"rays.cl_stack.primary.mrays_per_s", "%.4f"},
+	{"rays.cl_stack.primary.wall_mrays_per_s", "%.4f"},
+	{"rays.cl_stack.diffuse.mrays_per_s", "%.4f"},
+	{"rays.cl_stack.diffuse.wall_mrays_per_s", "%.4f"},
+	{"rays.cl_stackless.primary.mrays_per_s", "%.4f"},
+	{"rays.cl_stackless.primary.wall_mrays_per_s", "%.4f"},
+	{"rays.cl_stackless.diffuse.mrays_per_s", "%.4f"},
+	{"rays.cl_stackless.diffuse.wall_mrays_per_s", "%.4f"},
 };
 
 static void csv_row(struct strbuf *sb, const cJSON *run)

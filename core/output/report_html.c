@@ -50,7 +50,8 @@ static void range_cell(struct strbuf *sb, const cJSON *run, const char *kind)
 }
 
 /* Traversals a scene's table may show beside the main one, by name. */
-static const char *const other_traversals[] = {"wide", "stack", "stackless"};
+static const char *const other_traversals[] = {"wide", "stack", "stackless", "cl_stack",
+                                                 "cl_stackless"};
 #define OTHERS (sizeof(other_traversals) / sizeof(other_traversals[0]))
 
 static double other_num(const cJSON *run, const char *traversal, const char *what)
@@ -93,7 +94,7 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 			continue;
 		num_cell(sb, other_num(run, other_traversals[t], "primary.mrays_per_s"), "%.2f");
 		num_cell(sb, other_num(run, other_traversals[t], "diffuse.mrays_per_s"), "%.2f");
-		if (strcmp(other_traversals[t], "stackless") == 0) /* it counts its own nodes */
+		if (strstr(other_traversals[t], "stackless")) /* it counts its own nodes */
 			num_cell(sb, other_num(run, other_traversals[t], "primary.nodes_per_ray"),
 			         "%.1f");
 	}
@@ -138,7 +139,7 @@ static void table(struct strbuf *sb, const struct report_index *ix, const char *
 		if (!others[t])
 			continue;
 		sb_printf(sb, "<th>%s primary Mrays/s</th><th>%s diffuse Mrays/s</th>", name, name);
-		if (strcmp(name, "stackless") == 0)
+		if (strstr(name, "stackless"))
 			sb_printf(sb, "<th>%s primary nodes/ray</th>", name);
 	}
 	if (any_other)

@@ -36,6 +36,8 @@ struct ray_metrics {
 	/* by enum bvhlab_traversal */
 	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
 	uint64_t disagreements; /* rays whose hits differ from the main traversal's */
+	char device[96];        /* the OpenCL device of the cl_ traversals ("" if none ran) */
+	char error[512];        /* why the rays, or one traversal, could not be traced ("") */
 };
 
 /* Peak memory of one run's builds (harness/harness_memory.c measures it). */
