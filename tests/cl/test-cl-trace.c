@@ -82,37 +82,53 @@ static void check_run(const cJSON *run)
 	}
 }
 
-static void trace_mode(void)
+/* One sweep over these scenes and builders; its runs checked. */
+static void trace_sweep(const char *name, const char *scenes, const char *builders, int runs)
 {
-	char config[4096];
-	write_meshes();
+	char config[4096], out[600];
 	snprintf(config, sizeof(config),
-	         "{ \"format_version\": 1, \"output\": \"out\", \"repeat\": 1, \"warmup\": 0,\n"
+	         "{ \"format_version\": 1, \"output\": \"%s\", \"repeat\": 1, \"warmup\": 0,\n"
 	         "  \"threads\": [1], \"validate_rays\": 16, \"isolate\": false, %s"
-	         "  \"scenes\": [ { \"path\": \"%s/stanford-bunny.obj\" },\n"
-	         "    { \"path\": \"one.obj\" }, { \"path\": \"two.obj\" },\n"
-	         "    { \"path\": \"same.obj\" }, { \"path\": \"flat.obj\" },\n"
-	         "    { \"name\": \"needles\", \"generator\": \"needles\", \"count\": 300 } ],\n"
-	         "  \"builders\": [ { \"plugin\": \"lbvh\" }, { \"plugin\": \"ploc\" },\n"
-	         "    { \"plugin\": \"sah_tasks\" }, { \"plugin\": \"sbvh\" } ] }\n",
-	         rays_keys, BVHLAB_SHARED_SCENES);
-	char *path = write_config("trace.json", config);
+	         "  \"scenes\": [ %s ],\n  \"builders\": [ %s ] }\n",
+	         name, rays_keys, scenes, builders);
+	snprintf(out, sizeof(out), "%s.json", name);
+	char *path = write_config(out, config);
 	int rc = run(ARGS("run", path, "--quiet"));
 	if (rc != 0)
 		fprintf(stderr, "%s", err_text);
 	CHECK_INT(rc, 0);
-	char out[600];
-	snprintf(out, sizeof(out), "%s/out", tmpdir);
+	snprintf(out, sizeof(out), "%s/%s", tmpdir, name);
 	cJSON *doc = load_results(out);
 	const cJSON *r;
-	int runs = 0;
+	int n = 0;
 	cJSON_ArrayForEach(r, cJSON_GetObjectItem(doc, "runs")) {
 		check_run(r);
-		runs++;
+		n++;
 	}
-	CHECK_INT(runs, 24);
-	CHECK_INT(count_runs(doc, "sbvh", "ok"), 6);
+	CHECK_INT(n, runs);
+	CHECK_INT(count_runs(doc, "lbvh", "ok"), runs / (strstr(builders, "sbvh") ? 4 : 3));
 	cJSON_Delete(doc);
+}
+
+/* "isolate": false: one process, so PoCL builds the kernels once. sbvh
+ * (references duplicated by spatial splits) only on the small scenes:
+ * it takes seconds on the bunny. */
+static void trace_mode(void)
+{
+	char scene[1024];
+	write_meshes();
+	snprintf(scene, sizeof(scene), "{ \"path\": \"%s/stanford-bunny.obj\" }",
+	         BVHLAB_SHARED_SCENES);
+	trace_sweep("mesh", scene,
+	            "{ \"plugin\": \"lbvh\" }, { \"plugin\": \"ploc\" }, { \"plugin\": \"sah_tasks\" }",
+	            3);
+	trace_sweep("degenerate",
+	            "{ \"path\": \"one.obj\" }, { \"path\": \"two.obj\" },\n"
+	            "    { \"path\": \"same.obj\" }, { \"path\": \"flat.obj\" },\n"
+	            "    { \"name\": \"needles\", \"generator\": \"needles\", \"count\": 300 }",
+	            "{ \"plugin\": \"lbvh\" }, { \"plugin\": \"ploc\" }, { \"plugin\": \"sah_tasks\" },\n"
+	            "    { \"plugin\": \"sbvh\" }",
+	            20);
 }
 
 /* A run of one scene with this "rays" object; the document. */
