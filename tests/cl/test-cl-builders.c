@@ -36,6 +36,7 @@ struct pair {
 	const char *ref_name, *dev_name;
 	bvhlab_plugin *ref, *dev;
 	struct setup setups[3];
+	struct setup differ[2]; /* two setups that build different trees */
 	double dev_ms, ref_ms; /* summed over all builds, for the log */
 };
 
@@ -43,11 +44,13 @@ static struct pair pairs[] = {
 	{ .ref_name = "lbvh", .dev_name = "cl_lbvh",
 	  .setups = { { { "bits=63", "collapse=true" } },
 	              { { "bits=30", "collapse=false" } },
-	              { { "max_leaf=3", "c_trav=2.5" } } } },
+	              { { "max_leaf=3", "c_trav=2.5" } } },
+	  .differ = { { { "max_leaf=2" } }, { { "max_leaf=8" } } } },
 	{ .ref_name = "ploc", .dev_name = "cl_ploc",
 	  .setups = { { { "radius=16", "collapse=true" } },
 	              { { "radius=1", "collapse=false" } },
-	              { { "radius=4", "bits=30" } } } },
+	              { { "radius=4", "bits=30" } } },
+	  .differ = { { { "radius=1" } }, { { "radius=16" } } } },
 };
 #define PAIRS (sizeof(pairs) / sizeof(pairs[0]))
 
@@ -198,12 +201,10 @@ static void test_bad_device(struct pair *p)
 	bvhlab_scene_destroy(scene);
 }
 
-/* The compare tells trees apart: cl_lbvh with leaves of at most 2
- * against lbvh with at most 8 (the default), which differ in some leaves. */
+/* The compare tells trees apart: the device builder with one setup
+ * against its reference with another that changes the tree. */
 static void test_compare_sees(struct pair *p)
 {
-	static const struct setup two = { { "max_leaf=2" } };
-	static const struct setup eight = { { "max_leaf=8" } };
 	bvhlab_scene *scene = generate("soup", 3000, 0, 0);
 	bvhlab_prims prims;
 	bvhlab_tree ref = { 0 }, dev = { 0 };
@@ -212,8 +213,8 @@ static void test_compare_sees(struct pair *p)
 
 	if (!scene || bvhlab_prims_init(&prims, scene, &err) != 0)
 		return;
-	CHECK_INT(build(p->ref, &eight, NULL, &prims.input, &ref, &ms, &err), 0);
-	CHECK_INT(build(p->dev, &two, "auto", &prims.input, &dev, &ms, &err), 0);
+	CHECK_INT(build(p->ref, &p->differ[1], NULL, &prims.input, &ref, &ms, &err), 0);
+	CHECK_INT(build(p->dev, &p->differ[0], "auto", &prims.input, &dev, &ms, &err), 0);
 	CHECK_INT(bvhlab_tree_compare(&ref, &dev, &err), 1);
 	bvhlab_tree_finish(&ref);
 	bvhlab_tree_finish(&dev);
@@ -277,7 +278,9 @@ int main(void)
 		return test_finish();
 	}
 	test_bad_device(&pairs[0]);
-	test_compare_sees(&pairs[0]);
+	for (size_t k = 0; k < PAIRS; k++)
+		if (pairs[k].dev)
+			test_compare_sees(&pairs[k]);
 	test_scene("one", generate("soup", 1, 0, 0));
 	test_scene("two", generate("soup", 2, 0, 0));
 	test_scene("three", generate("soup", 3, 0, 0));
