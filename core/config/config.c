@@ -109,7 +109,8 @@ static int bad_traversal(struct config *cfg, const cJSON *item, bvhlab_error *er
 	return config_error(cfg, item, false, err,
 	                    "'rays.traversal' must be \"wide\", \"stack\", \"stackless\", "
 	                    "\"cl_stack\", \"cl_stackless\", \"both\" (stack and stackless) or an "
-	                    "array of those names, not %s",
+	                    "array of those names (an entry may be {\"name\": NAME, \"optional\": true}), "
+	                    "not %s",
 	                    cJSON_IsString(item) ? got
 	                                         : config_describe(cfg, item, got, sizeof(got)));
 }
@@ -130,20 +131,54 @@ static int traversal_built(struct config *cfg, const cJSON *item, int k, bvhlab_
 #endif
 }
 
-/* One name of the array form: the first is the main traversal. */
-static int add_traversal(struct config *cfg, const cJSON *item, bool first, bvhlab_error *err)
+/* {"name": NAME, "optional": BOOL} of the array form: its name (or NULL,
+ * an error said) and whether it is optional. */
+static const cJSON *entry_name(struct config *cfg, const cJSON *item, bool *optional,
+                               bvhlab_error *err)
 {
-	int k = cJSON_IsString(item) ? traversal_of(item->valuestring) : -1;
+	const cJSON *m, *name = NULL;
+	*optional = false;
+	if (!cJSON_IsObject(item))
+		return item;
+	cJSON_ArrayForEach(m, item) {
+		if (strcmp(m->string, "name") == 0 && cJSON_IsString(m)) {
+			name = m;
+		} else if (strcmp(m->string, "optional") == 0 && cJSON_IsBool(m)) {
+			*optional = cJSON_IsTrue(m);
+		} else {
+			config_error(cfg, m, true, err, "'rays.traversal' entries as objects take "
+			             "\"name\" (a string) and \"optional\" (true or false) only");
+			return NULL;
+		}
+	}
+	if (!name)
+		config_error(cfg, item, false, err, "'rays.traversal' entry lacks \"name\"");
+	return name;
+}
+
+/* One entry of the array form: the first kept is the main traversal. An
+ * optional one that this build lacks (a cl_ one without OpenCL) is left
+ * out quietly, like an optional builder whose plugin is missing. */
+static int add_traversal(struct config *cfg, const cJSON *item, bvhlab_error *err)
+{
+	bool optional;
+	const cJSON *name = entry_name(cfg, item, &optional, err);
+	if (!name)
+		return -EINVAL;
+	int k = cJSON_IsString(name) ? traversal_of(name->valuestring) : -1;
 	if (k < 0)
-		return bad_traversal(cfg, item, err);
-	if (traversal_built(cfg, item, k, err) < 0)
+		return bad_traversal(cfg, name, err);
+	if (optional && (k == BVHLAB_TRAVERSAL_CL_STACK || k == BVHLAB_TRAVERSAL_CL_STACKLESS) &&
+	    traversal_built(cfg, name, k, NULL) < 0)
+		return 0;
+	if (traversal_built(cfg, name, k, err) < 0)
 		return -EINVAL;
 	if (cfg->ray_traversals & (1u << k))
-		return config_error(cfg, item, false, err, "'rays.traversal' names \"%s\" twice",
-		                    item->valuestring);
-	cfg->ray_traversals |= 1u << k;
-	if (first)
+		return config_error(cfg, name, false, err, "'rays.traversal' names \"%s\" twice",
+		                    name->valuestring);
+	if (cfg->ray_traversals == 0)
 		cfg->ray_traversal = k;
+	cfg->ray_traversals |= 1u << k;
 	return 0;
 }
 
@@ -174,8 +209,11 @@ static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *
 	const cJSON *item;
 	cJSON_ArrayForEach(item, t) {
 		if (rc == 0)
-			rc = add_traversal(cfg, item, item == t->child, err);
+			rc = add_traversal(cfg, item, err);
 	}
+	if (rc == 0 && cfg->ray_traversals == 0)
+		return config_error(cfg, t, false, err, "'rays.traversal': every entry is optional "
+		                    "and none is built here (OpenCL was not built)");
 	return rc;
 }
 
