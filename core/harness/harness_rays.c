@@ -90,16 +90,17 @@ static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
 		if (k == rs->main || !(m->traversals & (1u << k)))
 			continue;
 		bvhlab_hit *other = malloc(n * sizeof(*other));
+		if (!other)
+			return -ENOMEM;
 		o.traversal = k;
-		r = other ? measure(tree, scene, rays, n, &o, other, NULL, &out[k], m) : -ENOMEM;
-		for (size_t i = 0; r == 0 && i < n; i++)
-			m->disagreements += !same_hit(&hits[i], &other[i]);
-		free(other);
-		if (r < 0 && r != -ENOMEM) { /* this traversal only: the others go on */
+		if (measure(tree, scene, rays, n, &o, other, NULL, &out[k], m) == 0) {
+			for (size_t i = 0; i < n; i++)
+				m->disagreements += !same_hit(&hits[i], &other[i]);
+		} else { /* this traversal only (no device, say): the others go on */
 			m->traversals &= ~(1u << k);
 			out[k] = (bvhlab_trace_timing){0};
-			r = 0;
 		}
+		free(other);
 	}
 	return r;
 }
