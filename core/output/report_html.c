@@ -102,6 +102,10 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 		num_cell(sb, report_num(run, "rays.traversal_disagreements"), "%.0f");
 	sb_printf(sb, "<td class=\"l\">");
 	esc(sb, report_str(run, "error"));
+	if (*report_str(run, "rays.error")) { /* a traversal's device missing, say */
+		sb_printf(sb, "%srays: ", *report_str(run, "error") ? "; " : "");
+		esc(sb, report_str(run, "rays.error"));
+	}
 	sb_printf(sb, "</td></tr>\n");
 }
 
