@@ -23,9 +23,12 @@
 
 /* -cl-fp32-correctly-rounded-divide-sqrt: the CPU's divisions are IEEE;
  * OpenCL's default float division may be 2.5 ulp off, which would move t,
- * u and v. No -cl-mad-enable, no fast math: the same operations as the
- * CPU, each rounded the same. */
-#define BUILD_OPTIONS "-cl-std=CL1.2 -cl-fp32-correctly-rounded-divide-sqrt -DSTACK_SIZE=%u"
+ * u and v. A device that cannot round them correctly is not asked to (the
+ * build would fail): its hits may then differ, and the disagreements say
+ * so. No -cl-mad-enable, no fast math: the same operations as the CPU,
+ * each rounded the same. */
+#define BUILD_OPTIONS "-cl-std=CL1.2 %s-DSTACK_SIZE=%u"
+#define EXACT_DIVIDE "-cl-fp32-correctly-rounded-divide-sqrt "
 
 struct device {
 	char spec[64];
@@ -106,7 +109,10 @@ static int get_program(struct device *d, unsigned stack, cl_program *out, bvhlab
 		error_set(err, "cl: too many stack sizes in one process");
 		return -ENOMEM;
 	}
-	snprintf(options, sizeof(options), BUILD_OPTIONS, stack);
+	cl_device_fp_config fp = 0;
+	clGetDeviceInfo(d->cl.device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, NULL);
+	snprintf(options, sizeof(options), BUILD_OPTIONS,
+	         fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT ? EXACT_DIVIDE : "", stack);
 	int r = bvhlab_cl_program(&d->cl, trace_cl_source, trace_cl_source_LEN, options,
 	                          &d->program[d->programs], why, sizeof(why));
 	if (r < 0) {
