@@ -48,7 +48,8 @@ static int hierarchy(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 	cl_mem keys = b->sort->b[SB_KEYS0 + b->sort->sorted].mem;
 	cl_mem order = b->sort->b[SB_VALS0 + b->sort->sorted].mem;
 	cl_uint collapse = b->collapse, n = b->n, max_leaf = b->max_leaf;
-	cl_uint block = d->cl.type & CL_DEVICE_TYPE_CPU ? CPU_LEAF_BLOCK : 1;
+	cl_uint block = b->leaf_block ? b->leaf_block
+	                              : d->cl.type & CL_DEVICE_TYPE_CPU ? CPU_LEAF_BLOCK : 1;
 	cl_arg ka[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(b->b[LB_PARENT].mem),
 	                CL_ARG(b->b[LB_END].mem) };
 	cl_arg ba[] = { CL_ARG(b->b[LB_BOUNDS].mem), CL_ARG(order), CL_ARG(n), CL_ARG(block),

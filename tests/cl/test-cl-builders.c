@@ -28,9 +28,11 @@
 #include "../refine_scenes.h"
 
 /* One option setup: the same options for the reference and the device
- * builder (name, value pairs, value as text for bvhlab_options_parse). */
+ * builder ("key=value" for bvhlab_options_parse), and one for the device
+ * builder only (may be NULL). */
 struct setup {
 	const char *opts[4];
+	const char *dev_only;
 };
 
 struct pair {
@@ -45,7 +47,8 @@ static struct pair pairs[] = {
 	{ .ref_name = "lbvh", .dev_name = "cl_lbvh",
 	  .setups = { { { "bits=63", "collapse=true" } },
 	              { { "bits=30", "collapse=false" } },
-	              { { "max_leaf=3", "c_trav=2.5" } } },
+	              /* a work-item per leaf in bounds: what a GPU runs */
+	              { { "max_leaf=3", "c_trav=2.5" }, "leaf_block=1" } },
 	  .differ = { { { "max_leaf=2" } }, { { "max_leaf=8" } } } },
 	{ .ref_name = "ploc", .dev_name = "cl_ploc",
 	  .setups = { { { "radius=16", "collapse=true" } },
@@ -77,6 +80,8 @@ static int build(bvhlab_plugin *p, const struct setup *s, const char *device,
 		snprintf(dev, sizeof(dev), "device=%s", device);
 		rc = bvhlab_options_parse(&opts, dev, err);
 	}
+	if (rc == 0 && device && s->dev_only)
+		rc = bvhlab_options_parse(&opts, s->dev_only, err);
 	double t0 = now_ms();
 	if (rc == 0)
 		rc = bvhlab_build(p, &opts, in, 2, tree, err);
