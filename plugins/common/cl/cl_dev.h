@@ -20,8 +20,10 @@
 #include <bvhlab/opencl.h>
 #include <bvhlab/builder.h>
 
-/* Build options of every device builder's program: no contraction into
- * fma and correctly rounded division, so the float results are the CPU's. */
+/* Build option of every device builder's program where the device has
+ * it: correctly rounded division and square root, as the CPU's. (The
+ * kernels also turn contraction into fma off, by pragma; none divides
+ * today: the quantiser's scale comes from the host.) */
 #define CL_DEV_OPTIONS "-cl-fp32-correctly-rounded-divide-sqrt"
 #define CL_DEV_MAX_KERNELS 16
 
