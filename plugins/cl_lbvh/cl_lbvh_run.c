@@ -26,8 +26,11 @@ static int size_buffers(cl_lbvh *b, char *err, size_t err_size)
 	want[LB_FLAGS] = want[LB_INNER] = n - 1;
 	want[LB_INDEX] = 4 * n;
 	cl_sort_sizes(b->n, want + LB_COUNT);
-	/* One check of the sum, then both sets (the second check passes). */
-	int rc = cl_bufs_size(b->dev, b->b, want, LB_COUNT, err, err_size);
+	/* Both sets at once against the device's memory, then each made. */
+	int rc = cl_bufs_fit(b->dev, want, LB_COUNT + SB_COUNT, err, err_size);
+
+	if (rc == 0)
+		rc = cl_bufs_size(b->dev, b->b, want, LB_COUNT, err, err_size);
 	return rc < 0 ? rc : cl_bufs_size(b->dev, b->sort->b, want + LB_COUNT, SB_COUNT, err,
 	                                  err_size);
 }

@@ -36,7 +36,11 @@ static int size_buffers(cl_ploc *b, char *err, size_t err_size)
 	want[PB_TREE] = 32 * (2 * n - 1);
 	want[PB_DESC] = 4 * (2 * n - 1);
 	cl_sort_sizes(b->n, want + PB_COUNT);
-	int rc = cl_bufs_size(b->dev, b->b, want, PB_COUNT, err, err_size);
+	/* Both sets at once against the device's memory, then each made. */
+	int rc = cl_bufs_fit(b->dev, want, PB_COUNT + SB_COUNT, err, err_size);
+
+	if (rc == 0)
+		rc = cl_bufs_size(b->dev, b->b, want, PB_COUNT, err, err_size);
 	return rc < 0 ? rc : cl_bufs_size(b->dev, b->sort->b, want + PB_COUNT, SB_COUNT, err,
 	                                  err_size);
 }

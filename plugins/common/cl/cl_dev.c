@@ -83,11 +83,10 @@ static size_t rounded(size_t bytes)
 	return bytes < 4096 ? 4096 : (bytes + 65535) & ~(size_t)65535;
 }
 
-int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count, char *err,
-                 size_t err_size)
+int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
+                size_t err_size)
 {
 	size_t total = 0;
-	cl_int rc = CL_SUCCESS;
 
 	for (unsigned k = 0; k < count; k++) {
 		total += rounded(want[k]);
@@ -101,6 +100,17 @@ int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count, ch
 		return bvhlab_cl_fail(-ENOMEM, err, err_size,
 			"cl: the build needs %zu MiB of device memory, %s has %llu MiB",
 			total >> 20, d->cl.name, (unsigned long long)(d->cl.global_mem >> 20));
+	return 0;
+}
+
+int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count, char *err,
+                 size_t err_size)
+{
+	cl_int rc = CL_SUCCESS;
+	int fit = cl_bufs_fit(d, want, count, err, err_size);
+
+	if (fit < 0)
+		return fit;
 	for (unsigned k = 0; k < count; k++) {
 		if (bufs[k].bytes >= want[k] && bufs[k].mem)
 			continue;
