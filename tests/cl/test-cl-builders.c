@@ -53,7 +53,8 @@ static struct pair pairs[] = {
 	{ .ref_name = "ploc", .dev_name = "cl_ploc",
 	  .setups = { { { "radius=16", "collapse=true" } },
 	              { { "radius=1", "collapse=false" } },
-	              { { "radius=4", "bits=30" } } },
+	              /* a work-item per cluster in nearest: what a GPU runs */
+	              { { "radius=4", "bits=30" }, "nn_block=1" } },
 	  .differ = { { { "radius=1" } }, { { "radius=16" } } } },
 };
 #define PAIRS (sizeof(pairs) / sizeof(pairs[0]))
