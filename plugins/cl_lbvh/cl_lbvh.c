@@ -22,6 +22,10 @@
 static const bvhlab_option_decl options[] = {
 	MORTON_OPTION_DECLS,
 	CL_DEVICE_OPTION_DECL,
+	{ .name = "leaf_block", .type = BVHLAB_OPTION_INT,
+	  .help = "leaves per work-item of the bounds kernel (0: 512 on a CPU device, "
+	          "1 on a GPU); the tree is the same for every value",
+	  .def_int = 0, .min = 0, .max = 1 << 20 },
 };
 
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
@@ -48,18 +52,21 @@ __attribute__((destructor)) static void release_device(void)
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_lbvh *b)
 {
 	morton_options o;
+	int64_t block;
 	int rc = morton_read_options(host, ctx, &o);
 
 	if (rc < 0)
 		return rc;
-	if ((rc = host->option_string(ctx, "device", &b->device)) < 0) {
-		host->set_error(ctx, "cannot read the option device");
+	if ((rc = host->option_string(ctx, "device", &b->device)) < 0 ||
+	    (rc = host->option_int(ctx, "leaf_block", &block)) < 0) {
+		host->set_error(ctx, "cannot read the options device and leaf_block");
 		return rc;
 	}
 	if (o.bits != 30 && o.bits != 63) {
 		host->set_error(ctx, "option bits: %lld, expected 30 or 63", (long long)o.bits);
 		return -EINVAL;
 	}
+	b->leaf_block = (uint32_t)block;
 	b->collapse = o.collapse;
 	b->bits = (unsigned)o.bits;
 	b->max_leaf = (uint32_t)o.max_leaf;

@@ -136,33 +136,56 @@ static void store_node(volatile __global node *p, const node *x)
 	p->count = x->count;
 }
 
-/* One work-item per leaf k: its slot, then up while it arrives second at
- * a parent (the first arrival stops; the counter's atomic and the fences
- * hand the first child's slot over). visits[] and flags[] zeroed. */
-__kernel void bounds(__global const float *prim_bounds, __global const uint *order, uint n,
-	__global const uint *parent, __global const uint *end, volatile __global node *nodes,
-	volatile __global uint *visits, __global float *cost, __global uchar *flags,
-	__global uint *prim_index, uint collapse, uint max_leaf, float c_trav, float c_isect)
+/* Leaf k's slot and index. */
+static void put_leaf(__global const float *prim_bounds, __global const uint *order,
+	__global const uint *parent, uint n, uint k, volatile __global node *nodes,
+	__global uint *prim_index)
 {
-	uint k = get_global_id(0);
-	if (k >= n)
-		return;
-	uint id = order[k], word = parent[n - 1 + k];
+	uint id = order[k];
 	__global const float *b = prim_bounds + 6 * (size_t)id;
 	node leaf = { { b[0], b[1], b[2] }, k, { b[3], b[4], b[5] }, 1 };
 	prim_index[k] = id;
-	store_node(nodes + 1 + (size_t)word, &leaf);
-	while (word != NO_NODE) {
-		uint p = word >> 1, e = end[p];
-		uint first = min(p, e), size = max(p, e) - first + 1;
-		mem_fence(CLK_GLOBAL_MEM_FENCE);
-		if (atomic_inc(&visits[p]) == 0)
-			return;
-		mem_fence(CLK_GLOBAL_MEM_FENCE);
-		node x = finish(nodes, p, size, first, cost, flags, collapse, max_leaf, c_trav,
-		                c_isect);
-		word = parent[p];
-		store_node(nodes + (word == NO_NODE ? 0 : 1 + (size_t)word), &x);
+	store_node(nodes + 1 + (size_t)parent[n - 1 + k], &leaf);
+}
+
+/*
+ * Work-item t takes the leaves [lo, hi) = [t * block, + block): their
+ * slots, then a climb from each while it arrives second at a parent; the
+ * first arrival stops. A parent whose range lies inside [lo, hi) is
+ * reached by this work-item alone, left child first (leaves in order), so
+ * it needs no counter; the others take the atomic one, whose fences hand
+ * the first child's slot over. block is 1 on a GPU (a work-item per leaf),
+ * larger on a CPU device, where it keeps the climbs in cache and off the
+ * atomics (lbvh_emit.c's blocks). visits[] and flags[] zeroed.
+ */
+__kernel void bounds(__global const float *prim_bounds, __global const uint *order, uint n,
+	uint block, __global const uint *parent, __global const uint *end,
+	volatile __global node *nodes, volatile __global uint *visits, __global float *cost,
+	__global uchar *flags, __global uint *prim_index, uint collapse, uint max_leaf,
+	float c_trav, float c_isect)
+{
+	size_t lo = get_global_id(0) * (size_t)block, hi = min((size_t)n, lo + block);
+	for (size_t k = lo; k < hi; k++)
+		put_leaf(prim_bounds, order, parent, n, (uint)k, nodes, prim_index);
+	for (size_t k = lo; k < hi; k++) {
+		uint word = parent[n - 1 + k];
+		while (word != NO_NODE) {
+			uint p = word >> 1, e = end[p];
+			uint first = min(p, e), size = max(p, e) - first + 1;
+			if (first >= lo && first + size <= hi) {
+				if (!(word & 1))
+					break;
+			} else {
+				mem_fence(CLK_GLOBAL_MEM_FENCE);
+				if (atomic_inc(&visits[p]) == 0)
+					break;
+				mem_fence(CLK_GLOBAL_MEM_FENCE);
+			}
+			node x = finish(nodes, p, size, first, cost, flags, collapse, max_leaf,
+			                c_trav, c_isect);
+			word = parent[p];
+			store_node(nodes + (word == NO_NODE ? 0 : 1 + (size_t)word), &x);
+		}
 	}
 }
 

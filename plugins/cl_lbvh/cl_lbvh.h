@@ -19,6 +19,7 @@ typedef struct cl_lbvh {
 	bool collapse;
 	uint32_t max_leaf;
 	float c_trav, c_isect;
+	uint32_t leaf_block;  /* leaves per work-item in bounds; 0: by device */
 
 	cl_dev *dev;
 	cl_sort *sort;

@@ -10,6 +10,11 @@
 
 enum { K_KARRAS = CL_SORT_KERNELS, K_BOUNDS, K_INNER };
 
+/* Leaves per work-item of the bounds kernel on a CPU device: a few
+ * thousand work-items on a million leaves, each climb mostly in cache and
+ * without atomics; on a GPU, one leaf each. */
+#define CPU_LEAF_BLOCK 512u
+
 static int size_buffers(cl_lbvh *b, char *err, size_t err_size)
 {
 	size_t n = b->n, want[LB_COUNT + SB_COUNT];
@@ -21,8 +26,11 @@ static int size_buffers(cl_lbvh *b, char *err, size_t err_size)
 	want[LB_FLAGS] = want[LB_INNER] = n - 1;
 	want[LB_INDEX] = 4 * n;
 	cl_sort_sizes(b->n, want + LB_COUNT);
-	/* One check of the sum, then both sets (the second check passes). */
-	int rc = cl_bufs_size(b->dev, b->b, want, LB_COUNT, err, err_size);
+	/* Both sets at once against the device's memory, then each made. */
+	int rc = cl_bufs_fit(b->dev, want, LB_COUNT + SB_COUNT, err, err_size);
+
+	if (rc == 0)
+		rc = cl_bufs_size(b->dev, b->b, want, LB_COUNT, err, err_size);
 	return rc < 0 ? rc : cl_bufs_size(b->dev, b->sort->b, want + LB_COUNT, SB_COUNT, err,
 	                                  err_size);
 }
@@ -43,9 +51,11 @@ static int hierarchy(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 	cl_mem keys = b->sort->b[SB_KEYS0 + b->sort->sorted].mem;
 	cl_mem order = b->sort->b[SB_VALS0 + b->sort->sorted].mem;
 	cl_uint collapse = b->collapse, n = b->n, max_leaf = b->max_leaf;
+	cl_uint block = b->leaf_block ? b->leaf_block
+	                              : d->cl.type & CL_DEVICE_TYPE_CPU ? CPU_LEAF_BLOCK : 1;
 	cl_arg ka[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(b->b[LB_PARENT].mem),
 	                CL_ARG(b->b[LB_END].mem) };
-	cl_arg ba[] = { CL_ARG(b->b[LB_BOUNDS].mem), CL_ARG(order), CL_ARG(n),
+	cl_arg ba[] = { CL_ARG(b->b[LB_BOUNDS].mem), CL_ARG(order), CL_ARG(n), CL_ARG(block),
 	                CL_ARG(b->b[LB_PARENT].mem), CL_ARG(b->b[LB_END].mem),
 	                CL_ARG(b->b[LB_NODES].mem), CL_ARG(b->b[LB_VISITS].mem),
 	                CL_ARG(b->b[LB_COST].mem), CL_ARG(b->b[LB_FLAGS].mem),
@@ -59,7 +69,8 @@ static int hierarchy(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 	if ((rc = cl_launch(d, d->k[K_KARRAS], n - 1, ka, 4, ev, err, err_size)) < 0 ||
 	    (rc = zero(b, LB_VISITS, 4 * (size_t)(n - 1), ev, err, err_size)) < 0 ||
 	    (rc = zero(b, LB_FLAGS, n - 1, ev, err, err_size)) < 0 ||
-	    (rc = cl_launch(d, d->k[K_BOUNDS], n, ba, 14, ev, err, err_size)) < 0)
+	    (rc = cl_launch(d, d->k[K_BOUNDS], (n + block - 1) / block, ba, 15, ev, err,
+	                    err_size)) < 0)
 		return rc;
 	if (!b->collapse)
 		return 0;

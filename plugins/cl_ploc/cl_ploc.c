@@ -26,13 +26,17 @@ static const bvhlab_option_decl options[] = {
 	  .def_int = 16, .min = 1, .max = CL_PLOC_MAX_RADIUS },
 	MORTON_OPTION_DECLS,
 	CL_DEVICE_OPTION_DECL,
+	{ .name = "nn_block", .type = BVHLAB_OPTION_INT,
+	  .help = "clusters per work-item of the nearest-neighbour search (0: 256 on a CPU "
+	          "device, 1 on a GPU); the tree is the same for every value",
+	  .def_int = 0, .min = 0, .max = CL_PLOC_MAX_NN_BLOCK },
 };
 
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "first_clusters", "nearest", "count_chunks", "prefix",
-	"write_chunks",
+	"write_chunks", "nearest_blocks",
 };
 
 /* Kept between builds (one build at a time, ABI rule), with the host's
@@ -58,10 +62,11 @@ __attribute__((destructor)) static void release_device(void)
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_ploc *b)
 {
 	morton_options o;
-	int64_t radius;
+	int64_t radius, nn_block;
 	int rc;
 
 	if ((rc = host->option_int(ctx, "radius", &radius)) < 0 ||
+	    (rc = host->option_int(ctx, "nn_block", &nn_block)) < 0 ||
 	    (rc = host->option_string(ctx, "device", &b->device)) < 0) {
 		host->set_error(ctx, "cannot read the options");
 		return rc;
@@ -73,6 +78,7 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_ploc 
 		return -EINVAL;
 	}
 	b->radius = (uint32_t)radius;
+	b->nn_block = (uint32_t)nn_block;
 	b->collapse = o.collapse;
 	b->bits = (unsigned)o.bits;
 	b->max_leaf = (uint32_t)o.max_leaf;

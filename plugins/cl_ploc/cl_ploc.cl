@@ -79,6 +79,41 @@ __kernel void nearest(__global const cluster *c, uint m, uint radius, __global u
 	nn[i] = best & 1 ? i + apart : i - apart;
 }
 
+/*
+ * The same nearest neighbours by blocks, for a CPU device: work-item t
+ * takes clusters [lo, hi) = [t * block, + block) and computes each pair's
+ * key once, in the row of its earlier cluster, offering it to both
+ * (ploc_cluster.c's nearest_block, rows from lo - radius on): half the
+ * distances of nearest(), read in order. block <= NN_BLOCK_MAX.
+ */
+#define NN_BLOCK_MAX 256u
+#define NN_RADIUS_MAX 64u
+
+__kernel void nearest_blocks(__global const cluster *c, uint m, uint radius, uint block,
+	__global uint *nn)
+{
+	uint best[NN_BLOCK_MAX + 2 * NN_RADIUS_MAX];
+	uint lo = get_global_id(0) * block;
+	if (lo >= m)
+		return;
+	uint hi = min(m, lo + block), from = lo > radius ? lo - radius : 0;
+	for (uint k = 0; k < hi + radius - from; k++)
+		best[k] = 0xffffffffu;
+	for (uint i = from; i < hi; i++) {
+		uint count = min(m - 1 - i, radius), least = 0xffffffffu;
+		for (uint k = 0; k < count; k++) {
+			uint key = pair_key(c + i, c + i + 1 + k, k, i);
+			least = min(least, key);
+			best[i + 1 + k - from] = min(best[i + 1 + k - from], key);
+		}
+		best[i - from] = min(best[i - from], least | 1);
+	}
+	for (uint i = lo; i < hi; i++) {
+		uint w = best[i - from], apart = 1 + ((w & TIE_MASK) >> 2);
+		nn[i] = w & 1 ? i + apart : i - apart;
+	}
+}
+
 /* Merges (counted at the earlier cluster) and survivors of each chunk. */
 __kernel void count_chunks(__global const uint *nn, uint m, uint chunk, uint chunks,
 	__global uint *counts)

@@ -9,6 +9,7 @@
 #include "cl_dev.h"
 
 #define CL_PLOC_MAX_RADIUS 64 /* ploc's PLOC_MAX_RADIUS */
+#define CL_PLOC_MAX_NN_BLOCK 256 /* cl_ploc.cl's NN_BLOCK_MAX */
 /* Record flags in the count field of the merge tree (ploc.h's). */
 #define REC_PRIM 0x80000000u
 #define REC_COLLAPSED 0x40000000u
@@ -25,6 +26,7 @@ typedef struct cl_ploc {
 	const char *device;
 	unsigned bits;
 	uint32_t radius;
+	uint32_t nn_block;      /* clusters per work-item of nearest; 0: by device */
 	bool collapse;
 	uint32_t max_leaf;
 	float c_trav, c_isect;

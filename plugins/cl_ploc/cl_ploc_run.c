@@ -11,7 +11,11 @@
 
 #include "cl_ploc.h"
 
-enum { K_FIRST = CL_SORT_KERNELS, K_NEAREST, K_COUNT, K_PREFIX, K_WRITE };
+enum { K_FIRST = CL_SORT_KERNELS, K_NEAREST, K_COUNT, K_PREFIX, K_WRITE, K_NEAREST_BLOCKS };
+
+/* Clusters per work-item of the nearest-neighbour search on a CPU device
+ * (nearest_blocks: each distance once, read in order). */
+#define CPU_NN_BLOCK 256u
 
 /* Chunks of the count and write kernels: one work-item each, in order. */
 #define MIN_CHUNK 64u
@@ -36,7 +40,11 @@ static int size_buffers(cl_ploc *b, char *err, size_t err_size)
 	want[PB_TREE] = 32 * (2 * n - 1);
 	want[PB_DESC] = 4 * (2 * n - 1);
 	cl_sort_sizes(b->n, want + PB_COUNT);
-	int rc = cl_bufs_size(b->dev, b->b, want, PB_COUNT, err, err_size);
+	/* Both sets at once against the device's memory, then each made. */
+	int rc = cl_bufs_fit(b->dev, want, PB_COUNT + SB_COUNT, err, err_size);
+
+	if (rc == 0)
+		rc = cl_bufs_size(b->dev, b->b, want, PB_COUNT, err, err_size);
 	return rc < 0 ? rc : cl_bufs_size(b->dev, b->sort->b, want + PB_COUNT, SB_COUNT, err,
 	                                  err_size);
 }
@@ -57,15 +65,32 @@ static int read_buf(cl_ploc *b, int which, size_t offset, size_t bytes, void *to
 	                       "clEnqueueReadBuffer", err, err_size);
 }
 
+/* Every cluster's nearest neighbour: one work-item each (nearest), or by
+ * blocks (nearest_blocks; the same result). */
+static int nearest(cl_ploc *b, cl_mem c, cl_uint m, cl_events *ev, char *err,
+                   size_t err_size)
+{
+	cl_dev *d = b->dev;
+	cl_uint r = b->radius;
+	cl_uint block = b->nn_block ? b->nn_block
+	                            : d->cl.type & CL_DEVICE_TYPE_CPU ? CPU_NN_BLOCK : 1;
+	cl_arg na[] = { CL_ARG(c), CL_ARG(m), CL_ARG(r), CL_ARG(b->b[PB_NN].mem) };
+	cl_arg ba[] = { CL_ARG(c), CL_ARG(m), CL_ARG(r), CL_ARG(block), CL_ARG(b->b[PB_NN].mem) };
+
+	if (block == 1)
+		return cl_launch(d, d->k[K_NEAREST], m, na, 4, ev, err, err_size);
+	return cl_launch(d, d->k[K_NEAREST_BLOCKS], (m + block - 1) / block, ba, 5, ev, err,
+	                 err_size);
+}
+
 /* One iteration over m clusters in buffer `from`; *m becomes what is left. */
 static int iteration(cl_ploc *b, uint32_t *m, int from, cl_events *ev, char *err,
                      size_t err_size)
 {
 	cl_dev *d = b->dev;
 	cl_uint mm = *m, chunk = chunk_size(mm), chunks = (mm + chunk - 1) / chunk;
-	cl_uint collapse = b->collapse, r = b->radius, max_leaf = b->max_leaf;
+	cl_uint collapse = b->collapse, max_leaf = b->max_leaf;
 	cl_mem c = b->b[from].mem, to = b->b[from == PB_CL0 ? PB_CL1 : PB_CL0].mem;
-	cl_arg na[] = { CL_ARG(c), CL_ARG(mm), CL_ARG(r), CL_ARG(b->b[PB_NN].mem) };
 	cl_arg ca[] = { CL_ARG(b->b[PB_NN].mem), CL_ARG(mm), CL_ARG(chunk), CL_ARG(chunks),
 	                CL_ARG(b->b[PB_COUNTS].mem) };
 	cl_arg pa[] = { CL_ARG(b->b[PB_COUNTS].mem), CL_ARG(chunks), CL_ARG(b->b[PB_STATE].mem) };
@@ -75,7 +100,7 @@ static int iteration(cl_ploc *b, uint32_t *m, int from, cl_events *ev, char *err
 	                CL_ARG(max_leaf), CL_ARG(b->c_trav), CL_ARG(b->c_isect) };
 	int rc;
 
-	if ((rc = cl_launch(d, d->k[K_NEAREST], mm, na, 4, ev, err, err_size)) < 0 ||
+	if ((rc = nearest(b, c, mm, ev, err, err_size)) < 0 ||
 	    (rc = cl_launch(d, d->k[K_COUNT], chunks, ca, 5, ev, err, err_size)) < 0 ||
 	    (rc = cl_launch(d, d->k[K_PREFIX], 1, pa, 3, ev, err, err_size)) < 0 ||
 	    (rc = cl_launch(d, d->k[K_WRITE], chunks, wa, 13, ev, err, err_size)) < 0)

@@ -10,7 +10,8 @@
  *
  * One process for everything: the OpenCL compiler (PoCL) builds each
  * plugin's kernels once per process. Skips (77) when there is no OpenCL
- * device, saying why; see main() for the sanitizer builds.
+ * device, saying why. The meshes get two setups; the sanitizer builds
+ * run smaller generated scenes only (UNDER_SANITIZER).
  */
 #include <errno.h>
 #include <stdio.h>
@@ -27,9 +28,11 @@
 #include "../refine_scenes.h"
 
 /* One option setup: the same options for the reference and the device
- * builder (name, value pairs, value as text for bvhlab_options_parse). */
+ * builder ("key=value" for bvhlab_options_parse), and one for the device
+ * builder only (may be NULL). */
 struct setup {
 	const char *opts[4];
+	const char *dev_only;
 };
 
 struct pair {
@@ -44,12 +47,14 @@ static struct pair pairs[] = {
 	{ .ref_name = "lbvh", .dev_name = "cl_lbvh",
 	  .setups = { { { "bits=63", "collapse=true" } },
 	              { { "bits=30", "collapse=false" } },
-	              { { "max_leaf=3", "c_trav=2.5" } } },
+	              /* a work-item per leaf in bounds: what a GPU runs */
+	              { { "max_leaf=3", "c_trav=2.5" }, "leaf_block=1" } },
 	  .differ = { { { "max_leaf=2" } }, { { "max_leaf=8" } } } },
 	{ .ref_name = "ploc", .dev_name = "cl_ploc",
 	  .setups = { { { "radius=16", "collapse=true" } },
 	              { { "radius=1", "collapse=false" } },
-	              { { "radius=4", "bits=30" } } },
+	              /* a work-item per cluster in nearest: what a GPU runs */
+	              { { "radius=4", "bits=30" }, "nn_block=1" } },
 	  .differ = { { { "radius=1" } }, { { "radius=16" } } } },
 };
 #define PAIRS (sizeof(pairs) / sizeof(pairs[0]))
@@ -76,6 +81,8 @@ static int build(bvhlab_plugin *p, const struct setup *s, const char *device,
 		snprintf(dev, sizeof(dev), "device=%s", device);
 		rc = bvhlab_options_parse(&opts, dev, err);
 	}
+	if (rc == 0 && device && s->dev_only)
+		rc = bvhlab_options_parse(&opts, s->dev_only, err);
 	double t0 = now_ms();
 	if (rc == 0)
 		rc = bvhlab_build(p, &opts, in, 2, tree, err);
@@ -138,8 +145,19 @@ static void check_setup(struct pair *p, const struct setup *s, const char *name,
 	bvhlab_tree_finish(&dev);
 }
 
-/* Every pair and setup on one scene; destroys it. */
-static void test_scene(const char *name, bvhlab_scene *scene)
+/* The sanitizer builds run the CPU references 3 to 10 times slower: they
+ * take smaller generated scenes and no mesh (the release build checks the
+ * trees on every mesh; the sanitizers look for memory errors and races,
+ * which the small scenes reach as well: several blocks, many iterations). */
+#if defined(__SANITIZE_ADDRESS__) || UNDER_TSAN
+#define UNDER_SANITIZER 1
+#else
+#define UNDER_SANITIZER 0
+#endif
+#define SAN(full, small) (UNDER_SANITIZER ? (small) : (full))
+
+/* The first `setups` setups of every pair on one scene; destroys it. */
+static void test_setups(const char *name, bvhlab_scene *scene, size_t setups)
 {
 	bvhlab_prims prims;
 	bvhlab_error err = { { 0 } };
@@ -148,16 +166,22 @@ static void test_scene(const char *name, bvhlab_scene *scene)
 		return;
 	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
 	for (size_t k = 0; k < PAIRS; k++)
-		for (size_t s = 0; pairs[k].dev && s < 3; s++)
+		for (size_t s = 0; pairs[k].dev && s < setups; s++)
 			check_setup(&pairs[k], &pairs[k].setups[s], name, &prims.input);
 	printf("%-20s %8u triangles\n", name, scene->triangle_count);
 	bvhlab_prims_finish(&prims);
 	bvhlab_scene_destroy(scene);
 }
 
+static void test_scene(const char *name, bvhlab_scene *scene)
+{
+	test_setups(name, scene, 3);
+}
+
+/* The meshes: the default setup (collapse) and 30-bit codes without. */
 static void test_shared(const char *file, bvhlab_scene *scene)
 {
-	test_scene(file, scene);
+	test_setups(file, scene, 2);
 }
 
 /* n triangles of zero area: points scattered on a plane, and segments. */
@@ -284,11 +308,14 @@ int main(void)
 	test_scene("one", generate("soup", 1, 0, 0));
 	test_scene("two", generate("soup", 2, 0, 0));
 	test_scene("three", generate("soup", 3, 0, 0));
-	test_scene("identical", identical_scene(3000));
-	test_scene("needles", needle_scene(5000));
-	test_scene("zero-area", zero_area_scene(4000));
-	test_scene("soup", generate("soup", 20000, 0, 0));
-	(void)for_shared(shared, sizeof(shared) / sizeof(shared[0]), 1, test_shared);
+	test_scene("identical", identical_scene(SAN(3000, 1000)));
+	test_scene("needles", needle_scene(SAN(5000, 1500)));
+	test_scene("zero-area", zero_area_scene(SAN(4000, 1500)));
+	test_scene("soup", generate("soup", SAN(20000, 4000), 0, 0));
+	if (!UNDER_SANITIZER)
+		(void)for_shared(shared, sizeof(shared) / sizeof(shared[0]), 0, test_shared);
+	else
+		printf("sanitizer build: the shared meshes are left to the release build\n");
 	for (size_t k = 0; k < PAIRS; k++) {
 		if (pairs[k].dev)
 			printf("%s %.1f ms, %s %.1f ms in all (2 threads)\n", pairs[k].dev_name,

@@ -35,6 +35,18 @@ static int make_kernels(cl_dev *d, const char *const *names, unsigned count, cha
 	return 0;
 }
 
+/* CL_DEV_OPTIONS where the device supports it: a device without it may
+ * refuse the option. */
+static const char *build_options(const cl_dev *d)
+{
+	cl_device_fp_config fp = 0;
+
+	if (clGetDeviceInfo(d->cl.device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, NULL) !=
+	    CL_SUCCESS)
+		return "";
+	return fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT ? CL_DEV_OPTIONS : "";
+}
+
 int cl_dev_open(cl_dev *d, const char *spec, const char *src, size_t len,
                 const char *const *names, unsigned count, char *err, size_t err_size)
 {
@@ -47,7 +59,7 @@ int cl_dev_open(cl_dev *d, const char *spec, const char *src, size_t len,
 		return bvhlab_cl_fail(-EINVAL, err, err_size, "cl: device '%.64s...' is too long",
 		                      spec);
 	if ((rc = bvhlab_cl_init(&d->cl, spec, err, err_size)) < 0 ||
-	    (rc = bvhlab_cl_program(&d->cl, src, len, CL_DEV_OPTIONS, &d->prog, err,
+	    (rc = bvhlab_cl_program(&d->cl, src, len, build_options(d), &d->prog, err,
 	                            err_size)) < 0 ||
 	    (rc = make_kernels(d, names, count, err, err_size)) < 0) {
 		cl_dev_close(d);
@@ -71,11 +83,10 @@ static size_t rounded(size_t bytes)
 	return bytes < 4096 ? 4096 : (bytes + 65535) & ~(size_t)65535;
 }
 
-int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count, char *err,
-                 size_t err_size)
+int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
+                size_t err_size)
 {
 	size_t total = 0;
-	cl_int rc = CL_SUCCESS;
 
 	for (unsigned k = 0; k < count; k++) {
 		total += rounded(want[k]);
@@ -89,6 +100,17 @@ int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count, ch
 		return bvhlab_cl_fail(-ENOMEM, err, err_size,
 			"cl: the build needs %zu MiB of device memory, %s has %llu MiB",
 			total >> 20, d->cl.name, (unsigned long long)(d->cl.global_mem >> 20));
+	return 0;
+}
+
+int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count, char *err,
+                 size_t err_size)
+{
+	cl_int rc = CL_SUCCESS;
+	int fit = cl_bufs_fit(d, want, count, err, err_size);
+
+	if (fit < 0)
+		return fit;
 	for (unsigned k = 0; k < count; k++) {
 		if (bufs[k].bytes >= want[k] && bufs[k].mem)
 			continue;

@@ -20,8 +20,10 @@
 #include <bvhlab/opencl.h>
 #include <bvhlab/builder.h>
 
-/* Build options of every device builder's program: no contraction into
- * fma and correctly rounded division, so the float results are the CPU's. */
+/* Build option of every device builder's program where the device has
+ * it: correctly rounded division and square root, as the CPU's. (The
+ * kernels also turn contraction into fma off, by pragma; none divides
+ * today: the quantiser's scale comes from the host.) */
 #define CL_DEV_OPTIONS "-cl-fp32-correctly-rounded-divide-sqrt"
 #define CL_DEV_MAX_KERNELS 16
 
@@ -54,9 +56,13 @@ typedef struct cl_buf {
 	size_t bytes;
 } cl_buf;
 
+/* Whether buffers of want[k] bytes fit the device (each its largest
+ * allocation, the sum its memory): 0, or -ENOMEM saying how much was
+ * needed. */
+int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
+                size_t err_size);
 /* Makes every buffer at least its wanted size (want[k] bytes), after
- * checking the sum against the device's memory: 0, or -ENOMEM saying
- * how much was needed. Done before any kernel runs. */
+ * cl_bufs_fit. Done before any kernel runs. */
 int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count,
                  char *err, size_t err_size);
 void cl_bufs_free(cl_buf *bufs, unsigned count);
@@ -108,9 +114,10 @@ typedef struct cl_sort {
 /* Bytes of each of the sort's buffers for n primitives (into want[]). */
 void cl_sort_sizes(uint32_t n, size_t want[SB_COUNT]);
 /*
- * Uploads the centroids (its own event in ev: the phase "upload" is taken
- * from it by the caller as ms_upload), computes the codes of `bits` (30 or
- * 63) as plugins/common/morton does, and sorts (code, id) pairs.
+ * Uploads the centroids (blocking; its wall-clock time into *ms_upload),
+ * computes the codes of `bits` (30 or 63) as plugins/common/morton does,
+ * and sorts the (code, id) pairs, the kernels' events into ev. Reads back
+ * once, the bits in which the codes vary (which digits need a pass).
  */
 int cl_sort_run(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned bits,
                 cl_events *ev, double *ms_upload, char *err, size_t err_size);
