@@ -354,22 +354,31 @@ fail:
 	return e;
 }
 
+/* The program's build log on cl's device (malloc'd; free it), or NULL. */
+static inline char *bvhlab_cl_read_log(const bvhlab_cl *cl, cl_program prog)
+{
+	size_t len = 0;
+	char *log = NULL;
+	if (clGetProgramBuildInfo(prog, cl->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &len) !=
+	    CL_SUCCESS || len == 0 || !(log = (char *)malloc(len + 1)))
+		return NULL;
+	if (clGetProgramBuildInfo(prog, cl->device, CL_PROGRAM_BUILD_LOG, len, log, NULL) !=
+	    CL_SUCCESS) {
+		free(log);
+		return NULL;
+	}
+	log[len] = '\0';
+	return log;
+}
+
 /* Puts "cl: kernel build failed on DEVICE: LOG" into err, the log cut to
  * what fits and the cut said so. */
 static inline int bvhlab_cl_build_log(bvhlab_cl *cl, cl_program prog, cl_int code,
 	char *err, size_t err_size)
 {
-	size_t len = 0, head;
-	char *log = NULL;
+	size_t head;
+	char *log = bvhlab_cl_read_log(cl, prog);
 	const char *cut = "\n[compiler log truncated]";
-	if (clGetProgramBuildInfo(prog, cl->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &len) == CL_SUCCESS
-	    && len > 0 && (log = (char *)malloc(len + 1)) != NULL
-	    && clGetProgramBuildInfo(prog, cl->device, CL_PROGRAM_BUILD_LOG, len, log, NULL) == CL_SUCCESS) {
-		log[len] = '\0';
-	} else {
-		free(log);
-		log = NULL;
-	}
 	if (!err || !err_size)
 		goto out;
 	head = (size_t)snprintf(err, err_size, "cl: kernel build failed (%s) on %s: ",

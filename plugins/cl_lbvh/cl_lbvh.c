@@ -31,7 +31,7 @@ static const bvhlab_option_decl options[] = {
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
 static const char *const kernel_names[] = {
-	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes",
+	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "gather_leaves",
 };
 
 /* Kept between builds (one build at a time, ABI rule); released when the

@@ -22,12 +22,12 @@ typedef struct node {
  * positions where the codes are equal (Karras's k_i ++ i); -1 outside. */
 static int delta(__global const ulong *keys, long n, long i, long j)
 {
-	if (j < 0 || j >= n)
-		return -1;
-	ulong x = keys[i] ^ keys[j];
-	if (x)
-		return 1 + (int)clz(x);
-	return 1 + 64 + (int)clz((uint)(i ^ j));
+	/* Without branches: the searches below compare deltas a coin toss
+	 * apart, and a mispredicted branch costs more than the arithmetic. */
+	bool inside = j >= 0 && j < n;
+	ulong x = keys[i] ^ keys[inside ? j : i];
+	int d = x ? 1 + (int)clz(x) : 1 + 64 + (int)clz((uint)(i ^ j));
+	return inside ? d : -1;
 }
 
 /* Internal node i: its range's other end and its split (the paper's
@@ -45,15 +45,13 @@ __kernel void karras(__global const ulong *keys, uint n, __global uint *parent,
 		lmax <<= 1;
 	long l = 0;
 	for (long t = lmax >> 1; t >= 1; t >>= 1)
-		if (delta(keys, nn, i, i + (l + t) * d) > dmin)
-			l += t;
+		l += delta(keys, nn, i, i + (l + t) * d) > dmin ? t : 0;
 	long j = i + l * d;
 	int dnode = delta(keys, nn, i, j);
 	long s = 0, t = l;
 	do {
 		t = (t + 1) >> 1;
-		if (delta(keys, nn, i, i + (s + t) * d) > dnode)
-			s += t;
+		s += delta(keys, nn, i, i + (s + t) * d) > dnode ? t : 0;
 	} while (t > 1);
 	uint split = (uint)(i + s * d + min(d, 0));
 	uint first = (uint)min(i, j), last = (uint)max(i, j), leaves = n - 1;
@@ -136,15 +134,30 @@ static void store_node(volatile __global node *p, const node *x)
 	p->count = x->count;
 }
 
-/* Leaf k's slot and index. */
-static void put_leaf(__global const float *prim_bounds, __global const uint *order,
-	__global const uint *parent, uint n, uint k, volatile __global node *nodes,
-	__global uint *prim_index)
+/* The primitives' boxes in sorted order, and their ids into prim_index:
+ * the one random read of the build, in a kernel of its own, one work-item
+ * per leaf with nothing else to wait for, so that many of its misses are
+ * in flight at once (lbvh_emit.c's leaf loop, for the same reason). */
+__kernel void gather_leaves(__global const float *prim_bounds, __global const uint *order,
+	uint n, __global float *leaf_bounds, __global uint *prim_index)
 {
+	uint k = get_global_id(0);
+	if (k >= n)
+		return;
 	uint id = order[k];
 	__global const float *b = prim_bounds + 6 * (size_t)id;
-	node leaf = { { b[0], b[1], b[2] }, k, { b[3], b[4], b[5] }, 1 };
+	__global float *to = leaf_bounds + 6 * (size_t)k;
+	for (int a = 0; a < 6; a++)
+		to[a] = b[a];
 	prim_index[k] = id;
+}
+
+/* Leaf k's slot. */
+static void put_leaf(__global const float *leaf_bounds, __global const uint *parent, uint n,
+	uint k, volatile __global node *nodes)
+{
+	__global const float *b = leaf_bounds + 6 * (size_t)k;
+	node leaf = { { b[0], b[1], b[2] }, k, { b[3], b[4], b[5] }, 1 };
 	store_node(nodes + 1 + (size_t)parent[n - 1 + k], &leaf);
 }
 
@@ -156,17 +169,17 @@ static void put_leaf(__global const float *prim_bounds, __global const uint *ord
  * it needs no counter; the others take the atomic one, whose fences hand
  * the first child's slot over. block is 1 on a GPU (a work-item per leaf),
  * larger on a CPU device, where it keeps the climbs in cache and off the
- * atomics (lbvh_emit.c's blocks). visits[] and flags[] zeroed.
+ * atomics (lbvh_emit.c's blocks). leaf_bounds from gather_leaves;
+ * visits[] and flags[] zeroed.
  */
-__kernel void bounds(__global const float *prim_bounds, __global const uint *order, uint n,
-	uint block, __global const uint *parent, __global const uint *end,
-	volatile __global node *nodes, volatile __global uint *visits, __global float *cost,
-	__global uchar *flags, __global uint *prim_index, uint collapse, uint max_leaf,
-	float c_trav, float c_isect)
+__kernel void bounds(__global const float *leaf_bounds, uint n, uint block,
+	__global const uint *parent, __global const uint *end, volatile __global node *nodes,
+	volatile __global uint *visits, __global float *cost, __global uchar *flags,
+	uint collapse, uint max_leaf, float c_trav, float c_isect)
 {
 	size_t lo = get_global_id(0) * (size_t)block, hi = min((size_t)n, lo + block);
 	for (size_t k = lo; k < hi; k++)
-		put_leaf(prim_bounds, order, parent, n, (uint)k, nodes, prim_index);
+		put_leaf(leaf_bounds, parent, n, (uint)k, nodes);
 	for (size_t k = lo; k < hi; k++) {
 		uint word = parent[n - 1 + k];
 		while (word != NO_NODE) {

@@ -9,7 +9,7 @@
 
 /* The device buffers besides the sort's. */
 enum { LB_BOUNDS, LB_PARENT, LB_END, LB_NODES, LB_VISITS, LB_COST, LB_FLAGS, LB_INDEX,
-       LB_INNER, LB_COUNT };
+       LB_INNER, LB_LEAVES, LB_COUNT };
 
 typedef struct cl_lbvh {
 	const bvhlab_build_input *in;

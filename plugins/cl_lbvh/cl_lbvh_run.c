@@ -8,7 +8,7 @@
 
 #include "cl_lbvh.h"
 
-enum { K_KARRAS = CL_SORT_KERNELS, K_BOUNDS, K_INNER };
+enum { K_KARRAS = CL_SORT_KERNELS, K_BOUNDS, K_INNER, K_GATHER };
 
 /* Leaves per work-item of the bounds kernel on a CPU device: a few
  * thousand work-items on a million leaves, each climb mostly in cache and
@@ -19,7 +19,7 @@ static int size_buffers(cl_lbvh *b, char *err, size_t err_size)
 {
 	size_t n = b->n, want[LB_COUNT + SB_COUNT];
 
-	want[LB_BOUNDS] = 24 * n;
+	want[LB_BOUNDS] = want[LB_LEAVES] = 24 * n;
 	want[LB_PARENT] = 4 * (2 * n - 1);
 	want[LB_END] = want[LB_VISITS] = want[LB_COST] = 4 * (n - 1);
 	want[LB_NODES] = 32 * (2 * n - 1);
@@ -55,21 +55,23 @@ static int hierarchy(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 	                              : d->cl.type & CL_DEVICE_TYPE_CPU ? CPU_LEAF_BLOCK : 1;
 	cl_arg ka[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(b->b[LB_PARENT].mem),
 	                CL_ARG(b->b[LB_END].mem) };
-	cl_arg ba[] = { CL_ARG(b->b[LB_BOUNDS].mem), CL_ARG(order), CL_ARG(n), CL_ARG(block),
+	cl_arg ga[] = { CL_ARG(b->b[LB_BOUNDS].mem), CL_ARG(order), CL_ARG(n),
+	                CL_ARG(b->b[LB_LEAVES].mem), CL_ARG(b->b[LB_INDEX].mem) };
+	cl_arg ba[] = { CL_ARG(b->b[LB_LEAVES].mem), CL_ARG(n), CL_ARG(block),
 	                CL_ARG(b->b[LB_PARENT].mem), CL_ARG(b->b[LB_END].mem),
 	                CL_ARG(b->b[LB_NODES].mem), CL_ARG(b->b[LB_VISITS].mem),
-	                CL_ARG(b->b[LB_COST].mem), CL_ARG(b->b[LB_FLAGS].mem),
-	                CL_ARG(b->b[LB_INDEX].mem), CL_ARG(collapse), CL_ARG(max_leaf),
-	                CL_ARG(b->c_trav), CL_ARG(b->c_isect) };
+	                CL_ARG(b->b[LB_COST].mem), CL_ARG(b->b[LB_FLAGS].mem), CL_ARG(collapse),
+	                CL_ARG(max_leaf), CL_ARG(b->c_trav), CL_ARG(b->c_isect) };
 	cl_arg ia[] = { CL_ARG(b->b[LB_PARENT].mem), CL_ARG(b->b[LB_END].mem),
 	                CL_ARG(b->b[LB_FLAGS].mem), CL_ARG(n), CL_ARG(max_leaf),
 	                CL_ARG(b->b[LB_INNER].mem) };
 	int rc;
 
-	if ((rc = cl_launch(d, d->k[K_KARRAS], n - 1, ka, 4, ev, err, err_size)) < 0 ||
+	if ((rc = cl_launch(d, d->k[K_GATHER], n, ga, 5, ev, err, err_size)) < 0 ||
+	    (rc = cl_launch(d, d->k[K_KARRAS], n - 1, ka, 4, ev, err, err_size)) < 0 ||
 	    (rc = zero(b, LB_VISITS, 4 * (size_t)(n - 1), ev, err, err_size)) < 0 ||
 	    (rc = zero(b, LB_FLAGS, n - 1, ev, err, err_size)) < 0 ||
-	    (rc = cl_launch(d, d->k[K_BOUNDS], (n + block - 1) / block, ba, 15, ev, err,
+	    (rc = cl_launch(d, d->k[K_BOUNDS], (n + block - 1) / block, ba, 13, ev, err,
 	                    err_size)) < 0)
 		return rc;
 	if (!b->collapse)

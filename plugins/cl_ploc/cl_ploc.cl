@@ -8,6 +8,13 @@
  * cluster, its `radius` neighbours on either side), count and write (one
  * work-item per chunk of clusters, in order), with a prefix over the
  * chunks between them (prefix, one work-item).
+ *
+ * The cluster count lives on the device, by iteration parity cur: state[cur]
+ * clusters now, state[2 + cur] the top of the record pairs; prefix writes
+ * the next ones at 1 - cur and 3 - cur. So the host may queue several
+ * iterations without reading the count back, launching for a bound on it:
+ * work-items past the count do nothing, and an iteration queued after one
+ * cluster is left only carries it to the other buffer.
  */
 #define REC_PRIM 0x80000000u
 #define REC_COLLAPSED 0x40000000u
@@ -66,10 +73,11 @@ static uint pair_key(__global const cluster *e, __global const cluster *l, uint 
 	return (as_uint(d) & ~TIE_MASK) | k << 2 | (e_index & 1) << 1;
 }
 
-__kernel void nearest(__global const cluster *c, uint m, uint radius, __global uint *nn)
+__kernel void nearest(__global const cluster *c, __global const uint *state, uint cur,
+	uint radius, __global uint *nn)
 {
-	uint i = get_global_id(0), best = 0xffffffffu;
-	if (i >= m)
+	uint i = get_global_id(0), best = 0xffffffffu, m = state[cur];
+	if (i >= m || m < 2)
 		return;
 	for (uint k = 0; k < radius && k < i; k++)
 		best = min(best, pair_key(c + i - 1 - k, c + i, k, i - 1 - k));
@@ -89,12 +97,12 @@ __kernel void nearest(__global const cluster *c, uint m, uint radius, __global u
 #define NN_BLOCK_MAX 256u
 #define NN_RADIUS_MAX 64u
 
-__kernel void nearest_blocks(__global const cluster *c, uint m, uint radius, uint block,
-	__global uint *nn)
+__kernel void nearest_blocks(__global const cluster *c, __global const uint *state,
+	uint cur, uint radius, uint block, __global uint *nn)
 {
 	uint best[NN_BLOCK_MAX + 2 * NN_RADIUS_MAX];
-	uint lo = get_global_id(0) * block;
-	if (lo >= m)
+	uint lo = get_global_id(0) * block, m = state[cur];
+	if (lo >= m || m < 2)
 		return;
 	uint hi = min(m, lo + block), from = lo > radius ? lo - radius : 0;
 	for (uint k = 0; k < hi + radius - from; k++)
@@ -115,13 +123,15 @@ __kernel void nearest_blocks(__global const cluster *c, uint m, uint radius, uin
 }
 
 /* Merges (counted at the earlier cluster) and survivors of each chunk. */
-__kernel void count_chunks(__global const uint *nn, uint m, uint chunk, uint chunks,
-	__global uint *counts)
+__kernel void count_chunks(__global const uint *nn, __global const uint *state, uint cur,
+	uint chunk, uint chunks, __global uint *counts)
 {
-	uint c = get_global_id(0), merges = 0, survivors = 0;
+	uint c = get_global_id(0), merges = 0, survivors = 0, m = state[cur];
 	if (c >= chunks)
 		return;
-	uint lo = c * chunk, hi = min(m, lo + chunk);
+	uint lo = c * chunk, hi = m < 2 ? lo : min(m, lo + chunk);
+	if (m < 2 && c == 0) /* done: the last cluster survives */
+		survivors = m;
 	for (uint i = lo; i < hi; i++) {
 		uint j = nn[i];
 		bool pair = nn[j] == i;
@@ -133,11 +143,12 @@ __kernel void count_chunks(__global const uint *nn, uint m, uint chunk, uint chu
 }
 
 /* Each chunk's first survivor position and the top of its record pairs
- * (pairs go downwards from state[1]); state[0] becomes the clusters left,
- * state[1] the new top. One work-item. */
-__kernel void prefix(__global uint *counts, uint chunks, __global uint *state)
+ * (pairs go downwards from the top, state[2 + cur]); the clusters left
+ * and the new top go to the other parity's state[1 - cur], state[3 - cur].
+ * One work-item. */
+__kernel void prefix(__global uint *counts, uint chunks, __global uint *state, uint cur)
 {
-	uint merges = 0, survivors = 0, base = state[1];
+	uint merges = 0, survivors = 0, base = state[2 + cur];
 	if (get_global_id(0) != 0)
 		return;
 	for (uint c = 0; c < chunks; c++) {
@@ -147,8 +158,8 @@ __kernel void prefix(__global uint *counts, uint chunks, __global uint *state)
 		merges += mc;
 		survivors += sc;
 	}
-	state[0] = survivors;
-	state[1] = base - 2 * merges;
+	state[1 - cur] = survivors;
+	state[3 - cur] = base - 2 * merges;
 }
 
 static void put_record(__global const cluster *c, __global record *tree, __global uint *desc,
@@ -187,14 +198,19 @@ static cluster merged(__global const cluster *a, __global const cluster *b, uint
 	return u;
 }
 
-__kernel void write_chunks(__global const cluster *c, __global const uint *nn, uint m,
-	uint chunk, uint chunks, __global const uint *counts, __global cluster *to,
-	__global record *tree, __global uint *desc, uint collapse, uint max_leaf, float c_trav,
-	float c_isect)
+__kernel void write_chunks(__global const cluster *c, __global const uint *nn,
+	__global const uint *state, uint cur, uint chunk, uint chunks,
+	__global const uint *counts, __global cluster *to, __global record *tree,
+	__global uint *desc, uint collapse, uint max_leaf, float c_trav, float c_isect)
 {
-	uint ch = get_global_id(0);
+	uint ch = get_global_id(0), m = state[cur];
 	if (ch >= chunks)
 		return;
+	if (m < 2) { /* done: the last cluster moves along with the parity */
+		if (ch == 0 && m == 1)
+			to[0] = c[0];
+		return;
+	}
 	uint lo = ch * chunk, hi = min(m, lo + chunk);
 	uint pair = counts[2 * ch], k = counts[2 * ch + 1];
 	for (uint i = lo; i < hi; i++) {
