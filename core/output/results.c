@@ -241,6 +241,10 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddItemToObject(o, "validation", validation_json(run));
 	if (run->rays)
 		cJSON_AddItemToObject(o, "rays", results_rays_json(run->rays));
+	if (run->load_read) {
+		cJSON_AddNumberToObject(o, "load_before", run->load_before);
+		cJSON_AddNumberToObject(o, "load_after", run->load_after);
+	}
 	cJSON_AddItemToArray(res->runs, o);
 	return 0;
 }

@@ -79,6 +79,11 @@ struct run_record {
 	const struct ray_metrics *rays; /* or NULL: not traced */
 	const struct stage_metrics *stages; /* [stage_count] refinement stages */
 	uint32_t stage_count;
+	/* The machine's 1-minute load average just before and after the run's
+	 * series (-1: unreadable), so a report can tell a busy machine;
+	 * recorded when load_read. */
+	bool load_read;
+	double load_before, load_after;
 };
 
 
