@@ -1,0 +1,194 @@
+/*
+ * Pareto fronts: which builders are worth considering at all. Per scene
+ * and thread count, a run is on the front of build time against a tree
+ * figure (SAH cost, primary nodes per ray; lower is better for both) when
+ * no other run is at least as fast and at least as good with one of the
+ * two strictly better. A run off the front names the run that dominates
+ * it; of those, the fastest (then the best figure), which is always on the
+ * front itself, so the reader is sent to a builder worth looking at.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "output/report.h"
+
+static bool dominates(const struct front_point *b, const struct front_point *a)
+{
+	return b->group == a->group && b->time <= a->time && b->figure <= a->figure &&
+	       (b->time < a->time || b->figure < a->figure);
+}
+
+static bool usable(const struct front_point *p)
+{
+	return isfinite(p->time) && isfinite(p->figure) && p->time > 0;
+}
+
+/* Whether b is the better pick than c (index -1: none yet) as a's dominator. */
+static bool better_dominator(const struct front_point *p, long c, size_t b)
+{
+	return c < 0 || p[b].time < p[c].time ||
+	       (p[b].time == p[c].time && p[b].figure < p[c].figure);
+}
+
+void report_front_points(const struct front_point *p, size_t n, long *by)
+{
+	for (size_t a = 0; a < n; a++) {
+		by[a] = usable(&p[a]) ? FRONT_ON : FRONT_NONE;
+		for (size_t b = 0; b < n && by[a] != FRONT_NONE; b++)
+			if (b != a && usable(&p[b]) && dominates(&p[b], &p[a]) &&
+			    better_dominator(p, by[a] >= 0 ? by[a] : -1, b))
+				by[a] = (long)b;
+	}
+}
+
+void report_front_text(char *buf, size_t size, const struct front_point *p, long by,
+                       size_t a, const char *by_name, const char *figure)
+{
+	if (by == FRONT_NONE) {
+		snprintf(buf, size, "—");
+		return;
+	}
+	if (by == FRONT_ON) {
+		snprintf(buf, size, "front");
+		return;
+	}
+	double t = p[by].time / p[a].time, f = 100 * (p[by].figure - p[a].figure) / p[a].figure;
+	char change[48];
+	if (fabs(f) < 0.05)
+		snprintf(change, sizeof(change), "same %s", figure);
+	else
+		snprintf(change, sizeof(change), "%s%.1f %% %s", f < 0 ? "−" : "+", fabs(f), figure);
+	snprintf(buf, size, "dominated by %s (%.2f× time, %s)", by_name, t, change);
+}
+
+/* The scene's runs as points of one figure, grouped by thread count; NaN
+ * for a run that is not ok. */
+static void scene_points(const cJSON *const *runs, size_t n, const char *figure,
+                         struct front_point *p)
+{
+	for (size_t k = 0; k < n; k++) {
+		bool ok = strcmp(report_str(runs[k], "status"), "ok") == 0;
+		p[k] = (struct front_point){ok ? report_num(runs[k], "build_ms.median") : NAN,
+		                            report_num(runs[k], figure),
+		                            (long)report_num(runs[k], "threads")};
+	}
+}
+
+int report_scene_front(const cJSON *const *runs, size_t n, const char *figure,
+                       struct front_point *p, long *by)
+{
+	scene_points(runs, n, figure, p);
+	report_front_points(p, n, by);
+	return 0;
+}
+
+/* The two views the tables show: build time against each figure. */
+static const char *const figures[2] = {"tree.sah_cost", "rays.primary.nodes_per_ray"};
+static const char *const figure_names[2] = {"SAH", "nodes/ray"};
+
+struct front_table {
+	const cJSON *const *runs;
+	size_t n;
+	struct front_point *p[2];
+	long *by[2];
+};
+
+static int table_init(struct front_table *t, const cJSON *const *runs, size_t n)
+{
+	t->runs = runs;
+	t->n = n;
+	for (int v = 0; v < 2; v++) {
+		t->p[v] = calloc(n + 1, sizeof(*t->p[v]));
+		t->by[v] = calloc(n + 1, sizeof(*t->by[v]));
+		if (!t->p[v] || !t->by[v])
+			return -1;
+		report_scene_front(runs, n, figures[v], t->p[v], t->by[v]);
+	}
+	return 0;
+}
+
+static void table_finish(struct front_table *t)
+{
+	for (int v = 0; v < 2; v++) {
+		free(t->p[v]);
+		free(t->by[v]);
+	}
+}
+
+/* The verdict of run k in view v. */
+static void verdict(const struct front_table *t, int v, size_t k, char *buf, size_t size)
+{
+	long by = t->by[v][k];
+	const char *name = by >= 0 ? report_str(t->runs[by], "builder") : "";
+	report_front_text(buf, size, t->p[v], by, k, name, figure_names[v]);
+}
+
+static const char intro[] =
+	"Per thread count: a builder is on the front when no other is at least as fast "
+	"and builds a tree at least as good (lower SAH cost; fewer primary nodes per ray), "
+	"one of the two strictly; off it, the fastest builder that dominates it, its "
+	"build time as a multiple of this one's and the change in the figure.";
+
+void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n)
+{
+	struct front_table t;
+	char buf[256];
+	if (table_init(&t, runs, n) == 0 && n > 0) {
+		sb_printf(sb, "\n### Pareto fronts\n\n%s\n\n| builder | threads | median ms | SAH cost "
+		              "| time × SAH | primary nodes/ray | time × nodes/ray |\n"
+		              "|---|---:|---:|---:|---|---:|---|\n", intro);
+		for (size_t k = 0; k < n; k++) {
+			if (t.by[0][k] == FRONT_NONE)
+				continue;
+			sb_printf(sb, "|");
+			report_md_cell(sb, report_str(runs[k], "builder"));
+			sb_printf(sb, " %.0f | %s | %.3f |", report_num(runs[k], "threads"),
+			          report_plain(buf, sizeof(buf), t.p[0][k].time), t.p[0][k].figure);
+			verdict(&t, 0, k, buf, sizeof(buf));
+			report_md_cell(sb, buf);
+			sb_printf(sb, " %.1f |", t.p[1][k].figure);
+			verdict(&t, 1, k, buf, sizeof(buf));
+			report_md_cell(sb, buf);
+			sb_printf(sb, "\n");
+		}
+	}
+	table_finish(&t);
+}
+
+static void html_verdict(struct strbuf *sb, const struct front_table *t, int v, size_t k)
+{
+	char buf[256];
+	verdict(t, v, k, buf, sizeof(buf));
+	sb_printf(sb, "<td class=\"l%s\">", t->by[v][k] == FRONT_ON ? " front" : "");
+	report_escape(sb, buf);
+	sb_printf(sb, "</td>");
+}
+
+void report_front_html(struct strbuf *sb, const cJSON *const *runs, size_t n)
+{
+	struct front_table t;
+	char buf[64];
+	if (table_init(&t, runs, n) == 0 && n > 0) {
+		sb_printf(sb, "<h3>Pareto fronts</h3>\n<p>%s</p>\n<table><tr><th class=\"l\">builder"
+		              "</th><th>threads</th><th>median ms</th><th>SAH cost</th>"
+		              "<th class=\"l\">time × SAH</th><th>primary nodes/ray</th>"
+		              "<th class=\"l\">time × nodes/ray</th></tr>\n", intro);
+		for (size_t k = 0; k < n; k++) {
+			if (t.by[0][k] == FRONT_NONE)
+				continue;
+			sb_printf(sb, "<tr><td class=\"l\">");
+			report_escape(sb, report_str(runs[k], "builder"));
+			sb_printf(sb, "</td><td>%.0f</td><td>%s</td><td>%.3f</td>",
+			          report_num(runs[k], "threads"),
+			          report_plain(buf, sizeof(buf), t.p[0][k].time), t.p[0][k].figure);
+			html_verdict(sb, &t, 0, k);
+			sb_printf(sb, "<td>%.1f</td>", t.p[1][k].figure);
+			html_verdict(sb, &t, 1, k);
+			sb_printf(sb, "</tr>\n");
+		}
+		sb_printf(sb, "</table>\n");
+	}
+	table_finish(&t);
+}
