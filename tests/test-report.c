@@ -16,13 +16,17 @@ static void test_front_points(void)
 {
 	/* A and B on the front of group 1; C behind A; D behind both, and B,
 	 * the faster, is named; F equals A (neither dominates); E alone in
-	 * group 2; G lacks a figure. */
+	 * group 2; G lacks a figure; H is 0.025 % better than A but slower:
+	 * within the tolerance, A dominates it. */
 	const struct front_point p[] = {
 		{10, 40, 1}, {5, 42, 1}, {12, 41, 1}, {11, 44, 1}, {100, 50, 2}, {10, 40, 1},
-		{1, NAN, 1}};
-	long by[7];
+		{1, NAN, 1}, {10.5, 39.99, 1}};
+	long by[8];
 	char buf[128];
-	report_front_points(p, 7, by);
+	report_front_points(p, 8, by);
+	CHECK_INT(by[7], 0);
+	report_front_text(buf, sizeof(buf), p, by[7], 7, "A", "SAH");
+	CHECK(strcmp(buf, "dominated by A (0.95× time, same SAH)") == 0);
 	CHECK_INT(by[0], FRONT_ON);
 	CHECK_INT(by[1], FRONT_ON);
 	CHECK_INT(by[2], 0);
@@ -162,15 +166,16 @@ static void test_html(void)
 	CHECK_CONTAINS(html, "primary nodes/ray vs. build time, 2 threads");
 	CHECK_CONTAINS(html, "<h3>Break-even against fast</h3>");
 	CHECK_CONTAINS(html, "⚠ Busy machine");
-	CHECK_CONTAINS(html, "≈ noisy: build repeats spread 20.0 %");
+	CHECK_CONTAINS(html, "title=\"build repeats spread 20.0 %\">≈ noisy</td>");
+	CHECK_CONTAINS(html, "title=\"load 3.50 before, 3.00 after; 1 core left free\">⚠ busy</td>");
 	CHECK_CONTAINS(html, "primary Mrays/s (best tile)");
 	CHECK_CONTAINS(html, "per pass min–max");
 	/* One colour per builder in every chart: mid is the second builder. */
-	CHECK_CONTAINS(html, "fill=\"#ee6677\" stroke=\"#222\" stroke-width=\"1.5\"><title>mid x1"
+	CHECK_CONTAINS(html, "fill=\"#ff7f0e\" stroke=\"#222\" stroke-width=\"1.5\"><title>mid x1"
 	                     "</title>");
-	CHECK_CONTAINS(html, "fill=\"#ee6677\"/><text x=\"374.0\" y=\"79.0\" text-anchor=\"start\">"
+	CHECK_CONTAINS(html, "fill=\"#ff7f0e\"/><text x=\"374.0\" y=\"79.0\" text-anchor=\"start\">"
 	                     "10.0 ms</text>");
-	CHECK_CONTAINS(html, "fill=\"#ee6677\"/><text x=\"128.8\" y=\"352.0\" text-anchor=\"start\">"
+	CHECK_CONTAINS(html, "fill=\"#ff7f0e\"/><text x=\"128.8\" y=\"352.0\" text-anchor=\"start\">"
 	                     "mid</text>"); /* the legend */
 	CHECK(!strstr(html, "e+0")); /* plain numbers */
 	free(html);

@@ -249,9 +249,10 @@ static void md_images(struct strbuf *sb, const cJSON *scene)
 	if (*shaded)
 		sb_printf(sb, "\n![%s](%s)\n", str(scene, "name"), shaded);
 	if (*legend)
-		sb_printf(sb, "\nHeat maps (nodes visited per primary ray, %.0f to %.0f): "
+		sb_printf(sb, "\nHeat maps (nodes visited per primary ray, %.0f to %.0f, %s scale): "
 		              "![scale](%s) and per builder in report.html.\n",
 		          report_num(scene, "images.heat_min"), report_num(scene, "images.heat_max"),
+		          strcmp(str(scene, "images.heat_scale"), "log") == 0 ? "log" : "linear",
 		          legend);
 }
 

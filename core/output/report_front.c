@@ -3,9 +3,10 @@
  * and thread count, a run is on the front of build time against a tree
  * figure (SAH cost, primary nodes per ray; lower is better for both) when
  * no other run is at least as fast and at least as good with one of the
- * two strictly better. A run off the front names the run that dominates
- * it; of those, the fastest (then the best figure), which is always on the
- * front itself, so the reader is sent to a builder worth looking at.
+ * two strictly better (figures within 0.05 % count as equal). A run off
+ * the front names the run that dominates it: of those, the fastest on the
+ * front (there is one without the tolerance; with it, the fastest of all
+ * when none is), so the reader is sent to a builder worth looking at.
  */
 #include <math.h>
 #include <stdio.h>
@@ -14,10 +15,17 @@
 
 #include "output/report.h"
 
+/* Figures this close count as equal: a parallel build summing in another
+ * order, or a tree that differs in a leaf, is not a better tree, and a
+ * builder 0.001 % better but 10 % slower is no reason to keep one. */
+#define SAME_FIGURE 5e-4
+
 static bool dominates(const struct front_point *b, const struct front_point *a)
 {
-	return b->group == a->group && b->time <= a->time && b->figure <= a->figure &&
-	       (b->time < a->time || b->figure < a->figure);
+	bool no_worse = b->figure <= a->figure * (1 + SAME_FIGURE);
+	bool better = b->figure < a->figure * (1 - SAME_FIGURE);
+	return b->group == a->group && b->time <= a->time && no_worse &&
+	       (b->time < a->time || better);
 }
 
 static bool usable(const struct front_point *p)
@@ -25,22 +33,33 @@ static bool usable(const struct front_point *p)
 	return isfinite(p->time) && isfinite(p->figure) && p->time > 0;
 }
 
-/* Whether b is the better pick than c (index -1: none yet) as a's dominator. */
-static bool better_dominator(const struct front_point *p, long c, size_t b)
+/* Whether b is the better pick than c (index < 0: none yet) as a
+ * dominator: on the front before off it, then faster, then better. */
+static bool better_dominator(const struct front_point *p, const bool *on, long c, size_t b)
 {
-	return c < 0 || p[b].time < p[c].time ||
-	       (p[b].time == p[c].time && p[b].figure < p[c].figure);
+	if (c < 0 || on[b] != on[c])
+		return c < 0 || on[b];
+	return p[b].time < p[c].time || (p[b].time == p[c].time && p[b].figure < p[c].figure);
 }
 
 void report_front_points(const struct front_point *p, size_t n, long *by)
 {
-	for (size_t a = 0; a < n; a++) {
-		by[a] = usable(&p[a]) ? FRONT_ON : FRONT_NONE;
-		for (size_t b = 0; b < n && by[a] != FRONT_NONE; b++)
+	bool *on = calloc(n + 1, sizeof(*on));
+	for (size_t a = 0; !on && a < n; a++)
+		by[a] = FRONT_NONE; /* no memory: nothing compared */
+	for (size_t a = 0; on && a < n; a++) {
+		on[a] = usable(&p[a]);
+		for (size_t b = 0; b < n && on[a]; b++)
+			on[a] = b == a || !usable(&p[b]) || !dominates(&p[b], &p[a]);
+	}
+	for (size_t a = 0; on && a < n; a++) {
+		by[a] = !usable(&p[a]) ? FRONT_NONE : FRONT_ON;
+		for (size_t b = 0; b < n && by[a] != FRONT_NONE && !on[a]; b++)
 			if (b != a && usable(&p[b]) && dominates(&p[b], &p[a]) &&
-			    better_dominator(p, by[a] >= 0 ? by[a] : -1, b))
+			    better_dominator(p, on, by[a], b))
 				by[a] = (long)b;
 	}
+	free(on);
 }
 
 void report_front_text(char *buf, size_t size, const struct front_point *p, long by,

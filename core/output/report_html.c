@@ -23,6 +23,7 @@ static const char css[] =
 	"table.summary td.good{background:#e3f4e3}table.summary td.worse{background:#fbe7e7}"
 	"td.front{background:#e3f4e3;font-weight:bold}.warn{color:#8a4b00}"
 	"td.warn{background:#fff4dc}.wide{overflow-x:auto;max-width:100%}"
+	".wide td,.wide th{white-space:nowrap}"
 	"h3{margin-bottom:0.2em}";
 
 static void esc(struct strbuf *sb, const char *s)
@@ -63,20 +64,17 @@ static double other_num(const cJSON *run, const char *traversal, const char *wha
 	return report_num(run, key);
 }
 
-/* "≈ noisy" and "⚠ busy", with why as the cell's tooltip and text. */
+/* "≈ noisy" and "⚠ busy", short beside the status; why in the tooltip
+ * (and in report.md). */
 static void marks_cell(struct strbuf *sb, const struct report_index *ix, const cJSON *run)
 {
 	char noise[160], load[160];
 	bool noisy = report_noise(ix, run, noise, sizeof(noise));
 	bool busy = report_busy(ix->doc, run, load, sizeof(load));
-	sb_printf(sb, "<td class=\"l%s\">", noisy || busy ? " warn" : "");
-	if (noisy) {
-		sb_printf(sb, "≈ noisy: ");
-		esc(sb, noise);
-	}
-	if (busy)
-		sb_printf(sb, "%s⚠ busy: %s", noisy ? "<br>" : "", load);
-	sb_printf(sb, "</td>");
+	sb_printf(sb, "<td class=\"l%s\" title=\"", noisy || busy ? " warn" : "");
+	esc(sb, noise);
+	sb_printf(sb, "%s%s\">%s%s%s</td>", noisy && busy ? "; " : "", load, noisy ? "≈ noisy" : "",
+	          noisy && busy ? " " : "", busy ? "⚠ busy" : "");
 }
 
 static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
@@ -90,6 +88,7 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 	sb_printf(sb, "<td class=\"l%s\">", ok ? "" : " bad");
 	esc(sb, report_str(run, "status"));
 	sb_printf(sb, "</td>");
+	marks_cell(sb, ix, run);
 	num_cell(sb, report_num(run, "build_ms.median"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.min"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.max"), "%.2f");
@@ -118,7 +117,6 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 	}
 	if (any_other)
 		num_cell(sb, report_num(run, "rays.traversal_disagreements"), "%.0f");
-	marks_cell(sb, ix, run);
 	sb_printf(sb, "<td class=\"l\">");
 	esc(sb, report_str(run, "error"));
 	sb_printf(sb, "</td></tr>\n");
@@ -147,7 +145,10 @@ static void table(struct strbuf *sb, const struct report_index *ix, const char *
 	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
 	bool any_other = find_others(runs, n, others);
 	sb_printf(sb, "<div class=\"wide\"><table><tr><th class=\"l\">builder</th><th>threads</th>"
-	              "<th class=\"l\">status</th><th>median ms</th><th>min ms</th><th>max ms</th>"
+	              "<th class=\"l\">status</th><th class=\"l\" title=\"≈ noisy: build repeats spread "
+	              "over 5 %%, or the same tree traced over 5 %% faster or slower elsewhere; ⚠ busy: "
+	              "the load exceeded the cores the run left free (hover a mark for its figures)"
+	              "\">marks</th><th>median ms</th><th>min ms</th><th>max ms</th>"
 	              "<th>cold ms</th>"
 	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>EPO</th>"
 	              "<th>peak MiB</th><th title=\"each tile of rays at its best pass: the "
@@ -166,7 +167,7 @@ static void table(struct strbuf *sb, const struct report_index *ix, const char *
 	}
 	if (any_other)
 		sb_printf(sb, "<th>hits differing</th>");
-	sb_printf(sb, "<th class=\"l\">marks</th><th class=\"l\">error</th></tr>\n");
+	sb_printf(sb, "<th class=\"l\">error</th></tr>\n");
 	for (size_t k = 0; k < n; k++)
 		run_row(sb, ix, runs[k], others, any_other);
 	sb_printf(sb, "</table></div>\n");
@@ -287,6 +288,21 @@ static void figure(struct strbuf *sb, const char *src, const char *caption)
 	sb_printf(sb, "</figcaption></figure>\n");
 }
 
+/* The colour bar under the heat maps; a log scale names its middle value
+ * (older results drew them on a linear one). */
+static void heat_legend(struct strbuf *sb, const cJSON *scene, const char *legend)
+{
+	double lo = report_num(scene, "images.heat_min"), hi = report_num(scene, "images.heat_max");
+	bool log_scale = strcmp(report_str(scene, "images.heat_scale"), "log") == 0;
+	sb_printf(sb, "<p>Nodes visited per primary ray, one %s scale for every builder: %.0f "
+	              "<img src=\"", log_scale ? "log" : "linear", lo);
+	esc(sb, legend);
+	sb_printf(sb, "\" alt=\"colour scale\" width=\"256\" height=\"16\"> %.0f", hi);
+	if (log_scale)
+		sb_printf(sb, " (the middle of the bar: %.0f)", lo + sqrt(1 + hi - lo) - 1);
+	sb_printf(sb, "</p>\n");
+}
+
 static void images(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
 {
 	const char *name = report_str(scene, "name"), *legend = report_str(scene, "images.legend");
@@ -301,13 +317,8 @@ static void images(struct strbuf *sb, const struct report_index *ix, const cJSON
 		if (*report_str(runs[k], "heat_image"))
 			figure(sb, report_str(runs[k], "heat_image"), report_str(runs[k], "builder"));
 	sb_printf(sb, "</div>\n");
-	if (*legend) {
-		sb_printf(sb, "<p>Nodes visited per primary ray, one scale for every builder: "
-		              "%.0f <img src=\"", report_num(scene, "images.heat_min"));
-		esc(sb, legend);
-		sb_printf(sb, "\" alt=\"colour scale\" width=\"256\" height=\"16\"> %.0f</p>\n",
-		          report_num(scene, "images.heat_max"));
-	}
+	if (*legend)
+		heat_legend(sb, scene, legend);
 }
 
 static void scene_section(struct strbuf *sb, const struct report_index *ix, const char *ref,

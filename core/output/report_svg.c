@@ -20,12 +20,13 @@
 #define PLOT_H 260
 #define LEGEND_H 16 /* a row of the legend under a plot */
 
-/* Distinct colours (Paul Tol's bright and muted sets), one per builder in
- * every chart of the report. */
+/* One colour per builder in every chart of the report: ten strong hues
+ * first (Tableau 10, told apart by most colour-blind readers too), then
+ * black and light variants for larger comparisons. */
 static const char *const palette[] = {
-	"#4477aa", "#ee6677", "#228833", "#ccbb44", "#66ccee", "#aa3377", "#bbbbbb",
-	"#332288", "#117733", "#882255", "#ddcc77", "#44aa99", "#999933", "#cc6677",
-	"#000000", "#aa4499"};
+	"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+	"#7f7f7f", "#bcbd22", "#17becf", "#000000", "#aec7e8", "#ffbb78", "#98df8a",
+	"#ff9896", "#c5b0d5"};
 #define PALETTE (sizeof(palette) / sizeof(palette[0]))
 
 const char *svg_colour(long k)

@@ -466,8 +466,10 @@ int results_set_scene_image(struct results *res, const char *scene, const char *
 	if (strcmp(kind, "legend") == 0) {
 		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_min");
 		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_max");
+		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_scale");
 		cJSON_AddNumberToObject(images, "heat_min", lo);
 		cJSON_AddNumberToObject(images, "heat_max", hi);
+		cJSON_AddStringToObject(images, "heat_scale", "log"); /* image_heat's */
 	}
 	return 0;
 }
