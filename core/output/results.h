@@ -79,6 +79,8 @@ struct run_record {
 	const struct ray_metrics *rays; /* or NULL: not traced */
 	const struct stage_metrics *stages; /* [stage_count] refinement stages */
 	uint32_t stage_count;
+	const bvhlab_phase *phases; /* [phase_count] the builder's phase medians */
+	uint32_t phase_count;
 	/* The machine's 1-minute load average just before and after the run's
 	 * series (-1: unreadable), so a report can tell a busy machine;
 	 * recorded when load_read. */
@@ -101,6 +103,9 @@ int results_add_run(struct results *res, const struct run_record *run);
 
 /* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of docs/design.md. */
 struct cJSON *results_rays_json(const struct ray_metrics *m);
+
+/* "build_phases": {"upload": ms, "device": ms, ...} (results_stages.c). */
+struct cJSON *results_phases_json(const bvhlab_phase *phases, uint32_t count);
 
 /* "stages": [{"plugin", "ms", "sah_before", "sah_after"}, ...] (results_stages.c). */
 struct cJSON *results_stages_json(const struct stage_metrics *stages, uint32_t count);
