@@ -2,8 +2,8 @@
  * The report's verdicts, from hand-written points and results documents
  * with every figure computed by hand: the Pareto front and who dominates
  * whom, the break-even ray counts, the reference's fallback when the one
- * asked for did not run, the noise and load marks, no empty tables and no
- * speedup for a builder that ran on 1 thread only.
+ * asked for did not run, the noise and load marks, no empty tables, no
+ * speedup for a builder that ran on 1 thread only, and build_phases.
  */
 #include <math.h>
 
@@ -102,6 +102,7 @@ static cJSON *document(const char *reference)
 	cJSON *mid = cJSON_GetArrayItem(runs, 1);
 	cJSON_AddNumberToObject(mid, "load_before", 1.5); /* 1.5 - 1 <= 1: not busy */
 	cJSON_AddNumberToObject(mid, "load_after", 1.9);
+	cJSON_AddItemToObject(mid, "build_phases", cJSON_Parse("{\"upload\": 0.5, \"device\": 1.5}"));
 	return doc;
 }
 
@@ -138,6 +139,9 @@ static void test_markdown_fallback(void)
 	/* Speedup: fast 2 / 1.5 = 1.33 on 2 threads; mid ran on 1 thread only. */
 	CHECK_CONTAINS(md, "| fast | 2 | ok | 1.50 | 1.50 | 1.50 |  |  | 1.33 |");
 	CHECK_CONTAINS(md, "| mid | 1 | ok | 10.00 | 9.00 | 11.00 |  |  |  |");
+	/* build_phases: a column where some run of the scene has them. */
+	CHECK_CONTAINS(md, "| marks | build phases ms | error |");
+	CHECK_CONTAINS(md, "spread 20.0 % | upload 0.500, device 1.50 |  |");
 	free(md);
 	cJSON_Delete(doc);
 }
@@ -169,6 +173,9 @@ static void test_html(void)
 	CHECK_CONTAINS(html, "title=\"build repeats spread 20.0 %\">≈ noisy</td>");
 	CHECK_CONTAINS(html, "title=\"load 3.50 before, 3.00 after; 1 core left free\">⚠ busy</td>");
 	CHECK_CONTAINS(html, "primary Mrays/s (best tile)");
+	/* (0.5 + 1.5) / 10 of the median build. */
+	CHECK_CONTAINS(html, "<td class=\"l\" title=\"the phases add up to 20 % of the median "
+	                     "build\">upload 0.500, device 1.50</td>");
 	CHECK_CONTAINS(html, "per pass min–max");
 	/* One colour per builder in every chart: mid is the second builder. */
 	CHECK_CONTAINS(html, "fill=\"#ff7f0e\" stroke=\"#222\" stroke-width=\"1.5\"><title>mid x1"

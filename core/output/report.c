@@ -197,6 +197,30 @@ const char *report_plain(char *buf, size_t size, double v)
 	return buf;
 }
 
+const char *report_phases(char *buf, size_t size, const cJSON *run)
+{
+	const cJSON *p;
+	size_t len = 0;
+	buf[0] = '\0';
+	cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(run, "build_phases")) {
+		char v[32];
+		if (!cJSON_IsNumber(p) || !p->string || len >= size)
+			continue;
+		int n = snprintf(buf + len, size - len, "%s%s %s", len ? ", " : "", p->string,
+		                 report_plain(v, sizeof(v), p->valuedouble));
+		len += n > 0 ? (size_t)n : 0;
+	}
+	return buf;
+}
+
+bool report_any_phases(const cJSON *const *runs, size_t n)
+{
+	for (size_t k = 0; k < n; k++)
+		if (cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(runs[k], "build_phases")) > 0)
+			return true;
+	return false;
+}
+
 /* Markdown cell text: pipes and newlines would break the table. */
 void report_md_cell(struct strbuf *sb, const char *s)
 {
@@ -240,7 +264,8 @@ static const char *md_marks(char *buf, size_t size, const struct report_index *i
 	return buf;
 }
 
-static void md_run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run)
+static void md_run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
+                       bool phases)
 {
 	char buf[400];
 	sb_printf(sb, "|");
@@ -253,6 +278,8 @@ static void md_run_row(struct strbuf *sb, const struct report_index *ix, const c
 	report_md_cell(sb, isnan(speedup) ? "" : buf);
 	md_numbers(sb, run, md_figures, sizeof(md_figures) / sizeof(md_figures[0]));
 	report_md_cell(sb, md_marks(buf, sizeof(buf), ix, run));
+	if (phases)
+		report_md_cell(sb, report_phases(buf, sizeof(buf), run));
 	report_md_cell(sb, str(run, "error"));
 	sb_printf(sb, "\n");
 }
@@ -283,13 +310,15 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | cold ms "
 	              "| Mtris/s | speedup | SAH cost | EPO | peak bytes | primary Mrays/s (best tile) "
 	              "| primary nodes/ray | diffuse Mrays/s (best tile) | diffuse nodes/ray | nodes "
-	              "| depth | avg leaf | refs | refs/tri | marks | error |\n"
-	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
-	              "|---:|---:|---:|---:|---:|---:|---|---|\n");
+	              "| depth | avg leaf | refs | refs/tri | marks |");
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
+	bool phases = report_any_phases(runs, n);
+	sb_printf(sb, "%s error |\n|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
+	              "|---:|---:|---:|---:|---:|---:|---:|---:|---|%s---|\n",
+	          phases ? " build phases ms |" : "", phases ? "---|" : "");
 	for (size_t k = 0; k < n; k++)
-		md_run_row(sb, ix, runs[k]);
+		md_run_row(sb, ix, runs[k], phases);
 	report_front_md(sb, runs, n);
 	report_breakeven_md(sb, ix, ref, runs, n);
 	md_images(sb, scene);

@@ -63,6 +63,10 @@ void report_machines_html(struct strbuf *sb, const cJSON *doc);
 
 /* Text with & < > " ' escaped for HTML and SVG. */
 void report_escape(struct strbuf *sb, const char *text);
+/* A run's build_phases as "upload 1.50, device 2.50" ("" when none). */
+const char *report_phases(char *buf, size_t size, const cJSON *run);
+/* Whether some run has build_phases (the tables then add their column). */
+bool report_any_phases(const cJSON *const *runs, size_t n);
 /* " text |": a Markdown table cell, pipes escaped and newlines flattened. */
 void report_md_cell(struct strbuf *sb, const char *text);
 /* A plain number with the decimals its size needs ("2140", "21.4", "2.14"),

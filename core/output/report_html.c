@@ -77,6 +77,23 @@ static void marks_cell(struct strbuf *sb, const struct report_index *ix, const c
 	          noisy && busy ? " " : "", busy ? "⚠ busy" : "");
 }
 
+/* The builder's phases of the median build, each with its share of it. */
+static void phases_cell(struct strbuf *sb, const cJSON *run)
+{
+	char buf[512];
+	double median = report_num(run, "build_ms.median"), sum = 0;
+	const cJSON *p;
+	cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(run, "build_phases"))
+		sum += cJSON_IsNumber(p) ? p->valuedouble : 0;
+	sb_printf(sb, "<td class=\"l\"");
+	if (median > 0 && sum > 0)
+		sb_printf(sb, " title=\"the phases add up to %.0f %% of the median build\"",
+		          100 * sum / median);
+	sb_printf(sb, ">");
+	esc(sb, report_phases(buf, sizeof(buf), run));
+	sb_printf(sb, "</td>");
+}
+
 static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
                     const bool *others, bool any_other)
 {
@@ -93,6 +110,8 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 	num_cell(sb, report_num(run, "build_ms.min"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.max"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.cold"), "%.2f");
+	if (others[OTHERS]) /* the scene has build phases */
+		phases_cell(sb, run);
 	num_cell(sb, report_num(run, "mtris_per_s"), "%.2f");
 	num_cell(sb, report_speedup(ix, run), "%.2f");
 	num_cell(sb, report_num(run, "tree.sah_cost"), "%.3f");
@@ -141,22 +160,27 @@ static bool find_others(const cJSON *const *runs, size_t n, bool *others)
 static void table(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
 	size_t n;
-	bool others[OTHERS];
+	bool others[OTHERS + 1];
 	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
 	bool any_other = find_others(runs, n, others);
+	others[OTHERS] = report_any_phases(runs, n);
 	sb_printf(sb, "<div class=\"wide\"><table><tr><th class=\"l\">builder</th><th>threads</th>"
 	              "<th class=\"l\">status</th><th class=\"l\" title=\"≈ noisy: build repeats spread "
 	              "over 5 %%, or the same tree traced over 5 %% faster or slower elsewhere; ⚠ busy: "
 	              "the load exceeded the cores the run left free (hover a mark for its figures)"
 	              "\">marks</th><th>median ms</th><th>min ms</th><th>max ms</th>"
-	              "<th>cold ms</th>"
+	              "<th>cold ms</th>%s"
 	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>EPO</th>"
 	              "<th>peak MiB</th><th title=\"each tile of rays at its best pass: the "
 	              "figure runs compare by\">primary Mrays/s (best tile)</th><th title=\"whole "
 	              "passes, slowest to fastest: the best-tile figure can lie above them, as "
 	              "no single pass had every tile at its best\">per pass min–max</th>"
-	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s</th>"
-	              "<th>diffuse nodes/ray</th><th>refs</th><th>refs/tri</th>");
+	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s "
+	              "(best tile)</th><th>diffuse nodes/ray</th><th>refs</th><th>refs/tri</th>",
+	          others[OTHERS] ? "<th class=\"l\" title=\"the builder's own timing of the "
+	                           "phases of a build (median over the timed repeats), inside "
+	                           "the whole call that median ms times\">build phases ms</th>"
+	                         : "");
 	for (size_t t = 0; t < OTHERS; t++) {
 		const char *name = other_traversals[t];
 		if (!others[t])
