@@ -177,14 +177,31 @@ static void test_html(void)
 	CHECK_CONTAINS(html, "<td class=\"l\" title=\"the phases add up to 20 % of the median "
 	                     "build\">upload 0.500, device 1.50</td>");
 	CHECK_CONTAINS(html, "per pass min–max");
-	/* One colour per builder in every chart: mid is the second builder. */
+	/* One colour per builder in every chart: mid is the second builder. Its
+	 * bar: labels of 7 characters leave 12 + 7 * 6.2 = 55.4 px, so 10 of
+	 * 20 ms is (640 - 55.4 - 90) / 2 = 247.3 px, its figure 4 px after. */
 	CHECK_CONTAINS(html, "fill=\"#ff7f0e\" stroke=\"#222\" stroke-width=\"1.5\"><title>mid x1"
 	                     "</title>");
-	CHECK_CONTAINS(html, "fill=\"#ff7f0e\"/><text x=\"374.0\" y=\"79.0\" text-anchor=\"start\">"
+	CHECK_CONTAINS(html, "fill=\"#ff7f0e\"/><text x=\"306.7\" y=\"79.0\" text-anchor=\"start\">"
 	                     "10.0 ms</text>");
 	CHECK_CONTAINS(html, "fill=\"#ff7f0e\"/><text x=\"128.8\" y=\"352.0\" text-anchor=\"start\">"
 	                     "mid</text>"); /* the legend */
 	CHECK(!strstr(html, "e+0")); /* plain numbers */
+	free(html);
+	cJSON_Delete(doc);
+}
+
+/* Nothing ok: no summary, no front or break-even table, no chart. */
+static void test_nothing_ok(void)
+{
+	cJSON *doc = cJSON_Parse("{\"scenes\": [{\"name\": \"s\"}], \"runs\": [{\"scene\": \"s\", "
+	                         "\"builder\": \"a\", \"threads\": 1, \"status\": \"failed\", "
+	                         "\"error\": \"no\"}]}");
+	char *md = report_markdown(doc), *html = report_html(doc);
+	CHECK_CONTAINS(md, "No ok run, so no summary.");
+	CHECK(!strstr(md, "Pareto fronts") && !strstr(md, "Break-even"));
+	CHECK(!strstr(html, "Pareto fronts") && !strstr(html, "Break-even") && !strstr(html, "<svg"));
+	free(md);
 	free(html);
 	cJSON_Delete(doc);
 }
@@ -196,5 +213,6 @@ int main(void)
 	test_markdown_fallback();
 	test_reference_kept();
 	test_html();
+	test_nothing_ok();
 	return test_finish();
 }

@@ -128,6 +128,15 @@ static int table_init(struct front_table *t, const cJSON *const *runs, size_t n)
 	return 0;
 }
 
+/* Whether some run was compared: a table of none would be empty. */
+static bool any_compared(const struct front_table *t)
+{
+	for (size_t k = 0; k < t->n; k++)
+		if (t->by[0][k] != FRONT_NONE)
+			return true;
+	return false;
+}
+
 static void table_finish(struct front_table *t)
 {
 	for (int v = 0; v < 2; v++) {
@@ -154,7 +163,7 @@ void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n)
 {
 	struct front_table t;
 	char buf[256];
-	if (table_init(&t, runs, n) == 0 && n > 0) {
+	if (table_init(&t, runs, n) == 0 && any_compared(&t)) {
 		sb_printf(sb, "\n### Pareto fronts\n\n%s\n\n| builder | threads | median ms | SAH cost "
 		              "| time × SAH | primary nodes/ray | time × nodes/ray |\n"
 		              "|---|---:|---:|---:|---|---:|---|\n", intro);
@@ -189,7 +198,7 @@ void report_front_html(struct strbuf *sb, const cJSON *const *runs, size_t n)
 {
 	struct front_table t;
 	char buf[64];
-	if (table_init(&t, runs, n) == 0 && n > 0) {
+	if (table_init(&t, runs, n) == 0 && any_compared(&t)) {
 		sb_printf(sb, "<h3>Pareto fronts</h3>\n<p>%s</p>\n<table><tr><th class=\"l\">builder"
 		              "</th><th>threads</th><th>median ms</th><th>SAH cost</th>"
 		              "<th class=\"l\">time × SAH</th><th>primary nodes/ray</th>"

@@ -267,7 +267,8 @@ static void bars_and_speedups(struct strbuf *sb, const struct report_index *ix,
 			                 report_num(runs[k], "build_ms.median"));
 			n++;
 		}
-	svg_bars(sb, "Build time (median)", "ms", q, n);
+	if (n > 0)
+		svg_bars(sb, "Build time (median)", "ms", q, n);
 	for (size_t k = 0; k < count; k++) {
 		double s = report_speedup(ix, runs[k]);
 		if (isfinite(s)) {

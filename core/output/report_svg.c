@@ -11,7 +11,6 @@
 #include "output/report.h"
 
 #define W 640
-#define PAD_L 190  /* bars: room for the labels */
 #define PAD_R 20   /* plots: right margin */
 #define PLOT_X 60  /* plots: left edge of the plotting area */
 #define PAD_T 44   /* the title, then the y axis's name, above the plot */
@@ -19,6 +18,8 @@
 #define BAR_H 18
 #define PLOT_H 260
 #define LEGEND_H 16 /* a row of the legend under a plot */
+#define CHAR_W 6.2  /* the width of a character of the 11 px font, about */
+#define LINE_H 12.0
 
 /* One colour per builder in every chart of the report: ten strong hues
  * first (Tableau 10, told apart by most colour-blind readers too), then
@@ -51,23 +52,47 @@ static void text_at(struct strbuf *sb, double x, double y, const char *anchor, c
 	sb_printf(sb, "</text>");
 }
 
+/* A bar's label, right-aligned at x; cut to max characters with an
+ * ellipsis (the whole label its tooltip) so it never runs off the left. */
+static void bar_label(struct strbuf *sb, double x, double y, const char *label, size_t max)
+{
+	size_t len = strlen(label);
+	sb_printf(sb, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">", x, y);
+	if (len <= max) {
+		report_escape(sb, label);
+	} else {
+		char cut[256];
+		snprintf(cut, sizeof(cut), "%.*s", (int)(max > 1 && max < sizeof(cut) ? max - 1 : 1),
+		         label);
+		report_escape(sb, cut);
+		sb_printf(sb, "…<title>");
+		report_escape(sb, label);
+		sb_printf(sb, "</title>");
+	}
+	sb_printf(sb, "</text>");
+}
+
 void svg_bars(struct strbuf *sb, const char *title, const char *unit,
               const struct svg_point *p, size_t n)
 {
 	double max = 0;
-	char buf[64];
-	for (size_t i = 0; i < n; i++)
+	size_t longest = 0, fit = (size_t)((W / 2 - 12) / CHAR_W);
+	char buf[64], v[32];
+	for (size_t i = 0; i < n; i++) {
 		max = isfinite(p[i].y) && p[i].y > max ? p[i].y : max;
+		longest = strlen(p[i].label) > longest ? strlen(p[i].label) : longest;
+	}
+	longest = longest < fit ? longest : fit;
+	double left = 12 + CHAR_W * (double)longest; /* as much room as the labels need */
 	open_svg(sb, title, PAD_T + (int)n * (BAR_H + 4) + 8);
 	for (size_t i = 0; i < n; i++) {
 		double y = PAD_T + (double)i * (BAR_H + 4);
-		double w = max > 0 && isfinite(p[i].y) ? p[i].y / max * (W - PAD_L - 90) : 0;
-		text_at(sb, PAD_L - 6, y + BAR_H - 5, "end", p[i].label);
-		sb_printf(sb, "<rect x=\"%d\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" fill=\"%s\"/>",
-		          PAD_L, y, w, BAR_H, p[i].colour ? p[i].colour : palette[0]);
-		char v[32];
+		double w = max > 0 && isfinite(p[i].y) ? p[i].y / max * (W - left - 90) : 0;
+		bar_label(sb, left - 6, y + BAR_H - 5, p[i].label, longest);
+		sb_printf(sb, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" fill=\"%s\"/>",
+		          left, y, w, BAR_H, p[i].colour ? p[i].colour : palette[0]);
 		snprintf(buf, sizeof(buf), "%s %s", report_plain(v, sizeof(v), p[i].y), unit);
-		text_at(sb, PAD_L + w + 4, y + BAR_H - 5, "start", buf);
+		text_at(sb, left + w + 4, y + BAR_H - 5, "start", buf);
 	}
 	sb_printf(sb, "</svg>\n");
 }
@@ -208,9 +233,6 @@ static bool opens_group(const struct svg_point *p, size_t n, size_t i)
 			return false;
 	return drawable(p, n, p[i].group);
 }
-
-#define CHAR_W 6.2
-#define LINE_H 12.0
 
 /* The legend under the plot: a swatch and the group's name per group
  * drawn, in rows that wrap at the chart's width. Draws when sb is not
