@@ -132,6 +132,8 @@ static const char *const csv_numbers[][2] = {
 	{"rays.stackless.diffuse.mrays_per_s", "%.4f"},
 	{"rays.stackless.diffuse.nodes_per_ray", "%.4f"},
 	{"rays.traversal_disagreements", "%.0f"},
+	{"load_before", "%.2f"},
+	{"load_after", "%.2f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary
