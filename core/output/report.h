@@ -91,10 +91,23 @@ void report_front_points(const struct front_point *p, size_t n, long *by);
 /* "front", "—" or "dominated by X (0.80× time, −1.2 % SAH)" for point a. */
 void report_front_text(char *buf, size_t size, const struct front_point *p, long by,
                        size_t a, const char *by_name, const char *figure);
-/* A scene's runs as points of the figure at a dotted path (runs not ok
- * are not compared), grouped by thread count, and their verdicts. */
-int report_scene_front(const cJSON *const *runs, size_t n, const char *figure,
-                       struct front_point *p, long *by);
+/* One candidate of a scene's front at a thread count: a run with that
+ * many threads, or the 1-thread run of a builder that ran on 1 thread only
+ * (it cannot use more, and is still a choice at every thread count). */
+struct front_entry {
+	const cJSON *run;
+	double threads; /* the front it competes on */
+	size_t order;   /* the run's place in the scene */
+};
+/* The scene's entries by thread count, then run order (malloc'd; NULL on
+ * no memory). */
+struct front_entry *report_front_entries(const cJSON *const *runs, size_t n, size_t *count);
+/* The entries as points of the figure at a dotted path (runs not ok are
+ * not compared), grouped by thread count, and their verdicts. */
+void report_entries_front(const struct front_entry *e, size_t m, const char *figure,
+                          struct front_point *p, long *by);
+/* The distinct thread counts of the runs, ascending, at most max. */
+size_t report_thread_counts(const cJSON *const *runs, size_t n, double *out, size_t max);
 /* The scene's front table (both views: SAH cost, primary nodes per ray). */
 void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n);
 void report_front_html(struct strbuf *sb, const cJSON *const *runs, size_t n);

@@ -82,25 +82,74 @@ void report_front_text(char *buf, size_t size, const struct front_point *p, long
 	snprintf(buf, size, "dominated by %s (%.2f× time, %s)", by_name, t, change);
 }
 
-/* The scene's runs as points of one figure, grouped by thread count; NaN
- * for a run that is not ok. */
-static void scene_points(const cJSON *const *runs, size_t n, const char *figure,
-                         struct front_point *p)
+/* Whether the scene holds a run of the builder with more than 1 thread. */
+static bool ran_parallel(const cJSON *const *runs, size_t n, const char *builder)
 {
-	for (size_t k = 0; k < n; k++) {
-		bool ok = strcmp(report_str(runs[k], "status"), "ok") == 0;
-		p[k] = (struct front_point){ok ? report_num(runs[k], "build_ms.median") : NAN,
-		                            report_num(runs[k], figure),
-		                            (long)report_num(runs[k], "threads")};
-	}
+	for (size_t k = 0; k < n; k++)
+		if (report_num(runs[k], "threads") > 1 &&
+		    strcmp(report_str(runs[k], "builder"), builder) == 0)
+			return true;
+	return false;
 }
 
-int report_scene_front(const cJSON *const *runs, size_t n, const char *figure,
-                       struct front_point *p, long *by)
+static int by_threads(const void *a, const void *b)
 {
-	scene_points(runs, n, figure, p);
-	report_front_points(p, n, by);
-	return 0;
+	const struct front_entry *x = a, *y = b;
+	if (x->threads != y->threads)
+		return (x->threads > y->threads) - (x->threads < y->threads);
+	return (x->order > y->order) - (x->order < y->order);
+}
+
+/* Whether run k competes at thread count t: its own, or any for the
+ * 1-thread run of a builder that ran on 1 thread only. */
+static bool competes(const cJSON *const *runs, size_t n, size_t k, double t)
+{
+	double own = report_num(runs[k], "threads");
+	return own == t ||
+	       (own == 1 && t > 1 && !ran_parallel(runs, n, report_str(runs[k], "builder")));
+}
+
+struct front_entry *report_front_entries(const cJSON *const *runs, size_t n, size_t *count)
+{
+	double t[64];
+	size_t nt = report_thread_counts(runs, n, t, 64), m = 0;
+	struct front_entry *e = calloc(n * nt + 1, sizeof(*e));
+	for (size_t i = 0; e && i < nt; i++)
+		for (size_t k = 0; k < n; k++)
+			if (competes(runs, n, k, t[i]))
+				e[m++] = (struct front_entry){runs[k], t[i], k};
+	if (e)
+		qsort(e, m, sizeof(*e), by_threads);
+	*count = m;
+	return e;
+}
+
+size_t report_thread_counts(const cJSON *const *runs, size_t n, double *out, size_t max)
+{
+	size_t m = 0;
+	for (size_t k = 0; k < n; k++) {
+		double t = report_num(runs[k], "threads");
+		size_t i = 0;
+		while (i < m && out[i] != t)
+			i++;
+		if (i < m || m == max || !isfinite(t))
+			continue;
+		for (i = m++; i > 0 && out[i - 1] > t; i--) /* insertion keeps them sorted */
+			out[i] = out[i - 1];
+		out[i] = t;
+	}
+	return m;
+}
+
+void report_entries_front(const struct front_entry *e, size_t m, const char *figure,
+                          struct front_point *p, long *by)
+{
+	for (size_t k = 0; k < m; k++) {
+		bool ok = strcmp(report_str(e[k].run, "status"), "ok") == 0;
+		p[k] = (struct front_point){ok ? report_num(e[k].run, "build_ms.median") : NAN,
+		                            report_num(e[k].run, figure), (long)e[k].threads};
+	}
+	report_front_points(p, m, by);
 }
 
 /* The two views the tables show: build time against each figure. */
@@ -108,7 +157,7 @@ static const char *const figures[2] = {"tree.sah_cost", "rays.primary.nodes_per_
 static const char *const figure_names[2] = {"SAH", "nodes/ray"};
 
 struct front_table {
-	const cJSON *const *runs;
+	struct front_entry *e;
 	size_t n;
 	struct front_point *p[2];
 	long *by[2];
@@ -116,16 +165,16 @@ struct front_table {
 
 static int table_init(struct front_table *t, const cJSON *const *runs, size_t n)
 {
-	t->runs = runs;
-	t->n = n;
-	for (int v = 0; v < 2; v++) {
-		t->p[v] = calloc(n + 1, sizeof(*t->p[v]));
-		t->by[v] = calloc(n + 1, sizeof(*t->by[v]));
+	memset(t, 0, sizeof(*t));
+	t->e = report_front_entries(runs, n, &t->n);
+	for (int v = 0; t->e && v < 2; v++) {
+		t->p[v] = calloc(t->n + 1, sizeof(*t->p[v]));
+		t->by[v] = calloc(t->n + 1, sizeof(*t->by[v]));
 		if (!t->p[v] || !t->by[v])
 			return -1;
-		report_scene_front(runs, n, figures[v], t->p[v], t->by[v]);
+		report_entries_front(t->e, t->n, figures[v], t->p[v], t->by[v]);
 	}
-	return 0;
+	return t->e ? 0 : -1;
 }
 
 /* Whether some run was compared: a table of none would be empty. */
@@ -139,6 +188,7 @@ static bool any_compared(const struct front_table *t)
 
 static void table_finish(struct front_table *t)
 {
+	free(t->e);
 	for (int v = 0; v < 2; v++) {
 		free(t->p[v]);
 		free(t->by[v]);
@@ -149,15 +199,28 @@ static void table_finish(struct front_table *t)
 static void verdict(const struct front_table *t, int v, size_t k, char *buf, size_t size)
 {
 	long by = t->by[v][k];
-	const char *name = by >= 0 ? report_str(t->runs[by], "builder") : "";
+	const char *name = by >= 0 ? report_str(t->e[by].run, "builder") : "";
 	report_front_text(buf, size, t->p[v], by, k, name, figure_names[v]);
+}
+
+/* "2", or "2 (ran on 1)" for a 1-thread run standing in at 2 threads. */
+static const char *threads_text(char *buf, size_t size, const struct front_entry *e)
+{
+	double own = report_num(e->run, "threads");
+	if (own == e->threads)
+		snprintf(buf, size, "%.0f", own);
+	else
+		snprintf(buf, size, "%.0f (ran on %.0f)", e->threads, own);
+	return buf;
 }
 
 static const char intro[] =
 	"Per thread count: a builder is on the front when no other is at least as fast "
 	"and builds a tree at least as good (lower SAH cost; fewer primary nodes per ray), "
-	"one of the two strictly; off it, the fastest builder that dominates it, its "
-	"build time as a multiple of this one's and the change in the figure.";
+	"one of the two strictly, figures within 0.05 % counting as equal; off it, the "
+	"fastest builder on the front that dominates it, its build time as a multiple of "
+	"this one's and the change in the figure. A builder that ran on 1 thread only "
+	"competes with its 1-thread run at every thread count.";
 
 void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n)
 {
@@ -167,13 +230,14 @@ void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n)
 		sb_printf(sb, "\n### Pareto fronts\n\n%s\n\n| builder | threads | median ms | SAH cost "
 		              "| time × SAH | primary nodes/ray | time × nodes/ray |\n"
 		              "|---|---:|---:|---:|---|---:|---|\n", intro);
-		for (size_t k = 0; k < n; k++) {
+		for (size_t k = 0; k < t.n; k++) {
 			if (t.by[0][k] == FRONT_NONE)
 				continue;
 			sb_printf(sb, "|");
-			report_md_cell(sb, report_str(runs[k], "builder"));
-			sb_printf(sb, " %.0f | %s | %.3f |", report_num(runs[k], "threads"),
-			          report_plain(buf, sizeof(buf), t.p[0][k].time), t.p[0][k].figure);
+			report_md_cell(sb, report_str(t.e[k].run, "builder"));
+			report_md_cell(sb, threads_text(buf, sizeof(buf), &t.e[k]));
+			sb_printf(sb, " %s | %.3f |", report_plain(buf, sizeof(buf), t.p[0][k].time),
+			          t.p[0][k].figure);
 			verdict(&t, 0, k, buf, sizeof(buf));
 			report_md_cell(sb, buf);
 			sb_printf(sb, " %.1f |", t.p[1][k].figure);
@@ -194,28 +258,31 @@ static void html_verdict(struct strbuf *sb, const struct front_table *t, int v, 
 	sb_printf(sb, "</td>");
 }
 
+static void html_row(struct strbuf *sb, const struct front_table *t, size_t k)
+{
+	char buf[64], ms[32];
+	sb_printf(sb, "<tr><td class=\"l\">");
+	report_escape(sb, report_str(t->e[k].run, "builder"));
+	sb_printf(sb, "</td><td>%s</td><td>%s</td><td>%.3f</td>",
+	          threads_text(buf, sizeof(buf), &t->e[k]),
+	          report_plain(ms, sizeof(ms), t->p[0][k].time), t->p[0][k].figure);
+	html_verdict(sb, t, 0, k);
+	sb_printf(sb, "<td>%.1f</td>", t->p[1][k].figure);
+	html_verdict(sb, t, 1, k);
+	sb_printf(sb, "</tr>\n");
+}
+
 void report_front_html(struct strbuf *sb, const cJSON *const *runs, size_t n)
 {
 	struct front_table t;
-	char buf[64];
 	if (table_init(&t, runs, n) == 0 && any_compared(&t)) {
 		sb_printf(sb, "<h3>Pareto fronts</h3>\n<p>%s</p>\n<table><tr><th class=\"l\">builder"
 		              "</th><th>threads</th><th>median ms</th><th>SAH cost</th>"
 		              "<th class=\"l\">time × SAH</th><th>primary nodes/ray</th>"
 		              "<th class=\"l\">time × nodes/ray</th></tr>\n", intro);
-		for (size_t k = 0; k < n; k++) {
-			if (t.by[0][k] == FRONT_NONE)
-				continue;
-			sb_printf(sb, "<tr><td class=\"l\">");
-			report_escape(sb, report_str(runs[k], "builder"));
-			sb_printf(sb, "</td><td>%.0f</td><td>%s</td><td>%.3f</td>",
-			          report_num(runs[k], "threads"),
-			          report_plain(buf, sizeof(buf), t.p[0][k].time), t.p[0][k].figure);
-			html_verdict(sb, &t, 0, k);
-			sb_printf(sb, "<td>%.1f</td>", t.p[1][k].figure);
-			html_verdict(sb, &t, 1, k);
-			sb_printf(sb, "</tr>\n");
-		}
+		for (size_t k = 0; k < t.n; k++)
+			if (t.by[0][k] != FRONT_NONE)
+				html_row(sb, &t, k);
 		sb_printf(sb, "</table>\n");
 	}
 	table_finish(&t);

@@ -207,28 +207,10 @@ static struct svg_point run_point(const struct report_index *ix, const cJSON *ru
 	                          false};
 }
 
-/* The distinct thread counts of the scene's runs, ascending; how many. */
-static size_t thread_counts(const cJSON *const *runs, size_t n, double *out, size_t max)
-{
-	size_t m = 0;
-	for (size_t k = 0; k < n; k++) {
-		double t = report_num(runs[k], "threads");
-		size_t i = 0;
-		while (i < m && out[i] != t)
-			i++;
-		if (i < m || m == max || !isfinite(t))
-			continue;
-		for (i = m++; i > 0 && out[i - 1] > t; i--) /* insertion keeps them sorted */
-			out[i] = out[i - 1];
-		out[i] = t;
-	}
-	return m;
-}
-
 /* One Pareto chart per thread count: build time against the figure, the
  * front joined by a line. */
 static void front_chart(struct strbuf *sb, const struct report_index *ix,
-                        const cJSON *const *runs, size_t n, double threads, int view,
+                        const struct front_entry *e, size_t n, double threads, int view,
                         struct svg_point *p, char (*labels)[96])
 {
 	static const char *const figures[2] = {"tree.sah_cost", "rays.primary.nodes_per_ray"};
@@ -237,11 +219,11 @@ static void front_chart(struct strbuf *sb, const struct report_index *ix,
 	long *by = calloc(n + 1, sizeof(*by));
 	size_t m = 0;
 	if (fp && by) {
-		report_scene_front(runs, n, figures[view], fp, by);
+		report_entries_front(e, n, figures[view], fp, by);
 		for (size_t k = 0; k < n; k++) {
-			if (by[k] == FRONT_NONE || report_num(runs[k], "threads") != threads)
+			if (by[k] == FRONT_NONE || e[k].threads != threads)
 				continue;
-			p[m] = run_point(ix, runs[k], labels[m], sizeof(labels[m]), fp[k].time,
+			p[m] = run_point(ix, e[k].run, labels[m], sizeof(labels[m]), fp[k].time,
 			                 fp[k].figure);
 			p[m++].front = by[k] == FRONT_ON;
 		}
@@ -283,21 +265,23 @@ static void bars_and_speedups(struct strbuf *sb, const struct report_index *ix,
 
 static void charts(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
-	size_t count, nt;
+	size_t count, nt, ne = 0;
 	double threads[16];
 	const cJSON *const *runs = report_scene_runs(ix, scene, &count);
-	struct svg_point *p = calloc(count + 1, sizeof(*p));
-	char (*labels)[96] = calloc(count + 1, sizeof(*labels));
-	if (!p || !labels || count == 0)
+	struct front_entry *e = report_front_entries(runs, count, &ne);
+	struct svg_point *p = calloc(ne + count + 1, sizeof(*p));
+	char (*labels)[96] = calloc(ne + count + 1, sizeof(*labels));
+	if (!e || !p || !labels || count == 0)
 		goto out;
 	sb_printf(sb, "<div class=\"charts\">\n");
 	bars_and_speedups(sb, ix, runs, count, p, labels);
-	nt = thread_counts(runs, count, threads, 16);
+	nt = report_thread_counts(runs, count, threads, 16);
 	for (int view = 0; view < 2; view++)
 		for (size_t t = 0; t < nt; t++)
-			front_chart(sb, ix, runs, count, threads[t], view, p, labels);
+			front_chart(sb, ix, e, ne, threads[t], view, p, labels);
 	sb_printf(sb, "</div>\n");
 out:
+	free(e);
 	free(p);
 	free(labels);
 }

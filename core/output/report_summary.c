@@ -168,13 +168,56 @@ static const char *ratio_text(char *buf, size_t size, double r)
 	return buf;
 }
 
+/* Whether the builder has a row with more than 1 thread. */
+static bool has_parallel_row(const struct summary_row *rows, int n, const char *builder)
+{
+	for (int i = 0; i < n; i++)
+		if (rows[i].threads > 1 && strcmp(rows[i].builder, builder) == 0)
+			return true;
+	return false;
+}
+
+static struct front_point row_point(const struct summary_row *r, double threads)
+{
+	return (struct front_point){r->ratio[0], r->ratio[1], (long)threads * 100000 + r->scenes};
+}
+
+/* The rows' points, then a stand-in at every other thread count for each
+ * row of a builder that ran on 1 thread only (it is a choice there too);
+ * map[k]: the row point k stands for. Returns the count. */
+static size_t with_stand_ins(const struct summary_row *rows, int n, struct front_point *q,
+                             int *map)
+{
+	size_t m = 0;
+	for (int i = 0; i < n; i++, m++)
+		q[m] = row_point(&rows[i], rows[i].threads), map[m] = i;
+	for (int t = 0; t < n; t++) {
+		bool first = rows[t].threads > 1;
+		for (int j = 0; j < t && first; j++) /* each thread count once */
+			first = rows[j].threads != rows[t].threads;
+		for (int i = 0; first && i < n; i++)
+			if (rows[i].threads == 1 && !has_parallel_row(rows, n, rows[i].builder))
+				q[m] = row_point(&rows[i], rows[t].threads), map[m++] = i;
+	}
+	return m;
+}
+
 void report_summary_fronts(const struct summary_row *rows, int n, struct front_point *p,
                            long *by)
 {
-	for (int i = 0; i < n; i++)
-		p[i] = (struct front_point){rows[i].ratio[0], rows[i].ratio[1],
-		                            (long)rows[i].threads * 100000 + rows[i].scenes};
-	report_front_points(p, (size_t)n, by);
+	size_t cap = (size_t)n * ((size_t)n + 1) + 1;
+	struct front_point *q = calloc(cap, sizeof(*q));
+	long *qb = calloc(cap, sizeof(*qb));
+	int *map = calloc(cap, sizeof(*map));
+	size_t m = q && qb && map ? with_stand_ins(rows, n, q, map) : 0;
+	report_front_points(q, m, qb);
+	for (int i = 0; i < n; i++) {
+		p[i] = row_point(&rows[i], rows[i].threads);
+		by[i] = (size_t)i >= m ? FRONT_NONE : qb[i] >= 0 ? map[qb[i]] : qb[i];
+	}
+	free(q);
+	free(qb);
+	free(map);
 }
 
 static const char intro[] =
@@ -182,8 +225,9 @@ static const char intro[] =
 	"**%s** on the same scene (its run with the fewest threads); below 1 is less "
 	"build time, a cheaper tree (SAH, end-point overlap) or fewer nodes visited per "
 	"ray. Scenes: how many had ok runs of both. Pareto: among the rows of the same "
-	"thread count over as many scenes, on the front of build time against SAH cost, "
-	"or the fastest row that is at least as fast and as good.\n\n";
+	"thread count over as many scenes (a builder that ran on 1 thread only counts at "
+	"every thread count), on the front of build time against SAH cost, or the fastest "
+	"row on it that is at least as fast and as good.\n\n";
 
 /* Where the configured reference did not run: which builder stands in. */
 static void fallback_note(struct strbuf *sb, const cJSON *doc, const char *ref, bool html)
@@ -297,8 +341,10 @@ void report_summary_html(struct strbuf *sb, const cJSON *doc)
 	sb_printf(sb, "</b> on the same scene (its run with the fewest threads); below 1 is less "
 	              "build time, a cheaper tree (SAH, end-point overlap) or fewer nodes "
 	              "visited per ray. Pareto: among the rows of the same thread count over "
-	              "as many scenes, on the front of build time against SAH cost, or the "
-	              "fastest row at least as fast and as good.</p>\n<table class=\"summary\">"
+	              "as many scenes (a builder that ran on 1 thread only counts at every "
+	              "thread count), on the front of build time against SAH cost, or the "
+	              "fastest row on it at least as fast and as good.</p>\n"
+	              "<table class=\"summary\">"
 	              "<tr><th class=\"l\">builder</th><th>threads</th><th>scenes</th>");
 	for (int m = 0; m < SUMMARY_METRICS; m++)
 		sb_printf(sb, "<th>%s</th>", metric_names[m]);
