@@ -209,30 +209,33 @@ static struct svg_point run_point(const struct report_index *ix, const cJSON *ru
 
 /* One Pareto chart per thread count: build time against the figure, the
  * front joined by a line. */
-static void front_chart(struct strbuf *sb, const struct report_index *ix,
-                        const struct front_entry *e, size_t n, double threads, int view,
-                        struct svg_point *p, char (*labels)[96])
+/* One view's Pareto charts, one per thread count: build time against the
+ * figure, the front joined by a line. The verdicts are computed once for
+ * every thread count (a 1-thread-only builder is on each). */
+static void front_charts(struct strbuf *sb, const struct report_index *ix,
+                         const struct front_entry *e, size_t n, const double *threads,
+                         size_t nt, int view, struct svg_point *p, char (*labels)[96])
 {
 	static const char *const figures[2] = {"tree.sah_cost", "rays.primary.nodes_per_ray"};
 	static const char *const names[2] = {"SAH cost", "primary nodes/ray"};
 	struct front_point *fp = calloc(n + 1, sizeof(*fp));
 	long *by = calloc(n + 1, sizeof(*by));
-	size_t m = 0;
-	if (fp && by) {
+	if (fp && by)
 		report_entries_front(e, n, figures[view], fp, by);
+	for (size_t t = 0; fp && by && t < nt; t++) {
+		size_t m = 0;
 		for (size_t k = 0; k < n; k++) {
-			if (by[k] == FRONT_NONE || e[k].threads != threads)
+			if (by[k] == FRONT_NONE || e[k].threads != threads[t])
 				continue;
 			p[m] = run_point(ix, e[k].run, labels[m], sizeof(labels[m]), fp[k].time,
 			                 fp[k].figure);
 			p[m++].front = by[k] == FRONT_ON;
 		}
-	}
-	if (m > 0) {
 		char title[96];
-		snprintf(title, sizeof(title), "%s vs. build time, %.0f thread%s", names[view], threads,
-		         threads == 1 ? "" : "s");
-		svg_scatter(sb, title, "build time (ms)", names[view], p, m);
+		snprintf(title, sizeof(title), "%s vs. build time, %.0f thread%s", names[view],
+		         threads[t], threads[t] == 1 ? "" : "s");
+		if (m > 0)
+			svg_scatter(sb, title, "build time (ms)", names[view], p, m);
 	}
 	free(fp);
 	free(by);
@@ -277,8 +280,7 @@ static void charts(struct strbuf *sb, const struct report_index *ix, const char 
 	bars_and_speedups(sb, ix, runs, count, p, labels);
 	nt = report_thread_counts(runs, count, threads, 16);
 	for (int view = 0; view < 2; view++)
-		for (size_t t = 0; t < nt; t++)
-			front_chart(sb, ix, e, ne, threads[t], view, p, labels);
+		front_charts(sb, ix, e, ne, threads, nt, view, p, labels);
 	sb_printf(sb, "</div>\n");
 out:
 	free(e);

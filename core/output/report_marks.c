@@ -42,19 +42,22 @@ bool report_same_tree(const cJSON *a, const cJSON *b)
 	return true;
 }
 
-/* The largest relative Mrays/s difference to a run with the same tree, and that run. */
+/* The largest relative Mrays/s difference to a run with the same tree, and
+ * that run. The SAH cost is compared first: it tells trees apart at once. */
 static double same_tree_gap(const struct report_index *ix, const cJSON *run,
                             const cJSON **other)
 {
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, report_str(run, "scene"), &n);
 	double best = 0, mine = report_num(run, "rays.primary.mrays_per_s");
+	double sah = report_num(run, "tree.sah_cost");
 	*other = NULL;
-	for (size_t k = 0; k < n && mine > 0; k++) {
-		double theirs = report_num(runs[k], "rays.primary.mrays_per_s");
-		if (runs[k] == run || !is_ok(runs[k]) || !(theirs > 0) || !report_same_tree(run, runs[k]))
+	for (size_t k = 0; k < n && mine > 0 && isfinite(sah); k++) {
+		if (runs[k] == run || report_num(runs[k], "tree.sah_cost") != sah ||
+		    !is_ok(runs[k]) || !report_same_tree(run, runs[k]))
 			continue;
-		double gap = fabs(mine - theirs) / fmin(mine, theirs);
+		double theirs = report_num(runs[k], "rays.primary.mrays_per_s");
+		double gap = theirs > 0 ? fabs(mine - theirs) / fmin(mine, theirs) : 0;
 		if (gap > best) {
 			best = gap;
 			*other = runs[k];
