@@ -207,8 +207,6 @@ static struct svg_point run_point(const struct report_index *ix, const cJSON *ru
 	                          false};
 }
 
-/* One Pareto chart per thread count: build time against the figure, the
- * front joined by a line. */
 /* One view's Pareto charts, one per thread count: build time against the
  * figure, the front joined by a line. The verdicts are computed once for
  * every thread count (a 1-thread-only builder is on each). */
