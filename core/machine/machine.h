@@ -54,6 +54,9 @@ struct machine_cl_device {
 int machine_cl_devices(struct machine_cl_device **devices, size_t *count, char *why,
                        size_t why_size);
 
+/* The 1-minute load average from /proc/loadavg, or -1 when unreadable. */
+double machine_load_average(void);
+
 /* 0, or -ENODEV when hwloc could not load (t is then filled from the mask). */
 int machine_topology_read(struct machine_topology *t);
 
