@@ -17,6 +17,7 @@
 #include "harness/harness_rounds.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
+#include "machine/machine.h"
 #include "output/results.h"
 #include "output/scene_images.h"
 #include "output/safe_file.h"
@@ -321,10 +322,13 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	char why[sizeof(rep->error)] = "", limited[sizeof(rep->error) + 64];
 	int outcome = ISOLATE_REPORTED;
 	struct isolate_limits limits = harness_run_limits(h->cfg, job->hb->cb);
+	run->load_before = machine_load_average();
 	if (h->cfg->isolate)
 		outcome = isolate_call(series_work, job, rep, size, &limits, why, sizeof(why));
 	else
 		series_work(job, rep, size);
+	run->load_after = machine_load_average();
+	run->load_read = true;
 	if (outcome == ISOLATE_REPORTED) {
 		report_to_run(rep, h->cfg->repeat, run);
 	} else {

@@ -36,6 +36,9 @@ struct machine_info {
 
 void machine_info_read(struct machine_info *info);
 
+/* The 1-minute load average from /proc/loadavg, or -1 when unreadable. */
+double machine_load_average(void);
+
 /* 0, or -ENODEV when hwloc could not load (t is then filled from the mask). */
 int machine_topology_read(struct machine_topology *t);
 

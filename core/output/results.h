@@ -81,6 +81,11 @@ struct run_record {
 	uint32_t stage_count;
 	const bvhlab_phase *phases; /* [phase_count] the builder's phase medians */
 	uint32_t phase_count;
+	/* The machine's 1-minute load average just before and after the run's
+	 * series (-1: unreadable), so a report can tell a busy machine;
+	 * recorded when load_read. */
+	bool load_read;
+	double load_before, load_after;
 };
 
 

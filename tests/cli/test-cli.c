@@ -87,6 +87,10 @@ static void check_good_results(const char *dir)
 	CHECK(cJSON_IsNumber(cold) && cold->valuedouble > 0);
 	CHECK(cJSON_GetObjectItem(cJSON_GetObjectItem(run0, "tree"), "sah_cost")->valuedouble > 1);
 	CHECK(!strcmp(run_str(cJSON_GetObjectItem(run0, "options"), "method"), "sweep"));
+	/* The load average around the run, as /proc/loadavg gave it. */
+	const cJSON *load = cJSON_GetObjectItem(run0, "load_before");
+	CHECK(cJSON_IsNumber(load) && load->valuedouble >= 0);
+	CHECK(cJSON_IsNumber(cJSON_GetObjectItem(run0, "load_after")));
 
 	char *csv = read_file(dir, "results.csv");
 	char *md = read_file(dir, "report.md");
