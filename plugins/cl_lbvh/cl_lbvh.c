@@ -26,12 +26,18 @@ static const bvhlab_option_decl options[] = {
 	  .help = "leaves per work-item of the bounds kernel (0: 512 on a CPU device, "
 	          "1 on a GPU); the tree is the same for every value",
 	  .def_int = 0, .min = 0, .max = 1 << 20 },
+	{ .name = "hierarchy", .type = BVHLAB_OPTION_STRING,
+	  .help = "how each node's range and split are found: search (Karras's searches), "
+	          "scan (lbvh's prefix scans), auto (scan on a CPU device, search on a GPU); "
+	          "the tree is the same",
+	  .def_string = "auto", .choices = "auto|search|scan" },
 };
 
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
 static const char *const kernel_names[] = {
-	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "gather_leaves",
+	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "gather_leaves", "prefixes",
+	"karras_scan",
 };
 
 /* Kept between builds (one build at a time, ABI rule); released when the
@@ -58,8 +64,9 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_lbvh 
 	if (rc < 0)
 		return rc;
 	if ((rc = host->option_string(ctx, "device", &b->device)) < 0 ||
-	    (rc = host->option_int(ctx, "leaf_block", &block)) < 0) {
-		host->set_error(ctx, "cannot read the options device and leaf_block");
+	    (rc = host->option_int(ctx, "leaf_block", &block)) < 0 ||
+	    (rc = host->option_string(ctx, "hierarchy", &b->hierarchy)) < 0) {
+		host->set_error(ctx, "cannot read the options device, leaf_block and hierarchy");
 		return rc;
 	}
 	if (o.bits != 30 && o.bits != 63) {

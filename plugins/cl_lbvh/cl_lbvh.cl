@@ -30,6 +30,19 @@ static int delta(__global const ulong *keys, long n, long i, long j)
 	return inside ? d : -1;
 }
 
+/* Node i of range [i, j] (either way) split after `split`: its range end
+ * and its children's parent words, as lbvh_emit.c's karras_node. */
+static void emit_node(uint i, uint j, uint split, uint n, __global uint *parent,
+	__global uint *end)
+{
+	uint first = min(i, j), last = max(i, j), leaves = n - 1;
+	end[i] = j;
+	parent[split + (split == first ? leaves : 0)] = 2 * i;
+	parent[split + 1 + (split + 1 == last ? leaves : 0)] = 2 * i + 1;
+	if (i == 0)
+		parent[0] = NO_NODE;
+}
+
 /* Internal node i: its range's other end and its split (the paper's
  * searches; lbvh_emit.c finds the same by scanning prefix lengths). */
 __kernel void karras(__global const ulong *keys, uint n, __global uint *parent,
@@ -53,13 +66,61 @@ __kernel void karras(__global const ulong *keys, uint n, __global uint *parent,
 		t = (t + 1) >> 1;
 		s += delta(keys, nn, i, i + (s + t) * d) > dnode ? t : 0;
 	} while (t > 1);
-	uint split = (uint)(i + s * d + min(d, 0));
-	uint first = (uint)min(i, j), last = (uint)max(i, j), leaves = n - 1;
-	end[i] = (uint)j;
-	parent[split + (split == first ? leaves : 0)] = 2 * (uint)i;
-	parent[split + 1 + (split + 1 == last ? leaves : 0)] = 2 * (uint)i + 1;
-	if (i == 0)
-		parent[0] = NO_NODE;
+	emit_node((uint)i, (uint)j, (uint)(i + s * d + min(d, 0)), n, parent, end);
+}
+
+/*
+ * The same hierarchy by lbvh_emit.c's scans, for a CPU device, where the
+ * searches' scattered reads and data-dependent steps cost more than a
+ * short scan: lcp[k] = delta(k, k + 1) as bytes (prefixes), then node i's
+ * range grows towards its larger neighbour until lcp[] drops to the
+ * smaller one, and the split is the one place in the range where lcp[]
+ * equals delta(first, last) (karras_scan). 16 bytes a step, then one at
+ * a time inside the 16 that hold the answer; LCP_PAD zero bytes on either
+ * side stop the scans.
+ */
+#define LCP_PAD 32
+
+__kernel void prefixes(__global const ulong *keys, uint n, __global uchar *lcp_buf)
+{
+	uint k = get_global_id(0);
+	__global uchar *lcp = lcp_buf + LCP_PAD;
+	if (k < n - 1)
+		lcp[k] = (uchar)delta(keys, n, k, k + 1);
+	if (k < LCP_PAD) {
+		lcp[(long)k - LCP_PAD] = 0;
+		lcp[n - 1 + k] = 0;
+	}
+}
+
+__kernel void karras_scan(__global const ulong *keys, uint n, __global const uchar *lcp_buf,
+	__global uint *parent, __global uint *end)
+{
+	long i = get_global_id(0), k;
+	__global const uchar *lcp = lcp_buf + LCP_PAD;
+	if (i >= (long)n - 1)
+		return;
+	uchar left = lcp[i - 1], right = lcp[i], bound = min(left, right);
+	if (right > left) {
+		for (k = i + 1; !any(vload16(0, lcp + k) <= bound); k += 16)
+			;
+		while (lcp[k] > bound)
+			k++;
+	} else {
+		for (k = i - 2; !any(vload16(0, lcp + k - 15) <= bound); k -= 16)
+			;
+		while (lcp[k] > bound)
+			k--;
+		k++;
+	}
+	long first = min(i, k), last = max(i, k);
+	uchar value = (uchar)delta(keys, n, first, last);
+	long split = first;
+	for (; !any(vload16(0, lcp + split) == value); split += 16)
+		;
+	while (lcp[split] != value)
+		split++;
+	emit_node((uint)i, (uint)k, (uint)split, n, parent, end);
 }
 
 static float half_area(float lx, float ly, float lz, float hx, float hy, float hz)

@@ -9,7 +9,7 @@
 
 /* The device buffers besides the sort's. */
 enum { LB_BOUNDS, LB_PARENT, LB_END, LB_NODES, LB_VISITS, LB_COST, LB_FLAGS, LB_INDEX,
-       LB_INNER, LB_LEAVES, LB_COUNT };
+       LB_INNER, LB_LEAVES, LB_LCP, LB_COUNT };
 
 typedef struct cl_lbvh {
 	const bvhlab_build_input *in;
@@ -20,6 +20,7 @@ typedef struct cl_lbvh {
 	uint32_t max_leaf;
 	float c_trav, c_isect;
 	uint32_t leaf_block;  /* leaves per work-item in bounds; 0: by device */
+	const char *hierarchy; /* auto, search or scan */
 
 	cl_dev *dev;
 	cl_sort *sort;

@@ -5,10 +5,14 @@
  */
 #include <errno.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "cl_lbvh.h"
 
-enum { K_KARRAS = CL_SORT_KERNELS, K_BOUNDS, K_INNER, K_GATHER };
+enum { K_KARRAS = CL_SORT_KERNELS, K_BOUNDS, K_INNER, K_GATHER, K_PREFIXES, K_SCAN };
+
+/* Zero bytes on either side of lcp[] (cl_lbvh.cl's LCP_PAD). */
+#define LCP_PAD 32
 
 /* Leaves per work-item of the bounds kernel on a CPU device: a few
  * thousand work-items on a million leaves, each climb mostly in cache and
@@ -24,6 +28,7 @@ static int size_buffers(cl_lbvh *b, char *err, size_t err_size)
 	want[LB_END] = want[LB_VISITS] = want[LB_COST] = 4 * (n - 1);
 	want[LB_NODES] = 32 * (2 * n - 1);
 	want[LB_FLAGS] = want[LB_INNER] = n - 1;
+	want[LB_LCP] = n - 1 + 2 * LCP_PAD;
 	want[LB_INDEX] = 4 * n;
 	cl_sort_sizes(b->n, want + LB_COUNT);
 	/* Both sets at once against the device's memory, then each made. */
@@ -45,6 +50,27 @@ static int zero(cl_lbvh *b, int which, size_t bytes, cl_events *ev, char *err,
 	                       "clEnqueueFillBuffer", err, err_size);
 }
 
+/* Every internal node's range and split: by Karras's searches, or by
+ * lbvh's scans of the prefix lengths (prefixes, then karras_scan). */
+static int karras(cl_lbvh *b, cl_mem keys, cl_events *ev, char *err, size_t err_size)
+{
+	cl_dev *d = b->dev;
+	cl_uint n = b->n, items = n - 1 > LCP_PAD ? n - 1 : LCP_PAD;
+	bool scan = !strcmp(b->hierarchy, "scan") ||
+	            (!strcmp(b->hierarchy, "auto") && (d->cl.type & CL_DEVICE_TYPE_CPU));
+	cl_mem lcp = b->b[LB_LCP].mem, parent = b->b[LB_PARENT].mem, end = b->b[LB_END].mem;
+	cl_arg ka[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(parent), CL_ARG(end) };
+	cl_arg pa[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(lcp) };
+	cl_arg sa[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(lcp), CL_ARG(parent), CL_ARG(end) };
+	int rc;
+
+	if (!scan)
+		return cl_launch(d, d->k[K_KARRAS], n - 1, ka, 4, ev, err, err_size);
+	if ((rc = cl_launch(d, d->k[K_PREFIXES], items, pa, 3, ev, err, err_size)) < 0)
+		return rc;
+	return cl_launch(d, d->k[K_SCAN], n - 1, sa, 5, ev, err, err_size);
+}
+
 static int hierarchy(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 {
 	cl_dev *d = b->dev;
@@ -53,8 +79,6 @@ static int hierarchy(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 	cl_uint collapse = b->collapse, n = b->n, max_leaf = b->max_leaf;
 	cl_uint block = b->leaf_block ? b->leaf_block
 	                              : d->cl.type & CL_DEVICE_TYPE_CPU ? CPU_LEAF_BLOCK : 1;
-	cl_arg ka[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(b->b[LB_PARENT].mem),
-	                CL_ARG(b->b[LB_END].mem) };
 	cl_arg ga[] = { CL_ARG(b->b[LB_BOUNDS].mem), CL_ARG(order), CL_ARG(n),
 	                CL_ARG(b->b[LB_LEAVES].mem), CL_ARG(b->b[LB_INDEX].mem) };
 	cl_arg ba[] = { CL_ARG(b->b[LB_LEAVES].mem), CL_ARG(n), CL_ARG(block),
@@ -68,7 +92,7 @@ static int hierarchy(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 	int rc;
 
 	if ((rc = cl_launch(d, d->k[K_GATHER], n, ga, 5, ev, err, err_size)) < 0 ||
-	    (rc = cl_launch(d, d->k[K_KARRAS], n - 1, ka, 4, ev, err, err_size)) < 0 ||
+	    (rc = karras(b, keys, ev, err, err_size)) < 0 ||
 	    (rc = zero(b, LB_VISITS, 4 * (size_t)(n - 1), ev, err, err_size)) < 0 ||
 	    (rc = zero(b, LB_FLAGS, n - 1, ev, err, err_size)) < 0 ||
 	    (rc = cl_launch(d, d->k[K_BOUNDS], (n + block - 1) / block, ba, 13, ev, err,

@@ -32,7 +32,7 @@
  * builder only (may be NULL). */
 struct setup {
 	const char *opts[4];
-	const char *dev_only;
+	const char *dev_only[2];
 };
 
 struct pair {
@@ -47,14 +47,15 @@ static struct pair pairs[] = {
 	{ .ref_name = "lbvh", .dev_name = "cl_lbvh",
 	  .setups = { { { "bits=63", "collapse=true" } },
 	              { { "bits=30", "collapse=false" } },
-	              /* a work-item per leaf in bounds: what a GPU runs */
-	              { { "max_leaf=3", "c_trav=2.5" }, "leaf_block=1" } },
+	              /* Karras's searches, a work-item per leaf: what a GPU runs */
+	              { { "max_leaf=3", "c_trav=2.5" },
+	                { "leaf_block=1", "hierarchy=search" } } },
 	  .differ = { { { "max_leaf=2" } }, { { "max_leaf=8" } } } },
 	{ .ref_name = "ploc", .dev_name = "cl_ploc",
 	  .setups = { { { "radius=16", "collapse=true" } },
 	              { { "radius=1", "collapse=false" } },
 	              /* a work-item per cluster in nearest: what a GPU runs */
-	              { { "radius=4", "bits=30" }, "nn_block=1" } },
+	              { { "radius=4", "bits=30" }, { "nn_block=1" } } },
 	  .differ = { { { "radius=1" } }, { { "radius=16" } } } },
 };
 #define PAIRS (sizeof(pairs) / sizeof(pairs[0]))
@@ -81,8 +82,8 @@ static int build(bvhlab_plugin *p, const struct setup *s, const char *device,
 		snprintf(dev, sizeof(dev), "device=%s", device);
 		rc = bvhlab_options_parse(&opts, dev, err);
 	}
-	if (rc == 0 && device && s->dev_only)
-		rc = bvhlab_options_parse(&opts, s->dev_only, err);
+	for (int k = 0; k < 2 && rc == 0 && device && s->dev_only[k]; k++)
+		rc = bvhlab_options_parse(&opts, s->dev_only[k], err);
 	double t0 = now_ms();
 	if (rc == 0)
 		rc = bvhlab_build(p, &opts, in, 2, tree, err);
