@@ -14,7 +14,9 @@ c++) std=-std=c++17 ;;
 *) echo "check-headers.sh: language must be c or c++, not '$lang'" >&2; exit 2 ;;
 esac
 status=0
-for h in "$incdir"/bvhlab/*.h; do
+headers="$incdir"/bvhlab/*.h
+[ "$lang" = c++ ] && headers="$headers $incdir/bvhlab/*.hpp" # C++-only helpers
+for h in $headers; do
 	name=$(basename "$h")
 	src=$(printf '#include <bvhlab/%s>\n#include <bvhlab/%s>\n' "$name" "$name")
 	if ! printf '%s\n' "$src" |
