@@ -23,6 +23,9 @@ struct harness_builder {
 	const char *status;    /* of its runs when unusable: "failed", "crashed", "timeout" */
 	bool skipped;          /* optional ("optional": true) and its plugin could not be
 	                        * loaded: it has no runs at all */
+	bool bad_config;       /* its plugin (or a stage's) is not there or not a
+	                        * bvhlab plugin, or an option is wrong: the config
+	                        * is refused before anything runs */
 	bvhlab_error error;
 	struct harness_stage {
 		bvhlab_plugin *plugin;
@@ -37,10 +40,15 @@ struct isolate_limits harness_run_limits(const struct config *cfg,
 
 /*
  * Opens every builder of cfg into *out ([cfg->builder_count]); a builder
- * that cannot be used keeps its status and message (printed to stderr
- * too), and the others go on. 0, or -ENOMEM.
+ * that cannot be used keeps its status and message, and the others go on.
+ * Messages go to stderr, each once (a grid's builders share theirs), as
+ * FILE:LINE:COLUMN: builder 'NAME': ...; *bad_configs counts the builders
+ * whose config is wrong (bad_config). A plugin that crashes or hangs while
+ * loading is not a config error: its runs are recorded as such. 0, or
+ * -ENOMEM.
  */
-int harness_open_builders(const struct config *cfg, struct harness_builder **out);
+int harness_open_builders(const struct config *cfg, struct harness_builder **out,
+                          size_t *bad_configs);
 void harness_close_builders(const struct config *cfg, struct harness_builder *builders);
 
 #endif
