@@ -127,9 +127,11 @@ static size_t serial_index(const struct harness *h, const struct harness_builder
 	return 0;
 }
 
+/* Runs picked by id (--only, a plan's parts) run as asked: a plan lists
+ * every run of its config, and its merge waits for each. */
 static bool applicable(const struct harness *h, const struct harness_builder *hb, size_t t)
 {
-	return !serial(hb) || t == serial_index(h, hb);
+	return h->only || !serial(hb) || t == serial_index(h, hb);
 }
 
 /* Says once, on stderr and in results.json, which thread counts a serial
@@ -140,7 +142,7 @@ static void note_not_applicable(struct harness *h, const struct harness_builder 
 	const uint32_t *threads = builder_threads(h, hb->cb, &n);
 	uint32_t skipped[CONFIG_MAX_THREADS];
 	char list[256] = "";
-	for (size_t t = 0, used = 0; t < n && serial(hb); t++) {
+	for (size_t t = 0, used = 0; t < n && serial(hb) && !h->only; t++) {
 		if (t == serial_index(h, hb))
 			continue;
 		skipped[k++] = resolve_threads(threads[t]);

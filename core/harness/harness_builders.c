@@ -54,8 +54,9 @@ static int probe(const struct config *cfg, struct harness_builder *hb)
 	if (outcome == ISOLATE_REPORTED && rep.ok)
 		return 0;
 	rep.error[sizeof(rep.error) - 1] = '\0';
-	if (outcome == ISOLATE_REPORTED) {
+	if (outcome == ISOLATE_REPORTED) { /* not there, or not a bvhlab plugin */
 		error_set(&hb->error, "%s", rep.error);
+		hb->bad_config = true;
 		return -EINVAL;
 	}
 	hb->status = outcome == ISOLATE_TIMEOUT ? "timeout" : outcome < 0 ? "failed" : "crashed";

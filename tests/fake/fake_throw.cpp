@@ -2,7 +2,10 @@
 // bvhlab::guarded_build (include/bvhlab/builder.hpp). Option "throw" picks
 // what it throws: "runtime" (std::runtime_error with a message the tests look
 // for), "bad_alloc", "int" (not a std::exception) or "none" (builds a
-// one-leaf-per-pair tree, to show the wrapper passes results through).
+// one-leaf tree, to show the wrapper passes results through); "escape"
+// throws where no wrapper can catch it (a noexcept function), as an
+// unwrapped build() would: std::terminate prints the message and aborts,
+// and the harness quotes the end of the child's stderr.
 #include <cstring>
 #include <new>
 #include <stdexcept>
@@ -13,8 +16,21 @@ namespace {
 
 const bvhlab_option_decl options[] = {
 	bvhlab::string_option("throw", "what build() throws", "runtime",
-	                      "runtime|bad_alloc|int|none"),
+	                      "runtime|bad_alloc|int|escape|none"),
 };
+
+void thrower()
+{
+	throw std::runtime_error("fake_throw: escaped build() unguarded");
+}
+
+// Through a pointer, so the compiler cannot see (and refuse) the throw.
+void (*volatile throw_fn)() = thrower;
+
+void escape() noexcept
+{
+	throw_fn();
+}
 
 // A valid tree without exceptions: the root a leaf of every primitive.
 int build_leaf(const bvhlab_build_input *input, bvhlab_build_output *output)
@@ -44,6 +60,8 @@ int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_inp
 		throw std::bad_alloc();
 	if (std::strcmp(what, "int") == 0)
 		throw 42;
+	if (std::strcmp(what, "escape") == 0)
+		escape();
 	return build_leaf(input, output);
 }
 
