@@ -106,59 +106,12 @@ static const uint32_t *builder_threads(const struct harness *h, const struct con
 	return threads;
 }
 
-/*
- * A builder without the PARALLEL flag ignores its thread count, so it runs
- * once per scene: at the first of its thread counts that resolves to 1
- * (else its first); the others are not applicable (README, "threads").
- * A builder whose plugin did not load keeps all its runs, to record them.
- */
-static bool serial(const struct harness_builder *hb)
-{
-	return hb->plugin && !(bvhlab_plugin_builder(hb->plugin)->flags & BVHLAB_BUILDER_PARALLEL);
-}
-
-static size_t serial_index(const struct harness *h, const struct harness_builder *hb)
+/* The runs a builder gets: harness_threads.c (one for a serial builder). */
+static bool applicable(const struct harness *h, const struct harness_builder *hb, size_t t)
 {
 	size_t n;
 	const uint32_t *threads = builder_threads(h, hb->cb, &n);
-	for (size_t t = 0; t < n; t++)
-		if (resolve_threads(threads[t]) == 1)
-			return t;
-	return 0;
-}
-
-/* Runs picked by id (--only, a plan's parts) run as asked: a plan lists
- * every run of its config, and its merge waits for each. */
-static bool applicable(const struct harness *h, const struct harness_builder *hb, size_t t)
-{
-	return h->only || !serial(hb) || t == serial_index(h, hb);
-}
-
-/* Says once, on stderr and in results.json, which thread counts a serial
- * builder is not run at. */
-static void note_not_applicable(struct harness *h, const struct harness_builder *hb)
-{
-	size_t n, k = 0;
-	const uint32_t *threads = builder_threads(h, hb->cb, &n);
-	uint32_t skipped[CONFIG_MAX_THREADS];
-	char list[256] = "";
-	for (size_t t = 0, used = 0; t < n && serial(hb) && !h->only; t++) {
-		if (t == serial_index(h, hb))
-			continue;
-		skipped[k++] = resolve_threads(threads[t]);
-		if (used < sizeof(list))
-			used += (size_t)snprintf(list + used, sizeof(list) - used, "%s%u",
-			                         used ? ", " : "", skipped[k - 1]);
-	}
-	if (k == 0)
-		return;
-	static const char reason[] = "not a parallel builder (no PARALLEL flag): one run per "
-	                             "scene, at 1 thread";
-	if (!h->progress.quiet)
-		fprintf(stderr, "bvhlab: builder '%s': %s; thread count%s %s not applicable\n",
-		        hb->cb->name, reason, k == 1 ? "" : "s", list);
-	if (results_set_not_applicable(&h->res, hb->cb->name, skipped, k, reason) < 0)
-		fprintf(stderr, "bvhlab: out of memory\n");
+	return harness_thread_applies(hb, threads, n, t, h->only != NULL);
 }
 
 /* A run left out by --only, or kept from the results resumed (counted as done). */
@@ -482,8 +435,8 @@ static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t sc
 	for (size_t b = 0; r == 0 && b < nb; b++) {
 		size_t n;
 		names[b] = h->cfg->builders[b].name;
-		size_t first = serial(&h->builders[b]) ? serial_index(h, &h->builders[b]) : 0;
-		threads[b] = resolve_threads(builder_threads(h, &h->cfg->builders[b], &n)[first]);
+		const uint32_t *list = builder_threads(h, &h->cfg->builders[b], &n);
+		threads[b] = resolve_threads(list[harness_first_run(&h->builders[b], list, n)]);
 	}
 	struct scene_images si = {.dir = h->cfg->output, .scene_index = scene_index,
 	                          .scene = scene->name, .width = h->cfg->ray_width,
@@ -596,8 +549,13 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 	bvhlab_set_pinning(cfg->pin);
 	if (r == 0 && opts->resume)
 		r = resume(&h, err);
-	for (size_t b = 0; r == 0 && b < cfg->builder_count; b++)
-		note_not_applicable(&h, &h.builders[b]);
+	for (size_t b = 0; r == 0 && !h.only && b < cfg->builder_count; b++) {
+		size_t n;
+		const uint32_t *threads = builder_threads(&h, h.builders[b].cb, &n);
+		if ((r = harness_note_not_applicable(&h.builders[b], threads, n, &h.res,
+		                                     opts->quiet)) < 0)
+			error_set(err, "out of memory");
+	}
 	if (r == 0)
 		r = results_write(&h.res, err);
 	if (r == 0)
