@@ -62,6 +62,8 @@ struct series_report {
 	bool tree_written; /* the tree is in the job's tree_path */
 	uint32_t stage_count;
 	struct stage_metrics stages[HARNESS_MAX_STAGES];
+	uint32_t phase_count;
+	bvhlab_phase phases[BVHLAB_MAX_PHASES];
 	char error[sizeof(((bvhlab_error *)0)->message)];
 	double samples[];      /* [repeat] */
 };
@@ -271,6 +273,8 @@ static void series_work(void *arg, void *report, size_t size)
 		rep->sample_count = s.repeat;
 		rep->cold_ms = s.cold_ms;
 		rep->stage_count = s.stage_count;
+		rep->phase_count = s.phase_count;
+		memcpy(rep->phases, s.phases, sizeof(rep->phases));
 		validate(job, &s.tree, rep, &err);
 		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
 		if (rep->has_stats)
@@ -292,7 +296,7 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	static const char *const names[] = {"ok", "invalid", "failed"};
 	rep->error[sizeof(rep->error) - 1] = '\0';
 	if (rep->status > SERIES_FAILED || rep->sample_count > repeat ||
-	    rep->stage_count > HARNESS_MAX_STAGES) {
+	    rep->stage_count > HARNESS_MAX_STAGES || rep->phase_count > BVHLAB_MAX_PHASES) {
 		run->status = "crashed";
 		run->error = "sent back a malformed report";
 		return;
@@ -314,6 +318,10 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 		rep->stages[k].plugin[sizeof(rep->stages[k].plugin) - 1] = '\0';
 	run->stages = rep->stages;
 	run->stage_count = rep->stage_count;
+	for (uint32_t k = 0; k < rep->phase_count; k++)
+		rep->phases[k].name[sizeof(rep->phases[k].name) - 1] = '\0';
+	run->phases = rep->phases;
+	run->phase_count = rep->phase_count;
 }
 
 /* Runs the series in a child (or here, with "isolate": false) and records it. */

@@ -56,6 +56,11 @@ struct build_series {
 	const struct refine_stage *stages; /* [stage_count], applied in order */
 	uint32_t stage_count;  /* at most HARNESS_MAX_STAGES */
 	struct stage_metrics *stage_out; /* [stage_count], filled */
+	/* The builder's own phases (ABI 1.3 host->phase): each one's median
+	 * over the timed repeats (0 in a repeat that did not report it), in
+	 * the order first reported; filled. */
+	bvhlab_phase phases[BVHLAB_MAX_PHASES];
+	uint32_t phase_count;
 	bvhlab_tree tree;      /* the last build's tree, refined */
 };
 

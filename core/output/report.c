@@ -134,6 +134,20 @@ static const char *const csv_numbers[][2] = {
 	{"rays.traversal_disagreements", "%.0f"},
 };
 
+/* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary
+ * by builder, so they do not get a column each. */
+static void csv_phases(struct strbuf *sb, const cJSON *phases)
+{
+	struct strbuf f = {0};
+	const cJSON *p;
+	cJSON_ArrayForEach(p, phases)
+		if (cJSON_IsNumber(p) && p->string)
+			sb_printf(&f, "%s%s=%.4f", f.len ? ";" : "", p->string, p->valuedouble);
+	char *text = sb_take(&f);
+	csv_field(sb, text ? text : "", false);
+	free(text);
+}
+
 static void csv_row(struct strbuf *sb, const cJSON *run)
 {
 	char buf[64];
@@ -147,6 +161,7 @@ static void csv_row(struct strbuf *sb, const cJSON *run)
 	csv_field(sb, cJSON_IsString(trav) ? trav->valuestring : "", false);
 	const cJSON *valid = at(run, "validation.valid");
 	csv_field(sb, cJSON_IsBool(valid) ? (cJSON_IsTrue(valid) ? "true" : "false") : "", false);
+	csv_phases(sb, cJSON_GetObjectItemCaseSensitive(run, "build_phases"));
 	csv_field(sb, str(run, "error"), true);
 }
 
@@ -156,7 +171,7 @@ char *report_csv(const cJSON *doc)
 	sb_printf(&sb, "scene,builder,plugin,status");
 	for (size_t k = 0; k < sizeof(csv_numbers) / sizeof(csv_numbers[0]); k++)
 		sb_printf(&sb, ",%s", csv_numbers[k][0]);
-	sb_printf(&sb, ",rays.traversal,validation.valid,error\n");
+	sb_printf(&sb, ",rays.traversal,validation.valid,build_phases,error\n");
 	const cJSON *run;
 	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
 		csv_row(&sb, run);

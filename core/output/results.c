@@ -229,6 +229,9 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddNumberToObject(o, "mtris_per_s",
 		                        med > 0 ? run->triangles / (med * 1e3) : 0);
 	}
+	if (run->phase_count)
+		cJSON_AddItemToObject(o, "build_phases",
+		                      results_phases_json(run->phases, run->phase_count));
 	if (run->stage_count)
 		cJSON_AddItemToObject(o, "stages", results_stages_json(run->stages, run->stage_count));
 	if (run->stats)

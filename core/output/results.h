@@ -79,6 +79,8 @@ struct run_record {
 	const struct ray_metrics *rays; /* or NULL: not traced */
 	const struct stage_metrics *stages; /* [stage_count] refinement stages */
 	uint32_t stage_count;
+	const bvhlab_phase *phases; /* [phase_count] the builder's phase medians */
+	uint32_t phase_count;
 };
 
 
@@ -103,6 +105,9 @@ int results_set_not_applicable(struct results *res, const char *builder,
 
 /* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of docs/design.md. */
 struct cJSON *results_rays_json(const struct ray_metrics *m);
+
+/* "build_phases": {"upload": ms, "device": ms, ...} (results_stages.c). */
+struct cJSON *results_phases_json(const bvhlab_phase *phases, uint32_t count);
 
 /* "stages": [{"plugin", "ms", "sah_before", "sah_after"}, ...] (results_stages.c). */
 struct cJSON *results_stages_json(const struct stage_metrics *stages, uint32_t count);
