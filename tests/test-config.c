@@ -16,6 +16,8 @@
 
 #include "config/config.h"
 #include "config/json_locate.h"
+#include "harness/harness.h"
+#include "trace/trace_cl.h"
 #include "testutil.h"
 
 #define SCENES "\"scenes\": [ { \"generator\": \"icosphere\" } ]"
@@ -242,14 +244,48 @@ static void test_traversal(void)
 	}
 	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"wid\" } }";
 	EXPECT_ERROR_AT(t, "\"wid\"", 0, "'rays.traversal' must be \"wide\", \"stack\", "
-	                "\"stackless\", \"both\" (stack and stackless) or an array of those "
-	                "names, not \"wid\"");
+	                "\"stackless\", \"cl_stack\", \"cl_stackless\", \"both\" (stack and "
+	                "stackless) or an array of those names (an entry may be {\"name\": NAME, "
+	                "\"optional\": true}), not \"wid\"");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", 2] } }";
-	EXPECT_ERROR_AT(t, "2]", 0, "an array of those names, not 2");
+	EXPECT_ERROR_AT(t, "2]", 0, "\"optional\": true}), not 2");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", \"wide\"] } }";
 	EXPECT_ERROR_AT(t, "\"wide\"", 1, "'rays.traversal' names \"wide\" twice");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [] } }";
 	EXPECT_ERROR_AT(t, "[]", 0, "not an array");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [{\"name\": \"stack\", "
+	    "\"opt\": true}] } }";
+	EXPECT_ERROR_AT(t, "\"opt\"", 0, "entries as objects take \"name\" (a string) and "
+	                "\"optional\" (true or false) only");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"device\": \"0:x\" } }";
+	EXPECT_ERROR_AT(t, "\"0:x\"", 0, "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or "
+	                "\"P:D\"");
+}
+
+/* The device traversals: refused, naming the key, in a build without
+ * OpenCL unless optional (then left out); kept in a build with it. */
+static void test_device_traversal(void)
+{
+	struct config cfg;
+	bvhlab_error err = {""};
+	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"device\": \"1:0\", \"traversal\": "
+	                "[{\"name\": \"cl_stack\", \"optional\": true}, \"stack\"] } }";
+	CHECK_INT(load(&cfg, t, &err), 0);
+	unsigned stack = 1u << BVHLAB_TRAVERSAL_STACK, cl = 1u << BVHLAB_TRAVERSAL_CL_STACK;
+	CHECK(strcmp(cfg.ray_device, "1:0") == 0);
+	if (trace_cl_built())
+		CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_CL_STACK && cfg.ray_traversals == (stack | cl));
+	else
+		CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_STACK && cfg.ray_traversals == stack);
+	config_finish(&cfg);
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"cl_stackless\" } }";
+	if (trace_cl_built()) {
+		CHECK_INT(load(&cfg, t, &err), 0);
+		config_finish(&cfg);
+	} else {
+		EXPECT_ERROR_AT(t, "\"cl_stackless\"", 0, "'rays.traversal' \"cl_stackless\" runs on "
+		                "an OpenCL device, and this bvhlab was built without OpenCL");
+	}
 }
 
 static void test_syntax(void)
@@ -299,7 +335,7 @@ static void test_unknown_keys(void)
 	EXPECT_ERROR_AT(t, "\"frequncy\"", 0,
 	                "unknown key 'frequncy' in scenes[0] (known: name, path, generator, parts, "
 	                "frequency, count, size, seed, width, subdivide, frames, animate, deform, "
-	                "amplitude); did you mean "
+	                "amplitude, camera); did you mean "
 	                "'frequency'?");
 	EXPECT_ERROR("{ " SCENES ",\n"
 	             "  \"builders\": [ { \"plugin\": \"a\" },\n"
@@ -310,7 +346,8 @@ static void test_unknown_keys(void)
 	             "mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
-	                "diffuse, camera, threads, min_ms, rounds, traversal); did you mean 'width'?");
+	                "diffuse, camera, threads, min_ms, rounds, traversal, device); did you mean "
+	                "'width'?");
 }
 
 static void test_types(void)
@@ -401,6 +438,41 @@ static void test_structure(void)
 	t = "{ \"scenes\": [ { \"generator\": \"soup\" }, { \"path\": \"m/soup.ply\" } ], "
 	    BUILDERS " }";
 	EXPECT_ERROR_AT(t, "{ \"path", 0, "duplicate scene name 'soup': scenes[0] has it too");
+}
+
+/* A scene's own "camera" wins over "rays"' one for that scene only; its
+ * errors name the scene. */
+static void test_scene_camera(void)
+{
+	const char *text =
+		"{ \"rays\": { \"camera\": { \"position\": [0, 0, 5] } },\n"
+		"  \"scenes\": [ { \"name\": \"a\", \"generator\": \"icosphere\" },\n"
+		"    { \"name\": \"room\", \"generator\": \"room\", \"camera\": {"
+		" \"position\": [0.5, -0.5, 0], \"target\": [-1, -0.4, 0], \"fov\": 70 } } ],\n"
+		"  " BUILDERS " }";
+	struct config cfg;
+	bvhlab_error err = { "" };
+	bvhlab_camera cam;
+	int rc = load(&cfg, text, &err);
+	CHECK_INT(rc, 0);
+	if (rc) {
+		fprintf(stderr, "%s\n", err.message);
+		return;
+	}
+	CHECK(!cfg.scenes[0].has_camera && cfg.scenes[1].has_camera);
+	CHECK(cfg.scenes[1].camera.fov_deg == 70.0f && cfg.scenes[1].camera.target[0] == -1.0f);
+	bvhlab_scene named = { .name = "room" }, other = { .name = "a" };
+	harness_camera(&cfg, &named, &cam);
+	CHECK(cam.position[0] == 0.5f && cam.fov_deg == 70.0f);
+	harness_camera(&cfg, &other, &cam);
+	CHECK(cam.position[2] == 5.0f && cam.fov_deg == 45.0f);
+	config_finish(&cfg);
+	const char *t = "{ \"scenes\": [ { \"generator\": \"room\",\n"
+	                "  \"camera\": { \"position\": [1, 1, 1], \"target\": [1, 1, 1] } } ], "
+	                BUILDERS " }";
+	EXPECT_ERROR_AT(t, "{ \"position", 0, "'scenes[0].camera': position and target must differ");
+	t = "{ \"scenes\": [ { \"generator\": \"room\", \"camera\": [1] } ], " BUILDERS " }";
+	EXPECT_ERROR_AT(t, "[1]", 0, "'scenes[0].camera' must be an object");
 }
 
 /* ---- builder options --------------------------------------------------------- */
@@ -662,9 +734,11 @@ int main(void)
 	test_defaults();
 	test_syntax();
 	test_traversal();
+	test_device_traversal();
 	test_unknown_keys();
 	test_types();
 	test_structure();
+	test_scene_camera();
 	test_options();
 	test_isolation_keys();
 	test_locate();

@@ -188,7 +188,8 @@ static void html_row(struct strbuf *sb, const struct strategy *s)
 }
 
 /* SAH and cumulative cost per frame of the runs at `threads`. */
-static void charts(struct strbuf *sb, const struct strategy *s, size_t n, double threads)
+static void charts(struct strbuf *sb, const struct report_index *ix, const struct strategy *s,
+                   size_t n, double threads)
 {
 	size_t total = 0, m = 0, c = 0;
 	for (size_t k = 0; k < n; k++)
@@ -203,9 +204,12 @@ static void charts(struct strbuf *sb, const struct strategy *s, size_t n, double
 			continue;
 		cJSON_ArrayForEach(f, s[k].frames) {
 			const char *g = report_str(s[k].run, "builder");
+			const char *colour = svg_colour(report_builder_number(ix, g));
 			sum += report_num(f, "cost_ms");
-			sah[m++] = (struct svg_point){"", g, report_num(f, "frame"), report_num(f, "sah")};
-			cost[c++] = (struct svg_point){"", g, report_num(f, "frame"), sum};
+			sah[m++] = (struct svg_point){.label = "", .group = g, .x = report_num(f, "frame"),
+			                              .y = report_num(f, "sah"), .colour = colour};
+			cost[c++] = (struct svg_point){.label = "", .group = g, .x = report_num(f, "frame"),
+			                               .y = sum, .colour = colour};
 		}
 	}
 	snprintf(title[0], sizeof(title[0]), "SAH over the frames, %.0f thread%s", threads,
@@ -223,7 +227,8 @@ static void charts(struct strbuf *sb, const struct strategy *s, size_t n, double
 }
 
 /* One pair of charts per thread count, in the order the runs have them. */
-static void all_charts(struct strbuf *sb, const struct strategy *s, size_t n)
+static void all_charts(struct strbuf *sb, const struct report_index *ix,
+                       const struct strategy *s, size_t n)
 {
 	for (size_t k = 0; k < n; k++) {
 		double t = report_num(s[k].run, "threads");
@@ -231,7 +236,7 @@ static void all_charts(struct strbuf *sb, const struct strategy *s, size_t n)
 		for (size_t j = 0; j < k && !seen; j++)
 			seen = report_num(s[j].run, "threads") == t;
 		if (!seen)
-			charts(sb, s, n, t);
+			charts(sb, ix, s, n, t);
 	}
 }
 
@@ -253,6 +258,6 @@ void report_frames_html(struct strbuf *sb, const struct report_index *ix, const 
 		html_row(sb, &s[k]);
 	sb_printf(sb, "</table>\n");
 	cheapest_line(sb, s, n, true);
-	all_charts(sb, s, n);
+	all_charts(sb, ix, s, n);
 	free(s);
 }
