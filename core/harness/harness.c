@@ -41,8 +41,7 @@ struct harness {
 	bool shade_done; /* this scene's shaded render is on its way */
 	bool rounds_on;  /* this scene's rays are timed in interleaved rounds */
 	struct harness_rounds rounds; /* this scene's trees waiting for them */
-	struct harness_anim anim; /* this scene's animation (harness_frames.c) */
-	bool animated;
+	struct harness_anim anim; /* this scene's animation, frames 0 if none (harness_anim.c) */
 };
 
 enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };
@@ -256,23 +255,6 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 	free(shade);
 }
 
-/* An animated scene's frames, on the series' tree (harness_frames.c). */
-static void run_frames(const struct series_job *job, struct build_series *s,
-                       struct series_report *rep, bvhlab_error *err)
-{
-	double mn, mx, median;
-	util_summarise(rep->samples, s->repeat, &median, &mn, &mx);
-	struct frames_job fj = {.cfg = job->h->cfg, .cb = job->hb->cb, .anim = &job->h->anim,
-	                        .first = job->scene, .plugin = job->hb->plugin,
-	                        .opts = &job->hb->opts, .stages = job->hb->refine,
-	                        .stage_count = s->stage_count, .threads = job->threads,
-	                        .spatial_splits = spatial_splits(job), .first_ms = median};
-	int r = harness_frames_run(&fj, &s->tree, (struct frame_metrics *)(rep->samples + s->repeat),
-	                           &rep->frame_count, err);
-	if (r != 0)
-		rep->status = r > 0 ? SERIES_INVALID : SERIES_FAILED;
-}
-
 /* Warm-up, timed builds, validation and metrics: what runs in the child. */
 static void series_work(void *arg, void *report, size_t size)
 {
@@ -307,8 +289,10 @@ static void series_work(void *arg, void *report, size_t size)
 			                               &rep->epo) == 0;
 		if (rep->status == SERIES_OK)
 			trace_rays(job, &s.tree, rep);
-		if (rep->status == SERIES_OK && job->h->animated)
-			run_frames(job, &s, rep, &err);
+		int f = rep->status != SERIES_OK ? 0 : harness_frames_after_series(cfg, job->hb,
+			&job->h->anim, job->scene, job->threads, rep->samples, s.repeat, &s.tree,
+			&rep->frame_count, &err); /* an animated scene's frames: harness_frames.c */
+		rep->status = f > 0 ? SERIES_INVALID : f < 0 ? SERIES_FAILED : rep->status;
 	}
 	if (rep->status != SERIES_OK)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
@@ -371,7 +355,7 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	run->load_after = machine_load_average();
 	run->load_read = true;
 	if (outcome == ISOLATE_REPORTED) {
-		report_to_run(rep, h->cfg->repeat, h->animated ? h->anim.frames : 0, run);
+		report_to_run(rep, h->cfg->repeat, h->anim.frames, run);
 	} else {
 		run->status = outcome < 0 ? "failed" : outcomes[outcome];
 		run->error = why;
@@ -427,7 +411,7 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 	if (skip_run(h, run.id, run.scene, run.builder, run.threads))
 		return;
 	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double) +
-	              harness_frames_size(h->animated ? &h->anim : NULL);
+	              harness_frames_size(&h->anim);
 	struct series_report *rep = calloc(1, size);
 	if (!rep) {
 		run.error = "out of memory for the run's samples";
@@ -504,11 +488,8 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (scene_done(h, cs, scene_index))
 		return;
 	int r = h->cfg->isolate ? harness_probe_scene(h->cfg, cs, &err) : 0;
-	h->animated = r == 0 && harness_anim_on(cs); /* frame 0 is the scene: harness_anim.c */
-	if (r == 0 && h->animated && (r = harness_anim_open(cs, &h->anim, &err)) == 0)
-		r = harness_anim_frame(&h->anim, 0, &scene, &err);
-	else if (r == 0)
-		r = harness_load_scene(cs, &scene, &err);
+	if (r == 0) /* an animated scene's frame 0 (harness_anim.c) */
+		r = harness_anim_load(cs, &h->anim, &scene, &err);
 	if (r == 0)
 		r = bvhlab_prims_init(&prims, scene, &err);
 	if (r < 0) {
@@ -530,9 +511,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)
 		scene_images(h, scene, scene_index);
 out:
-	if (h->animated)
-		harness_anim_close(&h->anim);
-	h->animated = false;
+	harness_anim_close(&h->anim);
 	bvhlab_prims_finish(&prims);
 	bvhlab_scene_destroy(scene);
 }

@@ -84,8 +84,17 @@ void harness_anim_close(struct harness_anim *a)
 		bvhlab_scene_destroy(a->meshes[i]);
 	free(a->meshes);
 	free(a->motions);
-	a->meshes = NULL;
-	a->motions = NULL;
+	*a = (struct harness_anim){0};
+}
+
+int harness_anim_load(const struct config_scene *cs, struct harness_anim *a,
+                      bvhlab_scene **scene, bvhlab_error *err)
+{
+	*a = (struct harness_anim){0};
+	if (!harness_anim_on(cs))
+		return harness_load_scene(cs, scene, err);
+	int r = harness_anim_open(cs, a, err);
+	return r < 0 ? r : harness_anim_frame(a, 0, scene, err);
 }
 
 /* Frame file f: its path, loaded and subdivided as the scene says, and

@@ -15,7 +15,7 @@
 
 struct harness_anim {
 	const struct config_scene *cs;
-	uint32_t frames;
+	uint32_t frames;              /* 0: not animated (nothing else is set) */
 	bvhlab_scene **meshes;        /* [mesh_count] at rest, in their own frame */
 	struct scene_motion *motions; /* [mesh_count] */
 	uint32_t mesh_count;          /* parts, or 1; 0 for frame files */
@@ -31,7 +31,13 @@ static inline bool harness_anim_on(const struct config_scene *cs)
 /* Loads the scene's meshes (a frame-file scene loads none). 0 or a negative
  * errno with err naming the scene (and the part). */
 int harness_anim_open(const struct config_scene *cs, struct harness_anim *a, bvhlab_error *err);
+/* Frees what open loaded and zeroes a (frames 0); fine on a zeroed one. */
 void harness_anim_close(struct harness_anim *a);
+
+/* The sweep's scene: harness_load_scene's for a static scene (a->frames
+ * 0), else the animation opened into a and its frame 0. */
+int harness_anim_load(const struct config_scene *cs, struct harness_anim *a,
+                      bvhlab_scene **scene, bvhlab_error *err);
 
 /*
  * Frame f (< a->frames) as a new scene, named as the config says. A frame

@@ -200,3 +200,21 @@ int harness_frames_run(const struct frames_job *job, bvhlab_tree *tree,
 	updater_close(&u);
 	return r;
 }
+
+int harness_frames_after_series(const struct config *cfg, const struct harness_builder *hb,
+                                const struct harness_anim *a, const bvhlab_scene *first,
+                                uint32_t threads, double *samples, uint32_t repeat,
+                                bvhlab_tree *tree, uint32_t *count, bvhlab_error *err)
+{
+	double mn, mx, median;
+	const bvhlab_builder *desc = bvhlab_plugin_builder(hb->plugin);
+	if (!a->frames)
+		return 0; /* a static scene */
+	util_summarise(samples, repeat, &median, &mn, &mx);
+	struct frames_job job = {.cfg = cfg, .cb = hb->cb, .anim = a, .first = first,
+	                         .plugin = hb->plugin, .opts = &hb->opts, .stages = hb->refine,
+	                         .stage_count = (uint32_t)hb->cb->refine_count, .threads = threads,
+	                         .spatial_splits = desc->flags & BVHLAB_BUILDER_SPATIAL_SPLITS,
+	                         .first_ms = median};
+	return harness_frames_run(&job, tree, (struct frame_metrics *)(samples + repeat), count, err);
+}

@@ -15,6 +15,7 @@
 
 #include "config/config.h"
 #include "harness/harness_anim.h"
+#include "harness/harness_builders.h"
 #include "harness/refine_stage.h"
 #include "output/results.h"
 
@@ -47,5 +48,16 @@ static inline size_t harness_frames_size(const struct harness_anim *a)
  */
 int harness_frames_run(const struct frames_job *job, bvhlab_tree *tree,
                        struct frame_metrics *out, uint32_t *count, bvhlab_error *err);
+
+/*
+ * The frames of a run of builder hb on the animated scene a, after its
+ * series on frame 0 (`first`): samples[repeat] the series' times, the
+ * frames' records after them (samples + repeat), `tree` the series' tree.
+ * Returns as harness_frames_run; 0 at once for a static scene (frames 0).
+ */
+int harness_frames_after_series(const struct config *cfg, const struct harness_builder *hb,
+                                const struct harness_anim *a, const bvhlab_scene *first,
+                                uint32_t threads, double *samples, uint32_t repeat,
+                                bvhlab_tree *tree, uint32_t *count, bvhlab_error *err);
 
 #endif
