@@ -58,8 +58,11 @@ static bool has_so_suffix(const char *s, size_t *stem)
 	return n > 3 && strcmp(s + n - 3, ".so") == 0;
 }
 
-/* NAME.so directly in dir, or NAME/NAME.so one level down. */
-static int scan_entry(struct names *ns, const char *dir, const struct dirent *e)
+static int scan_dir(struct names *ns, const char *dir, int depth);
+
+/* NAME.so directly in dir, or any NAME.so one folder down: NAME/NAME.so,
+ * or a family's folder of several (the build tree's plugins/sah/). */
+static int scan_entry(struct names *ns, const char *dir, const struct dirent *e, int depth)
 {
 	size_t stem;
 	if (e->d_name[0] == '.')
@@ -67,14 +70,13 @@ static int scan_entry(struct names *ns, const char *dir, const struct dirent *e)
 	if (has_so_suffix(e->d_name, &stem))
 		return add(ns, e->d_name, stem);
 	char path[4096];
-	struct stat st;
-	int n = snprintf(path, sizeof(path), "%s/%s/%s.so", dir, e->d_name, e->d_name);
-	if (n > 0 && (size_t)n < sizeof(path) && stat(path, &st) == 0 && S_ISREG(st.st_mode))
-		return add(ns, e->d_name, strlen(e->d_name));
-	return 0;
+	int n = snprintf(path, sizeof(path), "%s/%s", dir, e->d_name);
+	if (depth > 0 || n <= 0 || (size_t)n >= sizeof(path))
+		return 0;
+	return scan_dir(ns, path, depth + 1);
 }
 
-static int scan_dir(struct names *ns, const char *dir)
+static int scan_dir(struct names *ns, const char *dir, int depth)
 {
 	DIR *d = opendir(dir);
 	if (!d)
@@ -82,7 +84,7 @@ static int scan_dir(struct names *ns, const char *dir)
 	int r = 0;
 	struct dirent *e;
 	while (r == 0 && (e = readdir(d)))
-		r = scan_entry(ns, dir, e);
+		r = scan_entry(ns, dir, e, depth);
 	closedir(d);
 	return r;
 }
@@ -105,7 +107,7 @@ int bvhlab_plugin_names(char ***out, bvhlab_error *err)
 		if (len > 0 && len < sizeof(dir)) {
 			memcpy(dir, p, len);
 			dir[len] = '\0';
-			r = scan_dir(&ns, dir);
+			r = scan_dir(&ns, dir, 0);
 		}
 		p += len + (colon ? 1 : 0);
 	}
@@ -144,11 +146,30 @@ static bool ends_in_so(const char *s)
 	return n > 3 && strcmp(s + n - 3, ".so") == 0;
 }
 
-/* Finds NAME.so or NAME/NAME.so in a search folder; 0 and *out, or -ENOENT. */
+/* SUB/NAME.so in some folder SUB of dir (a family's folder), in readdir
+ * order; names are unique across the build tree, so the order is moot. */
+static int find_in_family(const char *dir, const char *name, char *out, size_t size)
+{
+	DIR *d = opendir(dir);
+	struct dirent *e;
+	int r = -ENOENT;
+	while (d && r < 0 && (e = readdir(d))) {
+		int n = snprintf(out, size, "%s/%s/%s.so", dir, e->d_name, name);
+		if (e->d_name[0] != '.' && n > 0 && (size_t)n < size && is_file(out))
+			r = 0;
+	}
+	if (d)
+		closedir(d);
+	return r;
+}
+
+/* Finds NAME.so, NAME/NAME.so or SUB/NAME.so in a search folder; 0 and
+ * *out, or -ENOENT. */
 static int find_in_dir(const char *dir, size_t dirlen, const char *name, char *out,
                        size_t size)
 {
-	if (dirlen == 0)
+	char folder[4096];
+	if (dirlen == 0 || dirlen >= sizeof(folder))
 		return -ENOENT;
 	int n = snprintf(out, size, "%.*s/%s.so", (int)dirlen, dir, name);
 	if (n > 0 && (size_t)n < size && is_file(out))
@@ -156,7 +177,9 @@ static int find_in_dir(const char *dir, size_t dirlen, const char *name, char *o
 	n = snprintf(out, size, "%.*s/%s/%s.so", (int)dirlen, dir, name, name);
 	if (n > 0 && (size_t)n < size && is_file(out))
 		return 0;
-	return -ENOENT;
+	memcpy(folder, dir, dirlen);
+	folder[dirlen] = '\0';
+	return find_in_family(folder, name, out, size);
 }
 
 /* Names what there is to choose from: a typo is then plain to see. */

@@ -1,7 +1,7 @@
 /*
  * sah_seq: the sequential top-down SAH builder, the reference the parallel
  * SAH strategies are compared with. All split decisions are the shared
- * kernel's (plugins/common/sah/sah_kernel.h); this plugin only runs the whole
+ * kernel's (sah_kernel.h); this plugin only runs the whole
  * tree as one subtree on the calling thread.
  */
 
