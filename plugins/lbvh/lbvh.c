@@ -146,6 +146,7 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b,
 {
 	morton_scratch s = { 0 };
 	double start = morton_now_ms();
+	team_host th;
 	int rc;
 
 	b->threads = morton_team_size(b->in);
@@ -158,8 +159,8 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b,
 		goto out;
 	}
 	b->phase_ms[4] = morton_now_ms();
-	if ((rc = team_run(&b->team, b->threads, host->hardware_threads(ctx), run_phases,
-	                   b)) < 0) {
+	team_host_init(&th, host, ctx);
+	if ((rc = team_run_on(&b->team, &th, b->threads, run_phases, b)) < 0) {
 		host->set_error(ctx, "cannot set up the thread team");
 		goto out;
 	}

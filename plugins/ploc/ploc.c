@@ -171,6 +171,7 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p,
 {
 	morton_scratch s = { 0 };
 	double start = morton_now_ms();
+	team_host th;
 	int rc;
 
 	p->threads = morton_team_size(p->in);
@@ -185,7 +186,8 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p,
 	}
 	p->nodes = out->nodes;
 	p->prim_index = out->prim_index;
-	if ((rc = team_run(&p->team, p->threads, host->hardware_threads(ctx), run_phases, p)) < 0) {
+	team_host_init(&th, host, ctx);
+	if ((rc = team_run_on(&p->team, &th, p->threads, run_phases, p)) < 0) {
 		host->set_error(ctx, "cannot set up the thread team");
 		goto out;
 	}

@@ -203,7 +203,7 @@ static void search_member(void *arg, unsigned t)
 	reinsert_search(arg);
 }
 
-static int iterate(reinsert *r, const struct params *o, uint32_t threads, uint32_t cpus)
+static int iterate(reinsert *r, const struct params *o, uint32_t threads, const team_host *th)
 {
 	double total = inner_area(r);
 
@@ -213,7 +213,7 @@ static int iterate(reinsert *r, const struct params *o, uint32_t threads, uint32
 
 		choose(r, o->batch);
 		atomic_store_explicit(&r->next, 0, memory_order_relaxed);
-		if ((rc = team_run(&r->team, threads, cpus, search_member, r)) < 0)
+		if ((rc = team_run_on(&r->team, th, threads, search_member, r)) < 0)
 			return rc;
 		change = apply(r);
 		if (-change < o->min_gain * total || change == 0)
@@ -231,8 +231,10 @@ static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct
 	reinsert r = { .nodes = tree->nodes, .node_count = tree->node_count,
 	               .max_visits = (uint32_t)o->max_visits, .children = o->children };
 	size_t n = tree->node_count;
+	team_host th;
 	int rc;
 
+	team_host_init(&th, host, ctx);
 	r.parent = malloc(n * sizeof(*r.parent));
 	r.cand = malloc(n * sizeof(*r.cand));
 	r.moves = malloc(n * sizeof(*r.moves));
@@ -244,7 +246,7 @@ static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct
 		goto out;
 	}
 	find_parents(&r);
-	if ((rc = iterate(&r, o, input->threads, host->hardware_threads(ctx))) < 0)
+	if ((rc = iterate(&r, o, input->threads, &th)) < 0)
 		host->set_error(ctx, "cannot start the search threads");
 out:
 	free(r.parent);

@@ -159,7 +159,8 @@ static int alloc_sweep(sah_builder *b, const bvhlab_build_input *input)
 }
 
 int sah_builder_init(sah_builder *b, const sah_options *opt,
-                     const bvhlab_build_input *input, bvhlab_build_output *output)
+                     const bvhlab_build_input *input, bvhlab_build_output *output,
+                     const team_host *th)
 {
 	int rc = -ENOMEM;
 
@@ -167,6 +168,7 @@ int sah_builder_init(sah_builder *b, const sah_options *opt,
 	if (!input_ok(opt, input, output))
 		return -EINVAL;
 	b->opt = *opt;
+	b->th = th;
 	b->prim_count = input->prim_count;
 	b->root_box = input->bounds;
 	b->nodes = output->nodes;

@@ -111,13 +111,15 @@ int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options
 /*
  * Prepares a build of input into output (prim_index needs prim_count
  * slots, nodes 2 * prim_count - 1): copies the primitives into the working
+ * arrays (with up to input->threads threads of th's build)
  * arrays and, for sweep, presorts them along each axis (LSD radix sort,
  * stable) and allocates the partition scratch.
  * Reserves node slot 0 for the root. 0, -EINVAL (bad input or too small
  * output) or -ENOMEM; on failure nothing is left allocated.
  */
 int sah_builder_init(sah_builder *b, const sah_options *opt,
-                     const bvhlab_build_input *input, bvhlab_build_output *output);
+                     const bvhlab_build_input *input, bvhlab_build_output *output,
+                     const team_host *th);
 
 /* The job that builds the whole tree into node 0. */
 void sah_builder_root(const sah_builder *b, sah_job *root);

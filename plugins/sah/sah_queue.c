@@ -67,9 +67,7 @@ struct queue {
 	sah_builder *b;
 	int policy;
 	uint32_t depth, low_mark, min_job;
-	const bvhlab_host *host;
-	bvhlab_build_ctx *ctx;
-	atomic_uint next_worker; /* hands out worker numbers for pin_thread */
+	team tm; /* the workers (its barrier goes unused) */
 };
 
 /* Private pending children of one queue2t worker. Entries shrink from lo
@@ -203,20 +201,13 @@ static void run_queue2t(struct queue *q, const sah_job *job)
 	}
 }
 
-/* With "pin": true each worker gets its own physical core (a no-op otherwise). */
-static void pin(struct queue *q)
-{
-	uint32_t id = atomic_fetch_add_explicit(&q->next_worker, 1, memory_order_relaxed);
-	if (BVHLAB_HOST_HAS(q->host, pin_thread))
-		q->host->pin_thread(q->ctx, id);
-}
-
-static void *worker(void *arg)
+/* Every member of the team, the calling thread too (pinned by the layer). */
+static void worker(void *arg, unsigned t)
 {
 	struct queue *q = arg;
 	sah_job job;
 
-	pin(q);
+	(void)t;
 	while (queue_take(q, &job)) {
 		if (q->policy == POLICY_DEPTH)
 			run_depth(q, &job);
@@ -224,7 +215,6 @@ static void *worker(void *arg)
 			run_queue2t(q, &job);
 		queue_done(q);
 	}
-	return NULL;
 }
 
 static int queue_init(struct queue *q, sah_builder *b, uint32_t threads,
@@ -243,7 +233,6 @@ static int queue_init(struct queue *q, sah_builder *b, uint32_t threads,
 		return -rc;
 	}
 	atomic_init(&q->waiting, 0);
-	atomic_init(&q->next_worker, 0);
 	q->b = b;
 	q->policy = cfg->policy;
 	q->depth = cfg->depth;
@@ -261,32 +250,25 @@ static void queue_destroy(struct queue *q)
 
 /* The calling thread works too; a worker that fails to start only means
  * fewer hands on the same queue. */
-static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
-                    const sah_job *root, uint32_t asked, void *arg)
+static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t asked,
+                    void *arg)
 {
 	/* no more OS threads than the scene has work for */
 	uint32_t threads = sah_useful_threads(asked, root);
 	struct queue q;
-	pthread_t *tids = calloc(threads, sizeof(*tids));
-	uint32_t started = 0;
-	int rc = tids ? queue_init(&q, b, threads, arg) : -ENOMEM;
+	int rc = queue_init(&q, b, threads, arg);
 
 	if (rc < 0) {
-		host->set_error(ctx, "cannot set up the job queue (%d)", rc);
-		free(tids);
+		th->host->set_error(th->ctx, "cannot set up the job queue (%d)", rc);
 		return rc;
 	}
-	q.host = host;
-	q.ctx = ctx;
 	/* The first push cannot fail: the heap starts with room. */
 	queue_push(&q, root);
-	for (uint32_t i = 1; i < threads; i++)
-		started += sah_thread_start(&tids[started], worker, &q) == 0;
-	worker(&q);
-	for (uint32_t i = 0; i < started; i++)
-		pthread_join(tids[i], NULL);
+	rc = team_run_on(&q.tm, th, threads, worker, &q);
+	/* Without a barrier no worker started: the calling thread does it all. */
+	if (rc < 0)
+		worker(&q, 0);
 	queue_destroy(&q);
-	free(tids);
 	return 0;
 }
 

@@ -11,11 +11,10 @@
 #include "sah_threads.h"
 
 /* The reference schedule: the whole tree as one subtree, on this thread. */
-static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
-                    const sah_job *root, uint32_t threads, void *arg)
+static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t threads,
+                    void *arg)
 {
-	(void)host;
-	(void)ctx;
+	(void)th;
 	(void)threads;
 	(void)arg;
 	sah_build_subtree(b, root);

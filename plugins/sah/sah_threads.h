@@ -1,7 +1,9 @@
 /*
  * What the SAH plugins share besides the split kernel: one build frame
  * around a scheduler (sah_seq's scheduler is sah_build_subtree on the calling
- * thread), and thread creation with a stack large enough for the kernel.
+ * thread), and a subtree on a thread of its own. Threads come from the
+ * thread layer (team.h), which pins them and gives them the stack the
+ * kernel needs.
  *
  * The frame does the checks, reads the options, ensures the output
  * capacity, sets the kernel up and tears it down, and hands the root job to
@@ -13,26 +15,19 @@
 #ifndef BVHLAB_SAH_THREADS_H
 #define BVHLAB_SAH_THREADS_H
 
-#include <pthread.h>
 #include <stdint.h>
 
 #include <bvhlab/builder.h>
 
 #include "sah_kernel.h"
-
-/*
- * Thread stacks: the binned split keeps ~30 KB of bins on the stack and
- * schedulers may recurse a few levels around it; 8 MiB matches the usual
- * main-thread stack, so nothing is safe there that would fail here.
- */
-#define SAH_THREAD_STACK (8u << 20)
+#include "team.h"
 
 /* Builds the tree below root with at most `threads` threads (>= 1), the
- * calling one included. 0 with every job done, or a negative errno after
- * host->set_error (called from the calling thread only). */
-typedef int (*sah_scheduler_fn)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                                sah_builder *b, const sah_job *root, uint32_t threads,
-                                void *arg);
+ * calling one included (worker 0), every thread started through th. 0
+ * with every job done, or a negative errno after th->host->set_error
+ * (called from the calling thread only). */
+typedef int (*sah_scheduler_fn)(team_host *th, sah_builder *b, const sah_job *root,
+                                uint32_t threads, void *arg);
 
 /* The whole build() of a SAH plugin around `schedule`: 0, or a negative
  * errno after host->set_error. */
@@ -57,24 +52,16 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	BVHLAB_PLUGIN(.name = plugin_name, .flags = plugin_flags, .summary = plugin_summary, \
 	              .option_count = SAH_OPTION_COUNT, .options = options, .build = build)
 
-/*
- * pthread_create with a SAH_THREAD_STACK stack. 0, or a negative errno
- * (the caller then does the work itself: every scheduler stays correct
- * with fewer threads than it asked for).
- */
-int sah_thread_start(pthread_t *tid, void *(*fn)(void *), void *arg);
-
 /* A job built whole by sah_build_subtree on a thread of its own. */
 typedef struct sah_subtree_task {
 	sah_builder *b;
 	sah_job job;
-	pthread_t tid;
-	int started; /* 1 once the thread runs: it must be joined */
+	team_thread thread;
 } sah_subtree_task;
 
 /* Starts task on a new thread, or, when that fails, builds it right away on
  * the calling thread. Either way sah_subtree_join finishes it. */
-void sah_subtree_spawn(sah_subtree_task *task);
+void sah_subtree_spawn(team_host *th, sah_subtree_task *task);
 void sah_subtree_join(sah_subtree_task *task);
 
 static inline uint32_t sah_job_size(const sah_job *job)
@@ -84,7 +71,7 @@ static inline uint32_t sah_job_size(const sah_job *job)
 
 /*
  * Threads worth starting for a root job: one per SAH_PRIMS_PER_THREAD
- * primitives at most. A thread costs its start-up and an 8 MiB stack, and
+ * primitives at most. A thread costs its start-up and a TEAM_STACK, and
  * below this size the jobs are too few to keep more of them busy; a
  * config asking for 1024 threads on a small scene gets a few.
  */

@@ -12,6 +12,8 @@
 
 #include <bvhlab/builder.h>
 
+#include "team.h"
+
 enum sah_method {
 	SAH_SWEEP = 0,  /* exact SAH over presorted centroids */
 	SAH_BINNED = 1, /* binned SAH */
@@ -87,6 +89,7 @@ _Static_assert(sizeof(sah_prim) == 32, "sah_prim is 32 bytes");
  */
 typedef struct sah_builder {
 	sah_options opt;            /* copy of the build parameters */
+	const team_host *th;        /* the build's thread layer (the input copy) */
 	uint32_t prim_count;        /* primitives in the build, >= 1 */
 	bvhlab_aabb root_box;       /* input->bounds */
 	bvhlab_aabb root_cbox;      /* bounds of all centroids (computed) */

@@ -134,6 +134,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 
 	if (rc < 0)
 		return rc;
+	team_host_init(&B.th, host, ctx);
 	want = ceil(B.opt.split_factor * input->prim_count);
 	B.capacity = want >= (double)UINT32_MAX / 2 ? UINT32_MAX / 2 : (uint32_t)want;
 	if (B.capacity < input->prim_count)

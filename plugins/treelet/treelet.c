@@ -41,7 +41,7 @@ static void member(void *arg, unsigned m)
 }
 
 static int rounds(treelet *t, int64_t count, uint32_t *scratch, unsigned threads,
-                  uint32_t cpus)
+                  const team_host *th)
 {
 	uint32_t task_nodes = t->node_count / TASK_SHARE;
 
@@ -52,7 +52,7 @@ static int rounds(treelet *t, int64_t count, uint32_t *scratch, unsigned threads
 		treelet_plan(t, task_nodes, scratch);
 		atomic_store_explicit(&t->next, 0, memory_order_relaxed);
 		atomic_store_explicit(&t->changed, 0, memory_order_relaxed);
-		if ((rc = team_run(&t->team, threads, cpus, member, t)) < 0)
+		if ((rc = team_run_on(&t->team, th, threads, member, t)) < 0)
 			return rc;
 		uint64_t changed = atomic_load_explicit(&t->changed, memory_order_relaxed);
 		for (uint32_t i = t->top_begin; i < t->top_end; i++)
@@ -81,6 +81,7 @@ static int optimise(void *arg, bvhlab_build_output *tree)
 	              .size = (uint32_t)o->size, .max_leaf = (uint32_t)o->max_leaf };
 	size_t n = tree->node_count;
 	uint32_t *scratch;
+	team_host th;
 	int rc;
 
 	if (n < 5)
@@ -95,7 +96,8 @@ static int optimise(void *arg, bvhlab_build_output *tree)
 		rc = -ENOMEM;
 		goto out;
 	}
-	rc = rounds(&t, o->rounds, scratch, o->input->threads, o->host->hardware_threads(o->ctx));
+	team_host_init(&th, o->host, o->ctx);
+	rc = rounds(&t, o->rounds, scratch, o->input->threads, &th);
 	if (rc < 0)
 		o->host->set_error(o->ctx, "cannot start the threads");
 out:
