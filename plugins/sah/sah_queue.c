@@ -47,10 +47,12 @@ static const bvhlab_option_decl options[] = {
 
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
-enum policy { POLICY_QUEUE2T, POLICY_DEPTH };
+/* The choices of option policy, in order. */
+enum policy { POLICY_QUEUE2T, POLICY_DEPTH, POLICY_AUTO };
 
-/* The plugin's own options, resolved ("auto" already decided). */
+/* The plugin's options ("auto" decided before the build). */
 struct queue_config {
+	sah_options sah;
 	int policy;
 	uint32_t depth, min_job;
 };
@@ -272,47 +274,25 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 	return 0;
 }
 
-static int read_config(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                       const bvhlab_build_input *input, struct queue_config *cfg)
-{
-	const char *policy;
-	int64_t depth, min_job;
-
-	if (host->option_string(ctx, "policy", &policy) < 0 || !policy ||
-	    host->option_int(ctx, "depth", &depth) < 0 ||
-	    host->option_int(ctx, "min_job", &min_job) < 0) {
-		host->set_error(ctx, "options policy, depth and min_job are not available");
-		return -EINVAL;
-	}
-	if (strcmp(policy, "depth") == 0)
-		cfg->policy = POLICY_DEPTH;
-	else if (strcmp(policy, "queue2t") == 0)
-		cfg->policy = POLICY_QUEUE2T;
-	else if (strcmp(policy, "auto") == 0)
-		cfg->policy = input->prim_count < AUTO_QUEUE_FROM ? POLICY_DEPTH : POLICY_QUEUE2T;
-	else {
-		host->set_error(ctx, "option \"policy\" = \"%s\" is not queue2t, depth or auto",
-		                policy);
-		return -EINVAL;
-	}
-	if (depth < 0 || depth > 30 || min_job < 1 || min_job > (1 << 30)) {
-		host->set_error(ctx, "option \"depth\" or \"min_job\" is out of range");
-		return -EINVAL;
-	}
-	cfg->depth = (uint32_t)depth;
-	cfg->min_job = (uint32_t)min_job;
-	return 0;
-}
+static const plugin_field fields[] = {
+	SAH_OPTION_FIELDS(struct queue_config),
+	PLUGIN_FIELD(struct queue_config, policy, "policy", CHOICE),
+	PLUGIN_FIELD(struct queue_config, depth, "depth", U32),
+	PLUGIN_FIELD(struct queue_config, min_job, "min_job", U32),
+};
 
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
 	struct queue_config cfg;
-	int rc = read_config(host, ctx, input, &cfg);
+	int rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
+	                             sizeof(fields) / sizeof(fields[0]), &cfg);
 
 	if (rc < 0)
 		return rc;
-	return sah_run_build(host, ctx, input, output, schedule, &cfg);
+	if (cfg.policy == POLICY_AUTO)
+		cfg.policy = input->prim_count < AUTO_QUEUE_FROM ? POLICY_DEPTH : POLICY_QUEUE2T;
+	return sah_run_build(host, ctx, input, output, &cfg.sah, schedule, &cfg);
 }
 
 BVHLAB_PLUGIN(.name = "sah_queue", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,

@@ -291,18 +291,26 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 	return rc;
 }
 
+struct tasks_options {
+	sah_options sah;
+	uint32_t parallel_min;
+};
+
+static const plugin_field fields[] = {
+	SAH_OPTION_FIELDS(struct tasks_options),
+	PLUGIN_FIELD(struct tasks_options, parallel_min, "parallel_min", U32),
+};
+
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	int64_t v;
-	uint32_t parallel_min;
+	struct tasks_options o;
+	int rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
+	                             sizeof(fields) / sizeof(fields[0]), &o);
 
-	if (host->option_int(ctx, "parallel_min", &v) < 0 || v < 128 || v > (1 << 30)) {
-		host->set_error(ctx, "option \"parallel_min\" is not available or out of range");
-		return -EINVAL;
-	}
-	parallel_min = (uint32_t)v;
-	return sah_run_build(host, ctx, input, output, schedule, &parallel_min);
+	if (rc < 0)
+		return rc;
+	return sah_run_build(host, ctx, input, output, &o.sah, schedule, &o.parallel_min);
 }
 
 BVHLAB_PLUGIN(.name = "sah_tasks", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,

@@ -24,10 +24,9 @@ static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 }
 
 int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                       const bvhlab_build_input *input, bvhlab_build_output *output,
-                       sah_scheduler_fn schedule, void *arg)
+                  const bvhlab_build_input *input, bvhlab_build_output *output,
+                  sah_options *opt, sah_scheduler_fn schedule, void *arg)
 {
-	sah_options opt;
 	sah_builder b;
 	sah_job root;
 	team_host th;
@@ -37,11 +36,11 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = sah_options_read(host, ctx, &opt)) < 0 ||
+	if ((rc = sah_options_resolve(host, ctx, opt)) < 0 ||
 	    (rc = ensure_capacity(host, ctx, input, output)) < 0)
 		return rc;
 	team_host_init(&th, host, ctx);
-	rc = sah_builder_init(&b, &opt, input, output, &th);
+	rc = sah_builder_init(&b, opt, input, output, &th);
 	if (rc < 0) {
 		host->set_error(ctx, "%s", rc == -ENOMEM ? "out of memory for the SAH scratch"
 		                                         : "invalid build input");

@@ -5,7 +5,8 @@
  * thread layer (team.h), which pins them and gives them the stack the
  * kernel needs.
  *
- * The frame does the checks, reads the options, ensures the output
+ * The frame does the checks, resolves the options the plugin filled
+ * (SAH_OPTION_FIELDS), ensures the output
  * capacity, sets the kernel up and tears it down, and hands the root job to
  * the scheduler, which
  * must have processed every job of the tree, with every thread it started
@@ -29,11 +30,17 @@
 typedef int (*sah_scheduler_fn)(team_host *th, sah_builder *b, const sah_job *root,
                                 uint32_t threads, void *arg);
 
-/* The whole build() of a SAH plugin around `schedule`: 0, or a negative
- * errno after host->set_error. */
+/* The whole build() of a SAH plugin around `schedule`, with the options
+ * as filled from SAH_OPTION_FIELDS: 0, or a negative errno after
+ * host->set_error. */
 int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                       const bvhlab_build_input *input, bvhlab_build_output *output,
-                       sah_scheduler_fn schedule, void *arg);
+                  const bvhlab_build_input *input, bvhlab_build_output *output,
+                  sah_options *opt, sah_scheduler_fn schedule, void *arg);
+
+/* The option struct of a plugin with the shared options only. */
+struct sah_plain_options {
+	sah_options sah;
+};
 
 /*
  * The options, build() and entry point of a SAH plugin with the shared
@@ -42,12 +49,17 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
  */
 #define SAH_PLAIN_PLUGIN(plugin_name, plugin_flags, plugin_summary, schedule)            \
 	static const bvhlab_option_decl options[] = { SAH_OPTION_DECLS };                  \
+	static const plugin_field fields[] = { SAH_OPTION_FIELDS(struct sah_plain_options) }; \
 	_Static_assert(sizeof(options) / sizeof(options[0]) == SAH_OPTION_COUNT,           \
 	               "SAH_OPTION_COUNT matches SAH_OPTION_DECLS");                       \
 	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,                   \
 	                 const bvhlab_build_input *input, bvhlab_build_output *output)     \
 	{                                                                                  \
-		return sah_run_build(host, ctx, input, output, schedule, NULL);            \
+		struct sah_plain_options o;                                                \
+		int rc = plugin_options_fill(host, ctx, options, SAH_OPTION_COUNT, fields,  \
+		                             SAH_OPTION_COUNT, &o);                        \
+		return rc < 0 ? rc : sah_run_build(host, ctx, input, output, &o.sah,       \
+		                                   schedule, NULL);                        \
 	}                                                                                  \
 	BVHLAB_PLUGIN(.name = plugin_name, .flags = plugin_flags, .summary = plugin_summary, \
 	              .option_count = SAH_OPTION_COUNT, .options = options, .build = build)

@@ -36,10 +36,19 @@ enum sah_quality {
 	SAH_FAST = 1,
 };
 
-/* Build parameters, as read from the plugin options. */
+/* What option simd asks for: its choices auto|avx2|sse, in order. */
+enum sah_simd_ask {
+	SAH_ASK_AUTO = 0,
+	SAH_ASK_AVX2 = 1,
+	SAH_ASK_SSE = 2,
+};
+
+/* Build parameters, as read from the plugin options (the enums are their
+ * choices' indices: sweep|binned, high|fast). */
 typedef struct sah_options {
 	int method;        /* enum sah_method */
-	int simd;          /* enum sah_simd; same trees either way */
+	int simd_asked;    /* enum sah_simd_ask, as the option says */
+	int simd;          /* enum sah_simd, resolved; same trees either way */
 	int quality;       /* enum sah_quality */
 	uint32_t bins;     /* bins per axis for SAH_BINNED, 2..SAH_MAX_BINS */
 	uint32_t max_leaf; /* largest leaf, >= 1 (except coincident centroids) */

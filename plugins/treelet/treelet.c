@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include "leaves.h"
+#include "plugin_options.h"
 #include "treelet.h"
 
 static const bvhlab_option_decl options[] = {
@@ -109,24 +110,22 @@ out:
 	return rc;
 }
 
+static const plugin_field fields[] = {
+	PLUGIN_FIELD(struct params, size, "size", I64),
+	PLUGIN_FIELD(struct params, rounds, "rounds", I64),
+	PLUGIN_FIELD(struct params, leaves, "leaves", BOOL),
+	PLUGIN_FIELD(struct params, max_leaf, "max_leaf", I64),
+};
+
 static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *tree)
 {
 	struct params o = { .host = host, .ctx = ctx, .input = input };
 	int rc;
 
-	if ((rc = host->option_int(ctx, "size", &o.size)) < 0 ||
-	    (rc = host->option_int(ctx, "rounds", &o.rounds)) < 0 ||
-	    (rc = host->option_bool(ctx, "leaves", &o.leaves)) < 0 ||
-	    (rc = host->option_int(ctx, "max_leaf", &o.max_leaf)) < 0) {
-		host->set_error(ctx, "cannot read the options");
+	if ((rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
+	                              sizeof(fields) / sizeof(fields[0]), &o)) < 0)
 		return rc;
-	}
-	if (o.size < 3 || o.size > TREELET_MAX || o.rounds < 1 || o.max_leaf < 1 ||
-	    o.max_leaf > 64) {
-		host->set_error(ctx, "options out of range");
-		return -EINVAL;
-	}
 	/* the costs assume the final cut, so it is made with or without splitting */
 	return leaves_run(host, ctx, input, tree, o.leaves, true, (uint32_t)o.max_leaf, optimise,
 	                  &o);
