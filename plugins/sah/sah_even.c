@@ -72,5 +72,4 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 }
 
 SAH_PLAIN_PLUGIN("sah_even", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	"parallel SAH, thesis \"symmetric\": a thread per split, budget halved",
-	schedule)
+	"parallel SAH, thesis \"symmetric\": a thread per split, budget halved")

@@ -45,12 +45,10 @@ static const bvhlab_option_decl options[] = {
 	  .def_int = 1024, .min = 1, .max = 1 << 30 },
 };
 
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
 /* The choices of option policy, in order. */
 enum policy { POLICY_QUEUE2T, POLICY_DEPTH, POLICY_AUTO };
 
-/* The plugin's options ("auto" decided before the build). */
+/* The plugin's options ("auto" is decided by queue_init). */
 struct queue_config {
 	sah_options sah;
 	int policy;
@@ -236,7 +234,8 @@ static int queue_init(struct queue *q, sah_builder *b, uint32_t threads,
 	}
 	atomic_init(&q->waiting, 0);
 	q->b = b;
-	q->policy = cfg->policy;
+	q->policy = cfg->policy != POLICY_AUTO ? cfg->policy
+	            : b->prim_count < AUTO_QUEUE_FROM ? POLICY_DEPTH : POLICY_QUEUE2T;
 	q->depth = cfg->depth;
 	q->min_job = cfg->min_job;
 	q->low_mark = threads > UINT32_MAX / 2 ? UINT32_MAX : 2 * threads;
@@ -281,20 +280,6 @@ static const plugin_field fields[] = {
 	PLUGIN_FIELD(struct queue_config, min_job, "min_job", U32),
 };
 
-static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *input, bvhlab_build_output *output)
-{
-	struct queue_config cfg;
-	int rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
-	                             sizeof(fields) / sizeof(fields[0]), &cfg);
-
-	if (rc < 0)
-		return rc;
-	if (cfg.policy == POLICY_AUTO)
-		cfg.policy = input->prim_count < AUTO_QUEUE_FROM ? POLICY_DEPTH : POLICY_QUEUE2T;
-	return sah_run_build(host, ctx, input, output, &cfg.sah, schedule, &cfg);
-}
-
-BVHLAB_PLUGIN(.name = "sah_queue", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.summary = "parallel SAH, thesis node queue: workers share a job queue, exact termination",
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+SAH_PLUGIN("sah_queue", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	"parallel SAH, thesis node queue: workers share a job queue, exact termination",
+	struct queue_config)

@@ -22,5 +22,4 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 }
 
 SAH_PLAIN_PLUGIN("sah_seq", BVHLAB_BUILDER_DETERMINISTIC,
-	"sequential top-down SAH (exact sweep or binned), the reference",
-	schedule)
+	"sequential top-down SAH (exact sweep or binned), the reference")

@@ -59,7 +59,11 @@ static const bvhlab_option_decl options[] = {
 	SAH_QUALITY_DECL,
 };
 
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
+/* Where the options go. */
+struct tasks_options {
+	sah_options sah;
+	uint32_t parallel_min;
+};
 
 /* A node larger than 64 (the most max_leaf allows) is never a leaf, which
  * the team split relies on. */
@@ -273,9 +277,10 @@ static void crew_member(void *arg, unsigned t)
 static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t asked,
                     void *arg)
 {
+	const struct tasks_options *o = arg;
 	/* no more OS threads than the scene has work for */
 	uint32_t threads = sah_useful_threads(asked, root);
-	struct crew tm = { .b = b, .parallel_min = *(const uint32_t *)arg, .root = root };
+	struct crew tm = { .b = b, .parallel_min = o->parallel_min, .root = root };
 	int rc;
 
 	atomic_init(&tm.next, 0);
@@ -291,28 +296,11 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 	return rc;
 }
 
-struct tasks_options {
-	sah_options sah;
-	uint32_t parallel_min;
-};
-
 static const plugin_field fields[] = {
 	SAH_OPTION_FIELDS(struct tasks_options),
 	PLUGIN_FIELD(struct tasks_options, parallel_min, "parallel_min", U32),
 };
 
-static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *input, bvhlab_build_output *output)
-{
-	struct tasks_options o;
-	int rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
-	                             sizeof(fields) / sizeof(fields[0]), &o);
-
-	if (rc < 0)
-		return rc;
-	return sah_run_build(host, ctx, input, output, &o.sah, schedule, &o.parallel_min);
-}
-
-BVHLAB_PLUGIN(.name = "sah_tasks", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.summary = "parallel binned SAH: large nodes split by all threads, small ones as tasks",
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+SAH_PLUGIN("sah_tasks", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	"parallel binned SAH: large nodes split by all threads, small ones as tasks",
+	struct tasks_options)

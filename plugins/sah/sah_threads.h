@@ -37,32 +37,40 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *output,
                   sah_options *opt, sah_scheduler_fn schedule, void *arg);
 
+/*
+ * build() and the entry point of a SAH plugin, at file scope after its
+ * `options` (declarations), `fields` (where they go, plugin_options.h) and
+ * `schedule`: the options fill a `struct options_type`, whose first member
+ * is `sah_options sah`, and the schedule gets that struct as its argument.
+ */
+#define SAH_PLUGIN(plugin_name, plugin_flags, plugin_summary, options_type)                \
+	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,                   \
+	                 const bvhlab_build_input *input, bvhlab_build_output *output)     \
+	{                                                                                  \
+		options_type o;                                                            \
+		int rc = plugin_options_fill(host, ctx, options,                           \
+		                             sizeof(options) / sizeof(options[0]), fields,  \
+		                             sizeof(fields) / sizeof(fields[0]), &o);      \
+		return rc < 0 ? rc : sah_run_build(host, ctx, input, output, &o.sah,       \
+		                                   schedule, &o);                          \
+	}                                                                                  \
+	BVHLAB_PLUGIN(.name = plugin_name, .flags = plugin_flags, .summary = plugin_summary, \
+	              .option_count = sizeof(options) / sizeof(options[0]),                \
+	              .options = options, .build = build)
+
 /* The option struct of a plugin with the shared options only. */
 struct sah_plain_options {
 	sah_options sah;
 };
 
-/*
- * The options, build() and entry point of a SAH plugin with the shared
- * options only, whose build is sah_run_build(schedule) without an argument;
- * at file scope, after schedule.
- */
-#define SAH_PLAIN_PLUGIN(plugin_name, plugin_flags, plugin_summary, schedule)            \
+/* SAH_PLUGIN for a plugin with the shared options only (its schedule's
+ * argument is then of no use to it). */
+#define SAH_PLAIN_PLUGIN(plugin_name, plugin_flags, plugin_summary)                      \
 	static const bvhlab_option_decl options[] = { SAH_OPTION_DECLS };                  \
 	static const plugin_field fields[] = { SAH_OPTION_FIELDS(struct sah_plain_options) }; \
 	_Static_assert(sizeof(options) / sizeof(options[0]) == SAH_OPTION_COUNT,           \
 	               "SAH_OPTION_COUNT matches SAH_OPTION_DECLS");                       \
-	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,                   \
-	                 const bvhlab_build_input *input, bvhlab_build_output *output)     \
-	{                                                                                  \
-		struct sah_plain_options o;                                                \
-		int rc = plugin_options_fill(host, ctx, options, SAH_OPTION_COUNT, fields,  \
-		                             SAH_OPTION_COUNT, &o);                        \
-		return rc < 0 ? rc : sah_run_build(host, ctx, input, output, &o.sah,       \
-		                                   schedule, NULL);                        \
-	}                                                                                  \
-	BVHLAB_PLUGIN(.name = plugin_name, .flags = plugin_flags, .summary = plugin_summary, \
-	              .option_count = SAH_OPTION_COUNT, .options = options, .build = build)
+	SAH_PLUGIN(plugin_name, plugin_flags, plugin_summary, struct sah_plain_options)
 
 /* A job built whole by sah_build_subtree on a thread of its own. */
 typedef struct sah_subtree_task {

@@ -66,5 +66,4 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 }
 
 SAH_PLAIN_PLUGIN("sah_uneven", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	"parallel SAH, thesis \"asymmetric\": only the larger child spawns threads",
-	schedule)
+	"parallel SAH, thesis \"asymmetric\": only the larger child spawns threads")
