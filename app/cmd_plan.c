@@ -112,8 +112,10 @@ static int check_builders(const struct config *cfg)
 		if (bvhlab_plugin_open(cb->plugin, &p, &err) < 0 ||
 		    bvhlab_options_init(&opts, bvhlab_plugin_builder(p)) < 0 ||
 		    config_apply_options(cfg, cb, &opts, &err) < 0) {
-			fprintf(stderr, "bvhlab: builder '%s': %s\n", cb->name,
-			        err.message[0] ? err.message : "out of memory");
+			if (!err.message[0])
+				error_set(&err, "out of memory");
+			config_locate_builder_error(cfg, cb, SIZE_MAX, &err);
+			fprintf(stderr, "bvhlab: %s\n", err.message);
 			bad = -1;
 		}
 		if (opts.values)

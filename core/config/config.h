@@ -106,6 +106,8 @@ struct config {
 	                          * of names, default wide: bit (1 << enum
 	                          * bvhlab_traversal) per traversal */
 	int ray_traversal; /* the main one (stack for "both", the first of an array) */
+	char *ray_device; /* "rays": "device", the cl_ traversals' OpenCL device spec
+	                   * (auto|gpu|cpu|P:D); NULL: auto */
 	char *report_reference; /* "report": {"reference"}, default "sah_seq": a builder
 	                         * name or, failing that, a plugin name */
 	bool has_camera;   /* "rays": {"camera": ...} given; else framed per scene */
@@ -153,6 +155,15 @@ const struct cJSON *config_grid_value(const struct config_builder *b,
 /* Same for the options of stage k of the builder's "refine" list. */
 int config_apply_refine_options(const struct config *cfg, const struct config_builder *b,
                                 size_t k, bvhlab_options *opts, bvhlab_error *err);
+
+/*
+ * Puts a builder's error in the form every config error has,
+ * FILE:LINE:COLUMN: builder 'NAME': message (the builder's object, or the
+ * refine stage k's when k < b->refine_count), unless the message already
+ * starts with the config's path (config_apply_options' do).
+ */
+void config_locate_builder_error(const struct config *cfg, const struct config_builder *b,
+                                 size_t stage, bvhlab_error *err);
 
 /* Replaces the thread list (command line --threads). */
 int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count);

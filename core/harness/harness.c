@@ -17,6 +17,7 @@
 #include "harness/harness_rounds.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
+#include "machine/machine.h"
 #include "output/results.h"
 #include "output/scene_images.h"
 #include "output/safe_file.h"
@@ -108,6 +109,14 @@ static const uint32_t *builder_threads(const struct harness *h, const struct con
 	return threads;
 }
 
+/* The runs a builder gets: harness_threads.c (one for a serial builder). */
+static bool applicable(const struct harness *h, const struct harness_builder *hb, size_t t)
+{
+	size_t n;
+	const uint32_t *threads = builder_threads(h, hb->cb, &n);
+	return harness_thread_applies(hb, threads, n, t, h->only != NULL);
+}
+
 /* A run left out by --only, or kept from the results resumed (counted as done). */
 static bool skip_run(struct harness *h, uint32_t id, const char *scene, const char *builder,
                      uint32_t threads)
@@ -127,6 +136,8 @@ static void record_all_failed(struct harness *h, size_t scene_index, const char 
 	size_t n, b = (size_t)(hb - h->builders);
 	const uint32_t *threads = builder_threads(h, hb->cb, &n);
 	for (size_t k = 0; k < n; k++) {
+		if (!applicable(h, hb, k))
+			continue;
 		struct run_record run = {.id = plan_run_id(h->cfg, scene_index, b, k),
 		                         .scene = scene, .builder = hb->cb->name,
 		                         .plugin = hb->cb->plugin, .threads = resolve_threads(threads[k]),
@@ -145,7 +156,8 @@ static bool scene_done(struct harness *h, const struct config_scene *cs, size_t 
 		size_t n;
 		const uint32_t *threads = builder_threads(h, &h->cfg->builders[b], &n);
 		for (size_t t = 0; t < n; t++) {
-			if (h->only && !h->only[plan_run_id(h->cfg, scene_index, b, t)])
+			if ((h->only && !h->only[plan_run_id(h->cfg, scene_index, b, t)]) ||
+			    !applicable(h, &h->builders[b], t))
 				continue;
 			total++;
 			done += results_has_run(&h->res, cs->name, h->cfg->builders[b].name,
@@ -206,7 +218,7 @@ static int image_buffers(const struct series_job *job, size_t n, uint32_t **node
 /* Traversal statistics on the valid tree, and the raw image data. A
  * failure here costs the numbers, not the run: the tree itself is fine. */
 static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
-                       struct series_report *rep, bvhlab_error *err)
+                       struct series_report *rep)
 {
 	const struct config *cfg = job->h->cfg;
 	size_t n = (size_t)cfg->ray_width * cfg->ray_height;
@@ -233,8 +245,9 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)
 		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
-	if (r < 0)
-		error_set(err, "tracing rays: %s", strerror(-r));
+	/* The run stays ok (its tree is); its "rays" says why there are no figures. */
+	if (r < 0 && !rep->rays.error[0])
+		snprintf(rep->rays.error, sizeof(rep->rays.error), "%s", strerror(-r));
 	free(nodes);
 	free(shade);
 }
@@ -272,7 +285,7 @@ static void series_work(void *arg, void *report, size_t size)
 			rep->has_epo = bvhlab_tree_epo(&s.tree, job->scene, EPO_SAMPLES, EPO_SEED,
 			                               &rep->epo) == 0;
 		if (rep->status == SERIES_OK)
-			trace_rays(job, &s.tree, rep, &err);
+			trace_rays(job, &s.tree, rep);
 	}
 	if (rep->status != SERIES_OK)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
@@ -302,7 +315,9 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->valid = rep->valid;
 	run->rays_checked = rep->rays_checked;
 	run->mismatches = rep->mismatches;
-	run->rays = rep->rays.measured ? &rep->rays : NULL;
+	rep->rays.error[sizeof(rep->rays.error) - 1] = '\0';
+	rep->rays.device[sizeof(rep->rays.device) - 1] = '\0';
+	run->rays = rep->rays.measured || rep->rays.error[0] ? &rep->rays : NULL;
 	for (uint32_t k = 0; k < rep->stage_count; k++)
 		rep->stages[k].plugin[sizeof(rep->stages[k].plugin) - 1] = '\0';
 	run->stages = rep->stages;
@@ -321,10 +336,13 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	char why[sizeof(rep->error)] = "", limited[sizeof(rep->error) + 64];
 	int outcome = ISOLATE_REPORTED;
 	struct isolate_limits limits = harness_run_limits(h->cfg, job->hb->cb);
+	run->load_before = machine_load_average();
 	if (h->cfg->isolate)
 		outcome = isolate_call(series_work, job, rep, size, &limits, why, sizeof(why));
 	else
 		series_work(job, rep, size);
+	run->load_after = machine_load_average();
+	run->load_read = true;
 	if (outcome == ISOLATE_REPORTED) {
 		report_to_run(rep, h->cfg->repeat, run);
 	} else {
@@ -412,6 +430,8 @@ static void run_builders(struct harness *h, const bvhlab_scene *scene,
 		size_t n;
 		const uint32_t *threads = builder_threads(h, hb->cb, &n);
 		for (size_t t = 0; t < n; t++) {
+			if (!applicable(h, hb, t))
+				continue;
 			struct series_job job = {.h = h, .scene = scene, .prims = prims, .hb = hb,
 			                         .threads = threads[t]};
 			run_one(h, &job, scene_index, b, t);
@@ -430,7 +450,8 @@ static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t sc
 	for (size_t b = 0; r == 0 && b < nb; b++) {
 		size_t n;
 		names[b] = h->cfg->builders[b].name;
-		threads[b] = resolve_threads(builder_threads(h, &h->cfg->builders[b], &n)[0]);
+		const uint32_t *list = builder_threads(h, &h->cfg->builders[b], &n);
+		threads[b] = resolve_threads(list[harness_first_run(&h->builders[b], list, n)]);
 	}
 	struct scene_images si = {.dir = h->cfg->output, .scene_index = scene_index,
 	                          .scene = scene->name, .width = h->cfg->ray_width,
@@ -484,16 +505,16 @@ out:
 
 static uint32_t count_runs(const struct harness *h)
 {
-	size_t total = plan_run_count(h->cfg), chosen = 0, n;
-	for (size_t id = 0; h->only && id < total; id++)
-		chosen += h->only[id];
-	if (h->only)
-		return (uint32_t)chosen;
-	for (size_t b = 0; b < h->cfg->builder_count; b++) {
-		builder_threads(h, &h->cfg->builders[b], &n);
-		chosen += n;
+	size_t chosen = 0, n;
+	for (size_t s = 0; s < h->cfg->scene_count; s++) {
+		for (size_t b = 0; b < h->cfg->builder_count; b++) {
+			builder_threads(h, &h->cfg->builders[b], &n);
+			for (size_t t = 0; t < n; t++)
+				chosen += (!h->only || h->only[plan_run_id(h->cfg, s, b, t)]) &&
+				          applicable(h, &h->builders[b], t);
+		}
 	}
-	return (uint32_t)(chosen * h->cfg->scene_count);
+	return (uint32_t)chosen;
 }
 
 /* Takes over the finished runs of the output folder's results.json. */
@@ -520,29 +541,47 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
                 bvhlab_error *err)
 {
 	struct harness h = {.cfg = cfg, .only = opts->only, .all_ok = true};
+	size_t bad_configs = 0;
 	progress_init(&h.progress, opts->quiet);
-	int r = opts->resume ? 0 : safe_claim_output(cfg->output, opts->force, err);
+	/* Every builder's plugin and options first: a config that cannot run
+	 * as written is refused whole (every error printed), before the output
+	 * folder is touched. */
+	int r = harness_open_builders(cfg, &h.builders, &bad_configs);
+	if (r < 0)
+		error_set(err, "out of memory opening plugins");
+	else if (bad_configs)
+		r = -EINVAL, error_set(err, "%s: %zu builder%s cannot run as configured (above); "
+		                       "nothing was run", cfg->path, bad_configs,
+		                       bad_configs == 1 ? "" : "s");
+	if (r == 0)
+		r = opts->resume ? 0 : safe_claim_output(cfg->output, opts->force, err);
 	if (r == 0)
 		r = results_init(&h.res, cfg, cfg->output, err);
 	if (r < 0)
-		return r;
+		goto out;
 	if (opts->plan_hash)
 		r = results_set_plan(&h.res, opts->plan_hash, plan_run_count(cfg), err);
 	bvhlab_set_pinning(cfg->pin);
 	if (r == 0 && opts->resume)
 		r = resume(&h, err);
+	for (size_t b = 0; r == 0 && !h.only && b < cfg->builder_count; b++) {
+		size_t n;
+		const uint32_t *threads = builder_threads(&h, h.builders[b].cb, &n);
+		if ((r = harness_note_not_applicable(&h.builders[b], threads, n, &h.res,
+		                                     opts->quiet)) < 0)
+			error_set(err, "out of memory");
+	}
 	if (r == 0)
 		r = results_write(&h.res, err);
 	if (r == 0)
 		harness_rounds_sweep(cfg->output);
-	if (r == 0 && (r = harness_open_builders(cfg, &h.builders)) < 0)
-		error_set(err, "out of memory opening plugins");
 	h.progress.total = count_runs(&h);
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
 		run_scene(&h, &cfg->scenes[s], s);
 	progress_finish(&h.progress);
-	harness_close_builders(cfg, h.builders);
 	harness_rounds_finish(&h.rounds);
 	results_finish(&h.res);
+out:
+	harness_close_builders(cfg, h.builders);
 	return r < 0 ? r : h.all_ok ? 0 : 1;
 }

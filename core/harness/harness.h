@@ -99,6 +99,7 @@ struct ray_settings {
 	uint32_t rounds;        /* slices min_ms is spread over (harness_rounds.c) */
 	unsigned traversals;    /* bit (1 << enum bvhlab_traversal) for each one measured */
 	int main;               /* the traversal whose hits feed images and diffuse rays */
+	const char *device;     /* the cl_ traversals' OpenCL device spec (NULL: auto) */
 };
 
 /* The config's settings (cfg NULL: one quick stack pass, all threads). */
@@ -112,7 +113,9 @@ void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_
  * each batch timed (bvhlab_trace_measure) with every traversal of rs.
  * nodes ([width * height], may be NULL) gets nodes visited per pixel,
  * shade ([3 * width * height], may be NULL) the shaded render, both from
- * the main traversal. 0 or a negative errno.
+ * the main traversal. 0 or a negative errno, with m->error saying why (it
+ * also names a traversal other than the main one that could not run: that
+ * one is left out of m and the others are measured).
  */
 int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
                        const bvhlab_camera *cam, const struct ray_settings *rs,

@@ -23,6 +23,9 @@ struct harness_builder {
 	const char *status;    /* of its runs when unusable: "failed", "crashed", "timeout" */
 	bool skipped;          /* optional ("optional": true) and its plugin could not be
 	                        * loaded: it has no runs at all */
+	bool bad_config;       /* its plugin (or a stage's) is not there or not a
+	                        * bvhlab plugin, or an option is wrong: the config
+	                        * is refused before anything runs */
 	bvhlab_error error;
 	struct harness_stage {
 		bvhlab_plugin *plugin;
@@ -37,10 +40,32 @@ struct isolate_limits harness_run_limits(const struct config *cfg,
 
 /*
  * Opens every builder of cfg into *out ([cfg->builder_count]); a builder
- * that cannot be used keeps its status and message (printed to stderr
- * too), and the others go on. 0, or -ENOMEM.
+ * that cannot be used keeps its status and message, and the others go on.
+ * Messages go to stderr, each once (a grid's builders share theirs), as
+ * FILE:LINE:COLUMN: builder 'NAME': ...; *bad_configs counts the builders
+ * whose config is wrong (bad_config). A plugin that crashes or hangs while
+ * loading is not a config error: its runs are recorded as such. 0, or
+ * -ENOMEM.
  */
-int harness_open_builders(const struct config *cfg, struct harness_builder **out);
+int harness_open_builders(const struct config *cfg, struct harness_builder **out,
+                          size_t *bad_configs);
 void harness_close_builders(const struct config *cfg, struct harness_builder *builders);
+
+/*
+ * Runs of a builder without the PARALLEL flag (harness_threads.c): it
+ * ignores its thread count, so it runs once per scene, at the first of its
+ * thread counts `threads[n]` that resolves to 1 (else its first); the
+ * others are not applicable. A builder whose plugin did not load keeps all
+ * its runs (to record them), and so do runs picked by id (`by_id`: a plan
+ * lists every run of its config).
+ */
+size_t harness_first_run(const struct harness_builder *hb, const uint32_t *threads, size_t n);
+bool harness_thread_applies(const struct harness_builder *hb, const uint32_t *threads,
+                            size_t n, size_t t, bool by_id);
+/* Says which thread counts are not applicable to hb, on stderr (unless
+ * quiet) and in results.json's "not_applicable". 0, or -ENOMEM. */
+struct results;
+int harness_note_not_applicable(const struct harness_builder *hb, const uint32_t *threads,
+                                size_t n, struct results *res, bool quiet);
 
 #endif

@@ -244,6 +244,10 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddItemToObject(o, "validation", validation_json(run));
 	if (run->rays)
 		cJSON_AddItemToObject(o, "rays", results_rays_json(run->rays));
+	if (run->load_read) {
+		cJSON_AddNumberToObject(o, "load_before", run->load_before);
+		cJSON_AddNumberToObject(o, "load_after", run->load_after);
+	}
 	cJSON_AddItemToArray(res->runs, o);
 	return 0;
 }
@@ -465,8 +469,10 @@ int results_set_scene_image(struct results *res, const char *scene, const char *
 	if (strcmp(kind, "legend") == 0) {
 		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_min");
 		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_max");
+		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_scale");
 		cJSON_AddNumberToObject(images, "heat_min", lo);
 		cJSON_AddNumberToObject(images, "heat_max", hi);
+		cJSON_AddStringToObject(images, "heat_scale", "log"); /* image_heat's */
 	}
 	return 0;
 }

@@ -36,6 +36,8 @@ struct ray_metrics {
 	/* by enum bvhlab_traversal */
 	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
 	uint64_t disagreements; /* rays whose hits differ from the main traversal's */
+	char device[96];        /* the OpenCL device of the cl_ traversals ("" if none ran) */
+	char error[512];        /* why the rays, or one traversal, could not be traced ("") */
 };
 
 /* Peak memory of one run's builds (harness/harness_memory.c measures it). */
@@ -81,6 +83,11 @@ struct run_record {
 	uint32_t stage_count;
 	const bvhlab_phase *phases; /* [phase_count] the builder's phase medians */
 	uint32_t phase_count;
+	/* The machine's 1-minute load average just before and after the run's
+	 * series (-1: unreadable), so a report can tell a busy machine;
+	 * recorded when load_read. */
+	bool load_read;
+	double load_before, load_after;
 };
 
 
@@ -95,6 +102,13 @@ void results_finish(struct results *res);
 int results_add_scene(struct results *res, const char *name, const char *source,
                       uint32_t triangles, const char *error);
 int results_add_run(struct results *res, const struct run_record *run);
+/*
+ * "not_applicable": [{"builder", "threads": [...], "reason"}]: thread counts
+ * of the config that a builder was not run at (one without the PARALLEL
+ * flag runs once per scene); replaces the builder's earlier entry.
+ */
+int results_set_not_applicable(struct results *res, const char *builder,
+                               const uint32_t *threads, size_t count, const char *reason);
 
 /* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of docs/design.md. */
 struct cJSON *results_rays_json(const struct ray_metrics *m);
