@@ -176,7 +176,7 @@ int main(void)
 	static const char *const stages[] = { "reinsert", "treelet" };
 	/* Large enough that every plugin starts its second thread (sah_queue
 	 * and sah_tasks want 4096 primitives a thread, lbvh and ploc 512). */
-	bvhlab_scene *scene = generate("soup", 20000, 0, 0);
+	bvhlab_scene *scene = generate("soup", 10000, 0, 0);
 	bvhlab_prims prims;
 	bvhlab_error err = { { 0 } };
 
