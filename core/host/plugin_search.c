@@ -58,31 +58,40 @@ static bool has_so_suffix(const char *s, size_t *stem)
 	return n > 3 && strcmp(s + n - 3, ".so") == 0;
 }
 
-/* NAME.so directly in dir, or NAME/NAME.so one level down. */
-static int scan_entry(struct names *ns, const char *dir, const struct dirent *e)
+/*
+ * A plugin one folder down is NAME/NAME.so, or a family's member: folder
+ * FAMILY holds FAMILY_*.so (the build tree's plugins/sah/ holds sah_seq.so,
+ * sah_even.so, ...). Other files there are not plugins (the tests' folders
+ * of crashing and hanging libraries are not named after them).
+ */
+static bool in_family(const char *folder, const char *file, size_t stem)
 {
-	size_t stem;
-	if (e->d_name[0] == '.')
-		return 0;
-	if (has_so_suffix(e->d_name, &stem))
-		return add(ns, e->d_name, stem);
-	char path[4096];
-	struct stat st;
-	int n = snprintf(path, sizeof(path), "%s/%s/%s.so", dir, e->d_name, e->d_name);
-	if (n > 0 && (size_t)n < sizeof(path) && stat(path, &st) == 0 && S_ISREG(st.st_mode))
-		return add(ns, e->d_name, strlen(e->d_name));
-	return 0;
+	size_t n = strlen(folder);
+	return strncmp(file, folder, n) == 0 && (stem == n || (stem > n + 1 && file[n] == '_'));
 }
 
-static int scan_dir(struct names *ns, const char *dir)
+/* NAME.so directly in dir, or a plugin one folder down (in_family). */
+static int scan_dir(struct names *ns, const char *dir, const char *family)
 {
 	DIR *d = opendir(dir);
 	if (!d)
 		return 0; /* a missing search folder is normal (not installed) */
 	int r = 0;
 	struct dirent *e;
-	while (r == 0 && (e = readdir(d)))
-		r = scan_entry(ns, dir, e);
+	while (r == 0 && (e = readdir(d))) {
+		size_t stem;
+		char path[4096];
+		if (e->d_name[0] == '.')
+			continue;
+		if (has_so_suffix(e->d_name, &stem)) {
+			if (!family || in_family(family, e->d_name, stem))
+				r = add(ns, e->d_name, stem);
+			continue;
+		}
+		int n = snprintf(path, sizeof(path), "%s/%s", dir, e->d_name);
+		if (!family && n > 0 && (size_t)n < sizeof(path))
+			r = scan_dir(ns, path, e->d_name);
+	}
 	closedir(d);
 	return r;
 }
@@ -105,7 +114,7 @@ int bvhlab_plugin_names(char ***out, bvhlab_error *err)
 		if (len > 0 && len < sizeof(dir)) {
 			memcpy(dir, p, len);
 			dir[len] = '\0';
-			r = scan_dir(&ns, dir);
+			r = scan_dir(&ns, dir, NULL);
 		}
 		p += len + (colon ? 1 : 0);
 	}
@@ -144,7 +153,9 @@ static bool ends_in_so(const char *s)
 	return n > 3 && strcmp(s + n - 3, ".so") == 0;
 }
 
-/* Finds NAME.so or NAME/NAME.so in a search folder; 0 and *out, or -ENOENT. */
+/* Finds NAME.so, NAME/NAME.so or, for NAME = FAMILY_REST, FAMILY/NAME.so
+ * (any '_' may end the family's name) in a search folder; 0 and *out, or
+ * -ENOENT. */
 static int find_in_dir(const char *dir, size_t dirlen, const char *name, char *out,
                        size_t size)
 {
@@ -156,6 +167,12 @@ static int find_in_dir(const char *dir, size_t dirlen, const char *name, char *o
 	n = snprintf(out, size, "%.*s/%s/%s.so", (int)dirlen, dir, name, name);
 	if (n > 0 && (size_t)n < size && is_file(out))
 		return 0;
+	for (const char *u = strchr(name, '_'); u; u = strchr(u + 1, '_')) {
+		n = snprintf(out, size, "%.*s/%.*s/%s.so", (int)dirlen, dir, (int)(u - name),
+		             name, name);
+		if (u > name && n > 0 && (size_t)n < size && is_file(out))
+			return 0;
+	}
 	return -ENOENT;
 }
 

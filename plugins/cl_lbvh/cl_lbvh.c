@@ -18,6 +18,7 @@
 #include "cl_lbvh.h"
 #include "cl_lbvh_src.h"
 #include "morton_front.h"
+#include "plugin_options.h"
 
 static const bvhlab_option_decl options[] = {
 	MORTON_OPTION_DECLS,
@@ -57,28 +58,28 @@ __attribute__((destructor)) static void release_device(void)
 
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_lbvh *b)
 {
+	static const plugin_field fields[] = {
+		PLUGIN_FIELD(cl_lbvh, device, "device", STRING),
+		PLUGIN_FIELD(cl_lbvh, leaf_block, "leaf_block", U32),
+		PLUGIN_FIELD(cl_lbvh, hierarchy, "hierarchy", STRING),
+	};
 	morton_options o;
-	int64_t block;
-	int rc = morton_read_options(host, ctx, &o);
+	int rc;
 
-	if (rc < 0)
+	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, &o)) < 0 ||
+	    (rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
+	                              sizeof(fields) / sizeof(fields[0]), b)) < 0)
 		return rc;
-	if ((rc = host->option_string(ctx, "device", &b->device)) < 0 ||
-	    (rc = host->option_int(ctx, "leaf_block", &block)) < 0 ||
-	    (rc = host->option_string(ctx, "hierarchy", &b->hierarchy)) < 0) {
-		host->set_error(ctx, "cannot read the options device, leaf_block and hierarchy");
-		return rc;
-	}
+	/* The one thing the declared range 30..63 does not say. */
 	if (o.bits != 30 && o.bits != 63) {
-		host->set_error(ctx, "option bits: %lld, expected 30 or 63", (long long)o.bits);
+		host->set_error(ctx, "option bits: %u, expected 30 or 63", o.bits);
 		return -EINVAL;
 	}
-	b->leaf_block = (uint32_t)block;
 	b->collapse = o.collapse;
-	b->bits = (unsigned)o.bits;
-	b->max_leaf = (uint32_t)o.max_leaf;
-	b->c_trav = (float)o.c_trav;
-	b->c_isect = (float)o.c_isect;
+	b->bits = o.bits;
+	b->max_leaf = o.max_leaf;
+	b->c_trav = o.c_trav;
+	b->c_isect = o.c_isect;
 	return 0;
 }
 

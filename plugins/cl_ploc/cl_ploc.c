@@ -18,6 +18,7 @@
 #include "cl_ploc.h"
 #include "cl_ploc_src.h"
 #include "morton_front.h"
+#include "plugin_options.h"
 
 static const bvhlab_option_decl options[] = {
 	{ .name = "radius", .type = BVHLAB_OPTION_INT,
@@ -61,29 +62,28 @@ __attribute__((destructor)) static void release_device(void)
 
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_ploc *b)
 {
+	static const plugin_field fields[] = {
+		PLUGIN_FIELD(cl_ploc, radius, "radius", U32),
+		PLUGIN_FIELD(cl_ploc, nn_block, "nn_block", U32),
+		PLUGIN_FIELD(cl_ploc, device, "device", STRING),
+	};
 	morton_options o;
-	int64_t radius, nn_block;
 	int rc;
 
-	if ((rc = host->option_int(ctx, "radius", &radius)) < 0 ||
-	    (rc = host->option_int(ctx, "nn_block", &nn_block)) < 0 ||
-	    (rc = host->option_string(ctx, "device", &b->device)) < 0) {
-		host->set_error(ctx, "cannot read the options");
+	if ((rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
+	                              sizeof(fields) / sizeof(fields[0]), b)) < 0 ||
+	    (rc = morton_options_fill(host, ctx, options, OPTION_COUNT, &o)) < 0)
 		return rc;
-	}
-	if ((rc = morton_read_options(host, ctx, &o)) < 0)
-		return rc;
+	/* The one thing the declared range 30..63 does not say. */
 	if (o.bits != 30 && o.bits != 63) {
-		host->set_error(ctx, "option bits: %lld, expected 30 or 63", (long long)o.bits);
+		host->set_error(ctx, "option bits: %u, expected 30 or 63", o.bits);
 		return -EINVAL;
 	}
-	b->radius = (uint32_t)radius;
-	b->nn_block = (uint32_t)nn_block;
 	b->collapse = o.collapse;
-	b->bits = (unsigned)o.bits;
-	b->max_leaf = (uint32_t)o.max_leaf;
-	b->c_trav = (float)o.c_trav;
-	b->c_isect = (float)o.c_isect;
+	b->bits = o.bits;
+	b->max_leaf = o.max_leaf;
+	b->c_trav = o.c_trav;
+	b->c_isect = o.c_isect;
 	return 0;
 }
 

@@ -29,6 +29,7 @@
 #include <time.h>
 
 #include "embree_internal.h"
+#include "plugin_options.h"
 
 /* Embree's recursion depth limit; larger leaves are split before it. */
 #define MAX_DEPTH 64
@@ -87,31 +88,36 @@ static RTCDevice device_for(uint32_t threads)
 
 typedef struct settings {
 	enum RTCBuildQuality quality;
+	int quality_choice; /* low|medium|high, as the option says */
 	int64_t max_leaf, min_leaf;
 	double c_trav, c_isect, split_factor;
 } settings;
 
+static const plugin_field fields[] = {
+	PLUGIN_FIELD(settings, quality_choice, "quality", CHOICE),
+	PLUGIN_FIELD(settings, max_leaf, "max_leaf", I64),
+	PLUGIN_FIELD(settings, min_leaf, "min_leaf", I64),
+	PLUGIN_FIELD(settings, c_trav, "c_trav", DOUBLE),
+	PLUGIN_FIELD(settings, c_isect, "c_isect", DOUBLE),
+	PLUGIN_FIELD(settings, split_factor, "split_factor", DOUBLE),
+};
+
 static int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, settings *s)
 {
-	const char *q;
-	int rc;
-	if ((rc = host->option_string(ctx, "quality", &q)) < 0 ||
-	    (rc = host->option_int(ctx, "max_leaf", &s->max_leaf)) < 0 ||
-	    (rc = host->option_int(ctx, "min_leaf", &s->min_leaf)) < 0 ||
-	    (rc = host->option_float(ctx, "c_trav", &s->c_trav)) < 0 ||
-	    (rc = host->option_float(ctx, "c_isect", &s->c_isect)) < 0 ||
-	    (rc = host->option_float(ctx, "split_factor", &s->split_factor)) < 0) {
-		host->set_error(ctx, "cannot read the options (%s)", strerror(-rc));
+	static const enum RTCBuildQuality quality[] = {
+		RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH,
+	};
+	int rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
+	                             sizeof(fields) / sizeof(fields[0]), s);
+	if (rc < 0)
 		return rc;
-	}
+	/* What the declarations cannot say: one option bounded by another. */
 	if (s->min_leaf > s->max_leaf) {
 		host->set_error(ctx, "min_leaf %lld exceeds max_leaf %lld", (long long)s->min_leaf,
 		                (long long)s->max_leaf);
 		return -EINVAL;
 	}
-	s->quality = strcmp(q, "low") == 0    ? RTC_BUILD_QUALITY_LOW
-	             : strcmp(q, "high") == 0 ? RTC_BUILD_QUALITY_HIGH
-	                                      : RTC_BUILD_QUALITY_MEDIUM;
+	s->quality = quality[s->quality_choice];
 	return 0;
 }
 

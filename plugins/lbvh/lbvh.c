@@ -19,23 +19,20 @@ static const bvhlab_option_decl options[] = { MORTON_OPTION_DECLS };
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b)
 {
 	morton_options o;
-	int rc = morton_read_options(host, ctx, &o);
+	int rc = morton_options_fill(host, ctx, options, OPTION_COUNT, &o);
 
 	if (rc < 0)
 		return rc;
+	/* The one thing the declared range 30..63 does not say. */
 	if (o.bits != 30 && o.bits != 63) {
-		host->set_error(ctx, "option bits: %lld, expected 30 or 63", (long long)o.bits);
-		return -EINVAL;
-	}
-	if (o.max_leaf < 1 || o.max_leaf > 64 || !(o.c_trav > 0) || !(o.c_isect > 0)) {
-		host->set_error(ctx, "options max_leaf, c_trav or c_isect out of range");
+		host->set_error(ctx, "option bits: %u, expected 30 or 63", o.bits);
 		return -EINVAL;
 	}
 	b->collapse = o.collapse;
-	b->bits = (unsigned)o.bits;
-	b->max_leaf = (uint32_t)o.max_leaf;
-	b->c_trav = (float)o.c_trav;
-	b->c_isect = (float)o.c_isect;
+	b->bits = o.bits;
+	b->max_leaf = o.max_leaf;
+	b->c_trav = o.c_trav;
+	b->c_isect = o.c_isect;
 	return 0;
 }
 
@@ -146,6 +143,7 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b,
 {
 	morton_scratch s = { 0 };
 	double start = morton_now_ms();
+	team_host th;
 	int rc;
 
 	b->threads = morton_team_size(b->in);
@@ -158,8 +156,8 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b,
 		goto out;
 	}
 	b->phase_ms[4] = morton_now_ms();
-	if ((rc = team_run(&b->team, b->threads, host->hardware_threads(ctx), run_phases,
-	                   b)) < 0) {
+	team_host_init(&th, host, ctx);
+	if ((rc = team_run_on(&b->team, &th, b->threads, run_phases, b)) < 0) {
 		host->set_error(ctx, "cannot set up the thread team");
 		goto out;
 	}

@@ -11,6 +11,7 @@
 
 #include "morton_front.h"
 #include "ploc.h"
+#include "plugin_options.h"
 
 static const bvhlab_option_decl options[] = {
 	{ .name = "radius", .type = BVHLAB_OPTION_INT,
@@ -24,28 +25,23 @@ static const bvhlab_option_decl options[] = {
 
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p)
 {
+	static const plugin_field radius[] = { PLUGIN_FIELD(ploc, radius, "radius", U32) };
 	morton_options o;
-	int64_t radius;
 	int rc;
 
-	if ((rc = host->option_int(ctx, "radius", &radius)) < 0) {
-		host->set_error(ctx, "cannot read the options");
+	if ((rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, radius, 1, p)) < 0 ||
+	    (rc = morton_options_fill(host, ctx, options, OPTION_COUNT, &o)) < 0)
 		return rc;
-	}
-	if ((rc = morton_read_options(host, ctx, &o)) < 0)
-		return rc;
-	if ((o.bits != 30 && o.bits != 63) || radius < 1 || radius > PLOC_MAX_RADIUS ||
-	    o.max_leaf < 1 || o.max_leaf > 64 || !(o.c_trav > 0) || !(o.c_isect > 0)) {
-		host->set_error(ctx, "options out of range (bits 30 or 63, radius 1..%d, "
-		                "max_leaf 1..64, costs > 0)", PLOC_MAX_RADIUS);
+	/* The one thing the declared range 30..63 does not say. */
+	if (o.bits != 30 && o.bits != 63) {
+		host->set_error(ctx, "option bits: %u, expected 30 or 63", o.bits);
 		return -EINVAL;
 	}
 	p->collapse = o.collapse;
-	p->sort.bits = (unsigned)o.bits;
-	p->radius = (uint32_t)radius;
-	p->max_leaf = (uint32_t)o.max_leaf;
-	p->c_trav = (float)o.c_trav;
-	p->c_isect = (float)o.c_isect;
+	p->sort.bits = o.bits;
+	p->max_leaf = o.max_leaf;
+	p->c_trav = o.c_trav;
+	p->c_isect = o.c_isect;
 	return 0;
 }
 
@@ -171,6 +167,7 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p,
 {
 	morton_scratch s = { 0 };
 	double start = morton_now_ms();
+	team_host th;
 	int rc;
 
 	p->threads = morton_team_size(p->in);
@@ -185,7 +182,8 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p,
 	}
 	p->nodes = out->nodes;
 	p->prim_index = out->prim_index;
-	if ((rc = team_run(&p->team, p->threads, host->hardware_threads(ctx), run_phases, p)) < 0) {
+	team_host_init(&th, host, ctx);
+	if ((rc = team_run_on(&p->team, &th, p->threads, run_phases, p)) < 0) {
 		host->set_error(ctx, "cannot set up the thread team");
 		goto out;
 	}

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "leaves.h"
+#include "plugin_options.h"
 #include "reinsert.h"
 
 static const bvhlab_option_decl options[] = {
@@ -39,27 +40,20 @@ struct params {
 	bool leaves, children;
 };
 
+static const plugin_field fields[] = {
+	PLUGIN_FIELD(struct params, batch, "batch", DOUBLE),
+	PLUGIN_FIELD(struct params, iterations, "iterations", I64),
+	PLUGIN_FIELD(struct params, min_gain, "min_gain", DOUBLE),
+	PLUGIN_FIELD(struct params, max_visits, "max_visits", I64),
+	PLUGIN_FIELD(struct params, leaves, "leaves", BOOL),
+	PLUGIN_FIELD(struct params, children, "children", BOOL),
+	PLUGIN_FIELD(struct params, max_leaf, "max_leaf", I64),
+};
+
 static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, struct params *o)
 {
-	int rc;
-
-	if ((rc = host->option_float(ctx, "batch", &o->batch)) < 0 ||
-	    (rc = host->option_int(ctx, "iterations", &o->iterations)) < 0 ||
-	    (rc = host->option_float(ctx, "min_gain", &o->min_gain)) < 0 ||
-	    (rc = host->option_int(ctx, "max_visits", &o->max_visits)) < 0 ||
-	    (rc = host->option_bool(ctx, "leaves", &o->leaves)) < 0 ||
-	    (rc = host->option_bool(ctx, "children", &o->children)) < 0 ||
-	    (rc = host->option_int(ctx, "max_leaf", &o->max_leaf)) < 0) {
-		host->set_error(ctx, "cannot read the options");
-		return rc;
-	}
-	if (!(o->batch > 0 && o->batch <= 1) || o->iterations < 1 || !(o->min_gain >= 0) ||
-	    o->max_visits < 16 || o->max_visits > (1 << 24) || o->max_leaf < 1 ||
-	    o->max_leaf > 64) {
-		host->set_error(ctx, "options out of range");
-		return -EINVAL;
-	}
-	return 0;
+	return plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
+	                           sizeof(fields) / sizeof(fields[0]), o);
 }
 
 /* ---- candidates --------------------------------------------------------- */
@@ -203,7 +197,7 @@ static void search_member(void *arg, unsigned t)
 	reinsert_search(arg);
 }
 
-static int iterate(reinsert *r, const struct params *o, uint32_t threads, uint32_t cpus)
+static int iterate(reinsert *r, const struct params *o, uint32_t threads, const team_host *th)
 {
 	double total = inner_area(r);
 
@@ -213,7 +207,7 @@ static int iterate(reinsert *r, const struct params *o, uint32_t threads, uint32
 
 		choose(r, o->batch);
 		atomic_store_explicit(&r->next, 0, memory_order_relaxed);
-		if ((rc = team_run(&r->team, threads, cpus, search_member, r)) < 0)
+		if ((rc = team_run_on(&r->team, th, threads, search_member, r)) < 0)
 			return rc;
 		change = apply(r);
 		if (-change < o->min_gain * total || change == 0)
@@ -231,8 +225,10 @@ static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct
 	reinsert r = { .nodes = tree->nodes, .node_count = tree->node_count,
 	               .max_visits = (uint32_t)o->max_visits, .children = o->children };
 	size_t n = tree->node_count;
+	team_host th;
 	int rc;
 
+	team_host_init(&th, host, ctx);
 	r.parent = malloc(n * sizeof(*r.parent));
 	r.cand = malloc(n * sizeof(*r.cand));
 	r.moves = malloc(n * sizeof(*r.moves));
@@ -244,7 +240,7 @@ static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct
 		goto out;
 	}
 	find_parents(&r);
-	if ((rc = iterate(&r, o, input->threads, host->hardware_threads(ctx))) < 0)
+	if ((rc = iterate(&r, o, input->threads, &th)) < 0)
 		host->set_error(ctx, "cannot start the search threads");
 out:
 	free(r.parent);

@@ -23,6 +23,7 @@
 
 #include <bvhlab/aabb.h>
 
+#include "plugin_options.h"
 #include "sbvh.h"
 
 static const bvhlab_option_decl options[] = {
@@ -59,28 +60,16 @@ static const bvhlab_option_decl options[] = {
 };
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
-static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, sbvh_options *o)
-{
-	int64_t bins, max_leaf, parallel_min, lookahead;
-	int rc;
-
-	if ((rc = host->option_float(ctx, "split_factor", &o->split_factor)) < 0 ||
-	    (rc = host->option_float(ctx, "alpha", &o->alpha)) < 0 ||
-	    (rc = host->option_float(ctx, "overlap", &o->overlap)) < 0 ||
-	    (rc = host->option_int(ctx, "bins", &bins)) < 0 ||
-	    (rc = host->option_int(ctx, "max_leaf", &max_leaf)) < 0 ||
-	    (rc = host->option_int(ctx, "parallel_min", &parallel_min)) < 0 ||
-	    (rc = host->option_float(ctx, "presplit", &o->presplit)) < 0 ||
-	    (rc = host->option_int(ctx, "lookahead", &lookahead)) < 0) {
-		host->set_error(ctx, "cannot read the options (%d)", rc);
-		return rc;
-	}
-	o->bins = (uint32_t)bins;
-	o->max_leaf = (uint32_t)max_leaf;
-	o->parallel_min = (uint32_t)parallel_min;
-	o->lookahead = (uint32_t)lookahead;
-	return 0;
-}
+static const plugin_field fields[] = {
+	PLUGIN_FIELD(sbvh_options, split_factor, "split_factor", DOUBLE),
+	PLUGIN_FIELD(sbvh_options, alpha, "alpha", DOUBLE),
+	PLUGIN_FIELD(sbvh_options, overlap, "overlap", DOUBLE),
+	PLUGIN_FIELD(sbvh_options, bins, "bins", U32),
+	PLUGIN_FIELD(sbvh_options, max_leaf, "max_leaf", U32),
+	PLUGIN_FIELD(sbvh_options, parallel_min, "parallel_min", U32),
+	PLUGIN_FIELD(sbvh_options, presplit, "presplit", DOUBLE),
+	PLUGIN_FIELD(sbvh_options, lookahead, "lookahead", U32),
+};
 
 /* Room for the whole budget: at most 2 * refs - 1 nodes and refs slots. */
 static int reserve(const bvhlab_host *host, bvhlab_build_ctx *ctx, bvhlab_build_output *out,
@@ -130,10 +119,12 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	sbvh_build B = { .in = input, .threads = input->threads ? input->threads : 1 };
 	sbvh_job root;
 	double want;
-	int rc = read_options(host, ctx, &B.opt);
+	int rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
+	                             sizeof(fields) / sizeof(fields[0]), &B.opt);
 
 	if (rc < 0)
 		return rc;
+	team_host_init(&B.th, host, ctx);
 	want = ceil(B.opt.split_factor * input->prim_count);
 	B.capacity = want >= (double)UINT32_MAX / 2 ? UINT32_MAX / 2 : (uint32_t)want;
 	if (B.capacity < input->prim_count)
@@ -180,20 +171,9 @@ out:
 	return rc;
 }
 
-static const bvhlab_builder descriptor = {
-	.abi_version = BVHLAB_ABI_CURRENT,
-	.struct_size = sizeof(bvhlab_builder),
-	.name = "sbvh",
+BVHLAB_PLUGIN(.name = "sbvh",
 	.summary = "SAH with object and spatial splits (Stich et al. 2009): exact triangle "
 	           "clipping, reference unsplitting, split_factor budget; parallel, deterministic",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
 	         BVHLAB_BUILDER_SPATIAL_SPLITS,
-	.option_count = OPTION_COUNT,
-	.options = options,
-	.build = build,
-};
-
-BVHLAB_PLUGIN_ENTRY
-{
-	return host_abi_major == BVHLAB_ABI_MAJOR ? &descriptor : NULL;
-}
+	.option_count = OPTION_COUNT, .options = options, .build = build)

@@ -32,6 +32,8 @@
 #include <bvhlab/aabb.h>
 #include <bvhlab/builder.h>
 
+#include "team.h"
+
 #define SBVH_MAX_BINS 64
 #define SBVH_MAX_LEAF 64 /* max_leaf's upper bound */
 
@@ -99,6 +101,7 @@ typedef struct sbvh_build {
 	uint32_t capacity;        /* references each buffer holds */
 	double root_area;         /* SA of the root box, for the alpha test */
 	uint32_t threads;
+	team_host th;                /* where the phases' threads pin themselves */
 	_Atomic uint32_t next_node;  /* output nodes handed out */
 	_Atomic uint32_t next_slot;  /* prim_index slots handed out */
 	_Atomic uint64_t spatial;    /* spatial splits taken (diagnostics) */

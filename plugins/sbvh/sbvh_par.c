@@ -4,14 +4,14 @@
  * share of the references; bins merge by box union and count sums, and
  * shares are written at prefix-summed offsets, so the result is what one
  * thread would write), breadth first; the smaller jobs left over are then
- * built as whole subtrees, largest first, one per thread at a time.
+ * built as whole subtrees, largest first, one per thread at a time. Every
+ * phase runs on a team of the thread layer (team.h), which pins it.
  *
  * The same jobs take the same path whatever the thread count (a single
  * thread runs the team path with one share), so the tree is the same.
  */
 #include <errno.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -20,7 +20,7 @@
 enum phase { PH_OBJECT, PH_SPATIAL, PH_COUNT, PH_WRITE };
 
 typedef struct member {
-	struct team *team;
+	struct crew *crew;
 	uint32_t t;
 	uint32_t begin, end;   /* its share of the job's references */
 	uint32_t nl, nr;       /* PH_COUNT */
@@ -29,15 +29,16 @@ typedef struct member {
 	sbvh_bins bins;
 } member;
 
-typedef struct team {
+typedef struct crew {
 	sbvh_build *B;
 	const sbvh_job *job;
 	const sbvh_split *split;
 	enum phase phase;
 	member *m;             /* [B->threads] */
-} team;
+	team team;             /* the threads of one phase */
+} crew;
 
-static unsigned side_of(const team *tm, uint32_t i, sbvh_ref *l, sbvh_ref *r)
+static unsigned side_of(const crew *tm, uint32_t i, sbvh_ref *l, sbvh_ref *r)
 {
 	const sbvh_ref *ref = &tm->B->refs[tm->job->buf][i];
 
@@ -54,7 +55,7 @@ static void count_share(member *m)
 
 	m->nl = m->nr = 0;
 	for (uint32_t i = m->begin; i < m->end; i++) {
-		unsigned side = side_of(m->team, i, &l, &r);
+		unsigned side = side_of(m->crew, i, &l, &r);
 		m->nl += (side & 1) != 0;
 		m->nr += (side & 2) != 0;
 	}
@@ -62,13 +63,13 @@ static void count_share(member *m)
 
 static void write_share(member *m)
 {
-	sbvh_ref *out = m->team->B->refs[!m->team->job->buf], l, r;
+	sbvh_ref *out = m->crew->B->refs[!m->crew->job->buf], l, r;
 	uint32_t li = m->lout, ri = m->rout;
 
 	sbvh_job_empty(&m->l);
 	sbvh_job_empty(&m->r);
 	for (uint32_t i = m->begin; i < m->end; i++) {
-		unsigned side = side_of(m->team, i, &l, &r);
+		unsigned side = side_of(m->crew, i, &l, &r);
 		if (side & 1) {
 			out[li++] = l;
 			sbvh_job_grow(&m->l, &l);
@@ -80,10 +81,9 @@ static void write_share(member *m)
 	}
 }
 
-static void *run_share(void *arg)
+static void run_share(member *m)
 {
-	member *m = arg;
-	team *tm = m->team;
+	crew *tm = m->crew;
 
 	switch (tm->phase) {
 	case PH_OBJECT:
@@ -100,26 +100,26 @@ static void *run_share(void *arg)
 		write_share(m);
 		break;
 	}
-	return NULL;
 }
 
-/* Every member runs the phase on its share; the caller is member 0. A
- * thread that cannot start has its share run here instead. */
-static void run_phase(team *tm, enum phase phase)
+/* Thread t runs shares t, t + size, ...: a team smaller than B->threads (a
+ * thread that could not start) still runs every share. */
+static void share_member(void *arg, unsigned t)
 {
-	uint32_t T = tm->B->threads;
-	pthread_t tid[T];
-	bool started[T];
+	crew *tm = arg;
 
+	for (uint32_t s = t; s < tm->B->threads; s += tm->team.threads)
+		run_share(&tm->m[s]);
+}
+
+/* Every share of the phase, on a team of the thread layer; the caller is
+ * member 0. Without a team (no barrier to be had) the caller runs them all. */
+static void run_phase(crew *tm, enum phase phase)
+{
 	tm->phase = phase;
-	for (uint32_t t = 1; t < T; t++)
-		started[t] = pthread_create(&tid[t], NULL, run_share, &tm->m[t]) == 0;
-	run_share(&tm->m[0]);
-	for (uint32_t t = 1; t < T; t++) {
-		if (started[t])
-			pthread_join(tid[t], NULL);
-		else
-			run_share(&tm->m[t]);
+	if (team_run_on(&tm->team, &tm->B->th, tm->B->threads, share_member, tm) < 0) {
+		for (uint32_t s = 0; s < tm->B->threads; s++)
+			run_share(&tm->m[s]);
 	}
 }
 
@@ -134,7 +134,7 @@ static void unite_job(sbvh_job *to, const sbvh_job *from)
 	}
 }
 
-static void merge_bins(team *tm)
+static void merge_bins(crew *tm)
 {
 	for (uint32_t t = 1; t < tm->B->threads; t++)
 		sbvh_bins_merge(&tm->m[0].bins, &tm->m[t].bins, tm->B->opt.bins);
@@ -142,7 +142,7 @@ static void merge_bins(team *tm)
 
 /* Counts every share under split s; false when the result overflows the
  * job's region. */
-static bool count_all(team *tm, const sbvh_split *s, uint32_t *nl, uint32_t *nr)
+static bool count_all(crew *tm, const sbvh_split *s, uint32_t *nl, uint32_t *nr)
 {
 	uint64_t l = 0, r = 0;
 
@@ -155,7 +155,7 @@ static bool count_all(team *tm, const sbvh_split *s, uint32_t *nl, uint32_t *nr)
 	return l + r <= tm->job->rend - tm->job->rbegin;
 }
 
-static void decide(team *tm, sbvh_split *obj, sbvh_split *best)
+static void decide(crew *tm, sbvh_split *obj, sbvh_split *best)
 {
 	run_phase(tm, PH_OBJECT);
 	merge_bins(tm);
@@ -183,7 +183,7 @@ static void decide(team *tm, sbvh_split *obj, sbvh_split *best)
 }
 
 /* Splits a big job with the whole team; false if it became a leaf. */
-static bool team_split(team *tm, const sbvh_job *job, sbvh_job *left, sbvh_job *right)
+static bool crew_split(crew *tm, const sbvh_job *job, sbvh_job *left, sbvh_job *right)
 {
 	uint32_t T = tm->B->threads, n = job->end - job->begin, nl, nr;
 	sbvh_split obj, best;
@@ -250,7 +250,7 @@ static int by_size(const void *a, const void *b)
 }
 
 /* The big jobs, breadth first with the whole team; the rest into `small`. */
-static int top_phase(team *tm, const sbvh_job *root, job_list *small)
+static int top_phase(crew *tm, const sbvh_job *root, job_list *small)
 {
 	job_list big = { 0 };
 	size_t next = 0;
@@ -258,7 +258,7 @@ static int top_phase(team *tm, const sbvh_job *root, job_list *small)
 
 	while (rc == 0 && next < big.n) {
 		sbvh_job job = big.jobs[next++], child[2];
-		if (!team_split(tm, &job, &child[0], &child[1]))
+		if (!crew_split(tm, &job, &child[0], &child[1]))
 			continue;
 		for (int c = 0; c < 2 && rc == 0; c++)
 			rc = push(child[c].end - child[c].begin >= tm->B->opt.parallel_min ? &big
@@ -277,24 +277,24 @@ typedef struct worker {
 	sbvh_bins bins;
 } worker;
 
-static void *run_worker(void *arg)
+static void run_worker(void *arg, unsigned t)
 {
-	worker *w = arg;
+	worker *w = (worker *)arg + t;
 	size_t i;
 
 	while (w->rc == 0 &&
 	       (i = atomic_fetch_add_explicit(w->next, 1, memory_order_relaxed)) < w->small->n)
 		w->rc = sbvh_build_subtree(w->B, &w->small->jobs[i], &w->bins);
-	return NULL;
 }
 
+/* The small jobs, claimed largest first by a team of the thread layer
+ * (the caller alone when no team is to be had). */
 static int task_phase(sbvh_build *B, job_list *small)
 {
 	uint32_t T = B->threads;
 	worker *w = calloc(T, sizeof(*w));
-	pthread_t tid[T];
-	bool started[T];
 	_Atomic size_t next = 0;
+	team tm;
 	int rc = 0;
 
 	if (!w)
@@ -303,26 +303,22 @@ static int task_phase(sbvh_build *B, job_list *small)
 		qsort(small->jobs, small->n, sizeof(*small->jobs), by_size);
 	for (uint32_t t = 0; t < T; t++)
 		w[t] = (worker){ .B = B, .small = small, .next = &next };
-	for (uint32_t t = 1; t < T; t++)
-		started[t] = pthread_create(&tid[t], NULL, run_worker, &w[t]) == 0;
-	run_worker(&w[0]);
-	for (uint32_t t = 0; t < T; t++) {
-		if (t > 0 && started[t])
-			pthread_join(tid[t], NULL);
+	if (team_run_on(&tm, &B->th, T, run_worker, w) < 0)
+		run_worker(w, 0);
+	for (uint32_t t = 0; t < T; t++)
 		rc = rc ? rc : w[t].rc;
-	}
 	free(w);
 	return rc;
 }
 
 int sbvh_build_all(sbvh_build *B, const sbvh_job *root)
 {
-	team tm = { .B = B, .m = calloc(B->threads, sizeof(member)) };
+	crew tm = { .B = B, .m = calloc(B->threads, sizeof(member)) };
 	job_list small = { 0 };
 	int rc = tm.m ? 0 : -ENOMEM;
 
 	for (uint32_t t = 0; rc == 0 && t < B->threads; t++)
-		tm.m[t] = (member){ .team = &tm, .t = t };
+		tm.m[t] = (member){ .crew = &tm, .t = t };
 	if (rc == 0)
 		rc = top_phase(&tm, root, &small);
 	if (rc == 0)

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include "leaves.h"
+#include "plugin_options.h"
 #include "treelet.h"
 
 static const bvhlab_option_decl options[] = {
@@ -41,7 +42,7 @@ static void member(void *arg, unsigned m)
 }
 
 static int rounds(treelet *t, int64_t count, uint32_t *scratch, unsigned threads,
-                  uint32_t cpus)
+                  const team_host *th)
 {
 	uint32_t task_nodes = t->node_count / TASK_SHARE;
 
@@ -52,7 +53,7 @@ static int rounds(treelet *t, int64_t count, uint32_t *scratch, unsigned threads
 		treelet_plan(t, task_nodes, scratch);
 		atomic_store_explicit(&t->next, 0, memory_order_relaxed);
 		atomic_store_explicit(&t->changed, 0, memory_order_relaxed);
-		if ((rc = team_run(&t->team, threads, cpus, member, t)) < 0)
+		if ((rc = team_run_on(&t->team, th, threads, member, t)) < 0)
 			return rc;
 		uint64_t changed = atomic_load_explicit(&t->changed, memory_order_relaxed);
 		for (uint32_t i = t->top_begin; i < t->top_end; i++)
@@ -81,6 +82,7 @@ static int optimise(void *arg, bvhlab_build_output *tree)
 	              .size = (uint32_t)o->size, .max_leaf = (uint32_t)o->max_leaf };
 	size_t n = tree->node_count;
 	uint32_t *scratch;
+	team_host th;
 	int rc;
 
 	if (n < 5)
@@ -95,7 +97,8 @@ static int optimise(void *arg, bvhlab_build_output *tree)
 		rc = -ENOMEM;
 		goto out;
 	}
-	rc = rounds(&t, o->rounds, scratch, o->input->threads, o->host->hardware_threads(o->ctx));
+	team_host_init(&th, o->host, o->ctx);
+	rc = rounds(&t, o->rounds, scratch, o->input->threads, &th);
 	if (rc < 0)
 		o->host->set_error(o->ctx, "cannot start the threads");
 out:
@@ -107,24 +110,22 @@ out:
 	return rc;
 }
 
+static const plugin_field fields[] = {
+	PLUGIN_FIELD(struct params, size, "size", I64),
+	PLUGIN_FIELD(struct params, rounds, "rounds", I64),
+	PLUGIN_FIELD(struct params, leaves, "leaves", BOOL),
+	PLUGIN_FIELD(struct params, max_leaf, "max_leaf", I64),
+};
+
 static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *tree)
 {
 	struct params o = { .host = host, .ctx = ctx, .input = input };
 	int rc;
 
-	if ((rc = host->option_int(ctx, "size", &o.size)) < 0 ||
-	    (rc = host->option_int(ctx, "rounds", &o.rounds)) < 0 ||
-	    (rc = host->option_bool(ctx, "leaves", &o.leaves)) < 0 ||
-	    (rc = host->option_int(ctx, "max_leaf", &o.max_leaf)) < 0) {
-		host->set_error(ctx, "cannot read the options");
+	if ((rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
+	                              sizeof(fields) / sizeof(fields[0]), &o)) < 0)
 		return rc;
-	}
-	if (o.size < 3 || o.size > TREELET_MAX || o.rounds < 1 || o.max_leaf < 1 ||
-	    o.max_leaf > 64) {
-		host->set_error(ctx, "options out of range");
-		return -EINVAL;
-	}
 	/* the costs assume the final cut, so it is made with or without splitting */
 	return leaves_run(host, ctx, input, tree, o.leaves, true, (uint32_t)o.max_leaf, optimise,
 	                  &o);

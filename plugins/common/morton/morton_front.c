@@ -5,24 +5,25 @@
 
 #include "big_alloc.h"
 #include "morton_front.h"
+#include "plugin_options.h"
 
 /* Below this many primitives per thread, more threads cost more than they
  * save (thread start and barriers are tens of microseconds). */
 #define MIN_PRIMS_PER_THREAD 512
 
-int morton_read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, morton_options *o)
+int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                        const bvhlab_option_decl *decls, size_t count, morton_options *o)
 {
-	int rc;
+	static const plugin_field fields[] = {
+		PLUGIN_FIELD(morton_options, bits, "bits", U32),
+		PLUGIN_FIELD(morton_options, collapse, "collapse", BOOL),
+		PLUGIN_FIELD(morton_options, max_leaf, "max_leaf", U32),
+		PLUGIN_FIELD(morton_options, c_trav, "c_trav", FLOAT),
+		PLUGIN_FIELD(morton_options, c_isect, "c_isect", FLOAT),
+	};
 
-	if ((rc = host->option_int(ctx, "bits", &o->bits)) < 0 ||
-	    (rc = host->option_bool(ctx, "collapse", &o->collapse)) < 0 ||
-	    (rc = host->option_int(ctx, "max_leaf", &o->max_leaf)) < 0 ||
-	    (rc = host->option_float(ctx, "c_trav", &o->c_trav)) < 0 ||
-	    (rc = host->option_float(ctx, "c_isect", &o->c_isect)) < 0) {
-		host->set_error(ctx, "cannot read the options");
-		return rc;
-	}
-	return 0;
+	return plugin_options_fill(host, ctx, decls, count, fields,
+	                           sizeof(fields) / sizeof(fields[0]), o);
 }
 
 double morton_now_ms(void)

@@ -35,15 +35,17 @@
 	  .help = "SAH cost of intersecting one primitive (> 0), for collapse",              \
 	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }
 
-/* MORTON_OPTION_DECLS as read, before the builder checks their ranges. */
+/* MORTON_OPTION_DECLS as the host checked them. */
 typedef struct morton_options {
-	int64_t bits, max_leaf;
+	uint32_t bits, max_leaf;
 	bool collapse;
-	double c_trav, c_isect;
+	float c_trav, c_isect;
 } morton_options;
 
-/* Reads MORTON_OPTION_DECLS: 0, or a negative errno after host->set_error. */
-int morton_read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, morton_options *o);
+/* Fills o from MORTON_OPTION_DECLS among a plugin's `decls`
+ * (plugin_options.h): 0, or a negative errno after host->set_error. */
+int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                        const bvhlab_option_decl *decls, size_t count, morton_options *o);
 
 /* Monotonic clock in milliseconds, for the phase times in the debug log. */
 double morton_now_ms(void);

@@ -1,4 +1,5 @@
-/* The thread team and its barrier (see team.h). */
+/* The thread team and its barrier (see team.h); spawned threads and
+ * pinning are team_spawn.c. */
 #include <errno.h>
 
 #include "team.h"
@@ -56,6 +57,7 @@ struct gate {
 
 struct member {
 	struct gate *gate;
+	const team_host *th; /* NULL: team_run, no pinning */
 	void (*fn)(void *arg, unsigned t);
 	void *arg;
 	unsigned t;
@@ -66,6 +68,8 @@ static void *member_main(void *p)
 {
 	struct member *m = p;
 
+	if (m->th)
+		team_pin(m->th, m->t);
 	pthread_mutex_lock(&m->gate->lock);
 	while (!m->gate->open)
 		pthread_cond_wait(&m->gate->cond, &m->gate->lock);
@@ -111,29 +115,58 @@ void team_barrier_finish(team *tm)
 	pthread_mutex_destroy(&tm->lock);
 }
 
+static int start_member(struct member *m)
+{
+	pthread_attr_t attr;
+	int rc = pthread_attr_init(&attr);
+
+	if (rc != 0)
+		return -rc;
+	rc = pthread_attr_setstacksize(&attr, TEAM_STACK);
+	if (rc == 0)
+		rc = pthread_create(&m->tid, &attr, member_main, m);
+	pthread_attr_destroy(&attr);
+	return -rc;
+}
+
 /* Joining the members is what makes their writes visible to the caller. */
-int team_run(team *tm, unsigned want, uint32_t cpus, void (*fn)(void *arg, unsigned t),
-             void *arg)
+static int run_team(team *tm, const team_host *th, unsigned want, uint32_t cpus,
+                    void (*fn)(void *arg, unsigned t), void *arg)
 {
 	struct member m[TEAM_MAX_THREADS];
 	struct gate gate = { PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, false };
 	unsigned size = 1;
 	int rc;
 
-	want = want > TEAM_MAX_THREADS ? TEAM_MAX_THREADS : want;
+	want = want > TEAM_MAX_THREADS ? TEAM_MAX_THREADS : want ? want : 1;
 	/* The size is set again below, once it is known. */
 	if ((rc = team_barrier_init(tm, want, cpus)) < 0)
 		return rc;
 	for (; size < want; size++) {
-		m[size] = (struct member){ .gate = &gate, .fn = fn, .arg = arg, .t = size };
-		if (pthread_create(&m[size].tid, NULL, member_main, &m[size]) != 0)
+		m[size] = (struct member){ .gate = &gate, .th = th, .fn = fn, .arg = arg,
+		                           .t = size };
+		if (start_member(&m[size]) < 0)
 			break;
 	}
 	set_size(tm, size, cpus);
+	if (th)
+		team_pin(th, 0);
 	open_gate(&gate);
 	fn(arg, 0);
 	for (unsigned t = 1; t < size; t++)
 		pthread_join(m[t].tid, NULL);
 	team_barrier_finish(tm);
 	return 0;
+}
+
+int team_run(team *tm, unsigned want, uint32_t cpus, void (*fn)(void *arg, unsigned t),
+             void *arg)
+{
+	return run_team(tm, NULL, want, cpus, fn, arg);
+}
+
+int team_run_on(team *tm, const team_host *th, unsigned want,
+                void (*fn)(void *arg, unsigned t), void *arg)
+{
+	return run_team(tm, th, want, team_cpus(th), fn, arg);
 }

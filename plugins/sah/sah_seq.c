@@ -1,7 +1,7 @@
 /*
  * sah_seq: the sequential top-down SAH builder, the reference the parallel
  * SAH strategies are compared with. All split decisions are the shared
- * kernel's (plugins/common/sah/sah_kernel.h); this plugin only runs the whole
+ * kernel's (sah_kernel.h); this plugin only runs the whole
  * tree as one subtree on the calling thread.
  */
 
@@ -11,11 +11,10 @@
 #include "sah_threads.h"
 
 /* The reference schedule: the whole tree as one subtree, on this thread. */
-static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
-                    const sah_job *root, uint32_t threads, void *arg)
+static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t threads,
+                    void *arg)
 {
-	(void)host;
-	(void)ctx;
+	(void)th;
 	(void)threads;
 	(void)arg;
 	sah_build_subtree(b, root);
@@ -23,5 +22,4 @@ static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder 
 }
 
 SAH_PLAIN_PLUGIN("sah_seq", BVHLAB_BUILDER_DETERMINISTIC,
-	"sequential top-down SAH (exact sweep or binned), the reference",
-	schedule)
+	"sequential top-down SAH (exact sweep or binned), the reference")

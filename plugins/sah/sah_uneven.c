@@ -22,8 +22,8 @@
 
 /* Splits along the larger child, handing each smaller one to a new thread,
  * until `spare` threads are started; returns how many tasks it used. */
-static uint32_t spawn_path(sah_builder *b, const sah_job *root, sah_subtree_task *tasks,
-                           uint32_t spare)
+static uint32_t spawn_path(team_host *th, sah_builder *b, const sah_job *root,
+                           sah_subtree_task *tasks, uint32_t spare)
 {
 	sah_job cur = *root, child[2];
 	uint32_t used = 0;
@@ -33,15 +33,15 @@ static uint32_t spawn_path(sah_builder *b, const sah_job *root, sah_subtree_task
 			return used;
 		unsigned big = sah_job_size(&child[1]) > sah_job_size(&child[0]);
 		tasks[used] = (sah_subtree_task){ .b = b, .job = child[1 - big] };
-		sah_subtree_spawn(&tasks[used++]);
+		sah_subtree_spawn(th, &tasks[used++]);
 		cur = child[big];
 	}
 	sah_build_subtree(b, &cur);
 	return used;
 }
 
-static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
-                    const sah_job *root, uint32_t threads, void *arg)
+static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t threads,
+                    void *arg)
 {
 	sah_subtree_task *tasks;
 	uint32_t used;
@@ -54,10 +54,11 @@ static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder 
 	/* The threads keep pointers into this array until joined. */
 	tasks = calloc(threads - 1, sizeof(*tasks));
 	if (!tasks) {
-		host->set_error(ctx, "out of memory for %u thread records", threads - 1);
+		th->host->set_error(th->ctx, "out of memory for %u thread records", threads - 1);
 		return -ENOMEM;
 	}
-	used = spawn_path(b, root, tasks, threads - 1);
+	team_pin(th, 0);
+	used = spawn_path(th, b, root, tasks, threads - 1);
 	for (uint32_t i = 0; i < used; i++)
 		sah_subtree_join(&tasks[i]);
 	free(tasks);
@@ -65,5 +66,4 @@ static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder 
 }
 
 SAH_PLAIN_PLUGIN("sah_uneven", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	"parallel SAH, thesis \"asymmetric\": only the larger child spawns threads",
-	schedule)
+	"parallel SAH, thesis \"asymmetric\": only the larger child spawns threads")

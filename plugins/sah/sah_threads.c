@@ -24,67 +24,50 @@ static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 }
 
 int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                       const bvhlab_build_input *input, bvhlab_build_output *output,
-                       sah_scheduler_fn schedule, void *arg)
+                  const bvhlab_build_input *input, bvhlab_build_output *output,
+                  sah_options *opt, sah_scheduler_fn schedule, void *arg)
 {
-	sah_options opt;
 	sah_builder b;
 	sah_job root;
+	team_host th;
 	int rc;
 
 	if (input->prim_count == 0 || input->prim_count > UINT32_MAX / 2) {
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = sah_options_read(host, ctx, &opt)) < 0 ||
+	if ((rc = sah_options_resolve(host, ctx, opt)) < 0 ||
 	    (rc = ensure_capacity(host, ctx, input, output)) < 0)
 		return rc;
-	rc = sah_builder_init(&b, &opt, input, output);
+	team_host_init(&th, host, ctx);
+	rc = sah_builder_init(&b, opt, input, output, &th);
 	if (rc < 0) {
 		host->set_error(ctx, "%s", rc == -ENOMEM ? "out of memory for the SAH scratch"
 		                                         : "invalid build input");
 		return rc;
 	}
 	sah_builder_root(&b, &root);
-	rc = schedule(host, ctx, &b, &root, input->threads ? input->threads : 1, arg);
+	rc = schedule(&th, &b, &root, input->threads ? input->threads : 1, arg);
 	if (rc == 0)
 		sah_builder_finish(&b, output);
 	sah_builder_free(&b);
 	return rc;
 }
 
-int sah_thread_start(pthread_t *tid, void *(*fn)(void *), void *arg)
-{
-	pthread_attr_t attr;
-	int rc = pthread_attr_init(&attr);
-
-	if (rc != 0)
-		return -rc;
-	rc = pthread_attr_setstacksize(&attr, SAH_THREAD_STACK);
-	if (rc == 0)
-		rc = pthread_create(tid, &attr, fn, arg);
-	pthread_attr_destroy(&attr);
-	return -rc;
-}
-
-static void *subtree_main(void *arg)
+static void subtree_main(void *arg)
 {
 	sah_subtree_task *task = arg;
 
 	sah_build_subtree(task->b, &task->job);
-	return NULL;
 }
 
-void sah_subtree_spawn(sah_subtree_task *task)
+void sah_subtree_spawn(team_host *th, sah_subtree_task *task)
 {
-	task->started = sah_thread_start(&task->tid, subtree_main, task) == 0;
-	if (!task->started)
+	if (team_spawn(th, &task->thread, subtree_main, task) < 0)
 		sah_build_subtree(task->b, &task->job);
 }
 
 void sah_subtree_join(sah_subtree_task *task)
 {
-	if (task->started)
-		pthread_join(task->tid, NULL);
-	task->started = 0;
+	team_join(&task->thread);
 }

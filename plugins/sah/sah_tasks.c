@@ -59,7 +59,11 @@ static const bvhlab_option_decl options[] = {
 	SAH_QUALITY_DECL,
 };
 
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
+/* Where the options go. */
+struct tasks_options {
+	sah_options sah;
+	uint32_t parallel_min;
+};
 
 /* A node larger than 64 (the most max_leaf allows) is never a leaf, which
  * the team split relies on. */
@@ -67,24 +71,19 @@ _Static_assert(128 > 64, "parallel_min's minimum exceeds max_leaf's maximum");
 
 enum command { CMD_BIN, CMD_SCATTER, CMD_TASKS, CMD_EXIT };
 
-/* The threads of one build (the name "team" is team.h's barrier). */
+/* The threads of one build (the name "team" is team.h's). */
 struct crew {
-	team bar;             /* polls, then sleeps: see team.h */
-	pthread_mutex_t gate; /* held while threads start: size is not final yet */
-	uint32_t size;
-	bool failed;          /* under gate: no barrier, members leave at once */
+	team bar;             /* the members; polls, then sleeps: see team.h */
+	uint32_t size;        /* bar.threads, once the team runs */
 	int cmd;              /* set by the caller between barriers */
+	int rc;               /* the calling thread's result */
+	uint32_t parallel_min;
+	const sah_job *root;
 	tasks_split split;
 	sah_builder *b;
 	sah_job *tasks;
 	uint32_t task_count, task_cap;
 	atomic_uint next;     /* first unclaimed task */
-};
-
-struct member {
-	struct crew *crew;
-	uint32_t index;
-	pthread_t tid;
 };
 
 /*
@@ -150,21 +149,14 @@ static void run_part(struct crew *tm, uint32_t part)
 	}
 }
 
-static void *member_main(void *arg)
+/* A member other than the calling thread: follows its commands. */
+static void follow(struct crew *tm, unsigned index)
 {
-	struct member *m = arg;
-	struct crew *tm = m->crew;
-
-	pthread_mutex_lock(&tm->gate);
-	bool failed = tm->failed;
-	pthread_mutex_unlock(&tm->gate);
-	if (failed)
-		return NULL;
 	for (;;) {
 		team_sync(&tm->bar);
 		if (tm->cmd == CMD_EXIT)
-			return NULL;
-		run_part(tm, m->index);
+			return;
+		run_part(tm, index);
 		team_sync(&tm->bar);
 	}
 }
@@ -248,70 +240,10 @@ static int by_size_desc(const void *pa, const void *pb)
 	return a->begin < b->begin ? -1 : a->begin > b->begin;
 }
 
-/* Starts up to threads - 1 members; the team is as large as what started
- * (every step is correct for any size). The number started, or a negative
- * errno with every started member joined. */
-static int crew_start(struct crew *tm, struct member *m, uint32_t threads, uint32_t cpus)
-{
-	uint32_t started = 0;
-	int rc;
-
-	pthread_mutex_lock(&tm->gate);
-	for (uint32_t i = 1; i < threads; i++) {
-		m[started].crew = tm;
-		m[started].index = started + 1;
-		started += sah_thread_start(&m[started].tid, member_main, &m[started]) == 0;
-	}
-	tm->size = started + 1;
-	tm->split.parts = tm->size;
-	rc = team_barrier_init(&tm->bar, tm->size, cpus);
-	tm->failed = rc < 0;
-	pthread_mutex_unlock(&tm->gate);
-	if (rc == 0)
-		return (int)started;
-	for (uint32_t i = 0; i < started; i++)
-		pthread_join(m[i].tid, NULL);
-	return rc;
-}
-
-static void crew_stop(struct crew *tm, struct member *m, uint32_t started)
-{
-	/* Members leave after the first barrier: no second one to meet. */
-	tm->cmd = CMD_EXIT;
-	if (tm->size > 1)
-		team_sync(&tm->bar);
-	for (uint32_t i = 0; i < started; i++)
-		pthread_join(m[i].tid, NULL);
-	team_barrier_finish(&tm->bar);
-}
-
-static int crew_init(struct crew *tm, sah_builder *b, uint32_t threads)
-{
-	int rc;
-
-	memset(tm, 0, sizeof(*tm));
-	tm->b = b;
-	atomic_init(&tm->next, 0);
-	rc = -pthread_mutex_init(&tm->gate, NULL);
-	if (rc < 0)
-		return rc;
-	rc = tasks_split_init(&tm->split, b, threads);
-	if (rc < 0)
-		pthread_mutex_destroy(&tm->gate);
-	return rc;
-}
-
-static void crew_destroy(struct crew *tm)
-{
-	tasks_split_free(&tm->split);
-	pthread_mutex_destroy(&tm->gate);
-	free(tm->tasks);
-}
-
 /* Top splits, then the tasks, largest first. */
-static int run_build(struct crew *tm, uint32_t parallel_min, const sah_job *root)
+static int run_build(struct crew *tm)
 {
-	int rc = split_top(tm, parallel_min, root);
+	int rc = split_top(tm, tm->parallel_min, tm->root);
 
 	if (rc < 0)
 		return rc;
@@ -320,45 +252,55 @@ static int run_build(struct crew *tm, uint32_t parallel_min, const sah_job *root
 	return 0;
 }
 
-static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
-                    const sah_job *root, uint32_t asked, void *arg)
+/*
+ * The calling thread (member 0) leads: the team is as large as what
+ * started (every step is correct for any size), known to all once the
+ * team runs. Members leave after the barrier that reads CMD_EXIT, so
+ * there is no second one to meet.
+ */
+static void crew_member(void *arg, unsigned t)
 {
+	struct crew *tm = arg;
+
+	if (t > 0) {
+		follow(tm, t);
+		return;
+	}
+	tm->size = tm->bar.threads;
+	tm->split.parts = tm->size;
+	tm->rc = run_build(tm);
+	tm->cmd = CMD_EXIT;
+	if (tm->size > 1)
+		team_sync(&tm->bar);
+}
+
+static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t asked,
+                    void *arg)
+{
+	const struct tasks_options *o = arg;
 	/* no more OS threads than the scene has work for */
 	uint32_t threads = sah_useful_threads(asked, root);
-	const uint32_t *parallel_min = arg;
-	struct member *m = calloc(threads, sizeof(*m));
-	struct crew tm;
-	int rc = m ? crew_init(&tm, b, threads) : -ENOMEM;
-	int started;
+	struct crew tm = { .b = b, .parallel_min = o->parallel_min, .root = root };
+	int rc;
 
+	atomic_init(&tm.next, 0);
+	rc = tasks_split_init(&tm.split, b, threads);
+	if (rc == 0)
+		rc = team_run_on(&tm.bar, th, threads, crew_member, &tm);
+	if (rc == 0)
+		rc = tm.rc;
+	tasks_split_free(&tm.split);
+	free(tm.tasks);
 	if (rc < 0)
-		goto out;
-	started = crew_start(&tm, m, threads, host->hardware_threads(ctx));
-	rc = started < 0 ? started : run_build(&tm, *parallel_min, root);
-	if (started >= 0)
-		crew_stop(&tm, m, (uint32_t)started);
-	crew_destroy(&tm);
-out:
-	if (rc < 0)
-		host->set_error(ctx, "sah_tasks: cannot set up the build (%d)", rc);
-	free(m);
+		th->host->set_error(th->ctx, "sah_tasks: cannot set up the build (%d)", rc);
 	return rc;
 }
 
-static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *input, bvhlab_build_output *output)
-{
-	int64_t v;
-	uint32_t parallel_min;
+static const plugin_field fields[] = {
+	SAH_OPTION_FIELDS(struct tasks_options),
+	PLUGIN_FIELD(struct tasks_options, parallel_min, "parallel_min", U32),
+};
 
-	if (host->option_int(ctx, "parallel_min", &v) < 0 || v < 128 || v > (1 << 30)) {
-		host->set_error(ctx, "option \"parallel_min\" is not available or out of range");
-		return -EINVAL;
-	}
-	parallel_min = (uint32_t)v;
-	return sah_run_build(host, ctx, input, output, schedule, &parallel_min);
-}
-
-BVHLAB_PLUGIN(.name = "sah_tasks", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.summary = "parallel binned SAH: large nodes split by all threads, small ones as tasks",
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+SAH_PLUGIN("sah_tasks", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	"parallel binned SAH: large nodes split by all threads, small ones as tasks",
+	struct tasks_options)

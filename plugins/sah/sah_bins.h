@@ -26,7 +26,7 @@ static inline uint32_t sah_grid_bin(const sah_grid *g, int a, const sah_prim *p)
 }
 
 /* Overwrites the grid's bins in out with prims[begin, end), with 8-lane
- * vectors when simd is SAH_SIMD_AVX2 (which sah_options_read only picks
+ * vectors when simd is SAH_SIMD_AVX2 (which sah_options_resolve only picks
  * where the CPU has AVX2). */
 void sah_bins_fill(sah_bins *out, const sah_grid *g, const sah_prim *prims, uint32_t begin,
                    uint32_t end, int simd);

@@ -45,12 +45,12 @@ static const bvhlab_option_decl options[] = {
 	  .def_int = 1024, .min = 1, .max = 1 << 30 },
 };
 
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
+/* The choices of option policy, in order. */
+enum policy { POLICY_QUEUE2T, POLICY_DEPTH, POLICY_AUTO };
 
-enum policy { POLICY_QUEUE2T, POLICY_DEPTH };
-
-/* The plugin's own options, resolved ("auto" already decided). */
+/* The plugin's options ("auto" is decided by queue_init). */
 struct queue_config {
+	sah_options sah;
 	int policy;
 	uint32_t depth, min_job;
 };
@@ -67,9 +67,7 @@ struct queue {
 	sah_builder *b;
 	int policy;
 	uint32_t depth, low_mark, min_job;
-	const bvhlab_host *host;
-	bvhlab_build_ctx *ctx;
-	atomic_uint next_worker; /* hands out worker numbers for pin_thread */
+	team tm; /* the workers (its barrier goes unused) */
 };
 
 /* Private pending children of one queue2t worker. Entries shrink from lo
@@ -203,20 +201,13 @@ static void run_queue2t(struct queue *q, const sah_job *job)
 	}
 }
 
-/* With "pin": true each worker gets its own physical core (a no-op otherwise). */
-static void pin(struct queue *q)
-{
-	uint32_t id = atomic_fetch_add_explicit(&q->next_worker, 1, memory_order_relaxed);
-	if (BVHLAB_HOST_HAS(q->host, pin_thread))
-		q->host->pin_thread(q->ctx, id);
-}
-
-static void *worker(void *arg)
+/* Every member of the team, the calling thread too (pinned by the layer). */
+static void worker(void *arg, unsigned t)
 {
 	struct queue *q = arg;
 	sah_job job;
 
-	pin(q);
+	(void)t;
 	while (queue_take(q, &job)) {
 		if (q->policy == POLICY_DEPTH)
 			run_depth(q, &job);
@@ -224,7 +215,6 @@ static void *worker(void *arg)
 			run_queue2t(q, &job);
 		queue_done(q);
 	}
-	return NULL;
 }
 
 static int queue_init(struct queue *q, sah_builder *b, uint32_t threads,
@@ -243,9 +233,9 @@ static int queue_init(struct queue *q, sah_builder *b, uint32_t threads,
 		return -rc;
 	}
 	atomic_init(&q->waiting, 0);
-	atomic_init(&q->next_worker, 0);
 	q->b = b;
-	q->policy = cfg->policy;
+	q->policy = cfg->policy != POLICY_AUTO ? cfg->policy
+	            : b->prim_count < AUTO_QUEUE_FROM ? POLICY_DEPTH : POLICY_QUEUE2T;
 	q->depth = cfg->depth;
 	q->min_job = cfg->min_job;
 	q->low_mark = threads > UINT32_MAX / 2 ? UINT32_MAX : 2 * threads;
@@ -261,78 +251,35 @@ static void queue_destroy(struct queue *q)
 
 /* The calling thread works too; a worker that fails to start only means
  * fewer hands on the same queue. */
-static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
-                    const sah_job *root, uint32_t asked, void *arg)
+static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t asked,
+                    void *arg)
 {
 	/* no more OS threads than the scene has work for */
 	uint32_t threads = sah_useful_threads(asked, root);
 	struct queue q;
-	pthread_t *tids = calloc(threads, sizeof(*tids));
-	uint32_t started = 0;
-	int rc = tids ? queue_init(&q, b, threads, arg) : -ENOMEM;
+	int rc = queue_init(&q, b, threads, arg);
 
 	if (rc < 0) {
-		host->set_error(ctx, "cannot set up the job queue (%d)", rc);
-		free(tids);
+		th->host->set_error(th->ctx, "cannot set up the job queue (%d)", rc);
 		return rc;
 	}
-	q.host = host;
-	q.ctx = ctx;
 	/* The first push cannot fail: the heap starts with room. */
 	queue_push(&q, root);
-	for (uint32_t i = 1; i < threads; i++)
-		started += sah_thread_start(&tids[started], worker, &q) == 0;
-	worker(&q);
-	for (uint32_t i = 0; i < started; i++)
-		pthread_join(tids[i], NULL);
-	queue_destroy(&q);
-	free(tids);
-	return 0;
-}
-
-static int read_config(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                       const bvhlab_build_input *input, struct queue_config *cfg)
-{
-	const char *policy;
-	int64_t depth, min_job;
-
-	if (host->option_string(ctx, "policy", &policy) < 0 || !policy ||
-	    host->option_int(ctx, "depth", &depth) < 0 ||
-	    host->option_int(ctx, "min_job", &min_job) < 0) {
-		host->set_error(ctx, "options policy, depth and min_job are not available");
-		return -EINVAL;
-	}
-	if (strcmp(policy, "depth") == 0)
-		cfg->policy = POLICY_DEPTH;
-	else if (strcmp(policy, "queue2t") == 0)
-		cfg->policy = POLICY_QUEUE2T;
-	else if (strcmp(policy, "auto") == 0)
-		cfg->policy = input->prim_count < AUTO_QUEUE_FROM ? POLICY_DEPTH : POLICY_QUEUE2T;
-	else {
-		host->set_error(ctx, "option \"policy\" = \"%s\" is not queue2t, depth or auto",
-		                policy);
-		return -EINVAL;
-	}
-	if (depth < 0 || depth > 30 || min_job < 1 || min_job > (1 << 30)) {
-		host->set_error(ctx, "option \"depth\" or \"min_job\" is out of range");
-		return -EINVAL;
-	}
-	cfg->depth = (uint32_t)depth;
-	cfg->min_job = (uint32_t)min_job;
-	return 0;
-}
-
-static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *input, bvhlab_build_output *output)
-{
-	struct queue_config cfg;
-	int rc = read_config(host, ctx, input, &cfg);
-
+	rc = team_run_on(&q.tm, th, threads, worker, &q);
+	/* Without a barrier no worker started: the calling thread does it all. */
 	if (rc < 0)
-		return rc;
-	return sah_run_build(host, ctx, input, output, schedule, &cfg);
+		worker(&q, 0);
+	queue_destroy(&q);
+	return 0;
 }
 
-BVHLAB_PLUGIN(.name = "sah_queue", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.summary = "parallel SAH, thesis node queue: workers share a job queue, exact termination",
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+static const plugin_field fields[] = {
+	SAH_OPTION_FIELDS(struct queue_config),
+	PLUGIN_FIELD(struct queue_config, policy, "policy", CHOICE),
+	PLUGIN_FIELD(struct queue_config, depth, "depth", U32),
+	PLUGIN_FIELD(struct queue_config, min_job, "min_job", U32),
+};
+
+SAH_PLUGIN("sah_queue", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	"parallel SAH, thesis node queue: workers share a job queue, exact termination",
+	struct queue_config)

@@ -12,122 +12,18 @@
 #include "sah_kernel.h"
 #include "sah_split.h"
 
-static int read_int(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *name,
-                    int64_t lo, int64_t hi, uint32_t *out)
+/* simd "auto" becomes avx2 where the CPU has it; "avx2" without it is refused
+ * (the declaration cannot say what the CPU has). */
+int sah_options_resolve(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt)
 {
-	int64_t v;
-	int rc = host->option_int(ctx, name, &v);
-
-	if (rc < 0) {
-		host->set_error(ctx, "option \"%s\" is not available (%d)", name, rc);
-		return rc;
-	}
-	if (v < lo || v > hi) {
-		host->set_error(ctx, "option \"%s\" = %lld is outside %lld..%lld", name,
-		                (long long)v, (long long)lo, (long long)hi);
-		return -EINVAL;
-	}
-	*out = (uint32_t)v;
-	return 0;
-}
-
-static int read_cost(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *name,
-                     float *out)
-{
-	double v;
-	int rc = host->option_float(ctx, name, &v);
-
-	if (rc < 0) {
-		host->set_error(ctx, "option \"%s\" is not available (%d)", name, rc);
-		return rc;
-	}
-	/* Written as a negation so that NaN is rejected too. */
-	if (!(v > 0 && v <= 1e30)) {
-		host->set_error(ctx, "option \"%s\" = %g must be positive and finite", name, v);
-		return -EINVAL;
-	}
-	*out = (float)v;
-	return 0;
-}
-
-static int read_method(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
-{
-	const char *s;
-	int rc = host->option_string(ctx, "method", &s);
-
-	if (rc < 0) {
-		host->set_error(ctx, "option \"method\" is not available (%d)", rc);
-		return rc;
-	}
-	if (s && strcmp(s, "sweep") == 0) {
-		*out = SAH_SWEEP;
-	} else if (s && strcmp(s, "binned") == 0) {
-		*out = SAH_BINNED;
-	} else {
-		host->set_error(ctx, "option \"method\" = \"%s\" is not sweep or binned",
-		                s ? s : "(null)");
-		return -EINVAL;
-	}
-	return 0;
-}
-
-static int read_simd(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
-{
-	const char *s;
-	int rc = host->option_string(ctx, "simd", &s);
 	bool avx2 = sah_cpu_has_avx2();
 
-	if (rc < 0) {
-		host->set_error(ctx, "option \"simd\" is not available (%d)", rc);
-		return rc;
-	}
-	if (s && strcmp(s, "avx2") == 0 && !avx2) {
+	if (opt->simd_asked == SAH_ASK_AVX2 && !avx2) {
 		host->set_error(ctx, "option \"simd\" = \"avx2\", but this CPU (or build) has no "
 		                "AVX2; use auto or sse");
 		return -ENOTSUP;
 	}
-	if (!s || (strcmp(s, "auto") && strcmp(s, "avx2") && strcmp(s, "sse"))) {
-		host->set_error(ctx, "option \"simd\" = \"%s\" is not auto, avx2 or sse",
-		                s ? s : "(null)");
-		return -EINVAL;
-	}
-	*out = strcmp(s, "sse") && avx2 ? SAH_SIMD_AVX2 : SAH_SIMD_SSE;
-	return 0;
-}
-
-static int read_quality(const bvhlab_host *host, bvhlab_build_ctx *ctx, int *out)
-{
-	const char *s;
-	int rc = host->option_string(ctx, "quality", &s);
-
-	if (rc < 0) {
-		host->set_error(ctx, "option \"quality\" is not available (%d)", rc);
-		return rc;
-	}
-	if (s && strcmp(s, "high") == 0) {
-		*out = SAH_HIGH;
-	} else if (s && strcmp(s, "fast") == 0) {
-		*out = SAH_FAST;
-	} else {
-		host->set_error(ctx, "option \"quality\" = \"%s\" is not high or fast",
-		                s ? s : "(null)");
-		return -EINVAL;
-	}
-	return 0;
-}
-
-int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt)
-{
-	int rc;
-
-	if ((rc = read_method(host, ctx, &opt->method)) < 0 ||
-	    (rc = read_int(host, ctx, "bins", 2, SAH_MAX_BINS, &opt->bins)) < 0 ||
-	    (rc = read_int(host, ctx, "max_leaf", 1, 64, &opt->max_leaf)) < 0 ||
-	    (rc = read_cost(host, ctx, "c_trav", &opt->c_trav)) < 0 ||
-	    (rc = read_cost(host, ctx, "c_isect", &opt->c_isect)) < 0 ||
-	    (rc = read_simd(host, ctx, &opt->simd)) < 0 ||
-	    (rc = read_quality(host, ctx, &opt->quality)) < 0)
-		return rc;
+	opt->simd = opt->simd_asked != SAH_ASK_SSE && avx2 ? SAH_SIMD_AVX2 : SAH_SIMD_SSE;
 	return 0;
 }
 
@@ -159,7 +55,8 @@ static int alloc_sweep(sah_builder *b, const bvhlab_build_input *input)
 }
 
 int sah_builder_init(sah_builder *b, const sah_options *opt,
-                     const bvhlab_build_input *input, bvhlab_build_output *output)
+                     const bvhlab_build_input *input, bvhlab_build_output *output,
+                     const team_host *th)
 {
 	int rc = -ENOMEM;
 
@@ -167,6 +64,7 @@ int sah_builder_init(sah_builder *b, const sah_options *opt,
 	if (!input_ok(opt, input, output))
 		return -EINVAL;
 	b->opt = *opt;
+	b->th = th;
 	b->prim_count = input->prim_count;
 	b->root_box = input->bounds;
 	b->nodes = output->nodes;

@@ -12,6 +12,8 @@
 
 #include <bvhlab/builder.h>
 
+#include "team.h"
+
 enum sah_method {
 	SAH_SWEEP = 0,  /* exact SAH over presorted centroids */
 	SAH_BINNED = 1, /* binned SAH */
@@ -34,10 +36,19 @@ enum sah_quality {
 	SAH_FAST = 1,
 };
 
-/* Build parameters, as read from the plugin options. */
+/* What option simd asks for: its choices auto|avx2|sse, in order. */
+enum sah_simd_ask {
+	SAH_ASK_AUTO = 0,
+	SAH_ASK_AVX2 = 1,
+	SAH_ASK_SSE = 2,
+};
+
+/* Build parameters, as read from the plugin options (the enums are their
+ * choices' indices: sweep|binned, high|fast). */
 typedef struct sah_options {
 	int method;        /* enum sah_method */
-	int simd;          /* enum sah_simd; same trees either way */
+	int simd_asked;    /* enum sah_simd_ask, as the option says */
+	int simd;          /* enum sah_simd, resolved; same trees either way */
 	int quality;       /* enum sah_quality */
 	uint32_t bins;     /* bins per axis for SAH_BINNED, 2..SAH_MAX_BINS */
 	uint32_t max_leaf; /* largest leaf, >= 1 (except coincident centroids) */
@@ -87,6 +98,7 @@ _Static_assert(sizeof(sah_prim) == 32, "sah_prim is 32 bytes");
  */
 typedef struct sah_builder {
 	sah_options opt;            /* copy of the build parameters */
+	const team_host *th;        /* the build's thread layer (the input copy) */
 	uint32_t prim_count;        /* primitives in the build, >= 1 */
 	bvhlab_aabb root_box;       /* input->bounds */
 	bvhlab_aabb root_cbox;      /* bounds of all centroids (computed) */

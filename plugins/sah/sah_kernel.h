@@ -6,7 +6,8 @@
  *
  * Use:
  *     sah_options opt;  sah_builder b;  sah_job root;
- *     sah_options_read(host, ctx, &opt);
+ *     plugin_options_fill(..., &opt);  (SAH_OPTION_FIELDS, then
+ *     sah_options_resolve(host, ctx, &opt.sah);
  *     sah_builder_init(&b, &opt, input, output);    (allocates, presorts)
  *     sah_builder_root(&b, &root);
  *     ... sah_split_job() on jobs, from any threads, and/or
@@ -63,6 +64,7 @@
 #ifndef BVHLAB_SAH_KERNEL_H
 #define BVHLAB_SAH_KERNEL_H
 
+#include "plugin_options.h"
 #include "sah_bins.h"
 #include "sah_types.h"
 
@@ -103,21 +105,37 @@
 	  .def_string = "auto", .choices = "auto|avx2|sse" }
 
 /*
- * Reads the SAH_OPTION_DECLS options through the host's getters and checks
- * them. 0, or a negative errno after host->set_error.
+ * Where SAH_OPTION_DECLS go (plugin_options.h): into the sah_options
+ * member `sah` of a plugin's option struct `type`.
  */
-int sah_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt);
+#define SAH_OPTION_FIELDS(type) \
+	PLUGIN_FIELD(type, sah.method, "method", CHOICE), \
+	PLUGIN_FIELD(type, sah.bins, "bins", U32), \
+	PLUGIN_FIELD(type, sah.max_leaf, "max_leaf", U32), \
+	PLUGIN_FIELD(type, sah.c_trav, "c_trav", FLOAT), \
+	PLUGIN_FIELD(type, sah.c_isect, "c_isect", FLOAT), \
+	PLUGIN_FIELD(type, sah.simd_asked, "simd", CHOICE), \
+	PLUGIN_FIELD(type, sah.quality, "quality", CHOICE)
+
+/*
+ * Decides opt->simd from opt->simd_asked, the one thing about the options
+ * their declarations cannot say (whether this CPU has AVX2). 0, or a
+ * negative errno after host->set_error.
+ */
+int sah_options_resolve(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt);
 
 /*
  * Prepares a build of input into output (prim_index needs prim_count
  * slots, nodes 2 * prim_count - 1): copies the primitives into the working
+ * arrays (with up to input->threads threads of th's build)
  * arrays and, for sweep, presorts them along each axis (LSD radix sort,
  * stable) and allocates the partition scratch.
  * Reserves node slot 0 for the root. 0, -EINVAL (bad input or too small
  * output) or -ENOMEM; on failure nothing is left allocated.
  */
 int sah_builder_init(sah_builder *b, const sah_options *opt,
-                     const bvhlab_build_input *input, bvhlab_build_output *output);
+                     const bvhlab_build_input *input, bvhlab_build_output *output,
+                     const team_host *th);
 
 /* The job that builds the whole tree into node 0. */
 void sah_builder_root(const sah_builder *b, sah_job *root);

@@ -21,24 +21,24 @@
 /* One subtree with its share of the threads; lives in its starter's frame
  * until the join, so the thread can use it throughout. */
 struct even_task {
+	team_host *th;
 	sah_builder *b;
 	sah_job job;
 	uint32_t budget;
-	pthread_t tid;
+	team_thread thread;
 };
 
-static void build_even(sah_builder *b, const sah_job *job, uint32_t budget);
+static void build_even(team_host *th, sah_builder *b, const sah_job *job, uint32_t budget);
 
-static void *even_main(void *arg)
+static void even_main(void *arg)
 {
 	struct even_task *task = arg;
 
-	build_even(task->b, &task->job, task->budget);
-	return NULL;
+	build_even(task->th, task->b, &task->job, task->budget);
 }
 
 /* Recursion depth is log2(budget): the budget halves at every level. */
-static void build_even(sah_builder *b, const sah_job *job, uint32_t budget)
+static void build_even(team_host *th, sah_builder *b, const sah_job *job, uint32_t budget)
 {
 	sah_job child[2];
 
@@ -49,27 +49,27 @@ static void build_even(sah_builder *b, const sah_job *job, uint32_t budget)
 	if (sah_split_job(b, job, child) == 0)
 		return;
 	unsigned big = sah_job_size(&child[1]) > sah_job_size(&child[0]);
-	struct even_task other = { .b = b, .job = child[1 - big], .budget = budget / 2 };
+	struct even_task other = { .th = th, .b = b, .job = child[1 - big],
+	                           .budget = budget / 2 };
 	/* Without a new thread the work is still done, only later. */
-	int started = sah_thread_start(&other.tid, even_main, &other) == 0;
+	bool started = team_spawn(th, &other.thread, even_main, &other) == 0;
 
-	build_even(b, &child[big], budget - budget / 2);
+	build_even(th, b, &child[big], budget - budget / 2);
 	if (started)
-		pthread_join(other.tid, NULL);
+		team_join(&other.thread);
 	else
-		build_even(b, &other.job, other.budget);
+		build_even(th, b, &other.job, other.budget);
 }
 
-static int schedule(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_builder *b,
-                    const sah_job *root, uint32_t threads, void *arg)
+static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t threads,
+                    void *arg)
 {
-	(void)host;
-	(void)ctx;
 	(void)arg;
-	build_even(b, root, threads);
+	if (threads > 1)
+		team_pin(th, 0);
+	build_even(th, b, root, threads);
 	return 0;
 }
 
 SAH_PLAIN_PLUGIN("sah_even", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	"parallel SAH, thesis \"symmetric\": a thread per split, budget halved",
-	schedule)
+	"parallel SAH, thesis \"symmetric\": a thread per split, budget halved")

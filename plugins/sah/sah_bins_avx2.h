@@ -2,7 +2,7 @@
  * The 8-lane binning (sah_bins_avx2.c), for sah_bins.c and the option
  * reader in sah_kernel.c: built where the compiler can target AVX2 for one
  * function (GCC and Clang on x86-64) and called only where the CPU has it
- * (sah_options_read). Self-contained: it clears and merges its own bins.
+ * (sah_options_resolve). Self-contained: it clears and merges its own bins.
  */
 #ifndef BVHLAB_SAH_BINS_AVX2_H
 #define BVHLAB_SAH_BINS_AVX2_H

@@ -1,0 +1,126 @@
+/* Options into a plugin's struct, by table (see plugin_options.h). */
+#include <errno.h>
+#include <stdbool.h>
+#include <string.h>
+
+#include "plugin_options.h"
+
+static const bvhlab_option_decl *find_decl(const bvhlab_option_decl *decls, size_t count,
+                                           const char *name)
+{
+	for (size_t k = 0; k < count; k++)
+		if (strcmp(decls[k].name, name) == 0)
+			return &decls[k];
+	return NULL;
+}
+
+/* The declared option type a field type is read from. */
+static uint32_t source_type(int type)
+{
+	switch (type) {
+	case PLUGIN_BOOL: return BVHLAB_OPTION_BOOL;
+	case PLUGIN_I64:
+	case PLUGIN_U32: return BVHLAB_OPTION_INT;
+	case PLUGIN_DOUBLE:
+	case PLUGIN_FLOAT: return BVHLAB_OPTION_FLOAT;
+	case PLUGIN_CHOICE:
+	case PLUGIN_STRING: return BVHLAB_OPTION_STRING;
+	default: return 0;
+	}
+}
+
+/* The index of s in "a|b|c", or -1. */
+static int choice_index(const char *choices, const char *s)
+{
+	size_t len = strlen(s);
+	int k = 0;
+
+	for (const char *p = choices; p; k++) {
+		const char *bar = strchr(p, '|');
+		size_t n = bar ? (size_t)(bar - p) : strlen(p);
+		if (n == len && strncmp(p, s, n) == 0)
+			return k;
+		p = bar ? bar + 1 : NULL;
+	}
+	return -1;
+}
+
+static int read_string(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                       const bvhlab_option_decl *d, const plugin_field *f, char *dst)
+{
+	const char *s;
+	int rc = host->option_string(ctx, f->name, &s);
+	int k;
+
+	if (rc < 0)
+		return rc;
+	if (f->type == PLUGIN_STRING) {
+		memcpy(dst, &s, sizeof(s));
+		return 0;
+	}
+	if (!d->choices || (k = choice_index(d->choices, s)) < 0)
+		return -EINVAL;
+	memcpy(dst, &k, sizeof(k));
+	return 0;
+}
+
+/* One field; memcpy, since the plugin's struct is not ours to alias. */
+static int read_field(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                      const bvhlab_option_decl *d, const plugin_field *f, char *dst)
+{
+	int64_t i;
+	double x;
+	int rc;
+
+	switch (f->type) {
+	case PLUGIN_BOOL: {
+		bool b;
+		if ((rc = host->option_bool(ctx, f->name, &b)) == 0)
+			memcpy(dst, &b, sizeof(b));
+		return rc;
+	}
+	case PLUGIN_I64:
+	case PLUGIN_U32:
+		if ((rc = host->option_int(ctx, f->name, &i)) < 0)
+			return rc;
+		if (f->type == PLUGIN_I64) {
+			memcpy(dst, &i, sizeof(i));
+			return 0;
+		}
+		if (!(d->min >= 0 && d->max <= UINT32_MAX && d->min <= d->max))
+			return -EINVAL;
+		memcpy(dst, &(uint32_t){ (uint32_t)i }, sizeof(uint32_t));
+		return 0;
+	case PLUGIN_DOUBLE:
+	case PLUGIN_FLOAT:
+		if ((rc = host->option_float(ctx, f->name, &x)) < 0)
+			return rc;
+		if (f->type == PLUGIN_DOUBLE)
+			memcpy(dst, &x, sizeof(x));
+		else
+			memcpy(dst, &(float){ (float)x }, sizeof(float));
+		return 0;
+	default:
+		return read_string(host, ctx, d, f, dst);
+	}
+}
+
+int plugin_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                        const bvhlab_option_decl *decls, size_t decl_count,
+                        const plugin_field *fields, size_t field_count, void *out)
+{
+	for (size_t k = 0; k < field_count; k++) {
+		const plugin_field *f = &fields[k];
+		const bvhlab_option_decl *d = find_decl(decls, decl_count, f->name);
+		int rc = d && d->type == source_type(f->type) ? 0 : -EINVAL;
+
+		if (rc == 0)
+			rc = read_field(host, ctx, d, f, (char *)out + f->offset);
+		if (rc < 0) {
+			host->set_error(ctx, "option \"%s\": the plugin's table does not match "
+			                "its declarations (%d)", f->name, rc);
+			return rc;
+		}
+	}
+	return 0;
+}
