@@ -35,7 +35,7 @@
 #include <system_error>
 #include <vector>
 
-#include <bvhlab/builder.h>
+#include <bvhlab/builder.hpp>
 
 #include "peer_tree.hpp"
 
@@ -201,36 +201,16 @@ int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_inp
 		host->set_error(ctx, "cannot build over %u primitives", in->prim_count);
 		return -EINVAL;
 	}
-	try {
-		return build_tree(host, ctx, in, s, out);
-	} catch (const std::bad_alloc &) {
-		host->set_error(ctx, "out of memory");
-		return -ENOMEM;
-	} catch (const std::system_error &e) {
-		host->set_error(ctx, "bvh2 could not start its thread pool: %s", e.what());
-		return -EAGAIN;
-	} catch (const std::exception &e) {
-		host->set_error(ctx, "bvh2 threw: %s", e.what());
-		return -EIO;
-	} catch (...) {
-		host->set_error(ctx, "bvh2 threw an unknown exception");
-		return -EIO;
-	}
+	return build_tree(host, ctx, in, s, out);
 }
 
-const bvhlab_builder descriptor = {
-	BVHLAB_ABI_CURRENT,
-	sizeof(bvhlab_builder),
+// Any exception out of build() becomes the run's error (bvhlab::guarded_build).
+const bvhlab_builder descriptor = bvhlab::make_builder(
 	"bvh2",
 	"madmann91/bvh v2 (ac41ab8): DefaultBuilder low/medium/high (mini-tree on a pool of the "
 	"run's threads), sweep and binned SAH, optional reinsertion",
 	BVHLAB_BUILDER_PARALLEL,
-	sizeof(options) / sizeof(options[0]),
-	options,
-	build,
-	nullptr, /* refine */
-	nullptr, /* update */
-};
+	options, bvhlab::guarded_build<build>);
 
 } // namespace
 

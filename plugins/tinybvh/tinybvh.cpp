@@ -30,7 +30,7 @@
 #include <new>
 #include <system_error>
 
-#include <bvhlab/builder.h>
+#include <bvhlab/builder.hpp>
 
 #include "peer_tree.hpp"
 #include "tinybvh_cpus.h"
@@ -210,36 +210,16 @@ int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_inp
 		host->set_error(ctx, "cannot build over %u primitives", in->prim_count);
 		return -EINVAL;
 	}
-	try {
-		return build_tree(host, ctx, in, s, out);
-	} catch (const std::bad_alloc &) {
-		host->set_error(ctx, "out of memory");
-		return -ENOMEM;
-	} catch (const std::system_error &e) {
-		host->set_error(ctx, "tinybvh could not start a thread: %s", e.what());
-		return -EAGAIN;
-	} catch (const std::exception &e) {
-		host->set_error(ctx, "tinybvh threw: %s", e.what());
-		return -EIO;
-	} catch (...) {
-		host->set_error(ctx, "tinybvh threw an unknown exception");
-		return -EIO;
-	}
+	return build_tree(host, ctx, in, s, out);
 }
 
-const bvhlab_builder descriptor = {
-	BVHLAB_ABI_CURRENT,
-	sizeof(bvhlab_builder),
+// Any exception out of build() becomes the run's error (bvhlab::guarded_build).
+const bvhlab_builder descriptor = bvhlab::make_builder(
 	"tinybvh",
 	"jbikker/tinybvh 1.6.7: quick, binned, avx, sweep, hq (spatial splits), optional "
 	"Optimize; thread count held by CPU affinity (see the builder option)",
 	BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_SPATIAL_SPLITS,
-	sizeof(options) / sizeof(options[0]),
-	options,
-	build,
-	nullptr, /* refine */
-	nullptr, /* update */
-};
+	options, bvhlab::guarded_build<build>);
 
 } // namespace
 
