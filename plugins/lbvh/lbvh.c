@@ -23,11 +23,6 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b)
 
 	if (rc < 0)
 		return rc;
-	/* The one thing the declared range 30..63 does not say. */
-	if (o.bits != 30 && o.bits != 63) {
-		host->set_error(ctx, "option bits: %u, expected 30 or 63", o.bits);
-		return -EINVAL;
-	}
 	b->collapse = o.collapse;
 	b->bits = o.bits;
 	b->max_leaf = o.max_leaf;

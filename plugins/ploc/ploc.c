@@ -32,11 +32,6 @@ static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p)
 	if ((rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, radius, 1, p)) < 0 ||
 	    (rc = morton_options_fill(host, ctx, options, OPTION_COUNT, &o)) < 0)
 		return rc;
-	/* The one thing the declared range 30..63 does not say. */
-	if (o.bits != 30 && o.bits != 63) {
-		host->set_error(ctx, "option bits: %u, expected 30 or 63", o.bits);
-		return -EINVAL;
-	}
 	p->collapse = o.collapse;
 	p->sort.bits = o.bits;
 	p->max_leaf = o.max_leaf;

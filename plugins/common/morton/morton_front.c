@@ -22,8 +22,14 @@ int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		PLUGIN_FIELD(morton_options, c_isect, "c_isect", FLOAT),
 	};
 
-	return plugin_options_fill(host, ctx, decls, count, fields,
-	                           sizeof(fields) / sizeof(fields[0]), o);
+	int rc = plugin_options_fill(host, ctx, decls, count, fields,
+	                             sizeof(fields) / sizeof(fields[0]), o);
+	/* The one thing the declared range 30..63 does not say. */
+	if (rc == 0 && o->bits != 30 && o->bits != 63) {
+		host->set_error(ctx, "option bits: %u, expected 30 or 63", o->bits);
+		rc = -EINVAL;
+	}
+	return rc;
 }
 
 double morton_now_ms(void)

@@ -43,7 +43,8 @@ typedef struct morton_options {
 } morton_options;
 
 /* Fills o from MORTON_OPTION_DECLS among a plugin's `decls`
- * (plugin_options.h): 0, or a negative errno after host->set_error. */
+ * (plugin_options.h) and checks what the declarations cannot say (bits
+ * 30 or 63): 0, or a negative errno after host->set_error. */
 int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                         const bvhlab_option_decl *decls, size_t count, morton_options *o);
 
