@@ -107,21 +107,22 @@ static int parse(int argc, char **argv, struct run_args *a)
 	return 0;
 }
 
-/* Command-line overrides; --out is taken as given (relative to the cwd). */
-static int apply_overrides(struct config *cfg, const struct run_args *a)
+/* Command-line overrides; --out is taken as given (relative to the cwd).
+ * Thread counts are resolved here, once, for every later step. */
+static int apply_overrides(struct config *cfg, const struct run_args *a, bvhlab_error *err)
 {
 	if (a->out) {
 		char *out = strdup(a->out);
 		if (!out)
-			return -1;
+			return error_set(err, "out of memory"), -1;
 		free(cfg->output);
 		cfg->output = out;
 	}
 	if (a->thread_count && config_set_threads(cfg, a->threads, a->thread_count) < 0)
-		return -1;
+		return error_set(err, "out of memory"), -1;
 	if (a->repeat)
 		cfg->repeat = (uint32_t)a->repeat;
-	return 0;
+	return plan_resolve_threads(cfg, err);
 }
 
 /* The config, or a plan's (checked, its hash kept for the results). */
@@ -168,8 +169,8 @@ int cmd_run(int argc, char **argv)
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
-	if (apply_overrides(&cfg, &a) < 0) {
-		fprintf(stderr, "bvhlab: out of memory\n");
+	if (apply_overrides(&cfg, &a, &err) < 0) {
+		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
 	r = harness_run(&cfg, &a.opts, &err);

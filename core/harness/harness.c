@@ -513,11 +513,17 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 {
 	struct harness h = {.cfg = cfg, .only = opts->only, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
-	int r = opts->resume ? 0 : safe_claim_output(cfg->output, opts->force, err);
-	if (r == 0)
-		r = results_init(&h.res, cfg, cfg->output, err);
+	int r = results_init(&h.res, cfg, cfg->output, err);
 	if (r < 0)
 		return r;
+	/* One writer per folder, from before anything in it is read or moved. */
+	r = results_lock(&h.res, err);
+	if (r == 0 && !opts->resume)
+		r = safe_claim_output(h.res.dir, opts->force, err);
+	if (r < 0) {
+		results_finish(&h.res);
+		return r;
+	}
 	if (opts->plan_hash)
 		r = results_set_plan(&h.res, opts->plan_hash, plan_run_count(cfg), err);
 	bvhlab_set_pinning(cfg->pin);

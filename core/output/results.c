@@ -16,29 +16,6 @@
 #include "output/safe_file.h"
 #include "util/util.h"
 
-int results_make_dirs(const char *path, bvhlab_error *err)
-{
-	char buf[4096];
-	if ((size_t)snprintf(buf, sizeof(buf), "%s", path) >= sizeof(buf)) {
-		error_set(err, "output folder name too long: %s", path);
-		return -ENAMETOOLONG;
-	}
-	for (char *p = buf + 1;; p++) {
-		char c = *p;
-		if (c != '/' && c != '\0')
-			continue;
-		*p = '\0';
-		if (mkdir(buf, 0777) < 0 && errno != EEXIST) {
-			int e = errno;
-			error_set(err, "cannot create output folder %s: %s", buf, strerror(e));
-			return -e;
-		}
-		*p = c;
-		if (c == '\0')
-			return 0;
-	}
-}
-
 static cJSON *machine_json(void)
 {
 	struct machine_info m;
@@ -84,6 +61,7 @@ int results_init(struct results *res, const struct config *cfg, const char *dir,
 	res->doc = cJSON_CreateObject();
 	if (!res->dir || !res->doc)
 		goto nomem;
+	results_normalise_dir(res->dir);
 	cJSON_AddStringToObject(res->doc, "bvhlab_version", bvhlab_version());
 	add_created(res->doc);
 	cJSON_AddItemToObject(res->doc, "machine", machine_json());
@@ -101,6 +79,7 @@ nomem:
 
 void results_finish(struct results *res)
 {
+	results_unlock(res);
 	cJSON_Delete(res->doc);
 	free(res->dir);
 	memset(res, 0, sizeof(*res));
@@ -266,7 +245,7 @@ static int write_rendering(const struct results *res, const char *name, char *te
 static const char *const renderings[] = {"results.json", "results.csv", "report.md",
                                          "report.html"};
 
-static int write_renderings(const struct results *res, bvhlab_error *err)
+int results_write_renderings(const struct results *res, bvhlab_error *err)
 {
 	int r = write_rendering(res, renderings[0], cJSON_Print(res->doc), err);
 	if (r == 0)
@@ -276,63 +255,6 @@ static int write_renderings(const struct results *res, bvhlab_error *err)
 	if (r == 0)
 		r = write_rendering(res, renderings[3], report_html(res->doc), err);
 	return r;
-}
-
-/* Removes dir/name if it is there (cleaning up a folder that failed). */
-static void remove_in(const char *dir, const char *name)
-{
-	char path[4096];
-	if ((size_t)snprintf(path, sizeof(path), "%s/%s", dir, name) < sizeof(path))
-		unlink(path);
-}
-
-/*
- * A new results folder appears whole: written as a temporary sibling and
- * renamed into place (over an empty folder too). A sweep killed while it
- * starts (GNU parallel stopping its jobs) leaves no folder, or one with a
- * results.json that says which plan it belongs to, never a bare folder
- * that `bvhlab merge` must refuse.
- */
-static int write_fresh(const struct results *res, bvhlab_error *err)
-{
-	char tmp[4096], *slash;
-	if ((size_t)snprintf(tmp, sizeof(tmp), "%s.new-XXXXXX", res->dir) >= sizeof(tmp)) {
-		error_set(err, "output folder name too long: %s", res->dir);
-		return -ENAMETOOLONG;
-	}
-	int r = 0;
-	if ((slash = strrchr(tmp, '/')) && slash != tmp) {
-		*slash = '\0';
-		r = results_make_dirs(tmp, err);
-		*slash = '/';
-	}
-	if (r == 0 && !mkdtemp(tmp)) {
-		r = -errno;
-		error_set(err, "cannot create output folder %s: %s", res->dir, strerror(-r));
-	}
-	if (r < 0)
-		return r;
-	struct results t = *res;
-	t.dir = tmp;
-	r = write_renderings(&t, err);
-	if (r == 0 && rename(tmp, res->dir) < 0) {
-		r = -errno;
-		error_set(err, "cannot create output folder %s: %s", res->dir, strerror(-r));
-	}
-	if (r < 0) {
-		for (size_t k = 0; k < sizeof(renderings) / sizeof(renderings[0]); k++)
-			remove_in(tmp, renderings[k]);
-		rmdir(tmp);
-	}
-	return r;
-}
-
-int results_write(const struct results *res, bvhlab_error *err)
-{
-	struct stat st;
-	if (stat(res->dir, &st) < 0 && errno == ENOENT)
-		return write_fresh(res, err);
-	return write_renderings(res, err);
 }
 
 /* ---- resuming ---------------------------------------------------------------- */

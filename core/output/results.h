@@ -22,6 +22,8 @@ struct results {
 	struct cJSON *scenes;
 	struct cJSON *runs;
 	char *dir;
+	bool locked;  /* lock_fd holds the folder's lock (results_dir.c) */
+	int lock_fd;
 };
 
 /* Traversal counters and timings of one run's primary and diffuse rays,
@@ -135,10 +137,36 @@ int results_check_runs(const struct cJSON *runs, const struct config *cfg, const
 bool results_has_run(const struct results *res, const char *scene, const char *builder,
                      uint32_t threads);
 
-/* Rewrites results.json, results.csv, report.md and report.html, each
+/* ---- the output folder (results_dir.c) ---------------------------------- */
+
+/*
+ * Rewrites results.json, results.csv, report.md and report.html, each
  * atomically; a folder that does not exist yet is made with all four in it
- * at once (a temporary sibling renamed into place), parents as needed. */
-int results_write(const struct results *res, bvhlab_error *err);
+ * at once (a hidden temporary sibling, .bvhlab-new-XXXXXX, renamed into
+ * place), parents as needed. The folder's lock is taken first if res does
+ * not hold it (a new folder comes with it held): -EBUSY, err naming the
+ * holder's pid, when another process writes there.
+ */
+int results_write(struct results *res, bvhlab_error *err);
+/* The four files into res->dir as it is (results_write's second half). */
+int results_write_renderings(const struct results *res, bvhlab_error *err);
+
+/*
+ * One writer per output folder: takes res->dir's advisory lock
+ * (.bvhlab.lock, flock) for as long as res lives, and writes this pid
+ * into it. 0 (also when the folder does not exist yet: results_write takes
+ * it when it makes the folder), or -EBUSY with err naming the folder and
+ * the pid of the process that holds it.
+ */
+int results_lock(struct results *res, bvhlab_error *err);
+void results_unlock(struct results *res);
+
+/* Removes the temporary folders (.bvhlab-new-*) in parent that no living
+ * process is making (their lock is free). */
+void results_sweep_temps(const char *parent);
+
+/* "out/", "out/." and "out//" become "out", in place. */
+void results_normalise_dir(char *dir);
 
 /* Writes `text` to dir/name through dir/.name.tmp and rename. */
 int results_write_file(const char *dir, const char *name, const char *text, bvhlab_error *err);

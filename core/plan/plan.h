@@ -32,6 +32,15 @@ struct plan_run {
 /* The builder's thread counts: its own list or the config's. */
 const uint32_t *plan_builder_threads(const struct config *cfg, const struct config_builder *b,
                                      size_t *count);
+/*
+ * A run's thread count is resolved once, when the run list is made: 0
+ * becomes this machine's hardware threads. plan_check_threads refuses
+ * (-EINVAL, err naming the list and "duplicate thread count N") a list in
+ * which 0 resolves to a count it already has; plan_resolve_threads checks
+ * and then resolves every list of cfg in place (ids do not change).
+ */
+int plan_check_threads(const struct config *cfg, bvhlab_error *err);
+int plan_resolve_threads(struct config *cfg, bvhlab_error *err);
 size_t plan_run_count(const struct config *cfg);
 /* The id of scene x builder x thread_index. */
 uint32_t plan_run_id(const struct config *cfg, size_t scene, size_t builder,

@@ -367,9 +367,12 @@ static int write_merged(const struct merge *m, const char *dir, struct merge_sum
 	if (r == 0)
 		r = results_make_dirs(dir, err);
 	if (r == 0)
+		r = results_lock(&res, err); /* one writer: a run or another merge */
+	if (r == 0)
 		r = copy_images(m, dir, err);
 	if (r == 0)
 		r = results_write(&res, err);
+	results_unlock(&res);
 	cJSON_Delete(res.doc);
 	return r;
 }
