@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "harness/harness_builders.h"
 
 static const char usage[] =
 	"usage: bvhlab list [PLUGIN...]\n"
@@ -43,11 +44,17 @@ static void print_option(const bvhlab_option_decl *d)
 	printf("\n      %s\n", d->help ? d->help : "");
 }
 
+/* Loading runs the plugin's code: a constructor that crashes or hangs
+ * costs its own line of the list, not the listing. */
+#define PROBE_TIMEOUT_S 30
+
 static int list_one(const char *name)
 {
 	bvhlab_plugin *p = NULL;
 	bvhlab_error err = {{0}};
-	if (bvhlab_plugin_open(name, &p, &err) < 0) {
+	const char *status;
+	if (harness_probe_plugin(name, PROBE_TIMEOUT_S, &status, &err) < 0 ||
+	    bvhlab_plugin_open(name, &p, &err) < 0) {
 		printf("%s: NOT USABLE: %s\n\n", name, err.message);
 		return 1;
 	}

@@ -11,6 +11,7 @@
 
 #include "cli.h"
 #include "config/config.h"
+#include "harness/harness_builders.h"
 #include "output/results.h"
 #include "plan/plan.h"
 #include "util/util.h"
@@ -100,25 +101,24 @@ static int parse(int argc, char **argv, struct plan_args *a)
 	return r;
 }
 
-/* Opens every builder's plugin and applies its options: a plan that cannot run is refused. */
+/*
+ * Opens every builder's plugin and refine stages, each first in a forked
+ * probe, and applies their options: a plan that cannot run is refused
+ * (every reason printed). An optional builder whose plugin is not here is
+ * kept, as `run` keeps it: the machines that run the parts may have it.
+ */
 static int check_builders(const struct config *cfg)
 {
-	int bad = 0;
-	for (size_t b = 0; b < cfg->builder_count; b++) {
-		const struct config_builder *cb = &cfg->builders[b];
-		bvhlab_plugin *p = NULL;
-		bvhlab_options opts = {0};
-		bvhlab_error err = {{0}};
-		if (bvhlab_plugin_open(cb->plugin, &p, &err) < 0 ||
-		    bvhlab_options_init(&opts, bvhlab_plugin_builder(p)) < 0 ||
-		    config_apply_options(cfg, cb, &opts, &err) < 0) {
-			fprintf(stderr, "bvhlab: builder '%s': %s\n", cb->name,
-			        err.message[0] ? err.message : "out of memory");
+	struct harness_builder *builders = NULL;
+	bvhlab_error err = {{0}};
+	int bad = harness_open_builders(cfg, true, &builders) < 0 ? -1 : 0;
+	for (size_t b = 0; bad == 0 && b < cfg->builder_count; b++)
+		if (!builders[b].skipped && (!builders[b].plugin || !builders[b].opts_ok))
 			bad = -1;
-		}
-		if (opts.values)
-			bvhlab_options_finish(&opts);
-		bvhlab_plugin_close(p);
+	harness_close_builders(cfg, builders);
+	if (bad == 0 && plan_check_threads(cfg, &err) < 0) {
+		fprintf(stderr, "bvhlab: %s\n", err.message);
+		bad = -1;
 	}
 	return bad;
 }

@@ -533,7 +533,7 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 		r = results_write(&h.res, err);
 	if (r == 0)
 		harness_rounds_sweep(cfg->output);
-	if (r == 0 && (r = harness_open_builders(cfg, &h.builders)) < 0)
+	if (r == 0 && (r = harness_open_builders(cfg, cfg->isolate, &h.builders)) < 0)
 		error_set(err, "out of memory opening plugins");
 	h.progress.total = count_runs(&h);
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)

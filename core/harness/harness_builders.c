@@ -31,38 +31,57 @@ struct isolate_limits harness_run_limits(const struct config *cfg,
  * since the child ends with _exit anyway. */
 static void probe_work(void *arg, void *report, size_t size)
 {
-	const struct config_builder *cb = arg;
+	const char *name = arg;
 	struct probe_report *rep = report;
 	bvhlab_plugin *plugin = NULL;
 	bvhlab_error err = {{0}};
 	(void)size;
-	rep->ok = bvhlab_plugin_open(cb->plugin, &plugin, &err) == 0;
+	rep->ok = bvhlab_plugin_open(name, &plugin, &err) == 0;
 	if (!rep->ok)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
 }
 
-/* 0 when the plugin loaded in a child; else the builder's status and error. */
-static int probe(const struct config *cfg, struct harness_builder *hb)
+int harness_probe_plugin(const char *plugin, double timeout_s, const char **status,
+                         bvhlab_error *err)
 {
 	struct probe_report rep = {0};
 	char why[sizeof(rep.error)] = "";
 	/* The timeout only: the limit is on the builds, and a child's address
 	 * space starts at the parent's (its libraries), which can exceed it. */
-	struct isolate_limits limits = {.timeout_s = harness_run_limits(cfg, hb->cb).timeout_s};
-	int outcome = isolate_call(probe_work, (void *)hb->cb, &rep, sizeof(rep), &limits, why,
+	struct isolate_limits limits = {.timeout_s = timeout_s};
+	int outcome = isolate_call(probe_work, (void *)plugin, &rep, sizeof(rep), &limits, why,
 	                           sizeof(why));
+	*status = "failed";
 	if (outcome == ISOLATE_REPORTED && rep.ok)
 		return 0;
 	rep.error[sizeof(rep.error) - 1] = '\0';
 	if (outcome == ISOLATE_REPORTED) {
-		error_set(&hb->error, "%s", rep.error);
+		error_set(err, "%s", rep.error);
 		return -EINVAL;
 	}
-	hb->status = outcome == ISOLATE_TIMEOUT ? "timeout" : outcome < 0 ? "failed" : "crashed";
-	error_set(&hb->error, "plugin %s: %s while loading (library constructor or entry "
-	          "point): %s", hb->cb->plugin, outcome == ISOLATE_TIMEOUT ? "hung" : "died",
-	          why);
+	*status = outcome == ISOLATE_TIMEOUT ? "timeout" : outcome < 0 ? "failed" : "crashed";
+	error_set(err, "plugin %s: %s while loading (library constructor or entry point): %s",
+	          plugin, outcome == ISOLATE_TIMEOUT ? "hung" : "died", why);
 	return -EINVAL;
+}
+
+/* 0 when the builder's plugin and every refine stage's loaded in a child
+ * each; else the builder's status and error, naming the stage. */
+static int probe(const struct config *cfg, struct harness_builder *hb)
+{
+	double timeout_s = harness_run_limits(cfg, hb->cb).timeout_s;
+	if (harness_probe_plugin(hb->cb->plugin, timeout_s, &hb->status, &hb->error) < 0)
+		return -EINVAL;
+	for (size_t k = 0; k < hb->cb->refine_count; k++) {
+		bvhlab_error err = {{0}};
+		if (harness_probe_plugin(hb->cb->refine[k].plugin, timeout_s, &hb->status,
+		                         &err) < 0) {
+			hb->stage_failed = true;
+			error_set(&hb->error, "refine stage %zu: %s", k + 1, err.message);
+			return -EINVAL;
+		}
+	}
+	return 0;
 }
 
 /* Opens a builder's refinement stages; *ok false (hb->error set) when one
@@ -91,10 +110,10 @@ static int open_stages(const struct config *cfg, struct harness_builder *hb, boo
 }
 
 /* 0, -EINVAL with hb's error set, or -ENOMEM. */
-static int open_one(const struct config *cfg, struct harness_builder *hb)
+static int open_one(const struct config *cfg, bool probed, struct harness_builder *hb)
 {
 	hb->status = "failed";
-	if (cfg->isolate && probe(cfg, hb) < 0)
+	if (probed && probe(cfg, hb) < 0)
 		return -EINVAL;
 	if (bvhlab_plugin_open(hb->cb->plugin, &hb->plugin, &hb->error) < 0)
 		return -EINVAL;
@@ -106,7 +125,8 @@ static int open_one(const struct config *cfg, struct harness_builder *hb)
 	return hb->opts_ok ? 0 : -EINVAL;
 }
 
-int harness_open_builders(const struct config *cfg, struct harness_builder **out)
+int harness_open_builders(const struct config *cfg, bool probed,
+                          struct harness_builder **out)
 {
 	struct harness_builder *builders = calloc(cfg->builder_count ? cfg->builder_count : 1,
 	                                          sizeof(*builders));
@@ -116,10 +136,10 @@ int harness_open_builders(const struct config *cfg, struct harness_builder **out
 	for (size_t b = 0; b < cfg->builder_count; b++) {
 		struct harness_builder *hb = &builders[b];
 		hb->cb = &cfg->builders[b];
-		int r = open_one(cfg, hb);
+		int r = open_one(cfg, probed, hb);
 		if (r == -ENOMEM)
 			return r;
-		hb->skipped = r < 0 && !hb->plugin && hb->cb->optional;
+		hb->skipped = r < 0 && !hb->plugin && !hb->stage_failed && hb->cb->optional;
 		if (hb->skipped)
 			fprintf(stderr, "bvhlab: optional builder '%s' skipped: %s\n", hb->cb->name,
 			        hb->error.message);

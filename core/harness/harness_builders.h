@@ -23,6 +23,7 @@ struct harness_builder {
 	const char *status;    /* of its runs when unusable: "failed", "crashed", "timeout" */
 	bool skipped;          /* optional ("optional": true) and its plugin could not be
 	                        * loaded: it has no runs at all */
+	bool stage_failed;     /* the builder loaded but a refine stage's plugin did not */
 	bvhlab_error error;
 	struct harness_stage {
 		bvhlab_plugin *plugin;
@@ -36,11 +37,22 @@ struct isolate_limits harness_run_limits(const struct config *cfg,
                                          const struct config_builder *cb);
 
 /*
- * Opens every builder of cfg into *out ([cfg->builder_count]); a builder
+ * Opens `plugin` in a forked child killed after timeout_s (> 0): 0 when it
+ * loaded there. Else *status is "failed" (err: why it was refused),
+ * "crashed" or "timeout" (err: it died or hung while loading, naming the
+ * plugin). Nothing of the plugin stays in this process.
+ */
+int harness_probe_plugin(const char *plugin, double timeout_s, const char **status,
+                         bvhlab_error *err);
+
+/*
+ * Opens every builder of cfg into *out ([cfg->builder_count]), each plugin
+ * (builder and refine stages) first in a probe when `probed`; a builder
  * that cannot be used keeps its status and message (printed to stderr
  * too), and the others go on. 0, or -ENOMEM.
  */
-int harness_open_builders(const struct config *cfg, struct harness_builder **out);
+int harness_open_builders(const struct config *cfg, bool probed,
+                          struct harness_builder **out);
 void harness_close_builders(const struct config *cfg, struct harness_builder *builders);
 
 #endif

@@ -1,0 +1,247 @@
+/*
+ * Issue 29's cases, one mode per mechanism, each a meson test of its own
+ * (cli-rel-MODE):
+ *   probe     every plugin opened (builder, refine stage; run, plan, list)
+ *             is tried in a forked probe first
+ *   lock      one writer per output folder, the second told the holder's pid
+ *   threads   0 resolved once: [0, N] with N the machine's count is a duplicate
+ *   temps     new folders appear whole, leftovers are hidden and swept,
+ *             out/, out/. and 250-byte names work
+ *   identity  a run's options are part of its identity (resume, merge),
+ *             --retry-failed, parts of other plans or scene data refused
+ *   measure   a missing measurement says why; stale heat data is never drawn
+ *   force     a kill during --force's move-aside loses nothing
+ * Usage: test-cli-rel BVHLAB_EXE MODE
+ */
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+
+#include "cliutil.h"
+
+#define LOADCRASH_DIR BVHLAB_TEST_BUILDDIR "/fake/loadcrash"
+/* Long enough for any of these runs on a loaded machine; a hang ends here. */
+#define LIMIT_S 60
+
+static int run_in(const char *cwd, const char *const *args)
+{
+	return finish(start_in(cwd, LIMIT_S, args));
+}
+
+static const char *path_in(const char *name)
+{
+	static char buf[4][600];
+	static int next;
+	char *p = buf[next++ % 4];
+	snprintf(p, 600, "%s/%s", tmpdir, name);
+	return p;
+}
+
+static bool exists(const char *path)
+{
+	struct stat st;
+	return lstat(path, &st) == 0;
+}
+
+/* ASan's own SEGV handler would turn the plugins' crashes into aborts. */
+static void plain_crashes(void)
+{
+	const char *old = getenv("ASAN_OPTIONS");
+	char opts[512];
+	snprintf(opts, sizeof(opts), "%s%shandle_segv=0", old ? old : "", old && *old ? ":" : "");
+	setenv("ASAN_OPTIONS", opts, 1);
+}
+
+static const cJSON *run_of(const cJSON *doc, const char *builder, int threads)
+{
+	const cJSON *r;
+	cJSON_ArrayForEach(r, cJSON_GetObjectItem(doc, "runs"))
+		if (!strcmp(run_str(r, "builder"), builder) &&
+		    cJSON_GetObjectItem(r, "threads")->valueint == threads)
+			return r;
+	return NULL;
+}
+
+static void check_run(const cJSON *doc, const char *builder, int threads, const char *status,
+                      const char *error)
+{
+	const cJSON *r = run_of(doc, builder, threads);
+	if (!r) {
+		fprintf(stderr, "no run %s / %d\n", builder, threads);
+		test_failures++;
+		return;
+	}
+	CHECK_CONTAINS(run_str(r, "status"), status);
+	if (error)
+		CHECK_CONTAINS(run_str(r, "error"), error);
+}
+
+/* 1. Refine stages that crash or hang while loading cost their builder's
+ * runs only; plan and list probe too, and plan checks stages' options. */
+static void test_probe(void)
+{
+	char text[2048];
+	plain_crashes();
+	snprintf(text, sizeof(text),
+	         "{ \"output\": \"out-probe\", \"repeat\": 1, \"timeout_s\": 5,\n"
+	         "  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+	         "  \"builders\": [\n"
+	         "    { \"plugin\": \"fake_good\", \"name\": \"c\",\n"
+	         "      \"refine\": [ { \"plugin\": \"%s/crash_ctor.so\" } ] },\n"
+	         "    { \"plugin\": \"fake_good\", \"name\": \"h\", \"timeout_s\": 1,\n"
+	         "      \"refine\": [ { \"plugin\": \"%s/hang_entry.so\" } ] },\n"
+	         "    { \"plugin\": \"fake_good\", \"name\": \"good\" } ] }\n",
+	         LOADCRASH_DIR, LOADCRASH_DIR);
+	const char *cfg = write_config("probe.json", text);
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 1);
+	cJSON *doc = load_results(path_in("out-probe"));
+	check_run(doc, "c", 1, "crashed", "refine stage 1: plugin");
+	check_run(doc, "c", 1, "crashed", "died while loading");
+	check_run(doc, "h", 1, "timeout", "hung while loading");
+	check_run(doc, "good", 1, "ok", NULL);
+	cJSON_Delete(doc);
+
+	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "plan-probe")), 2);
+	CHECK_CONTAINS(err_text, "builder 'c': refine stage 1: plugin");
+	CHECK_CONTAINS(err_text, "died while loading");
+	CHECK(!exists(path_in("plan-probe/plan.json")));
+
+	const char *bad_opt = write_config("refopt.json",
+		"{ \"repeat\": 1, \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\",\n"
+		"    \"refine\": [ { \"plugin\": \"reinsert\", \"options\": { \"nope\": 1 } } ] } ] }\n");
+	CHECK_INT(run_in(tmpdir, ARGS("plan", bad_opt, "--out", "plan-opt")), 2);
+	CHECK_CONTAINS(err_text, "nope");
+	const char *optional = write_config("optional.json",
+		"{ \"repeat\": 1, \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
+		"    { \"plugin\": \"not_built_here\", \"optional\": true } ] }\n");
+	CHECK_INT(run_in(tmpdir, ARGS("plan", optional, "--out", "plan-optional")), 0);
+	CHECK_CONTAINS(err_text, "optional builder 'not_built_here' skipped");
+
+	char crash[600];
+	snprintf(crash, sizeof(crash), "%s/crash_ctor.so", LOADCRASH_DIR);
+	CHECK_INT(run_in(tmpdir, ARGS("list", crash, "fake_good")), 1);
+	CHECK_CONTAINS(out_text, "NOT USABLE");
+	CHECK_CONTAINS(out_text, "died while loading");
+	CHECK_CONTAINS(out_text, "fake_good");
+}
+
+/* Holds dir's lock as another bvhlab would, with `pid` written in it. */
+static int hold_lock(const char *dir, const char *pid)
+{
+	char path[700];
+	snprintf(path, sizeof(path), "%s/.bvhlab.lock", dir);
+	int fd = open(path, O_RDWR | O_CREAT, 0644);
+	CHECK(fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0);
+	CHECK(write(fd, pid, strlen(pid)) == (ssize_t)strlen(pid));
+	return fd;
+}
+
+static const char small[] =
+	"{ \"output\": \"%s\", \"repeat\": 1, \"threads\": [1, 2],\n"
+	"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1 },\n"
+	"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+	"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n";
+
+/* 2. A second writer is refused, naming the first, and nothing is lost. */
+static void test_lock(void)
+{
+	char text[1024];
+	snprintf(text, sizeof(text), small, "out-lock");
+	const char *cfg = write_config("lock.json", text);
+	const char *dir = path_in("out-lock");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--threads", "1", cfg)), 0);
+	char *before = read_file(dir, "results.json");
+	int fd = hold_lock(dir, "4242\n");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--resume", cfg)), 2);
+	CHECK_CONTAINS(err_text, "out-lock is in use by another bvhlab (pid 4242)");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--force", cfg)), 2);
+	CHECK_CONTAINS(err_text, "pid 4242");
+	char *after = read_file(dir, "results.json");
+	CHECK(before && after && !strcmp(before, after));
+	CHECK(!exists(path_in("out-lock/results.json.1")));
+	close(fd);
+	CHECK_INT(run(ARGS("run", "--quiet", "--resume", cfg)), 0);
+	cJSON *doc = load_results(dir);
+	CHECK_INT(count_runs(doc, "fake_good", "ok"), 2);
+	cJSON_Delete(doc);
+	free(before);
+	free(after);
+}
+
+/* 3, 13. Thread counts are checked after 0 is resolved. */
+static void test_threads(void)
+{
+	char text[1024], list[32];
+	long cores = sysconf(_SC_NPROCESSORS_ONLN);
+	snprintf(text, sizeof(text),
+	         "{ \"output\": \"out-thr\", \"repeat\": 1, \"threads\": [0, %ld],\n"
+	         "  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+	         "  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", cores);
+	const char *cfg = write_config("thr.json", text);
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 2);
+	CHECK_CONTAINS(err_text, "duplicate thread count");
+	CHECK(!exists(path_in("out-thr")));
+	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "plan-thr")), 2);
+	CHECK_CONTAINS(err_text, "duplicate thread count");
+	snprintf(list, sizeof(list), "%ld,0", cores);
+	snprintf(text, sizeof(text), small, "out-thr2");
+	const char *ok = write_config("thr2.json", text);
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--threads", list, ok)), 2);
+	CHECK_CONTAINS(err_text, "duplicate thread count");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--threads", "2,2", ok)), 2);
+	CHECK_CONTAINS(err_text, "--threads: duplicate thread count 2");
+	CHECK(!strstr(err_text, "out of memory"));
+}
+
+/* 4, 12. New folders appear whole; what a killed start leaves is hidden and swept. */
+static void test_temps(void)
+{
+	char text[1024], name[300];
+	snprintf(text, sizeof(text), small, "parts/6");
+	const char *cfg = write_config("tmp.json", text);
+	/* What a sweep killed while making parts/7 leaves: a hidden folder
+	 * holding a complete results.json, its lock free. */
+	char leftover[700];
+	snprintf(leftover, sizeof(leftover), "mkdir -p '%s/parts/.bvhlab-new-abc123' && "
+	         "echo '{\"runs\": []}' > '%s/parts/.bvhlab-new-abc123/results.json' && "
+	         "touch '%s/parts/.bvhlab-new-abc123/.bvhlab.lock'", tmpdir, tmpdir, tmpdir);
+	CHECK_INT(system(leftover), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 0);
+	CHECK(exists(path_in("parts/6/results.json")));
+	CHECK(!exists(path_in("parts/.bvhlab-new-abc123")));
+
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--out", "trail/", cfg)), 0);
+	CHECK(exists(path_in("trail/results.json")));
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--out", "dot/.", cfg)), 0);
+	CHECK(exists(path_in("dot/results.json")));
+	memset(name, 'x', 250);
+	name[250] = '\0';
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--out", name, cfg)), 0);
+	CHECK_INT(runs_written(path_in(name)), 2);
+}
+
+int main(int argc, char **argv)
+{
+	static const struct {
+		const char *mode;
+		void (*fn)(void);
+	} modes[] = {
+		{"probe", test_probe},     {"lock", test_lock}, {"threads", test_threads},
+		{"temps", test_temps},
+	};
+	if (!cli_begin(argc, argv))
+		return fprintf(stderr, "usage: test-cli-rel BVHLAB_EXE MODE\n"), 2;
+	/* Absolute: the modes run it in tmpdir. */
+	static char absolute[4096];
+	if (realpath(argv[1], absolute))
+		exe = absolute;
+	for (size_t k = 0; k < sizeof(modes) / sizeof(modes[0]); k++)
+		if (!strcmp(argv[2], modes[k].mode)) {
+			modes[k].fn();
+			return cli_end();
+		}
+	fprintf(stderr, "test-cli-rel: unknown mode %s\n", argv[2]);
+	return 2;
+}
