@@ -32,7 +32,9 @@ static const char usage[] =
 	"options:\n"
 	"  --out DIR        output folder (overrides the config's \"output\")\n"
 	"  --resume         keep the finished runs of the output folder's results.json\n"
-	"                   and run only the missing ones (a fresh start if there is none)\n"
+	"                   and run only the missing ones (a fresh start if there is none);\n"
+	"                   runs made with other builder or stage options run again\n"
+	"  --retry-failed   with --resume: also run again the runs that did not end ok\n"
 	"  --force          start afresh in a folder that holds results: the old files\n"
 	"                   are moved aside to results.json.N, ... (without --resume or\n"
 	"                   --force such a folder is refused)\n"
@@ -67,6 +69,7 @@ static int parse(int argc, char **argv, struct run_args *a)
 		{"repeat", required_argument, NULL, 'r'}, {"quiet", no_argument, NULL, 'q'},
 		{"resume", no_argument, NULL, 'R'},      {"help", no_argument, NULL, 'h'},
 		{"force", no_argument, NULL, 'F'},
+		{"retry-failed", no_argument, NULL, 'Y'},
 		{"only", required_argument, NULL, 'O'},
 		{NULL, 0, NULL, 0}};
 	int c;
@@ -88,6 +91,8 @@ static int parse(int argc, char **argv, struct run_args *a)
 			a->opts.resume = true;
 		} else if (c == 'F') {
 			a->opts.force = true;
+		} else if (c == 'Y') {
+			a->opts.retry_failed = true;
 		} else if (c == 'O') {
 			a->only = optarg;
 		} else {
@@ -101,6 +106,10 @@ static int parse(int argc, char **argv, struct run_args *a)
 	if (a->opts.resume && a->opts.force) {
 		fprintf(stderr, "bvhlab run: --resume keeps the old results, --force moves them "
 		        "aside: give one of them\n");
+		return -1;
+	}
+	if (a->opts.retry_failed && !a->opts.resume) {
+		fprintf(stderr, "bvhlab run: --retry-failed goes with --resume\n");
 		return -1;
 	}
 	a->config = argv[optind];

@@ -129,6 +129,7 @@ static void record_all_failed(struct harness *h, size_t scene_index, const char 
 		                         .scene = scene, .builder = hb->cb->name,
 		                         .plugin = hb->cb->plugin, .threads = resolve_threads(threads[k]),
 		                         .opts = hb->opts_ok ? &hb->opts : NULL,
+		                         .options_hash = hb->opts_ok ? hb->options_hash : NULL,
 		                         .status = status, .error = error};
 		if (!skip_run(h, run.id, run.scene, run.builder, run.threads))
 			record(h, &run);
@@ -368,7 +369,8 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 	struct run_record run = {.id = plan_run_id(h->cfg, scene_index, builder_index, thread_index),
 	                         .scene = job->scene->name, .builder = job->hb->cb->name,
 	                         .plugin = desc->name, .threads = resolve_threads(job->threads),
-	                         .opts = &job->hb->opts, .status = "failed",
+	                         .opts = &job->hb->opts, .options_hash = job->hb->options_hash,
+	                         .status = "failed",
 	                         .triangles = job->scene->triangle_count};
 	char paths[2][4096], tree_path[4096];
 	if (skip_run(h, run.id, run.scene, run.builder, run.threads))
@@ -508,33 +510,64 @@ static int resume(struct harness *h, bvhlab_error *err)
 	return 0;
 }
 
+/*
+ * Resumed runs that are not what this sweep would make are made again:
+ * those of a builder whose options (or stages') changed, and with
+ * --retry-failed those that did not end ok. Written at once.
+ */
+static int forget_stale(struct harness *h, bool retry_failed, bvhlab_error *err)
+{
+	size_t changed = 0, failed = 0;
+	for (size_t b = 0; b < h->cfg->builder_count; b++) {
+		const struct harness_builder *hb = &h->builders[b];
+		if (hb->opts_ok)
+			changed += results_forget_runs(&h->res, hb->cb->name, hb->options_hash, false);
+		if (retry_failed)
+			failed += results_forget_runs(&h->res, hb->cb->name, NULL, true);
+	}
+	if (!h->progress.quiet && changed)
+		fprintf(stderr, "bvhlab: %zu resumed run%s made with other options will run again\n",
+		        changed, changed == 1 ? "" : "s");
+	if (!h->progress.quiet && failed)
+		fprintf(stderr, "bvhlab: --retry-failed: %zu run%s that did not end ok will run "
+		        "again\n", failed, failed == 1 ? "" : "s");
+	h->all_ok = results_all_ok(&h->res);
+	return changed || failed ? results_write(&h->res, err) : 0;
+}
+
+/* The folder locked and claimed, the document started (resumed). */
+static int start(struct harness *h, const struct harness_options *opts, bvhlab_error *err)
+{
+	const struct config *cfg = h->cfg;
+	int r = results_init(&h->res, cfg, cfg->output, err);
+	if (r < 0)
+		return r;
+	/* One writer per folder, from before anything in it is read or moved. */
+	r = results_lock(&h->res, err);
+	if (r == 0 && !opts->resume)
+		r = safe_claim_output(h->res.dir, opts->force, err);
+	if (r == 0 && opts->plan_hash)
+		r = results_set_plan(&h->res, opts->plan_hash, plan_run_count(cfg), err);
+	if (r == 0 && opts->resume)
+		r = resume(h, err);
+	if (r == 0)
+		r = results_write(&h->res, err);
+	if (r == 0)
+		harness_rounds_sweep(cfg->output);
+	if (r == 0 && (r = harness_open_builders(cfg, cfg->isolate, &h->builders)) < 0)
+		error_set(err, "out of memory opening plugins");
+	if (r == 0 && opts->resume)
+		r = forget_stale(h, opts->retry_failed, err);
+	return r;
+}
+
 int harness_run(const struct config *cfg, const struct harness_options *opts,
                 bvhlab_error *err)
 {
 	struct harness h = {.cfg = cfg, .only = opts->only, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
-	int r = results_init(&h.res, cfg, cfg->output, err);
-	if (r < 0)
-		return r;
-	/* One writer per folder, from before anything in it is read or moved. */
-	r = results_lock(&h.res, err);
-	if (r == 0 && !opts->resume)
-		r = safe_claim_output(h.res.dir, opts->force, err);
-	if (r < 0) {
-		results_finish(&h.res);
-		return r;
-	}
-	if (opts->plan_hash)
-		r = results_set_plan(&h.res, opts->plan_hash, plan_run_count(cfg), err);
 	bvhlab_set_pinning(cfg->pin);
-	if (r == 0 && opts->resume)
-		r = resume(&h, err);
-	if (r == 0)
-		r = results_write(&h.res, err);
-	if (r == 0)
-		harness_rounds_sweep(cfg->output);
-	if (r == 0 && (r = harness_open_builders(cfg, cfg->isolate, &h.builders)) < 0)
-		error_set(err, "out of memory opening plugins");
+	int r = start(&h, opts, err);
 	h.progress.total = count_runs(&h);
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
 		run_scene(&h, &cfg->scenes[s], s);

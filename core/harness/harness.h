@@ -32,6 +32,7 @@ struct harness_options {
 	bool quiet;  /* no progress lines on stderr */
 	bool resume; /* keep the finished runs of the output's results.json, skip them */
 	bool force;  /* without resume: move an earlier results.json aside, not refuse */
+	bool retry_failed; /* with resume: runs kept that did not end ok run again */
 	const bool *only;      /* [plan_run_count]: run just these ids; NULL: all */
 	const char *plan_hash; /* run from a plan: recorded so merge can match parts */
 };

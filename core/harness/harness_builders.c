@@ -10,7 +10,11 @@
 #include <string.h>
 
 #include "harness/harness_builders.h"
+#include <cJSON.h>
+
 #include "harness/isolate.h"
+#include "output/results.h"
+#include "plan/plan.h"
 #include "util/util.h"
 
 /* What the probe child sends back. */
@@ -109,6 +113,35 @@ static int open_stages(const struct config *cfg, struct harness_builder *hb, boo
 	return 0;
 }
 
+/*
+ * The hash of what a builder's runs are made with beyond its name: its
+ * plugin and resolved options, each stage's plugin and options. Part of a
+ * run's identity: --resume runs again what was made with other options,
+ * and merge refuses parts that disagree.
+ */
+static int hash_options(struct harness_builder *hb)
+{
+	struct strbuf sb = {0};
+	for (size_t k = 0; k <= hb->cb->refine_count; k++) {
+		const bvhlab_options *opts = k ? &hb->stages[k - 1].opts : &hb->opts;
+		const char *plugin = k ? hb->cb->refine[k - 1].plugin : hb->cb->plugin;
+		cJSON *o = results_options_json(opts);
+		char *text = o ? cJSON_PrintUnformatted(o) : NULL;
+		cJSON_Delete(o);
+		if (text)
+			sb_printf(&sb, "%s%s %s", k ? " | " : "", plugin, text);
+		free(text);
+		if (!text)
+			return free(sb_take(&sb)), -ENOMEM;
+	}
+	char *all = sb_take(&sb);
+	if (!all)
+		return -ENOMEM;
+	plan_hash_text(all, hb->options_hash);
+	free(all);
+	return 0;
+}
+
 /* 0, -EINVAL with hb's error set, or -ENOMEM. */
 static int open_one(const struct config *cfg, bool probed, struct harness_builder *hb)
 {
@@ -121,6 +154,8 @@ static int open_one(const struct config *cfg, bool probed, struct harness_builde
 		return -ENOMEM;
 	hb->opts_ok = config_apply_options(cfg, hb->cb, &hb->opts, &hb->error) == 0;
 	if (hb->opts_ok && open_stages(cfg, hb, &hb->opts_ok) < 0)
+		return -ENOMEM;
+	if (hb->opts_ok && hash_options(hb) < 0)
 		return -ENOMEM;
 	return hb->opts_ok ? 0 : -EINVAL;
 }

@@ -23,6 +23,7 @@ struct harness_builder {
 	const char *status;    /* of its runs when unusable: "failed", "crashed", "timeout" */
 	bool skipped;          /* optional ("optional": true) and its plugin could not be
 	                        * loaded: it has no runs at all */
+	char options_hash[17]; /* of the resolved options and stages, when opts_ok */
 	bool stage_failed;     /* the builder loaded but a refine stage's plugin did not */
 	bvhlab_error error;
 	struct harness_stage {

@@ -116,7 +116,7 @@ int results_add_scene(struct results *res, const char *name, const char *source,
 	return 0;
 }
 
-static cJSON *options_json(const bvhlab_options *opts)
+cJSON *results_options_json(const bvhlab_options *opts)
 {
 	cJSON *o = cJSON_CreateObject();
 	for (uint32_t k = 0; opts && k < opts->builder->option_count; k++) {
@@ -197,7 +197,9 @@ int results_add_run(struct results *res, const struct run_record *run)
 	cJSON_AddStringToObject(o, "builder", run->builder);
 	cJSON_AddStringToObject(o, "plugin", run->plugin ? run->plugin : "");
 	cJSON_AddNumberToObject(o, "threads", run->threads);
-	cJSON_AddItemToObject(o, "options", options_json(run->opts));
+	cJSON_AddItemToObject(o, "options", results_options_json(run->opts));
+	if (run->options_hash)
+		cJSON_AddStringToObject(o, "options_hash", run->options_hash);
 	cJSON_AddStringToObject(o, "status", run->status);
 	if (run->error)
 		cJSON_AddStringToObject(o, "error", run->error);
@@ -300,6 +302,37 @@ bool results_has_run(const struct results *res, const char *scene, const char *b
 	return find_run(res, scene, builder, threads) != NULL;
 }
 
+size_t results_forget_runs(struct results *res, const char *builder, const char *options_hash,
+                           bool not_ok)
+{
+	size_t n = 0;
+	cJSON *run = res->runs->child;
+	while (run) {
+		cJSON *next = run->next;
+		const char *b = string_of(run, "builder"), *h = string_of(run, "options_hash");
+		const char *status = string_of(run, "status");
+		bool other_options = options_hash && h && strcmp(h, options_hash) != 0;
+		bool failed = not_ok && (!status || strcmp(status, "ok") != 0);
+		if (b && strcmp(b, builder) == 0 && (other_options || failed)) {
+			cJSON_Delete(cJSON_DetachItemViaPointer(res->runs, run));
+			n++;
+		}
+		run = next;
+	}
+	return n;
+}
+
+bool results_all_ok(const struct results *res)
+{
+	const cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
+		const char *status = string_of(run, "status");
+		if (!status || strcmp(status, "ok") != 0)
+			return false;
+	}
+	return true;
+}
+
 /* The file's text; -ENOENT quietly when there is none. */
 static int read_text(const char *path, char **out, bvhlab_error *err)
 {
@@ -341,6 +374,26 @@ static void take_over(struct results *res, cJSON *old, size_t *kept, size_t *not
 	}
 }
 
+static const char *plan_hash(const cJSON *doc)
+{
+	return string_of(cJSON_GetObjectItemCaseSensitive(doc, "plan"), "hash");
+}
+
+/* Runs of one plan are resumed by that plan only (and a sweep's by a sweep):
+ * the hash is the runs' identity in a merge, and must not be stamped anew. */
+static int same_plan(const cJSON *doc, const cJSON *old, const char *path, bvhlab_error *err)
+{
+	const char *now = plan_hash(doc), *then = plan_hash(old);
+	if ((!now && !then) || (now && then && strcmp(now, then) == 0))
+		return 0;
+	char a[40], b[40];
+	snprintf(a, sizeof(a), then ? "from plan %s" : "without a plan", then);
+	snprintf(b, sizeof(b), now ? "from plan %s" : "not from a plan", now);
+	error_set(err, "cannot resume from %s: its runs were made %s, this sweep is %s: "
+	          "resume it with what made it, or write to another folder", path, a, b);
+	return -EINVAL;
+}
+
 int results_resume(struct results *res, const struct config *cfg, size_t *kept, size_t *not_ok,
                    bvhlab_error *err)
 {
@@ -362,6 +415,8 @@ int results_resume(struct results *res, const struct config *cfg, size_t *kept, 
 	} else {
 		r = results_check_runs(cJSON_GetObjectItemCaseSensitive(old, "runs"), cfg, path, err);
 	}
+	if (r == 0)
+		r = same_plan(res->doc, old, path, err);
 	if (r == 0)
 		take_over(res, old, kept, not_ok);
 	cJSON_Delete(old);

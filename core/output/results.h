@@ -66,6 +66,8 @@ struct run_record {
 	const char *plugin;    /* the descriptor's name */
 	uint32_t threads;      /* resolved thread count */
 	const bvhlab_options *opts; /* resolved options, or NULL */
+	const char *options_hash; /* of opts and the refine stages' (part of the
+	                           * run's identity), or NULL */
 	const char *status;    /* "ok", "invalid", "failed", ... */
 	const char *error;     /* message when status is not "ok", or NULL */
 	const double *samples_ms;
@@ -133,6 +135,19 @@ int results_resume(struct results *res, const struct config *cfg, size_t *kept, 
  */
 int results_check_runs(const struct cJSON *runs, const struct config *cfg, const char *path,
                        bvhlab_error *err);
+/*
+ * Removes the runs of `builder` that were made with other options (their
+ * "options_hash" is not options_hash; runs without one, or options_hash
+ * NULL, stay) and, when not_ok, those whose status is not "ok", so that
+ * a resumed sweep runs them again. How many went.
+ */
+size_t results_forget_runs(struct results *res, const char *builder, const char *options_hash,
+                           bool not_ok);
+/* Whether every run of the document is "ok". */
+bool results_all_ok(const struct results *res);
+/* "options": {name: value, ...} of resolved options (NULL: {}). */
+struct cJSON *results_options_json(const bvhlab_options *opts);
+
 /* Whether the document holds a run of scene x builder x threads. */
 bool results_has_run(const struct results *res, const char *scene, const char *builder,
                      uint32_t threads);

@@ -154,6 +154,51 @@ static int collect(struct merge *m, const char *const *dirs, bvhlab_error *err)
 	return 0;
 }
 
+static bool same_string(const cJSON *a, const cJSON *b, const char *key)
+{
+	const char *x = string_at(a, key), *y = string_at(b, key);
+	return x && y && strcmp(x, y) == 0;
+}
+
+/* Two runs of one scene and builder are one run when their thread counts
+ * resolved alike (0 on a machine with that many): the merge would count it
+ * twice. Runs of one builder made with other options come from another
+ * configuration of it. */
+static int check_pair(const struct merge *m, size_t a, size_t b, bvhlab_error *err)
+{
+	const cJSON *x = m->owner_run[a], *y = m->owner_run[b];
+	const cJSON *tx = cJSON_GetObjectItemCaseSensitive(x, "threads");
+	const cJSON *ty = cJSON_GetObjectItemCaseSensitive(y, "threads");
+	const char *hx = string_at(x, "options_hash"), *hy = string_at(y, "options_hash");
+	if (!same_string(x, y, "builder"))
+		return 0;
+	if (hx && hy && strcmp(hx, hy) != 0) {
+		error_set(err, "runs %zu (part %s) and %zu (part %s) of builder '%s' were made with "
+		          "other options (hash %s and %s): parts of another configuration; nothing "
+		          "merged", a, m->parts[m->owner_part[a]].dir, b, m->parts[m->owner_part[b]].dir,
+		          string_at(x, "builder"), hx, hy);
+		return -EINVAL;
+	}
+	if (same_string(x, y, "scene") && cJSON_IsNumber(tx) && cJSON_IsNumber(ty) &&
+	    tx->valuedouble == ty->valuedouble) {
+		error_set(err, "runs %zu (part %s) and %zu (part %s) are the same run (%s, %s, %g "
+		          "threads, a count of 0 resolved on its machine): remove one of them", a,
+		          m->parts[m->owner_part[a]].dir, b, m->parts[m->owner_part[b]].dir,
+		          string_at(x, "scene"), string_at(x, "builder"), tx->valuedouble);
+		return -EINVAL;
+	}
+	return 0;
+}
+
+static int check_identities(const struct merge *m, bvhlab_error *err)
+{
+	for (size_t a = 0; a < m->plan->run_count; a++)
+		for (size_t b = a + 1; m->owner_run[a] && b < m->plan->run_count; b++)
+			if (m->owner_run[b] && check_pair(m, a, b, err) < 0)
+				return -EINVAL;
+	return 0;
+}
+
 /* ---- the merged document --------------------------------------------------------- */
 
 /* A copy of the run with its part's machine, unless it carries its own. */
@@ -394,6 +439,8 @@ int plan_merge(const struct plan_file *plan, const char *const *parts, size_t pa
 	}
 	if (r == 0)
 		r = collect(&m, parts, err);
+	if (r == 0)
+		r = check_identities(&m, err);
 	if (r == 0)
 		r = check_target(plan, dir, err);
 	if (r == 0)
