@@ -222,6 +222,95 @@ static void test_temps(void)
 	CHECK_INT(runs_written(path_in(name)), 2);
 }
 
+static const char alpha_config[] =
+	"{ \"output\": \"out-id\", \"repeat\": 1, \"threads\": [1, 2],\n"
+	"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1 },\n"
+	"  \"scenes\": [ { \"path\": \"tri.obj\" } ],\n"
+	"  \"builders\": [ { \"plugin\": \"fake_good\", \"options\": { \"alpha\": %d } } ] }\n";
+
+static void write_mesh(const char *text)
+{
+	FILE *f = fopen(path_in("tri.obj"), "w");
+	fputs(text, f);
+	fclose(f);
+}
+
+static const char *alpha(int value)
+{
+	char text[1024], name[32];
+	snprintf(text, sizeof(text), alpha_config, value);
+	snprintf(name, sizeof(name), "id-%d.json", value);
+	return write_config(name, text);
+}
+
+static int alpha_of(const cJSON *run)
+{
+	return cJSON_GetObjectItem(cJSON_GetObjectItem(run, "options"), "alpha")->valueint;
+}
+
+/* Resumed runs made with other options run again; --retry-failed reruns failures. */
+static void identity_resume(void)
+{
+	const char *dir = path_in("out-id");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", alpha(2))), 1); /* no tri.obj yet */
+	write_mesh("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", alpha(2))), 1);
+	CHECK_CONTAINS(err_text, "2 finished runs kept");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", "--retry-failed", alpha(2))), 0);
+	CHECK_CONTAINS(err_text, "--retry-failed: 2 runs that did not end ok will run again");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", alpha(3))), 0);
+	CHECK_CONTAINS(err_text, "2 resumed runs made with other options will run again");
+	cJSON *doc = load_results(dir);
+	CHECK_INT(count_runs(doc, "fake_good", "ok"), 2);
+	const cJSON *r;
+	cJSON_ArrayForEach(r, cJSON_GetObjectItem(doc, "runs")) {
+		CHECK_INT(alpha_of(r), 3);
+		CHECK(strlen(run_str(r, "options_hash")) == 16);
+	}
+	cJSON_Delete(doc);
+}
+
+/* Parts: of another plan (other options), on other scene data, or
+ * disagreeing on options are refused. */
+static void identity_parts(void)
+{
+	CHECK_INT(run_in(tmpdir, ARGS("plan", alpha(2), "--out", "pa")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("plan", alpha(5), "--out", "pb")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pa/plan.json"), "--only", "0", "--out",
+	                              path_in("pa/parts/0"), "--quiet")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pa/plan.json"), "--only", "1", "--out",
+	                              path_in("pa/parts/1"), "--quiet")), 0);
+	char cmd[1400];
+	snprintf(cmd, sizeof(cmd), "cp -r '%s/pa/parts' '%s/pb/'", tmpdir, tmpdir);
+	CHECK_INT(system(cmd), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pb/plan.json"), "--only", "0", "--out",
+	                              path_in("pb/parts/0"), "--resume", "--quiet")), 2);
+	CHECK_CONTAINS(err_text, "its runs were made from plan");
+	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pb/parts/0"), "--out", path_in("pb"))), 2);
+	CHECK_CONTAINS(err_text, "comes from another plan");
+
+	/* A part whose options_hash differs from another part's run of its builder. */
+	snprintf(cmd, sizeof(cmd), "sed -i 's/\"options_hash\":[[:space:]]*\"[0-9a-f]*\"/\"options_hash\": "
+	         "\"00000000deadbeef\"/' '%s/pa/parts/1/results.json'", tmpdir);
+	CHECK_INT(system(cmd), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pa/parts/0"), path_in("pa/parts/1"),
+	                              "--out", path_in("pa"))), 2);
+	CHECK_CONTAINS(err_text, "were made with other options");
+
+	/* The mesh regenerated after planning: its runs are refused. */
+	write_mesh("v 0 0 0\nv 2 0 0\nv 0 2 0\nf 1 2 3\n");
+	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pb/plan.json"), "--only", "1", "--out",
+	                              path_in("pb/parts/9"), "--quiet")), 2);
+	CHECK_CONTAINS(err_text, "tri.obj has changed since planning");
+	CHECK(!exists(path_in("pb/parts/9")));
+}
+
+static void test_identity(void)
+{
+	identity_resume();
+	identity_parts();
+}
+
 int main(int argc, char **argv)
 {
 	static const struct {
@@ -229,7 +318,7 @@ int main(int argc, char **argv)
 		void (*fn)(void);
 	} modes[] = {
 		{"probe", test_probe},     {"lock", test_lock}, {"threads", test_threads},
-		{"temps", test_temps},
+		{"temps", test_temps},     {"identity", test_identity},
 	};
 	if (!cli_begin(argc, argv))
 		return fprintf(stderr, "usage: test-cli-rel BVHLAB_EXE MODE\n"), 2;
