@@ -162,6 +162,22 @@ static int select_runs(const struct config *cfg, struct run_args *a, bool **only
 	return 0;
 }
 
+/* The sweep's last line: where the results are and what went wrong, by kind. */
+static void print_outcome(const char *dir, int r, const struct harness_tally *t)
+{
+	fprintf(stderr, "bvhlab: results in %s/ (results.json, results.csv, report.md, "
+	        "report.html)", dir);
+	if (t->unsaved)
+		fprintf(stderr, "; %zu finished run%s could not be saved (see above)", t->unsaved,
+		        t->unsaved == 1 ? "" : "s");
+	if (t->untraced)
+		fprintf(stderr, "; %zu run%s traced no rays (see rays_error)", t->untraced,
+		        t->untraced == 1 ? "" : "s");
+	if (t->not_ok || (r && !t->unsaved && !t->untraced))
+		fprintf(stderr, "; some runs failed or were invalid");
+	fprintf(stderr, "\n");
+}
+
 int cmd_run(int argc, char **argv)
 {
 	struct run_args a = {0};
@@ -182,14 +198,15 @@ int cmd_run(int argc, char **argv)
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
+	struct harness_tally tally = {0};
+	a.opts.tally = &tally;
 	r = harness_run(&cfg, &a.opts, &err);
 	if (r < 0) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
 	if (!a.opts.quiet)
-		fprintf(stderr, "bvhlab: results in %s/ (results.json, results.csv, report.md, report.html)%s\n",
-		        cfg.output, r ? "; some runs failed or were invalid" : "");
+		print_outcome(cfg.output, r, &tally);
 	status = r ? EXIT_RUNS_FAILED : 0;
 out:
 	free(only);

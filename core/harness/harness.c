@@ -36,6 +36,7 @@ struct harness {
 	struct harness_builder *builders;
 	struct progress progress;
 	bool all_ok;
+	struct harness_tally tally;
 	bool shade_done; /* this scene's shaded render is on its way */
 	bool rounds_on;  /* this scene's rays are timed in interleaved rounds */
 	struct harness_rounds rounds; /* this scene's trees waiting for them */
@@ -58,6 +59,7 @@ struct series_report {
 	double epo;
 	struct build_memory memory;
 	struct ray_metrics rays;
+	bool rays_failed;  /* the tree is fine but tracing failed: error says why */
 	bool heat_written, shade_written;
 	bool tree_written; /* the tree is in the job's tree_path */
 	uint32_t stage_count;
@@ -87,12 +89,15 @@ static uint32_t resolve_threads(uint32_t t)
 static void record(struct harness *h, struct run_record *run)
 {
 	bvhlab_error err = {{0}};
-	if (strcmp(run->status, "ok") != 0)
+	h->tally.not_ok += strcmp(run->status, "ok") != 0;
+	h->tally.untraced += !strcmp(run->status, "ok") && run->rays_error;
+	if (strcmp(run->status, "ok") != 0 || run->rays_error)
 		h->all_ok = false;
 	progress_done(&h->progress, run);
 	if (results_add_run(&h->res, run) < 0 || results_write(&h->res, &err) < 0) {
 		fprintf(stderr, "bvhlab: cannot write results: %s\n",
 		        err.message[0] ? err.message : "out of memory");
+		h->tally.unsaved++;
 		h->all_ok = false;
 	}
 }
@@ -228,12 +233,17 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 	int r = image_buffers(job, n, &nodes, &shade);
 	if (r == 0)
 		r = harness_trace_rays(tree, job->scene, &cam, &rs, &rep->rays, nodes, shade);
+	/* One slice, until the scene's rounds replace it. */
+	rep->rays.provisional = r == 0 && rep->tree_written;
 	if (r == 0 && nodes)
 		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)
 		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
-	if (r < 0)
+	if (r < 0) {
+		rep->rays_failed = true;
+		rep->rays.measured = false;
 		error_set(err, "tracing rays: %s", strerror(-r));
+	}
 	free(nodes);
 	free(shade);
 }
@@ -271,7 +281,7 @@ static void series_work(void *arg, void *report, size_t size)
 		if (rep->status == SERIES_OK)
 			trace_rays(job, &s.tree, rep, &err);
 	}
-	if (rep->status != SERIES_OK)
+	if (rep->status != SERIES_OK || rep->rays_failed)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
 	bvhlab_tree_finish(&s.tree);
 }
@@ -300,6 +310,7 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->rays_checked = rep->rays_checked;
 	run->mismatches = rep->mismatches;
 	run->rays = rep->rays.measured ? &rep->rays : NULL;
+	run->rays_error = rep->status == SERIES_OK && rep->rays_failed ? rep->error : NULL;
 	for (uint32_t k = 0; k < rep->stage_count; k++)
 		rep->stages[k].plugin[sizeof(rep->stages[k].plugin) - 1] = '\0';
 	run->stages = rep->stages;
@@ -341,11 +352,15 @@ static void image_paths(struct harness *h, struct series_job *job, size_t scene_
 {
 	if (!h->cfg->images || h->cfg->ray_width == 0 || h->cfg->ray_height == 0)
 		return;
+	/* Unlinked first: a run that dies or times out leaves no data, and no
+	 * older run's is drawn in its place. */
 	if (first && images_temp_path(paths[0], sizeof(paths[0]), h->cfg->output, "heat",
-	                               scene_index, builder_index) == 0)
+	                               scene_index, builder_index) == 0 &&
+	    (unlink(paths[0]) == 0 || errno == ENOENT))
 		job->heat_path = paths[0];
 	if (!h->shade_done && images_temp_path(paths[1], sizeof(paths[1]), h->cfg->output,
-	                                        "shade", scene_index, 0) == 0)
+	                                        "shade", scene_index, 0) == 0 &&
+	    (unlink(paths[1]) == 0 || errno == ENOENT))
 		job->shade_path = paths[1];
 }
 
@@ -512,12 +527,13 @@ static int resume(struct harness *h, bvhlab_error *err)
 
 /*
  * Resumed runs that are not what this sweep would make are made again:
- * those of a builder whose options (or stages') changed, and with
- * --retry-failed those that did not end ok. Written at once.
+ * those whose ray timings are one provisional slice (killed before the
+ * scene's rounds), those of a builder whose options (or stages') changed,
+ * and with --retry-failed those that did not end ok. Written at once.
  */
 static int forget_stale(struct harness *h, bool retry_failed, bvhlab_error *err)
 {
-	size_t changed = 0, failed = 0;
+	size_t changed = 0, failed = 0, provisional = results_forget_provisional(&h->res);
 	for (size_t b = 0; b < h->cfg->builder_count; b++) {
 		const struct harness_builder *hb = &h->builders[b];
 		if (hb->opts_ok)
@@ -531,8 +547,12 @@ static int forget_stale(struct harness *h, bool retry_failed, bvhlab_error *err)
 	if (!h->progress.quiet && failed)
 		fprintf(stderr, "bvhlab: --retry-failed: %zu run%s that did not end ok will run "
 		        "again\n", failed, failed == 1 ? "" : "s");
+	if (!h->progress.quiet && provisional)
+		fprintf(stderr, "bvhlab: %zu resumed run%s with provisional ray timings (killed "
+		        "before their rounds) will run again\n", provisional,
+		        provisional == 1 ? "" : "s");
 	h->all_ok = results_all_ok(&h->res);
-	return changed || failed ? results_write(&h->res, err) : 0;
+	return changed || failed || provisional ? results_write(&h->res, err) : 0;
 }
 
 /* The folder locked and claimed, the document started (resumed). */
@@ -572,6 +592,8 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
 		run_scene(&h, &cfg->scenes[s], s);
 	progress_finish(&h.progress);
+	if (opts->tally)
+		*opts->tally = h.tally;
 	harness_close_builders(cfg, h.builders);
 	harness_rounds_finish(&h.rounds);
 	results_finish(&h.res);

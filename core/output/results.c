@@ -222,6 +222,8 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddItemToObject(o, "validation", validation_json(run));
 	if (run->rays)
 		cJSON_AddItemToObject(o, "rays", results_rays_json(run->rays));
+	if (run->rays_error)
+		cJSON_AddStringToObject(o, "rays_error", run->rays_error);
 	cJSON_AddItemToArray(res->runs, o);
 	return 0;
 }
@@ -322,12 +324,28 @@ size_t results_forget_runs(struct results *res, const char *builder, const char 
 	return n;
 }
 
+size_t results_forget_provisional(struct results *res)
+{
+	size_t n = 0;
+	cJSON *run = res->runs->child;
+	while (run) {
+		cJSON *next = run->next;
+		const cJSON *rays = cJSON_GetObjectItemCaseSensitive(run, "rays");
+		if (cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(rays, "provisional"))) {
+			cJSON_Delete(cJSON_DetachItemViaPointer(res->runs, run));
+			n++;
+		}
+		run = next;
+	}
+	return n;
+}
+
 bool results_all_ok(const struct results *res)
 {
 	const cJSON *run;
 	cJSON_ArrayForEach(run, res->runs) {
 		const char *status = string_of(run, "status");
-		if (!status || strcmp(status, "ok") != 0)
+		if (!status || strcmp(status, "ok") != 0 || string_of(run, "rays_error"))
 			return false;
 	}
 	return true;

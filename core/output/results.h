@@ -35,6 +35,9 @@ struct ray_metrics {
 	int main;              /* the traversal "primary"/"diffuse" report */
 	uint32_t rounds;       /* interleaved rounds the timings are spread over
 	                        * (harness_rounds.c); 1: one stretch in the run's child */
+	bool provisional;      /* one slice, timed in the run's child while the rounds
+	                        * that replace it are still to come ("provisional":
+	                        * true; a resumed sweep runs such a run again) */
 	/* by enum bvhlab_traversal */
 	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
 	uint64_t disagreements; /* rays whose hits differ from the main traversal's */
@@ -81,6 +84,7 @@ struct run_record {
 	bool valid;
 	uint64_t rays_checked, mismatches;
 	const struct ray_metrics *rays; /* or NULL: not traced */
+	const char *rays_error; /* why rays were not traced although the tree is valid */
 	const struct stage_metrics *stages; /* [stage_count] refinement stages */
 	uint32_t stage_count;
 };
@@ -143,7 +147,10 @@ int results_check_runs(const struct cJSON *runs, const struct config *cfg, const
  */
 size_t results_forget_runs(struct results *res, const char *builder, const char *options_hash,
                            bool not_ok);
-/* Whether every run of the document is "ok". */
+/* Removes the runs whose rays are provisional (their sweep was killed
+ * before the rounds replaced them); how many went. */
+size_t results_forget_provisional(struct results *res);
+/* Whether every run of the document is "ok" (and traced, if it tried). */
 bool results_all_ok(const struct results *res);
 /* "options": {name: value, ...} of resolved options (NULL: {}). */
 struct cJSON *results_options_json(const bvhlab_options *opts);

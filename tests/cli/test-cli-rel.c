@@ -14,6 +14,7 @@
  * Usage: test-cli-rel BVHLAB_EXE MODE
  */
 #include <signal.h>
+#include <stdint.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 
@@ -150,7 +151,8 @@ static void test_lock(void)
 	char text[1024];
 	snprintf(text, sizeof(text), small, "out-lock");
 	const char *cfg = write_config("lock.json", text);
-	const char *dir = path_in("out-lock");
+	char dir[600];
+	snprintf(dir, sizeof(dir), "%s", path_in("out-lock"));
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--threads", "1", cfg)), 0);
 	char *before = read_file(dir, "results.json");
 	int fd = hold_lock(dir, "4242\n");
@@ -251,7 +253,8 @@ static int alpha_of(const cJSON *run)
 /* Resumed runs made with other options run again; --retry-failed reruns failures. */
 static void identity_resume(void)
 {
-	const char *dir = path_in("out-id");
+	char dir[600];
+	snprintf(dir, sizeof(dir), "%s", path_in("out-id"));
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", alpha(2))), 1); /* no tri.obj yet */
 	write_mesh("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", alpha(2))), 1);
@@ -311,6 +314,152 @@ static void test_identity(void)
 	identity_parts();
 }
 
+#define SHIM BVHLAB_TEST_BUILDDIR "/fake/shim/rename_fault.so"
+
+/* bvhlab killed just before its nth rename (or link) onto a name ending in
+ * `to` (rename_fault.so): its exit status. */
+static int killed_at(const char *to, const char *n, const char *const *args)
+{
+	setenv("BVHLAB_FAULT_RENAME", n, 1);
+	setenv("BVHLAB_FAULT_TO", to, 1);
+	setenv("LD_PRELOAD", SHIM, 1);
+	/* ASan wants to come first in the library list; the shim is harmless. */
+	const char *asan = getenv("ASAN_OPTIONS");
+	char *saved = asan ? strdup(asan) : NULL, opts[512];
+	snprintf(opts, sizeof(opts), "%s%sverify_asan_link_order=0", asan ? asan : "",
+	         asan && *asan ? ":" : "");
+	setenv("ASAN_OPTIONS", opts, 1);
+	int status = run_in(tmpdir, args);
+	unsetenv("LD_PRELOAD");
+	unsetenv("BVHLAB_FAULT_RENAME");
+	unsetenv("BVHLAB_FAULT_TO");
+	if (saved)
+		setenv("ASAN_OPTIONS", saved, 1);
+	else
+		unsetenv("ASAN_OPTIONS");
+	free(saved);
+	return status;
+}
+
+static const cJSON *rays_of(const cJSON *run)
+{
+	return cJSON_GetObjectItem(run, "rays");
+}
+
+/* 7. Tracing that fails says so, in the run and the last line. */
+static void measure_rays_error(void)
+{
+	const char *cfg = write_config("cam.json",
+		"{ \"output\": \"out-cam\", \"repeat\": 1,\n"
+		"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1,\n"
+		"            \"camera\": { \"position\": [1e20, 1e20, 1e20], \"target\": [0, 0, 0] } },\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
+	CHECK_INT(run_in(tmpdir, ARGS("run", cfg)), 1);
+	CHECK_CONTAINS(err_text, "1 run traced no rays (see rays_error)");
+	cJSON *doc = load_results(path_in("out-cam"));
+	check_run(doc, "fake_good", 1, "ok", NULL);
+	CHECK_CONTAINS(run_str(run_of(doc, "fake_good", 1), "rays_error"), "tracing rays");
+	cJSON_Delete(doc);
+}
+
+/* 8. Killed in the rounds: the resumed sweep times those runs again, draws
+ * the images and leaves no raw data behind. */
+static void measure_rounds(void)
+{
+	char dir[600];
+	snprintf(dir, sizeof(dir), "%s", path_in("out-rounds"));
+	const char *cfg = write_config("rounds.json",
+		"{ \"output\": \"out-rounds\", \"repeat\": 1, \"threads\": [1, 2], \"images\": true,\n"
+		"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 2, \"rounds\": 2 },\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
+	/* Renames of results.json: 1 the empty document, 2 and 3 the runs, 4 the rounds. */
+	CHECK_INT(killed_at("/results.json", "4", ARGS("run", "--quiet", cfg)), 128 + SIGKILL);
+	cJSON *doc = load_results(dir);
+	const cJSON *r = run_of(doc, "fake_good", 2);
+	CHECK(r && cJSON_IsTrue(cJSON_GetObjectItem(rays_of(r), "provisional")));
+	cJSON_Delete(doc);
+	CHECK(exists(path_in("out-rounds/.heat-0-0.raw")));
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", cfg)), 0);
+	CHECK_CONTAINS(err_text, "2 resumed runs with provisional ray timings");
+	doc = load_results(dir);
+	cJSON_ArrayForEach(r, cJSON_GetObjectItem(doc, "runs")) {
+		CHECK_INT(cJSON_GetObjectItem(rays_of(r), "rounds")->valueint, 2);
+		CHECK(!cJSON_GetObjectItem(rays_of(r), "provisional"));
+	}
+	CHECK(run_str(run_of(doc, "fake_good", 1), "heat_image")[0] != '\0');
+	cJSON_Delete(doc);
+	CHECK(!exists(path_in("out-rounds/.heat-0-0.raw")));
+	CHECK(!exists(path_in("out-rounds/.shade-0-0.raw")));
+}
+
+/* 9. Heat data an earlier sweep left is not drawn for a run that timed out. */
+static void measure_stale_heat(void)
+{
+	uint32_t stale[64];
+	for (int k = 0; k < 64; k++)
+		stale[k] = 999;
+	CHECK_INT(mkdir(path_in("out-stale"), 0755), 0);
+	FILE *f = fopen(path_in("out-stale/.heat-0-0.raw"), "wb");
+	CHECK(f && fwrite(stale, sizeof(stale), 1, f) == 1);
+	fclose(f);
+	const char *cfg = write_config("stale.json",
+		"{ \"output\": \"out-stale\", \"repeat\": 1, \"images\": true,\n"
+		"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1 },\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"slow\", \"timeout_s\": 1,\n"
+		"                    \"options\": { \"fail\": \"loop\" } },\n"
+		"                  { \"plugin\": \"fake_good\" } ] }\n");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 1);
+	cJSON *doc = load_results(path_in("out-stale"));
+	check_run(doc, "slow", 1, "timeout", NULL);
+	CHECK(!cJSON_GetObjectItem(run_of(doc, "slow", 1), "heat_image"));
+	const cJSON *images = cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(doc,
+	                                          "scenes"), 0), "images");
+	const cJSON *hi = cJSON_GetObjectItem(images, "heat_max");
+	CHECK(cJSON_IsNumber(hi) && hi->valuedouble < 999);
+	cJSON_Delete(doc);
+}
+
+static void test_measure(void)
+{
+	plain_crashes();
+	measure_rays_error();
+	measure_rounds();
+	measure_stale_heat();
+}
+
+/* 10. Killed while --force moves the old results aside: nothing new is
+ * written over them, and the next --force finishes the move. */
+static void test_force(void)
+{
+	char text[1024];
+	snprintf(text, sizeof(text), small, "out-force");
+	const char *cfg = write_config("force.json", text);
+	char dir[600];
+	snprintf(dir, sizeof(dir), "%s", path_in("out-force"));
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 0);
+	char *json = read_file(dir, "results.json"), *csv = read_file(dir, "results.csv");
+	CHECK_INT(killed_at("/report.md.1", "1", ARGS("run", "--quiet", "--force", cfg)),
+	          128 + SIGKILL);
+	CHECK(exists(path_in("out-force/results.csv.1")));
+	CHECK(!exists(path_in("out-force/results.json.1")));
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 2);
+	CHECK_CONTAINS(err_text, "already holds a results.json");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--force", cfg)), 0);
+	char *json1 = read_file(dir, "results.json.1"), *csv1 = read_file(dir, "results.csv.1");
+	CHECK(json && json1 && !strcmp(json, json1));
+	CHECK(csv && csv1 && !strcmp(csv, csv1));
+	CHECK(exists(path_in("out-force/report.md.1")));
+	CHECK(!exists(path_in("out-force/results.csv.2")));
+	CHECK_INT(runs_written(dir), 2);
+	free(json);
+	free(csv);
+	free(json1);
+	free(csv1);
+}
+
 int main(int argc, char **argv)
 {
 	static const struct {
@@ -318,7 +467,8 @@ int main(int argc, char **argv)
 		void (*fn)(void);
 	} modes[] = {
 		{"probe", test_probe},     {"lock", test_lock}, {"threads", test_threads},
-		{"temps", test_temps},     {"identity", test_identity},
+		{"temps", test_temps},     {"identity", test_identity}, {"measure", test_measure},
+		{"force", test_force},
 	};
 	if (!cli_begin(argc, argv))
 		return fprintf(stderr, "usage: test-cli-rel BVHLAB_EXE MODE\n"), 2;

@@ -5,7 +5,8 @@
  * $BVHLAB_FAULT_RENAME. At that moment the new document is complete in its
  * temporary file and not yet in place: results.json must still be the
  * previous complete one. A writer that writes results.json in place never
- * renames, is never killed, and the test sees that.
+ * renames, is never killed, and the test sees that. $BVHLAB_FAULT_TO names
+ * another target (the end of its path), for renames and links alike.
  */
 #include <dlfcn.h>
 #include <signal.h>
@@ -22,13 +23,29 @@ static int ends_with(const char *s, const char *tail)
 	return n >= m && strcmp(s + n - m, tail) == 0;
 }
 
+/* $BVHLAB_FAULT_TO: the end of the target's name (default /results.json). */
+static void maybe_die(const char *to)
+{
+	const char *at = getenv("BVHLAB_FAULT_RENAME"), *tail = getenv("BVHLAB_FAULT_TO");
+	if (at && ends_with(to, tail ? tail : "/results.json") && ++renames == atoi(at))
+		kill(getpid(), SIGKILL);
+}
+
 __attribute__((visibility("default"))) int rename(const char *from, const char *to)
 {
-	const char *at = getenv("BVHLAB_FAULT_RENAME");
-	if (at && ends_with(to, "/results.json") && ++renames == atoi(at))
-		kill(getpid(), SIGKILL);
+	maybe_die(to);
 	int (*real)(const char *, const char *);
 	void *sym = dlsym(RTLD_NEXT, "rename");
+	memcpy(&real, &sym, sizeof(real));
+	return real(from, to);
+}
+
+/* Moving aside (--force) links files to their new names. */
+__attribute__((visibility("default"))) int link(const char *from, const char *to)
+{
+	maybe_die(to);
+	int (*real)(const char *, const char *);
+	void *sym = dlsym(RTLD_NEXT, "link");
 	memcpy(&real, &sym, sizeof(real));
 	return real(from, to);
 }
