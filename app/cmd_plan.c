@@ -67,6 +67,14 @@ static int parse_format(const char *text, enum format *out)
 	return -1;
 }
 
+static bool has_control(const char *s)
+{
+	for (; *s; s++)
+		if ((unsigned char)*s < 0x20 || *s == 0x7f)
+			return true;
+	return false;
+}
+
 static int parse(int argc, char **argv, struct plan_args *a)
 {
 	static const struct option longopts[] = {
@@ -92,6 +100,14 @@ static int parse(int argc, char **argv, struct plan_args *a)
 		r = -1;
 	}
 	bool operands_ok = a->missing ? optind == argc && !a->out : optind == argc - 1 && a->out;
+	const char *dir = a->missing ? a->missing : a->out;
+	if (r == 0 && operands_ok && (has_control(dir) || (a->command && has_control(a->command)))) {
+		/* Shell lines, Slurm's #SBATCH lines and comments end at a newline. */
+		fprintf(stderr, "bvhlab plan: the %s contains a control character (a newline?), "
+		        "which a command line or sweep.sbatch cannot carry: choose another\n",
+		        has_control(dir) ? "plan folder's name" : "--command");
+		return -1;
+	}
 	if (r == 0 && !operands_ok) {
 		fprintf(stderr, "bvhlab plan: expected CONFIG.json --out DIR, or --missing DIR\n\n%s",
 		        usage);
@@ -295,6 +311,11 @@ static int load_plan(const struct plan_args *a, struct plan_file *plan, char *di
 	config_finish(&cfg);
 	if (r == 0 && !realpath(d, dir)) {
 		error_set(&err, "cannot resolve %s: %s", d, strerror(errno));
+		r = -1;
+	}
+	if (r == 0 && has_control(dir)) {
+		error_set(&err, "the plan folder's path %s contains a control character (a "
+		          "newline?), which a command line or sweep.sbatch cannot carry", dir);
 		r = -1;
 	}
 	snprintf(path, sizeof(path), "%s/plan.json", dir);

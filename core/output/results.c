@@ -489,6 +489,24 @@ int results_set_run_rays(struct results *res, const char *scene, const char *bui
 	return 0;
 }
 
+/* The reports of a folder describe its results.json: another document's
+ * are not written there. */
+static int own_reports(const char *json_path, const char *dir, bvhlab_error *err)
+{
+	char path[4096];
+	struct stat mine, theirs;
+	if ((size_t)snprintf(path, sizeof(path), "%s/results.json", dir) >= sizeof(path)) {
+		error_set(err, "path too long: %s/results.json", dir);
+		return -ENAMETOOLONG;
+	}
+	if (stat(path, &theirs) < 0 || (stat(json_path, &mine) == 0 &&
+	                                mine.st_dev == theirs.st_dev && mine.st_ino == theirs.st_ino))
+		return 0;
+	error_set(err, "%s holds the results.json of another sweep, whose reports these would "
+	          "replace: nothing written; render into another folder", dir);
+	return -EEXIST;
+}
+
 int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err)
 {
 	char *text = NULL;
@@ -507,11 +525,16 @@ int results_render_saved(const char *json_path, const char *dir, bvhlab_error *e
 	if (r == 0)
 		r = results_make_dirs(dir, err);
 	if (r == 0)
+		r = results_lock(&res, err);
+	if (r == 0)
+		r = own_reports(json_path, dir, err);
+	if (r == 0)
 		r = write_rendering(&res, "results.csv", report_csv(res.doc), err);
 	if (r == 0)
 		r = write_rendering(&res, "report.md", report_markdown(res.doc), err);
 	if (r == 0)
 		r = write_rendering(&res, "report.html", report_html(res.doc), err);
+	results_unlock(&res);
 	cJSON_Delete(res.doc);
 	return r;
 }

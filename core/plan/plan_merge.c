@@ -201,16 +201,6 @@ static int check_identities(const struct merge *m, bvhlab_error *err)
 
 /* ---- the merged document --------------------------------------------------------- */
 
-/* A copy of the run with its part's machine, unless it carries its own. */
-static cJSON *run_copy(const cJSON *run, const cJSON *part_doc)
-{
-	cJSON *copy = cJSON_Duplicate(run, 1);
-	const cJSON *machine = cJSON_GetObjectItemCaseSensitive(part_doc, "machine");
-	if (copy && machine && !cJSON_GetObjectItemCaseSensitive(copy, "machine"))
-		cJSON_AddItemToObject(copy, "machine", cJSON_Duplicate(machine, 1));
-	return copy;
-}
-
 static const cJSON *find_named(const cJSON *array, const char *name)
 {
 	const cJSON *e;
@@ -222,6 +212,52 @@ static const cJSON *find_named(const cJSON *array, const char *name)
 	return NULL;
 }
 
+/* A copy of the run with its part's machine, unless it carries its own,
+ * and the colour scale its heat map was drawn with in its part. */
+static cJSON *run_copy(const cJSON *run, const cJSON *part_doc)
+{
+	cJSON *copy = cJSON_Duplicate(run, 1);
+	const cJSON *machine = cJSON_GetObjectItemCaseSensitive(part_doc, "machine");
+	if (copy && machine && !cJSON_GetObjectItemCaseSensitive(copy, "machine"))
+		cJSON_AddItemToObject(copy, "machine", cJSON_Duplicate(machine, 1));
+	const char *scene = string_at(run, "scene");
+	const cJSON *images = cJSON_GetObjectItemCaseSensitive(
+		scene ? find_named(cJSON_GetObjectItemCaseSensitive(part_doc, "scenes"), scene) : NULL,
+		"images");
+	const cJSON *lo = cJSON_GetObjectItemCaseSensitive(images, "heat_min");
+	const cJSON *hi = cJSON_GetObjectItemCaseSensitive(images, "heat_max");
+	if (copy && string_at(run, "heat_image") && cJSON_IsNumber(lo) && cJSON_IsNumber(hi) &&
+	    !cJSON_GetObjectItemCaseSensitive(copy, "heat_scale")) {
+		cJSON *scale = cJSON_AddObjectToObject(copy, "heat_scale");
+		cJSON_AddNumberToObject(scale, "min", lo->valuedouble);
+		cJSON_AddNumberToObject(scale, "max", hi->valuedouble);
+	}
+	return copy;
+}
+
+static bool same_number(const cJSON *a, const cJSON *b, const char *key)
+{
+	const cJSON *x = cJSON_GetObjectItemCaseSensitive(a, key);
+	const cJSON *y = cJSON_GetObjectItemCaseSensitive(b, key);
+	return cJSON_IsNumber(x) && cJSON_IsNumber(y) && x->valuedouble == y->valuedouble;
+}
+
+/* Parts draw a scene's heat maps each on its own scale: when they differ
+ * the merged scene states none (each run keeps its own, "heat_scale"). */
+static void join_heat_scales(cJSON *kept, const cJSON *other)
+{
+	cJSON *a = cJSON_GetObjectItemCaseSensitive(kept, "images");
+	const cJSON *b = cJSON_GetObjectItemCaseSensitive(other, "images");
+	if (!cJSON_GetObjectItemCaseSensitive(a, "legend") ||
+	    !cJSON_GetObjectItemCaseSensitive(b, "legend") ||
+	    (same_number(a, b, "heat_min") && same_number(a, b, "heat_max")))
+		return;
+	cJSON_DeleteItemFromObjectCaseSensitive(a, "legend");
+	cJSON_DeleteItemFromObjectCaseSensitive(a, "heat_min");
+	cJSON_DeleteItemFromObjectCaseSensitive(a, "heat_max");
+	cJSON_AddBoolToObject(a, "heat_scales_differ", true);
+}
+
 /* Every scene any part loaded, one entry each; one with images wins. */
 static void add_scenes(cJSON *scenes, const struct merge *m)
 {
@@ -230,6 +266,8 @@ static void add_scenes(cJSON *scenes, const struct merge *m)
 		cJSON_ArrayForEach(s, cJSON_GetObjectItemCaseSensitive(m->parts[p].doc, "scenes")) {
 			const char *name = string_at(s, "name");
 			cJSON *old = name ? (cJSON *)find_named(scenes, name) : NULL;
+			if (old)
+				join_heat_scales(old, s);
 			if (!name || (old && (cJSON_GetObjectItemCaseSensitive(old, "images") ||
 			                      !cJSON_GetObjectItemCaseSensitive(s, "images"))))
 				continue;
@@ -348,7 +386,10 @@ static int copy_file(const char *from, const char *dir, const char *name, bvhlab
 		return -ENAMETOOLONG;
 	}
 	unlink(tmp);
-	FILE *in = fopen(from, "rb");
+	int from_fd = open(from, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+	FILE *in = from_fd >= 0 ? fdopen(from_fd, "rb") : NULL;
+	if (from_fd >= 0 && !in)
+		close(from_fd);
 	int fd = in ? open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW, 0644) : -1;
 	FILE *out = fd >= 0 ? fdopen(fd, "wb") : NULL;
 	bool ok = out != NULL;
@@ -382,8 +423,11 @@ static int copy_images(const struct merge *m, const char *dir, bvhlab_error *err
 		for (struct dirent *e; r == 0 && (e = readdir(d));) {
 			if (e->d_name[0] == '.')
 				continue; /* ., .. and temporary files */
+			struct stat st;
 			if ((size_t)snprintf(file, sizeof(file), "%s/%s", from, e->d_name) >= sizeof(file))
 				continue; /* not a name bvhlab writes */
+			if (lstat(file, &st) < 0 || !S_ISREG(st.st_mode))
+				continue; /* bvhlab writes plain files: a link is not followed */
 			r = copy_file(file, to, e->d_name, err);
 		}
 		closedir(d);

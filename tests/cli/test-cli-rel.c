@@ -460,6 +460,74 @@ static void test_force(void)
 	free(csv1);
 }
 
+static int shell(const char *fmt, const char *arg)
+{
+	char cmd[1600], line[1400];
+	snprintf(line, sizeof(line), fmt, arg);
+	snprintf(cmd, sizeof(cmd), "cd '%s' && %s", tmpdir, line);
+	return system(cmd);
+}
+
+/* 11, 17. Merge: heat scales of parts are not stated as one; links in a
+ * part's images/ are not followed. */
+static void misc_merge(void)
+{
+	const char *cfg = write_config("heat.json",
+		"{ \"repeat\": 1, \"images\": true,\n"
+		"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1 },\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
+		"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n");
+	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "ph")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("ph/plan.json"), "--only", "0", "--out",
+	                              path_in("ph/parts/0"), "--quiet")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("ph/plan.json"), "--only", "1", "--out",
+	                              path_in("ph/parts/1"), "--quiet")), 0);
+	CHECK_INT(shell("sed -i 's/\"heat_max\":[[:space:]]*[0-9.]*/\"heat_max\": 77/' "
+	                "ph/parts/1/results.json%s", ""), 0);
+	CHECK_INT(shell("echo secret > secret.txt && ln -s '%s/secret.txt' ph/parts/1/images/"
+	                "s--stolen.png", tmpdir), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("ph/parts/0"), path_in("ph/parts/1"),
+	                              "--out", path_in("ph"))), 0);
+	CHECK(!exists(path_in("ph/images/s--stolen.png")));
+	cJSON *doc = load_results(path_in("ph"));
+	const cJSON *images = cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(doc,
+	                                          "scenes"), 0), "images");
+	CHECK(!cJSON_GetObjectItem(images, "heat_max"));
+	CHECK(cJSON_IsTrue(cJSON_GetObjectItem(images, "heat_scales_differ")));
+	const cJSON *scale = cJSON_GetObjectItem(run_of(doc, "b", 1), "heat_scale");
+	CHECK(cJSON_IsNumber(cJSON_GetObjectItem(scale, "max")) &&
+	      cJSON_GetObjectItem(scale, "max")->valuedouble == 77);
+	cJSON_Delete(doc);
+	char *md = read_file(path_in("ph"), "report.md");
+	CHECK(md && !strstr(md, "nan"));
+	free(md);
+}
+
+/* 14, 16. A plan folder with a newline; report over another sweep's folder. */
+static void test_misc(void)
+{
+	char text[1024];
+	misc_merge();
+	snprintf(text, sizeof(text), small, "out-m1");
+	const char *a = write_config("m1.json", text);
+	CHECK_INT(run_in(tmpdir, ARGS("plan", a, "--out", "bad\nname")), 2);
+	CHECK_CONTAINS(err_text, "control character");
+	CHECK(!exists(path_in("bad\nname")));
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", a)), 0);
+	snprintf(text, sizeof(text), small, "out-m2");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", write_config("m2.json", text))), 0);
+	char *before = read_file(path_in("out-m2"), "report.md");
+	CHECK_INT(run_in(tmpdir, ARGS("report", path_in("out-m1/results.json"), "--out",
+	                              path_in("out-m2"))), 2);
+	CHECK_CONTAINS(err_text, "holds the results.json of another sweep");
+	char *after = read_file(path_in("out-m2"), "report.md");
+	CHECK(before && after && !strcmp(before, after));
+	CHECK_INT(run_in(tmpdir, ARGS("report", path_in("out-m1/results.json"))), 0);
+	free(before);
+	free(after);
+}
+
 int main(int argc, char **argv)
 {
 	static const struct {
@@ -468,7 +536,7 @@ int main(int argc, char **argv)
 	} modes[] = {
 		{"probe", test_probe},     {"lock", test_lock}, {"threads", test_threads},
 		{"temps", test_temps},     {"identity", test_identity}, {"measure", test_measure},
-		{"force", test_force},
+		{"force", test_force},     {"misc", test_misc},
 	};
 	if (!cli_begin(argc, argv))
 		return fprintf(stderr, "usage: test-cli-rel BVHLAB_EXE MODE\n"), 2;
