@@ -504,11 +504,27 @@ static void misc_merge(void)
 	free(md);
 }
 
+/* 15. A full disk: the runs not saved are counted as such, not as failed. */
+static void misc_full(void)
+{
+	char text[1024];
+	snprintf(text, sizeof(text), small, "out-full");
+	setenv("BVHLAB_FAULT_FULL", "1", 1);
+	/* Renames: 1 the empty document, 2 the first run; the disk is full from 3. */
+	CHECK_INT(killed_at("/results.json", "3", ARGS("run", "--threads", "1,2,3",
+	                                               write_config("full.json", text))), 1);
+	unsetenv("BVHLAB_FAULT_FULL");
+	CHECK_CONTAINS(err_text, "2 finished runs could not be saved");
+	CHECK(!strstr(err_text, "some runs failed or were invalid"));
+	CHECK_INT(runs_written(path_in("out-full")), 1);
+}
+
 /* 14, 16. A plan folder with a newline; report over another sweep's folder. */
 static void test_misc(void)
 {
 	char text[1024];
 	misc_merge();
+	misc_full();
 	snprintf(text, sizeof(text), small, "out-m1");
 	const char *a = write_config("m1.json", text);
 	CHECK_INT(run_in(tmpdir, ARGS("plan", a, "--out", "bad\nname")), 2);
