@@ -519,12 +519,30 @@ static void misc_full(void)
 	CHECK_INT(runs_written(path_in("out-full")), 1);
 }
 
+/* 17. JSON nested past the reader's limit, names that are not UTF-8. */
+static void misc_input(void)
+{
+	static char deep[2 * 1200 + 2];
+	memset(deep, '[', 1200);
+	memset(deep + 1200, ']', 1200);
+	CHECK_INT(run_in(tmpdir, ARGS("run", write_config("deep.json", deep))), 2);
+	CHECK_CONTAINS(err_text, "JSON nested deeper than 1000 levels");
+	const char *cfg = write_config("latin1.json",
+		"{ \"output\": \"out-latin1\", \"repeat\": 1,\n"
+		"  \"scenes\": [ { \"name\": \"caf\xe9\", \"generator\": \"soup\", \"count\": 10 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 2);
+	CHECK_CONTAINS(err_text, "its scene name is not valid UTF-8");
+	CHECK(!exists(path_in("out-latin1")));
+}
+
 /* 14, 16. A plan folder with a newline; report over another sweep's folder. */
 static void test_misc(void)
 {
 	char text[1024];
 	misc_merge();
 	misc_full();
+	misc_input();
 	snprintf(text, sizeof(text), small, "out-m1");
 	const char *a = write_config("m1.json", text);
 	CHECK_INT(run_in(tmpdir, ARGS("plan", a, "--out", "bad\nname")), 2);
