@@ -170,6 +170,12 @@ static void print_stages(const struct stages *st)
 		       st->out[k].ms, st->out[k].sah_before, st->out[k].sah_after);
 }
 
+static void print_phases(const struct build_series *s)
+{
+	for (uint32_t k = 0; k < s->phase_count; k++)
+		printf("phase:      %s %.3f ms median\n", s->phases[k].name, s->phases[k].ms);
+}
+
 static int build_and_check(bvhlab_plugin *p, const bvhlab_options *opts,
                            const bvhlab_scene *scene, const struct build_args *a)
 {
@@ -195,6 +201,7 @@ static int build_and_check(bvhlab_plugin *p, const bvhlab_options *opts,
 	       bvhlab_plugin_builder(p)->name, s.threads ? s.threads : bvhlab_hardware_threads(),
 	       scene->name, scene->triangle_count, med, mn, mx, s.repeat,
 	       scene->triangle_count / (med * 1e3), s.cold_ms);
+	print_phases(&s);
 	print_stages(&st);
 	status = check(scene, &prims, bvhlab_plugin_builder(p), &s.tree, a->rays);
 out:

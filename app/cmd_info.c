@@ -1,4 +1,5 @@
 /* bvhlab info: what a scene is, or what the machine is. */
+#include <errno.h>
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,7 +22,10 @@ static const char usage[] =
 	"\n"
 	"With --machine, prints the CPU topology this process may use (hwloc,\n"
 	"narrowed by its affinity mask and cgroup cpuset): packages, physical\n"
-	"cores (what threads 0 means), logical CPUs and L1d/L2/L3 caches.\n"
+	"cores (what threads 0 means), logical CPUs and L1d/L2/L3 caches; then\n"
+	"the OpenCL devices (name, kind, compute units, global memory, version)\n"
+	"by the P:D a device option or rays.device names them by, or why there\n"
+	"are none (OpenCL not built, no platform).\n"
 	"\n"
 	"options:\n"
 	"  --subdivide K    split every triangle into 4, K times\n"
@@ -55,6 +59,36 @@ static void print_text(const bvhlab_scene *s)
 	       s->bounds.lo[2], s->bounds.hi[0], s->bounds.hi[1], s->bounds.hi[2]);
 }
 
+/* "opencl": {"devices": [...]} or {"error": why there are none}. */
+static void add_opencl_json(cJSON *o)
+{
+	struct machine_cl_device *d;
+	size_t n;
+	char why[512];
+	cJSON *cl = cJSON_AddObjectToObject(o, "opencl");
+	int r = machine_cl_devices(&d, &n, why, sizeof(why));
+	cJSON_AddBoolToObject(cl, "built", r != -ENOTSUP);
+	if (r < 0) {
+		cJSON_AddStringToObject(cl, "error", why);
+		return;
+	}
+	cJSON *list = cJSON_AddArrayToObject(cl, "devices");
+	for (size_t k = 0; list && k < n; k++) {
+		cJSON *e = cJSON_CreateObject();
+		char spec[32];
+		snprintf(spec, sizeof(spec), "%u:%u", d[k].platform_index, d[k].device_index);
+		cJSON_AddStringToObject(e, "device", spec);
+		cJSON_AddStringToObject(e, "platform", d[k].platform);
+		cJSON_AddStringToObject(e, "name", d[k].name);
+		cJSON_AddStringToObject(e, "kind", d[k].kind);
+		cJSON_AddNumberToObject(e, "compute_units", d[k].compute_units);
+		cJSON_AddNumberToObject(e, "global_mem_bytes", (double)d[k].global_mem);
+		cJSON_AddStringToObject(e, "version", d[k].version);
+		cJSON_AddItemToArray(list, e);
+	}
+	free(d);
+}
+
 static void print_machine_json(const struct machine_info *m)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -72,6 +106,7 @@ static void print_machine_json(const struct machine_info *m)
 		cJSON_AddNumberToObject(c, "bytes", (double)m->topo.caches[k].size);
 		cJSON_AddNumberToObject(c, "instances", m->topo.caches[k].instances);
 	}
+	add_opencl_json(o);
 	char *text = cJSON_Print(o);
 	if (text)
 		puts(text);
@@ -87,6 +122,27 @@ static const char *size_text(uint64_t bytes, char *buf, size_t size)
 	else
 		snprintf(buf, size, "%llu KiB", (unsigned long long)(bytes >> 10));
 	return buf;
+}
+
+/* One line per OpenCL device, by the "P:D" a device spec names it by. */
+static void print_opencl_text(void)
+{
+	struct machine_cl_device *d;
+	size_t n;
+	char why[512];
+	int r = machine_cl_devices(&d, &n, why, sizeof(why));
+	if (r < 0) {
+		printf("OpenCL:     %s\n", why);
+		return;
+	}
+	if (n == 0)
+		printf("OpenCL:     platforms but no device\n");
+	for (size_t k = 0; k < n; k++)
+		printf("%s %u:%u %s \"%s\" (%s), %u compute units, %.1f GiB, %s\n",
+		       k ? "           " : "OpenCL:    ", d[k].platform_index, d[k].device_index,
+		       d[k].kind, d[k].name, d[k].platform, d[k].compute_units,
+		       (double)d[k].global_mem / (1u << 30), d[k].version);
+	free(d);
 }
 
 static void print_machine_text(const struct machine_info *m)
@@ -106,6 +162,7 @@ static void print_machine_text(const struct machine_info *m)
 		sep = ", ";
 	}
 	printf("\nsource:     %s\n", m->topo.from_hwloc ? "hwloc" : "affinity mask (hwloc failed)");
+	print_opencl_text();
 }
 
 static int info_machine(bool json)

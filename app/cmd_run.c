@@ -171,7 +171,7 @@ static void print_outcome(const char *dir, int r, const struct harness_tally *t)
 		fprintf(stderr, "; %zu finished run%s could not be saved (see above)", t->unsaved,
 		        t->unsaved == 1 ? "" : "s");
 	if (t->untraced)
-		fprintf(stderr, "; %zu run%s traced no rays (see rays_error)", t->untraced,
+		fprintf(stderr, "; %zu run%s traced no rays (see their rays.error)", t->untraced,
 		        t->untraced == 1 ? "" : "s");
 	if (t->not_ok || (r && !t->unsaved && !t->untraced))
 		fprintf(stderr, "; some runs failed or were invalid");

@@ -37,7 +37,9 @@
 #define MAX_SAMPLES 4096
 #define MIN_ROUNDS 5
 #define PASSES 3
-#define TRACERS (1 + BVHLAB_TRAVERSAL_COUNT) /* embree, then ours by enum bvhlab_traversal */
+/* The CPU's traversals (the cl_ ones come after them in the enum). */
+#define OURS BVHLAB_TRAVERSAL_CL_STACK
+#define TRACERS (1 + OURS) /* embree, then ours by enum bvhlab_traversal */
 
 struct args {
 	const char *scene, *builder;
@@ -194,9 +196,9 @@ static void time_all(RTCScene sc, const bvhlab_tree *tree, const bvhlab_scene *s
 	while (h && k < MAX_SAMPLES && (k < MIN_ROUNDS || util_now() - start < a->min_ms * 1e-3)) {
 		embree_round(sc, rays, n, &t[0], k);
 		int j = 0;
-		while (j < BVHLAB_TRAVERSAL_COUNT && ours_round(tree, s, rays, n, j, h, &t[1 + j], k))
+		while (j < OURS && ours_round(tree, s, rays, n, j, h, &t[1 + j], k))
 			j++;
-		if (j < BVHLAB_TRAVERSAL_COUNT)
+		if (j < OURS)
 			break;
 		k++;
 	}

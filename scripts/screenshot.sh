@@ -3,6 +3,7 @@
 # screenshot, to see the summary table and the charts as a reader does.
 # Usage: scripts/screenshot.sh [REPORT.html] [OUT.png]
 #   default: results/default/report.html -> results/default/report.png
+#   SCREENSHOT_HEIGHT=6000 takes more of a long page (default 2000 px).
 # Exits 0 without a screenshot (and says so) when chromium is not installed:
 # it is an optional check, not a dependency (apt-get install chromium).
 set -euo pipefail
@@ -37,7 +38,7 @@ profile=$(mktemp -d)
 trap 'rm -rf "$profile"' EXIT
 # --no-sandbox: root in a container has no user namespaces for the sandbox.
 "$browser" --headless --no-sandbox --disable-gpu --hide-scrollbars \
-	--user-data-dir="$profile" --window-size=1400,2000 \
+	--user-data-dir="$profile" --window-size=1400,"${SCREENSHOT_HEIGHT:-2000}" \
 	--screenshot="$out" "file://$abs" >/dev/null 2>&1
 [ -s "$out" ] || { echo "screenshot.sh: $browser wrote no screenshot" >&2; exit 1; }
 echo "screenshot.sh: $out"

@@ -55,6 +55,22 @@ install_optional() {
 	return 0
 }
 
+# Optional: OpenCL headers, ICD loader and PoCL (OpenCL on the CPU) for the
+# device plugins (cl_*) and their tests. Never fails the set-up.
+install_opencl() {
+	local want=""
+	[ -f /usr/include/CL/cl.h ] || want="$want opencl-c-headers"
+	{ [ -f /usr/lib/x86_64-linux-gnu/libOpenCL.so ] || [ -f /usr/lib/libOpenCL.so ] ||
+		{ command -v pkg-config >/dev/null 2>&1 && pkg-config --exists OpenCL; }; } ||
+		want="$want ocl-icd-opencl-dev"
+	ls /etc/OpenCL/vendors/*.icd >/dev/null 2>&1 || want="$want pocl-opencl-icd"
+	[ -z "$want" ] && return 0
+	# shellcheck disable=SC2086
+	apt_install "setup (optional: OpenCL device plugins)" $want ||
+		echo "setup: without$want the device plugins are not built or their tests skip" >&2
+	return 0
+}
+
 # Optional: GNU parallel (the cli-plan-parallel test) and a single-node Slurm
 # (scripts/slurm-smoke.sh). Their tests report themselves skipped without
 # them, so this never fails the set-up.
@@ -93,6 +109,7 @@ setup_build() {
 	shift
 	install_deps || return 1
 	install_optional
+	install_opencl
 	install_sweep_tools
 	if [ ! -f "$dir/build.ninja" ]; then
 		meson setup "$dir" "$BVHLAB_ROOT" "$@" >&2 || return 1

@@ -16,6 +16,7 @@
 
 #include "config/config.h"
 #include "config/json_locate.h"
+#include "trace/trace_cl.h"
 #include "testutil.h"
 
 #define SCENES "\"scenes\": [ { \"generator\": \"icosphere\" } ]"
@@ -242,14 +243,48 @@ static void test_traversal(void)
 	}
 	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"wid\" } }";
 	EXPECT_ERROR_AT(t, "\"wid\"", 0, "'rays.traversal' must be \"wide\", \"stack\", "
-	                "\"stackless\", \"both\" (stack and stackless) or an array of those "
-	                "names, not \"wid\"");
+	                "\"stackless\", \"cl_stack\", \"cl_stackless\", \"both\" (stack and "
+	                "stackless) or an array of those names (an entry may be {\"name\": NAME, "
+	                "\"optional\": true}), not \"wid\"");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", 2] } }";
-	EXPECT_ERROR_AT(t, "2]", 0, "an array of those names, not 2");
+	EXPECT_ERROR_AT(t, "2]", 0, "\"optional\": true}), not 2");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", \"wide\"] } }";
 	EXPECT_ERROR_AT(t, "\"wide\"", 1, "'rays.traversal' names \"wide\" twice");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [] } }";
 	EXPECT_ERROR_AT(t, "[]", 0, "not an array");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [{\"name\": \"stack\", "
+	    "\"opt\": true}] } }";
+	EXPECT_ERROR_AT(t, "\"opt\"", 0, "entries as objects take \"name\" (a string) and "
+	                "\"optional\" (true or false) only");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"device\": \"0:x\" } }";
+	EXPECT_ERROR_AT(t, "\"0:x\"", 0, "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or "
+	                "\"P:D\"");
+}
+
+/* The device traversals: refused, naming the key, in a build without
+ * OpenCL unless optional (then left out); kept in a build with it. */
+static void test_device_traversal(void)
+{
+	struct config cfg;
+	bvhlab_error err = {""};
+	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"device\": \"1:0\", \"traversal\": "
+	                "[{\"name\": \"cl_stack\", \"optional\": true}, \"stack\"] } }";
+	CHECK_INT(load(&cfg, t, &err), 0);
+	unsigned stack = 1u << BVHLAB_TRAVERSAL_STACK, cl = 1u << BVHLAB_TRAVERSAL_CL_STACK;
+	CHECK(strcmp(cfg.ray_device, "1:0") == 0);
+	if (trace_cl_built())
+		CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_CL_STACK && cfg.ray_traversals == (stack | cl));
+	else
+		CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_STACK && cfg.ray_traversals == stack);
+	config_finish(&cfg);
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"cl_stackless\" } }";
+	if (trace_cl_built()) {
+		CHECK_INT(load(&cfg, t, &err), 0);
+		config_finish(&cfg);
+	} else {
+		EXPECT_ERROR_AT(t, "\"cl_stackless\"", 0, "'rays.traversal' \"cl_stackless\" runs on "
+		                "an OpenCL device, and this bvhlab was built without OpenCL");
+	}
 }
 
 static void test_syntax(void)
@@ -307,7 +342,8 @@ static void test_unknown_keys(void)
 	             "timeout_s, memory_limit_mb, options, optional, refine); did you mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
-	                "diffuse, camera, threads, min_ms, rounds, traversal); did you mean 'width'?");
+	                "diffuse, camera, threads, min_ms, rounds, traversal, device); did you mean "
+	                "'width'?");
 }
 
 static void test_types(void)
@@ -616,6 +652,7 @@ int main(void)
 	test_defaults();
 	test_syntax();
 	test_traversal();
+	test_device_traversal();
 	test_unknown_keys();
 	test_types();
 	test_structure();

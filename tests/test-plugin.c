@@ -104,6 +104,7 @@ static void test_good_plugin(void)
 	CHECK_CONTAINS(err.message, "builder 'fake_good' failed (Input/output error) without");
 	CHECK_INT(build_with(p, "fail=positive", &tree, &err), -EPROTO);
 	CHECK_CONTAINS(err.message, "returned 1; the ABI allows 0 or a negative errno");
+	CHECK_INT(tree.phase_count, 0);
 	bvhlab_tree_finish(&tree);
 	bvhlab_plugin_close(p);
 
@@ -111,6 +112,33 @@ static void test_good_plugin(void)
 	CHECK_INT(bvhlab_plugin_open(FAKE_DIR "/fake_good.so", &p, &err), 0);
 	bvhlab_plugin_close(p);
 	bvhlab_plugin_close(NULL);
+}
+
+/* ABI 1.3 phases: reports add up by name, in the order first reported, a
+ * build starts with none, and a report that breaks the rules fails the
+ * build naming the phase. */
+static void test_phases(void)
+{
+	bvhlab_plugin *p = NULL;
+	bvhlab_error err = {{0}};
+	bvhlab_tree tree = {0};
+	CHECK_INT(bvhlab_plugin_open("fake_good", &p, &err), 0);
+	if (!p)
+		return;
+	CHECK_INT(build_with(p, "phases=two", &tree, &err), 0);
+	CHECK_INT(tree.phase_count, 2);
+	CHECK(strcmp(tree.phases[0].name, "upload") == 0 && tree.phases[0].ms == 1.5);
+	CHECK(strcmp(tree.phases[1].name, "device") == 0 && tree.phases[1].ms == 2.5);
+	CHECK_INT(build_with(p, NULL, &tree, &err), 0);
+	CHECK_INT(tree.phase_count, 0);
+	CHECK_INT(build_with(p, "phases=bad_name", &tree, &err), -EPROTO);
+	CHECK_CONTAINS(err.message, "builder 'fake_good' reported phase 'Device Time'");
+	CHECK_INT(build_with(p, "phases=negative", &tree, &err), -EPROTO);
+	CHECK_CONTAINS(err.message, "reported phase 'device' (-1 ms)");
+	CHECK_INT(build_with(p, "phases=too_many", &tree, &err), -EPROTO);
+	CHECK_CONTAINS(err.message, "'p8' (more than 8 phases)");
+	bvhlab_tree_finish(&tree);
+	bvhlab_plugin_close(p);
 }
 
 static void test_names(void)
@@ -133,6 +161,7 @@ int main(void)
 	test_broken_plugins();
 	test_not_a_library();
 	test_good_plugin();
+	test_phases();
 	test_names();
 	return test_finish();
 }

@@ -267,7 +267,9 @@ static void add_run(cJSON *runs, const char *scene, const char *builder, const c
 }
 
 /* The report's thesis table: gain and speedup against sah_seq on 1 thread,
- * the first ok run of a duplicated thread count, "—" for what is missing. */
+ * the first ok run of a duplicated thread count, "—" for what is missing,
+ * and no column that would hold only dashes (queue failed on 2 threads,
+ * even did not run on 4). */
 static void test_report(void)
 {
 	cJSON *doc = cJSON_CreateObject();
@@ -289,11 +291,12 @@ static void test_report(void)
 	add_run(runs, "b", "even", "sah_even", 2, "ok", 40);
 	char *md = report_markdown(doc);
 	CHECK_CONTAINS(md, "### 2 threads\n\n| scene | sah_seq 1 thread ms | even ms | gain | "
-	                   "speedup | queue ms | gain | speedup |");
-	CHECK_CONTAINS(md, "| a | 100.00 | 80.00 | 20.0 % | 1.25 | — | — | — |");
-	CHECK_CONTAINS(md, "| b | — | 40.00 | — | — | — | — | — |");
-	CHECK_CONTAINS(md, "### 4 threads");
-	CHECK_CONTAINS(md, "| a | 100.00 | — | — | — | 125.00 | -25.0 % | 0.80 |");
+	                   "speedup |\n");
+	CHECK_CONTAINS(md, "| a | 100.00 | 80.00 | 20.0 % | 1.25 |\n");
+	CHECK_CONTAINS(md, "| b | — | 40.00 | — | — |\n");
+	CHECK_CONTAINS(md, "### 4 threads\n\n| scene | sah_seq 1 thread ms | queue ms | gain | "
+	                   "speedup |\n");
+	CHECK_CONTAINS(md, "| a | 100.00 | 125.00 | -25.0 % | 0.80 |\n");
 	CHECK(!strstr(md ? md : "", "### 1 thread"));
 	free(md);
 	cJSON_Delete(doc);

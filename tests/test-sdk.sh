@@ -5,7 +5,10 @@
 # (pkg-config), checks each exports only its entry point, loads the C one
 # with the installed bvhlab by path and then by name after installing it,
 # and runs the C++ one through `bvhlab run` beside sah_seq: every run ok,
-# every tree valid.
+# every tree valid. When bvhlab was built with OpenCL (bvhlab/opencl.h
+# installed), it builds examples/plugin-template-cl too and, when the
+# machine has an OpenCL device, builds a tree with it that must be valid
+# and report its phases; with no device, the build must fail saying why.
 # Usage: test-sdk.sh SOURCE_ROOT
 set -eu
 src=$1
@@ -75,4 +78,23 @@ valid=$(grep -cE '"valid":[[:space:]]*true' "$results" || true)
 cpp=$(grep -cE '"builder":[[:space:]]*"template_cpp"' "$results" || true)
 echo "runs ok: $runs of 8, valid trees: $valid, template_cpp runs: $cpp"
 [ "$runs" = 8 ] && [ "$valid" = 8 ] && [ "$cpp" = 4 ] || { cat "$results"; exit 1; }
+
+if [ -f "$tmp/prefix/include/bvhlab/opencl.h" ] && pkg-config --exists OpenCL; then
+	build_template plugin-template-cl template_cl
+	step "the OpenCL template on the machine's device"
+	if "$bvhlab" info --machine --json | grep -q '"compute_units"'; then
+		out=$("$bvhlab" build "$tmp/plugin-template-cl-build/template_cl.so" \
+			icosphere:frequency=8 -o device=auto) || { echo "$out"; exit 1; }
+		echo "$out"
+		echo "$out" | grep -q "^valid:      yes" || { echo "tree not valid"; exit 1; }
+		echo "$out" | grep -q "^phase:      device" || { echo "no device phase"; exit 1; }
+	else
+		out=$("$bvhlab" build "$tmp/plugin-template-cl-build/template_cl.so" \
+			icosphere:frequency=8 2>&1) && { echo "built without a device?"; exit 1; }
+		echo "$out" | grep -q "OpenCL" || { echo "$out"; exit 1; }
+		echo "no OpenCL device here: the template says so: $out"
+	fi
+else
+	echo "== OpenCL template skipped: bvhlab was built without OpenCL"
+fi
 echo "sdk: ok"

@@ -108,23 +108,77 @@ static int bad_traversal(struct config *cfg, const cJSON *item, bvhlab_error *er
 		         strlen(item->valuestring) > 36 ? "..." : "");
 	return config_error(cfg, item, false, err,
 	                    "'rays.traversal' must be \"wide\", \"stack\", \"stackless\", "
-	                    "\"both\" (stack and stackless) or an array of those names, not %s",
+	                    "\"cl_stack\", \"cl_stackless\", \"both\" (stack and stackless) or an "
+	                    "array of those names (an entry may be {\"name\": NAME, \"optional\": true}), "
+	                    "not %s",
 	                    cJSON_IsString(item) ? got
 	                                         : config_describe(cfg, item, got, sizeof(got)));
 }
 
-/* One name of the array form: the first is the main traversal. */
-static int add_traversal(struct config *cfg, const cJSON *item, bool first, bvhlab_error *err)
+/* The device traversals exist only in a build with OpenCL. */
+static int traversal_built(struct config *cfg, const cJSON *item, int k, bvhlab_error *err)
 {
-	int k = cJSON_IsString(item) ? traversal_of(item->valuestring) : -1;
+#ifdef BVHLAB_HAVE_OPENCL
+	(void)cfg, (void)item, (void)k, (void)err;
+	return 0;
+#else
+	if (k != BVHLAB_TRAVERSAL_CL_STACK && k != BVHLAB_TRAVERSAL_CL_STACKLESS)
+		return 0;
+	return config_error(cfg, item, false, err,
+	                    "'rays.traversal' \"%s\" runs on an OpenCL device, and this bvhlab "
+	                    "was built without OpenCL (install ocl-icd-opencl-dev and "
+	                    "opencl-c-headers, then meson setup again)", bvhlab_traversal_name(k));
+#endif
+}
+
+/* {"name": NAME, "optional": BOOL} of the array form: its name (or NULL,
+ * an error said) and whether it is optional. */
+static const cJSON *entry_name(struct config *cfg, const cJSON *item, bool *optional,
+                               bvhlab_error *err)
+{
+	const cJSON *m, *name = NULL;
+	*optional = false;
+	if (!cJSON_IsObject(item))
+		return item;
+	cJSON_ArrayForEach(m, item) {
+		if (strcmp(m->string, "name") == 0 && cJSON_IsString(m)) {
+			name = m;
+		} else if (strcmp(m->string, "optional") == 0 && cJSON_IsBool(m)) {
+			*optional = cJSON_IsTrue(m);
+		} else {
+			config_error(cfg, m, true, err, "'rays.traversal' entries as objects take "
+			             "\"name\" (a string) and \"optional\" (true or false) only");
+			return NULL;
+		}
+	}
+	if (!name)
+		config_error(cfg, item, false, err, "'rays.traversal' entry lacks \"name\"");
+	return name;
+}
+
+/* One entry of the array form: the first kept is the main traversal. An
+ * optional one that this build lacks (a cl_ one without OpenCL) is left
+ * out quietly, like an optional builder whose plugin is missing. */
+static int add_traversal(struct config *cfg, const cJSON *item, bvhlab_error *err)
+{
+	bool optional;
+	const cJSON *name = entry_name(cfg, item, &optional, err);
+	if (!name)
+		return -EINVAL;
+	int k = cJSON_IsString(name) ? traversal_of(name->valuestring) : -1;
 	if (k < 0)
-		return bad_traversal(cfg, item, err);
+		return bad_traversal(cfg, name, err);
+	if (optional && (k == BVHLAB_TRAVERSAL_CL_STACK || k == BVHLAB_TRAVERSAL_CL_STACKLESS) &&
+	    traversal_built(cfg, name, k, NULL) < 0)
+		return 0;
+	if (traversal_built(cfg, name, k, err) < 0)
+		return -EINVAL;
 	if (cfg->ray_traversals & (1u << k))
-		return config_error(cfg, item, false, err, "'rays.traversal' names \"%s\" twice",
-		                    item->valuestring);
-	cfg->ray_traversals |= 1u << k;
-	if (first)
+		return config_error(cfg, name, false, err, "'rays.traversal' names \"%s\" twice",
+		                    name->valuestring);
+	if (cfg->ray_traversals == 0)
 		cfg->ray_traversal = k;
+	cfg->ray_traversals |= 1u << k;
 	return 0;
 }
 
@@ -141,6 +195,8 @@ static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *
 		return 0;
 	}
 	int k = cJSON_IsString(t) ? traversal_of(t->valuestring) : -1;
+	if (k >= 0 && traversal_built(cfg, t, k, err) < 0)
+		return -EINVAL;
 	if (k >= 0) {
 		cfg->ray_traversal = k;
 		cfg->ray_traversals = 1u << k;
@@ -153,9 +209,29 @@ static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *
 	const cJSON *item;
 	cJSON_ArrayForEach(item, t) {
 		if (rc == 0)
-			rc = add_traversal(cfg, item, item == t->child, err);
+			rc = add_traversal(cfg, item, err);
 	}
+	if (rc == 0 && cfg->ray_traversals == 0)
+		return config_error(cfg, t, false, err, "'rays.traversal': every entry is optional "
+		                    "and none is built here (OpenCL was not built)");
 	return rc;
+}
+
+/* "device": auto, gpu, cpu or P:D, checked here so a typo fails the
+ * config, not every run (which device exists is known only when tracing). */
+static int check_device(struct config *cfg, const cJSON *rays, bvhlab_error *err)
+{
+	const char *d = cfg->ray_device;
+	if (!d || !strcmp(d, "auto") || !strcmp(d, "gpu") || !strcmp(d, "cpu"))
+		return 0;
+	const char *p = d;
+	size_t a = strspn(p, "0123456789"), b = a && p[a] == ':' ? strspn(p + a + 1, "0123456789") : 0;
+	if (a && a <= 5 && b && b <= 5 && p[a + 1 + b] == '\0')
+		return 0;
+	return config_error(cfg, config_member(rays, "device"), false, err,
+	                    "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or \"P:D\" (OpenCL "
+	                    "platform and device indices, e.g. \"0:0\"; clinfo -l lists them), "
+	                    "not \"%.40s\"", d);
 }
 
 static int parse_rays(struct config *cfg, bvhlab_error *err)
@@ -174,6 +250,8 @@ static int parse_rays(struct config *cfg, bvhlab_error *err)
 		rc = config_read_keys(cfg, rays, config_ray_keys, "rays.", cfg, err);
 	if (!rc)
 		rc = parse_traversal(cfg, rays, err);
+	if (!rc)
+		rc = check_device(cfg, rays, err);
 	if (!rc)
 		rc = config_parse_camera(cfg, rays, err);
 	return rc;
@@ -334,6 +412,7 @@ void config_finish(struct config *cfg)
 	free(cfg->builders);
 	free(cfg->threads);
 	free(cfg->output);
+	free(cfg->ray_device);
 	free(cfg->report_reference);
 	json_locations_destroy(cfg->locations);
 	cJSON_Delete(cfg->root);

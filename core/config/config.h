@@ -106,6 +106,8 @@ struct config {
 	                          * of names, default wide: bit (1 << enum
 	                          * bvhlab_traversal) per traversal */
 	int ray_traversal; /* the main one (stack for "both", the first of an array) */
+	char *ray_device; /* "rays": "device", the cl_ traversals' OpenCL device spec
+	                   * (auto|gpu|cpu|P:D); NULL: auto */
 	char *report_reference; /* "report": {"reference"}, default "sah_seq": a builder
 	                         * name or, failing that, a plugin name */
 	bool has_camera;   /* "rays": {"camera": ...} given; else framed per scene */

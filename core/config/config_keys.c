@@ -58,6 +58,7 @@ const struct config_key config_ray_keys[] = {
 	TOP("min_ms", CONFIG_POSITIVE, ray_min_ms, 0, 0),
 	TOP("rounds", CONFIG_U32, ray_rounds, 1, MAX_RAY_ROUNDS),
 	CUSTOM("traversal"), /* a name, "both" or an array of names: config.c */
+	TOP("device", CONFIG_STRING, ray_device, 0, 0), /* checked in config.c */
 	END,
 };
 

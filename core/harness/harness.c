@@ -17,6 +17,7 @@
 #include "harness/harness_rounds.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
+#include "machine/machine.h"
 #include "output/results.h"
 #include "output/scene_images.h"
 #include "output/safe_file.h"
@@ -59,11 +60,12 @@ struct series_report {
 	double epo;
 	struct build_memory memory;
 	struct ray_metrics rays;
-	bool rays_failed;  /* the tree is fine but tracing failed: error says why */
 	bool heat_written, shade_written;
 	bool tree_written; /* the tree is in the job's tree_path */
 	uint32_t stage_count;
 	struct stage_metrics stages[HARNESS_MAX_STAGES];
+	uint32_t phase_count;
+	bvhlab_phase phases[BVHLAB_MAX_PHASES];
 	char error[sizeof(((bvhlab_error *)0)->message)];
 	double samples[];      /* [repeat] */
 };
@@ -90,8 +92,10 @@ static void record(struct harness *h, struct run_record *run)
 {
 	bvhlab_error err = {{0}};
 	h->tally.not_ok += strcmp(run->status, "ok") != 0;
-	h->tally.untraced += !strcmp(run->status, "ok") && run->rays_error;
-	if (strcmp(run->status, "ok") != 0 || run->rays_error)
+	/* A valid tree whose rays could not be traced stays ok ("rays": "error"
+	 * says why), but the last line counts it. */
+	h->tally.untraced += !strcmp(run->status, "ok") && run->rays && !run->rays->measured;
+	if (strcmp(run->status, "ok") != 0)
 		h->all_ok = false;
 	progress_done(&h->progress, run);
 	if (results_add_run(&h->res, run) < 0 || results_write(&h->res, &err) < 0) {
@@ -210,7 +214,7 @@ static int image_buffers(const struct series_job *job, size_t n, uint32_t **node
 /* Traversal statistics on the valid tree, and the raw image data. A
  * failure here costs the numbers, not the run: the tree itself is fine. */
 static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
-                       struct series_report *rep, bvhlab_error *err)
+                       struct series_report *rep)
 {
 	const struct config *cfg = job->h->cfg;
 	size_t n = (size_t)cfg->ray_width * cfg->ray_height;
@@ -239,11 +243,9 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)
 		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
-	if (r < 0) {
-		rep->rays_failed = true;
-		rep->rays.measured = false;
-		error_set(err, "tracing rays: %s", strerror(-r));
-	}
+	/* The run stays ok (its tree is); its "rays" says why there are no figures. */
+	if (r < 0 && !rep->rays.error[0])
+		snprintf(rep->rays.error, sizeof(rep->rays.error), "%s", strerror(-r));
 	free(nodes);
 	free(shade);
 }
@@ -271,6 +273,8 @@ static void series_work(void *arg, void *report, size_t size)
 		rep->sample_count = s.repeat;
 		rep->cold_ms = s.cold_ms;
 		rep->stage_count = s.stage_count;
+		rep->phase_count = s.phase_count;
+		memcpy(rep->phases, s.phases, sizeof(rep->phases));
 		validate(job, &s.tree, rep, &err);
 		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
 		if (rep->has_stats)
@@ -279,9 +283,9 @@ static void series_work(void *arg, void *report, size_t size)
 			rep->has_epo = bvhlab_tree_epo(&s.tree, job->scene, EPO_SAMPLES, EPO_SEED,
 			                               &rep->epo) == 0;
 		if (rep->status == SERIES_OK)
-			trace_rays(job, &s.tree, rep, &err);
+			trace_rays(job, &s.tree, rep);
 	}
-	if (rep->status != SERIES_OK || rep->rays_failed)
+	if (rep->status != SERIES_OK)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
 	bvhlab_tree_finish(&s.tree);
 }
@@ -292,7 +296,7 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	static const char *const names[] = {"ok", "invalid", "failed"};
 	rep->error[sizeof(rep->error) - 1] = '\0';
 	if (rep->status > SERIES_FAILED || rep->sample_count > repeat ||
-	    rep->stage_count > HARNESS_MAX_STAGES) {
+	    rep->stage_count > HARNESS_MAX_STAGES || rep->phase_count > BVHLAB_MAX_PHASES) {
 		run->status = "crashed";
 		run->error = "sent back a malformed report";
 		return;
@@ -309,12 +313,17 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, struct run
 	run->valid = rep->valid;
 	run->rays_checked = rep->rays_checked;
 	run->mismatches = rep->mismatches;
-	run->rays = rep->rays.measured ? &rep->rays : NULL;
-	run->rays_error = rep->status == SERIES_OK && rep->rays_failed ? rep->error : NULL;
+	rep->rays.error[sizeof(rep->rays.error) - 1] = '\0';
+	rep->rays.device[sizeof(rep->rays.device) - 1] = '\0';
+	run->rays = rep->rays.measured || rep->rays.error[0] ? &rep->rays : NULL;
 	for (uint32_t k = 0; k < rep->stage_count; k++)
 		rep->stages[k].plugin[sizeof(rep->stages[k].plugin) - 1] = '\0';
 	run->stages = rep->stages;
 	run->stage_count = rep->stage_count;
+	for (uint32_t k = 0; k < rep->phase_count; k++)
+		rep->phases[k].name[sizeof(rep->phases[k].name) - 1] = '\0';
+	run->phases = rep->phases;
+	run->phase_count = rep->phase_count;
 }
 
 /* Runs the series in a child (or here, with "isolate": false) and records it. */
@@ -325,10 +334,13 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	char why[sizeof(rep->error)] = "", limited[sizeof(rep->error) + 64];
 	int outcome = ISOLATE_REPORTED;
 	struct isolate_limits limits = harness_run_limits(h->cfg, job->hb->cb);
+	run->load_before = machine_load_average();
 	if (h->cfg->isolate)
 		outcome = isolate_call(series_work, job, rep, size, &limits, why, sizeof(why));
 	else
 		series_work(job, rep, size);
+	run->load_after = machine_load_average();
+	run->load_read = true;
 	if (outcome == ISOLATE_REPORTED) {
 		report_to_run(rep, h->cfg->repeat, run);
 	} else {

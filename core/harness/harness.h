@@ -31,7 +31,7 @@ int harness_probe_scene(const struct config *cfg, const struct config_scene *cs,
 /* What went wrong in a sweep, for its last line. */
 struct harness_tally {
 	size_t not_ok;   /* runs of this process that did not end ok */
-	size_t untraced; /* ok runs without ray figures ("rays_error" says why) */
+	size_t untraced; /* ok runs without ray figures (their "rays": "error" says why) */
 	size_t unsaved;  /* runs that finished but could not be written */
 };
 
@@ -65,6 +65,11 @@ struct build_series {
 	const struct refine_stage *stages; /* [stage_count], applied in order */
 	uint32_t stage_count;  /* at most HARNESS_MAX_STAGES */
 	struct stage_metrics *stage_out; /* [stage_count], filled */
+	/* The builder's own phases (ABI 1.3 host->phase): each one's median
+	 * over the timed repeats (0 in a repeat that did not report it), in
+	 * the order first reported; filled. */
+	bvhlab_phase phases[BVHLAB_MAX_PHASES];
+	uint32_t phase_count;
 	bvhlab_tree tree;      /* the last build's tree, refined */
 };
 
@@ -103,6 +108,7 @@ struct ray_settings {
 	uint32_t rounds;        /* slices min_ms is spread over (harness_rounds.c) */
 	unsigned traversals;    /* bit (1 << enum bvhlab_traversal) for each one measured */
 	int main;               /* the traversal whose hits feed images and diffuse rays */
+	const char *device;     /* the cl_ traversals' OpenCL device spec (NULL: auto) */
 };
 
 /* The config's settings (cfg NULL: one quick stack pass, all threads). */
@@ -116,7 +122,9 @@ void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_
  * each batch timed (bvhlab_trace_measure) with every traversal of rs.
  * nodes ([width * height], may be NULL) gets nodes visited per pixel,
  * shade ([3 * width * height], may be NULL) the shaded render, both from
- * the main traversal. 0 or a negative errno.
+ * the main traversal. 0 or a negative errno, with m->error saying why (it
+ * also names a traversal other than the main one that could not run: that
+ * one is left out of m and the others are measured).
  */
 int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
                        const bvhlab_camera *cam, const struct ray_settings *rs,

@@ -14,6 +14,7 @@
 #include "harness/harness.h"
 #include "output/image.h"
 #include "output/results.h"
+#include "trace/trace_series.h"
 #include "util/util.h"
 
 void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam)
@@ -35,7 +36,7 @@ void harness_ray_settings(const struct config *cfg, struct ray_settings *rs)
 	                            .diffuse = cfg->ray_diffuse, .threads = cfg->ray_threads,
 	                            .min_ms = cfg->ray_min_ms, .min_repeats = HARNESS_MIN_REPEATS,
 	                            .rounds = cfg->ray_rounds, .traversals = cfg->ray_traversals,
-	                            .main = cfg->ray_traversal};
+	                            .main = cfg->ray_traversal, .device = cfg->ray_device};
 }
 
 /* Same triangle at bit-identical t, u, v. */
@@ -45,10 +46,35 @@ static bool same_hit(const bvhlab_hit *a, const bvhlab_hit *b)
 	       memcmp(&a->u, &b->u, sizeof(a->u)) == 0 && memcmp(&a->v, &b->v, sizeof(a->v)) == 0;
 }
 
+/* One traversal of a batch; a failure's reason, named after the
+ * traversal, goes to m->error. */
+static int measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhlab_ray *rays,
+                   size_t n, const bvhlab_trace_options *o, bvhlab_hit *hits, uint32_t *nodes,
+                   bvhlab_trace_timing *out, struct ray_metrics *m)
+{
+	bvhlab_error err = {{0}};
+	char device[sizeof(m->device)] = "";
+	int r = trace_measure(tree, scene, rays, n, o, hits, nodes, out, device, sizeof(device),
+	                      &err);
+	if (device[0])
+		memcpy(m->device, device, sizeof(device));
+	if (r < 0) {
+		if (!err.message[0])
+			error_set(&err, "%s", strerror(-r));
+		error_prefix(&err, "%s", bvhlab_traversal_name(o->traversal));
+		_Static_assert(sizeof(m->error) == sizeof(err.message), "error sizes");
+		memcpy(m->error, err.message, sizeof(m->error));
+	}
+	return r;
+}
+
 /*
- * One batch with every traversal of rs, the main one first (its hits go to
- * hits, its node counts to nodes); another traversal's hits are compared
- * with the main one's, ray by ray, into m->disagreements.
+ * One batch with every traversal of m (rs's, less those that failed), the
+ * main one first (its hits go to hits, its node counts to nodes); another
+ * traversal's hits are compared with the main one's, ray by ray, into
+ * m->disagreements. Another traversal that cannot run (no OpenCL device)
+ * is dropped from m with its reason in m->error; the main one failing
+ * fails the batch.
  */
 static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
                       const bvhlab_ray *rays, size_t n, const struct ray_settings *rs,
@@ -56,18 +82,24 @@ static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
                       struct ray_metrics *m)
 {
 	bvhlab_trace_options o = {.traversal = rs->main, .threads = rs->threads,
-	                          .min_ms = rs->min_ms, .min_repeats = rs->min_repeats};
-	int r = bvhlab_trace_measure(tree, scene, rays, n, &o, hits, nodes, &out[rs->main]);
+	                          .min_ms = rs->min_ms, .min_repeats = rs->min_repeats,
+	                          .device = rs->device};
+	int r = measure(tree, scene, rays, n, &o, hits, nodes, &out[rs->main], m);
 	m->threads = out[rs->main].threads;
 	for (int k = 0; r == 0 && k < BVHLAB_TRAVERSAL_COUNT; k++) {
-		if (k == rs->main || !(rs->traversals & (1u << k)))
+		if (k == rs->main || !(m->traversals & (1u << k)))
 			continue;
 		bvhlab_hit *other = malloc(n * sizeof(*other));
+		if (!other)
+			return -ENOMEM;
 		o.traversal = k;
-		r = other ? bvhlab_trace_measure(tree, scene, rays, n, &o, other, NULL, &out[k])
-		          : -ENOMEM;
-		for (size_t i = 0; r == 0 && i < n; i++)
-			m->disagreements += !same_hit(&hits[i], &other[i]);
+		if (measure(tree, scene, rays, n, &o, other, NULL, &out[k], m) == 0) {
+			for (size_t i = 0; i < n; i++)
+				m->disagreements += !same_hit(&hits[i], &other[i]);
+		} else { /* this traversal only (no device, say): the others go on */
+			m->traversals &= ~(1u << k);
+			out[k] = (bvhlab_trace_timing){0};
+		}
 		free(other);
 	}
 	return r;
@@ -100,8 +132,10 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	m->main = rs->main;
 	m->rounds = 1;
 	int r = bvhlab_rays_primary(cam, rs->width, rs->height, &rays);
-	if (r < 0)
+	if (r < 0) {
+		snprintf(m->error, sizeof(m->error), "primary rays: %s", strerror(-r));
 		return r;
+	}
 	bvhlab_hit *hits = malloc(n * sizeof(*hits));
 	if (!hits) {
 		r = -ENOMEM;
@@ -113,6 +147,8 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	if (r == 0)
 		r = trace_diffuse(tree, scene, rays, hits, n, rs, m);
 	m->measured = r == 0;
+	if (r < 0 && !m->error[0])
+		snprintf(m->error, sizeof(m->error), "%s", strerror(-r));
 out:
 	free(hits);
 	free(rays);

@@ -232,13 +232,16 @@ static int prepare(const struct rounds_job *job, const struct rounds_entry *e,
 	/* Zeroed: make_bounces reads them even if no pass could run. */
 	if (r == 0 && !(tt->hits = calloc(job->n, sizeof(*tt->hits))))
 		r = -ENOMEM;
+	/* The traversals the run's child could trace with (a device one that
+	 * could not run there is left out here too). */
 	for (int k = 0; r == 0 && k < BVHLAB_TRAVERSAL_COUNT; k++) {
-		if (!(rs->traversals & (1u << k)))
+		if (!(rs->traversals & e->rays.traversals & (1u << k)))
 			continue;
-		bvhlab_trace_options o = {.traversal = k, .threads = rs->threads};
+		bvhlab_trace_options o = {.traversal = k, .threads = rs->threads,
+		                          .device = rs->device};
 		r = trace_series_create(&tt->tree, job->scene, job->primary, job->n, &o,
 		                        k == rs->main ? tt->hits : NULL, NULL, false,
-		                        &tt->primary[k]);
+		                        &tt->primary[k], &err);
 	}
 	return r;
 }

@@ -59,11 +59,13 @@ void progress_done(struct progress *p, const struct run_record *run)
 		util_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
 		fprintf(stderr, ", %.2f ms median, SAH %.3f", med, run->stats->sah_cost);
 	}
-	if (run->rays)
+	if (run->rays && run->rays->measured)
 		fprintf(stderr, ", %.1f nodes/ray", run->rays->primary[run->rays->main].stats.rays
 		        ? (double)run->rays->primary[run->rays->main].stats.nodes_visited /
 		                  (double)run->rays->primary[run->rays->main].stats.rays
 		        : 0);
+	if (run->rays && run->rays->error[0]) /* a device that is not there, say */
+		fprintf(stderr, ", rays: %s", run->rays->error);
 	if (run->error)
 		fprintf(stderr, " (%s)", run->error);
 	elapsed_and_left(p);

@@ -35,3 +35,15 @@ void machine_info_read(struct machine_info *info)
 	machine_topology_read(&info->topo);
 	info->threads_available = info->topo.physical_cores;
 }
+
+double machine_load_average(void)
+{
+	double load = -1;
+	FILE *f = fopen("/proc/loadavg", "r");
+	if (!f)
+		return -1;
+	if (fscanf(f, "%lf", &load) != 1)
+		load = -1;
+	fclose(f);
+	return load;
+}

@@ -36,6 +36,27 @@ struct machine_info {
 
 void machine_info_read(struct machine_info *info);
 
+/* One OpenCL device: its "P:D" indices, names and size. */
+struct machine_cl_device {
+	unsigned platform_index, device_index;
+	char platform[128], name[128], version[128];
+	char kind[16];           /* "gpu", "cpu", "accelerator", "other" */
+	uint32_t compute_units;
+	uint64_t global_mem;     /* bytes */
+};
+
+/*
+ * Every OpenCL device of every platform, in "P:D" order: 0 and *devices
+ * (malloc'd, *count, may be 0: a platform without devices), or a negative
+ * errno with why saying what is missing: -ENOTSUP OpenCL not built,
+ * -ENODEV no platform (what to install), -ENOMEM, -EIO.
+ */
+int machine_cl_devices(struct machine_cl_device **devices, size_t *count, char *why,
+                       size_t why_size);
+
+/* The 1-minute load average from /proc/loadavg, or -1 when unreadable. */
+double machine_load_average(void);
+
 /* 0, or -ENODEV when hwloc could not load (t is then filled from the mask). */
 int machine_topology_read(struct machine_topology *t);
 

@@ -61,9 +61,9 @@ void image_heat_color(float t, uint8_t rgb[3])
 
 void image_heat(const uint32_t *counts, size_t count, uint32_t lo, uint32_t hi, uint8_t *rgb)
 {
-	float span = hi > lo ? (float)(hi - lo) : 1.0f;
+	float span = log1pf(hi > lo ? (float)(hi - lo) : 1.0f);
 	for (size_t i = 0; i < count; i++) {
-		float t = counts[i] > lo ? (float)(counts[i] - lo) / span : 0.0f;
+		float t = counts[i] > lo ? log1pf((float)(counts[i] - lo)) / span : 0.0f;
 		image_heat_color(t, rgb + 3 * i);
 	}
 }

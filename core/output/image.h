@@ -31,7 +31,10 @@ int image_read_rgb8(const char *path, int *width, int *height, uint8_t **rgb,
 void image_shade(const bvhlab_scene *scene, const bvhlab_ray *rays, const bvhlab_hit *hits,
                  size_t count, uint8_t *rgb);
 
-/* Heat-map colours of per-pixel counts on the scale [lo, hi]. */
+/* Heat-map colours of per-pixel counts on a log scale over [lo, hi]:
+ * t = log(1 + c - lo) / log(1 + hi - lo). Most pixels visit a few nodes
+ * and a few visit hundreds; on a linear scale every map was the same dark
+ * blue. The scale stays shared, so maps of one scene still compare. */
 void image_heat(const uint32_t *counts, size_t count, uint32_t lo, uint32_t hi, uint8_t *rgb);
 
 /* The heat map's colour at t in [0, 1]. */

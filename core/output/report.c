@@ -132,7 +132,31 @@ static const char *const csv_numbers[][2] = {
 	{"rays.stackless.diffuse.mrays_per_s", "%.4f"},
 	{"rays.stackless.diffuse.nodes_per_ray", "%.4f"},
 	{"rays.traversal_disagreements", "%.0f"},
+	{"rays.cl_stack.primary.mrays_per_s", "%.4f"},
+	{"rays.cl_stack.primary.wall_mrays_per_s", "%.4f"},
+	{"rays.cl_stack.diffuse.mrays_per_s", "%.4f"},
+	{"rays.cl_stack.diffuse.wall_mrays_per_s", "%.4f"},
+	{"rays.cl_stackless.primary.mrays_per_s", "%.4f"},
+	{"rays.cl_stackless.primary.wall_mrays_per_s", "%.4f"},
+	{"rays.cl_stackless.diffuse.mrays_per_s", "%.4f"},
+	{"rays.cl_stackless.diffuse.wall_mrays_per_s", "%.4f"},
+	{"load_before", "%.2f"},
+	{"load_after", "%.2f"},
 };
+
+/* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary
+ * by builder, so they do not get a column each. */
+static void csv_phases(struct strbuf *sb, const cJSON *phases)
+{
+	struct strbuf f = {0};
+	const cJSON *p;
+	cJSON_ArrayForEach(p, phases)
+		if (cJSON_IsNumber(p) && p->string)
+			sb_printf(&f, "%s%s=%.4f", f.len ? ";" : "", p->string, p->valuedouble);
+	char *text = sb_take(&f);
+	csv_field(sb, text ? text : "", false);
+	free(text);
+}
 
 static void csv_row(struct strbuf *sb, const cJSON *run)
 {
@@ -147,6 +171,7 @@ static void csv_row(struct strbuf *sb, const cJSON *run)
 	csv_field(sb, cJSON_IsString(trav) ? trav->valuestring : "", false);
 	const cJSON *valid = at(run, "validation.valid");
 	csv_field(sb, cJSON_IsBool(valid) ? (cJSON_IsTrue(valid) ? "true" : "false") : "", false);
+	csv_phases(sb, cJSON_GetObjectItemCaseSensitive(run, "build_phases"));
 	csv_field(sb, str(run, "error"), true);
 }
 
@@ -156,15 +181,58 @@ char *report_csv(const cJSON *doc)
 	sb_printf(&sb, "scene,builder,plugin,status");
 	for (size_t k = 0; k < sizeof(csv_numbers) / sizeof(csv_numbers[0]); k++)
 		sb_printf(&sb, ",%s", csv_numbers[k][0]);
-	sb_printf(&sb, ",rays.traversal,validation.valid,error\n");
+	sb_printf(&sb, ",rays.traversal,validation.valid,build_phases,error\n");
 	const cJSON *run;
 	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
 		csv_row(&sb, run);
 	return sb_take(&sb);
 }
 
+/* Decimals for a magnitude: three significant digits, at least. */
+static int plain_decimals(double a)
+{
+	return a >= 100 ? 0 : a >= 10 ? 1 : a >= 1 ? 2 : 3;
+}
+
+const char *report_plain(char *buf, size_t size, double v)
+{
+	if (!isfinite(v)) {
+		snprintf(buf, size, "%s", "");
+		return buf;
+	}
+	int d = plain_decimals(fabs(v));
+	double scale = pow(10, d);
+	d = plain_decimals(fabs(round(v * scale) / scale)); /* 9.996 is "10.0", not "10.00" */
+	snprintf(buf, size, "%.*f", d, v);
+	return buf;
+}
+
+const char *report_phases(char *buf, size_t size, const cJSON *run)
+{
+	const cJSON *p;
+	size_t len = 0;
+	buf[0] = '\0';
+	cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(run, "build_phases")) {
+		char v[32];
+		if (!cJSON_IsNumber(p) || !p->string || len >= size)
+			continue;
+		int n = snprintf(buf + len, size - len, "%s%s %s", len ? ", " : "", p->string,
+		                 report_plain(v, sizeof(v), p->valuedouble));
+		len += n > 0 ? (size_t)n : 0;
+	}
+	return buf;
+}
+
+bool report_any_phases(const cJSON *const *runs, size_t n)
+{
+	for (size_t k = 0; k < n; k++)
+		if (cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(runs[k], "build_phases")) > 0)
+			return true;
+	return false;
+}
+
 /* Markdown cell text: pipes and newlines would break the table. */
-static void md_cell(struct strbuf *sb, const char *s)
+void report_md_cell(struct strbuf *sb, const char *s)
 {
 	sb_printf(sb, " ");
 	for (const char *p = s; *p; p++)
@@ -191,22 +259,38 @@ static void md_numbers(struct strbuf *sb, const cJSON *run, const char *const (*
 {
 	char buf[64];
 	for (size_t k = 0; k < count; k++)
-		md_cell(sb, num(buf, sizeof(buf), run, cols[k][0], cols[k][1]));
+		report_md_cell(sb, num(buf, sizeof(buf), run, cols[k][0], cols[k][1]));
 }
 
-static void md_run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run)
+/* "noisy: why; busy: load" or "". */
+static const char *md_marks(char *buf, size_t size, const struct report_index *ix,
+                            const cJSON *run)
 {
-	char buf[64];
+	char noise[160], load[160];
+	bool noisy = report_noise(ix, run, noise, sizeof(noise));
+	bool busy = report_busy(ix->doc, run, load, sizeof(load));
+	snprintf(buf, size, "%s%s%s%s%s", noisy ? "noisy: " : "", noise,
+	         noisy && busy ? "; " : "", busy ? "busy: " : "", load);
+	return buf;
+}
+
+static void md_run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
+                       bool phases)
+{
+	char buf[400];
 	sb_printf(sb, "|");
-	md_cell(sb, str(run, "builder"));
-	md_cell(sb, num(buf, sizeof(buf), run, "threads", "%.0f"));
-	md_cell(sb, str(run, "status"));
+	report_md_cell(sb, str(run, "builder"));
+	report_md_cell(sb, num(buf, sizeof(buf), run, "threads", "%.0f"));
+	report_md_cell(sb, str(run, "status"));
 	md_numbers(sb, run, md_times, sizeof(md_times) / sizeof(md_times[0]));
 	double speedup = report_speedup(ix, run);
 	snprintf(buf, sizeof(buf), "%.2f", speedup);
-	md_cell(sb, isnan(speedup) ? "" : buf);
+	report_md_cell(sb, isnan(speedup) ? "" : buf);
 	md_numbers(sb, run, md_figures, sizeof(md_figures) / sizeof(md_figures[0]));
-	md_cell(sb, str(run, "error"));
+	report_md_cell(sb, md_marks(buf, sizeof(buf), ix, run));
+	if (phases)
+		report_md_cell(sb, report_phases(buf, sizeof(buf), run));
+	report_md_cell(sb, str(run, "error"));
 	sb_printf(sb, "\n");
 }
 
@@ -217,13 +301,15 @@ static void md_images(struct strbuf *sb, const cJSON *scene)
 	if (*shaded)
 		sb_printf(sb, "\n![%s](%s)\n", str(scene, "name"), shaded);
 	if (*legend)
-		sb_printf(sb, "\nHeat maps (nodes visited per primary ray, %.0f to %.0f): "
+		sb_printf(sb, "\nHeat maps (nodes visited per primary ray, %.0f to %.0f, %s scale): "
 		              "![scale](%s) and per builder in report.html.\n",
 		          report_num(scene, "images.heat_min"), report_num(scene, "images.heat_max"),
+		          strcmp(str(scene, "images.heat_scale"), "log") == 0 ? "log" : "linear",
 		          legend);
 }
 
-static void md_scene(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
+static void md_scene(struct strbuf *sb, const struct report_index *ix, const char *ref,
+                     const cJSON *scene)
 {
 	const char *name = str(scene, "name");
 	char buf[64];
@@ -232,15 +318,19 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cJS
 	if (*str(scene, "error"))
 		sb_printf(sb, ". **Could not be loaded:** %s", str(scene, "error"));
 	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | cold ms "
-	              "| Mtris/s | speedup | SAH cost | EPO | peak bytes | primary Mrays/s "
-	              "| primary nodes/ray | diffuse Mrays/s | diffuse nodes/ray | nodes | depth "
-	              "| avg leaf | refs | refs/tri | error |\n"
-	              "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
-	              "|---:|---:|---:|---:|---:|---:|---|\n");
+	              "| Mtris/s | speedup | SAH cost | EPO | peak bytes | primary Mrays/s (best tile) "
+	              "| primary nodes/ray | diffuse Mrays/s (best tile) | diffuse nodes/ray | nodes "
+	              "| depth | avg leaf | refs | refs/tri | marks |");
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
+	bool phases = report_any_phases(runs, n);
+	sb_printf(sb, "%s error |\n|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:"
+	              "|---:|---:|---:|---:|---:|---:|---:|---:|---|%s---|\n",
+	          phases ? " build phases ms |" : "", phases ? "---|" : "");
 	for (size_t k = 0; k < n; k++)
-		md_run_row(sb, ix, runs[k]);
+		md_run_row(sb, ix, runs[k], phases);
+	report_front_md(sb, runs, n);
+	report_breakeven_md(sb, ix, ref, runs, n);
 	md_images(sb, scene);
 }
 
@@ -262,21 +352,26 @@ char *report_markdown(const cJSON *doc)
 	               "threads for every run, whatever its build thread count, so traversal "
 	               "numbers compare trees; Mrays/s: rays per CPU second of the tracing "
 	               "threads times their number, each tile of rays at its best of the "
-	               "repeated passes (spread over rays.rounds rounds taken in turn by the "
-	               "scene's trees), by the run's rays.traversal (default wide: the tree "
+	               "repeated passes (best tile; spread over rays.rounds rounds taken in turn "
+	               "by the scene's trees), by the run's rays.traversal (default wide: the tree "
 	               "collapsed into 4-child nodes); nodes and triangles per ray are the "
-	               "binary tree's, counted by the stack traversal, whichever is timed.\n",
+	               "binary tree's, counted by the stack traversal, whichever is timed. "
+	               "Marks: noisy where the build repeats spread more than 5 %% or a run "
+	               "of the same tree traced more than 5 %% faster or slower; busy where "
+	               "the load average exceeded the cores the run left free.\n",
 	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);
 	struct report_index ix;
 	if (report_index_init(&ix, doc) < 0)
 		sb.failed = true;
+	const char *asked, *ref = report_reference(doc, &asked, &(bool){false});
+	report_load_warning(&sb, doc, false);
 	report_summary_md(&sb, doc);
 	report_machines_md(&sb, doc);
 	report_thesis(&sb, doc, &ix);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
-		md_scene(&sb, &ix, scene);
+		md_scene(&sb, &ix, ref, scene);
 	report_index_finish(&ix);
 	return sb_take(&sb);
 }

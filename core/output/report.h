@@ -30,8 +30,10 @@ double report_num(const cJSON *o, const char *path);
 struct report_slot;
 struct report_index {
 	struct report_slot *scenes, *pairs; /* open-addressed tables of cap slots */
+	struct report_slot *names;          /* builder labels, numbered */
 	const cJSON **order;                /* every run, grouped by scene */
-	size_t cap;
+	size_t cap, builder_count;
+	const cJSON *doc;
 };
 
 /* 0, or -ENOMEM (the index is then empty, and finishing it is safe). */
@@ -40,8 +42,12 @@ void report_index_finish(struct report_index *ix);
 /* The scene's runs, in document order; *count 0 when it has none. */
 const cJSON *const *report_scene_runs(const struct report_index *ix, const char *scene,
                                       size_t *count);
+/* The builder's number in order of first appearance (its colour in every
+ * chart), or -1 when no run has it. */
+long report_builder_number(const struct report_index *ix, const char *builder);
 /* Build-time speedup of a run over the same builder's 1-thread run on
- * the same scene, or NaN when there is none. */
+ * the same scene, or NaN when there is none or the builder never ran on
+ * more than 1 thread (a builder without the PARALLEL flag). */
 double report_speedup(const struct report_index *ix, const cJSON *run);
 
 /* Appends the thesis-style speedup tables (parallel builders against
@@ -57,23 +63,124 @@ void report_machines_html(struct strbuf *sb, const cJSON *doc);
 
 /* Text with & < > " ' escaped for HTML and SVG. */
 void report_escape(struct strbuf *sb, const char *text);
+/* A run's build_phases as "upload 1.50, device 2.50" ("" when none). */
+const char *report_phases(char *buf, size_t size, const cJSON *run);
+/* Whether some run has build_phases (the tables then add their column). */
+bool report_any_phases(const cJSON *const *runs, size_t n);
+/* " text |": a Markdown table cell, pipes escaped and newlines flattened. */
+void report_md_cell(struct strbuf *sb, const char *text);
+/* A plain number with the decimals its size needs ("2140", "21.4", "2.14"),
+ * never an exponent; "" for NaN. Returns buf. */
+const char *report_plain(char *buf, size_t size, double v);
+
+/* ---- Pareto fronts (report_front.c) -------------------------------------- */
+
+/* One candidate: its build time and a tree figure, both lower-is-better;
+ * only points of the same group (thread count) are compared. */
+struct front_point {
+	double time, figure;
+	long group;
+};
+#define FRONT_ON (-1)   /* on the front */
+#define FRONT_NONE (-2) /* not compared: a figure is missing */
+
+/* by[i]: FRONT_ON, FRONT_NONE, or the index of the point that dominates
+ * point i (no slower, a figure no more than 0.05 % worse, better in one;
+ * the fastest such on the front). O(n^2); all FRONT_NONE on no memory. */
+void report_front_points(const struct front_point *p, size_t n, long *by);
+/* "front", "—" or "dominated by X (0.80× time, −1.2 % SAH)" for point a. */
+void report_front_text(char *buf, size_t size, const struct front_point *p, long by,
+                       size_t a, const char *by_name, const char *figure);
+/* One candidate of a scene's front at a thread count: a run with that
+ * many threads, or the 1-thread run of a builder that ran on 1 thread only
+ * (it cannot use more, and is still a choice at every thread count). */
+struct front_entry {
+	const cJSON *run;
+	double threads; /* the front it competes on */
+	size_t order;   /* the run's place in the scene */
+};
+/* The scene's entries by thread count, then run order (malloc'd; NULL on
+ * no memory). */
+struct front_entry *report_front_entries(const cJSON *const *runs, size_t n, size_t *count);
+/* The entries as points of the figure at a dotted path (runs not ok are
+ * not compared), grouped by thread count, and their verdicts. */
+void report_entries_front(const struct front_entry *e, size_t m, const char *figure,
+                          struct front_point *p, long *by);
+/* The distinct thread counts of the runs, ascending, at most max. */
+size_t report_thread_counts(const cJSON *const *runs, size_t n, double *out, size_t max);
+/* The scene's front table (both views: SAH cost, primary nodes per ray). */
+void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n);
+void report_front_html(struct strbuf *sb, const cJSON *const *runs, size_t n);
 
 /* One point or bar: a label and its values. */
 struct svg_point {
-	const char *label;
-	const char *group; /* lines: the series it belongs to */
+	const char *label;  /* bars: beside the bar; scatter: the point's tooltip */
+	const char *group;  /* the builder: the legend's entry, a line's series */
 	double x, y;
+	const char *colour; /* the group's (svg_colour) */
+	bool front;         /* scatter: on the Pareto front (a line joins them) */
 };
+
+/* The colour of builder number k (report_builder_number) in every chart. */
+const char *svg_colour(long k);
 
 /* Horizontal bars of y, one per point, labelled. */
 void svg_bars(struct strbuf *sb, const char *title, const char *unit,
               const struct svg_point *p, size_t n);
-/* Points at (x, y), labelled, with axes named. */
+/* Points at (x, y) with axes named, a legend of the groups, the front's
+ * points joined by a line and named. */
 void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                  const struct svg_point *p, size_t n);
-/* One polyline per group, points in the given order. */
+/* One polyline per group, points in the given order, and a legend. */
 void svg_lines(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                const struct svg_point *p, size_t n);
+
+/* ---- break-even against the reference (report_breakeven.c) -------------- */
+
+enum breakeven_kind {
+	BREAKEVEN_NONE,   /* a figure is missing */
+	BREAKEVEN_SAME,   /* the same cost at any ray count */
+	BREAKEVEN_ALWAYS, /* no slower to build nor to trace: cheaper from the first ray */
+	BREAKEVEN_NEVER,  /* no faster to build nor to trace */
+	BREAKEVEN_AFTER,  /* slower build, faster rays: cheaper after `rays` rays */
+	BREAKEVEN_UNTIL,  /* faster build, slower rays: cheaper up to `rays` rays */
+};
+struct breakeven {
+	enum breakeven_kind kind;
+	double rays;
+};
+
+/* Where build_ms + n rays at mrays Mrays/s costs the same as the
+ * reference's build and rays. */
+struct breakeven report_breakeven(double build_ms, double mrays, double ref_build_ms,
+                                  double ref_mrays);
+/* "after 1.2 M rays (33 frames)", "always cheaper", ...; frame_rays <= 0:
+ * no frames. */
+void report_breakeven_text(char *buf, size_t size, struct breakeven b, double frame_rays);
+/* The scene's break-even table against reference builder ref (none when
+ * ref is NULL or no run has rays). */
+void report_breakeven_md(struct strbuf *sb, const struct report_index *ix, const char *ref,
+                         const cJSON *const *runs, size_t n);
+void report_breakeven_html(struct strbuf *sb, const struct report_index *ix, const char *ref,
+                           const cJSON *const *runs, size_t n);
+
+/* ---- marks on figures not to trust (report_marks.c) --------------------- */
+
+/* Whether two runs built the very same tree (SAH cost, nodes, primary
+ * nodes per ray all equal). */
+bool report_same_tree(const cJSON *a, const cJSON *b);
+/* The relative difference under which two throughputs count as noise. */
+#define REPORT_NOISE 0.05
+/* (max - min) / median of the run's timed builds, or NaN. */
+double report_build_spread(const cJSON *run);
+/* Whether the run is marked noisy (build repeats spread > 5 %, or a run of
+ * the same tree traced > 5 % faster or slower); buf says why. */
+bool report_noise(const struct report_index *ix, const cJSON *run, char *buf, size_t size);
+/* Whether the load around the run exceeded the cores it left free (plus
+ * the sweep's own thread); buf gives the figures. */
+bool report_busy(const cJSON *doc, const cJSON *run, char *buf, size_t size);
+/* The report's warning when some runs are busy; nothing otherwise. */
+void report_load_warning(struct strbuf *sb, const cJSON *doc, bool html);
 
 /* ---- the summary across scenes (report_summary.c) ------------------------ */
 
@@ -88,13 +195,27 @@ struct summary_row {
 	double ratio[SUMMARY_METRICS];
 };
 
+/* The reference builder: report.reference (default sah_seq) as a builder
+ * label, else the first builder of that plugin; when neither ran, the
+ * first builder with an ok run (*fallback true). NULL when no run is ok.
+ * *asked: the name the config asked for. */
+const char *report_reference(const cJSON *doc, const char **asked, bool *fallback);
+/* The reference's ok run on a scene with `threads` threads, else its ok
+ * run with the fewest; NULL when it has none there. */
+const cJSON *report_reference_run(const struct report_index *ix, const char *ref,
+                                  const char *scene, double threads);
 /* The rows (malloc'd, in run order) and the reference builder's label;
- * 0 rows (and *ref NULL) when the reference builder has no run. */
+ * 0 rows (and *ref NULL) when no run is ok. */
 int report_summary(const cJSON *doc, struct summary_row **rows, const char **ref);
 /* The column name of metric m. */
 const char *report_summary_metric(int m);
 /* The summary section of report.md / report.html. */
 void report_summary_md(struct strbuf *sb, const cJSON *doc);
 void report_summary_html(struct strbuf *sb, const cJSON *doc);
+/* The summary rows as points of build time against SAH cost (ratios),
+ * compared among the rows of one thread count over as many scenes, and
+ * their verdicts (report_front_points). */
+void report_summary_fronts(const struct summary_row *rows, int n, struct front_point *p,
+                           long *by);
 
 #endif

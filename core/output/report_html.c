@@ -20,7 +20,11 @@ static const char css[] =
 	".bad{color:#b00}.charts,.images{display:flex;flex-wrap:wrap;gap:1em}"
 	"figure{margin:0}figcaption{font-size:12px;text-align:center}"
 	"img{image-rendering:pixelated;border:1px solid #ccc}"
-	"table.summary td.good{background:#e3f4e3}table.summary td.worse{background:#fbe7e7}";
+	"table.summary td.good{background:#e3f4e3}table.summary td.worse{background:#fbe7e7}"
+	"td.front{background:#e3f4e3;font-weight:bold}.warn{color:#8a4b00}"
+	"td.warn{background:#fff4dc}.wide{overflow-x:auto;max-width:100%}"
+	".wide td,.wide th{white-space:nowrap}"
+	"h3{margin-bottom:0.2em}";
 
 static void esc(struct strbuf *sb, const char *s)
 {
@@ -50,7 +54,8 @@ static void range_cell(struct strbuf *sb, const cJSON *run, const char *kind)
 }
 
 /* Traversals a scene's table may show beside the main one, by name. */
-static const char *const other_traversals[] = {"wide", "stack", "stackless"};
+static const char *const other_traversals[] = {"wide", "stack", "stackless", "cl_stack",
+                                                 "cl_stackless"};
 #define OTHERS (sizeof(other_traversals) / sizeof(other_traversals[0]))
 
 static double other_num(const cJSON *run, const char *traversal, const char *what)
@@ -58,6 +63,36 @@ static double other_num(const cJSON *run, const char *traversal, const char *wha
 	char key[96];
 	snprintf(key, sizeof(key), "rays.%s.%s", traversal, what);
 	return report_num(run, key);
+}
+
+/* "≈ noisy" and "⚠ busy", short beside the status; why in the tooltip
+ * (and in report.md). */
+static void marks_cell(struct strbuf *sb, const struct report_index *ix, const cJSON *run)
+{
+	char noise[160], load[160];
+	bool noisy = report_noise(ix, run, noise, sizeof(noise));
+	bool busy = report_busy(ix->doc, run, load, sizeof(load));
+	sb_printf(sb, "<td class=\"l%s\" title=\"", noisy || busy ? " warn" : "");
+	esc(sb, noise);
+	sb_printf(sb, "%s%s\">%s%s%s</td>", noisy && busy ? "; " : "", load, noisy ? "≈ noisy" : "",
+	          noisy && busy ? " " : "", busy ? "⚠ busy" : "");
+}
+
+/* The builder's phases of the median build, each with its share of it. */
+static void phases_cell(struct strbuf *sb, const cJSON *run)
+{
+	char buf[512];
+	double median = report_num(run, "build_ms.median"), sum = 0;
+	const cJSON *p;
+	cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(run, "build_phases"))
+		sum += cJSON_IsNumber(p) ? p->valuedouble : 0;
+	sb_printf(sb, "<td class=\"l\"");
+	if (median > 0 && sum > 0)
+		sb_printf(sb, " title=\"the phases add up to %.0f %% of the median build\"",
+		          100 * sum / median);
+	sb_printf(sb, ">");
+	esc(sb, report_phases(buf, sizeof(buf), run));
+	sb_printf(sb, "</td>");
 }
 
 static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
@@ -71,10 +106,13 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 	sb_printf(sb, "<td class=\"l%s\">", ok ? "" : " bad");
 	esc(sb, report_str(run, "status"));
 	sb_printf(sb, "</td>");
+	marks_cell(sb, ix, run);
 	num_cell(sb, report_num(run, "build_ms.median"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.min"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.max"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.cold"), "%.2f");
+	if (others[OTHERS]) /* the scene has build phases */
+		phases_cell(sb, run);
 	num_cell(sb, report_num(run, "mtris_per_s"), "%.2f");
 	num_cell(sb, report_speedup(ix, run), "%.2f");
 	num_cell(sb, report_num(run, "tree.sah_cost"), "%.3f");
@@ -93,7 +131,7 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 			continue;
 		num_cell(sb, other_num(run, other_traversals[t], "primary.mrays_per_s"), "%.2f");
 		num_cell(sb, other_num(run, other_traversals[t], "diffuse.mrays_per_s"), "%.2f");
-		if (strcmp(other_traversals[t], "stackless") == 0) /* it counts its own nodes */
+		if (strstr(other_traversals[t], "stackless")) /* it counts its own nodes */
 			num_cell(sb, other_num(run, other_traversals[t], "primary.nodes_per_ray"),
 			         "%.1f");
 	}
@@ -101,6 +139,10 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 		num_cell(sb, report_num(run, "rays.traversal_disagreements"), "%.0f");
 	sb_printf(sb, "<td class=\"l\">");
 	esc(sb, report_str(run, "error"));
+	if (*report_str(run, "rays.error")) { /* a traversal's device missing, say */
+		sb_printf(sb, "%srays: ", *report_str(run, "error") ? "; " : "");
+		esc(sb, report_str(run, "rays.error"));
+	}
 	sb_printf(sb, "</td></tr>\n");
 }
 
@@ -123,22 +165,33 @@ static bool find_others(const cJSON *const *runs, size_t n, bool *others)
 static void table(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
 	size_t n;
-	bool others[OTHERS];
+	bool others[OTHERS + 1];
 	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
 	bool any_other = find_others(runs, n, others);
-	sb_printf(sb, "<table><tr><th class=\"l\">builder</th><th>threads</th>"
-	              "<th class=\"l\">status</th><th>median ms</th><th>min ms</th><th>max ms</th>"
-	              "<th>cold ms</th>"
+	others[OTHERS] = report_any_phases(runs, n);
+	sb_printf(sb, "<div class=\"wide\"><table><tr><th class=\"l\">builder</th><th>threads</th>"
+	              "<th class=\"l\">status</th><th class=\"l\" title=\"≈ noisy: build repeats spread "
+	              "over 5 %%, or the same tree traced over 5 %% faster or slower elsewhere; ⚠ busy: "
+	              "the load exceeded the cores the run left free (hover a mark for its figures)"
+	              "\">marks</th><th>median ms</th><th>min ms</th><th>max ms</th>"
+	              "<th>cold ms</th>%s"
 	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>EPO</th>"
-	              "<th>peak MiB</th><th>primary Mrays/s</th><th>min–max</th>"
-	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s</th>"
-	              "<th>diffuse nodes/ray</th><th>refs</th><th>refs/tri</th>");
+	              "<th>peak MiB</th><th title=\"each tile of rays at its best pass: the "
+	              "figure runs compare by\">primary Mrays/s (best tile)</th><th title=\"whole "
+	              "passes, slowest to fastest: the best-tile figure can lie above them, as "
+	              "no single pass had every tile at its best\">per pass min–max</th>"
+	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s "
+	              "(best tile)</th><th>diffuse nodes/ray</th><th>refs</th><th>refs/tri</th>",
+	          others[OTHERS] ? "<th class=\"l\" title=\"the builder's own timing of the "
+	                           "phases of a build (median over the timed repeats), inside "
+	                           "the whole call that median ms times\">build phases ms</th>"
+	                         : "");
 	for (size_t t = 0; t < OTHERS; t++) {
 		const char *name = other_traversals[t];
 		if (!others[t])
 			continue;
 		sb_printf(sb, "<th>%s primary Mrays/s</th><th>%s diffuse Mrays/s</th>", name, name);
-		if (strcmp(name, "stackless") == 0)
+		if (strstr(name, "stackless"))
 			sb_printf(sb, "<th>%s primary nodes/ray</th>", name);
 	}
 	if (any_other)
@@ -146,57 +199,95 @@ static void table(struct strbuf *sb, const struct report_index *ix, const char *
 	sb_printf(sb, "<th class=\"l\">error</th></tr>\n");
 	for (size_t k = 0; k < n; k++)
 		run_row(sb, ix, runs[k], others, any_other);
-	sb_printf(sb, "</table>\n");
+	sb_printf(sb, "</table></div>\n");
 }
 
-/* The scene's runs with a build time, as chart points ("builder xT" labels). */
-static size_t points(const cJSON *const *runs, size_t count, struct svg_point *p,
-                     char (*labels)[96])
+/* A chart point of a run: its builder's colour, "builder x2" as its label. */
+static struct svg_point run_point(const struct report_index *ix, const cJSON *run, char *label,
+                                  size_t size, double x, double y)
 {
-	size_t n = 0;
-	for (size_t k = 0; k < count; k++) {
-		const cJSON *run = runs[k];
-		if (!isfinite(report_num(run, "build_ms.median")))
-			continue;
-		snprintf(labels[n], sizeof(labels[n]), "%s x%.0f", report_str(run, "builder"),
-		         report_num(run, "threads"));
-		p[n] = (struct svg_point){labels[n], report_str(run, "builder"),
-		                          report_num(run, "build_ms.median"),
-		                          report_num(run, "tree.sah_cost")};
-		n++;
+	snprintf(label, size, "%s x%.0f", report_str(run, "builder"), report_num(run, "threads"));
+	return (struct svg_point){label, report_str(run, "builder"), x, y,
+	                          svg_colour(report_builder_number(ix, report_str(run, "builder"))),
+	                          false};
+}
+
+/* One view's Pareto charts, one per thread count: build time against the
+ * figure, the front joined by a line. The verdicts are computed once for
+ * every thread count (a 1-thread-only builder is on each). */
+static void front_charts(struct strbuf *sb, const struct report_index *ix,
+                         const struct front_entry *e, size_t n, const double *threads,
+                         size_t nt, int view, struct svg_point *p, char (*labels)[96])
+{
+	static const char *const figures[2] = {"tree.sah_cost", "rays.primary.nodes_per_ray"};
+	static const char *const names[2] = {"SAH cost", "primary nodes/ray"};
+	struct front_point *fp = calloc(n + 1, sizeof(*fp));
+	long *by = calloc(n + 1, sizeof(*by));
+	if (fp && by)
+		report_entries_front(e, n, figures[view], fp, by);
+	for (size_t t = 0; fp && by && t < nt; t++) {
+		size_t m = 0;
+		for (size_t k = 0; k < n; k++) {
+			if (by[k] == FRONT_NONE || e[k].threads != threads[t])
+				continue;
+			p[m] = run_point(ix, e[k].run, labels[m], sizeof(labels[m]), fp[k].time,
+			                 fp[k].figure);
+			p[m++].front = by[k] == FRONT_ON;
+		}
+		char title[96];
+		snprintf(title, sizeof(title), "%s vs. build time, %.0f thread%s", names[view],
+		         threads[t], threads[t] == 1 ? "" : "s");
+		if (m > 0)
+			svg_scatter(sb, title, "build time (ms)", names[view], p, m);
 	}
-	return n;
+	free(fp);
+	free(by);
+}
+
+static void bars_and_speedups(struct strbuf *sb, const struct report_index *ix,
+                              const cJSON *const *runs, size_t count, struct svg_point *q,
+                              char (*labels)[96])
+{
+	size_t n = 0, m = 0;
+	for (size_t k = 0; k < count; k++)
+		if (isfinite(report_num(runs[k], "build_ms.median"))) {
+			q[n] = run_point(ix, runs[k], labels[n], sizeof(labels[n]), 0,
+			                 report_num(runs[k], "build_ms.median"));
+			n++;
+		}
+	if (n > 0)
+		svg_bars(sb, "Build time (median)", "ms", q, n);
+	for (size_t k = 0; k < count; k++) {
+		double s = report_speedup(ix, runs[k]);
+		if (isfinite(s)) {
+			q[m] = run_point(ix, runs[k], labels[m], sizeof(labels[m]),
+			                 report_num(runs[k], "threads"), s);
+			m++;
+		}
+	}
+	if (m > 0)
+		svg_lines(sb, "Speedup over 1 thread", "threads", "speedup", q, m);
 }
 
 static void charts(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
-	size_t count;
+	size_t count, nt, ne = 0;
+	double threads[16];
 	const cJSON *const *runs = report_scene_runs(ix, scene, &count);
-	size_t total = count + 1;
-	struct svg_point *p = calloc(total, sizeof(*p)), *q = calloc(total, sizeof(*q));
-	char (*labels)[96] = calloc(total, sizeof(*labels));
-	if (!p || !q || !labels)
-		goto out;
-	size_t n = points(runs, count, p, labels);
-	if (n == 0)
+	struct front_entry *e = report_front_entries(runs, count, &ne);
+	struct svg_point *p = calloc(ne + count + 1, sizeof(*p));
+	char (*labels)[96] = calloc(ne + count + 1, sizeof(*labels));
+	if (!e || !p || !labels || count == 0)
 		goto out;
 	sb_printf(sb, "<div class=\"charts\">\n");
-	for (size_t i = 0; i < n; i++)
-		q[i] = (struct svg_point){p[i].label, p[i].group, 0, p[i].x};
-	svg_bars(sb, "Build time (median)", "ms", q, n);
-	svg_scatter(sb, "SAH cost vs. build time", "build time (ms)", "SAH cost", p, n);
-	size_t m = 0;
-	for (size_t k = 0; k < count; k++) {
-		double s = report_speedup(ix, runs[k]);
-		if (isfinite(s))
-			q[m++] = (struct svg_point){"", report_str(runs[k], "builder"),
-			                            report_num(runs[k], "threads"), s};
-	}
-	svg_lines(sb, "Speedup over 1 thread", "threads", "speedup", q, m);
+	bars_and_speedups(sb, ix, runs, count, p, labels);
+	nt = report_thread_counts(runs, count, threads, 16);
+	for (int view = 0; view < 2; view++)
+		front_charts(sb, ix, e, ne, threads, nt, view, p, labels);
 	sb_printf(sb, "</div>\n");
 out:
+	free(e);
 	free(p);
-	free(q);
 	free(labels);
 }
 
@@ -209,6 +300,21 @@ static void figure(struct strbuf *sb, const char *src, const char *caption)
 	sb_printf(sb, "\"><figcaption>");
 	esc(sb, caption);
 	sb_printf(sb, "</figcaption></figure>\n");
+}
+
+/* The colour bar under the heat maps; a log scale names its middle value
+ * (older results drew them on a linear one). */
+static void heat_legend(struct strbuf *sb, const cJSON *scene, const char *legend)
+{
+	double lo = report_num(scene, "images.heat_min"), hi = report_num(scene, "images.heat_max");
+	bool log_scale = strcmp(report_str(scene, "images.heat_scale"), "log") == 0;
+	sb_printf(sb, "<p>Nodes visited per primary ray, one %s scale for every builder: %.0f "
+	              "<img src=\"", log_scale ? "log" : "linear", lo);
+	esc(sb, legend);
+	sb_printf(sb, "\" alt=\"colour scale\" width=\"256\" height=\"16\"> %.0f", hi);
+	if (log_scale)
+		sb_printf(sb, " (the middle of the bar: %.0f)", lo + sqrt(1 + hi - lo) - 1);
+	sb_printf(sb, "</p>\n");
 }
 
 static void images(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
@@ -225,16 +331,12 @@ static void images(struct strbuf *sb, const struct report_index *ix, const cJSON
 		if (*report_str(runs[k], "heat_image"))
 			figure(sb, report_str(runs[k], "heat_image"), report_str(runs[k], "builder"));
 	sb_printf(sb, "</div>\n");
-	if (*legend) {
-		sb_printf(sb, "<p>Nodes visited per primary ray, one scale for every builder: "
-		              "%.0f <img src=\"", report_num(scene, "images.heat_min"));
-		esc(sb, legend);
-		sb_printf(sb, "\" alt=\"colour scale\" width=\"256\" height=\"16\"> %.0f</p>\n",
-		          report_num(scene, "images.heat_max"));
-	}
+	if (*legend)
+		heat_legend(sb, scene, legend);
 }
 
-static void scene_section(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
+static void scene_section(struct strbuf *sb, const struct report_index *ix, const char *ref,
+                          const cJSON *scene)
 {
 	const char *name = report_str(scene, "name");
 	sb_printf(sb, "<h2>");
@@ -249,6 +351,10 @@ static void scene_section(struct strbuf *sb, const struct report_index *ix, cons
 	sb_printf(sb, "</p>\n");
 	table(sb, ix, name);
 	charts(sb, ix, name);
+	size_t n;
+	const cJSON *const *runs = report_scene_runs(ix, name, &n);
+	report_front_html(sb, runs, n);
+	report_breakeven_html(sb, ix, ref, runs, n);
 	images(sb, ix, scene);
 }
 
@@ -274,16 +380,22 @@ char *report_html(const cJSON *doc)
 	               "Rays are traced with the same threads for every run, so traversal "
 	               "numbers compare trees, not thread counts; Mrays/s: rays per CPU "
 	               "second of the tracing threads times their number, each tile of rays "
-	               "at its best of the repeated passes (spread over rounds taken in turn "
-	               "by the scene's trees; min–max: whole passes), by the "
+	               "at its best of the repeated passes (best tile; spread over rounds taken "
+	               "in turn by the scene's trees; per pass min–max: whole passes, which the "
+	               "best-tile figure can exceed), by the "
 	               "run's traversal (default wide: the tree collapsed into 4-child "
 	               "nodes); nodes and triangles per ray are the binary tree's, counted "
-	               "by the stack traversal, whichever is timed.</p>\n",
+	               "by the stack traversal, whichever is timed. Marks: ≈ noisy where the "
+	               "build repeats spread more than 5 %% or a run of the same tree traced "
+	               "more than 5 %% faster or slower; ⚠ busy where the load average "
+	               "exceeded the cores the run left free.</p>\n",
 	          report_num(doc, "machine.cores"));
+	const char *asked, *ref = report_reference(doc, &asked, &(bool){false});
+	report_load_warning(&sb, doc, true);
 	report_summary_html(&sb, doc);
 	report_machines_html(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
-		scene_section(&sb, &ix, scene);
+		scene_section(&sb, &ix, ref, scene);
 	report_index_finish(&ix);
 	sb_printf(&sb, "</body></html>\n");
 	return sb_take(&sb);

@@ -1,6 +1,6 @@
 /*
  * The runs of a results document grouped by scene, and each scene x
- * builder's 1-thread median, built in one pass. Reports are rendered after
+ * builder's 1-thread median and most threads, built in one pass. Reports are rendered after
  * every run of a sweep; looking runs up by scanning all of them for every
  * scene and every speedup made each rendering quadratic in the run count
  * (an 8-run sweep resumed over 8,000 kept runs took 50 s).
@@ -17,7 +17,8 @@
 struct report_slot {
 	const char *scene, *builder; /* builder NULL in the scene table */
 	size_t start, count;         /* scene table: its runs in ix->order */
-	double median;               /* pair table: the 1-thread median */
+	double median;               /* pair table: the 1-thread median (NaN: none) */
+	double max_threads;          /* pair table: the most threads it ran with */
 };
 
 static uint64_t hash(const char *s, uint64_t h)
@@ -55,15 +56,22 @@ static void first_pass(struct report_index *ix, const cJSON *runs)
 		struct report_slot *s = slot(ix->scenes, ix->cap, scene_of(run), NULL);
 		s->scene = scene_of(run);
 		s->count++;
-		if (report_num(run, "threads") != 1)
-			continue;
 		struct report_slot *p = slot(ix->pairs, ix->cap, scene_of(run),
 		                             report_str(run, "builder"));
-		if (!p->scene) { /* the first 1-thread run counts, as before */
+		double threads = report_num(run, "threads");
+		if (!p->scene) {
 			p->scene = scene_of(run);
 			p->builder = report_str(run, "builder");
-			p->median = report_num(run, "build_ms.median");
+			p->median = NAN;
 		}
+		p->max_threads = threads > p->max_threads ? threads : p->max_threads;
+		struct report_slot *b = slot(ix->names, ix->cap, report_str(run, "builder"), NULL);
+		if (!b->scene) { /* builders numbered in order of appearance: their colours */
+			b->scene = report_str(run, "builder");
+			b->start = ix->builder_count++;
+		}
+		if (threads == 1 && isnan(p->median)) /* the first 1-thread run counts */
+			p->median = report_num(run, "build_ms.median");
 	}
 }
 
@@ -92,11 +100,13 @@ int report_index_init(struct report_index *ix, const cJSON *doc)
 		;
 	ix->scenes = calloc(ix->cap, sizeof(*ix->scenes));
 	ix->pairs = calloc(ix->cap, sizeof(*ix->pairs));
+	ix->names = calloc(ix->cap, sizeof(*ix->names));
 	ix->order = calloc(n + 1, sizeof(*ix->order));
-	if (!ix->scenes || !ix->pairs || !ix->order) {
+	if (!ix->scenes || !ix->pairs || !ix->names || !ix->order) {
 		report_index_finish(ix);
 		return -ENOMEM;
 	}
+	ix->doc = doc;
 	first_pass(ix, runs);
 	second_pass(ix, runs);
 	return 0;
@@ -106,6 +116,7 @@ void report_index_finish(struct report_index *ix)
 {
 	free(ix->scenes);
 	free(ix->pairs);
+	free(ix->names);
 	free(ix->order);
 	memset(ix, 0, sizeof(*ix));
 }
@@ -127,5 +138,14 @@ double report_speedup(const struct report_index *ix, const cJSON *run)
 	const struct report_slot *p = slot(ix->pairs, ix->cap, scene_of(run),
 	                                   report_str(run, "builder"));
 	double t = report_num(run, "build_ms.median");
-	return p->scene && t > 0 ? p->median / t : NAN;
+	/* A builder that ran on 1 thread only (no PARALLEL flag) has no speedup. */
+	if (!p->scene || !(p->max_threads > 1))
+		return NAN;
+	return t > 0 ? p->median / t : NAN;
+}
+
+long report_builder_number(const struct report_index *ix, const char *builder)
+{
+	const struct report_slot *b = ix->cap ? slot(ix->names, ix->cap, builder, NULL) : NULL;
+	return b && b->scene ? (long)b->start : -1;
 }

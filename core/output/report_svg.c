@@ -5,20 +5,35 @@
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "output/report.h"
 
-#define W 720
-#define PAD_L 190
-#define PAD_R 140
-#define PAD_T 28
+#define W 640
+#define PAD_R 20   /* plots: right margin */
+#define PLOT_X 60  /* plots: left edge of the plotting area */
+#define PAD_T 44   /* the title, then the y axis's name, above the plot */
 #define PAD_B 40
 #define BAR_H 18
 #define PLOT_H 260
+#define LEGEND_H 16 /* a row of the legend under a plot */
+#define CHAR_W 6.2  /* the width of a character of the 11 px font, about */
+#define LINE_H 12.0
 
-static const char *const palette[] = {"#4477aa", "#ee6677", "#228833", "#ccbb44",
-                                      "#66ccee", "#aa3377", "#bbbbbb", "#000000"};
+/* One colour per builder in every chart of the report: ten strong hues
+ * first (Tableau 10, told apart by most colour-blind readers too), then
+ * black and light variants for larger comparisons. */
+static const char *const palette[] = {
+	"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+	"#7f7f7f", "#bcbd22", "#17becf", "#000000", "#aec7e8", "#ffbb78", "#98df8a",
+	"#ff9896", "#c5b0d5"};
+#define PALETTE (sizeof(palette) / sizeof(palette[0]))
+
+const char *svg_colour(long k)
+{
+	return k < 0 ? "#888888" : palette[(size_t)k % PALETTE];
+}
 
 static void open_svg(struct strbuf *sb, const char *title, int height)
 {
@@ -37,22 +52,47 @@ static void text_at(struct strbuf *sb, double x, double y, const char *anchor, c
 	sb_printf(sb, "</text>");
 }
 
+/* A bar's label, right-aligned at x; cut to max characters with an
+ * ellipsis (the whole label its tooltip) so it never runs off the left. */
+static void bar_label(struct strbuf *sb, double x, double y, const char *label, size_t max)
+{
+	size_t len = strlen(label);
+	sb_printf(sb, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">", x, y);
+	if (len <= max) {
+		report_escape(sb, label);
+	} else {
+		char cut[256];
+		snprintf(cut, sizeof(cut), "%.*s", (int)(max > 1 && max < sizeof(cut) ? max - 1 : 1),
+		         label);
+		report_escape(sb, cut);
+		sb_printf(sb, "…<title>");
+		report_escape(sb, label);
+		sb_printf(sb, "</title>");
+	}
+	sb_printf(sb, "</text>");
+}
+
 void svg_bars(struct strbuf *sb, const char *title, const char *unit,
               const struct svg_point *p, size_t n)
 {
 	double max = 0;
-	char buf[64];
-	for (size_t i = 0; i < n; i++)
+	size_t longest = 0, fit = (size_t)((W / 2 - 12) / CHAR_W);
+	char buf[64], v[32];
+	for (size_t i = 0; i < n; i++) {
 		max = isfinite(p[i].y) && p[i].y > max ? p[i].y : max;
+		longest = strlen(p[i].label) > longest ? strlen(p[i].label) : longest;
+	}
+	longest = longest < fit ? longest : fit;
+	double left = 12 + CHAR_W * (double)longest; /* as much room as the labels need */
 	open_svg(sb, title, PAD_T + (int)n * (BAR_H + 4) + 8);
 	for (size_t i = 0; i < n; i++) {
 		double y = PAD_T + (double)i * (BAR_H + 4);
-		double w = max > 0 && isfinite(p[i].y) ? p[i].y / max * (W - PAD_L - PAD_R) : 0;
-		text_at(sb, PAD_L - 6, y + BAR_H - 5, "end", p[i].label);
-		sb_printf(sb, "<rect x=\"%d\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" fill=\"%s\"/>",
-		          PAD_L, y, w, BAR_H, palette[0]);
-		snprintf(buf, sizeof(buf), "%.3g %s", p[i].y, unit);
-		text_at(sb, PAD_L + w + 4, y + BAR_H - 5, "start", buf);
+		double w = max > 0 && isfinite(p[i].y) ? p[i].y / max * (W - left - 90) : 0;
+		bar_label(sb, left - 6, y + BAR_H - 5, p[i].label, longest);
+		sb_printf(sb, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" fill=\"%s\"/>",
+		          left, y, w, BAR_H, p[i].colour ? p[i].colour : palette[0]);
+		snprintf(buf, sizeof(buf), "%s %s", report_plain(v, sizeof(v), p[i].y), unit);
+		text_at(sb, left + w + 4, y + BAR_H - 5, "start", buf);
 	}
 	sb_printf(sb, "</svg>\n");
 }
@@ -104,7 +144,7 @@ static double unit(const struct axis *a, double v)
 
 static double px(const struct frame *f, double x)
 {
-	return 60 + unit(&f->x, x) * (W - 60 - PAD_R);
+	return PLOT_X + unit(&f->x, x) * (W - PLOT_X - PAD_R);
 }
 
 static double py(const struct frame *f, double y)
@@ -157,8 +197,8 @@ static void axes(struct strbuf *sb, const struct frame *f, const char *xname, co
 	char buf[64];
 	double v[16];
 	int d;
-	sb_printf(sb, "<rect x=\"60\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" "
-	              "stroke=\"#888\"/>", PAD_T, W - 60 - PAD_R, PLOT_H);
+	sb_printf(sb, "<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" "
+	              "stroke=\"#888\"/>", PLOT_X, PAD_T, W - PLOT_X - PAD_R, PLOT_H);
 	int n = ticks(&f->x, v, &d, 16);
 	for (int k = 0; k < n; k++) {
 		snprintf(buf, sizeof(buf), "%.*f", d, v[k]);
@@ -171,79 +211,9 @@ static void axes(struct strbuf *sb, const struct frame *f, const char *xname, co
 	}
 	char name[160];
 	snprintf(name, sizeof(name), "%s%s", xname, f->x.log ? " (log scale)" : "");
-	text_at(sb, 60 + 0.5 * (W - 60 - PAD_R), PAD_T + PLOT_H + 32, "middle", name);
+	text_at(sb, PLOT_X + 0.5 * (W - PLOT_X - PAD_R), PAD_T + PLOT_H + 32, "middle", name);
 	snprintf(name, sizeof(name), "%s%s", yname, f->y.log ? " (log scale)" : "");
-	text_at(sb, 62, PAD_T - 4, "start", name);
-}
-
-static void plot_frame(struct strbuf *sb, const char *title, const char *xname,
-                       const char *yname, const struct svg_point *p, size_t n, struct frame *f)
-{
-	range(p, n, false, &f->x);
-	range(p, n, true, &f->y);
-	open_svg(sb, title, PAD_T + PLOT_H + PAD_B + 4);
-	axes(sb, f, xname, yname);
-}
-
-/* Text boxes already placed, to keep labels apart. */
-struct placed {
-	double x0, y0, x1, y1;
-};
-
-#define CHAR_W 6.2
-#define LINE_H 12.0
-
-static bool overlaps(const struct placed *a, const struct placed *b)
-{
-	return a->x0 < b->x1 && b->x0 < a->x1 && a->y0 < b->y1 && b->y0 < a->y1;
-}
-
-/* The first free slot for a label near (x, y): right of the point, moving
- * down (then up) a line at a time; *moved when it is not the first slot. */
-static struct placed place(const struct placed *taken, size_t n, double x, double y,
-                           size_t len, bool *moved)
-{
-	for (int k = 0; k < 40; k++) {
-		int step = k % 2 ? (k + 1) / 2 : -(k / 2);
-		struct placed b = {x + 6, y - 4 - LINE_H + 2 + step * LINE_H, 0, 0};
-		b.x1 = b.x0 + CHAR_W * (double)len;
-		b.y1 = b.y0 + LINE_H;
-		bool free_slot = b.y0 >= PAD_T - 2 && b.y1 <= PAD_T + PLOT_H + 2;
-		for (size_t i = 0; i < n && free_slot; i++)
-			free_slot = !overlaps(&b, &taken[i]);
-		if (free_slot) {
-			*moved = k > 0;
-			return b;
-		}
-	}
-	*moved = false;
-	return (struct placed){x + 6, y - 16, x + 6 + CHAR_W * (double)len, y - 4};
-}
-
-void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const char *yname,
-                 const struct svg_point *p, size_t n)
-{
-	struct frame f;
-	struct placed taken[64];
-	size_t nt = 0;
-	plot_frame(sb, title, xname, yname, p, n, &f);
-	for (size_t i = 0; i < n; i++) {
-		if (!isfinite(p[i].x) || !isfinite(p[i].y))
-			continue;
-		double x = px(&f, p[i].x), y = py(&f, p[i].y);
-		sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\"/>", x, y,
-		          palette[i % 8]);
-		bool moved;
-		struct placed b = place(taken, nt, x, y, strlen(p[i].label), &moved);
-		if (nt < sizeof(taken) / sizeof(taken[0]))
-			taken[nt++] = b;
-		if (moved) /* a leader line ties a displaced label to its point */
-			sb_printf(sb, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" "
-			              "stroke=\"#999\" stroke-width=\"0.7\"/>",
-			          x, y, b.x0 - 1, b.y1 - 4);
-		text_at(sb, b.x0, b.y1 - 2, "start", p[i].label);
-	}
-	sb_printf(sb, "</svg>\n");
+	text_at(sb, PLOT_X + 2, PAD_T - 8, "start", name); /* below the title's line */
 }
 
 /* Whether group g has a point that can be drawn. */
@@ -255,19 +225,174 @@ static bool drawable(const struct svg_point *p, size_t n, const char *g)
 	return false;
 }
 
+/* Whether point i is the first drawable one of its group. */
+static bool opens_group(const struct svg_point *p, size_t n, size_t i)
+{
+	for (size_t j = 0; j < i; j++)
+		if (strcmp(p[j].group, p[i].group) == 0)
+			return false;
+	return drawable(p, n, p[i].group);
+}
+
+/* The legend under the plot: a swatch and the group's name per group
+ * drawn, in rows that wrap at the chart's width. Draws when sb is not
+ * NULL; returns the rows it takes. */
+static int legend(struct strbuf *sb, const struct svg_point *p, size_t n, double top)
+{
+	double x = PLOT_X;
+	int rows = 0;
+	for (size_t i = 0; i < n; i++) {
+		if (!opens_group(p, n, i))
+			continue;
+		double w = 16 + CHAR_W * (double)strlen(p[i].group) + 14;
+		if (rows == 0 || (x + w > W - 4 && x > PLOT_X))
+			x = PLOT_X, rows++;
+		if (sb) {
+			double y = top + (rows - 1) * LEGEND_H;
+			sb_printf(sb, "<rect x=\"%.1f\" y=\"%.1f\" width=\"10\" height=\"10\" fill=\"%s\"/>",
+			          x, y - 9, p[i].colour);
+			text_at(sb, x + 14, y, "start", p[i].group);
+		}
+		x += w;
+	}
+	return rows;
+}
+
+static double plot_frame(struct strbuf *sb, const char *title, const char *xname,
+                         const char *yname, const struct svg_point *p, size_t n, struct frame *f)
+{
+	range(p, n, false, &f->x);
+	range(p, n, true, &f->y);
+	int rows = legend(NULL, p, n, 0);
+	open_svg(sb, title, PAD_T + PLOT_H + PAD_B + 8 + rows * LEGEND_H);
+	axes(sb, f, xname, yname);
+	return PAD_T + PLOT_H + PAD_B + 8; /* the legend's first baseline */
+}
+
+/* Text boxes already placed, to keep labels apart. */
+struct placed {
+	double x0, y0, x1, y1;
+};
+
+static bool overlaps(const struct placed *a, const struct placed *b)
+{
+	return a->x0 < b->x1 && b->x0 < a->x1 && a->y0 < b->y1 && b->y0 < a->y1;
+}
+
+/* Whether box b is inside the plot and clear of every box taken. */
+static bool free_slot(const struct placed *taken, size_t n, const struct placed *b)
+{
+	if (b->y0 < PAD_T || b->y1 > PAD_T + PLOT_H || b->x0 < PLOT_X || b->x1 > W - PAD_R)
+		return false;
+	for (size_t i = 0; i < n; i++)
+		if (overlaps(b, &taken[i]))
+			return false;
+	return true;
+}
+
+/* The first free slot for a label near (x, y): right of the point, then
+ * left of it, moving down (then up) a line at a time; *moved when it is
+ * not beside the point. Every point is taken too, so no label hides one. */
+static struct placed place(const struct placed *taken, size_t n, double x, double y,
+                           size_t len, bool *moved)
+{
+	double w = CHAR_W * (double)len;
+	for (int k = 0; k < 40; k++) {
+		int step = k % 2 ? (k + 1) / 2 : -(k / 2);
+		for (int side = 0; side < 2; side++) {
+			struct placed b = {side ? x - 7 - w : x + 7, y - LINE_H / 2 + step * LINE_H, 0, 0};
+			b.x1 = b.x0 + w;
+			b.y1 = b.y0 + LINE_H;
+			if (free_slot(taken, n, &b)) {
+				*moved = k > 0;
+				return b;
+			}
+		}
+	}
+	*moved = false;
+	return (struct placed){x + 7, y - LINE_H / 2, x + 7 + w, y + LINE_H / 2};
+}
+
+static int by_x(const void *a, const void *b)
+{
+	const struct svg_point *p = *(const struct svg_point *const *)a;
+	const struct svg_point *q = *(const struct svg_point *const *)b;
+	return (p->x > q->x) - (p->x < q->x);
+}
+
+/* The front: a line through its points in order of x. */
+static void front_line(struct strbuf *sb, const struct frame *f, const struct svg_point *p,
+                       size_t n)
+{
+	const struct svg_point *on[64];
+	size_t m = 0;
+	for (size_t i = 0; i < n && m < 64; i++)
+		if (p[i].front && isfinite(p[i].x) && isfinite(p[i].y))
+			on[m++] = &p[i];
+	if (m == 0)
+		return;
+	qsort(on, m, sizeof(on[0]), by_x);
+	sb_printf(sb, "<polyline fill=\"none\" stroke=\"#444\" stroke-width=\"1.5\" "
+	              "stroke-dasharray=\"5,3\" points=\"");
+	for (size_t i = 0; i < m; i++)
+		sb_printf(sb, "%.1f,%.1f ", px(f, on[i]->x), py(f, on[i]->y));
+	sb_printf(sb, "\"/>");
+}
+
+/* A point with its label as a tooltip; front points are ringed. */
+static void marker(struct strbuf *sb, const struct frame *f, const struct svg_point *p)
+{
+	sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4.5\" fill=\"%s\"%s><title>",
+	          px(f, p->x), py(f, p->y), p->colour,
+	          p->front ? " stroke=\"#222\" stroke-width=\"1.5\"" : "");
+	report_escape(sb, p->label);
+	sb_printf(sb, "</title></circle>");
+}
+
+void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const char *yname,
+                 const struct svg_point *p, size_t n)
+{
+	struct frame f;
+	struct placed taken[128];
+	size_t nt = 0;
+	double legend_top = plot_frame(sb, title, xname, yname, p, n, &f);
+	front_line(sb, &f, p, n);
+	for (size_t i = 0; i < n; i++) {
+		if (!isfinite(p[i].x) || !isfinite(p[i].y))
+			continue;
+		marker(sb, &f, &p[i]);
+		double x = px(&f, p[i].x), y = py(&f, p[i].y);
+		if (nt < sizeof(taken) / sizeof(taken[0]))
+			taken[nt++] = (struct placed){x - 5, y - 5, x + 5, y + 5};
+	}
+	/* Only the front is named on the plot: the legend names every colour,
+	 * and a name beside every point of a cluster would only collide. */
+	for (size_t i = 0; i < n && nt < sizeof(taken) / sizeof(taken[0]); i++) {
+		if (!p[i].front || !isfinite(p[i].x) || !isfinite(p[i].y))
+			continue;
+		double x = px(&f, p[i].x), y = py(&f, p[i].y);
+		bool moved;
+		struct placed b = place(taken, nt, x, y, strlen(p[i].group), &moved);
+		taken[nt++] = b;
+		if (moved) /* a leader line ties a displaced label to its point */
+			sb_printf(sb, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" "
+			              "stroke=\"#999\" stroke-width=\"0.7\"/>",
+			          x, y, b.x0 < x ? b.x1 : b.x0, (b.y0 + b.y1) / 2);
+		text_at(sb, b.x0, b.y1 - 2.5, "start", p[i].group);
+	}
+	legend(sb, p, n, legend_top);
+	sb_printf(sb, "</svg>\n");
+}
+
 void svg_lines(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                const struct svg_point *p, size_t n)
 {
 	struct frame f;
-	size_t color = 0;
-	plot_frame(sb, title, xname, yname, p, n, &f);
+	double legend_top = plot_frame(sb, title, xname, yname, p, n, &f);
 	for (size_t i = 0; i < n; i++) {
-		bool seen = false;
-		for (size_t j = 0; j < i && !seen; j++)
-			seen = strcmp(p[j].group, p[i].group) == 0;
-		if (seen || !drawable(p, n, p[i].group))
+		if (!opens_group(p, n, i))
 			continue; /* the legend names only what is drawn */
-		const char *c = palette[color++ % 8];
+		const char *c = p[i].colour;
 		sb_printf(sb, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\" points=\"", c);
 		for (size_t j = i; j < n; j++)
 			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y))
@@ -278,9 +403,7 @@ void svg_lines(struct strbuf *sb, const char *title, const char *xname, const ch
 			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y))
 				sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>",
 				          px(&f, p[j].x), py(&f, p[j].y), c);
-		sb_printf(sb, "<rect x=\"%d\" y=\"%.1f\" width=\"8\" height=\"8\" fill=\"%s\"/>",
-		          W - PAD_R + 4, PAD_T + 12 * (double)color - 8, c);
-		text_at(sb, W - PAD_R + 15, PAD_T + 12 * (double)color, "start", p[i].group);
 	}
+	legend(sb, p, n, legend_top);
 	sb_printf(sb, "</svg>\n");
 }

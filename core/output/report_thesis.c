@@ -5,7 +5,8 @@
  * t_seq / t. The sequential time is the first ok run of plugin sah_seq
  * with 1 thread. Only ok runs count; a missing one shows as "—". When a
  * thread count appears twice for a builder (threads 0 resolving to a
- * count also listed), the first ok run is used.
+ * count also listed), the first ok run is used. A table that would hold
+ * only dashes is left out: no sah_seq time, or no builder at that count.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -126,23 +127,53 @@ static void row(struct strbuf *sb, const struct report_index *ix, const char *sc
 	sb_printf(sb, "\n");
 }
 
+/* Whether some scene has a time for the builder (key = value) at threads. */
+static bool any_time(const cJSON *doc, const struct report_index *ix, const char *key,
+                     const char *value, double threads)
+{
+	const cJSON *scene;
+	cJSON_ArrayForEach(scene, cJSON_GetObjectItemCaseSensitive(doc, "scenes"))
+		if (median_ms(ix, text(scene, "name"), key, value, threads) > 0)
+			return true;
+	return false;
+}
+
+/* The columns with a time at this thread count: a column of dashes says
+ * nothing (a builder that ran on 1 thread only, say). */
+static int columns_at(const cJSON *doc, const struct report_index *ix, double threads,
+                      const char **cols, int n, const char **out)
+{
+	int m = 0;
+	for (int i = 0; i < n; i++)
+		if (any_time(doc, ix, "builder", cols[i], threads))
+			out[m++] = cols[i];
+	return m;
+}
+
 void report_thesis(struct strbuf *sb, const cJSON *doc, const struct report_index *ix)
 {
 	const cJSON *runs = cJSON_GetObjectItemCaseSensitive(doc, "runs");
 	const cJSON *scene;
-	const char *cols[MAX_COLUMNS];
+	const char *cols[MAX_COLUMNS], *shown[MAX_COLUMNS];
 	double counts[MAX_THREAD_COUNTS];
 	int ncols = columns(runs, cols), ncounts = thread_counts(runs, counts);
+	bool titled = false;
 
-	if (ncols == 0 || ncounts == 0)
+	/* Without a sequential time every gain and speedup would be a dash. */
+	if (ncols == 0 || ncounts == 0 || !any_time(doc, ix, "plugin", SEQ_PLUGIN, 1))
 		return;
-	sb_printf(sb, "\n## Parallel builders against " SEQ_PLUGIN "\n\n"
-	              "The thesis's table: median build times in ms; the sequential time is "
-	              SEQ_PLUGIN " on 1 thread; gain = (t_seq − t) / t_seq, speedup = t_seq / t. "
-	              "Only ok runs count; " MISSING " marks a missing one.\n");
 	for (int k = 0; k < ncounts; k++) {
-		header(sb, counts[k], cols, ncols);
+		int nshown = columns_at(doc, ix, counts[k], cols, ncols, shown);
+		if (nshown == 0)
+			continue;
+		if (!titled)
+			sb_printf(sb, "\n## Parallel builders against " SEQ_PLUGIN "\n\n"
+			              "The thesis's table: median build times in ms; the sequential time "
+			              "is " SEQ_PLUGIN " on 1 thread; gain = (t_seq − t) / t_seq, speedup "
+			              "= t_seq / t. Only ok runs count; " MISSING " marks a missing one.\n");
+		titled = true;
+		header(sb, counts[k], shown, nshown);
 		cJSON_ArrayForEach(scene, cJSON_GetObjectItemCaseSensitive(doc, "scenes"))
-			row(sb, ix, text(scene, "name"), counts[k], cols, ncols);
+			row(sb, ix, text(scene, "name"), counts[k], shown, nshown);
 	}
 }

@@ -210,6 +210,9 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddNumberToObject(o, "mtris_per_s",
 		                        med > 0 ? run->triangles / (med * 1e3) : 0);
 	}
+	if (run->phase_count)
+		cJSON_AddItemToObject(o, "build_phases",
+		                      results_phases_json(run->phases, run->phase_count));
 	if (run->stage_count)
 		cJSON_AddItemToObject(o, "stages", results_stages_json(run->stages, run->stage_count));
 	if (run->stats)
@@ -222,8 +225,10 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddItemToObject(o, "validation", validation_json(run));
 	if (run->rays)
 		cJSON_AddItemToObject(o, "rays", results_rays_json(run->rays));
-	if (run->rays_error)
-		cJSON_AddStringToObject(o, "rays_error", run->rays_error);
+	if (run->load_read) {
+		cJSON_AddNumberToObject(o, "load_before", run->load_before);
+		cJSON_AddNumberToObject(o, "load_after", run->load_after);
+	}
 	cJSON_AddItemToArray(res->runs, o);
 	return 0;
 }
@@ -345,7 +350,7 @@ bool results_all_ok(const struct results *res)
 	const cJSON *run;
 	cJSON_ArrayForEach(run, res->runs) {
 		const char *status = string_of(run, "status");
-		if (!status || strcmp(status, "ok") != 0 || string_of(run, "rays_error"))
+		if (!status || strcmp(status, "ok") != 0)
 			return false;
 	}
 	return true;
@@ -457,8 +462,10 @@ int results_set_scene_image(struct results *res, const char *scene, const char *
 	if (strcmp(kind, "legend") == 0) {
 		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_min");
 		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_max");
+		cJSON_DeleteItemFromObjectCaseSensitive(images, "heat_scale");
 		cJSON_AddNumberToObject(images, "heat_min", lo);
 		cJSON_AddNumberToObject(images, "heat_max", hi);
+		cJSON_AddStringToObject(images, "heat_scale", "log"); /* image_heat's */
 	}
 	return 0;
 }

@@ -41,6 +41,8 @@ struct ray_metrics {
 	/* by enum bvhlab_traversal */
 	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
 	uint64_t disagreements; /* rays whose hits differ from the main traversal's */
+	char device[96];        /* the OpenCL device of the cl_ traversals ("" if none ran) */
+	char error[512];        /* why the rays, or one traversal, could not be traced ("") */
 };
 
 /* Peak memory of one run's builds (harness/harness_memory.c measures it). */
@@ -84,9 +86,15 @@ struct run_record {
 	bool valid;
 	uint64_t rays_checked, mismatches;
 	const struct ray_metrics *rays; /* or NULL: not traced */
-	const char *rays_error; /* why rays were not traced although the tree is valid */
 	const struct stage_metrics *stages; /* [stage_count] refinement stages */
 	uint32_t stage_count;
+	const bvhlab_phase *phases; /* [phase_count] the builder's phase medians */
+	uint32_t phase_count;
+	/* The machine's 1-minute load average just before and after the run's
+	 * series (-1: unreadable), so a report can tell a busy machine;
+	 * recorded when load_read. */
+	bool load_read;
+	double load_before, load_after;
 };
 
 
@@ -104,6 +112,9 @@ int results_add_run(struct results *res, const struct run_record *run);
 
 /* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of docs/design.md. */
 struct cJSON *results_rays_json(const struct ray_metrics *m);
+
+/* "build_phases": {"upload": ms, "device": ms, ...} (results_stages.c). */
+struct cJSON *results_phases_json(const bvhlab_phase *phases, uint32_t count);
 
 /* "stages": [{"plugin", "ms", "sah_before", "sah_after"}, ...] (results_stages.c). */
 struct cJSON *results_stages_json(const struct stage_metrics *stages, uint32_t count);
@@ -150,7 +161,7 @@ size_t results_forget_runs(struct results *res, const char *builder, const char 
 /* Removes the runs whose rays are provisional (their sweep was killed
  * before the rounds replaced them); how many went. */
 size_t results_forget_provisional(struct results *res);
-/* Whether every run of the document is "ok" (and traced, if it tried). */
+/* Whether every run of the document is "ok". */
 bool results_all_ok(const struct results *res);
 /* "options": {name: value, ...} of resolved options (NULL: {}). */
 struct cJSON *results_options_json(const bvhlab_options *opts);

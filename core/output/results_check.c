@@ -121,6 +121,18 @@ static bool timing_ok(const cJSON *t)
 	return true;
 }
 
+/* "build_phases": an object of finite times >= 0. */
+static bool phases_ok(const cJSON *p)
+{
+	const cJSON *v;
+	if (!cJSON_IsObject(p))
+		return false;
+	cJSON_ArrayForEach(v, p)
+		if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble) || v->valuedouble < 0)
+			return false;
+	return true;
+}
+
 /* The optional members the reports read, each of its type: "" or what is wrong. */
 static const char *optional_fields(const cJSON *run)
 {
@@ -139,6 +151,9 @@ static const char *optional_fields(const cJSON *run)
 	const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "build_ms");
 	if (t && !timing_ok(t))
 		return "build_ms";
+	const cJSON *p = cJSON_GetObjectItemCaseSensitive(run, "build_phases");
+	if (p && !phases_ok(p))
+		return "build_phases";
 	if (cJSON_GetObjectItemCaseSensitive(run, "mtris_per_s") && !finite_at(run, "mtris_per_s"))
 		return "mtris_per_s";
 	return "";

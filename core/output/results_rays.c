@@ -41,6 +41,13 @@ cJSON *results_rays_json(const struct ray_metrics *m)
 	cJSON_AddNumberToObject(o, "rounds", m->rounds ? m->rounds : 1);
 	if (m->provisional)
 		cJSON_AddBoolToObject(o, "provisional", true);
+	if (m->device[0])
+		cJSON_AddStringToObject(o, "device", m->device);
+	/* Why there are no figures, or none of one traversal: never silent. */
+	if (m->error[0])
+		cJSON_AddStringToObject(o, "error", m->error);
+	if (!m->measured)
+		return o;
 	add_kinds(o, m, m->main);
 	bool others = false;
 	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {

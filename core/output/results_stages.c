@@ -2,7 +2,10 @@
  * The "stages" member of a run whose builder has a "refine" list: each
  * refinement stage's median time over the timed repeats (already part of
  * the run's build_ms, which times the build and every stage together) and
- * the SAH cost of the tree just before and after it, on the last repeat.
+ * the SAH cost of the tree just before and after it, on the last repeat;
+ * and the "build_phases" member of a run whose builder reported phases of
+ * its build (ABI 1.3): each phase's median over the timed repeats, part of
+ * build_ms too.
  */
 #include <cJSON.h>
 
@@ -22,4 +25,12 @@ cJSON *results_stages_json(const struct stage_metrics *stages, uint32_t count)
 		cJSON_AddItemToArray(a, o);
 	}
 	return a;
+}
+
+cJSON *results_phases_json(const bvhlab_phase *phases, uint32_t count)
+{
+	cJSON *o = cJSON_CreateObject();
+	for (uint32_t k = 0; o && k < count; k++)
+		cJSON_AddNumberToObject(o, phases[k].name, phases[k].ms);
+	return o;
 }

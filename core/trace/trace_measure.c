@@ -11,6 +11,7 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,6 +19,7 @@
 #include <bvhlab/traversal.h>
 
 #include "trace/trace_batch.h"
+#include "trace/trace_cl.h"
 #include "trace/trace_kernel.h"
 #include "trace/trace_series.h"
 #include "util/util.h"
@@ -34,6 +36,10 @@ const char *bvhlab_traversal_name(int traversal)
 		return "stackless";
 	case BVHLAB_TRAVERSAL_WIDE:
 		return "wide";
+	case BVHLAB_TRAVERSAL_CL_STACK:
+		return "cl_stack";
+	case BVHLAB_TRAVERSAL_CL_STACKLESS:
+		return "cl_stackless";
 	default:
 		return NULL;
 	}
@@ -113,7 +119,19 @@ struct trace_series {
 	bvhlab_trace_stats stats;
 	double seconds_total;
 	double cpu_total;       /* CPU seconds per thread of all passes */
+	/* the device traversals: the tree (owned unless borrowed from the
+	 * series this one was made like), the batch, the least kernel time */
+	struct trace_cl_tree *cl_tree;
+	struct trace_cl_batch *cl_batch;
+	bool cl_borrowed;
+	double cl_best_s;
+	bvhlab_error err;       /* why a slice failed */
 };
+
+static bool on_device(int traversal)
+{
+	return traversal == BVHLAB_TRAVERSAL_CL_STACK || traversal == BVHLAB_TRAVERSAL_CL_STACKLESS;
+}
 
 static int grow(struct trace_series *s)
 {
@@ -156,6 +174,31 @@ static double timed_pass(struct trace_series *s)
 	return c / s->threads;
 }
 
+/* A device pass: its kernel time is the "cpu" sample, and the wall time
+ * (launch to completion) what min_ms counts. Negative errno on failure. */
+static double timed_pass_cl(struct trace_series *s)
+{
+	bvhlab_trace_stats st;
+	double k, w;
+	bool first = !s->counted;
+	int r = trace_cl_pass(s->cl_batch, first ? s->b.hits : NULL, first ? s->b.nodes : NULL,
+	                      first ? &st : NULL, &k, &w, &s->err);
+	if (r < 0)
+		return r;
+	if (first) {
+		s->stats = st;
+		s->counted = true;
+		s->b.hits = NULL;
+		s->b.nodes = NULL;
+	}
+	s->cl_best_s = s->n == 0 || k < s->cl_best_s ? k : s->cl_best_s;
+	s->cpu[s->n] = mrays(s->b.count, k);
+	s->wall[s->n++] = mrays(s->b.count, w);
+	s->seconds_total += w;
+	s->cpu_total += w;
+	return w;
+}
+
 int trace_series_slice(struct trace_series *s, const bvhlab_trace_options *o)
 {
 	double cpu_s = 0;
@@ -165,7 +208,10 @@ int trace_series_slice(struct trace_series *s, const bvhlab_trace_options *o)
 	while (s->n < s->max_repeats) {
 		if (s->n == s->cap && grow(s) < 0)
 			return s->n ? 0 : -ENOMEM; /* the passes so far still make a median */
-		cpu_s += timed_pass(s);
+		double t = s->cl_batch ? timed_pass_cl(s) : timed_pass(s);
+		if (t < 0)
+			return s->n ? 0 : (int)t;
+		cpu_s += t;
 		done++;
 		if (!more(o, done, cpu_s, (uint64_t)done * s->b.count))
 			break;
@@ -188,7 +234,8 @@ void trace_series_timing(const struct trace_series *s, bvhlab_trace_timing *t)
 	double sum = 0;
 	for (size_t i = 0; i < trace_tiles(s->b.count); i++)
 		sum += s->best[i];
-	t->mrays_best = mrays(s->b.count, sum / s->threads);
+	t->mrays_best = s->cl_batch ? mrays(s->b.count, s->cl_best_s)
+	                            : mrays(s->b.count, sum / s->threads);
 	summarise(s->cpu, s->n, &t->mrays_median, &t->mrays_min, &t->mrays_max);
 	summarise(s->wall, s->n, &t->wall_mrays_median, &t->wall_mrays_min, &t->wall_mrays_max);
 }
@@ -214,6 +261,9 @@ void trace_series_destroy(struct trace_series *s)
 	if (!s)
 		return;
 	trace_view_free(&s->b.view);
+	trace_cl_batch_destroy(s->cl_batch);
+	if (!s->cl_borrowed)
+		trace_cl_tree_destroy(s->cl_tree);
 	free(s->parents);
 	free(s->w);
 	free(s->best);
@@ -261,22 +311,42 @@ static struct trace_series *series_alloc(const struct batch *b, uint32_t threads
 	return s;
 }
 
+/* The device's copies of the tree and rays, instead of the CPU's. */
+static int series_device(struct trace_series *s, const bvhlab_trace_options *o)
+{
+	int r = trace_cl_tree_create(o->device, o->traversal, s->b.tree, s->b.scene, &s->cl_tree,
+	                             &s->err);
+	if (r == 0)
+		r = trace_cl_batch_create(s->cl_tree, s->b.rays, s->b.count, o->any_hit,
+		                          &s->cl_batch, &s->err);
+	return r;
+}
+
 int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
                         const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
                         bvhlab_hit *hits, uint32_t *nodes, bool counters,
-                        struct trace_series **out)
+                        struct trace_series **out, bvhlab_error *err)
 {
 	*out = NULL;
-	if (!bvhlab_traversal_name(opts->traversal))
+	if (!bvhlab_traversal_name(opts->traversal)) {
+		error_set(err, "no traversal %d", opts->traversal);
 		return -EINVAL;
+	}
 	struct batch b = {.tree = tree, .scene = scene, .rays = rays, .count = count,
 	                  .any = opts->any_hit, .traversal = opts->traversal, .hits = hits,
 	                  .nodes = nodes};
 	struct trace_series *s = series_alloc(&b, opts->threads, opts->max_repeats);
-	if (!s)
+	if (!s) {
+		error_set(err, "out of memory");
 		return -ENOMEM;
-	int r = series_views(s, opts->traversal, counters);
+	}
+	int r = on_device(opts->traversal) ? series_device(s, opts)
+	                                    : series_views(s, opts->traversal, counters);
 	if (r < 0) {
+		if (s->err.message[0])
+			error_set(err, "%s", s->err.message);
+		else
+			error_set(err, "%s", r == -ENOMEM ? "out of memory" : "the tree's links");
 		trace_series_destroy(s);
 		return r;
 	}
@@ -296,24 +366,62 @@ int trace_series_create_like(const struct trace_series *base, const bvhlab_ray *
 	b.view.owned_tris = NULL;
 	b.view.owned_wide = NULL;
 	*out = series_alloc(&b, base->threads, base->max_repeats);
-	return *out ? 0 : -ENOMEM;
+	if (!*out)
+		return -ENOMEM;
+	if (!base->cl_tree)
+		return 0;
+	(*out)->cl_tree = base->cl_tree;
+	(*out)->cl_borrowed = true;
+	int r = trace_cl_batch_create(base->cl_tree, rays, count, b.any, &(*out)->cl_batch,
+	                              &(*out)->err);
+	if (r < 0) {
+		trace_series_destroy(*out);
+		*out = NULL;
+	}
+	return r;
+}
+
+const char *trace_series_error(const struct trace_series *s)
+{
+	return s->err.message;
+}
+
+const char *trace_series_device(const struct trace_series *s)
+{
+	return s->cl_tree ? trace_cl_device_name(s->cl_tree) : NULL;
+}
+
+int trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhlab_ray *rays,
+                  size_t count, const bvhlab_trace_options *opts, bvhlab_hit *hits,
+                  uint32_t *nodes, bvhlab_trace_timing *timing, char *device, size_t device_size,
+                  bvhlab_error *err)
+{
+	struct trace_series *s;
+	*timing = (bvhlab_trace_timing){0};
+	if (!bvhlab_traversal_name(opts->traversal)) {
+		error_set(err, "no traversal %d", opts->traversal);
+		return -EINVAL;
+	}
+	if (count == 0)
+		return 0;
+	int r = trace_series_create(tree, scene, rays, count, opts, hits, nodes, true, &s, err);
+	if (r < 0)
+		return r;
+	r = trace_series_slice(s, opts);
+	if (r == 0)
+		trace_series_timing(s, timing);
+	else
+		error_set(err, "%s", s->err.message[0] ? s->err.message : strerror(-r));
+	if (device && device_size && trace_series_device(s))
+		snprintf(device, device_size, "%s", trace_series_device(s));
+	trace_series_destroy(s);
+	return r;
 }
 
 int bvhlab_trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene,
                          const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
                          bvhlab_hit *hits, uint32_t *nodes, bvhlab_trace_timing *timing)
 {
-	struct trace_series *s;
-	*timing = (bvhlab_trace_timing){0};
-	if (!bvhlab_traversal_name(opts->traversal))
-		return -EINVAL;
-	if (count == 0)
-		return 0;
-	int r = trace_series_create(tree, scene, rays, count, opts, hits, nodes, true, &s);
-	if (r == 0)
-		r = trace_series_slice(s, opts);
-	if (r == 0)
-		trace_series_timing(s, timing);
-	trace_series_destroy(s);
-	return r;
+	bvhlab_error err = {{0}};
+	return trace_measure(tree, scene, rays, count, opts, hits, nodes, timing, NULL, 0, &err);
 }

@@ -23,24 +23,29 @@ struct trace_series;
  * get each ray's hit and node count from the series' first pass, with the
  * meaning bvhlab_trace_measure gives them; they must live until then.
  * counters false spares the wide traversal its counting pass: its
- * timing's counters and nodes then stay zero. 0, -EINVAL (bad traversal
- * or tree links), -ENOMEM.
+ * timing's counters and nodes then stay zero. The device traversals
+ * (cl_stack, cl_stackless) upload the tree and rays to opts->device and
+ * count on the device. 0, or a negative errno with err saying why:
+ * -EINVAL (bad traversal or tree links), -ENOMEM, and for the device
+ * -ENOTSUP (OpenCL not built), -ENODEV (no device), -EIO.
  */
 int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
                         const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
                         bvhlab_hit *hits, uint32_t *nodes, bool counters,
-                        struct trace_series **out);
+                        struct trace_series **out, bvhlab_error *err);
 
 /* A series of other rays through base's tree with base's traversal,
  * threads and tracing copies (base must outlive it). Its timing's
  * counters are those of its first pass for the stack and stackless
- * traversals and zero for the wide one (no counting pass). 0 or -ENOMEM. */
+ * traversals and zero for the wide one (no counting pass). 0 or a
+ * negative errno (trace_series_error says why). */
 int trace_series_create_like(const struct trace_series *base, const bvhlab_ray *rays,
                              size_t count, struct trace_series **out);
 
 /* Timed passes until this slice meets opts' min_ms, min_rays and
  * min_repeats (counted within the slice); max_repeats bounds the series'
- * passes in all. 0 or -ENOMEM (the passes so far still count). */
+ * passes in all. 0, or a negative errno when no pass could be timed
+ * (trace_series_error says why; the passes so far still count). */
 int trace_series_slice(struct trace_series *s, const bvhlab_trace_options *opts);
 
 /* Whether the series' passes in all meet opts' minimums (as one slice
@@ -51,5 +56,20 @@ bool trace_series_done(const struct trace_series *s, const bvhlab_trace_options 
 void trace_series_timing(const struct trace_series *s, bvhlab_trace_timing *t);
 
 void trace_series_destroy(struct trace_series *s);
+
+/* Why the series' last slice failed ("" if none). */
+const char *trace_series_error(const struct trace_series *s);
+
+/* The device a cl_ series traces on (CL_DEVICE_NAME); NULL for the CPU's. */
+const char *trace_series_device(const struct trace_series *s);
+
+/*
+ * bvhlab_trace_measure with the reason for a failure in err, and the
+ * device's name in device (when a cl_ traversal; may be NULL).
+ */
+int trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhlab_ray *rays,
+                  size_t count, const bvhlab_trace_options *opts, bvhlab_hit *hits,
+                  uint32_t *nodes, bvhlab_trace_timing *timing, char *device, size_t device_size,
+                  bvhlab_error *err);
 
 #endif

@@ -39,7 +39,30 @@ static const char good_config[] =
 	"  \"builders\": [ { \"plugin\": \"sah_seq\", \"name\": \"sweep\", \"threads\": [1] },\n"
 	"                { \"plugin\": \"sah_seq\", \"name\": \"binned\", \"threads\": [1],\n"
 	"                  \"options\": { \"method\": \"binned\", \"bins\": 16 } },\n"
-	"                { \"plugin\": \"fake_good\" } ] }\n";
+	"                { \"plugin\": \"fake_good\", \"options\": { \"phases\": \"two\" } } ] }\n";
+
+/* fake_good reports upload twice (1 + 0.5 ms) and device (2.5 ms) in every
+ * build: build_phases holds their medians, sah_seq's runs have none. */
+static void check_phases(const cJSON *doc, const char *csv)
+{
+	const cJSON *run;
+	int with = 0;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs")) {
+		const cJSON *ph = cJSON_GetObjectItem(run, "build_phases");
+		if (strcmp(run_str(run, "builder"), "fake_good") != 0) {
+			CHECK(ph == NULL);
+			continue;
+		}
+		with++;
+		CHECK(cJSON_GetArraySize(ph) == 2);
+		CHECK(!strcmp(cJSON_GetArrayItem(ph, 0)->string, "upload"));
+		CHECK(cJSON_GetObjectItem(ph, "upload")->valuedouble == 1.5);
+		CHECK(cJSON_GetObjectItem(ph, "device")->valuedouble == 2.5);
+	}
+	CHECK_INT(with, 4);
+	CHECK_CONTAINS(csv, ",build_phases,error\n");
+	CHECK_CONTAINS(csv, ",upload=1.5000;device=2.5000,");
+}
 
 static void check_good_results(const char *dir)
 {
@@ -64,10 +87,15 @@ static void check_good_results(const char *dir)
 	CHECK(cJSON_IsNumber(cold) && cold->valuedouble > 0);
 	CHECK(cJSON_GetObjectItem(cJSON_GetObjectItem(run0, "tree"), "sah_cost")->valuedouble > 1);
 	CHECK(!strcmp(run_str(cJSON_GetObjectItem(run0, "options"), "method"), "sweep"));
-	cJSON_Delete(doc);
+	/* The load average around the run, as /proc/loadavg gave it. */
+	const cJSON *load = cJSON_GetObjectItem(run0, "load_before");
+	CHECK(cJSON_IsNumber(load) && load->valuedouble >= 0);
+	CHECK(cJSON_IsNumber(cJSON_GetObjectItem(run0, "load_after")));
 
 	char *csv = read_file(dir, "results.csv");
 	char *md = read_file(dir, "report.md");
+	check_phases(doc, csv);
+	cJSON_Delete(doc);
 	CHECK_CONTAINS(csv, "scene,builder,plugin,status,threads,build_ms.median");
 	CHECK_CONTAINS(csv, "build_ms.max,build_ms.cold,");
 	CHECK_CONTAINS(csv, "soup,binned,sah_seq,ok,1,");
@@ -134,6 +162,8 @@ static void test_info_build_list(void)
 	CHECK_CONTAINS(out_text, "valid:      yes");
 	CHECK_CONTAINS(out_text, "cold:       ");
 	CHECK_CONTAINS(out_text, "SAH cost:");
+	CHECK_INT(run(ARGS("build", "fake_good", "soup:count=50", "-o", "phases=two")), 0);
+	CHECK_CONTAINS(out_text, "phase:      upload 1.500 ms median\nphase:      device 2.500");
 	CHECK_INT(run(ARGS("build", "sah_seq", "soup:count=500", "-o", "bins=1")), 2);
 	CHECK_CONTAINS(err_text, "option 'bins' of builder 'sah_seq' is out of range");
 	CHECK_INT(run(ARGS("build", "no_such_plugin", "soup")), 2);

@@ -30,6 +30,9 @@ static const bvhlab_option_decl options[] = {
 #ifdef FAKE_BAD_OPTION
 	{.name = "broken", .type = 0, .help = "an option of no type"},
 #endif
+	{.name = "phases", .type = BVHLAB_OPTION_STRING,
+	 .help = "phases build() reports (ABI 1.3): none, two (upload twice, device), or broken",
+	 .def_string = "none", .choices = "none|two|bad_name|negative|too_many"},
 	{.name = "wait_for", .type = BVHLAB_OPTION_STRING,
 	 .help = "a file build() waits for first (up to a minute)", .def_string = ""},
 };
@@ -149,6 +152,27 @@ static int build_shared(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return 0;
 }
 
+/* The "phases" option: upload is reported twice to show that calls add up. */
+static void report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx)
+{
+	static const char *const many[] = {"p0", "p1", "p2", "p3", "p4", "p5", "p6", "p7", "p8"};
+	const char *how = "none";
+	if (!BVHLAB_HOST_HAS(host, phase) || host->option_string(ctx, "phases", &how) < 0)
+		return;
+	if (strcmp(how, "two") == 0) {
+		host->phase(ctx, "upload", 1.0);
+		host->phase(ctx, "device", 2.5);
+		host->phase(ctx, "upload", 0.5);
+	} else if (strcmp(how, "bad_name") == 0) {
+		host->phase(ctx, "Device Time", 1.0);
+	} else if (strcmp(how, "negative") == 0) {
+		host->phase(ctx, "device", -1.0);
+	} else if (strcmp(how, "too_many") == 0) {
+		for (size_t k = 0; k < sizeof(many) / sizeof(many[0]); k++)
+			host->phase(ctx, many[k], 1.0);
+	}
+}
+
 /* unused in the variant without a build function */
 __attribute__((unused)) static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *in, bvhlab_build_output *out)
@@ -156,6 +180,7 @@ __attribute__((unused)) static int build(const bvhlab_host *host, bvhlab_build_c
 	int r = maybe_fail(host, ctx);
 	if (r != 0)
 		return r;
+	report_phases(host, ctx);
 	if (fail_is(host, ctx, "shared"))
 		return build_shared(host, ctx, in, out);
 	bvhlab_node *root = &out->nodes[0];

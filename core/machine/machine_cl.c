@@ -1,0 +1,93 @@
+/*
+ * The OpenCL platforms and devices of this machine, for `bvhlab info
+ * --machine` (machine.h): what the cl_ builders' and traversals' device
+ * specs can name, "P:D" being the indices listed here.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "machine/machine.h"
+
+#ifdef BVHLAB_HAVE_OPENCL
+
+#include <bvhlab/opencl.h>
+
+static const char *kind_name(cl_device_type t)
+{
+	return t & CL_DEVICE_TYPE_GPU ? "gpu"
+	       : t & CL_DEVICE_TYPE_CPU ? "cpu"
+	       : t & CL_DEVICE_TYPE_ACCELERATOR ? "accelerator" : "other";
+}
+
+static void describe(cl_platform_id p, cl_device_id d, struct machine_cl_device *out)
+{
+	cl_device_type type = 0;
+	cl_uint units = 0;
+	cl_ulong mem = 0;
+	clGetPlatformInfo(p, CL_PLATFORM_NAME, sizeof(out->platform) - 1, out->platform, NULL);
+	clGetDeviceInfo(d, CL_DEVICE_NAME, sizeof(out->name) - 1, out->name, NULL);
+	clGetDeviceInfo(d, CL_DEVICE_VERSION, sizeof(out->version) - 1, out->version, NULL);
+	clGetDeviceInfo(d, CL_DEVICE_TYPE, sizeof(type), &type, NULL);
+	clGetDeviceInfo(d, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof(units), &units, NULL);
+	clGetDeviceInfo(d, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof(mem), &mem, NULL);
+	snprintf(out->kind, sizeof(out->kind), "%s", kind_name(type));
+	out->compute_units = units;
+	out->global_mem = mem;
+}
+
+/* Appends platform p's devices to *list. 0 or a negative errno. */
+static int add_platform(cl_platform_id p, unsigned pi, struct machine_cl_device **list,
+                        size_t *n, char *why, size_t why_size)
+{
+	cl_device_id *devs = NULL;
+	cl_uint nd = 0;
+	int r = bvhlab_cl_devices(p, &devs, &nd, why, why_size);
+	struct machine_cl_device *grown = r == 0 && nd ? realloc(*list, (*n + nd) * sizeof(**list))
+	                                               : *list;
+	if (r == 0 && nd && !grown)
+		r = -ENOMEM;
+	for (cl_uint d = 0; r == 0 && d < nd; d++) {
+		struct machine_cl_device *m = &grown[(*n)++];
+		memset(m, 0, sizeof(*m));
+		m->platform_index = pi;
+		m->device_index = d;
+		describe(p, devs[d], m);
+	}
+	if (grown)
+		*list = grown;
+	free(devs);
+	return r;
+}
+
+int machine_cl_devices(struct machine_cl_device **out, size_t *count, char *why, size_t why_size)
+{
+	cl_platform_id *plats = NULL;
+	cl_uint np = 0;
+	*out = NULL;
+	*count = 0;
+	int r = bvhlab_cl_platforms(&plats, &np, why, why_size);
+	for (cl_uint p = 0; r == 0 && p < np; p++)
+		r = add_platform(plats[p], p, out, count, why, why_size);
+	free(plats);
+	if (r < 0) {
+		free(*out);
+		*out = NULL;
+		*count = 0;
+	}
+	return r;
+}
+
+#else
+
+int machine_cl_devices(struct machine_cl_device **out, size_t *count, char *why, size_t why_size)
+{
+	*out = NULL;
+	*count = 0;
+	snprintf(why, why_size, "not built (this bvhlab was built without OpenCL: install "
+	                        "ocl-icd-opencl-dev and opencl-c-headers, then meson setup again)");
+	return -ENOTSUP;
+}
+
+#endif

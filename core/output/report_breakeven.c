@@ -1,0 +1,173 @@
+/*
+ * Break-even: the figure an engine developer asks for. A builder that
+ * takes longer than the reference but builds a tree that traces faster
+ * pays for itself after some number of rays; one that builds faster but
+ * traces slower is cheaper only up to some number. Total cost of n rays:
+ * build_ms / 1000 + n / (Mrays/s * 1e6) seconds, with Mrays/s as measured
+ * (rays per CPU second of the tracing threads times their number, each
+ * tile at its best pass), so the rays are traced with the run's ray
+ * threads and the tree is built with the run's build threads.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "output/report.h"
+
+struct breakeven report_breakeven(double build_ms, double mrays, double ref_build_ms,
+                                  double ref_mrays)
+{
+	struct breakeven b = {BREAKEVEN_NONE, NAN};
+	if (!(build_ms >= 0 && mrays > 0 && ref_build_ms >= 0 && ref_mrays > 0))
+		return b;
+	double d_build = (build_ms - ref_build_ms) / 1e3;      /* seconds */
+	double d_ray = 1 / (mrays * 1e6) - 1 / (ref_mrays * 1e6); /* seconds per ray */
+	if (d_build == 0 && d_ray == 0)
+		b.kind = BREAKEVEN_SAME;
+	else if (d_build <= 0 && d_ray <= 0)
+		b.kind = BREAKEVEN_ALWAYS;
+	else if (d_build >= 0 && d_ray >= 0)
+		b.kind = BREAKEVEN_NEVER;
+	else {
+		b.kind = d_build > 0 ? BREAKEVEN_AFTER : BREAKEVEN_UNTIL;
+		b.rays = fabs(d_build / d_ray);
+	}
+	return b;
+}
+
+/* "950", "12.3 k", "1.2 M", "3.4 G" rays. */
+static void count_text(char *buf, size_t size, double n)
+{
+	static const char *const units[] = {"k", "M", "G", "T"};
+	int u = -1;
+	while (n >= 1e3 && u < 3) {
+		n /= 1e3;
+		u++;
+	}
+	if (u < 0)
+		snprintf(buf, size, "%.0f", n);
+	else
+		snprintf(buf, size, "%.1f %s", n, units[u]);
+}
+
+void report_breakeven_text(char *buf, size_t size, struct breakeven b, double frame_rays)
+{
+	char n[32], frames[48] = "";
+	switch (b.kind) {
+	case BREAKEVEN_SAME: snprintf(buf, size, "same cost"); return;
+	case BREAKEVEN_ALWAYS: snprintf(buf, size, "always cheaper"); return;
+	case BREAKEVEN_NEVER: snprintf(buf, size, "never cheaper"); return;
+	case BREAKEVEN_NONE: snprintf(buf, size, "—"); return;
+	case BREAKEVEN_AFTER: case BREAKEVEN_UNTIL: break;
+	}
+	count_text(n, sizeof(n), b.rays);
+	if (frame_rays > 0)
+		snprintf(frames, sizeof(frames), " (%s frames)",
+		         report_plain((char[32]){0}, 32, b.rays / frame_rays));
+	snprintf(buf, size, "%s %s rays%s", b.kind == BREAKEVEN_AFTER ? "after" : "up to", n,
+	         frames);
+}
+
+/* The break-even of run against base for one kind of ray ("primary");
+ * *noise when the two throughputs are within the noise. The same tree
+ * traces at the same speed: a difference measured there is the machine's,
+ * so only the builds count. */
+static struct breakeven of_kind(const cJSON *run, const cJSON *base, const char *kind,
+                                bool *noise)
+{
+	char key[64];
+	snprintf(key, sizeof(key), "rays.%s.mrays_per_s", kind);
+	double mine = report_num(run, key), theirs = report_num(base, key);
+	bool same = report_same_tree(run, base);
+	*noise = !same && fabs(mine - theirs) < REPORT_NOISE * fmin(mine, theirs);
+	return report_breakeven(report_num(run, "build_ms.median"), same ? theirs : mine,
+	                        report_num(base, "build_ms.median"), theirs);
+}
+
+static const char intro[] =
+	"The rays after which a builder's total cost (build, then tracing) falls below "
+	"the reference's (after N: a slower build that a faster tree pays back; up to N: "
+	"a faster build that a slower tree loses again), from the median build time and "
+	"the measured Mrays/s (best tile), against the reference's run with the same "
+	"threads, else its fewest. A frame: the run's primary rays. The same tree as the "
+	"reference's counts as tracing at its speed; ≈: the two Mrays/s differ by less "
+	"than 5 %, within the noise, so the figure is uncertain.";
+
+/* The verdicts of one run, in text, for both kinds of ray. */
+static void run_texts(const cJSON *run, const cJSON *base, char (*out)[96])
+{
+	static const char *const kinds[2] = {"primary", "diffuse"};
+	double frame = report_num(run, "rays.primary.rays");
+	for (int k = 0; k < 2; k++) {
+		bool noise;
+		struct breakeven b = of_kind(run, base, kinds[k], &noise);
+		report_breakeven_text(out[k], sizeof(out[k]) - 8, b, frame);
+		if (noise && (b.kind == BREAKEVEN_AFTER || b.kind == BREAKEVEN_UNTIL))
+			strcat(out[k], " ≈");
+	}
+}
+
+/* The ok traced runs of a scene and the reference run each is set against. */
+static const cJSON *base_of(const struct report_index *ix, const char *ref, const cJSON *run)
+{
+	if (strcmp(report_str(run, "status"), "ok") != 0 ||
+	    !isfinite(report_num(run, "rays.primary.mrays_per_s")))
+		return NULL;
+	return report_reference_run(ix, ref, report_str(run, "scene"), report_num(run, "threads"));
+}
+
+void report_breakeven_md(struct strbuf *sb, const struct report_index *ix, const char *ref,
+                         const cJSON *const *runs, size_t n)
+{
+	char texts[2][96], buf[32];
+	bool header = false;
+	for (size_t k = 0; ref && k < n; k++) {
+		const cJSON *base = base_of(ix, ref, runs[k]);
+		if (!base || base == runs[k])
+			continue;
+		if (!header)
+			sb_printf(sb, "\n### Break-even against %s\n\n%s\n\n| builder | threads "
+			              "| median ms | reference ms | primary rays | diffuse rays |\n"
+			              "|---|---:|---:|---:|---|---|\n", ref, intro);
+		header = true;
+		run_texts(runs[k], base, texts);
+		sb_printf(sb, "|");
+		report_md_cell(sb, report_str(runs[k], "builder"));
+		sb_printf(sb, " %.0f | %s |", report_num(runs[k], "threads"),
+		          report_plain(buf, sizeof(buf), report_num(runs[k], "build_ms.median")));
+		sb_printf(sb, " %s | %s | %s |\n",
+		          report_plain(buf, sizeof(buf), report_num(base, "build_ms.median")),
+		          texts[0], texts[1]);
+	}
+}
+
+void report_breakeven_html(struct strbuf *sb, const struct report_index *ix, const char *ref,
+                           const cJSON *const *runs, size_t n)
+{
+	char texts[2][96], a[32], b[32];
+	bool header = false;
+	for (size_t k = 0; ref && k < n; k++) {
+		const cJSON *base = base_of(ix, ref, runs[k]);
+		if (!base || base == runs[k])
+			continue;
+		if (!header) {
+			sb_printf(sb, "<h3>Break-even against ");
+			report_escape(sb, ref);
+			sb_printf(sb, "</h3>\n<p>%s</p>\n<table class=\"breakeven\"><tr><th class=\"l\">"
+			              "builder</th><th>threads</th><th>median ms</th><th>reference ms"
+			              "</th><th class=\"l\">primary rays</th><th class=\"l\">diffuse rays"
+			              "</th></tr>\n", intro);
+		}
+		header = true;
+		run_texts(runs[k], base, texts);
+		sb_printf(sb, "<tr><td class=\"l\">");
+		report_escape(sb, report_str(runs[k], "builder"));
+		sb_printf(sb, "</td><td>%.0f</td><td>%s</td><td>%s</td><td class=\"l\">%s</td>"
+		              "<td class=\"l\">%s</td></tr>\n", report_num(runs[k], "threads"),
+		          report_plain(a, sizeof(a), report_num(runs[k], "build_ms.median")),
+		          report_plain(b, sizeof(b), report_num(base, "build_ms.median")), texts[0],
+		          texts[1]);
+	}
+	if (header)
+		sb_printf(sb, "</table>\n");
+}

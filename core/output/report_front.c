@@ -1,0 +1,289 @@
+/*
+ * Pareto fronts: which builders are worth considering at all. Per scene
+ * and thread count, a run is on the front of build time against a tree
+ * figure (SAH cost, primary nodes per ray; lower is better for both) when
+ * no other run is at least as fast and at least as good with one of the
+ * two strictly better (figures within 0.05 % count as equal). A run off
+ * the front names the run that dominates it: of those, the fastest on the
+ * front (there is one without the tolerance; with it, the fastest of all
+ * when none is), so the reader is sent to a builder worth looking at.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "output/report.h"
+
+/* Figures this close count as equal: a parallel build summing in another
+ * order, or a tree that differs in a leaf, is not a better tree, and a
+ * builder 0.001 % better but 10 % slower is no reason to keep one. */
+#define SAME_FIGURE 5e-4
+
+static bool dominates(const struct front_point *b, const struct front_point *a)
+{
+	bool no_worse = b->figure <= a->figure * (1 + SAME_FIGURE);
+	bool better = b->figure < a->figure * (1 - SAME_FIGURE);
+	return b->group == a->group && b->time <= a->time && no_worse &&
+	       (b->time < a->time || better);
+}
+
+static bool usable(const struct front_point *p)
+{
+	return isfinite(p->time) && isfinite(p->figure) && p->time > 0;
+}
+
+/* Whether b is the better pick than c (index < 0: none yet) as a
+ * dominator: on the front before off it, then faster, then better. */
+static bool better_dominator(const struct front_point *p, const bool *on, long c, size_t b)
+{
+	if (c < 0 || on[b] != on[c])
+		return c < 0 || on[b];
+	return p[b].time < p[c].time || (p[b].time == p[c].time && p[b].figure < p[c].figure);
+}
+
+void report_front_points(const struct front_point *p, size_t n, long *by)
+{
+	bool *on = calloc(n + 1, sizeof(*on));
+	for (size_t a = 0; !on && a < n; a++)
+		by[a] = FRONT_NONE; /* no memory: nothing compared */
+	for (size_t a = 0; on && a < n; a++) {
+		on[a] = usable(&p[a]);
+		for (size_t b = 0; b < n && on[a]; b++)
+			on[a] = b == a || !usable(&p[b]) || !dominates(&p[b], &p[a]);
+	}
+	for (size_t a = 0; on && a < n; a++) {
+		by[a] = !usable(&p[a]) ? FRONT_NONE : FRONT_ON;
+		for (size_t b = 0; b < n && by[a] != FRONT_NONE && !on[a]; b++)
+			if (b != a && usable(&p[b]) && dominates(&p[b], &p[a]) &&
+			    better_dominator(p, on, by[a], b))
+				by[a] = (long)b;
+	}
+	free(on);
+}
+
+void report_front_text(char *buf, size_t size, const struct front_point *p, long by,
+                       size_t a, const char *by_name, const char *figure)
+{
+	if (by == FRONT_NONE) {
+		snprintf(buf, size, "—");
+		return;
+	}
+	if (by == FRONT_ON) {
+		snprintf(buf, size, "front");
+		return;
+	}
+	double t = p[by].time / p[a].time, f = 100 * (p[by].figure - p[a].figure) / p[a].figure;
+	char change[48];
+	if (fabs(f) < 0.05)
+		snprintf(change, sizeof(change), "same %s", figure);
+	else
+		snprintf(change, sizeof(change), "%s%.1f %% %s", f < 0 ? "−" : "+", fabs(f), figure);
+	snprintf(buf, size, "dominated by %s (%.2f× time, %s)", by_name, t, change);
+}
+
+/* Whether the scene holds a run of the builder with more than 1 thread. */
+static bool ran_parallel(const cJSON *const *runs, size_t n, const char *builder)
+{
+	for (size_t k = 0; k < n; k++)
+		if (report_num(runs[k], "threads") > 1 &&
+		    strcmp(report_str(runs[k], "builder"), builder) == 0)
+			return true;
+	return false;
+}
+
+static int by_threads(const void *a, const void *b)
+{
+	const struct front_entry *x = a, *y = b;
+	if (x->threads != y->threads)
+		return (x->threads > y->threads) - (x->threads < y->threads);
+	return (x->order > y->order) - (x->order < y->order);
+}
+
+/* Whether run k competes at thread count t: its own, or any for the
+ * 1-thread run of a builder that ran on 1 thread only. */
+static bool competes(const cJSON *const *runs, size_t n, size_t k, double t)
+{
+	double own = report_num(runs[k], "threads");
+	return own == t ||
+	       (own == 1 && t > 1 && !ran_parallel(runs, n, report_str(runs[k], "builder")));
+}
+
+struct front_entry *report_front_entries(const cJSON *const *runs, size_t n, size_t *count)
+{
+	double t[64];
+	size_t nt = report_thread_counts(runs, n, t, 64), m = 0;
+	struct front_entry *e = calloc(n * nt + 1, sizeof(*e));
+	for (size_t i = 0; e && i < nt; i++)
+		for (size_t k = 0; k < n; k++)
+			if (competes(runs, n, k, t[i]))
+				e[m++] = (struct front_entry){runs[k], t[i], k};
+	if (e)
+		qsort(e, m, sizeof(*e), by_threads);
+	*count = m;
+	return e;
+}
+
+size_t report_thread_counts(const cJSON *const *runs, size_t n, double *out, size_t max)
+{
+	size_t m = 0;
+	for (size_t k = 0; k < n; k++) {
+		double t = report_num(runs[k], "threads");
+		size_t i = 0;
+		while (i < m && out[i] != t)
+			i++;
+		if (i < m || m == max || !isfinite(t))
+			continue;
+		for (i = m++; i > 0 && out[i - 1] > t; i--) /* insertion keeps them sorted */
+			out[i] = out[i - 1];
+		out[i] = t;
+	}
+	return m;
+}
+
+void report_entries_front(const struct front_entry *e, size_t m, const char *figure,
+                          struct front_point *p, long *by)
+{
+	for (size_t k = 0; k < m; k++) {
+		bool ok = strcmp(report_str(e[k].run, "status"), "ok") == 0;
+		p[k] = (struct front_point){ok ? report_num(e[k].run, "build_ms.median") : NAN,
+		                            report_num(e[k].run, figure), (long)e[k].threads};
+	}
+	report_front_points(p, m, by);
+}
+
+/* The two views the tables show: build time against each figure. */
+static const char *const figures[2] = {"tree.sah_cost", "rays.primary.nodes_per_ray"};
+static const char *const figure_names[2] = {"SAH", "nodes/ray"};
+
+struct front_table {
+	struct front_entry *e;
+	size_t n;
+	struct front_point *p[2];
+	long *by[2];
+};
+
+static int table_init(struct front_table *t, const cJSON *const *runs, size_t n)
+{
+	memset(t, 0, sizeof(*t));
+	t->e = report_front_entries(runs, n, &t->n);
+	for (int v = 0; t->e && v < 2; v++) {
+		t->p[v] = calloc(t->n + 1, sizeof(*t->p[v]));
+		t->by[v] = calloc(t->n + 1, sizeof(*t->by[v]));
+		if (!t->p[v] || !t->by[v])
+			return -1;
+		report_entries_front(t->e, t->n, figures[v], t->p[v], t->by[v]);
+	}
+	return t->e ? 0 : -1;
+}
+
+/* Whether some run was compared: a table of none would be empty. */
+static bool any_compared(const struct front_table *t)
+{
+	for (size_t k = 0; k < t->n; k++)
+		if (t->by[0][k] != FRONT_NONE)
+			return true;
+	return false;
+}
+
+static void table_finish(struct front_table *t)
+{
+	free(t->e);
+	for (int v = 0; v < 2; v++) {
+		free(t->p[v]);
+		free(t->by[v]);
+	}
+}
+
+/* The verdict of run k in view v. */
+static void verdict(const struct front_table *t, int v, size_t k, char *buf, size_t size)
+{
+	long by = t->by[v][k];
+	const char *name = by >= 0 ? report_str(t->e[by].run, "builder") : "";
+	report_front_text(buf, size, t->p[v], by, k, name, figure_names[v]);
+}
+
+/* "2", or "2 (ran on 1)" for a 1-thread run standing in at 2 threads. */
+static const char *threads_text(char *buf, size_t size, const struct front_entry *e)
+{
+	double own = report_num(e->run, "threads");
+	if (own == e->threads)
+		snprintf(buf, size, "%.0f", own);
+	else
+		snprintf(buf, size, "%.0f (ran on %.0f)", e->threads, own);
+	return buf;
+}
+
+static const char intro[] =
+	"Per thread count: a builder is on the front when no other is at least as fast "
+	"and builds a tree at least as good (lower SAH cost; fewer primary nodes per ray), "
+	"one of the two strictly, figures within 0.05 % counting as equal; off it, the "
+	"fastest builder on the front that dominates it, its build time as a multiple of "
+	"this one's and the change in the figure. A builder that ran on 1 thread only "
+	"competes with its 1-thread run at every thread count.";
+
+void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n)
+{
+	struct front_table t;
+	char buf[256];
+	if (table_init(&t, runs, n) == 0 && any_compared(&t)) {
+		sb_printf(sb, "\n### Pareto fronts\n\n%s\n\n| builder | threads | median ms | SAH cost "
+		              "| time × SAH | primary nodes/ray | time × nodes/ray |\n"
+		              "|---|---:|---:|---:|---|---:|---|\n", intro);
+		for (size_t k = 0; k < t.n; k++) {
+			if (t.by[0][k] == FRONT_NONE)
+				continue;
+			sb_printf(sb, "|");
+			report_md_cell(sb, report_str(t.e[k].run, "builder"));
+			report_md_cell(sb, threads_text(buf, sizeof(buf), &t.e[k]));
+			sb_printf(sb, " %s | %.3f |", report_plain(buf, sizeof(buf), t.p[0][k].time),
+			          t.p[0][k].figure);
+			verdict(&t, 0, k, buf, sizeof(buf));
+			report_md_cell(sb, buf);
+			sb_printf(sb, " %.1f |", t.p[1][k].figure);
+			verdict(&t, 1, k, buf, sizeof(buf));
+			report_md_cell(sb, buf);
+			sb_printf(sb, "\n");
+		}
+	}
+	table_finish(&t);
+}
+
+static void html_verdict(struct strbuf *sb, const struct front_table *t, int v, size_t k)
+{
+	char buf[256];
+	verdict(t, v, k, buf, sizeof(buf));
+	sb_printf(sb, "<td class=\"l%s\">", t->by[v][k] == FRONT_ON ? " front" : "");
+	report_escape(sb, buf);
+	sb_printf(sb, "</td>");
+}
+
+static void html_row(struct strbuf *sb, const struct front_table *t, size_t k)
+{
+	char buf[64], ms[32];
+	sb_printf(sb, "<tr><td class=\"l\">");
+	report_escape(sb, report_str(t->e[k].run, "builder"));
+	sb_printf(sb, "</td><td>%s</td><td>%s</td><td>%.3f</td>",
+	          threads_text(buf, sizeof(buf), &t->e[k]),
+	          report_plain(ms, sizeof(ms), t->p[0][k].time), t->p[0][k].figure);
+	html_verdict(sb, t, 0, k);
+	sb_printf(sb, "<td>%.1f</td>", t->p[1][k].figure);
+	html_verdict(sb, t, 1, k);
+	sb_printf(sb, "</tr>\n");
+}
+
+void report_front_html(struct strbuf *sb, const cJSON *const *runs, size_t n)
+{
+	struct front_table t;
+	if (table_init(&t, runs, n) == 0 && any_compared(&t)) {
+		sb_printf(sb, "<h3>Pareto fronts</h3>\n<p>%s</p>\n<table><tr><th class=\"l\">builder"
+		              "</th><th>threads</th><th>median ms</th><th>SAH cost</th>"
+		              "<th class=\"l\">time × SAH</th><th>primary nodes/ray</th>"
+		              "<th class=\"l\">time × nodes/ray</th></tr>\n", intro);
+		for (size_t k = 0; k < t.n; k++)
+			if (t.by[0][k] != FRONT_NONE)
+				html_row(sb, &t, k);
+		sb_printf(sb, "</table>\n");
+	}
+	table_finish(&t);
+}

@@ -1,0 +1,445 @@
+/*
+ * The device traversals' host side (trace_cl.h): the process's devices and
+ * programs, a tree's buffers, a batch's buffers, one timed pass.
+ */
+#include <errno.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <bvhlab/opencl.h>
+#include <bvhlab/traversal.h>
+
+#include "trace/trace_cl.h"
+#include "trace/trace_cl_source.h"
+#include "util/util.h"
+
+/* The private stack of the stack kernel: this many entries, or the next
+ * power of two at or above a deeper tree's depth (a program per size). */
+#define MIN_STACK 64
+#define MAX_PROGRAMS 8
+#define RAYS_PER_GROUP 64
+#define OVERFLOW UINT32_MAX
+
+/* -cl-fp32-correctly-rounded-divide-sqrt: the CPU's divisions are IEEE;
+ * OpenCL's default float division may be 2.5 ulp off, which would move t,
+ * u and v. A device that cannot round them correctly is not asked to (the
+ * build would fail): its hits may then differ, and the disagreements say
+ * so. No -cl-mad-enable, no fast math: the same operations as the CPU,
+ * each rounded the same. */
+#define BUILD_OPTIONS "-cl-std=CL1.2 %s-DSTACK_SIZE=%u"
+#define EXACT_DIVIDE "-cl-fp32-correctly-rounded-divide-sqrt "
+
+struct device {
+	char spec[64];
+	bvhlab_cl cl;
+	unsigned stack[MAX_PROGRAMS]; /* the stack size each program was built with */
+	cl_program program[MAX_PROGRAMS];
+	unsigned programs;
+};
+
+/* Kept for the process's life (see trace_cl.h): at most a few specs. */
+static struct device devices[4];
+static unsigned device_count;
+static pthread_mutex_t devices_lock = PTHREAD_MUTEX_INITIALIZER;
+
+struct trace_cl_tree {
+	struct device *dev;
+	cl_kernel kernel;
+	cl_mem nodes, tris, prim_index, parents;
+	uint32_t node_count, index_count, tri_count;
+};
+
+struct trace_cl_batch {
+	struct trace_cl_tree *t;
+	cl_mem rays, hits, counts;
+	size_t count;
+	cl_uint any;
+};
+
+bool trace_cl_built(void)
+{
+	return true;
+}
+
+static void cl_error(bvhlab_error *err, const char *msg)
+{
+	error_set(err, "%s", msg);
+}
+
+/* The device a spec names, made once. */
+static int get_device(const char *spec, struct device **out, bvhlab_error *err)
+{
+	char why[BVHLAB_CL_ERROR_SIZE];
+	spec = spec ? spec : "auto";
+	for (unsigned i = 0; i < device_count; i++) {
+		if (strcmp(devices[i].spec, spec) == 0) {
+			*out = &devices[i];
+			return 0;
+		}
+	}
+	if (device_count == sizeof(devices) / sizeof(devices[0]) ||
+	    strlen(spec) >= sizeof(devices[0].spec)) {
+		error_set(err, "cl: too many device specs in one process (or '%.40s' too long)", spec);
+		return -EINVAL;
+	}
+	struct device *d = &devices[device_count];
+	int r = bvhlab_cl_init(&d->cl, spec, why, sizeof(why));
+	if (r < 0) {
+		cl_error(err, why);
+		return r;
+	}
+	snprintf(d->spec, sizeof(d->spec), "%s", spec);
+	device_count++;
+	*out = d;
+	return 0;
+}
+
+/* The program for a stack of at least `stack` entries, built once. */
+static int get_program(struct device *d, unsigned stack, cl_program *out, bvhlab_error *err)
+{
+	char why[BVHLAB_CL_ERROR_SIZE], options[160];
+	for (unsigned i = 0; i < d->programs; i++) {
+		if (d->stack[i] == stack) {
+			*out = d->program[i];
+			return 0;
+		}
+	}
+	if (d->programs == MAX_PROGRAMS) {
+		error_set(err, "cl: too many stack sizes in one process");
+		return -ENOMEM;
+	}
+	cl_device_fp_config fp = 0;
+	clGetDeviceInfo(d->cl.device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, NULL);
+	snprintf(options, sizeof(options), BUILD_OPTIONS,
+	         fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT ? EXACT_DIVIDE : "", stack);
+	int r = bvhlab_cl_program(&d->cl, trace_cl_source, trace_cl_source_LEN, options,
+	                          &d->program[d->programs], why, sizeof(why));
+	if (r < 0) {
+		cl_error(err, why);
+		return r;
+	}
+	d->stack[d->programs] = stack;
+	*out = d->program[d->programs++];
+	return 0;
+}
+
+/* Inner nodes on the longest root-to-leaf path: the most far children the
+ * stack kernel holds at once. -EINVAL for links that leave the array. */
+static int tree_depth(const bvhlab_tree *tree, unsigned *depth)
+{
+	uint32_t n = tree->node_count, sp = 0;
+	uint32_t (*stack)[2] = malloc((n ? n : 1) * sizeof(*stack));
+	*depth = 0;
+	if (!stack)
+		return -ENOMEM;
+	if (n)
+		stack[sp][0] = 0, stack[sp++][1] = 0;
+	while (sp) {
+		uint32_t node = stack[--sp][0], d = stack[sp][1];
+		const bvhlab_node *nd = &tree->nodes[node];
+		if (nd->count)
+			continue;
+		if (nd->first == 0 || nd->first >= n - 1 || sp + 2 > n) {
+			free(stack);
+			return -EINVAL;
+		}
+		*depth = d + 1 > *depth ? d + 1 : *depth;
+		stack[sp][0] = nd->first, stack[sp++][1] = d + 1;
+		stack[sp][0] = nd->first + 1, stack[sp++][1] = d + 1;
+	}
+	free(stack);
+	return 0;
+}
+
+static unsigned stack_size(unsigned depth)
+{
+	unsigned s = MIN_STACK;
+	while (s < depth + 1)
+		s *= 2;
+	return s;
+}
+
+/* A read-only buffer holding bytes (at least 4, so empty arrays upload). */
+static int upload(struct device *d, const void *data, size_t bytes, cl_mem *out,
+                  const char *what, bvhlab_error *err)
+{
+	char why[256];
+	cl_int rc;
+	static const uint32_t zero = 0;
+	*out = clCreateBuffer(d->cl.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+	                      bytes ? bytes : sizeof(zero), bytes ? (void *)data : (void *)&zero,
+	                      &rc);
+	int r = bvhlab_cl_check(rc, what, why, sizeof(why));
+	if (r < 0)
+		error_set(err, "%s (%zu bytes on %s)", why, bytes, d->cl.name);
+	return r;
+}
+
+/* The triangles' vertices in leaf-slot order, as the CPU batch copy. */
+static float *slot_vertices(const bvhlab_tree *tree, const bvhlab_scene *scene)
+{
+	float *v = calloc((size_t)tree->index_count * 9 + 1, sizeof(*v));
+	for (uint32_t i = 0; v && i < tree->index_count; i++) {
+		uint32_t prim = tree->prim_index[i];
+		if (prim >= scene->triangle_count)
+			continue; /* zeros: the kernel skips such slots */
+		for (int k = 0; k < 3; k++)
+			memcpy(v + 9 * (size_t)i + 3 * k,
+			       scene->vertices + 3 * (size_t)scene->indices[3 * (size_t)prim + k],
+			       3 * sizeof(float));
+	}
+	return v;
+}
+
+static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
+                       const bvhlab_scene *scene, bvhlab_error *err)
+{
+	uint32_t *parents = NULL;
+	float *verts = slot_vertices(tree, scene);
+	int r = verts ? bvhlab_tree_parents(tree, &parents) : -ENOMEM;
+	if (r == -EINVAL)
+		error_set(err, "cl: the tree's child links do not make a tree");
+	else if (r < 0)
+		error_set(err, "cl: out of memory");
+	if (r == 0)
+		r = upload(t->dev, tree->nodes, (size_t)tree->node_count * sizeof(bvhlab_node),
+		           &t->nodes, "nodes", err);
+	if (r == 0)
+		r = upload(t->dev, verts, (size_t)tree->index_count * 9 * sizeof(float), &t->tris,
+		           "triangles", err);
+	if (r == 0)
+		r = upload(t->dev, tree->prim_index, (size_t)tree->index_count * sizeof(uint32_t),
+		           &t->prim_index, "prim_index", err);
+	if (r == 0)
+		r = upload(t->dev, parents, (size_t)tree->node_count * sizeof(uint32_t), &t->parents,
+		           "parents", err);
+	free(verts);
+	free(parents);
+	return r;
+}
+
+static int set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
+{
+	char why[256];
+	cl_int rc = clSetKernelArg(t->kernel, 0, sizeof(cl_mem), &t->nodes);
+	rc |= clSetKernelArg(t->kernel, 1, sizeof(cl_mem), &t->tris);
+	rc |= clSetKernelArg(t->kernel, 2, sizeof(cl_mem), &t->prim_index);
+	rc |= clSetKernelArg(t->kernel, 3, sizeof(cl_mem), &t->parents);
+	rc |= clSetKernelArg(t->kernel, 4, sizeof(cl_uint), &t->node_count);
+	rc |= clSetKernelArg(t->kernel, 5, sizeof(cl_uint), &t->index_count);
+	rc |= clSetKernelArg(t->kernel, 6, sizeof(cl_uint), &t->tri_count);
+	int r = bvhlab_cl_check(rc ? CL_INVALID_KERNEL_ARGS : CL_SUCCESS, "clSetKernelArg", why,
+	                        sizeof(why));
+	if (r < 0)
+		cl_error(err, why);
+	return r;
+}
+
+static int make_kernel(struct trace_cl_tree *t, int traversal, unsigned depth,
+                       bvhlab_error *err)
+{
+	char why[512];
+	cl_program prog;
+	int r = get_program(t->dev, stack_size(depth), &prog, err);
+	if (r == 0)
+		r = bvhlab_cl_kernel(prog, traversal == BVHLAB_TRAVERSAL_CL_STACK ? "trace_stack"
+		                                                                   : "trace_stackless",
+		                     &t->kernel, why, sizeof(why));
+	if (r < 0 && !err->message[0])
+		cl_error(err, why);
+	return r;
+}
+
+int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *tree,
+                         const bvhlab_scene *scene, struct trace_cl_tree **out,
+                         bvhlab_error *err)
+{
+	unsigned depth;
+	*out = NULL;
+	if (traversal != BVHLAB_TRAVERSAL_CL_STACK && traversal != BVHLAB_TRAVERSAL_CL_STACKLESS) {
+		error_set(err, "cl: not a device traversal (%d)", traversal);
+		return -EINVAL;
+	}
+	int r = tree_depth(tree, &depth);
+	if (r < 0) {
+		error_set(err, r == -ENOMEM ? "cl: out of memory" : "cl: the tree's links leave it");
+		return r;
+	}
+	struct trace_cl_tree *t = calloc(1, sizeof(*t));
+	if (!t)
+		return -ENOMEM;
+	t->node_count = tree->node_count;
+	t->index_count = tree->index_count;
+	t->tri_count = scene->triangle_count;
+	pthread_mutex_lock(&devices_lock);
+	r = get_device(device, &t->dev, err);
+	if (r == 0)
+		r = make_kernel(t, traversal, depth, err);
+	pthread_mutex_unlock(&devices_lock);
+	if (r == 0)
+		r = upload_tree(t, tree, scene, err);
+	if (r == 0)
+		r = set_tree_args(t, err);
+	if (r < 0) {
+		trace_cl_tree_destroy(t);
+		return r;
+	}
+	*out = t;
+	return 0;
+}
+
+void trace_cl_tree_destroy(struct trace_cl_tree *t)
+{
+	if (!t)
+		return;
+	bvhlab_cl_release_kernel(&t->kernel);
+	bvhlab_cl_release_mem(&t->nodes);
+	bvhlab_cl_release_mem(&t->tris);
+	bvhlab_cl_release_mem(&t->prim_index);
+	bvhlab_cl_release_mem(&t->parents);
+	free(t);
+}
+
+const char *trace_cl_device_name(const struct trace_cl_tree *t)
+{
+	return t->dev->cl.name;
+}
+
+static int output_buffer(struct trace_cl_tree *t, size_t bytes, cl_mem *out, bvhlab_error *err)
+{
+	char why[256];
+	cl_int rc;
+	*out = clCreateBuffer(t->dev->cl.context, CL_MEM_WRITE_ONLY, bytes ? bytes : 16, NULL, &rc);
+	int r = bvhlab_cl_check(rc, "clCreateBuffer", why, sizeof(why));
+	if (r < 0)
+		error_set(err, "%s (%zu bytes on %s)", why, bytes, t->dev->cl.name);
+	return r;
+}
+
+int trace_cl_batch_create(struct trace_cl_tree *t, const bvhlab_ray *rays, size_t count,
+                          bool any_hit, struct trace_cl_batch **out, bvhlab_error *err)
+{
+	*out = NULL;
+	if (count > UINT32_MAX - RAYS_PER_GROUP) {
+		error_set(err, "cl: %zu rays in one batch: too many", count);
+		return -EINVAL;
+	}
+	struct trace_cl_batch *b = calloc(1, sizeof(*b));
+	if (!b)
+		return -ENOMEM;
+	b->t = t;
+	b->count = count;
+	b->any = any_hit;
+	int r = upload(t->dev, rays, count * sizeof(*rays), &b->rays, "rays", err);
+	if (r == 0)
+		r = output_buffer(t, count * sizeof(bvhlab_hit), &b->hits, err);
+	if (r == 0)
+		r = output_buffer(t, count * 2 * sizeof(uint32_t), &b->counts, err);
+	if (r < 0) {
+		trace_cl_batch_destroy(b);
+		return r;
+	}
+	*out = b;
+	return 0;
+}
+
+void trace_cl_batch_destroy(struct trace_cl_batch *b)
+{
+	if (!b)
+		return;
+	bvhlab_cl_release_mem(&b->rays);
+	bvhlab_cl_release_mem(&b->hits);
+	bvhlab_cl_release_mem(&b->counts);
+	free(b);
+}
+
+/* The batch's own arguments: the kernel is the tree's, shared by its
+ * batches, so they are set before every launch. */
+static cl_int set_batch_args(struct trace_cl_batch *b)
+{
+	cl_kernel k = b->t->kernel;
+	cl_uint n = (cl_uint)b->count;
+	cl_int rc = clSetKernelArg(k, 7, sizeof(cl_mem), &b->rays);
+	rc |= clSetKernelArg(k, 8, sizeof(cl_uint), &n);
+	rc |= clSetKernelArg(k, 9, sizeof(cl_uint), &b->any);
+	rc |= clSetKernelArg(k, 10, sizeof(cl_mem), &b->hits);
+	rc |= clSetKernelArg(k, 11, sizeof(cl_mem), &b->counts);
+	return rc ? CL_INVALID_KERNEL_ARGS : CL_SUCCESS;
+}
+
+/* The per-ray counters into nodes and stats; -EIO when a ray overflowed
+ * the stack (the host sized it from the tree: cannot happen on one). */
+static int take_counts(const uint32_t *c, size_t n, uint32_t *nodes, bvhlab_trace_stats *stats,
+                       bvhlab_error *err)
+{
+	bvhlab_trace_stats s = {.rays = n};
+	for (size_t i = 0; i < n; i++) {
+		if (c[2 * i] == OVERFLOW) {
+			error_set(err, "cl: ray %zu overflowed the stack kernel's stack", i);
+			return -EIO;
+		}
+		s.nodes_visited += c[2 * i];
+		s.tris_tested += c[2 * i + 1];
+		if (nodes)
+			nodes[i] = c[2 * i];
+	}
+	if (stats)
+		*stats = s;
+	return 0;
+}
+
+static int read_back(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
+                     bvhlab_trace_stats *stats, bvhlab_error *err)
+{
+	char why[256];
+	cl_command_queue q = b->t->dev->cl.queue;
+	cl_int rc = CL_SUCCESS;
+	uint32_t *c = malloc(b->count * 2 * sizeof(*c) + 1);
+	if (!c)
+		return -ENOMEM;
+	if (hits) /* uint4 (t, u, v bits, prim): bvhlab_hit's layout */
+		rc = clEnqueueReadBuffer(q, b->hits, CL_TRUE, 0, b->count * sizeof(*hits), hits, 0,
+		                         NULL, NULL);
+	if (rc == CL_SUCCESS)
+		rc = clEnqueueReadBuffer(q, b->counts, CL_TRUE, 0, b->count * 2 * sizeof(*c), c, 0,
+		                         NULL, NULL);
+	int r = bvhlab_cl_check(rc, "clEnqueueReadBuffer", why, sizeof(why));
+	if (r < 0)
+		cl_error(err, why);
+	else
+		r = take_counts(c, b->count, nodes, stats, err);
+	free(c);
+	return r;
+}
+
+int trace_cl_pass(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
+                  bvhlab_trace_stats *stats, double *kernel_s, double *wall_s,
+                  bvhlab_error *err)
+{
+	char why[256];
+	cl_event ev = NULL;
+	size_t global = (b->count + RAYS_PER_GROUP - 1) / RAYS_PER_GROUP * RAYS_PER_GROUP;
+	*kernel_s = *wall_s = 0;
+	if (b->count == 0)
+		return 0;
+	cl_int rc = set_batch_args(b);
+	double t0 = util_now();
+	if (rc == CL_SUCCESS)
+		rc = clEnqueueNDRangeKernel(b->t->dev->cl.queue, b->t->kernel, 1, NULL, &global, NULL,
+		                            0, NULL, &ev);
+	if (rc == CL_SUCCESS)
+		rc = clWaitForEvents(1, &ev);
+	*wall_s = util_now() - t0;
+	int r = bvhlab_cl_check(rc, "tracing kernel", why, sizeof(why));
+	if (r == 0) {
+		double ms = bvhlab_cl_event_ms(ev);
+		*kernel_s = ms >= 0 ? ms * 1e-3 : *wall_s; /* no profiling: the wall clock */
+	} else {
+		error_set(err, "%s on %s", why, b->t->dev->cl.name);
+	}
+	bvhlab_cl_release_event(&ev);
+	if (r == 0 && (hits || nodes || stats))
+		r = read_back(b, hits, nodes, stats, err);
+	return r;
+}

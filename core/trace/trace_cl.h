@@ -1,0 +1,58 @@
+/*
+ * The device traversals (rays.traversal "cl_stack", "cl_stackless"):
+ * trace_cl.cl's kernels on an OpenCL device chosen by a spec (auto, gpu,
+ * cpu or P:D, include/bvhlab/opencl.h). A tree is uploaded once (nodes,
+ * its triangles' vertices in leaf-slot order, prim_index, parent links);
+ * each batch of rays once; a pass is one kernel launch, timed by its
+ * profiling event (the kernel's own time) and by the wall clock (launch to
+ * completion). Built only with OpenCL (BVHLAB_HAVE_OPENCL); without it
+ * trace_cl_tree_create says so.
+ *
+ * The device and its compiled program are kept for the life of the
+ * process (one per device spec and stack size): PoCL takes seconds to
+ * compile a program, and a sweep's child traces many batches.
+ */
+#ifndef BVHLAB_CORE_TRACE_CL_H
+#define BVHLAB_CORE_TRACE_CL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <bvhlab/trace.h>
+#include <bvhlab/types.h>
+
+struct trace_cl_tree;
+struct trace_cl_batch;
+
+/* Whether this build has the device traversals. */
+bool trace_cl_built(void);
+
+/* The traversal (BVHLAB_TRAVERSAL_CL_STACK or _CL_STACKLESS) of tree on
+ * the device `device` names (NULL: "auto"). 0, or a negative errno with
+ * err saying why: -ENOTSUP OpenCL not built, -ENODEV no platform or device
+ * (what to install), -EINVAL a bad spec or tree links, -ENOMEM, -EIO. */
+int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *tree,
+                         const bvhlab_scene *scene, struct trace_cl_tree **out,
+                         bvhlab_error *err);
+void trace_cl_tree_destroy(struct trace_cl_tree *t);
+
+/* The device's name (CL_DEVICE_NAME). */
+const char *trace_cl_device_name(const struct trace_cl_tree *t);
+
+/* A batch of rays on t's device (t must outlive it); count may be 0. */
+int trace_cl_batch_create(struct trace_cl_tree *t, const bvhlab_ray *rays, size_t count,
+                          bool any_hit, struct trace_cl_batch **out, bvhlab_error *err);
+void trace_cl_batch_destroy(struct trace_cl_batch *b);
+
+/*
+ * One pass over the batch: *kernel_s the kernel's own time (profiling
+ * event), *wall_s launch to completion. hits and nodes (may be NULL) get
+ * each ray's hit and nodes entered, stats (may be NULL) this pass's
+ * counters: read back after the timed part. 0 or a negative errno (err).
+ */
+int trace_cl_pass(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
+                  bvhlab_trace_stats *stats, double *kernel_s, double *wall_s,
+                  bvhlab_error *err);
+
+#endif

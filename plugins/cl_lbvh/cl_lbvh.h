@@ -1,0 +1,41 @@
+/* cl_lbvh: one build's state and its device run (see cl_lbvh.c). */
+#ifndef BVHLAB_CL_LBVH_H
+#define BVHLAB_CL_LBVH_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "cl_dev.h"
+
+/* The device buffers besides the sort's. */
+enum { LB_BOUNDS, LB_PARENT, LB_END, LB_NODES, LB_VISITS, LB_COST, LB_FLAGS, LB_INDEX,
+       LB_INNER, LB_LEAVES, LB_LCP, LB_COUNT };
+
+typedef struct cl_lbvh {
+	const bvhlab_build_input *in;
+	uint32_t n;
+	const char *device;
+	unsigned bits;
+	bool collapse;
+	uint32_t max_leaf;
+	float c_trav, c_isect;
+	uint32_t leaf_block;  /* leaves per work-item in bounds; 0: by device */
+	const char *hierarchy; /* auto, search or scan */
+
+	cl_dev *dev;
+	cl_sort *sort;
+	cl_buf *b;           /* [LB_COUNT] */
+	double ms[4];        /* upload, device, download, convert */
+} cl_lbvh;
+
+/* Builds the tree of n >= 2 primitives into out (room for 2n - 1 nodes and
+ * n indices): 0, or a negative errno with the message in err. */
+int cl_lbvh_run(cl_lbvh *b, bvhlab_build_output *out, char *err, size_t err_size);
+
+/* The collapsed tree compacted as lbvh_collapse.c does it: inner[i] says
+ * whether internal node i stays inner, parent[] holds the internal nodes'
+ * parent words. Returns the node count. */
+uint32_t cl_lbvh_compact(bvhlab_node *nodes, const uint8_t *inner, const uint32_t *parent,
+                         uint32_t n);
+
+#endif /* BVHLAB_CL_LBVH_H */

@@ -1,0 +1,177 @@
+/*
+ * cl_lbvh's device run: every buffer sized first, the uploads, the sort
+ * (plugins/common/cl), then karras, bounds and inner_nodes; the kernels
+ * queue back to back on the in-order queue and the host waits once.
+ */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cl_lbvh.h"
+
+enum { K_KARRAS = CL_SORT_KERNELS, K_BOUNDS, K_INNER, K_GATHER, K_PREFIXES, K_SCAN };
+
+/* Zero bytes on either side of lcp[] (cl_lbvh.cl's LCP_PAD). */
+#define LCP_PAD 32
+
+/* Leaves per work-item of the bounds kernel on a CPU device: a few
+ * thousand work-items on a million leaves, each climb mostly in cache and
+ * without atomics; on a GPU, one leaf each. */
+#define CPU_LEAF_BLOCK 512u
+
+static int size_buffers(cl_lbvh *b, char *err, size_t err_size)
+{
+	size_t n = b->n, want[LB_COUNT + SB_COUNT];
+
+	want[LB_BOUNDS] = want[LB_LEAVES] = 24 * n;
+	want[LB_PARENT] = 4 * (2 * n - 1);
+	want[LB_END] = want[LB_VISITS] = want[LB_COST] = 4 * (n - 1);
+	want[LB_NODES] = 32 * (2 * n - 1);
+	want[LB_FLAGS] = want[LB_INNER] = n - 1;
+	want[LB_LCP] = n - 1 + 2 * LCP_PAD;
+	want[LB_INDEX] = 4 * n;
+	cl_sort_sizes(b->n, want + LB_COUNT);
+	/* Both sets at once against the device's memory, then each made. */
+	int rc = cl_bufs_fit(b->dev, want, LB_COUNT + SB_COUNT, err, err_size);
+
+	if (rc == 0)
+		rc = cl_bufs_size(b->dev, b->b, want, LB_COUNT, err, err_size);
+	return rc < 0 ? rc : cl_bufs_size(b->dev, b->sort->b, want + LB_COUNT, SB_COUNT, err,
+	                                  err_size);
+}
+
+static int zero(cl_lbvh *b, int which, size_t bytes, cl_events *ev, char *err,
+                size_t err_size)
+{
+	cl_uchar z = 0;
+
+	return bvhlab_cl_check(clEnqueueFillBuffer(b->dev->cl.queue, b->b[which].mem, &z, 1, 0,
+	                                           bytes, 0, NULL, cl_events_next(ev)),
+	                       "clEnqueueFillBuffer", err, err_size);
+}
+
+/* Every internal node's range and split: by Karras's searches, or by
+ * lbvh's scans of the prefix lengths (prefixes, then karras_scan). */
+static int karras(cl_lbvh *b, cl_mem keys, cl_events *ev, char *err, size_t err_size)
+{
+	cl_dev *d = b->dev;
+	cl_uint n = b->n, items = n - 1 > LCP_PAD ? n - 1 : LCP_PAD;
+	bool scan = !strcmp(b->hierarchy, "scan") ||
+	            (!strcmp(b->hierarchy, "auto") && (d->cl.type & CL_DEVICE_TYPE_CPU));
+	cl_mem lcp = b->b[LB_LCP].mem, parent = b->b[LB_PARENT].mem, end = b->b[LB_END].mem;
+	cl_arg ka[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(parent), CL_ARG(end) };
+	cl_arg pa[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(lcp) };
+	cl_arg sa[] = { CL_ARG(keys), CL_ARG(n), CL_ARG(lcp), CL_ARG(parent), CL_ARG(end) };
+	int rc;
+
+	if (!scan)
+		return cl_launch(d, d->k[K_KARRAS], n - 1, ka, 4, ev, err, err_size);
+	if ((rc = cl_launch(d, d->k[K_PREFIXES], items, pa, 3, ev, err, err_size)) < 0)
+		return rc;
+	return cl_launch(d, d->k[K_SCAN], n - 1, sa, 5, ev, err, err_size);
+}
+
+static int hierarchy(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
+{
+	cl_dev *d = b->dev;
+	cl_mem keys = b->sort->b[SB_KEYS0 + b->sort->sorted].mem;
+	cl_mem order = b->sort->b[SB_VALS0 + b->sort->sorted].mem;
+	cl_uint collapse = b->collapse, n = b->n, max_leaf = b->max_leaf;
+	cl_uint block = b->leaf_block ? b->leaf_block
+	                              : d->cl.type & CL_DEVICE_TYPE_CPU ? CPU_LEAF_BLOCK : 1;
+	cl_arg ga[] = { CL_ARG(b->b[LB_BOUNDS].mem), CL_ARG(order), CL_ARG(n),
+	                CL_ARG(b->b[LB_LEAVES].mem), CL_ARG(b->b[LB_INDEX].mem) };
+	cl_arg ba[] = { CL_ARG(b->b[LB_LEAVES].mem), CL_ARG(n), CL_ARG(block),
+	                CL_ARG(b->b[LB_PARENT].mem), CL_ARG(b->b[LB_END].mem),
+	                CL_ARG(b->b[LB_NODES].mem), CL_ARG(b->b[LB_VISITS].mem),
+	                CL_ARG(b->b[LB_COST].mem), CL_ARG(b->b[LB_FLAGS].mem), CL_ARG(collapse),
+	                CL_ARG(max_leaf), CL_ARG(b->c_trav), CL_ARG(b->c_isect) };
+	cl_arg ia[] = { CL_ARG(b->b[LB_PARENT].mem), CL_ARG(b->b[LB_END].mem),
+	                CL_ARG(b->b[LB_FLAGS].mem), CL_ARG(n), CL_ARG(max_leaf),
+	                CL_ARG(b->b[LB_INNER].mem) };
+	int rc;
+
+	if ((rc = cl_launch(d, d->k[K_GATHER], n, ga, 5, ev, err, err_size)) < 0 ||
+	    (rc = karras(b, keys, ev, err, err_size)) < 0 ||
+	    (rc = zero(b, LB_VISITS, 4 * (size_t)(n - 1), ev, err, err_size)) < 0 ||
+	    (rc = zero(b, LB_FLAGS, n - 1, ev, err, err_size)) < 0 ||
+	    (rc = cl_launch(d, d->k[K_BOUNDS], (n + block - 1) / block, ba, 13, ev, err,
+	                    err_size)) < 0)
+		return rc;
+	if (!b->collapse)
+		return 0;
+	return cl_launch(d, d->k[K_INNER], n - 1, ia, 6, ev, err, err_size);
+}
+
+static int read(cl_lbvh *b, int which, size_t bytes, void *to, char *err, size_t err_size)
+{
+	return bvhlab_cl_check(clEnqueueReadBuffer(b->dev->cl.queue, b->b[which].mem, CL_TRUE,
+	                                           0, bytes, to, 0, NULL, NULL),
+	                       "clEnqueueReadBuffer", err, err_size);
+}
+
+/* The tree into out; with collapse, the flags and parents for the
+ * compaction into `inner` and `parent` (host memory). */
+static int download(cl_lbvh *b, bvhlab_build_output *out, uint8_t *inner, uint32_t *parent,
+                    char *err, size_t err_size)
+{
+	size_t n = b->n;
+	int rc;
+
+	if ((rc = read(b, LB_NODES, 32 * (2 * n - 1), out->nodes, err, err_size)) < 0 ||
+	    (rc = read(b, LB_INDEX, 4 * n, out->prim_index, err, err_size)) < 0)
+		return rc;
+	if (!b->collapse)
+		return 0;
+	if ((rc = read(b, LB_INNER, n - 1, inner, err, err_size)) < 0)
+		return rc;
+	return read(b, LB_PARENT, 4 * (n - 1), parent, err, err_size);
+}
+
+static int upload(cl_lbvh *b, char *err, size_t err_size)
+{
+	double t0 = cl_now_ms();
+	int rc = bvhlab_cl_check(clEnqueueWriteBuffer(b->dev->cl.queue, b->b[LB_BOUNDS].mem,
+	                                              CL_TRUE, 0, 24 * (size_t)b->n,
+	                                              b->in->prim_bounds, 0, NULL, NULL),
+	                         "uploading the primitive boxes", err, err_size);
+
+	b->ms[0] += cl_now_ms() - t0;
+	return rc;
+}
+
+int cl_lbvh_run(cl_lbvh *b, bvhlab_build_output *out, char *err, size_t err_size)
+{
+	cl_events ev = { .count = 0 };
+	uint8_t *inner = NULL;
+	uint32_t *parent = NULL;
+	double t0, up = 0;
+	int rc;
+
+	if ((rc = size_buffers(b, err, err_size)) < 0 || (rc = upload(b, err, err_size)) < 0)
+		return rc;
+	if (b->collapse && (!(inner = malloc(b->n)) || !(parent = malloc(4 * (size_t)b->n)))) {
+		rc = bvhlab_cl_fail(-ENOMEM, err, err_size, "out of memory for %u primitives", b->n);
+		goto out;
+	}
+	if ((rc = cl_sort_run(b->dev, b->sort, b->in, b->bits, &ev, &up, err, err_size)) < 0 ||
+	    (rc = hierarchy(b, &ev, err, err_size)) < 0 ||
+	    (rc = bvhlab_cl_check(clFinish(b->dev->cl.queue), "clFinish", err, err_size)) < 0)
+		goto out;
+	b->ms[0] += up;
+	t0 = cl_now_ms();
+	if ((rc = download(b, out, inner, parent, err, err_size)) < 0)
+		goto out;
+	b->ms[2] = cl_now_ms() - t0;
+	t0 = cl_now_ms();
+	out->node_count = b->collapse ? cl_lbvh_compact(out->nodes, inner, parent, b->n)
+	                              : 2 * b->n - 1;
+	out->index_count = b->n;
+	b->ms[3] = cl_now_ms() - t0;
+out:
+	clFinish(b->dev->cl.queue);
+	b->ms[1] = cl_events_ms(&ev);
+	free(inner);
+	free(parent);
+	return rc;
+}

@@ -1,0 +1,125 @@
+/*
+ * What the device builders (cl_lbvh, cl_ploc) share on the host side, over
+ * the device layer of include/bvhlab/opencl.h (a static library linked into
+ * each plugin):
+ *
+ *   - cl_dev: the device, its built program and kernels, kept between
+ *     builds (a build is timed whole, and compiling the kernels is not the
+ *     builder's work), made again when the `device` option changes;
+ *   - cl_buf: device buffers that grow, all sized before any kernel runs;
+ *   - cl_events: the kernels' events, summed into the phase "device";
+ *   - the Morton codes and their radix sort (cl_sort.c, kernels in
+ *     morton_sort.cl), mirroring plugins/common/morton.
+ */
+#ifndef BVHLAB_CL_DEV_H
+#define BVHLAB_CL_DEV_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include <bvhlab/opencl.h>
+#include <bvhlab/builder.h>
+
+/* Build option of every device builder's program where the device has
+ * it: correctly rounded division and square root, as the CPU's. (The
+ * kernels also turn contraction into fma off, by pragma; none divides
+ * today: the quantiser's scale comes from the host.) */
+#define CL_DEV_OPTIONS "-cl-fp32-correctly-rounded-divide-sqrt"
+#define CL_DEV_MAX_KERNELS 16
+
+/* The option every device builder has. */
+#define CL_DEVICE_OPTION_DECL                                                         \
+	{ .name = "device", .type = BVHLAB_OPTION_STRING,                              \
+	  .help = "OpenCL device: auto (the first GPU, else the first device), gpu, "   \
+	          "cpu, or P:D (platform and device indices, as clinfo -l lists them)", \
+	  .def_string = "auto" }
+
+typedef struct cl_dev {
+	bvhlab_cl cl;
+	char spec[64];
+	cl_program prog;
+	cl_kernel k[CL_DEV_MAX_KERNELS];
+	unsigned kernel_count;
+} cl_dev;
+
+/* The device of `spec` with the program of `src` built and its kernels
+ * (`names`, in order, into d->k) made; reuses what d holds for the same
+ * spec and source. 0, or a negative errno with the message in err. */
+int cl_dev_open(cl_dev *d, const char *spec, const char *src, size_t len,
+                const char *const *names, unsigned count, char *err, size_t err_size);
+/* Releases everything; safe on a zeroed or closed cl_dev. */
+void cl_dev_close(cl_dev *d);
+
+/* A device buffer of at least `bytes`, kept and grown between builds. */
+typedef struct cl_buf {
+	cl_mem mem;
+	size_t bytes;
+} cl_buf;
+
+/* Whether buffers of want[k] bytes fit the device (each its largest
+ * allocation, the sum its memory): 0, or -ENOMEM saying how much was
+ * needed. */
+int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
+                size_t err_size);
+/* Makes every buffer at least its wanted size (want[k] bytes), after
+ * cl_bufs_fit. Done before any kernel runs. */
+int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count,
+                 char *err, size_t err_size);
+void cl_bufs_free(cl_buf *bufs, unsigned count);
+
+/* The events of one build's kernels, for the phase "device". */
+#define CL_EVENTS_MAX 256
+typedef struct cl_events {
+	cl_event ev[CL_EVENTS_MAX];
+	unsigned count;
+	double ms; /* of events already summed and released (a full list) */
+} cl_events;
+
+/* Runs kernel k over `items` work-items (rounded up to a work-group
+ * multiple; kernels check their bounds) after setting its arguments:
+ * pairs of (size, pointer) in args, `nargs` of them. */
+typedef struct cl_arg {
+	size_t size;
+	const void *value;
+} cl_arg;
+#define CL_ARG(x) ((cl_arg){ sizeof(x), &(x) })
+
+int cl_launch(cl_dev *d, cl_kernel k, size_t items, const cl_arg *args, unsigned nargs,
+              cl_events *ev, char *err, size_t err_size);
+/* An event slot for a kernel, copy or fill; a full list is waited for
+ * and summed first. */
+cl_event *cl_events_next(cl_events *ev);
+/* Sum of the events' profiled times in ms (after clFinish); releases them. */
+double cl_events_ms(cl_events *ev);
+
+/* Monotonic clock, ms. */
+double cl_now_ms(void);
+
+/* ---- Morton codes and sort (cl_sort.c) -------------------------------- */
+
+/* Kernel names the program must have, first in the names given to
+ * cl_dev_open (cl_sort uses d->k[0..CL_SORT_KERNELS - 1]). */
+#define CL_SORT_KERNEL_NAMES "morton_codes", "morton_varying", "radix_hist", \
+	"radix_scan", "radix_scatter"
+#define CL_SORT_KERNELS 5
+
+/* The sort's buffers. */
+enum { SB_CENTROIDS, SB_KEYS0, SB_KEYS1, SB_VALS0, SB_VALS1, SB_HIST, SB_PART, SB_COUNT };
+
+typedef struct cl_sort {
+	cl_buf b[SB_COUNT];
+	unsigned sorted; /* after cl_sort_run: keys/vals[sorted] hold the order */
+} cl_sort;
+
+/* Bytes of each of the sort's buffers for n primitives (into want[]). */
+void cl_sort_sizes(uint32_t n, size_t want[SB_COUNT]);
+/*
+ * Uploads the centroids (blocking; its wall-clock time into *ms_upload),
+ * computes the codes of `bits` (30 or 63) as plugins/common/morton does,
+ * and sorts the (code, id) pairs, the kernels' events into ev. Reads back
+ * once, the bits in which the codes vary (which digits need a pass).
+ */
+int cl_sort_run(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned bits,
+                cl_events *ev, double *ms_upload, char *err, size_t err_size);
+
+#endif /* BVHLAB_CL_DEV_H */

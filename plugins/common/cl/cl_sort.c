@@ -1,0 +1,138 @@
+/*
+ * Morton codes and their radix sort on the device (kernels in
+ * morton_sort.cl), giving the order plugins/common/morton gives: the same
+ * quantiser (computed here by the same arithmetic as its quantiser_init),
+ * then stable LSD passes over the 8-bit digits in which some code differs
+ * from the first (the rest would move nothing).
+ */
+#include <errno.h>
+
+#include "cl_dev.h"
+
+enum { K_CODES, K_VARYING, K_HIST, K_SCAN, K_SCATTER };
+
+/* Chunks of the sort: one work-item each; a few hundred keep the scan's
+ * counts small (256 per chunk) and every core busy. */
+#define MIN_CHUNK 256u
+#define CHUNKS 512u
+
+static uint32_t chunk_size(uint32_t n)
+{
+	uint32_t c = (n + CHUNKS - 1) / CHUNKS;
+
+	return c < MIN_CHUNK ? MIN_CHUNK : c;
+}
+
+void cl_sort_sizes(uint32_t n, size_t want[SB_COUNT])
+{
+	uint32_t chunks = (n + chunk_size(n) - 1) / chunk_size(n);
+
+	want[SB_CENTROIDS] = 12 * (size_t)n;
+	want[SB_KEYS0] = want[SB_KEYS1] = 8 * (size_t)n;
+	want[SB_VALS0] = want[SB_VALS1] = 4 * (size_t)n;
+	want[SB_HIST] = 256 * 4 * (size_t)chunks;
+	want[SB_PART] = 8 * (size_t)chunks;
+}
+
+/* morton_sort.c's quantiser_init: cell scale per axis, 0 for a flat one. */
+struct quant {
+	float lo[3], scale[3], top;
+};
+
+static void quant_init(struct quant *q, const bvhlab_aabb *cb, unsigned bits)
+{
+	unsigned axis_bits = bits / 3;
+
+	q->top = (float)((1u << axis_bits) - 1);
+	for (int k = 0; k < 3; k++) {
+		float extent = cb->hi[k] - cb->lo[k];
+		float s = (float)(1u << axis_bits) / extent;
+		q->lo[k] = cb->lo[k];
+		q->scale[k] = extent > 0 && s < 1e30f ? s : 0.0f;
+	}
+}
+
+static int codes(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned bits,
+                 cl_events *ev, char *err, size_t err_size)
+{
+	struct quant q;
+	uint32_t n = in->prim_count;
+
+	quant_init(&q, &in->centroid_bounds, bits);
+	cl_arg args[] = {
+		CL_ARG(s->b[SB_CENTROIDS].mem), CL_ARG(n), CL_ARG(q.lo[0]), CL_ARG(q.lo[1]),
+		CL_ARG(q.lo[2]), CL_ARG(q.scale[0]), CL_ARG(q.scale[1]), CL_ARG(q.scale[2]),
+		CL_ARG(q.top), CL_ARG(s->b[SB_KEYS0].mem), CL_ARG(s->b[SB_VALS0].mem),
+	};
+	return cl_launch(d, d->k[K_CODES], n, args, 11, ev, err, err_size);
+}
+
+/* The bits in which some code differs from the first one's. */
+static int varying(cl_dev *d, cl_sort *s, uint32_t n, uint64_t *bits, cl_events *ev,
+                   char *err, size_t err_size)
+{
+	uint32_t chunk = chunk_size(n), chunks = (n + chunk - 1) / chunk;
+	uint64_t part[CHUNKS + 1];
+	cl_arg args[] = {
+		CL_ARG(s->b[SB_KEYS0].mem), CL_ARG(n), CL_ARG(chunk), CL_ARG(s->b[SB_PART].mem),
+	};
+	int rc = cl_launch(d, d->k[K_VARYING], chunks, args, 4, ev, err, err_size);
+
+	if (rc < 0)
+		return rc;
+	rc = bvhlab_cl_check(clEnqueueReadBuffer(d->cl.queue, s->b[SB_PART].mem, CL_TRUE, 0,
+	                                         8 * (size_t)chunks, part, 0, NULL,
+	                                         cl_events_next(ev)),
+	                     "reading the varying bits", err, err_size);
+	*bits = 0;
+	for (uint32_t c = 0; c < chunks; c++)
+		*bits |= part[c];
+	return rc;
+}
+
+/* One stable pass on the digit at `shift`, from buffers `from` to 1 - from. */
+static int pass(cl_dev *d, cl_sort *s, uint32_t n, uint32_t shift, unsigned from,
+                cl_events *ev, char *err, size_t err_size)
+{
+	uint32_t chunk = chunk_size(n), chunks = (n + chunk - 1) / chunk, total = 256 * chunks;
+	cl_mem kin = s->b[SB_KEYS0 + from].mem, kout = s->b[SB_KEYS0 + 1 - from].mem;
+	cl_mem vin = s->b[SB_VALS0 + from].mem, vout = s->b[SB_VALS0 + 1 - from].mem;
+	cl_mem hist = s->b[SB_HIST].mem;
+	cl_arg h[] = { CL_ARG(kin), CL_ARG(n), CL_ARG(chunk), CL_ARG(chunks), CL_ARG(shift),
+	               CL_ARG(hist) };
+	cl_arg sc[] = { CL_ARG(hist), CL_ARG(total) };
+	cl_arg x[] = { CL_ARG(kin), CL_ARG(vin), CL_ARG(kout), CL_ARG(vout), CL_ARG(n),
+	               CL_ARG(chunk), CL_ARG(chunks), CL_ARG(shift), CL_ARG(hist) };
+	int rc;
+
+	if ((rc = cl_launch(d, d->k[K_HIST], chunks, h, 6, ev, err, err_size)) < 0 ||
+	    (rc = cl_launch(d, d->k[K_SCAN], 1, sc, 2, ev, err, err_size)) < 0)
+		return rc;
+	return cl_launch(d, d->k[K_SCATTER], chunks, x, 9, ev, err, err_size);
+}
+
+int cl_sort_run(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned bits,
+                cl_events *ev, double *ms_upload, char *err, size_t err_size)
+{
+	uint32_t n = in->prim_count;
+	uint64_t vary = 0;
+	double t0 = cl_now_ms();
+	int rc = bvhlab_cl_check(clEnqueueWriteBuffer(d->cl.queue, s->b[SB_CENTROIDS].mem,
+	                                              CL_TRUE, 0, 12 * (size_t)n, in->centroids,
+	                                              0, NULL, NULL),
+	                         "uploading the centroids", err, err_size);
+
+	*ms_upload = cl_now_ms() - t0;
+	s->sorted = 0;
+	if (rc < 0 || (rc = codes(d, s, in, bits, ev, err, err_size)) < 0 ||
+	    (rc = varying(d, s, n, &vary, ev, err, err_size)) < 0)
+		return rc;
+	for (uint32_t shift = 0; shift < 64; shift += 8) {
+		if (!((vary >> shift) & 0xff))
+			continue;
+		if ((rc = pass(d, s, n, shift, s->sorted, ev, err, err_size)) < 0)
+			return rc;
+		s->sorted = 1 - s->sorted;
+	}
+	return 0;
+}

@@ -1,0 +1,114 @@
+/*
+ * Morton codes and their stable LSD radix sort on the device, shared by
+ * cl_lbvh and cl_ploc (concatenated before each plugin's own kernels).
+ *
+ * The codes mirror plugins/common/morton exactly (the host passes the
+ * quantiser's lo, scale and top, computed by the same C), and the sort
+ * gives the CPU builders' (code, primitive) order: values start as the
+ * primitive ids in order and every pass is stable.
+ *
+ * A pass over one 8-bit digit: radix_hist counts each chunk's digits,
+ * radix_scan turns the counts (digit-major: all chunks of digit 0 first)
+ * into each chunk's first output position per digit, radix_scatter moves
+ * each chunk's keys in order. A chunk is one work-item's contiguous run:
+ * simple and stable, and on a CPU device (PoCL) streaming in cache.
+ */
+#pragma OPENCL FP_CONTRACT OFF
+
+#define RADIX 256u
+
+/* The bits of x spread out to every third bit, 21 bits into 63. */
+static ulong spread21(ulong x)
+{
+	x &= 0x1ffffful;
+	x = (x | x << 32) & 0x001f00000000fffful;
+	x = (x | x << 16) & 0x001f0000ff0000fful;
+	x = (x | x << 8) & 0x100f00f00f00f00ful;
+	x = (x | x << 4) & 0x10c30c30c30c30c3ul;
+	x = (x | x << 2) & 0x1249249249249249ul;
+	return x;
+}
+
+/* As morton_sort.c's axis(): clamped, NaN to cell 0, truncated. */
+static ulong axis_cell(float c, float lo, float scale, float top)
+{
+	float x = (c - lo) * scale;
+	x = x > 0 ? x : 0;
+	x = x < top ? x : top;
+	return spread21((ulong)(uint)(int)x);
+}
+
+__kernel void morton_codes(__global const float *centroids, uint n, float lo0, float lo1,
+	float lo2, float s0, float s1, float s2, float top, __global ulong *keys,
+	__global uint *vals)
+{
+	uint i = get_global_id(0);
+	if (i >= n)
+		return;
+	__global const float *c = centroids + 3 * (size_t)i;
+	keys[i] = axis_cell(c[0], lo0, s0, top) << 2 | axis_cell(c[1], lo1, s1, top) << 1 |
+	          axis_cell(c[2], lo2, s2, top);
+	vals[i] = i;
+}
+
+/* Which key bits vary, per chunk: the OR of key ^ keys[0]. Digits that
+ * vary nowhere need no pass. */
+__kernel void morton_varying(__global const ulong *keys, uint n, uint chunk,
+	__global ulong *part)
+{
+	uint c = get_global_id(0);
+	size_t lo = (size_t)c * chunk, hi = min((size_t)n, lo + chunk);
+	ulong k0 = keys[0], acc = 0;
+	if (lo >= n)
+		return;
+	for (size_t i = lo; i < hi; i++)
+		acc |= keys[i] ^ k0;
+	part[c] = acc;
+}
+
+__kernel void radix_hist(__global const ulong *keys, uint n, uint chunk, uint chunks,
+	uint shift, __global uint *hist)
+{
+	uint c = get_global_id(0), count[RADIX];
+	size_t lo = (size_t)c * chunk, hi = min((size_t)n, lo + chunk);
+	if (c >= chunks)
+		return;
+	for (uint d = 0; d < RADIX; d++)
+		count[d] = 0;
+	for (size_t i = lo; i < hi; i++)
+		count[(uint)(keys[i] >> shift) & (RADIX - 1)]++;
+	for (uint d = 0; d < RADIX; d++)
+		hist[d * chunks + c] = count[d];
+}
+
+/* Exclusive prefix over RADIX * chunks counts, in place; one work-item
+ * (a few hundred thousand adds at most). */
+__kernel void radix_scan(__global uint *hist, uint total)
+{
+	uint sum = 0;
+	if (get_global_id(0) != 0)
+		return;
+	for (uint k = 0; k < total; k++) {
+		uint v = hist[k];
+		hist[k] = sum;
+		sum += v;
+	}
+}
+
+__kernel void radix_scatter(__global const ulong *keys, __global const uint *vals,
+	__global ulong *keys_out, __global uint *vals_out, uint n, uint chunk, uint chunks,
+	uint shift, __global const uint *hist)
+{
+	uint c = get_global_id(0), at[RADIX];
+	size_t lo = (size_t)c * chunk, hi = min((size_t)n, lo + chunk);
+	if (c >= chunks)
+		return;
+	for (uint d = 0; d < RADIX; d++)
+		at[d] = hist[d * chunks + c];
+	for (size_t i = lo; i < hi; i++) {
+		ulong k = keys[i];
+		uint d = (uint)(k >> shift) & (RADIX - 1), to = at[d]++;
+		keys_out[to] = k;
+		vals_out[to] = vals[i];
+	}
+}

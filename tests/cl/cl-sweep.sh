@@ -1,0 +1,51 @@
+#!/bin/sh
+# Usage: cl-sweep.sh BVHLAB
+# A sweep naming the device builders beside lbvh, run twice: with OpenCL's
+# drivers hidden (OCL_ICD_VENDORS at an empty folder) the cl_* runs are
+# `failed` with the message that says what to install and lbvh's run is
+# ok; with the machine's drivers, every run is ok and the device runs
+# carry build_phases (device no more than build_ms). Skips (77) when the
+# machine has no OpenCL device.
+set -u
+bvhlab=$1
+dir=$(mktemp -d /tmp/bvhlab-cl-sweep-XXXXXX) || exit 1
+trap 'rm -rf "$dir"' EXIT
+cat > "$dir/sweep.json" <<JSON
+{
+  "format_version": 1, "repeat": 1, "warmup": 0, "threads": [1], "validate": true,
+  "scenes": [ { "name": "soup", "generator": "soup", "count": 500, "seed": 3 } ],
+  "builders": [ { "plugin": "cl_lbvh" }, { "plugin": "cl_ploc" }, { "plugin": "lbvh" } ]
+}
+JSON
+check() { # check RESULTS_DIR python-assertions...
+	python3 - "$1/results.json" "$2" <<'PY'
+import json, sys
+runs = json.load(open(sys.argv[1]))["runs"]
+by = {r["builder"]: r for r in runs}
+exec(sys.argv[2])
+PY
+}
+OCL_ICD_VENDORS="$dir/none" "$bvhlab" run "$dir/sweep.json" --out "$dir/none" >"$dir/log" 2>&1
+check "$dir/none" '
+for b in ("cl_lbvh", "cl_ploc"):
+    assert by[b]["status"] == "failed", by[b]
+    assert "no OpenCL platform found" in by[b]["error"], by[b]["error"]
+    assert "pocl-opencl-icd" in by[b]["error"], by[b]["error"]
+assert by["lbvh"]["status"] == "ok", by["lbvh"]
+print("no drivers: cl_* failed with the message, lbvh ok")
+' || { cat "$dir/log"; exit 1; }
+"$bvhlab" run "$dir/sweep.json" --out "$dir/dev" >"$dir/log" 2>&1
+check "$dir/dev" '
+if "no OpenCL platform" in by["cl_lbvh"].get("error", "") or "no such OpenCL device" in by["cl_lbvh"].get("error", ""):
+    print("skip: no OpenCL device:", by["cl_lbvh"]["error"]); sys.exit(77)
+for b in ("cl_lbvh", "cl_ploc", "lbvh"):
+    assert by[b]["status"] == "ok", by[b]
+for b in ("cl_lbvh", "cl_ploc"):
+    ph = by[b]["build_phases"]
+    assert set(ph) == {"upload", "device", "download", "convert"}, ph
+    assert 0 <= ph["device"] <= by[b]["build_ms"]["median"], (ph, by[b]["build_ms"])
+print("with drivers: every run ok, device phases within build_ms")
+'
+rc=$?
+[ $rc = 0 ] || [ $rc = 77 ] || cat "$dir/log"
+exit $rc

@@ -1,0 +1,231 @@
+/*
+ * The report's verdicts, from hand-written points and results documents
+ * with every figure computed by hand: the Pareto front and who dominates
+ * whom, the break-even ray counts, the reference's fallback when the one
+ * asked for did not run, the noise and load marks, no empty tables, no
+ * speedup for a builder that ran on 1 thread only, and build_phases.
+ */
+#include <math.h>
+
+#include <cJSON.h>
+
+#include "output/report.h"
+#include "testutil.h"
+
+static void test_front_points(void)
+{
+	/* A and B on the front of group 1; C behind A; D behind both, and B,
+	 * the faster, is named; F equals A (neither dominates); E alone in
+	 * group 2; G lacks a figure; H is 0.025 % better than A but slower:
+	 * within the tolerance, A dominates it. */
+	const struct front_point p[] = {
+		{10, 40, 1}, {5, 42, 1}, {12, 41, 1}, {11, 44, 1}, {100, 50, 2}, {10, 40, 1},
+		{1, NAN, 1}, {10.5, 39.99, 1}};
+	long by[8];
+	char buf[128];
+	report_front_points(p, 8, by);
+	CHECK_INT(by[7], 0);
+	report_front_text(buf, sizeof(buf), p, by[7], 7, "A", "SAH");
+	CHECK(strcmp(buf, "dominated by A (0.95× time, same SAH)") == 0);
+	CHECK_INT(by[0], FRONT_ON);
+	CHECK_INT(by[1], FRONT_ON);
+	CHECK_INT(by[2], 0);
+	CHECK_INT(by[3], 1);
+	CHECK_INT(by[4], FRONT_ON);
+	CHECK_INT(by[5], FRONT_ON);
+	CHECK_INT(by[6], FRONT_NONE);
+	/* 10 / 12 = 0.83; (40 - 41) / 41 = -2.44 %. */
+	report_front_text(buf, sizeof(buf), p, by[2], 2, "A", "SAH");
+	CHECK(strcmp(buf, "dominated by A (0.83× time, −2.4 % SAH)") == 0);
+	/* 5 / 11 = 0.45; (42 - 44) / 44 = -4.55 %. */
+	report_front_text(buf, sizeof(buf), p, by[3], 3, "B", "SAH");
+	CHECK(strcmp(buf, "dominated by B (0.45× time, −4.5 % SAH)") == 0);
+	report_front_text(buf, sizeof(buf), p, by[0], 0, "", "SAH");
+	CHECK(strcmp(buf, "front") == 0);
+}
+
+static void test_breakeven(void)
+{
+	char buf[128];
+	/* 10 ms more to build, 1e-7 s less per ray: 100,000 rays. */
+	struct breakeven b = report_breakeven(20, 10, 10, 5);
+	CHECK_INT(b.kind, BREAKEVEN_AFTER);
+	CHECK(fabs(b.rays - 1e5) < 1e-3);
+	report_breakeven_text(buf, sizeof(buf), b, 10000);
+	CHECK(strcmp(buf, "after 100.0 k rays (10.0 frames)") == 0);
+	b = report_breakeven(10, 5, 20, 10);
+	CHECK_INT(b.kind, BREAKEVEN_UNTIL);
+	CHECK(fabs(b.rays - 1e5) < 1e-3);
+	CHECK_INT(report_breakeven(5, 10, 10, 5).kind, BREAKEVEN_ALWAYS);
+	CHECK_INT(report_breakeven(20, 5, 10, 10).kind, BREAKEVEN_NEVER);
+	CHECK_INT(report_breakeven(10, 5, 10, 5).kind, BREAKEVEN_SAME);
+	CHECK_INT(report_breakeven(10, NAN, 10, 5).kind, BREAKEVEN_NONE);
+}
+
+/* A run of scene s: build median (min, max), SAH, primary and diffuse Mrays/s. */
+static void add_run(cJSON *runs, const char *builder, const char *plugin, int threads,
+                    const double ms[3], double sah, double nodes_per_ray, double mrays,
+                    double diffuse)
+{
+	char text[1024];
+	snprintf(text, sizeof(text),
+	         "{\"scene\": \"s\", \"builder\": \"%s\", \"plugin\": \"%s\", \"threads\": %d, "
+	         "\"status\": \"ok\", \"build_ms\": {\"median\": %g, \"min\": %g, \"max\": %g}, "
+	         "\"tree\": {\"sah_cost\": %g, \"nodes\": %d}, \"rays\": {\"primary\": "
+	         "{\"rays\": 10000, \"mrays_per_s\": %g, \"nodes_per_ray\": %g}, "
+	         "\"diffuse\": {\"mrays_per_s\": %g, \"nodes_per_ray\": 20}}}",
+	         builder, plugin, threads, ms[0], ms[1], ms[2], sah, (int)sah * 10, mrays,
+	         nodes_per_ray, diffuse);
+	cJSON_AddItemToArray(runs, cJSON_Parse(text));
+}
+
+/* No sah_seq ran: fast (the first builder) is the reference. */
+static cJSON *document(const char *reference)
+{
+	char text[512];
+	snprintf(text, sizeof(text),
+	         "{\"machine\": {\"cpu\": \"test\", \"cores\": 2, \"threads_available\": 2}, "
+	         "\"config\": {%s}, \"scenes\": [{\"name\": \"s\", \"triangles\": 100}], "
+	         "\"runs\": []}", reference);
+	cJSON *doc = cJSON_Parse(text), *runs = cJSON_GetObjectItem(doc, "runs");
+	add_run(runs, "fast", "lbvh", 1, (double[]){2, 2, 2}, 50, 12, 10, 5);
+	/* Spread (11 - 9) / 10 = 20 %: noisy. */
+	add_run(runs, "mid", "sah_tasks", 1, (double[]){10, 9, 11}, 40, 9, 12.5, 6);
+	add_run(runs, "slow", "sbvh", 1, (double[]){20, 20, 20}, 45, 10, 11, 5.5);
+	/* fast's very tree, traced 25 % slower: both marked noisy. */
+	add_run(runs, "twin", "lbvh", 1, (double[]){2.2, 2.2, 2.2}, 50, 12, 8, 5);
+	add_run(runs, "fast", "lbvh", 2, (double[]){1.5, 1.5, 1.5}, 50, 12, 10, 5);
+	/* A parallel builder that mid, on 1 thread only, beats on 2 threads too. */
+	add_run(runs, "par", "sah_queue", 1, (double[]){30, 30, 30}, 45, 11, 11, 5);
+	add_run(runs, "par", "sah_queue", 2, (double[]){15, 15, 15}, 45, 11, 11, 5);
+	/* Load 3.5 on 2 CPUs with 1 build thread: 3.5 - 1 > 1 core free. */
+	cJSON *slow = cJSON_GetArrayItem(runs, 2);
+	cJSON_AddNumberToObject(slow, "load_before", 3.5);
+	cJSON_AddNumberToObject(slow, "load_after", 3.0);
+	cJSON *mid = cJSON_GetArrayItem(runs, 1);
+	cJSON_AddNumberToObject(mid, "load_before", 1.5); /* 1.5 - 1 <= 1: not busy */
+	cJSON_AddNumberToObject(mid, "load_after", 1.9);
+	cJSON_AddItemToObject(mid, "build_phases", cJSON_Parse("{\"upload\": 0.5, \"device\": 1.5}"));
+	return doc;
+}
+
+static void test_markdown_fallback(void)
+{
+	cJSON *doc = document("");
+	char *md = report_markdown(doc);
+	CHECK_CONTAINS(md, "(report.reference: 'sah_seq') did not run, so the reference is the "
+	                   "first builder that did: fast.");
+	CHECK_CONTAINS(md, "reference builder **fast**");
+	/* Summary and scene front: slow behind mid, 10 / 20 and (40 - 45) / 45. */
+	CHECK_CONTAINS(md, "| slow | 1 | 1 | 10.00× | 0.90× | n/a | 0.83× | 1.00× | dominated by mid "
+	                   "(0.50× time, −11.1 % SAH) |");
+	CHECK_CONTAINS(md, "| slow | 1 | 20.0 | 45.000 | dominated by mid (0.50× time, −11.1 % SAH) "
+	                   "| 10.0 | dominated by mid (0.50× time, −10.0 % nodes/ray) |");
+	CHECK_CONTAINS(md, "| twin | 1 | 2.20 | 50.000 | dominated by fast (0.91× time, same SAH) |");
+	CHECK_CONTAINS(md, "| fast | 2 | 1.50 | 50.000 | front | 12.0 | front |");
+	/* The 1-thread-only builders compete on the 2-thread front too:
+	 * twin's 2.2 ms against fast's 1.5 on 2 threads is 0.68x. */
+	CHECK_CONTAINS(md, "| mid | 2 (ran on 1) | 10.0 | 40.000 | front |");
+	/* 10 / 15 ms; (40 - 45) / 45. In the summary the same from the ratios
+	 * to fast's: 5.0 / 7.5 and (0.80 - 0.90) / 0.90. */
+	CHECK_CONTAINS(md, "| par | 2 | 15.0 | 45.000 | dominated by mid (0.67× time, −11.1 % SAH) |");
+	CHECK_CONTAINS(md, "| par | 2 | 1 | 7.50× | 0.90× | n/a | 0.92× | 1.00× | dominated by mid "
+	                   "(0.67× time, −11.1 % SAH) |");
+	CHECK_CONTAINS(md, "| twin | 2 (ran on 1) | 2.20 | 50.000 | dominated by fast (0.68× time, "
+	                   "same SAH) |");
+	/* Break-even against fast: mid builds 8 ms longer and saves
+	 * 1/10e6 - 1/12.5e6 = 2e-8 s per primary ray: 400,000 rays, 40 frames of
+	 * 10,000; diffuse 1/5e6 - 1/6e6 = 3.33e-8 s: 240,000. slow: 18 ms over
+	 * 1/10e6 - 1/11e6 = 9.09e-9 s: 1.98 M rays. */
+	CHECK_CONTAINS(md, "| mid | 1 | 10.0 | 2.00 | after 400.0 k rays (40.0 frames) "
+	                   "| after 240.0 k rays (24.0 frames) |");
+	CHECK_CONTAINS(md, "| slow | 1 | 20.0 | 2.00 | after 2.0 M rays (198 frames) |");
+	/* twin: the same tree as fast, so its slower rays are noise; it only
+	 * builds slower. */
+	CHECK_CONTAINS(md, "| twin | 1 | 2.20 | 2.00 | never cheaper | never cheaper |");
+	CHECK_CONTAINS(md, "noisy: build repeats spread 20.0 %");
+	CHECK_CONTAINS(md, "noisy: same tree as twin x1, Mrays/s 25 % apart");
+	CHECK_CONTAINS(md, "busy: load 3.50 before, 3.00 after; 1 core left free");
+	CHECK_CONTAINS(md, "**Busy machine:** 1 of 2 runs");
+	/* No sah_seq: no thesis table of dashes. */
+	CHECK(!strstr(md, "Parallel builders against"));
+	/* Speedup: fast 2 / 1.5 = 1.33 on 2 threads; mid ran on 1 thread only. */
+	CHECK_CONTAINS(md, "| fast | 2 | ok | 1.50 | 1.50 | 1.50 |  |  | 1.33 |");
+	CHECK_CONTAINS(md, "| mid | 1 | ok | 10.00 | 9.00 | 11.00 |  |  |  |");
+	/* build_phases: a column where some run of the scene has them. */
+	CHECK_CONTAINS(md, "| marks | build phases ms | error |");
+	CHECK_CONTAINS(md, "spread 20.0 % | upload 0.500, device 1.50 |  |");
+	free(md);
+	cJSON_Delete(doc);
+}
+
+static void test_reference_kept(void)
+{
+	cJSON *doc = document("\"report\": {\"reference\": \"mid\"}");
+	char *md = report_markdown(doc);
+	CHECK_CONTAINS(md, "reference builder **mid**");
+	CHECK(!strstr(md, "did not run"));
+	/* fast against mid: 8 ms less to build, 2e-8 s more per ray. */
+	CHECK_CONTAINS(md, "| fast | 1 | 2.00 | 10.0 | up to 400.0 k rays (40.0 frames) |");
+	free(md);
+	cJSON_Delete(doc);
+}
+
+static void test_html(void)
+{
+	cJSON *doc = document("");
+	char *html = report_html(doc);
+	CHECK_CONTAINS(html, "did not run, so the reference is the first builder that did: fast.");
+	CHECK_CONTAINS(html, "<td class=\"l front\">front</td>");
+	CHECK_CONTAINS(html, "dominated by mid (0.50× time, −11.1 % SAH)");
+	CHECK_CONTAINS(html, "stroke-dasharray=\"5,3\""); /* the front's line */
+	CHECK_CONTAINS(html, "SAH cost vs. build time, 1 thread");
+	CHECK_CONTAINS(html, "primary nodes/ray vs. build time, 2 threads");
+	CHECK_CONTAINS(html, "<h3>Break-even against fast</h3>");
+	CHECK_CONTAINS(html, "⚠ Busy machine");
+	CHECK_CONTAINS(html, "title=\"build repeats spread 20.0 %\">≈ noisy</td>");
+	CHECK_CONTAINS(html, "title=\"load 3.50 before, 3.00 after; 1 core left free\">⚠ busy</td>");
+	CHECK_CONTAINS(html, "primary Mrays/s (best tile)");
+	/* (0.5 + 1.5) / 10 of the median build. */
+	CHECK_CONTAINS(html, "<td class=\"l\" title=\"the phases add up to 20 % of the median "
+	                     "build\">upload 0.500, device 1.50</td>");
+	CHECK_CONTAINS(html, "per pass min–max");
+	/* One colour per builder in every chart: mid is the second builder. Its
+	 * bar: labels of 7 characters leave 12 + 7 * 6.2 = 55.4 px, so 10 of
+	 * 30 ms is (640 - 55.4 - 90) / 3 = 164.9 px, its figure 4 px after. */
+	CHECK_CONTAINS(html, "fill=\"#ff7f0e\" stroke=\"#222\" stroke-width=\"1.5\"><title>mid x1"
+	                     "</title>");
+	CHECK_CONTAINS(html, "fill=\"#ff7f0e\"/><text x=\"224.3\" y=\"79.0\" text-anchor=\"start\">"
+	                     "10.0 ms</text>");
+	CHECK_CONTAINS(html, "fill=\"#ff7f0e\"/><text x=\"128.8\" y=\"352.0\" text-anchor=\"start\">"
+	                     "mid</text>"); /* the legend */
+	CHECK(!strstr(html, "e+0")); /* plain numbers */
+	free(html);
+	cJSON_Delete(doc);
+}
+
+/* Nothing ok: no summary, no front or break-even table, no chart. */
+static void test_nothing_ok(void)
+{
+	cJSON *doc = cJSON_Parse("{\"scenes\": [{\"name\": \"s\"}], \"runs\": [{\"scene\": \"s\", "
+	                         "\"builder\": \"a\", \"threads\": 1, \"status\": \"failed\", "
+	                         "\"error\": \"no\"}]}");
+	char *md = report_markdown(doc), *html = report_html(doc);
+	CHECK_CONTAINS(md, "No ok run, so no summary.");
+	CHECK(!strstr(md, "Pareto fronts") && !strstr(md, "Break-even"));
+	CHECK(!strstr(html, "Pareto fronts") && !strstr(html, "Break-even") && !strstr(html, "<svg"));
+	free(md);
+	free(html);
+	cJSON_Delete(doc);
+}
+
+int main(void)
+{
+	test_front_points();
+	test_breakeven();
+	test_markdown_fallback();
+	test_reference_kept();
+	test_html();
+	test_nothing_ok();
+	return test_finish();
+}
