@@ -14,6 +14,7 @@
 
 #include "harness/harness.h"
 #include "harness/harness_builders.h"
+#include "harness/harness_resume.h"
 #include "harness/harness_rounds.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
@@ -517,55 +518,6 @@ static uint32_t count_runs(const struct harness *h)
 	return (uint32_t)(chosen * h->cfg->scene_count);
 }
 
-/* Takes over the finished runs of the output folder's results.json. */
-static int resume(struct harness *h, bvhlab_error *err)
-{
-	size_t kept = 0, not_ok = 0;
-	int r = results_resume(&h->res, h->cfg, &kept, &not_ok, err);
-	if (r == -ENOENT) {
-		if (!h->progress.quiet)
-			fprintf(stderr, "bvhlab: nothing to resume in %s/; starting afresh\n",
-			        h->cfg->output);
-		return 0;
-	}
-	if (r < 0)
-		return r;
-	h->all_ok = not_ok == 0;
-	if (!h->progress.quiet)
-		fprintf(stderr, "bvhlab: resuming %s/: %zu finished run%s kept\n", h->cfg->output,
-		        kept, kept == 1 ? "" : "s");
-	return 0;
-}
-
-/*
- * Resumed runs that are not what this sweep would make are made again:
- * those whose ray timings are one provisional slice (killed before the
- * scene's rounds), those of a builder whose options (or stages') changed,
- * and with --retry-failed those that did not end ok. Written at once.
- */
-static int forget_stale(struct harness *h, bool retry_failed, bvhlab_error *err)
-{
-	size_t changed = 0, failed = 0, provisional = results_forget_provisional(&h->res);
-	for (size_t b = 0; b < h->cfg->builder_count; b++) {
-		const struct harness_builder *hb = &h->builders[b];
-		if (hb->opts_ok)
-			changed += results_forget_runs(&h->res, hb->cb->name, hb->options_hash, false);
-		if (retry_failed)
-			failed += results_forget_runs(&h->res, hb->cb->name, NULL, true);
-	}
-	if (!h->progress.quiet && changed)
-		fprintf(stderr, "bvhlab: %zu resumed run%s made with other options will run again\n",
-		        changed, changed == 1 ? "" : "s");
-	if (!h->progress.quiet && failed)
-		fprintf(stderr, "bvhlab: --retry-failed: %zu run%s that did not end ok will run "
-		        "again\n", failed, failed == 1 ? "" : "s");
-	if (!h->progress.quiet && provisional)
-		fprintf(stderr, "bvhlab: %zu resumed run%s with provisional ray timings (killed "
-		        "before their rounds) will run again\n", provisional,
-		        provisional == 1 ? "" : "s");
-	h->all_ok = results_all_ok(&h->res);
-	return changed || failed || provisional ? results_write(&h->res, err) : 0;
-}
 
 /* The folder locked and claimed, the document started (resumed). */
 static int start(struct harness *h, const struct harness_options *opts, bvhlab_error *err)
@@ -581,7 +533,7 @@ static int start(struct harness *h, const struct harness_options *opts, bvhlab_e
 	if (r == 0 && opts->plan_hash)
 		r = results_set_plan(&h->res, opts->plan_hash, plan_run_count(cfg), err);
 	if (r == 0 && opts->resume)
-		r = resume(h, err);
+		r = harness_resume(&h->res, cfg, h->progress.quiet, &h->all_ok, err);
 	if (r == 0)
 		r = results_write(&h->res, err);
 	if (r == 0)
@@ -589,7 +541,8 @@ static int start(struct harness *h, const struct harness_options *opts, bvhlab_e
 	if (r == 0 && (r = harness_open_builders(cfg, cfg->isolate, &h->builders)) < 0)
 		error_set(err, "out of memory opening plugins");
 	if (r == 0 && opts->resume)
-		r = forget_stale(h, opts->retry_failed, err);
+		r = harness_forget_stale(&h->res, cfg, h->builders, opts->retry_failed,
+		                         h->progress.quiet, &h->all_ok, err);
 	return r;
 }
 
