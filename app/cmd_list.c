@@ -10,7 +10,8 @@ static const char usage[] =
 	"\n"
 	"Lists the builder plugins on the search path (or the named ones, by name or\n"
 	"path) with their summary, flags and options (type, default, range, help).\n"
-	"A plugin that cannot be loaded is listed with the reason.\n"
+	"A plugin that cannot be loaded is listed with the reason; each is loaded\n"
+	"first in a forked probe, so one that crashes or hangs (30 s) costs its line.\n"
 	"\n"
 	"search path: $BVHLAB_PLUGIN_PATH, then the build tree, then the install folder.\n";
 
