@@ -1,4 +1,5 @@
 /* bvhlab list: the plugins on the search path and their options. */
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -7,12 +8,14 @@
 
 static const char usage[] =
 	"usage: bvhlab list [PLUGIN...]\n"
+	"       bvhlab list --names\n"
 	"\n"
 	"Lists the builder plugins on the search path (or the named ones, by name or\n"
 	"path) with their summary, flags and options (type, default, range, help).\n"
 	"A plugin that cannot be loaded is listed with the reason; each is loaded\n"
 	"first in a forked probe, so one that crashes or hangs (30 s) costs its line.\n"
-	"\n"
+	"--names prints only the names found on the search path, one a line,\n"
+	"loading none.\n"	"\n"
 	"search path: $BVHLAB_PLUGIN_PATH, then the build tree, then the install folder.\n";
 
 static void print_flags(uint32_t flags)
@@ -28,6 +31,27 @@ static void print_flags(uint32_t flags)
 	printf("%s\n", *sep ? "" : " none");
 }
 
+/* A bound as the user writes it: 1073741824, not 1.07374e+09; 0.05. */
+static void print_bound(double v, bool integer)
+{
+	char buf[64];
+	bvhlab_option_value value = {.type = BVHLAB_OPTION_FLOAT, .f = v};
+	if (integer && v >= -9.2e18 && v <= 9.2e18)
+		value = (bvhlab_option_value){.type = BVHLAB_OPTION_INT, .i = (int64_t)v};
+	bvhlab_option_format(&value, buf, sizeof(buf));
+	printf("%s", buf);
+}
+
+static void print_range(const bvhlab_option_decl *d)
+{
+	bool integer = d->type == BVHLAB_OPTION_INT;
+	printf(", range [");
+	print_bound(d->min, integer);
+	printf(", ");
+	print_bound(d->max, integer);
+	printf("]");
+}
+
 static void print_option(const bvhlab_option_decl *d)
 {
 	static const char *types[] = {"?", "bool", "int", "float", "string"};
@@ -41,7 +65,7 @@ static void print_option(const bvhlab_option_decl *d)
 	else if (d->min <= d->max && (d->type == BVHLAB_OPTION_INT || d->type == BVHLAB_OPTION_FLOAT))
 		/* Ranges mean something for numbers only; a bool's zeroed
 		 * min and max would print as [0, 0]. */
-		printf(", range [%g, %g]", d->min, d->max);
+		print_range(d);
 	printf("\n      %s\n", d->help ? d->help : "");
 }
 
@@ -81,7 +105,8 @@ int cmd_list(int argc, char **argv)
 		return 0;
 	}
 	int bad = 0;
-	if (argc > 1) {
+	bool names_only = argc == 2 && strcmp(argv[1], "--names") == 0;
+	if (argc > 1 && !names_only) {
 		for (int k = 1; k < argc; k++)
 			bad |= list_one(argv[k]);
 		return bad ? EXIT_RUNS_FAILED : 0;
@@ -95,7 +120,10 @@ int cmd_list(int argc, char **argv)
 	if (!names[0])
 		printf("no plugins found on the search path %s\n", bvhlab_plugin_search_path());
 	for (char **n = names; *n; n++)
-		bad |= list_one(*n);
+		if (names_only)
+			printf("%s\n", *n);
+		else
+			bad |= list_one(*n);
 	bvhlab_plugin_names_free(names);
 	return bad ? EXIT_RUNS_FAILED : 0;
 }

@@ -130,7 +130,8 @@ static int check_builders(const struct config *cfg)
 {
 	struct harness_builder *builders = NULL;
 	bvhlab_error err = {{0}};
-	int bad = harness_open_builders(cfg, true, &builders) < 0 ? -1 : 0;
+	size_t bad_configs = 0;
+	int bad = harness_open_builders(cfg, true, &builders, &bad_configs) < 0 ? -1 : 0;
 	for (size_t b = 0; bad == 0 && b < cfg->builder_count; b++)
 		if (!builders[b].skipped && (!builders[b].plugin || !builders[b].opts_ok))
 			bad = -1;

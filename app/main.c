@@ -13,6 +13,7 @@ static const char usage[] =
 	"  run CONFIG.json [--out DIR] [--threads LIST] [--repeat N] [--only IDS]\n"
 	"                        run an experiment: every scene x builder x thread count\n"
 	"  list                  the plugins on the search path, with their options\n"
+	"                        (--names: the names only)\n"
 	"  info SCENE [--json]   triangle count and bounds of a mesh file or generator\n"
 	"  info --machine        packages, physical cores, logical CPUs, caches (hwloc),\n"
 	"                        OpenCL devices\n"

@@ -113,6 +113,10 @@ setup_build() {
 	install_sweep_tools
 	if [ ! -f "$dir/build.ninja" ]; then
 		meson setup "$dir" "$BVHLAB_ROOT" "$@" >&2 || return 1
+	elif meson configure "$dir" 2>/dev/null | grep -qE '^ *pkgconfig\.relocatable +false'; then
+		# A folder set up before meson.build asked for it: default_options
+		# apply only at setup, and the sdk test needs a relocatable .pc.
+		meson configure "$dir" -Dpkgconfig.relocatable=true >&2 || return 1
 	fi
 	ninja -C "$dir" >&2 || return 1
 }

@@ -16,7 +16,9 @@ c++) std=-std=c++17 ;;
 *) echo "check-headers.sh: language must be c or c++, not '$lang'" >&2; exit 2 ;;
 esac
 status=0
-for h in "$incdir"/bvhlab/*.h; do
+headers="$incdir"/bvhlab/*.h
+[ "$lang" = c++ ] && headers="$headers $incdir/bvhlab/*.hpp" # C++-only helpers
+for h in $headers; do
 	name=$(basename "$h")
 	case " ${BVHLAB_HEADERS_SKIP:-} " in
 	*" $name "*) echo "skip: bvhlab/$name (built without its dependency)"; continue ;;

@@ -1,97 +1,113 @@
 #!/bin/sh
-# The SDK end to end: installs bvhlab into a temporary prefix, builds the
-# template plugins from copies of examples/plugin-template (C) and
-# examples/plugin-template-cpp (C++17) against the installed files only
-# (pkg-config), checks each exports only its entry point, loads the C one
-# with the installed bvhlab by path and then by name after installing it,
-# and runs the C++ one through `bvhlab run` beside sah_seq: every run ok,
-# every tree valid. When bvhlab was built with OpenCL (bvhlab/opencl.h
-# installed), it builds examples/plugin-template-cl too and, when the
+# The SDK end to end, both ways a plugin author builds against bvhlab:
+#  - against the checkout: PKG_CONFIG_PATH=BUILD/meson-uninstalled, headers
+#    from the source tree, plugindir the build tree's plugins/;
+#  - against an install: `meson install --destdir` into a temporary folder,
+#    so bvhlab.pc must be relocatable (${pcfiledir}) and the installed
+#    bvhlab must find its plugins from where it lies, not from its prefix.
+# Each way builds copies of examples/plugin-template (C) and
+# examples/plugin-template-cpp (C++17), checks each exports only its entry
+# point and loads both through `bvhlab run` (every run ok, every tree
+# valid); the installed C template is also installed and loaded by name.
+# When bvhlab was built with OpenCL (bvhlab/opencl.h installed), the
+# installed way also builds examples/plugin-template-cl and, when the
 # machine has an OpenCL device, builds a tree with it that must be valid
 # and report its phases; with no device, the build must fail saying why.
-# Usage: test-sdk.sh SOURCE_ROOT
+# Usage: test-sdk.sh SOURCE_ROOT BUILD_ROOT
 set -eu
 src=$1
+build=$2
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/bvhlab-sdk.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT INT TERM
-unset BVHLAB_PLUGIN_PATH PKG_CONFIG_PATH CFLAGS CXXFLAGS LDFLAGS
+unset BVHLAB_PLUGIN_PATH PKG_CONFIG_PATH CFLAGS CXXFLAGS LDFLAGS DESTDIR
 
 step() { echo "== $*"; }
+fail() { echo "FAIL: $*"; exit 1; }
 
-step "install bvhlab into $tmp/prefix"
-meson setup "$tmp/build" "$src" --prefix="$tmp/prefix" -Dbuildtype=release \
-	-Dtests=false -Dembree=disabled >"$tmp/setup.log" 2>&1 || { cat "$tmp/setup.log"; exit 1; }
-ninja -C "$tmp/build" install >"$tmp/install.log" 2>&1 || { cat "$tmp/install.log"; exit 1; }
+# Copies examples/$2 and builds it out of tree as $1-$2; $3 is the module's name.
+build_template() {
+	step "$1: build $2 out of tree ($(pkg-config --cflags bvhlab))"
+	cp -R "$src/examples/$2" "$tmp/$1-$2"
+	meson setup "$tmp/$1-$2-build" "$tmp/$1-$2" -Dwerror=true >"$tmp/setup.log" 2>&1 ||
+		{ cat "$tmp/setup.log"; fail "meson setup of $2 ($1)"; }
+	ninja -C "$tmp/$1-$2-build" >"$tmp/build.log" 2>&1 ||
+		{ cat "$tmp/build.log"; fail "build of $2 ($1)"; }
+	exports=$(nm -D --defined-only "$tmp/$1-$2-build/$3.so" | awk '{print $3}')
+	[ "$exports" = bvhlab_plugin_entry ] ||
+		{ echo "$exports"; fail "$3.so exports more than its entry point"; }
+}
 
-pc=$(find "$tmp/prefix" -name bvhlab.pc)
-[ -n "$pc" ] || { echo "no bvhlab.pc installed"; exit 1; }
+# Runs both templates (by the plugin names or paths $2 and $3) with bvhlab $1.
+run_both() {
+	step "$1 run: template and template_cpp, 1 and 2 threads"
+	cat >"$tmp/both.json" <<EOF
+{ "format_version": 1, "output": "both-results", "repeat": 1, "warmup": 0,
+  "threads": [1, 2], "validate_rays": 64,
+  "rays": { "width": 32, "height": 32, "min_ms": 1, "rounds": 1 },
+  "scenes": [ { "generator": "stadium", "count": 3000 } ],
+  "builders": [ { "plugin": "$2" },
+                { "plugin": "$3", "options": { "bins": 32, "max_leaf": 8 } } ] }
+EOF
+	rm -rf "$tmp/both-results"
+	"$1" run "$tmp/both.json" --quiet || fail "bvhlab run failed"
+	results=$tmp/both-results/results.json
+	ok=$(grep -cE '"status":[[:space:]]*"ok"' "$results" || true)
+	valid=$(grep -cE '"valid":[[:space:]]*true' "$results" || true)
+	cpp=$(grep -cE '"builder":[[:space:]]*"template_cpp"' "$results" || true)
+	echo "runs ok: $ok, valid trees: $valid, template_cpp runs: $cpp"
+	# template is not PARALLEL: one run at 1 thread; template_cpp: 1 and 2.
+	[ "$ok" = 3 ] && [ "$valid" = 3 ] && [ "$cpp" = 2 ] || { cat "$results"; fail "runs"; }
+}
+
+step "against the checkout: $build/meson-uninstalled"
+export PKG_CONFIG_PATH="$build/meson-uninstalled"
+[ "$(pkg-config --variable=plugindir bvhlab)" = "$build/plugins" ] ||
+	fail "uninstalled plugindir is $(pkg-config --variable=plugindir bvhlab)"
+build_template tree plugin-template template
+build_template tree plugin-template-cpp template_cpp
+grep -q -- "-I$src/include" "$tmp/tree-plugin-template-build/build.ninja" ||
+	fail "the uninstalled build did not use the source tree's include/"
+run_both "$build/app/bvhlab" "$tmp/tree-plugin-template-build/template.so" \
+	"$tmp/tree-plugin-template-cpp-build/template_cpp.so"
+
+step "install with --destdir into $tmp/stage"
+meson install -C "$build" --no-rebuild --destdir "$tmp/stage" >"$tmp/install.log" 2>&1 ||
+	{ cat "$tmp/install.log"; fail "meson install"; }
+pc=$(find "$tmp/stage" -name bvhlab.pc)
+[ -n "$pc" ] || fail "no bvhlab.pc installed"
 export PKG_CONFIG_PATH=$(dirname "$pc")
+bvhlab=$(find "$tmp/stage" -path '*/bin/bvhlab' -type f)
+[ -x "$bvhlab" ] || fail "no bin/bvhlab installed"
 plugindir=$(pkg-config --variable=plugindir bvhlab)
 echo "pkg-config: $(pkg-config --cflags bvhlab) | plugindir $plugindir"
-[ -f "$plugindir/sah_seq.so" ] || { echo "sah_seq.so not in plugindir"; exit 1; }
-bvhlab=$tmp/prefix/bin/bvhlab
+[ -f "$plugindir/sah_seq.so" ] || fail "sah_seq.so not in plugindir $plugindir"
+"$bvhlab" list --names | grep -qx sah_seq || fail "installed bvhlab does not list sah_seq"
 
-# Copies examples/$1 and builds it out of tree; $2 is the module's name.
-build_template() {
-	step "build $1 out of tree"
-	cp -R "$src/examples/$1" "$tmp/$1"
-	meson setup "$tmp/$1-build" "$tmp/$1" -Dwerror=true >"$tmp/$1-setup.log" 2>&1 ||
-		{ cat "$tmp/$1-setup.log"; exit 1; }
-	ninja -C "$tmp/$1-build" >"$tmp/$1-build.log" 2>&1 || { cat "$tmp/$1-build.log"; exit 1; }
-	# Headers from the prefix, nothing from the source tree.
-	if grep -q -- "-I$src" "$tmp/$1-build/build.ninja"; then
-		echo "$1 saw the source tree's headers"; exit 1
-	fi
-	exports=$(nm -D --defined-only "$tmp/$1-build/$2.so" | awk '{print $3}')
-	[ "$exports" = bvhlab_plugin_entry ] ||
-		{ echo "$2.so exports more than its entry point:"; echo "$exports"; exit 1; }
-}
+build_template inst plugin-template template
+build_template inst plugin-template-cpp template_cpp
+if grep -q -- "-I$src" "$tmp/inst-plugin-template-build/build.ninja"; then
+	fail "the installed build saw the source tree's headers"
+fi
+step "install the C template into plugindir: loaded by name"
+ninja -C "$tmp/inst-plugin-template-build" install >/dev/null
+[ -f "$plugindir/template.so" ] || fail "template.so not installed into $plugindir"
+run_both "$bvhlab" template "$tmp/inst-plugin-template-cpp-build/template_cpp.so"
 
-check() {
-	out=$("$bvhlab" build "$1" icosphere:frequency=8) || { echo "$out"; exit 1; }
-	echo "$out"
-	echo "$out" | grep -q "^valid:      yes" || { echo "tree not valid"; exit 1; }
-}
-
-build_template plugin-template template
-step "load it by path"
-check "$tmp/plugin-template-build/template.so"
-step "install it into plugindir and load it by name"
-ninja -C "$tmp/plugin-template-build" install >/dev/null
-check template
-
-build_template plugin-template-cpp template_cpp
-step "bvhlab run: the C++ template and sah_seq, 2 scenes, 1 and 2 threads"
-cat >"$tmp/cpp.json" <<EOF
-{ "format_version": 1, "output": "cpp-results", "repeat": 1, "warmup": 0,
-  "threads": [1, 2],
-  "scenes": [ { "generator": "icosphere", "frequency": 16 },
-              { "generator": "stadium", "count": 3000 } ],
-  "builders": [ { "plugin": "$tmp/plugin-template-cpp-build/template_cpp.so",
-                  "options": { "bins": 32, "max_leaf": 8 } },
-                { "plugin": "sah_seq", "options": { "method": "binned" } } ] }
-EOF
-"$bvhlab" run "$tmp/cpp.json" --quiet || { echo "bvhlab run failed"; exit 1; }
-results=$tmp/cpp-results/results.json
-runs=$(grep -cE '"status":[[:space:]]*"ok"' "$results" || true)
-valid=$(grep -cE '"valid":[[:space:]]*true' "$results" || true)
-cpp=$(grep -cE '"builder":[[:space:]]*"template_cpp"' "$results" || true)
-echo "runs ok: $runs of 8, valid trees: $valid, template_cpp runs: $cpp"
-[ "$runs" = 8 ] && [ "$valid" = 8 ] && [ "$cpp" = 4 ] || { cat "$results"; exit 1; }
-
-if [ -f "$tmp/prefix/include/bvhlab/opencl.h" ] && pkg-config --exists OpenCL; then
-	build_template plugin-template-cl template_cl
+# The OpenCL template, against the install, when bvhlab has OpenCL.
+if [ -n "$(find "$tmp/stage" -path '*/bvhlab/opencl.h')" ] && pkg-config --exists OpenCL; then
+	build_template inst plugin-template-cl template_cl
 	step "the OpenCL template on the machine's device"
+	so=$tmp/inst-plugin-template-cl-build/template_cl.so
 	if "$bvhlab" info --machine --json | grep -q '"compute_units"'; then
-		out=$("$bvhlab" build "$tmp/plugin-template-cl-build/template_cl.so" \
-			icosphere:frequency=8 -o device=auto) || { echo "$out"; exit 1; }
+		out=$("$bvhlab" build "$so" icosphere:frequency=8 -o device=auto) ||
+			{ echo "$out"; fail "the OpenCL template's build"; }
 		echo "$out"
-		echo "$out" | grep -q "^valid:      yes" || { echo "tree not valid"; exit 1; }
-		echo "$out" | grep -q "^phase:      device" || { echo "no device phase"; exit 1; }
+		echo "$out" | grep -q "^valid:      yes" || fail "OpenCL template: tree not valid"
+		echo "$out" | grep -q "^phase:      device" || fail "OpenCL template: no device phase"
 	else
-		out=$("$bvhlab" build "$tmp/plugin-template-cl-build/template_cl.so" \
-			icosphere:frequency=8 2>&1) && { echo "built without a device?"; exit 1; }
-		echo "$out" | grep -q "OpenCL" || { echo "$out"; exit 1; }
+		out=$("$bvhlab" build "$so" icosphere:frequency=8 2>&1) &&
+			fail "the OpenCL template built without a device?"
+		echo "$out" | grep -q "OpenCL" || { echo "$out"; fail "no OpenCL message"; }
 		echo "no OpenCL device here: the template says so: $out"
 	fi
 else

@@ -68,6 +68,7 @@ static void test_counts(void)
 	tree_copy(&t, &fx.tree, 0);
 	t.node_count = 0;
 	expect(&t, false, "no nodes");
+	expect(&t, false, "did build() set output->node_count?"); /* the likely cause */
 	t.node_count = t.node_capacity + 1;
 	expect(&t, false, "node_count");
 	expect(&t, false, "exceeds node_capacity");
@@ -239,6 +240,7 @@ static void test_ranges(void)
 	t.nodes[x].first = t.node_count - 1; /* second child just past the end */
 	snprintf(needle, sizeof(needle), "node %u: child index %u out of range", x, t.node_count);
 	expect(&t, false, needle);
+	expect(&t, false, "is the second one counted in node_count?");
 	t.nodes[x].first = UINT32_MAX;
 	snprintf(needle, sizeof(needle), "node %u: child index %u out of range", x, UINT32_MAX);
 	expect(&t, false, needle);
@@ -252,6 +254,22 @@ static void test_ranges(void)
 	expect(&t, false, needle);
 	t.nodes[leaf].first = UINT32_MAX; /* no wrap-around */
 	snprintf(needle, sizeof(needle), "node %u: leaf range", leaf);
+	expect(&t, false, needle);
+	bvhlab_tree_finish(&t);
+
+	/* The likely causes: index_count never set; a range one too long. */
+	tree_copy(&t, &fx.tree, 0);
+	t.index_count = 0;
+	expect(&t, false, "exceeds index_count 0: did build() set output->index_count?");
+	t.index_count = fx.tree.index_count;
+	for (leaf = 0; leaf < t.node_count; leaf++)
+		if (t.nodes[leaf].count && t.nodes[leaf].first + t.nodes[leaf].count == t.index_count)
+			break;
+	CHECK(leaf < t.node_count);
+	t.nodes[leaf].count++;
+	snprintf(needle, sizeof(needle), "node %u: leaf range [%u, %u) exceeds index_count %u: "
+	         "a leaf range off by one?", leaf, t.nodes[leaf].first, t.index_count + 1,
+	         t.index_count);
 	expect(&t, false, needle);
 	bvhlab_tree_finish(&t);
 

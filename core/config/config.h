@@ -156,6 +156,15 @@ const struct cJSON *config_grid_value(const struct config_builder *b,
 int config_apply_refine_options(const struct config *cfg, const struct config_builder *b,
                                 size_t k, bvhlab_options *opts, bvhlab_error *err);
 
+/*
+ * Puts a builder's error in the form every config error has,
+ * FILE:LINE:COLUMN: builder 'NAME': message (the builder's object, or the
+ * refine stage k's when k < b->refine_count), unless the message already
+ * starts with the config's path (config_apply_options' do).
+ */
+void config_locate_builder_error(const struct config *cfg, const struct config_builder *b,
+                                 size_t stage, bvhlab_error *err);
+
 /* Replaces the thread list (command line --threads). */
 int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count);
 

@@ -37,6 +37,21 @@ int config_error(const struct config *cfg, const cJSON *item, bool at_key,
 	return -EINVAL;
 }
 
+void config_locate_builder_error(const struct config *cfg, const struct config_builder *b,
+                                 size_t stage, bvhlab_error *err)
+{
+	const char *path = cfg->path ? cfg->path : "(config)";
+	size_t n = strlen(path);
+	if (strncmp(err->message, path, n) == 0 && err->message[n] == ':')
+		return;
+	char message[sizeof(err->message)];
+	memcpy(message, err->message, sizeof(message));
+	bool in_stage = stage < b->refine_count;
+	error_set(err, "%s:%d:%d: builder '%s': %s", path,
+	          in_stage ? b->refine[stage].line : b->line,
+	          in_stage ? b->refine[stage].column : b->column, b->name, message);
+}
+
 static const char *describe_number(const struct config *cfg, const cJSON *item, char *buf,
                                    size_t size)
 {

@@ -116,6 +116,14 @@ static const uint32_t *builder_threads(const struct harness *h, const struct con
 	return threads;
 }
 
+/* The runs a builder gets: harness_threads.c (one for a serial builder). */
+static bool applicable(const struct harness *h, const struct harness_builder *hb, size_t t)
+{
+	size_t n;
+	const uint32_t *threads = builder_threads(h, hb->cb, &n);
+	return harness_thread_applies(hb, threads, n, t, h->only != NULL);
+}
+
 /* A run left out by --only, or kept from the results resumed (counted as done). */
 static bool skip_run(struct harness *h, uint32_t id, const char *scene, const char *builder,
                      uint32_t threads)
@@ -135,6 +143,8 @@ static void record_all_failed(struct harness *h, size_t scene_index, const char 
 	size_t n, b = (size_t)(hb - h->builders);
 	const uint32_t *threads = builder_threads(h, hb->cb, &n);
 	for (size_t k = 0; k < n; k++) {
+		if (!applicable(h, hb, k))
+			continue;
 		struct run_record run = {.id = plan_run_id(h->cfg, scene_index, b, k),
 		                         .scene = scene, .builder = hb->cb->name,
 		                         .plugin = hb->cb->plugin, .threads = resolve_threads(threads[k]),
@@ -154,7 +164,8 @@ static bool scene_done(struct harness *h, const struct config_scene *cs, size_t 
 		size_t n;
 		const uint32_t *threads = builder_threads(h, &h->cfg->builders[b], &n);
 		for (size_t t = 0; t < n; t++) {
-			if (h->only && !h->only[plan_run_id(h->cfg, scene_index, b, t)])
+			if ((h->only && !h->only[plan_run_id(h->cfg, scene_index, b, t)]) ||
+			    !applicable(h, &h->builders[b], t))
 				continue;
 			total++;
 			done += results_has_run(&h->res, cs->name, h->cfg->builders[b].name,
@@ -434,6 +445,8 @@ static void run_builders(struct harness *h, const bvhlab_scene *scene,
 		size_t n;
 		const uint32_t *threads = builder_threads(h, hb->cb, &n);
 		for (size_t t = 0; t < n; t++) {
+			if (!applicable(h, hb, t))
+				continue;
 			struct series_job job = {.h = h, .scene = scene, .prims = prims, .hb = hb,
 			                         .threads = threads[t]};
 			run_one(h, &job, scene_index, b, t);
@@ -452,7 +465,8 @@ static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t sc
 	for (size_t b = 0; r == 0 && b < nb; b++) {
 		size_t n;
 		names[b] = h->cfg->builders[b].name;
-		threads[b] = resolve_threads(builder_threads(h, &h->cfg->builders[b], &n)[0]);
+		const uint32_t *list = builder_threads(h, &h->cfg->builders[b], &n);
+		threads[b] = resolve_threads(list[harness_first_run(&h->builders[b], list, n)]);
 	}
 	struct scene_images si = {.dir = h->cfg->output, .scene_index = scene_index,
 	                          .scene = scene->name, .width = h->cfg->ray_width,
@@ -506,18 +520,46 @@ out:
 
 static uint32_t count_runs(const struct harness *h)
 {
-	size_t total = plan_run_count(h->cfg), chosen = 0, n;
-	for (size_t id = 0; h->only && id < total; id++)
-		chosen += h->only[id];
-	if (h->only)
-		return (uint32_t)chosen;
-	for (size_t b = 0; b < h->cfg->builder_count; b++) {
-		builder_threads(h, &h->cfg->builders[b], &n);
-		chosen += n;
+	size_t chosen = 0, n;
+	for (size_t s = 0; s < h->cfg->scene_count; s++) {
+		for (size_t b = 0; b < h->cfg->builder_count; b++) {
+			builder_threads(h, &h->cfg->builders[b], &n);
+			for (size_t t = 0; t < n; t++)
+				chosen += (!h->only || h->only[plan_run_id(h->cfg, s, b, t)]) &&
+				          applicable(h, &h->builders[b], t);
+		}
 	}
-	return (uint32_t)(chosen * h->cfg->scene_count);
+	return (uint32_t)chosen;
 }
 
+
+/* Every builder's plugin and options first: a config that cannot run as
+ * written is refused whole (every error printed), before the output folder
+ * is touched. */
+static int open_builders(struct harness *h, bvhlab_error *err)
+{
+	size_t bad = 0;
+	int r = harness_open_builders(h->cfg, h->cfg->isolate, &h->builders, &bad);
+	if (r < 0)
+		error_set(err, "out of memory opening plugins");
+	else if (bad)
+		r = -EINVAL, error_set(err, "%s: %zu builder%s cannot run as configured (above); "
+		                       "nothing was run", h->cfg->path, bad, bad == 1 ? "" : "s");
+	return r;
+}
+
+/* Which thread counts of each builder do not apply, noted in the document. */
+static int note_not_applicable(struct harness *h, bool quiet, bvhlab_error *err)
+{
+	int r = 0;
+	for (size_t b = 0; r == 0 && !h->only && b < h->cfg->builder_count; b++) {
+		size_t n;
+		const uint32_t *threads = builder_threads(h, h->builders[b].cb, &n);
+		if ((r = harness_note_not_applicable(&h->builders[b], threads, n, &h->res, quiet)) < 0)
+			error_set(err, "out of memory");
+	}
+	return r;
+}
 
 /* The folder locked and claimed, the document started (resumed). */
 static int start(struct harness *h, const struct harness_options *opts, bvhlab_error *err)
@@ -534,15 +576,15 @@ static int start(struct harness *h, const struct harness_options *opts, bvhlab_e
 		r = results_set_plan(&h->res, opts->plan_hash, plan_run_count(cfg), err);
 	if (r == 0 && opts->resume)
 		r = harness_resume(&h->res, cfg, h->progress.quiet, &h->all_ok, err);
+	if (r == 0 && opts->resume)
+		r = harness_forget_stale(&h->res, cfg, h->builders, opts->retry_failed,
+		                         h->progress.quiet, &h->all_ok, err);
+	if (r == 0)
+		r = note_not_applicable(h, opts->quiet, err);
 	if (r == 0)
 		r = results_write(&h->res, err);
 	if (r == 0)
 		harness_rounds_sweep(cfg->output);
-	if (r == 0 && (r = harness_open_builders(cfg, cfg->isolate, &h->builders)) < 0)
-		error_set(err, "out of memory opening plugins");
-	if (r == 0 && opts->resume)
-		r = harness_forget_stale(&h->res, cfg, h->builders, opts->retry_failed,
-		                         h->progress.quiet, &h->all_ok, err);
 	return r;
 }
 
@@ -552,15 +594,17 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 	struct harness h = {.cfg = cfg, .only = opts->only, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
 	bvhlab_set_pinning(cfg->pin);
-	int r = start(&h, opts, err);
-	h.progress.total = count_runs(&h);
+	int r = open_builders(&h, err);
+	if (r == 0)
+		r = start(&h, opts, err);
+	h.progress.total = r == 0 ? count_runs(&h) : 0;
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
 		run_scene(&h, &cfg->scenes[s], s);
 	progress_finish(&h.progress);
 	if (opts->tally)
 		*opts->tally = h.tally;
-	harness_close_builders(cfg, h.builders);
 	harness_rounds_finish(&h.rounds);
 	results_finish(&h.res);
+	harness_close_builders(cfg, h.builders);
 	return r < 0 ? r : h.all_ok ? 0 : 1;
 }

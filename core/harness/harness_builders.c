@@ -59,33 +59,34 @@ int harness_probe_plugin(const char *plugin, double timeout_s, const char **stat
 	if (outcome == ISOLATE_REPORTED && rep.ok)
 		return 0;
 	rep.error[sizeof(rep.error) - 1] = '\0';
-	if (outcome == ISOLATE_REPORTED) {
+	if (outcome == ISOLATE_REPORTED) { /* not there, or not a bvhlab plugin */
 		error_set(err, "%s", rep.error);
 		return -EINVAL;
 	}
 	*status = outcome == ISOLATE_TIMEOUT ? "timeout" : outcome < 0 ? "failed" : "crashed";
 	error_set(err, "plugin %s: %s while loading (library constructor or entry point): %s",
 	          plugin, outcome == ISOLATE_TIMEOUT ? "hung" : "died", why);
-	return -EINVAL;
+	return -ECHILD;
 }
 
 /* 0 when the builder's plugin and every refine stage's loaded in a child
- * each; else the builder's status and error, naming the stage. */
+ * each; else the builder's status and error, naming the stage. One that is
+ * not there or not a plugin is a config error; one that died or hung is not
+ * (its runs record it). */
 static int probe(const struct config *cfg, struct harness_builder *hb)
 {
 	double timeout_s = harness_run_limits(cfg, hb->cb).timeout_s;
-	if (harness_probe_plugin(hb->cb->plugin, timeout_s, &hb->status, &hb->error) < 0)
-		return -EINVAL;
-	for (size_t k = 0; k < hb->cb->refine_count; k++) {
+	int r = harness_probe_plugin(hb->cb->plugin, timeout_s, &hb->status, &hb->error);
+	for (size_t k = 0; r == 0 && k < hb->cb->refine_count; k++) {
 		bvhlab_error err = {{0}};
-		if (harness_probe_plugin(hb->cb->refine[k].plugin, timeout_s, &hb->status,
-		                         &err) < 0) {
+		r = harness_probe_plugin(hb->cb->refine[k].plugin, timeout_s, &hb->status, &err);
+		if (r < 0) {
 			hb->stage_failed = true;
 			error_set(&hb->error, "refine stage %zu: %s", k + 1, err.message);
-			return -EINVAL;
 		}
 	}
-	return 0;
+	hb->bad_config = r == -EINVAL;
+	return r < 0 ? -EINVAL : 0;
 }
 
 /* Opens a builder's refinement stages; *ok false (hb->error set) when one
@@ -95,20 +96,20 @@ static int open_stages(const struct config *cfg, struct harness_builder *hb, boo
 	*ok = true;
 	for (size_t k = 0; *ok && k < hb->cb->refine_count; k++) {
 		struct harness_stage *st = &hb->stages[k];
-		if (bvhlab_plugin_open(hb->cb->refine[k].plugin, &st->plugin, &hb->error) < 0) {
-			*ok = false;
-			break;
-		}
-		if (!bvhlab_builder_refine(bvhlab_plugin_builder(st->plugin))) {
+		*ok = bvhlab_plugin_open(hb->cb->refine[k].plugin, &st->plugin, &hb->error) == 0;
+		if (*ok && !bvhlab_builder_refine(bvhlab_plugin_builder(st->plugin))) {
 			error_set(&hb->error, "refine stage %zu: plugin '%s' has no refinement stage",
 			          k + 1, hb->cb->refine[k].plugin);
 			*ok = false;
-			break;
 		}
-		if (bvhlab_options_init(&st->opts, bvhlab_plugin_builder(st->plugin)) < 0)
+		if (*ok && bvhlab_options_init(&st->opts, bvhlab_plugin_builder(st->plugin)) < 0)
 			return -ENOMEM;
-		*ok = config_apply_refine_options(cfg, hb->cb, k, &st->opts, &hb->error) == 0;
-		hb->refine[k] = (struct refine_stage){.plugin = st->plugin, .opts = &st->opts};
+		if (*ok)
+			*ok = config_apply_refine_options(cfg, hb->cb, k, &st->opts, &hb->error) == 0;
+		if (!*ok)
+			config_locate_builder_error(cfg, hb->cb, k, &hb->error);
+		else
+			hb->refine[k] = (struct refine_stage){.plugin = st->plugin, .opts = &st->opts};
 	}
 	return 0;
 }
@@ -146,10 +147,13 @@ static int hash_options(struct harness_builder *hb)
 static int open_one(const struct config *cfg, bool probed, struct harness_builder *hb)
 {
 	hb->status = "failed";
-	if (probed && probe(cfg, hb) < 0)
-		return -EINVAL;
-	if (bvhlab_plugin_open(hb->cb->plugin, &hb->plugin, &hb->error) < 0)
-		return -EINVAL;
+	int r = probed ? probe(cfg, hb) : 0;
+	if (r == 0 && bvhlab_plugin_open(hb->cb->plugin, &hb->plugin, &hb->error) < 0)
+		r = -EINVAL, hb->bad_config = true;
+	if (r < 0) {
+		config_locate_builder_error(cfg, hb->cb, SIZE_MAX, &hb->error);
+		return r;
+	}
 	if (bvhlab_options_init(&hb->opts, bvhlab_plugin_builder(hb->plugin)) < 0)
 		return -ENOMEM;
 	hb->opts_ok = config_apply_options(cfg, hb->cb, &hb->opts, &hb->error) == 0;
@@ -157,12 +161,37 @@ static int open_one(const struct config *cfg, bool probed, struct harness_builde
 		return -ENOMEM;
 	if (hb->opts_ok && hash_options(hb) < 0)
 		return -ENOMEM;
+	hb->bad_config = !hb->opts_ok;
 	return hb->opts_ok ? 0 : -EINVAL;
 }
 
-int harness_open_builders(const struct config *cfg, bool probed,
-                          struct harness_builder **out)
+/* FILE:LINE:COLUMN: of a message, or its whole length when it has none. */
+static size_t position_length(const char *message)
 {
+	const char *p = message;
+	for (int colons = 0; *p && colons < 3; p++)
+		colons += *p == ':';
+	return (size_t)(p - message);
+}
+
+/* True when an earlier builder's message came from the same place: the
+ * builders of one grid share their plugin and most options. */
+static bool said_before(const struct harness_builder *builders, size_t b)
+{
+	const char *m = builders[b].error.message;
+	size_t n = position_length(m);
+	for (size_t k = 0; k < b; k++)
+		if ((builders[k].bad_config || builders[k].skipped) &&
+		    strncmp(builders[k].error.message, m, n) == 0 &&
+		    position_length(builders[k].error.message) == n)
+			return true;
+	return false;
+}
+
+int harness_open_builders(const struct config *cfg, bool probed,
+                          struct harness_builder **out, size_t *bad_configs)
+{
+	*bad_configs = 0;
 	struct harness_builder *builders = calloc(cfg->builder_count ? cfg->builder_count : 1,
 	                                          sizeof(*builders));
 	*out = builders;
@@ -175,11 +204,14 @@ int harness_open_builders(const struct config *cfg, bool probed,
 		if (r == -ENOMEM)
 			return r;
 		hb->skipped = r < 0 && !hb->plugin && !hb->stage_failed && hb->cb->optional;
+		hb->bad_config = hb->bad_config && !hb->skipped;
+		*bad_configs += hb->bad_config;
+		if (r == 0 || said_before(builders, b))
+			continue;
 		if (hb->skipped)
-			fprintf(stderr, "bvhlab: optional builder '%s' skipped: %s\n", hb->cb->name,
-			        hb->error.message);
-		else if (r < 0)
-			fprintf(stderr, "bvhlab: builder '%s': %s\n", hb->cb->name, hb->error.message);
+			fprintf(stderr, "bvhlab: optional builder skipped: %s\n", hb->error.message);
+		else
+			fprintf(stderr, "bvhlab: %s\n", hb->error.message);
 	}
 	return 0;
 }

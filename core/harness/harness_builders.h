@@ -25,6 +25,9 @@ struct harness_builder {
 	                        * loaded: it has no runs at all */
 	char options_hash[17]; /* of the resolved options and stages, when opts_ok */
 	bool stage_failed;     /* the builder loaded but a refine stage's plugin did not */
+	bool bad_config;       /* its plugin (or a stage's) is not there or not a
+	                        * bvhlab plugin, or an option is wrong: the config
+	                        * is refused before anything runs */
 	bvhlab_error error;
 	struct harness_stage {
 		bvhlab_plugin *plugin;
@@ -39,21 +42,44 @@ struct isolate_limits harness_run_limits(const struct config *cfg,
 
 /*
  * Opens `plugin` in a forked child killed after timeout_s (> 0): 0 when it
- * loaded there. Else *status is "failed" (err: why it was refused),
- * "crashed" or "timeout" (err: it died or hung while loading, naming the
- * plugin). Nothing of the plugin stays in this process.
+ * loaded there. Else *status is "failed" and -EINVAL (err: why it was
+ * refused: not there, not a bvhlab plugin), or "crashed"/"timeout" (or
+ * "failed" when no child started) and -ECHILD (err: it died or hung while
+ * loading, naming the plugin). Nothing of the plugin stays in this process.
  */
 int harness_probe_plugin(const char *plugin, double timeout_s, const char **status,
                          bvhlab_error *err);
 
 /*
  * Opens every builder of cfg into *out ([cfg->builder_count]), each plugin
- * (builder and refine stages) first in a probe when `probed`; a builder
- * that cannot be used keeps its status and message (printed to stderr
- * too), and the others go on. 0, or -ENOMEM.
+ * (the builder's and every refine stage's) first in a forked probe when
+ * `probed`; a builder that cannot be used keeps its status and message,
+ * and the others go on.
+ * Messages go to stderr, each once (a grid's builders share theirs), as
+ * FILE:LINE:COLUMN: builder 'NAME': ...; *bad_configs counts the builders
+ * whose config is wrong (bad_config). A plugin that crashes or hangs while
+ * loading is not a config error: its runs are recorded as such. 0, or
+ * -ENOMEM.
  */
 int harness_open_builders(const struct config *cfg, bool probed,
-                          struct harness_builder **out);
+                          struct harness_builder **out, size_t *bad_configs);
 void harness_close_builders(const struct config *cfg, struct harness_builder *builders);
+
+/*
+ * Runs of a builder without the PARALLEL flag (harness_threads.c): it
+ * ignores its thread count, so it runs once per scene, at the first of its
+ * thread counts `threads[n]` that resolves to 1 (else its first); the
+ * others are not applicable. A builder whose plugin did not load keeps all
+ * its runs (to record them), and so do runs picked by id (`by_id`: a plan
+ * lists every run of its config).
+ */
+size_t harness_first_run(const struct harness_builder *hb, const uint32_t *threads, size_t n);
+bool harness_thread_applies(const struct harness_builder *hb, const uint32_t *threads,
+                            size_t n, size_t t, bool by_id);
+/* Says which thread counts are not applicable to hb, on stderr (unless
+ * quiet) and in results.json's "not_applicable". 0, or -ENOMEM. */
+struct results;
+int harness_note_not_applicable(const struct harness_builder *hb, const uint32_t *threads,
+                                size_t n, struct results *res, bool quiet);
 
 #endif

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/mman.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -21,6 +22,11 @@
 
 #include "harness/isolate.h"
 #include "util/util.h"
+
+/* The most of a child's stderr passed on, from its end; and the most of
+ * it quoted in the message of a child that died. */
+#define STDERR_RELAY_MAX (64 * 1024)
+#define STDERR_TAIL_MAX 300
 
 /* Exit statuses of the child's own failures, outside what plugins use. */
 #define EXIT_ORPHANED 120
@@ -71,13 +77,15 @@ static void exit_now(int status, void *arg)
 }
 
 /* _exit only: the parent's atexit handlers and stdio buffers are not ours. */
-static void child(int fd, pid_t parent, isolate_work work, void *arg, void *report,
+static void child(int fd, int errfd, pid_t parent, isolate_work work, void *arg, void *report,
                   size_t size, const struct isolate_limits *limits)
 {
 	/* A killed sweep must not leave its runs behind, spinning. */
 	prctl(PR_SET_PDEATHSIG, SIGKILL);
 	if (getppid() != parent)
 		_exit(EXIT_ORPHANED);
+	if (errfd >= 0) /* the parent relays it, and quotes its end if we die */
+		dup2(errfd, STDERR_FILENO);
 	on_exit(exit_now, NULL);
 	if (limits->memory_bytes) {
 		struct rlimit rl = {.rlim_cur = limits->memory_bytes, .rlim_max = limits->memory_bytes};
@@ -197,6 +205,46 @@ static int await(pid_t pid, int fd, void *report, size_t size, double timeout_s,
 	return ISOLATE_CRASHED;
 }
 
+/* The end of what the child wrote to stderr, on one line, after why:
+ * what libstdc++, a sanitizer or the plugin said before it died. */
+static void quote_tail(const char *text, size_t n, char *why, size_t why_size)
+{
+	while (n > 0 && (text[n - 1] == '\n' || text[n - 1] == ' '))
+		n--;
+	size_t from = n > STDERR_TAIL_MAX ? n - STDERR_TAIL_MAX : 0;
+	if (n == 0)
+		return;
+	size_t used = strlen(why);
+	used += (size_t)snprintf(why + used, why_size > used ? why_size - used : 0,
+	                         "; its stderr ended: %s", from ? "..." : "");
+	for (size_t k = from; k < n && used + 1 < why_size; k++) {
+		bool space = text[k] == '\n' || text[k] == '\t' || text[k] == ' ';
+		if (!space || why[used - 1] != ' ') /* lines and their indents: one space */
+			why[used++] = space ? ' ' : text[k];
+	}
+	if (used < why_size)
+		why[used] = '\0';
+}
+
+/* Passes the child's stderr on to ours (its last STDERR_RELAY_MAX bytes)
+ * and, when it did not report, quotes its end in why. */
+static void relay_stderr(int errfd, bool died, char *why, size_t why_size)
+{
+	static char buf[STDERR_RELAY_MAX];
+	off_t end = lseek(errfd, 0, SEEK_END);
+	if (end <= 0)
+		return;
+	off_t from = end > STDERR_RELAY_MAX ? end - STDERR_RELAY_MAX : 0;
+	ssize_t n = pread(errfd, buf, (size_t)(end - from), from);
+	if (n <= 0)
+		return;
+	for (ssize_t done = 0, w; done < n; done += w)
+		if ((w = write(STDERR_FILENO, buf + done, (size_t)(n - done))) <= 0)
+			break;
+	if (died)
+		quote_tail(buf, (size_t)n, why, why_size);
+}
+
 int isolate_call(isolate_work work, void *arg, void *report, size_t size,
                  const struct isolate_limits *limits, char *why, size_t why_size)
 {
@@ -206,6 +254,8 @@ int isolate_call(isolate_work work, void *arg, void *report, size_t size,
 		snprintf(why, why_size, "cannot create a pipe: %s", strerror(e));
 		return -e;
 	}
+	/* The child's stderr, kept (in memory) to quote if it dies; -1: not kept. */
+	int errfd = memfd_create("bvhlab-child-stderr", MFD_CLOEXEC);
 	/* Buffered output would be written twice, once by each process. */
 	fflush(stdout);
 	fflush(stderr);
@@ -213,16 +263,22 @@ int isolate_call(isolate_work work, void *arg, void *report, size_t size,
 	pid_t pid = fork();
 	if (pid == 0) {
 		close(fds[0]);
-		child(fds[1], parent, work, arg, report, size, limits);
+		child(fds[1], errfd, parent, work, arg, report, size, limits);
 	}
 	close(fds[1]);
 	if (pid < 0) {
 		int e = errno;
 		close(fds[0]);
+		if (errfd >= 0)
+			close(errfd);
 		snprintf(why, why_size, "cannot fork: %s", strerror(e));
 		return -e;
 	}
 	int r = await(pid, fds[0], report, size, limits->timeout_s, why, why_size);
 	close(fds[0]);
+	if (errfd >= 0) {
+		relay_stderr(errfd, r == ISOLATE_CRASHED || r == ISOLATE_TIMEOUT, why, why_size);
+		close(errfd);
+	}
 	return r;
 }

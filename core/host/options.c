@@ -106,7 +106,7 @@ static int check_range(const bvhlab_options *opts, int k, double v, bvhlab_error
 	const bvhlab_option_decl *d = &opts->builder->options[k];
 	if (!has_range(d) || (v >= d->min && v <= d->max))
 		return 0;
-	error_set(err, "option '%s' of builder '%s' is out of range: %g not in [%g, %g]",
+	error_set(err, "option '%s' of builder '%s' is out of range: %.15g not in [%.15g, %.15g]",
 	                 d->name, opts->builder->name, v, d->min, d->max);
 	return -EINVAL;
 }

@@ -109,6 +109,13 @@ void results_finish(struct results *res);
 int results_add_scene(struct results *res, const char *name, const char *source,
                       uint32_t triangles, const char *error);
 int results_add_run(struct results *res, const struct run_record *run);
+/*
+ * "not_applicable": [{"builder", "threads": [...], "reason"}]: thread counts
+ * of the config that a builder was not run at (one without the PARALLEL
+ * flag runs once per scene); replaces the builder's earlier entry.
+ */
+int results_set_not_applicable(struct results *res, const char *builder,
+                               const uint32_t *threads, size_t count, const char *reason);
 
 /* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of docs/design.md. */
 struct cJSON *results_rays_json(const struct ray_metrics *m);

@@ -50,7 +50,8 @@ static int check_counts(vstate *st)
 	const bvhlab_tree *t = st->tree;
 
 	if (t->node_count == 0)
-		return FAIL(st, "tree has no nodes (node_count 0)");
+		return FAIL(st, "tree has no nodes (node_count 0): did build() set "
+		            "output->node_count?");
 	if (t->node_count > t->node_capacity)
 		return FAIL(st, "node_count %" PRIu32 " exceeds node_capacity %" PRIu32,
 		            t->node_count, t->node_capacity);
@@ -111,6 +112,25 @@ static int reach(vstate *st, uint32_t node, uint32_t parent)
 	return 0;
 }
 
+/*
+ * The likely cause of a child index past the end, for the message: counts
+ * a build() forgot, or a pair that is one short (children are nodes[first]
+ * and nodes[first + 1], both below node_count).
+ */
+static const char *child_hint(const bvhlab_tree *t, uint32_t node, uint32_t c)
+{
+	if (t->node_count == 1)
+		return ": did build() set output->node_count to the nodes it wrote?";
+	if (c == t->node_count - 1)
+		return ": children are the pair nodes[first] and nodes[first + 1]; is the "
+		       "second one counted in node_count?";
+	if (node > 0 && c < node)
+		return ": an inner node's children come from 'first'; is this a leaf whose "
+		       "count was left 0?";
+	return ": a child index past the end (did build() count every node it wrote in "
+	       "node_count?)";
+}
+
 static int check_inner(vstate *st, uint32_t node)
 {
 	uint32_t c = st->tree->nodes[node].first;
@@ -118,9 +138,9 @@ static int check_inner(vstate *st, uint32_t node)
 
 	if (c >= st->tree->node_count - 1)
 		return FAIL(st, "node %" PRIu32 ": child index %" PRIu32 " out of range "
-		            "(children %" PRIu32 " and %" PRIu64 ", node_count %" PRIu32 ")",
+		            "(children %" PRIu32 " and %" PRIu64 ", node_count %" PRIu32 ")%s",
 		            node, c >= st->tree->node_count ? c : c + 1, c, (uint64_t)c + 1,
-		            st->tree->node_count);
+		            st->tree->node_count, child_hint(st->tree, node, c));
 	rc = reach(st, c, node);
 	if (rc == 0)
 		rc = reach(st, c + 1, node);
@@ -154,6 +174,17 @@ static int check_slot(vstate *st, uint32_t node, uint32_t slot)
 	return 0;
 }
 
+/* The likely cause of a leaf range past index_count, for the message. */
+static const char *leaf_hint(const bvhlab_tree *t, uint64_t end)
+{
+	if (t->index_count == 0)
+		return ": did build() set output->index_count?";
+	if (end == (uint64_t)t->index_count + 1)
+		return ": a leaf range off by one? (a leaf holds prim_index[first .. first + "
+		       "count), count primitives)";
+	return "";
+}
+
 static int check_leaf(vstate *st, uint32_t node)
 {
 	const bvhlab_node *n = &st->tree->nodes[node];
@@ -165,8 +196,8 @@ static int check_leaf(vstate *st, uint32_t node)
 	 * range lies (partly) outside the referenced slots. */
 	if (end > st->tree->index_count)
 		return FAIL(st, "node %" PRIu32 ": leaf range [%" PRIu32 ", %" PRIu64
-		            ") exceeds index_count %" PRIu32, node, n->first, end,
-		            st->tree->index_count);
+		            ") exceeds index_count %" PRIu32 "%s", node, n->first, end,
+		            st->tree->index_count, leaf_hint(st->tree, end));
 	for (slot = n->first; slot < end; slot++) {
 		rc = check_slot(st, node, slot);
 		if (rc < 0)
@@ -184,7 +215,8 @@ static int check_leftovers(vstate *st)
 		for (i = 0; i < st->tree->node_count; i++)
 			if (!(st->visited[i >> 6] & ((uint64_t)1 << (i & 63))))
 				return FAIL(st, "node %" PRIu32 " is not reachable from the root "
-				            "(orphan)", i);
+				            "(orphan)%s", i, st->reached < st->tree->node_count / 2 ?
+				            ": does node_count count more nodes than build() wrote?" : "");
 	for (i = 0; i < st->input->prim_count; i++)
 		if (st->prim_leaf[i] == NONE)
 			return FAIL(st, "primitive %" PRIu32 " is referenced by no leaf", i);

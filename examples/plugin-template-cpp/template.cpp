@@ -6,35 +6,33 @@
 // layout (children as adjacent pairs) by one thread.
 //
 // The bvhlab headers are C and C++ alike (extern "C"); the only rule C++
-// adds is that no exception may cross into the host: build() catches them
-// and returns a negative errno with a message, as every plugin must.
+// adds is that no exception may cross into the host. <bvhlab/builder.hpp>
+// (optional) takes care of that: bvhlab::guarded_build<build> turns any
+// exception build() lets out into host->set_error(what()) and a negative
+// errno; it also gives named option constructors and make_builder.
 // Build it out of tree against an installed bvhlab (meson.build beside this
 // file), then:  bvhlab build ./build/template_cpp.so icosphere:frequency=64
 #include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cstdint>
-#include <exception>
 #include <functional>
 #include <memory>
-#include <new>
 #include <system_error>
 #include <thread>
 #include <vector>
 
 #include <bvhlab/aabb.h>
-#include <bvhlab/builder.h>
+#include <bvhlab/builder.hpp>
 
 namespace {
 
 constexpr uint32_t max_bins = 256;
 
 const bvhlab_option_decl options[] = {
-	// name, type, help, def_bool, def_int, def_float, def_string, min, max, choices
-	{"bins", BVHLAB_OPTION_INT, "centroid bins per axis", false, 16, 0.0, nullptr, 2, max_bins,
-	 nullptr},
-	{"max_leaf", BVHLAB_OPTION_INT, "most primitives in a leaf", false, 4, 0.0, nullptr, 1, 64,
-	 nullptr},
+	// name, help, default, min, max
+	bvhlab::int_option("bins", "centroid bins per axis", 16, 2, max_bins),
+	bvhlab::int_option("max_leaf", "most primitives in a leaf", 4, 1, 64),
 };
 
 struct Subtree;
@@ -219,47 +217,34 @@ unsigned spawn_levels(uint32_t threads)
 	return levels;
 }
 
+// May throw (std::bad_alloc, std::system_error from std::thread, ...):
+// the descriptor names bvhlab::guarded_build<build>, which catches it.
 int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *input,
           bvhlab_build_output *output)
 {
 	int64_t bins = 16, max_leaf = 4;
 	host->option_int(ctx, "bins", &bins);
 	host->option_int(ctx, "max_leaf", &max_leaf);
-	try {
-		Builder b{input, std::vector<uint32_t>(input->prim_count),
-		          static_cast<uint32_t>(bins), static_cast<uint32_t>(max_leaf)};
-		for (uint32_t i = 0; i < input->prim_count; i++)
-			b.ids[i] = i;
-		unsigned levels = spawn_levels(input->threads);
-		Subtree root;
-		root.nodes.emplace_back();
-		build_node(b, root, 0, 0, input->prim_count, levels);
-		Writer w{output};
-		w.write(root, 0, 0);
-		std::copy(b.ids.begin(), b.ids.end(), output->prim_index);
-		output->node_count = w.next;
-		output->index_count = input->prim_count;
-		return 0;
-	} catch (const std::bad_alloc &) {
-		host->set_error(ctx, "out of memory for %u primitives", input->prim_count);
-		return -ENOMEM;
-	} catch (const std::exception &e) {
-		host->set_error(ctx, "%s", e.what());
-		return -EIO;
-	}
+	Builder b{input, std::vector<uint32_t>(input->prim_count), static_cast<uint32_t>(bins),
+	          static_cast<uint32_t>(max_leaf)};
+	for (uint32_t i = 0; i < input->prim_count; i++)
+		b.ids[i] = i;
+	unsigned levels = spawn_levels(input->threads);
+	Subtree root;
+	root.nodes.emplace_back();
+	build_node(b, root, 0, 0, input->prim_count, levels);
+	Writer w{output};
+	w.write(root, 0, 0);
+	std::copy(b.ids.begin(), b.ids.end(), output->prim_index);
+	output->node_count = w.next;
+	output->index_count = input->prim_count;
+	return 0;
 }
 
-const bvhlab_builder descriptor = {
-	BVHLAB_ABI_CURRENT,                       // abi_version
-	sizeof(bvhlab_builder),                   // struct_size
-	"template_cpp",                           // name
-	"C++17 template: binned SAH, top levels on std::threads",
-	BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC, // flags
-	sizeof(options) / sizeof(options[0]),     // option_count
-	options,
-	build,
-	nullptr,                                  // refine (ABI 1.2): none
-};
+const bvhlab_builder descriptor = bvhlab::make_builder(
+	"template_cpp", "C++17 template: binned SAH, top levels on std::threads",
+	BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC, options,
+	bvhlab::guarded_build<build>);
 
 } // namespace
 

@@ -118,7 +118,8 @@ static void test_probe(void)
 		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
 		"    { \"plugin\": \"not_built_here\", \"optional\": true } ] }\n");
 	CHECK_INT(run_in(tmpdir, ARGS("plan", optional, "--out", "plan-optional")), 0);
-	CHECK_CONTAINS(err_text, "optional builder 'not_built_here' skipped");
+	CHECK_CONTAINS(err_text, "optional builder skipped");
+	CHECK_CONTAINS(err_text, "builder 'not_built_here'");
 
 	char crash[600];
 	snprintf(crash, sizeof(crash), "%s/crash_ctor.so", LOADCRASH_DIR);
@@ -139,11 +140,13 @@ static int hold_lock(const char *dir, const char *pid)
 	return fd;
 }
 
+/* Two runs: fake_good is not a parallel builder, so one run per scene each. */
 static const char small[] =
-	"{ \"output\": \"%s\", \"repeat\": 1, \"threads\": [1, 2],\n"
+	"{ \"output\": \"%s\", \"repeat\": 1, \"threads\": [1],\n"
 	"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1 },\n"
 	"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-	"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n";
+	"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
+	"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n";
 
 /* 2. A second writer is refused, naming the first, and nothing is lost. */
 static void test_lock(void)
@@ -153,7 +156,7 @@ static void test_lock(void)
 	const char *cfg = write_config("lock.json", text);
 	char dir[600];
 	snprintf(dir, sizeof(dir), "%s", path_in("out-lock"));
-	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--threads", "1", cfg)), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--only", "0", cfg)), 0);
 	char *before = read_file(dir, "results.json");
 	int fd = hold_lock(dir, "4242\n");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--resume", cfg)), 2);
@@ -166,7 +169,7 @@ static void test_lock(void)
 	close(fd);
 	CHECK_INT(run(ARGS("run", "--quiet", "--resume", cfg)), 0);
 	cJSON *doc = load_results(dir);
-	CHECK_INT(count_runs(doc, "fake_good", "ok"), 2);
+	CHECK_INT(count_runs(doc, "a", "ok") + count_runs(doc, "b", "ok"), 2);
 	cJSON_Delete(doc);
 	free(before);
 	free(after);
@@ -224,10 +227,12 @@ static void test_temps(void)
 	CHECK_INT(runs_written(path_in(name)), 2);
 }
 
+/* Two runs, ids 0 (tri) and 1 (soup), of one builder. */
 static const char alpha_config[] =
-	"{ \"output\": \"out-id\", \"repeat\": 1, \"threads\": [1, 2],\n"
+	"{ \"output\": \"out-id\", \"repeat\": 1,\n"
 	"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1 },\n"
-	"  \"scenes\": [ { \"path\": \"tri.obj\" } ],\n"
+	"  \"scenes\": [ { \"path\": \"tri.obj\" },\n"
+	"              { \"generator\": \"soup\", \"count\": 10 } ],\n"
 	"  \"builders\": [ { \"plugin\": \"fake_good\", \"options\": { \"alpha\": %d } } ] }\n";
 
 static void write_mesh(const char *text)
@@ -260,7 +265,7 @@ static void identity_resume(void)
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", alpha(2))), 1);
 	CHECK_CONTAINS(err_text, "2 finished runs kept");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", "--retry-failed", alpha(2))), 0);
-	CHECK_CONTAINS(err_text, "--retry-failed: 2 runs that did not end ok will run again");
+	CHECK_CONTAINS(err_text, "--retry-failed: 1 run that did not end ok will run again");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", alpha(3))), 0);
 	CHECK_CONTAINS(err_text, "2 resumed runs made with other options will run again");
 	cJSON *doc = load_results(dir);
@@ -370,14 +375,15 @@ static void measure_rounds(void)
 	char dir[600];
 	snprintf(dir, sizeof(dir), "%s", path_in("out-rounds"));
 	const char *cfg = write_config("rounds.json",
-		"{ \"output\": \"out-rounds\", \"repeat\": 1, \"threads\": [1, 2], \"images\": true,\n"
+		"{ \"output\": \"out-rounds\", \"repeat\": 1, \"images\": true,\n"
 		"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 2, \"rounds\": 2 },\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
+		"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n");
 	/* Renames of results.json: 1 the empty document, 2 and 3 the runs, 4 the rounds. */
 	CHECK_INT(killed_at("/results.json", "4", ARGS("run", "--quiet", cfg)), 128 + SIGKILL);
 	cJSON *doc = load_results(dir);
-	const cJSON *r = run_of(doc, "fake_good", 2);
+	const cJSON *r = run_of(doc, "b", 1);
 	CHECK(r && cJSON_IsTrue(cJSON_GetObjectItem(rays_of(r), "provisional")));
 	cJSON_Delete(doc);
 	CHECK(exists(path_in("out-rounds/.heat-0-0.raw")));
@@ -388,7 +394,7 @@ static void measure_rounds(void)
 		CHECK_INT(cJSON_GetObjectItem(rays_of(r), "rounds")->valueint, 2);
 		CHECK(!cJSON_GetObjectItem(rays_of(r), "provisional"));
 	}
-	CHECK(run_str(run_of(doc, "fake_good", 1), "heat_image")[0] != '\0');
+	CHECK(run_str(run_of(doc, "a", 1), "heat_image")[0] != '\0');
 	cJSON_Delete(doc);
 	CHECK(!exists(path_in("out-rounds/.heat-0-0.raw")));
 	CHECK(!exists(path_in("out-rounds/.shade-0-0.raw")));
@@ -507,12 +513,16 @@ static void misc_merge(void)
 /* 15. A full disk: the runs not saved are counted as such, not as failed. */
 static void misc_full(void)
 {
-	char text[1024];
-	snprintf(text, sizeof(text), small, "out-full");
+	const char *cfg = write_config("full.json",
+		"{ \"output\": \"out-full\", \"repeat\": 1,\n"
+		"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1 },\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 10 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
+		"    { \"plugin\": \"fake_good\", \"name\": \"b\" },\n"
+		"    { \"plugin\": \"fake_good\", \"name\": \"c\" } ] }\n");
 	setenv("BVHLAB_FAULT_FULL", "1", 1);
 	/* Renames: 1 the empty document, 2 the first run; the disk is full from 3. */
-	CHECK_INT(killed_at("/results.json", "3", ARGS("run", "--threads", "1,2,3",
-	                                               write_config("full.json", text))), 1);
+	CHECK_INT(killed_at("/results.json", "3", ARGS("run", cfg)), 1);
 	unsetenv("BVHLAB_FAULT_FULL");
 	CHECK_CONTAINS(err_text, "2 finished runs could not be saved");
 	CHECK(!strstr(err_text, "some runs failed or were invalid"));

@@ -7,12 +7,25 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cJSON.h>
 
 #include "cliutil.h"
 
+static const char *path_in(const char *name)
+{
+	static char buf[512];
+	snprintf(buf, sizeof(buf), "%s/%s", tmpdir, name);
+	return buf;
+}
+
+static bool exists(const char *path)
+{
+	struct stat st;
+	return stat(path, &st) == 0;
+}
 
 static void test_help(void)
 {
@@ -59,7 +72,7 @@ static void check_phases(const cJSON *doc, const char *csv)
 		CHECK(cJSON_GetObjectItem(ph, "upload")->valuedouble == 1.5);
 		CHECK(cJSON_GetObjectItem(ph, "device")->valuedouble == 2.5);
 	}
-	CHECK_INT(with, 4);
+	CHECK_INT(with, 2); /* fake_good is not PARALLEL: one run per scene */
 	CHECK_CONTAINS(csv, ",build_phases,error\n");
 	CHECK_CONTAINS(csv, ",upload=1.5000;device=2.5000,");
 }
@@ -69,10 +82,21 @@ static void check_good_results(const char *dir)
 	cJSON *doc = load_results(dir);
 	if (!doc)
 		return;
-	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 8);
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 6);
 	CHECK_INT(count_runs(doc, "sweep", "ok"), 2);
 	CHECK_INT(count_runs(doc, "binned", "ok"), 2);
-	CHECK_INT(count_runs(doc, "fake_good", "ok"), 4);
+	/* fake_good has no PARALLEL flag: one run per scene, at 1 thread; its
+	 * thread count 2 is listed as not applicable. */
+	CHECK_INT(count_runs(doc, "fake_good", "ok"), 2);
+	const cJSON *runs = cJSON_GetObjectItem(doc, "runs"), *r;
+	cJSON_ArrayForEach(r, runs)
+		CHECK_INT(cJSON_GetObjectItem(r, "threads")->valueint, 1);
+	const cJSON *na = cJSON_GetObjectItem(doc, "not_applicable");
+	CHECK_INT(cJSON_GetArraySize(na), 1);
+	CHECK(!strcmp(run_str(cJSON_GetArrayItem(na, 0), "builder"), "fake_good"));
+	const cJSON *na_threads = cJSON_GetObjectItem(cJSON_GetArrayItem(na, 0), "threads");
+	CHECK_INT(cJSON_GetArraySize(na_threads), 1);
+	CHECK_INT(cJSON_GetArrayItem(na_threads, 0)->valueint, 2);
 	const cJSON *scenes = cJSON_GetObjectItem(doc, "scenes");
 	CHECK_INT(cJSON_GetArraySize(scenes), 2);
 	const cJSON *ico = cJSON_GetArrayItem(scenes, 0);
@@ -117,7 +141,9 @@ static void test_run_good(void)
 	/* --out and --repeat override the config. */
 	snprintf(dir, sizeof(dir), "%s/out-override", tmpdir);
 	CHECK_INT(run(ARGS("run", cfg, "--out", dir, "--repeat", "1")), 0);
-	CHECK_CONTAINS(err_text, "[8/8");
+	CHECK_CONTAINS(err_text, "[6/6");
+	CHECK_CONTAINS(err_text, "builder 'fake_good': not a parallel builder (no PARALLEL flag): "
+	                         "one run per scene, at 1 thread; thread count 2 not applicable");
 	cJSON *doc = load_results(dir);
 	const cJSON *run0 = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
 	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(cJSON_GetObjectItem(run0, "build_ms"),
@@ -176,6 +202,15 @@ static void test_info_build_list(void)
 	CHECK_INT(run(ARGS("list")), 1); /* the broken fake plugins are on the path */
 	CHECK_CONTAINS(out_text, "fake_abi2: NOT USABLE");
 	CHECK_CONTAINS(out_text, "fake_good");
+	/* Integer ranges as integers, not 1.07374e+09. */
+	CHECK_INT(run(ARGS("list", "sah_tasks")), 0);
+	CHECK_CONTAINS(out_text, "range [128, 1073741824]");
+	CHECK(!strstr(out_text, "e+"));
+	/* Names only, one a line, none loaded (the broken ones are listed too). */
+	CHECK_INT(run(ARGS("list", "--names")), 0);
+	CHECK_CONTAINS(out_text, "\nfake_good\n");
+	CHECK_CONTAINS(out_text, "\nsah_seq\n");
+	CHECK(!strstr(out_text, "NOT USABLE") && !strstr(out_text, "options"));
 }
 
 static void test_config_errors(void)
@@ -197,38 +232,119 @@ static void test_config_errors(void)
 	CHECK_CONTAINS(err_text, "/nonexistent/config.json");
 }
 
-/* Bad builders and scenes are recorded as failed runs; the rest still run. */
+/* How often needle occurs in hay. */
+static int occurrences(const char *hay, const char *needle)
+{
+	int n = 0;
+	for (const char *p = hay; (p = strstr(p, needle)); p += strlen(needle))
+		n++;
+	return n;
+}
+
+/*
+ * Builders whose config is wrong (unknown plugin, unknown option, an
+ * option of the wrong type, a plugin of another ABI, and a second error in
+ * the same file) refuse the whole config before anything runs: exit 2,
+ * every error printed once with its position, no output folder.
+ */
 static void test_bad_builders(void)
 {
 	const char *cfg = write_config("bad.json",
 		"{ \"output\": \"out-bad\", \"repeat\": 1, \"rays\": { \"min_ms\": 1 },\n"
-		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 500 },\n"
-		"              { \"name\": \"broken\", \"path\": \"missing.obj\" } ],\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 500 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"no_such_plugin\" },\n"
 		"                { \"plugin\": \"fake_abi2\" },\n"
-		"                { \"plugin\": \"fake_good\", \"name\": \"fails\",\n"
-		"                  \"options\": { \"fail\": \"error\" } },\n"
+		"                { \"plugin\": \"fake_good\", \"name\": \"typed\",\n"
+		"                  \"options\": { \"alpha\": \"two\" } },\n"
 		"                { \"plugin\": \"fake_good\", \"name\": \"typo\",\n"
 		"                  \"options\": { \"alpah\": 2 } },\n"
 		"                { \"plugin\": \"sah_seq\" } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 2);
+	CHECK_CONTAINS(err_text, "bad.json:3:17: builder 'no_such_plugin': plugin "
+	                         "'no_such_plugin' not found");
+	CHECK_CONTAINS(err_text, "bad.json:4:17: builder 'fake_abi2': ");
+	CHECK_CONTAINS(err_text, "built for ABI 2.0");
+	CHECK_CONTAINS(err_text, "bad.json:6:32: builder 'typed': option 'alpha' must be");
+	CHECK_CONTAINS(err_text, "bad.json:8:32: builder 'typo': unknown option 'alpah'");
+	CHECK_CONTAINS(err_text, "4 builders cannot run as configured");
+	CHECK_INT(occurrences(err_text, "builder 'typo'"), 1); /* said once, not twice */
+	CHECK_INT(occurrences(err_text, "builder 'no_such_plugin'"), 1);
+	CHECK(!exists(path_in("out-bad")));
+
+	/* A grid's builders share a bad plugin: one message, not one per value. */
+	cfg = write_config("badgrid.json",
+		"{ \"output\": \"out-badgrid\", \"scenes\": [ { \"generator\": \"soup\" } ],\n"
+		"  \"builders\": [ { \"plugin\": \"no_such_plugin\",\n"
+		"                  \"options\": { \"bins\": { \"grid\": [4, 8] } } } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 2);
+	CHECK_INT(occurrences(err_text, "not found on the search path"), 1);
+	CHECK(!exists(path_in("out-badgrid")));
+}
+
+/* Failures at run time (a build that fails, a scene that does not load)
+ * are recorded as failed runs; the rest still run. */
+static void test_failed_runs(void)
+{
+	const char *cfg = write_config("fails.json",
+		"{ \"output\": \"out-fails\", \"repeat\": 1, \"rays\": { \"min_ms\": 1 },\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 500 },\n"
+		"              { \"name\": \"broken\", \"path\": \"missing.obj\" } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"fails\",\n"
+		"                  \"options\": { \"fail\": \"error\" } },\n"
+		"                { \"plugin\": \"sah_seq\" } ] }\n");
 	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 1);
-	CHECK_CONTAINS(err_text, "bad.json:9:32: builder 'typo': unknown option 'alpah'");
 	char dir[512];
-	snprintf(dir, sizeof(dir), "%s/out-bad", tmpdir);
+	snprintf(dir, sizeof(dir), "%s/out-fails", tmpdir);
 	cJSON *doc = load_results(dir);
 	if (!doc)
 		return;
-	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 10);
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 4);
 	CHECK_INT(count_runs(doc, "sah_seq", "ok"), 1);
 	CHECK_INT(count_runs(doc, "sah_seq", "failed"), 1); /* the missing scene */
-	CHECK_INT(count_runs(doc, "no_such_plugin", "failed"), 2);
-	CHECK_INT(count_runs(doc, "fake_abi2", "failed"), 2);
 	CHECK_INT(count_runs(doc, "fails", "failed"), 2);
 	char *json = cJSON_PrintUnformatted(doc);
-	CHECK_CONTAINS(json, "plugin 'no_such_plugin' not found");
-	CHECK_CONTAINS(json, "built for ABI 2.0");
 	CHECK_CONTAINS(json, "builder 'fake_good': asked to fail");
 	CHECK_CONTAINS(json, "missing.obj");
+	free(json);
+	cJSON_Delete(doc);
+}
+
+/*
+ * A C++ exception out of build(), behind bvhlab::guarded_build
+ * (include/bvhlab/builder.hpp): its what() is the run's error in
+ * results.json and what `bvhlab build` prints, not an abort. One that
+ * escapes unwrapped kills the run's child: libstdc++'s last words, from
+ * its stderr, are the run's error.
+ */
+static void test_cxx_exception(void)
+{
+	CHECK_INT(run(ARGS("build", "fake_throw", "soup:count=100")), 1);
+	CHECK_CONTAINS(err_text, "builder 'fake_throw': fake_throw: thrown from build() on purpose");
+	CHECK_INT(run(ARGS("build", "fake_throw", "soup:count=100", "-o", "throw=int")), 1);
+	CHECK_CONTAINS(err_text, "a C++ exception that is not a std::exception");
+	CHECK_INT(run(ARGS("build", "fake_throw", "soup:count=100", "-o", "throw=none")), 0);
+	const char *cfg = write_config("throw.json",
+		"{ \"output\": \"out-throw\", \"repeat\": 1, \"rays\": { \"min_ms\": 1 },\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 200 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_throw\" },\n"
+		"                { \"plugin\": \"fake_throw\", \"name\": \"oom\",\n"
+		"                  \"options\": { \"throw\": \"bad_alloc\" } },\n"
+		"                { \"plugin\": \"fake_throw\", \"name\": \"escape\",\n"
+		"                  \"options\": { \"throw\": \"escape\" } } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 1);
+	cJSON *doc = load_results(path_in("out-throw"));
+	if (!doc)
+		return;
+	CHECK_INT(count_runs(doc, "fake_throw", "failed"), 1);
+	CHECK_INT(count_runs(doc, "oom", "failed"), 1);
+	char *json = cJSON_PrintUnformatted(doc);
+	CHECK_CONTAINS(json, "fake_throw: thrown from build() on purpose");
+	CHECK_CONTAINS(json, "out of memory (std::bad_alloc) for 200 primitives");
+	/* Unwrapped, the child dies; the end of its stderr is in the run's error. */
+	CHECK_INT(count_runs(doc, "escape", "crashed"), 1);
+	CHECK_CONTAINS(json, "killed by SIGABRT (Aborted); its stderr ended: terminate called "
+	                     "after throwing an instance of 'std::runtime_error' what(): "
+	                     "fake_throw: escaped build() unguarded");
 	free(json);
 	cJSON_Delete(doc);
 }
@@ -283,6 +399,8 @@ int main(int argc, char **argv)
 	} else if (!strcmp(argv[2], "errors")) {
 		test_config_errors();
 		test_bad_builders();
+		test_failed_runs();
+		test_cxx_exception();
 	} else if (!strcmp(argv[2], "shared")) {
 		if (access(BVHLAB_SHARED_SCENES "/ogre.obj", R_OK) != 0)
 			return TEST_SKIP;
