@@ -22,7 +22,8 @@ int harness_resume(struct results *res, const struct config *cfg, bool quiet, bo
  * those whose ray timings are one provisional slice (killed before the
  * scene's rounds), those of a builder whose options (or stages') changed,
  * and with retry_failed those that did not end ok. Says how many unless
- * quiet, recomputes *all_ok and writes the document when any went.
+ * quiet and recomputes *all_ok; each stays in the file until its new record
+ * replaces it.
  */
 int harness_forget_stale(struct results *res, const struct config *cfg,
                          const struct harness_builder *builders, bool retry_failed, bool quiet,

@@ -80,6 +80,7 @@ nomem:
 void results_finish(struct results *res)
 {
 	results_unlock(res);
+	free(res->stale);
 	cJSON_Delete(res->doc);
 	free(res->dir);
 	memset(res, 0, sizeof(*res));
@@ -187,6 +188,24 @@ static cJSON *validation_json(const struct run_record *run)
 	return o;
 }
 
+static cJSON *find_any(const struct results *res, const char *scene, const char *builder,
+                       uint32_t threads, bool stale);
+
+/* A run made again takes its stale record's place (which stayed on disk
+ * until now); any other is appended. */
+static void replace_or_add(struct results *res, const struct run_record *run, cJSON *o)
+{
+	cJSON *old = find_any(res, run->scene ? run->scene : "", run->builder, run->threads, true);
+	if (!old) {
+		cJSON_AddItemToArray(res->runs, o);
+		return;
+	}
+	for (size_t k = 0; k < res->stale_count; k++)
+		if (res->stale[k] == old)
+			res->stale[k] = res->stale[--res->stale_count];
+	cJSON_ReplaceItemViaPointer(res->runs, old, o);
+}
+
 int results_add_run(struct results *res, const struct run_record *run)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -229,7 +248,7 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddNumberToObject(o, "load_before", run->load_before);
 		cJSON_AddNumberToObject(o, "load_after", run->load_after);
 	}
-	cJSON_AddItemToArray(res->runs, o);
+	replace_or_add(res, run, o);
 	return 0;
 }
 
@@ -293,14 +312,30 @@ static bool run_matches(const cJSON *run, const char *scene, const char *builder
 }
 
 /* The document's run of scene x builder x threads, or NULL. */
-static cJSON *find_run(const struct results *res, const char *scene, const char *builder,
-                       uint32_t threads)
+static bool is_stale(const struct results *res, const cJSON *run)
+{
+	for (size_t k = 0; k < res->stale_count; k++)
+		if (res->stale[k] == run)
+			return true;
+	return false;
+}
+
+/* The document's run of scene x builder x threads, or NULL; one to be
+ * made again (stale) only when `stale`. */
+static cJSON *find_any(const struct results *res, const char *scene, const char *builder,
+                       uint32_t threads, bool stale)
 {
 	cJSON *run;
 	cJSON_ArrayForEach(run, res->runs)
-		if (run_matches(run, scene, builder, threads))
+		if (run_matches(run, scene, builder, threads) && stale == is_stale(res, run))
 			return run;
 	return NULL;
+}
+
+static cJSON *find_run(const struct results *res, const char *scene, const char *builder,
+                       uint32_t threads)
+{
+	return find_any(res, scene, builder, threads, false);
 }
 
 bool results_has_run(const struct results *res, const char *scene, const char *builder,
@@ -309,22 +344,32 @@ bool results_has_run(const struct results *res, const char *scene, const char *b
 	return find_run(res, scene, builder, threads) != NULL;
 }
 
+/* Marks a run to be made again; it stays in the document (and the file)
+ * until its new record replaces it. 0, or 1 when it was not marked yet. */
+static size_t mark_stale(struct results *res, cJSON *run)
+{
+	if (is_stale(res, run))
+		return 0;
+	cJSON **grown = realloc(res->stale, (res->stale_count + 1) * sizeof(*grown));
+	if (!grown)
+		return 0; /* kept as it is: a run not made again, not one lost */
+	res->stale = grown;
+	res->stale[res->stale_count++] = run;
+	return 1;
+}
+
 size_t results_forget_runs(struct results *res, const char *builder, const char *options_hash,
                            bool not_ok)
 {
 	size_t n = 0;
-	cJSON *run = res->runs->child;
-	while (run) {
-		cJSON *next = run->next;
+	cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
 		const char *b = string_of(run, "builder"), *h = string_of(run, "options_hash");
 		const char *status = string_of(run, "status");
 		bool other_options = options_hash && h && strcmp(h, options_hash) != 0;
 		bool failed = not_ok && (!status || strcmp(status, "ok") != 0);
-		if (b && strcmp(b, builder) == 0 && (other_options || failed)) {
-			cJSON_Delete(cJSON_DetachItemViaPointer(res->runs, run));
-			n++;
-		}
-		run = next;
+		if (b && strcmp(b, builder) == 0 && (other_options || failed))
+			n += mark_stale(res, run);
 	}
 	return n;
 }
@@ -332,15 +377,11 @@ size_t results_forget_runs(struct results *res, const char *builder, const char 
 size_t results_forget_provisional(struct results *res)
 {
 	size_t n = 0;
-	cJSON *run = res->runs->child;
-	while (run) {
-		cJSON *next = run->next;
+	cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
 		const cJSON *rays = cJSON_GetObjectItemCaseSensitive(run, "rays");
-		if (cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(rays, "provisional"))) {
-			cJSON_Delete(cJSON_DetachItemViaPointer(res->runs, run));
-			n++;
-		}
-		run = next;
+		if (cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(rays, "provisional")))
+			n += mark_stale(res, run);
 	}
 	return n;
 }
@@ -350,7 +391,7 @@ bool results_all_ok(const struct results *res)
 	const cJSON *run;
 	cJSON_ArrayForEach(run, res->runs) {
 		const char *status = string_of(run, "status");
-		if (!status || strcmp(status, "ok") != 0)
+		if (!is_stale(res, run) && (!status || strcmp(status, "ok") != 0))
 			return false;
 	}
 	return true;

@@ -22,6 +22,9 @@ struct results {
 	struct cJSON *scenes;
 	struct cJSON *runs;
 	char *dir;
+	struct cJSON **stale; /* [stale_count] runs of runs[] to be made again: not
+	                       * found as done, replaced by their new record */
+	size_t stale_count;
 	bool locked;  /* lock_fd holds the folder's lock (results_dir.c) */
 	int lock_fd;
 };
@@ -158,17 +161,19 @@ int results_resume(struct results *res, const struct config *cfg, size_t *kept, 
 int results_check_runs(const struct cJSON *runs, const struct config *cfg, const char *path,
                        bvhlab_error *err);
 /*
- * Removes the runs of `builder` that were made with other options (their
+ * Marks the runs of `builder` that were made with other options (their
  * "options_hash" is not options_hash; runs without one, or options_hash
- * NULL, stay) and, when not_ok, those whose status is not "ok", so that
- * a resumed sweep runs them again. How many went.
+ * NULL, stay) and, when not_ok, those whose status is not "ok", to be made
+ * again: results_has_run no longer finds them, and each stays in the
+ * document until results_add_run replaces it (a kill in between loses
+ * nothing). How many were marked.
  */
 size_t results_forget_runs(struct results *res, const char *builder, const char *options_hash,
                            bool not_ok);
-/* Removes the runs whose rays are provisional (their sweep was killed
- * before the rounds replaced them); how many went. */
+/* Marks the runs whose rays are provisional (their sweep was killed before
+ * the rounds replaced them) to be made again, as results_forget_runs does. */
 size_t results_forget_provisional(struct results *res);
-/* Whether every run of the document is "ok". */
+/* Whether every run of the document is "ok" (those to be made again aside). */
 bool results_all_ok(const struct results *res);
 /* "options": {name: value, ...} of resolved options (NULL: {}). */
 struct cJSON *results_options_json(const bvhlab_options *opts);
