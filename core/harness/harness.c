@@ -533,21 +533,6 @@ static uint32_t count_runs(const struct harness *h)
 }
 
 
-/* Every builder's plugin and options first: a config that cannot run as
- * written is refused whole (every error printed), before the output folder
- * is touched. */
-static int open_builders(struct harness *h, bvhlab_error *err)
-{
-	size_t bad = 0;
-	int r = harness_open_builders(h->cfg, h->cfg->isolate, &h->builders, &bad);
-	if (r < 0)
-		error_set(err, "out of memory opening plugins");
-	else if (bad)
-		r = -EINVAL, error_set(err, "%s: %zu builder%s cannot run as configured (above); "
-		                       "nothing was run", h->cfg->path, bad, bad == 1 ? "" : "s");
-	return r;
-}
-
 /* Which thread counts of each builder do not apply, noted in the document. */
 static int note_not_applicable(struct harness *h, bool quiet, bvhlab_error *err)
 {
@@ -594,7 +579,8 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 	struct harness h = {.cfg = cfg, .only = opts->only, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
 	bvhlab_set_pinning(cfg->pin);
-	int r = open_builders(&h, err);
+	/* Every builder's plugin and options first, before the folder is touched. */
+	int r = harness_open_sweep_builders(cfg, &h.builders, err);
 	if (r == 0)
 		r = start(&h, opts, err);
 	h.progress.total = r == 0 ? count_runs(&h) : 0;

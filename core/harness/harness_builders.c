@@ -230,3 +230,16 @@ void harness_close_builders(const struct config *cfg, struct harness_builder *bu
 	}
 	free(builders);
 }
+
+int harness_open_sweep_builders(const struct config *cfg, struct harness_builder **out,
+                                bvhlab_error *err)
+{
+	size_t bad = 0;
+	int r = harness_open_builders(cfg, cfg->isolate, out, &bad);
+	if (r < 0)
+		error_set(err, "out of memory opening plugins");
+	else if (bad)
+		r = -EINVAL, error_set(err, "%s: %zu builder%s cannot run as configured (above); "
+		                       "nothing was run", cfg->path, bad, bad == 1 ? "" : "s");
+	return r;
+}

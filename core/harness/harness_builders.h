@@ -63,6 +63,11 @@ int harness_probe_plugin(const char *plugin, double timeout_s, const char **stat
  */
 int harness_open_builders(const struct config *cfg, bool probed,
                           struct harness_builder **out, size_t *bad_configs);
+/* A sweep's builders (probed when the config isolates runs): a config that
+ * cannot run as written is refused whole (-EINVAL, every error printed,
+ * err counting the builders) before the output folder is touched. */
+int harness_open_sweep_builders(const struct config *cfg, struct harness_builder **out,
+                                bvhlab_error *err);
 void harness_close_builders(const struct config *cfg, struct harness_builder *builders);
 
 /*
