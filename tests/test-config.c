@@ -16,6 +16,7 @@
 
 #include "config/config.h"
 #include "config/json_locate.h"
+#include "harness/harness.h"
 #include "trace/trace_cl.h"
 #include "testutil.h"
 
@@ -332,7 +333,7 @@ static void test_unknown_keys(void)
 	t = "{ \"scenes\": [ { \"generator\": \"icosphere\", \"frequncy\": 4 } ], " BUILDERS " }";
 	EXPECT_ERROR_AT(t, "\"frequncy\"", 0,
 	                "unknown key 'frequncy' in scenes[0] (known: name, path, generator, parts, "
-	                "frequency, count, size, seed, width, subdivide); did you mean "
+	                "frequency, count, size, seed, width, subdivide, camera); did you mean "
 	                "'frequency'?");
 	EXPECT_ERROR("{ " SCENES ",\n"
 	             "  \"builders\": [ { \"plugin\": \"a\" },\n"
@@ -434,6 +435,41 @@ static void test_structure(void)
 	t = "{ \"scenes\": [ { \"generator\": \"soup\" }, { \"path\": \"m/soup.ply\" } ], "
 	    BUILDERS " }";
 	EXPECT_ERROR_AT(t, "{ \"path", 0, "duplicate scene name 'soup': scenes[0] has it too");
+}
+
+/* A scene's own "camera" wins over "rays"' one for that scene only; its
+ * errors name the scene. */
+static void test_scene_camera(void)
+{
+	const char *text =
+		"{ \"rays\": { \"camera\": { \"position\": [0, 0, 5] } },\n"
+		"  \"scenes\": [ { \"name\": \"a\", \"generator\": \"icosphere\" },\n"
+		"    { \"name\": \"room\", \"generator\": \"room\", \"camera\": {"
+		" \"position\": [0.5, -0.5, 0], \"target\": [-1, -0.4, 0], \"fov\": 70 } } ],\n"
+		"  " BUILDERS " }";
+	struct config cfg;
+	bvhlab_error err = { "" };
+	bvhlab_camera cam;
+	int rc = load(&cfg, text, &err);
+	CHECK_INT(rc, 0);
+	if (rc) {
+		fprintf(stderr, "%s\n", err.message);
+		return;
+	}
+	CHECK(!cfg.scenes[0].has_camera && cfg.scenes[1].has_camera);
+	CHECK(cfg.scenes[1].camera.fov_deg == 70.0f && cfg.scenes[1].camera.target[0] == -1.0f);
+	bvhlab_scene named = { .name = "room" }, other = { .name = "a" };
+	harness_camera(&cfg, &named, &cam);
+	CHECK(cam.position[0] == 0.5f && cam.fov_deg == 70.0f);
+	harness_camera(&cfg, &other, &cam);
+	CHECK(cam.position[2] == 5.0f && cam.fov_deg == 45.0f);
+	config_finish(&cfg);
+	const char *t = "{ \"scenes\": [ { \"generator\": \"room\",\n"
+	                "  \"camera\": { \"position\": [1, 1, 1], \"target\": [1, 1, 1] } } ], "
+	                BUILDERS " }";
+	EXPECT_ERROR_AT(t, "{ \"position", 0, "'scenes[0].camera': position and target must differ");
+	t = "{ \"scenes\": [ { \"generator\": \"room\", \"camera\": [1] } ], " BUILDERS " }";
+	EXPECT_ERROR_AT(t, "[1]", 0, "'scenes[0].camera' must be an object");
 }
 
 /* ---- builder options --------------------------------------------------------- */
@@ -656,6 +692,7 @@ int main(void)
 	test_unknown_keys();
 	test_types();
 	test_structure();
+	test_scene_camera();
 	test_options();
 	test_isolation_keys();
 	test_locate();

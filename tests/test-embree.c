@@ -4,8 +4,8 @@
  * whose rays agree with brute force. "low" and "medium" reference each
  * primitive exactly once; "high" really splits (more references than
  * triangles on a soup of long triangles) and keeps its clipped leaf boxes,
- * which the coverage check accepts and the whole-box rule rejects. Built
- * only when Embree is found.
+ * which the coverage check accepts and the whole-box rule rejects; every
+ * tree carries the "convert" phase. Built only when Embree is found.
  */
 #include <errno.h>
 #include <unistd.h>
@@ -47,6 +47,16 @@ static void check_leaves(const bvhlab_tree *t, const char *what)
 		}
 }
 
+/* The conversion into the standard layout is reported apart (ABI 1.3). */
+static void check_convert_phase(const bvhlab_tree *t, const char *what)
+{
+	for (uint32_t k = 0; k < t->phase_count; k++)
+		if (strcmp(t->phases[k].name, "convert") == 0 && t->phases[k].ms >= 0)
+			return;
+	fprintf(stderr, "%s: no convert phase\n", what);
+	test_failures++;
+}
+
 /* One build, judged like the harness does; returns its reference count. */
 static uint32_t check_one(const bvhlab_scene *s, const bvhlab_prims *prims, int q,
                           uint32_t threads)
@@ -68,6 +78,7 @@ static uint32_t check_one(const bvhlab_scene *s, const bvhlab_prims *prims, int 
 		test_failures++;
 	} else {
 		check_leaves(&tree, what);
+		check_convert_phase(&tree, what);
 		refs = tree.index_count;
 		/* Split references have clipped boxes: judged without the
 		 * spatial-splits flag, some leaf box must miss part of its triangle. */

@@ -34,6 +34,9 @@ struct config_scene {
 	int line, column;  /* where the scene's object starts */
 	struct config_part *parts; /* "parts" of a composite scene, or NULL */
 	size_t part_count;
+	bool has_camera;   /* "camera" given: the scene's rays start there, not from
+	                    * "rays"' camera or the framing */
+	bvhlab_camera camera;
 };
 
 /* One entry of a composite scene's "parts": a mesh or generator (src, whose

@@ -157,6 +157,8 @@ static int parse_scene(struct config *cfg, const cJSON *obj, size_t index,
 	else if (!rc)
 		rc = config_scene_source(cfg, obj, prefix, config_scene_keys, sc, err);
 	if (!rc)
+		rc = config_parse_scene_camera(cfg, obj, index, sc, err);
+	if (!rc)
 		rc = scene_name_and_path(cfg, sc, err);
 	return rc;
 }

@@ -124,6 +124,9 @@ char *config_stem(const char *path);
 
 /* "rays": {"camera": {position, target, up, fov}}; absent: automatic framing. */
 int config_parse_camera(struct config *cfg, const cJSON *rays, bvhlab_error *err);
+/* scenes[index]'s own "camera", if any, into sc (config_camera.c). */
+int config_parse_scene_camera(const struct config *cfg, const cJSON *scene, size_t index,
+                              struct config_scene *sc, bvhlab_error *err);
 int config_parse_scenes(struct config *cfg, bvhlab_error *err);
 /* After its table's keys are read: a scene's (or a part's) one source,
  * without generator parameters (the table's CONFIG_GENERATED keys) for a

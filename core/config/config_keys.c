@@ -80,6 +80,7 @@ const struct config_key config_scene_keys[] = {
 	SCENE("seed", CONFIG_U64, gen.seed, 0, UINT64_MAX, CONFIG_GENERATED),
 	SCENE("width", CONFIG_POSITIVE, gen.width, 0, 0, CONFIG_GENERATED),
 	SCENE("subdivide", CONFIG_U32, subdivide, 0, MAX_SUBDIVIDE, 0),
+	CUSTOM("camera"), /* the scene's own view: config_camera.c */
 	END,
 };
 

@@ -19,6 +19,13 @@
 
 void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam)
 {
+	/* Scene names are unique in a config, and the harness names each
+	 * loaded scene after its config entry. */
+	for (size_t i = 0; cfg && scene->name && i < cfg->scene_count; i++)
+		if (cfg->scenes[i].has_camera && strcmp(cfg->scenes[i].name, scene->name) == 0) {
+			*cam = cfg->scenes[i].camera;
+			return;
+		}
 	if (cfg && cfg->has_camera)
 		*cam = cfg->camera;
 	else

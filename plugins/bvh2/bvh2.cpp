@@ -1,0 +1,236 @@
+// bvh2: madmann91/bvh v2's builders as a peer in the same harness.
+//
+// builder: low, medium, high are its DefaultBuilder at that quality. With
+// a thread pool (2 threads or more) that is its mini-tree builder (pruning
+// off for low, on for medium and high; high then runs its reinsertion
+// optimizer); at 1 thread it is the library's single-thread path, a
+// different algorithm: binned SAH for low, sweep SAH for medium, sweep SAH
+// and reinsertion for high (one_thread: pool runs the mini-tree builder on
+// a pool of one thread instead). sweep and binned are its top-down SAH
+// builders, single-threaded in the library whatever the thread count.
+// reinsertion: its ReinsertionOptimizer after the build (on the pool).
+//
+// Threads: the pool (bvh::v2::ThreadPool) has exactly input->threads
+// workers; the calling thread only waits while they run, so at most
+// input->threads threads work at a time. At 1 thread no pool is made.
+//
+// The inputs are the host's boxes and centroids, copied into the
+// library's types (phase "input"); its tree is turned into the standard
+// layout last (phase "convert"); both are inside build_ms.
+#include <bvh/v2/binned_sah_builder.h>
+#include <bvh/v2/bvh.h>
+#include <bvh/v2/default_builder.h>
+#include <bvh/v2/node.h>
+#include <bvh/v2/reinsertion_optimizer.h>
+#include <bvh/v2/sweep_sah_builder.h>
+#include <bvh/v2/thread_pool.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
+#include <optional>
+#include <system_error>
+#include <vector>
+
+#include <bvhlab/builder.h>
+
+#include "peer_tree.hpp"
+
+namespace {
+
+using Node = bvh::v2::Node<float, 3>;
+using Bvh = bvh::v2::Bvh<Node>;
+using Vec3 = bvh::v2::Vec<float, 3>;
+using BBox = bvh::v2::BBox<float, 3>;
+using Default = bvh::v2::DefaultBuilder<Node>;
+using clk = std::chrono::steady_clock;
+
+// The node's 4-bit primitive count caps a leaf at 15.
+constexpr int64_t max_leaf_cap = Node::Index::max_prim_count;
+
+const bvhlab_option_decl options[] = {
+	// name, type, help, def_bool, def_int, def_float, def_string, min, max, choices
+	{"builder", BVHLAB_OPTION_STRING,
+	 "low, medium, high (DefaultBuilder: mini-tree on a pool of the run's threads; at 1 "
+	 "thread the library's single-thread path), sweep, binned (top-down SAH, 1 thread)",
+	 false, 0, 0.0, "medium", 1, 0, "low|medium|high|sweep|binned"},
+	{"reinsertion", BVHLAB_OPTION_BOOL,
+	 "run its ReinsertionOptimizer after the build (high already runs it once)", false, 0,
+	 0.0, nullptr, 1, 0, nullptr},
+	{"one_thread", BVHLAB_OPTION_STRING,
+	 "low/medium/high at 1 thread: sequential (the library's single-thread path) or pool "
+	 "(the mini-tree builder on a one-thread pool)",
+	 false, 0, 0.0, "sequential", 1, 0, "sequential|pool"},
+	{"min_leaf", BVHLAB_OPTION_INT, "nodes this small are never split", false, 1, 0.0, nullptr,
+	 1, max_leaf_cap, nullptr},
+	{"max_leaf", BVHLAB_OPTION_INT, "larger nodes are split even against the SAH", false, 8,
+	 0.0, nullptr, 1, max_leaf_cap, nullptr},
+	{"cost_ratio", BVHLAB_OPTION_FLOAT,
+	 "SAH cost of a node over that of a primitive (the library's cost_ratio)", false, 0, 1.0,
+	 nullptr, 1e-6, 1e6, nullptr},
+};
+
+struct Settings {
+	const char *builder = "medium";
+	bool reinsertion = false, pool_at_one = false;
+	int64_t min_leaf = 1, max_leaf = 8;
+	double cost_ratio = 1;
+};
+
+int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, Settings &s)
+{
+	const char *one = nullptr;
+	int rc;
+	if ((rc = host->option_string(ctx, "builder", &s.builder)) < 0 ||
+	    (rc = host->option_bool(ctx, "reinsertion", &s.reinsertion)) < 0 ||
+	    (rc = host->option_string(ctx, "one_thread", &one)) < 0 ||
+	    (rc = host->option_int(ctx, "min_leaf", &s.min_leaf)) < 0 ||
+	    (rc = host->option_int(ctx, "max_leaf", &s.max_leaf)) < 0 ||
+	    (rc = host->option_float(ctx, "cost_ratio", &s.cost_ratio)) < 0) {
+		host->set_error(ctx, "cannot read the options (%s)", std::strerror(-rc));
+		return rc;
+	}
+	if (s.min_leaf > s.max_leaf) {
+		host->set_error(ctx, "min_leaf %lld exceeds max_leaf %lld",
+		                static_cast<long long>(s.min_leaf), static_cast<long long>(s.max_leaf));
+		return -EINVAL;
+	}
+	s.pool_at_one = std::strcmp(one, "pool") == 0;
+	return 0;
+}
+
+Default::Config config_of(const Settings &s)
+{
+	Default::Config c;
+	c.sah = bvh::v2::SplitHeuristic<float>(0, static_cast<float>(s.cost_ratio));
+	c.min_leaf_size = static_cast<size_t>(s.min_leaf);
+	c.max_leaf_size = static_cast<size_t>(s.max_leaf);
+	const char *b = s.builder;
+	c.quality = std::strcmp(b, "low") == 0    ? Default::Quality::Low
+	            : std::strcmp(b, "high") == 0 ? Default::Quality::High
+	                                          : Default::Quality::Medium;
+	return c;
+}
+
+// The library's call; `pool` is null for the single-thread paths.
+Bvh run_builder(const Settings &s, bvh::v2::ThreadPool *pool, const std::vector<BBox> &boxes,
+                const std::vector<Vec3> &centers)
+{
+	Default::Config c = config_of(s);
+	Bvh bvh;
+	if (std::strcmp(s.builder, "sweep") == 0)
+		bvh = bvh::v2::SweepSahBuilder<Node>::build(boxes, centers, c);
+	else if (std::strcmp(s.builder, "binned") == 0)
+		bvh = bvh::v2::BinnedSahBuilder<Node>::build(boxes, centers, c);
+	else if (pool)
+		bvh = Default::build(*pool, boxes, centers, c);
+	else
+		bvh = Default::build(boxes, centers, c);
+	if (s.reinsertion && pool)
+		bvh::v2::ReinsertionOptimizer<Node>::optimize(*pool, bvh);
+	else if (s.reinsertion)
+		bvh::v2::ReinsertionOptimizer<Node>::optimize(bvh);
+	return bvh;
+}
+
+// The library's tree as peer::write_tree reads it.
+struct View {
+	const Bvh &b;
+	uint64_t max_nodes() const { return b.nodes.size(); }
+	uint64_t max_refs() const { return b.prim_ids.size(); }
+	uint32_t root() const { return 0; }
+	bool leaf(uint32_t n) const { return b.nodes[n].is_leaf(); }
+	uint32_t child(uint32_t n, int k) const
+	{
+		return static_cast<uint32_t>(b.nodes[n].index.first_id()) + k;
+	}
+	uint32_t prim_count(uint32_t n) const
+	{
+		return static_cast<uint32_t>(b.nodes[n].index.prim_count());
+	}
+	uint32_t prim(uint32_t n, uint32_t k) const
+	{
+		return static_cast<uint32_t>(b.prim_ids[b.nodes[n].index.first_id() + k]);
+	}
+	void box(uint32_t n, float lo[3], float hi[3]) const
+	{
+		BBox x = b.nodes[n].get_bbox();
+		for (int a = 0; a < 3; a++)
+			lo[a] = x.min[a], hi[a] = x.max[a];
+	}
+};
+
+int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+               const Settings &s, bvhlab_build_output *out)
+{
+	auto t0 = clk::now();
+	std::vector<BBox> boxes(in->prim_count);
+	std::vector<Vec3> centers(in->prim_count);
+	for (size_t i = 0; i < in->prim_count; i++) {
+		const bvhlab_aabb &b = in->prim_bounds[i];
+		const float *c = &in->centroids[3 * i];
+		boxes[i] = BBox(Vec3(b.lo[0], b.lo[1], b.lo[2]), Vec3(b.hi[0], b.hi[1], b.hi[2]));
+		centers[i] = Vec3(c[0], c[1], c[2]);
+	}
+	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
+	// sweep and binned are single-threaded: a pool only for what uses one.
+	bool top_down = std::strcmp(s.builder, "sweep") == 0 || std::strcmp(s.builder, "binned") == 0;
+	std::optional<bvh::v2::ThreadPool> pool;
+	if ((in->threads > 1 || s.pool_at_one) && (!top_down || s.reinsertion))
+		pool.emplace(in->threads);
+	Bvh bvh = run_builder(s, pool ? &*pool : nullptr, boxes, centers);
+	pool.reset(); // joins the workers inside the call
+	auto t1 = clk::now();
+	int rc = peer::write_tree(host, ctx, View{bvh}, out);
+	peer::report_phase(host, ctx, "convert", peer::ms_since(t1));
+	return rc;
+}
+
+int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+          bvhlab_build_output *out)
+{
+	Settings s;
+	int rc = read_settings(host, ctx, s);
+	if (rc < 0)
+		return rc;
+	// 28 bits of the node's index address children and primitives.
+	if (in->prim_count == 0 || in->prim_count > Node::Index::max_first_id / 2) {
+		host->set_error(ctx, "cannot build over %u primitives", in->prim_count);
+		return -EINVAL;
+	}
+	try {
+		return build_tree(host, ctx, in, s, out);
+	} catch (const std::bad_alloc &) {
+		host->set_error(ctx, "out of memory");
+		return -ENOMEM;
+	} catch (const std::system_error &e) {
+		host->set_error(ctx, "bvh2 could not start its thread pool: %s", e.what());
+		return -EAGAIN;
+	} catch (const std::exception &e) {
+		host->set_error(ctx, "bvh2 threw: %s", e.what());
+		return -EIO;
+	} catch (...) {
+		host->set_error(ctx, "bvh2 threw an unknown exception");
+		return -EIO;
+	}
+}
+
+const bvhlab_builder descriptor = {
+	BVHLAB_ABI_CURRENT,
+	sizeof(bvhlab_builder),
+	"bvh2",
+	"madmann91/bvh v2 (ac41ab8): DefaultBuilder low/medium/high (mini-tree on a pool of the "
+	"run's threads), sweep and binned SAH, optional reinsertion",
+	BVHLAB_BUILDER_PARALLEL,
+	sizeof(options) / sizeof(options[0]),
+	options,
+	build,
+	nullptr,
+};
+
+} // namespace
+
+BVHLAB_PLUGIN_EXPORT(descriptor)

@@ -1,0 +1,111 @@
+// peer_tree.hpp: a peer library's binary tree written out in bvhlab's
+// standard layout (tinybvh, bvh2), header-only C++.
+//
+// The library's tree is read through a small view (see peer_write_tree)
+// and written depth first with the children of each inner node as an
+// adjacent pair, so the output's order is the same whatever order the
+// library's threads numbered its nodes in. Boxes are copied as the library
+// made them, never recomputed: the validator judges the library's own tree
+// (a box that misses its contents is the library's finding, not fixed up).
+#ifndef BVHLAB_PEER_TREE_HPP
+#define BVHLAB_PEER_TREE_HPP
+
+#include <cerrno>
+#include <chrono>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include <bvhlab/builder.h>
+
+namespace peer {
+
+// Milliseconds since `t0` on the steady clock, for host->phase.
+inline double ms_since(std::chrono::steady_clock::time_point t0)
+{
+	using ms = std::chrono::duration<double, std::milli>;
+	return ms(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Adds `ms` to phase `name` when the host has ABI 1.3's phases.
+inline void report_phase(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *name,
+                         double ms)
+{
+	if (BVHLAB_HOST_HAS(host, phase))
+		host->phase(ctx, name, ms);
+}
+
+// Room for `nodes` nodes and `refs` references (one grow, from upper bounds
+// the view gives, so the writer never grows mid-way).
+inline int reserve(const bvhlab_host *host, bvhlab_build_ctx *ctx, bvhlab_build_output *out,
+                   uint64_t nodes, uint64_t refs)
+{
+	if (nodes <= out->node_capacity && refs <= out->index_capacity)
+		return 0;
+	if (nodes > UINT32_MAX || refs > UINT32_MAX ||
+	    host->grow_output(ctx, out, static_cast<uint32_t>(nodes),
+	                      static_cast<uint32_t>(refs)) < 0) {
+		host->set_error(ctx, "cannot grow the output to %llu nodes, %llu references",
+		                static_cast<unsigned long long>(nodes),
+		                static_cast<unsigned long long>(refs));
+		return -ENOMEM;
+	}
+	return 0;
+}
+
+// Writes the tree seen through `view` into `out`. The view provides:
+//   uint64_t max_nodes(), max_refs()   upper bounds of what will be written
+//   uint32_t root()
+//   bool leaf(n); uint32_t child(n, k) for k = 0, 1 (inner nodes)
+//   uint32_t prim_count(n); uint32_t prim(n, k) (leaves)
+//   void box(n, float lo[3], float hi[3])
+// 0, or a negative errno after host->set_error (-EPROTO when the library's
+// tree is not a tree of non-empty leaves within the bounds it stated).
+template <class View>
+int write_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const View &view,
+               bvhlab_build_output *out)
+{
+	int rc = reserve(host, ctx, out, view.max_nodes(), view.max_refs());
+	if (rc < 0)
+		return rc;
+	std::vector<std::pair<uint32_t, uint32_t>> stack; // (library node, output slot)
+	stack.reserve(128);
+	stack.emplace_back(view.root(), 0);
+	out->node_count = 1;
+	out->index_count = 0;
+	while (!stack.empty()) {
+		auto [src, slot] = stack.back();
+		stack.pop_back();
+		bvhlab_node &n = out->nodes[slot];
+		view.box(src, n.lo, n.hi);
+		if (!view.leaf(src)) {
+			if (uint64_t{out->node_count} + 2 > view.max_nodes()) {
+				host->set_error(ctx, "the library's tree has more nodes than its %llu "
+				                "(a cycle?)", static_cast<unsigned long long>(view.max_nodes()));
+				return -EPROTO;
+			}
+			n.first = out->node_count;
+			n.count = 0;
+			out->node_count += 2;
+			stack.emplace_back(view.child(src, 1), n.first + 1);
+			stack.emplace_back(view.child(src, 0), n.first);
+			continue;
+		}
+		uint32_t count = view.prim_count(src);
+		if (count == 0 || uint64_t{out->index_count} + count > view.max_refs()) {
+			host->set_error(ctx, "the library's leaf %u holds %u primitives (%u written of "
+			                "at most %llu)", src, count, out->index_count,
+			                static_cast<unsigned long long>(view.max_refs()));
+			return -EPROTO;
+		}
+		n.first = out->index_count;
+		n.count = count;
+		for (uint32_t k = 0; k < count; k++)
+			out->prim_index[out->index_count++] = view.prim(src, k);
+	}
+	return 0;
+}
+
+} // namespace peer
+
+#endif

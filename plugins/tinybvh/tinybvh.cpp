@@ -1,0 +1,245 @@
+// tinybvh: jbikker/tinybvh's builders as a peer in the same harness, so
+// bvhlab's builders are measured against the most active BVH library of
+// the day with the same timer, input and validation.
+//
+// builder: quick (BuildQuick: midpoint of the longest axis, one thread),
+// binned (Build: 8-bin SAH), avx (BuildAVX: the same tree, AVX binning),
+// sweep (Build with useFullSweep: full-sweep SAH), hq (BuildHQ: SBVH with
+// spatial splits; a leaf's box may hold only the clipped part of a
+// triangle, so the descriptor declares spatial splits, as embree's does;
+// the other builders reference each triangle once, which the tests check).
+// optimize: iterations of tinybvh's Optimize (reinsertion) after it.
+//
+// Threads: see tinybvh_cpus.h (the library spawns a fixed tree of
+// std::threads; the calling thread's CPU affinity holds them to the run's
+// thread count; at one thread the threaded path is off).
+//
+// tinybvh takes 16-byte vertices; the plugin copies the indexed mesh into
+// a triangle soup of them first (phase "input"), and the library's tree
+// into the standard layout last (phase "convert"). Both are inside
+// build_ms, as everything in the call is for every plugin.
+#define TINYBVH_IMPLEMENTATION
+#include <tiny_bvh.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
+#include <system_error>
+
+#include <bvhlab/builder.h>
+
+#include "peer_tree.hpp"
+#include "tinybvh_cpus.h"
+
+namespace {
+
+using tinybvh::BVH;
+using tinybvh::bvhvec4;
+using clk = std::chrono::steady_clock;
+
+const bvhlab_option_decl options[] = {
+	// name, type, help, def_bool, def_int, def_float, def_string, min, max, choices
+	{"builder", BVHLAB_OPTION_STRING,
+	 "quick (BuildQuick, 1 thread), binned (Build), avx (BuildAVX), sweep (full-sweep SAH), "
+	 "hq (BuildHQ, spatial splits); threads: the caller's CPU affinity is narrowed to the "
+	 "run's count around the call (the threads tinybvh spawns inherit it), and at 1 thread "
+	 "its threaded path is off",
+	 false, 0, 0.0, "avx", 1, 0, "quick|binned|avx|sweep|hq"},
+	{"optimize", BVHLAB_OPTION_INT,
+	 "iterations of tinybvh's Optimize (reinsertion, one thread) after the build; 0: off",
+	 false, 0, 0.0, nullptr, 0, 1000, nullptr},
+	{"optimize_extreme", BVHLAB_OPTION_BOOL, "Optimize's 'extreme' mode (more candidates)",
+	 false, 0, 0.0, nullptr, 1, 0, nullptr},
+	{"c_trav", BVHLAB_OPTION_FLOAT, "SAH cost of a traversal step (tinybvh's c_trav)", false,
+	 0, 1.0, nullptr, 1e-6, 1e6, nullptr},
+	{"c_int", BVHLAB_OPTION_FLOAT, "SAH cost of a triangle test (tinybvh's c_int)", false, 0,
+	 1.0, nullptr, 1e-6, 1e6, nullptr},
+	{"hq_bins", BVHLAB_OPTION_INT, "hq: bins per axis for object and spatial splits", false,
+	 HQBVHBINS, 0.0, nullptr, 2, MAXHQBINS, nullptr},
+};
+
+enum class Method { quick, binned, avx, sweep, hq };
+
+struct Settings {
+	Method method = Method::avx;
+	int64_t optimize = 0, hq_bins = HQBVHBINS;
+	bool extreme = false;
+	double c_trav = 1, c_int = 1;
+};
+
+int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, Settings &s)
+{
+	const char *b = nullptr;
+	int rc;
+	if ((rc = host->option_string(ctx, "builder", &b)) < 0 ||
+	    (rc = host->option_int(ctx, "optimize", &s.optimize)) < 0 ||
+	    (rc = host->option_bool(ctx, "optimize_extreme", &s.extreme)) < 0 ||
+	    (rc = host->option_float(ctx, "c_trav", &s.c_trav)) < 0 ||
+	    (rc = host->option_float(ctx, "c_int", &s.c_int)) < 0 ||
+	    (rc = host->option_int(ctx, "hq_bins", &s.hq_bins)) < 0) {
+		host->set_error(ctx, "cannot read the options (%s)", std::strerror(-rc));
+		return rc;
+	}
+	const char *names[] = {"quick", "binned", "avx", "sweep", "hq"};
+	for (int k = 0; k < 5; k++)
+		if (std::strcmp(b, names[k]) == 0)
+			s.method = static_cast<Method>(k);
+	return 0;
+}
+
+// Three 16-byte vertices per triangle, in primitive order.
+std::unique_ptr<bvhvec4[]> soup(const bvhlab_build_input *in)
+{
+	std::unique_ptr<bvhvec4[]> v(new bvhvec4[3 * static_cast<size_t>(in->prim_count)]);
+	for (size_t t = 0; t < in->prim_count; t++)
+		for (size_t k = 0; k < 3; k++) {
+			const float *p = &in->vertices[3 * static_cast<size_t>(in->indices[3 * t + k])];
+			v[3 * t + k] = bvhvec4(p[0], p[1], p[2], 0.0f);
+		}
+	return v;
+}
+
+// tinybvh 1.6.7's Build, BuildAVX and full sweep allocate their node
+// counter (BVH::atomicNewNodePtr, private) on 50,000 triangles or more even
+// with threadedBuild off, and free it only when it is on: 4 bytes leak per
+// one-thread build. An explicit instantiation may name a private member
+// ([temp.spec]), which is how the plugin reaches it to free it.
+struct CounterTag {
+	using type = std::atomic<uint32_t> *BVH::*;
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wnon-template-friend"
+	friend type counter_member(CounterTag);
+#pragma GCC diagnostic pop
+};
+template <typename Tag, typename Tag::type M> struct Reach {
+	friend typename Tag::type counter_member(Tag) { return M; }
+};
+template struct Reach<CounterTag, &BVH::atomicNewNodePtr>;
+
+// The library's call for `s`, on the calling thread (which may spawn more).
+void run_builder(BVH &bvh, const Settings &s, const bvhvec4 *v, uint32_t n)
+{
+	switch (s.method) {
+	case Method::quick: bvh.BuildQuick(v, n); break;
+	case Method::binned: bvh.Build(v, n); break;
+	case Method::avx: bvh.BuildAVX(v, n); break;
+	case Method::sweep: bvh.useFullSweep = true; bvh.Build(v, n); break;
+	case Method::hq: bvh.BuildHQ(v, n); break;
+	}
+	if (!bvh.threadedBuild) {
+		std::atomic<uint32_t> *&counter = bvh.*counter_member(CounterTag{});
+		delete counter;
+		counter = nullptr;
+	}
+}
+
+// BVH::Optimize does exactly this, but with a BVH_Verbose it never frees
+// (tinybvh 1.6.7 leaks one per call); this one lives on the stack. Optimize
+// visits nodes by index, and a threaded build numbers them in the order
+// its threads happened to take them: Compact renumbers them depth first
+// first, so the same tree gives the same result at any thread count.
+void optimize(BVH &bvh, const Settings &s)
+{
+	bvh.Compact();
+	tinybvh::BVH_Verbose verbose;
+	verbose.ConvertFrom(bvh);
+	verbose.Optimize(static_cast<uint32_t>(s.optimize), s.extreme, false);
+	bvh.ConvertFrom(verbose);
+}
+
+// tinybvh's tree as peer::write_tree reads it.
+struct View {
+	const BVH &b;
+	uint64_t max_nodes() const { return b.usedNodes; }
+	uint64_t max_refs() const { return b.idxCount; }
+	uint32_t root() const { return 0; }
+	bool leaf(uint32_t n) const { return b.bvhNode[n].isLeaf(); }
+	uint32_t child(uint32_t n, int k) const { return b.bvhNode[n].leftFirst + k; }
+	uint32_t prim_count(uint32_t n) const { return b.bvhNode[n].triCount; }
+	uint32_t prim(uint32_t n, uint32_t k) const { return b.primIdx[b.bvhNode[n].leftFirst + k]; }
+	void box(uint32_t n, float lo[3], float hi[3]) const
+	{
+		const BVH::BVHNode &x = b.bvhNode[n];
+		lo[0] = x.aabbMin.x, lo[1] = x.aabbMin.y, lo[2] = x.aabbMin.z;
+		hi[0] = x.aabbMax.x, hi[1] = x.aabbMax.y, hi[2] = x.aabbMax.z;
+	}
+};
+
+int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+               const Settings &s, bvhlab_build_output *out)
+{
+	auto t0 = clk::now();
+	std::unique_ptr<bvhvec4[]> v = soup(in);
+	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
+	BVH bvh;
+	bvh.c_trav = static_cast<float>(s.c_trav);
+	bvh.c_int = static_cast<float>(s.c_int);
+	bvh.hqbvhbins = static_cast<uint32_t>(s.hq_bins);
+	bvh.threadedBuild = in->threads > 1;
+	{
+		tbvh::CpuLimit cpus;
+		int rc = in->threads > 1 ? cpus.limit(in->threads) : 0;
+		if (rc < 0) {
+			host->set_error(ctx, "cannot narrow the CPU affinity to %u CPUs (%s)",
+			                in->threads, std::strerror(-rc));
+			return rc;
+		}
+		run_builder(bvh, s, v.get(), in->prim_count);
+	}
+	if (s.optimize > 0)
+		optimize(bvh, s);
+	auto t1 = clk::now();
+	int rc = peer::write_tree(host, ctx, View{bvh}, out);
+	peer::report_phase(host, ctx, "convert", peer::ms_since(t1));
+	return rc;
+}
+
+int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+          bvhlab_build_output *out)
+{
+	Settings s;
+	int rc = read_settings(host, ctx, s);
+	if (rc < 0)
+		return rc;
+	// tinybvh's counts are 32-bit and hq keeps 3 nodes per triangle.
+	if (in->prim_count == 0 || in->prim_count > UINT32_MAX / 8) {
+		host->set_error(ctx, "cannot build over %u primitives", in->prim_count);
+		return -EINVAL;
+	}
+	try {
+		return build_tree(host, ctx, in, s, out);
+	} catch (const std::bad_alloc &) {
+		host->set_error(ctx, "out of memory");
+		return -ENOMEM;
+	} catch (const std::system_error &e) {
+		host->set_error(ctx, "tinybvh could not start a thread: %s", e.what());
+		return -EAGAIN;
+	} catch (const std::exception &e) {
+		host->set_error(ctx, "tinybvh threw: %s", e.what());
+		return -EIO;
+	} catch (...) {
+		host->set_error(ctx, "tinybvh threw an unknown exception");
+		return -EIO;
+	}
+}
+
+const bvhlab_builder descriptor = {
+	BVHLAB_ABI_CURRENT,
+	sizeof(bvhlab_builder),
+	"tinybvh",
+	"jbikker/tinybvh 1.6.7: quick, binned, avx, sweep, hq (spatial splits), optional "
+	"Optimize; thread count held by CPU affinity (see the builder option)",
+	BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_SPATIAL_SPLITS,
+	sizeof(options) / sizeof(options[0]),
+	options,
+	build,
+	nullptr,
+};
+
+} // namespace
+
+BVHLAB_PLUGIN_EXPORT(descriptor)
