@@ -41,6 +41,11 @@ int cli_parse_threads(const char *text, uint32_t *out, size_t max, size_t *count
 			                "cores, at most %zu entries), not '%s'\n", max, text);
 			return -EINVAL;
 		}
+		for (size_t k = 0; k < *count; k++)
+			if (out[k] == v) {
+				fprintf(stderr, "bvhlab: --threads: duplicate thread count %lu\n", v);
+				return -EINVAL;
+			}
 		out[(*count)++] = (uint32_t)v;
 		p = *end ? end + 1 : end;
 	}

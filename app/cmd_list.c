@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "harness/harness_builders.h"
 
 static const char usage[] =
 	"usage: bvhlab list [PLUGIN...]\n"
@@ -11,9 +12,10 @@ static const char usage[] =
 	"\n"
 	"Lists the builder plugins on the search path (or the named ones, by name or\n"
 	"path) with their summary, flags and options (type, default, range, help).\n"
-	"A plugin that cannot be loaded is listed with the reason. --names prints\n"
-	"only the names found on the search path, one a line, loading none.\n"
-	"\n"
+	"A plugin that cannot be loaded is listed with the reason; each is loaded\n"
+	"first in a forked probe, so one that crashes or hangs (30 s) costs its line.\n"
+	"--names prints only the names found on the search path, one a line,\n"
+	"loading none.\n"	"\n"
 	"search path: $BVHLAB_PLUGIN_PATH, then the build tree, then the install folder.\n";
 
 static void print_flags(uint32_t flags)
@@ -67,11 +69,17 @@ static void print_option(const bvhlab_option_decl *d)
 	printf("\n      %s\n", d->help ? d->help : "");
 }
 
+/* Loading runs the plugin's code: a constructor that crashes or hangs
+ * costs its own line of the list, not the listing. */
+#define PROBE_TIMEOUT_S 30
+
 static int list_one(const char *name)
 {
 	bvhlab_plugin *p = NULL;
 	bvhlab_error err = {{0}};
-	if (bvhlab_plugin_open(name, &p, &err) < 0) {
+	const char *status;
+	if (harness_probe_plugin(name, PROBE_TIMEOUT_S, &status, &err) < 0 ||
+	    bvhlab_plugin_open(name, &p, &err) < 0) {
 		printf("%s: NOT USABLE: %s\n\n", name, err.message);
 		return 1;
 	}

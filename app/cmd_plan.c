@@ -11,6 +11,7 @@
 
 #include "cli.h"
 #include "config/config.h"
+#include "harness/harness_builders.h"
 #include "output/results.h"
 #include "plan/plan.h"
 #include "util/util.h"
@@ -21,8 +22,11 @@ static const char usage[] =
 	"\n"
 	"Splits a sweep into its runs (scene x builder x thread count, ids from 0 in\n"
 	"the order `bvhlab run` takes them) so that other engines can spread them\n"
-	"over machines. Checks every builder's plugin and options, writes\n"
-	"DIR/plan.json (the config with absolute paths, its hash, the run list) and\n"
+	"over machines. Checks every builder's plugin, refine stages and options\n"
+	"(each plugin opened first in a forked probe; an optional builder whose\n"
+	"plugin is missing is kept, as run keeps it) and the thread counts, writes\n"
+	"DIR/plan.json (the config with absolute paths, its scene files' sizes and\n"
+	"hashes, the plan's hash over both, the run list) and\n"
 	"gives one command per run, each writing the results folder DIR/parts/ID:\n"
 	"\n"
 	"  lines   one shell command per line on stdout, for\n"
@@ -66,6 +70,14 @@ static int parse_format(const char *text, enum format *out)
 	return -1;
 }
 
+static bool has_control(const char *s)
+{
+	for (; *s; s++)
+		if ((unsigned char)*s < 0x20 || *s == 0x7f)
+			return true;
+	return false;
+}
+
 static int parse(int argc, char **argv, struct plan_args *a)
 {
 	static const struct option longopts[] = {
@@ -91,6 +103,14 @@ static int parse(int argc, char **argv, struct plan_args *a)
 		r = -1;
 	}
 	bool operands_ok = a->missing ? optind == argc && !a->out : optind == argc - 1 && a->out;
+	const char *dir = a->missing ? a->missing : a->out;
+	if (r == 0 && operands_ok && (has_control(dir) || (a->command && has_control(a->command)))) {
+		/* Shell lines, Slurm's #SBATCH lines and comments end at a newline. */
+		fprintf(stderr, "bvhlab plan: the %s contains a control character (a newline?), "
+		        "which a command line or sweep.sbatch cannot carry: choose another\n",
+		        has_control(dir) ? "plan folder's name" : "--command");
+		return -1;
+	}
 	if (r == 0 && !operands_ok) {
 		fprintf(stderr, "bvhlab plan: expected CONFIG.json --out DIR, or --missing DIR\n\n%s",
 		        usage);
@@ -100,27 +120,25 @@ static int parse(int argc, char **argv, struct plan_args *a)
 	return r;
 }
 
-/* Opens every builder's plugin and applies its options: a plan that cannot run is refused. */
+/*
+ * Opens every builder's plugin and refine stages, each first in a forked
+ * probe, and applies their options: a plan that cannot run is refused
+ * (every reason printed). An optional builder whose plugin is not here is
+ * kept, as `run` keeps it: the machines that run the parts may have it.
+ */
 static int check_builders(const struct config *cfg)
 {
-	int bad = 0;
-	for (size_t b = 0; b < cfg->builder_count; b++) {
-		const struct config_builder *cb = &cfg->builders[b];
-		bvhlab_plugin *p = NULL;
-		bvhlab_options opts = {0};
-		bvhlab_error err = {{0}};
-		if (bvhlab_plugin_open(cb->plugin, &p, &err) < 0 ||
-		    bvhlab_options_init(&opts, bvhlab_plugin_builder(p)) < 0 ||
-		    config_apply_options(cfg, cb, &opts, &err) < 0) {
-			if (!err.message[0])
-				error_set(&err, "out of memory");
-			config_locate_builder_error(cfg, cb, SIZE_MAX, &err);
-			fprintf(stderr, "bvhlab: %s\n", err.message);
+	struct harness_builder *builders = NULL;
+	bvhlab_error err = {{0}};
+	size_t bad_configs = 0;
+	int bad = harness_open_builders(cfg, true, &builders, &bad_configs) < 0 ? -1 : 0;
+	for (size_t b = 0; bad == 0 && b < cfg->builder_count; b++)
+		if (!builders[b].skipped && (!builders[b].plugin || !builders[b].opts_ok))
 			bad = -1;
-		}
-		if (opts.values)
-			bvhlab_options_finish(&opts);
-		bvhlab_plugin_close(p);
+	harness_close_builders(cfg, builders);
+	if (bad == 0 && plan_check_threads(cfg, &err) < 0) {
+		fprintf(stderr, "bvhlab: %s\n", err.message);
+		bad = -1;
 	}
 	return bad;
 }
@@ -297,6 +315,11 @@ static int load_plan(const struct plan_args *a, struct plan_file *plan, char *di
 	config_finish(&cfg);
 	if (r == 0 && !realpath(d, dir)) {
 		error_set(&err, "cannot resolve %s: %s", d, strerror(errno));
+		r = -1;
+	}
+	if (r == 0 && has_control(dir)) {
+		error_set(&err, "the plan folder's path %s contains a control character (a "
+		          "newline?), which a command line or sweep.sbatch cannot carry", dir);
 		r = -1;
 	}
 	snprintf(path, sizeof(path), "%s/plan.json", dir);

@@ -36,7 +36,9 @@ static const char usage[] =
 	"options:\n"
 	"  --out DIR        output folder (overrides the config's \"output\")\n"
 	"  --resume         keep the finished runs of the output folder's results.json\n"
-	"                   and run only the missing ones (a fresh start if there is none)\n"
+	"                   and run only the missing ones (a fresh start if there is none);\n"
+	"                   runs made with other builder or stage options run again\n"
+	"  --retry-failed   with --resume: also run again the runs that did not end ok\n"
 	"  --force          start afresh in a folder that holds results: the old files\n"
 	"                   are moved aside to results.json.N, ... (without --resume or\n"
 	"                   --force such a folder is refused)\n"
@@ -75,6 +77,7 @@ static int parse(int argc, char **argv, struct run_args *a)
 		{"repeat", required_argument, NULL, 'r'}, {"quiet", no_argument, NULL, 'q'},
 		{"resume", no_argument, NULL, 'R'},      {"help", no_argument, NULL, 'h'},
 		{"force", no_argument, NULL, 'F'},
+		{"retry-failed", no_argument, NULL, 'Y'},
 		{"only", required_argument, NULL, 'O'},
 		{NULL, 0, NULL, 0}};
 	int c;
@@ -96,6 +99,8 @@ static int parse(int argc, char **argv, struct run_args *a)
 			a->opts.resume = true;
 		} else if (c == 'F') {
 			a->opts.force = true;
+		} else if (c == 'Y') {
+			a->opts.retry_failed = true;
 		} else if (c == 'O') {
 			a->only = optarg;
 		} else {
@@ -111,25 +116,30 @@ static int parse(int argc, char **argv, struct run_args *a)
 		        "aside: give one of them\n");
 		return -1;
 	}
+	if (a->opts.retry_failed && !a->opts.resume) {
+		fprintf(stderr, "bvhlab run: --retry-failed goes with --resume\n");
+		return -1;
+	}
 	a->config = argv[optind];
 	return 0;
 }
 
-/* Command-line overrides; --out is taken as given (relative to the cwd). */
-static int apply_overrides(struct config *cfg, const struct run_args *a)
+/* Command-line overrides; --out is taken as given (relative to the cwd).
+ * Thread counts are resolved here, once, for every later step. */
+static int apply_overrides(struct config *cfg, const struct run_args *a, bvhlab_error *err)
 {
 	if (a->out) {
 		char *out = strdup(a->out);
 		if (!out)
-			return -1;
+			return error_set(err, "out of memory"), -1;
 		free(cfg->output);
 		cfg->output = out;
 	}
 	if (a->thread_count && config_set_threads(cfg, a->threads, a->thread_count) < 0)
-		return -1;
+		return error_set(err, "out of memory"), -1;
 	if (a->repeat)
 		cfg->repeat = (uint32_t)a->repeat;
-	return 0;
+	return plan_resolve_threads(cfg, err);
 }
 
 /* The config, or a plan's (checked, its hash kept for the results). */
@@ -160,6 +170,22 @@ static int select_runs(const struct config *cfg, struct run_args *a, bool **only
 	return 0;
 }
 
+/* The sweep's last line: where the results are and what went wrong, by kind. */
+static void print_outcome(const char *dir, int r, const struct harness_tally *t)
+{
+	fprintf(stderr, "bvhlab: results in %s/ (results.json, results.csv, report.md, "
+	        "report.html)", dir);
+	if (t->unsaved)
+		fprintf(stderr, "; %zu finished run%s could not be saved (see above)", t->unsaved,
+		        t->unsaved == 1 ? "" : "s");
+	if (t->untraced)
+		fprintf(stderr, "; %zu run%s traced no rays (see their rays.error)", t->untraced,
+		        t->untraced == 1 ? "" : "s");
+	if (t->not_ok || (r && !t->unsaved && !t->untraced))
+		fprintf(stderr, "; some runs failed or were invalid");
+	fprintf(stderr, "\n");
+}
+
 int cmd_run(int argc, char **argv)
 {
 	struct run_args a = {0};
@@ -176,18 +202,19 @@ int cmd_run(int argc, char **argv)
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
-	if (apply_overrides(&cfg, &a) < 0) {
-		fprintf(stderr, "bvhlab: out of memory\n");
+	if (apply_overrides(&cfg, &a, &err) < 0) {
+		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
+	struct harness_tally tally = {0};
+	a.opts.tally = &tally;
 	r = harness_run(&cfg, &a.opts, &err);
 	if (r < 0) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
 	if (!a.opts.quiet)
-		fprintf(stderr, "bvhlab: results in %s/ (results.json, results.csv, report.md, report.html)%s\n",
-		        cfg.output, r ? "; some runs failed or were invalid" : "");
+		print_outcome(cfg.output, r, &tally);
 	status = r ? EXIT_RUNS_FAILED : 0;
 out:
 	free(only);

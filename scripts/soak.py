@@ -5,9 +5,16 @@ random moment and resumed (sometimes killed again while resuming).
 Each config mixes generated scenes, adversarial scene files (empty, NaN,
 a FIFO, a folder, a missing file, all-degenerate triangles), real builders
 and test plugins that crash, abort, hang, exit, leak memory, fail, return
-broken trees or crash while loading. After every sweep:
+broken trees or crash while loading. Kills come at random moments and, with
+rename_fault.so, at chosen ones: the Nth write of results.json (the folder's
+creation, a run, the interleaved ray rounds) and the Nth file --force moves
+aside. Some resumes run as two concurrent writers. After every sweep:
   - results.json parses and holds each scene x builder x thread count once;
-  - every run finished before the kill is still there, unchanged;
+  - every run finished before the kill is still there, unchanged (but for
+    provisional ray figures, which a resume measures again);
+  - --force's move keeps the old results.json whole, in place or as .1;
+  - of two concurrent writers one is refused, naming the other;
+  - no temporary folder, tree, heat or shade file is left behind;
   - the exit status matches the runs: 0 all ok, 1 otherwise.
 
 Usage: soak.py N BUILD_DIR [SEED]   (scripts/soak.sh N wraps it)
@@ -91,7 +98,8 @@ def random_config(rng, folder, out, loadcrash, memory_limits):
     threads = sorted(rng.sample([1, 2, 3], rng.randrange(1, 4)))
     cfg = {"output": out, "repeat": rng.randrange(1, 3), "warmup": rng.randrange(0, 2),
            "threads": threads, "validate_rays": 64,
-           "rays": {"width": 16, "height": 12, "diffuse": rng.randrange(0, 2)},
+           "rays": {"width": 16, "height": 12, "diffuse": rng.randrange(0, 2),
+                    "rounds": rng.choice([1, 2, 4])},
            "images": rng.random() < 0.5,
            "scenes": [random_scene(rng, folder, k) for k in range(rng.randrange(1, 4))],
            "builders": [random_builder(rng, k, loadcrash, memory_limits)
@@ -134,21 +142,68 @@ def load_runs(out):
     return runs
 
 
-def launch(bvhlab, config, resume):
-    args = [bvhlab, "run", "--quiet", config] + (["--resume"] if resume else [])
-    return subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+def launch(bvhlab, config, resume, extra=(), env=None):
+    args = [bvhlab, "run", "--quiet", config] + (["--resume"] if resume else []) + list(extra)
+    return subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
 
 
-def killed_sweep(rng, bvhlab, config, out, resume):
-    """Starts a sweep, kills it at a random moment; the runs it left."""
-    p = launch(bvhlab, config, resume)
+def shim_env(shim, nth, to):
+    """Kills bvhlab just before its nth rename (or link) onto a name ending in `to`."""
+    env = dict(os.environ, LD_PRELOAD=shim, BVHLAB_FAULT_RENAME=str(nth), BVHLAB_FAULT_TO=to)
+    env["ASAN_OPTIONS"] = env.get("ASAN_OPTIONS", "") + ":verify_asan_link_order=0"
+    return env
+
+
+def killed_sweep(rng, bvhlab, config, out, resume, shim):
+    """Starts a sweep, kills it at a random moment or at its Nth write of
+    results.json (creating the folder, a run, the rounds); the runs it left."""
+    env = shim_env(shim, rng.randrange(1, 8), "/results.json") if rng.random() < 0.4 else None
+    p = launch(bvhlab, config, resume, env=env)
     try:
-        p.wait(timeout=rng.uniform(0.0, 2.0))
+        p.wait(timeout=rng.uniform(0.0, 2.0) if env is None else LIMIT_S)
     except subprocess.TimeoutExpired:
         p.send_signal(signal.SIGKILL)
         p.wait()
     p.stderr.close()
     return load_runs(out) or {}
+
+
+def killed_force(rng, bvhlab, config, out, before, shim):
+    """--force killed while it moves the old files aside: the old results.json
+    stays whole, in place or as results.json.1. The runs left to resume."""
+    old = os.path.join(out, "results.json")
+    text = open(old).read() if os.path.exists(old) else None
+    p = launch(bvhlab, config, False, ["--force"], shim_env(shim, 1, rng.choice(
+        ["/results.csv.1", "/report.md.1", "/report.html.1", "/images.1", "/results.json.1"])))
+    p.communicate(timeout=LIMIT_S)
+    moved = os.path.join(out, "results.json.1")
+    if text is not None and os.path.exists(moved):
+        if open(moved).read() != text:
+            raise AssertionError("--force killed: results.json.1 is not the old results.json")
+        return {}
+    if text is not None and open(old).read() != text:
+        raise AssertionError("--force killed: results.json changed before it was moved")
+    for name in os.listdir(out) if os.path.isdir(out) else []:
+        if name.endswith(".2"):
+            raise AssertionError(f"--force killed: a second generation {name}")
+    return before
+
+
+def concurrent_resume(bvhlab, config, where):
+    """Two writers at once: each ends normally or is refused naming the other."""
+    ps = [launch(bvhlab, config, True) for _ in range(2)]
+    codes = []
+    for p in ps:
+        try:
+            _, err = p.communicate(timeout=LIMIT_S)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            raise AssertionError(f"{where}: concurrent sweep still running after {LIMIT_S} s")
+        refused = p.returncode == 2 and b"in use by another bvhlab (pid" in err
+        if p.returncode not in (0, 1) and not refused:
+            raise AssertionError(f"{where}: concurrent writer exit {p.returncode}\n{err.decode()}")
+        codes.append(p.returncode)
+    return codes
 
 
 def same_run(a, b):
@@ -158,10 +213,23 @@ def same_run(a, b):
     return a is not None and b is not None and strip(a) == strip(b)
 
 
+def provisional(run):
+    return bool(run.get("rays", {}).get("provisional"))
+
+
 def check_kept(before, after, where):
     for key, run in before.items():
-        if not same_run(after.get(key), run):
+        if not provisional(run) and not same_run(after.get(key), run):
             raise AssertionError(f"{where}: finished run {key} lost or changed")
+
+
+def check_no_leftovers(work, out, where):
+    for name in os.listdir(work):
+        if name.startswith(".bvhlab-new-"):
+            raise AssertionError(f"{where}: temporary folder {name} left behind")
+    for name in os.listdir(out):
+        if name.startswith((".tree-", ".heat-", ".shade-")):
+            raise AssertionError(f"{where}: {name} left behind")
 
 
 def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
@@ -172,11 +240,16 @@ def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
     config = os.path.join(work, "config.json")
     with open(config, "w") as f:
         json.dump(cfg, f, indent=1)
-    before = killed_sweep(rng, bvhlab, config, out, False)
+    shim = os.path.join(os.path.dirname(loadcrash), "shim", "rename_fault.so")
+    before = killed_sweep(rng, bvhlab, config, out, False, shim)
     if rng.random() < 0.4:
-        again = killed_sweep(rng, bvhlab, config, out, True)
+        again = killed_sweep(rng, bvhlab, config, out, True, shim)
         check_kept(before, again, f"config {i} (second kill)")
         before = again
+    if rng.random() < 0.2 and os.path.exists(os.path.join(out, "results.json")):
+        before = killed_force(rng, bvhlab, config, out, before, shim)
+    if rng.random() < 0.2:
+        concurrent_resume(bvhlab, config, f"config {i}")
     p = launch(bvhlab, config, True)
     try:
         _, err = p.communicate(timeout=LIMIT_S)
@@ -188,6 +261,7 @@ def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
     want = expected_runs(cfg)
     if set(after) != want:
         raise AssertionError(f"config {i}: runs {sorted(set(after) ^ want)} missing or extra")
+    check_no_leftovers(work, out, f"config {i}")
     all_ok = all(r["status"] == "ok" for r in after.values())
     if p.returncode != (0 if all_ok else 1):
         raise AssertionError(f"config {i}: exit status {p.returncode} but "

@@ -40,12 +40,42 @@ static int entry_array(struct config *cfg, const char *key, size_t size, const c
 	return 0;
 }
 
+/* Whether s is UTF-8 (no overlong forms, surrogates or code points past
+ * U+10FFFF): names go into results.json, which JSON readers must read. */
+static bool utf8_valid(const char *s)
+{
+	const unsigned char *p = (const unsigned char *)s;
+	while (*p) {
+		int n = *p < 0x80 ? 0 : (*p & 0xe0) == 0xc0 ? 1 : (*p & 0xf0) == 0xe0 ? 2
+		        : (*p & 0xf8) == 0xf0 ? 3 : -1;
+		if (n < 0 || (n == 1 && *p < 0xc2) || (n == 3 && *p > 0xf4))
+			return false;
+		uint32_t cp = *p & (0x7f >> n);
+		for (int k = 1; k <= n; k++) {
+			if ((p[k] & 0xc0) != 0x80)
+				return false;
+			cp = cp << 6 | (p[k] & 0x3f);
+		}
+		if ((n == 2 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
+		    (n == 3 && (cp < 0x10000 || cp > 0x10ffff)))
+			return false;
+		p += n + 1;
+	}
+	return true;
+}
+
 /* Scene and builder names label runs and reports: two alike would mix them up. */
 static int unique_names(const struct config *cfg, const cJSON *array, const char **names,
                         const char *what, const char *key, bvhlab_error *err)
 {
 	size_t i = 0;
 	for (const cJSON *e = array->child; e; e = e->next, i++) {
+		if (!utf8_valid(names[i])) {
+			const cJSON *name = config_member(e, "name");
+			return config_error(cfg, name ? name : e, false, err,
+			                    "%s[%zu]: its %s name is not valid UTF-8 (results.json "
+			                    "could not be read): give it a \"name\"", key, i, what);
+		}
 		for (size_t j = 0; j < i; j++) {
 			if (strcmp(names[i], names[j]) != 0)
 				continue;

@@ -321,6 +321,26 @@ static void excerpt(const char *at, char *buf, size_t size)
 	buf[n] = '\0';
 }
 
+/* Open arrays and objects before text[offset], strings skipped: cJSON
+ * stops at CJSON_NESTING_LIMIT levels, which is not a syntax error. */
+static size_t depth_at(const char *text, size_t offset)
+{
+	size_t depth = 0;
+	bool in_string = false;
+	for (size_t i = 0; i < offset; i++) {
+		char c = text[i];
+		if (in_string && c == '\\' && i + 1 < offset)
+			i++;
+		else if (c == '"')
+			in_string = !in_string;
+		else if (!in_string && (c == '[' || c == '{'))
+			depth++;
+		else if (!in_string && (c == ']' || c == '}') && depth)
+			depth--;
+	}
+	return depth;
+}
+
 static int syntax_error(const char *path, const char *text, const char *at, bvhlab_error *err)
 {
 	if (!at)
@@ -329,6 +349,12 @@ static int syntax_error(const char *path, const char *text, const char *at, bvhl
 	size_t offset = at && at >= text && at <= text + len ? (size_t)(at - text) : len;
 	int line, col;
 	json_offset_position(text, offset, &line, &col);
+	if (depth_at(text, offset) >= CJSON_NESTING_LIMIT) {
+		error_set(err, "%s:%d:%d: JSON nested deeper than %d levels (arrays and objects "
+		          "within each other), more than bvhlab reads", path, line, col,
+		          CJSON_NESTING_LIMIT);
+		return -EINVAL;
+	}
 	char near[EXCERPT_BYTES + 1];
 	excerpt(text + offset, near, sizeof(near));
 	if (near[0] == '\0') {

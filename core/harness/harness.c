@@ -15,6 +15,7 @@
 #include "harness/harness.h"
 #include "harness/harness_builders.h"
 #include "harness/harness_frames.h"
+#include "harness/harness_resume.h"
 #include "harness/harness_rounds.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
@@ -38,6 +39,7 @@ struct harness {
 	struct harness_builder *builders;
 	struct progress progress;
 	bool all_ok;
+	struct harness_tally tally;
 	bool shade_done; /* this scene's shaded render is on its way */
 	bool rounds_on;  /* this scene's rays are timed in interleaved rounds */
 	struct harness_rounds rounds; /* this scene's trees waiting for them */
@@ -93,12 +95,17 @@ static uint32_t resolve_threads(uint32_t t)
 static void record(struct harness *h, struct run_record *run)
 {
 	bvhlab_error err = {{0}};
+	h->tally.not_ok += strcmp(run->status, "ok") != 0;
+	/* A valid tree whose rays could not be traced stays ok ("rays": "error"
+	 * says why), but the last line counts it. */
+	h->tally.untraced += !strcmp(run->status, "ok") && run->rays && !run->rays->measured;
 	if (strcmp(run->status, "ok") != 0)
 		h->all_ok = false;
 	progress_done(&h->progress, run);
 	if (results_add_run(&h->res, run) < 0 || results_write(&h->res, &err) < 0) {
 		fprintf(stderr, "bvhlab: cannot write results: %s\n",
 		        err.message[0] ? err.message : "out of memory");
+		h->tally.unsaved++;
 		h->all_ok = false;
 	}
 }
@@ -145,6 +152,7 @@ static void record_all_failed(struct harness *h, size_t scene_index, const char 
 		                         .scene = scene, .builder = hb->cb->name,
 		                         .plugin = hb->cb->plugin, .threads = resolve_threads(threads[k]),
 		                         .opts = hb->opts_ok ? &hb->opts : NULL,
+		                         .options_hash = hb->opts_ok ? hb->options_hash : NULL,
 		                         .status = status, .error = error};
 		if (!skip_run(h, run.id, run.scene, run.builder, run.threads))
 			record(h, &run);
@@ -244,6 +252,8 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 	int r = image_buffers(job, n, &nodes, &shade);
 	if (r == 0)
 		r = harness_trace_rays(tree, job->scene, &cam, &rs, &rep->rays, nodes, shade);
+	/* One slice, until the scene's rounds replace it. */
+	rep->rays.provisional = r == 0 && rep->tree_written;
 	if (r == 0 && nodes)
 		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
 	if (r == 0 && shade)
@@ -377,11 +387,15 @@ static void image_paths(struct harness *h, struct series_job *job, size_t scene_
 {
 	if (!h->cfg->images || h->cfg->ray_width == 0 || h->cfg->ray_height == 0)
 		return;
+	/* Unlinked first: a run that dies or times out leaves no data, and no
+	 * older run's is drawn in its place. */
 	if (first && images_temp_path(paths[0], sizeof(paths[0]), h->cfg->output, "heat",
-	                               scene_index, builder_index) == 0)
+	                               scene_index, builder_index) == 0 &&
+	    (unlink(paths[0]) == 0 || errno == ENOENT))
 		job->heat_path = paths[0];
 	if (!h->shade_done && images_temp_path(paths[1], sizeof(paths[1]), h->cfg->output,
-	                                        "shade", scene_index, 0) == 0)
+	                                        "shade", scene_index, 0) == 0 &&
+	    (unlink(paths[1]) == 0 || errno == ENOENT))
 		job->shade_path = paths[1];
 }
 
@@ -405,7 +419,8 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 	struct run_record run = {.id = plan_run_id(h->cfg, scene_index, builder_index, thread_index),
 	                         .scene = job->scene->name, .builder = job->hb->cb->name,
 	                         .plugin = desc->name, .threads = resolve_threads(job->threads),
-	                         .opts = &job->hb->opts, .status = "failed",
+	                         .opts = &job->hb->opts, .options_hash = job->hb->options_hash,
+	                         .status = "failed",
 	                         .triangles = job->scene->triangle_count};
 	char paths[2][4096], tree_path[4096];
 	if (skip_run(h, run.id, run.scene, run.builder, run.threads))
@@ -530,71 +545,65 @@ static uint32_t count_runs(const struct harness *h)
 	return (uint32_t)chosen;
 }
 
-/* Takes over the finished runs of the output folder's results.json. */
-static int resume(struct harness *h, bvhlab_error *err)
+
+/* Which thread counts of each builder do not apply, noted in the document. */
+static int note_not_applicable(struct harness *h, bool quiet, bvhlab_error *err)
 {
-	size_t kept = 0, not_ok = 0;
-	int r = results_resume(&h->res, h->cfg, &kept, &not_ok, err);
-	if (r == -ENOENT) {
-		if (!h->progress.quiet)
-			fprintf(stderr, "bvhlab: nothing to resume in %s/; starting afresh\n",
-			        h->cfg->output);
-		return 0;
+	int r = 0;
+	for (size_t b = 0; r == 0 && !h->only && b < h->cfg->builder_count; b++) {
+		size_t n;
+		const uint32_t *threads = builder_threads(h, h->builders[b].cb, &n);
+		if ((r = harness_note_not_applicable(&h->builders[b], threads, n, &h->res, quiet)) < 0)
+			error_set(err, "out of memory");
 	}
+	return r;
+}
+
+/* The folder locked and claimed, the document started (resumed). */
+static int start(struct harness *h, const struct harness_options *opts, bvhlab_error *err)
+{
+	const struct config *cfg = h->cfg;
+	int r = results_init(&h->res, cfg, cfg->output, err);
 	if (r < 0)
 		return r;
-	h->all_ok = not_ok == 0;
-	if (!h->progress.quiet)
-		fprintf(stderr, "bvhlab: resuming %s/: %zu finished run%s kept\n", h->cfg->output,
-		        kept, kept == 1 ? "" : "s");
-	return 0;
+	/* One writer per folder, from before anything in it is read or moved. */
+	r = results_lock(&h->res, err);
+	if (r == 0 && !opts->resume)
+		r = safe_claim_output(h->res.dir, opts->force, err);
+	if (r == 0 && opts->plan_hash)
+		r = results_set_plan(&h->res, opts->plan_hash, plan_run_count(cfg), err);
+	if (r == 0 && opts->resume)
+		r = harness_resume(&h->res, cfg, h->progress.quiet, &h->all_ok, err);
+	if (r == 0 && opts->resume)
+		r = harness_forget_stale(&h->res, cfg, h->builders, opts->retry_failed,
+		                         h->progress.quiet, &h->all_ok, err);
+	if (r == 0)
+		r = note_not_applicable(h, opts->quiet, err);
+	if (r == 0)
+		r = results_write(&h->res, err);
+	if (r == 0)
+		harness_rounds_sweep(cfg->output);
+	return r;
 }
 
 int harness_run(const struct config *cfg, const struct harness_options *opts,
                 bvhlab_error *err)
 {
 	struct harness h = {.cfg = cfg, .only = opts->only, .all_ok = true};
-	size_t bad_configs = 0;
 	progress_init(&h.progress, opts->quiet);
-	/* Every builder's plugin and options first: a config that cannot run
-	 * as written is refused whole (every error printed), before the output
-	 * folder is touched. */
-	int r = harness_open_builders(cfg, &h.builders, &bad_configs);
-	if (r < 0)
-		error_set(err, "out of memory opening plugins");
-	else if (bad_configs)
-		r = -EINVAL, error_set(err, "%s: %zu builder%s cannot run as configured (above); "
-		                       "nothing was run", cfg->path, bad_configs,
-		                       bad_configs == 1 ? "" : "s");
-	if (r == 0)
-		r = opts->resume ? 0 : safe_claim_output(cfg->output, opts->force, err);
-	if (r == 0)
-		r = results_init(&h.res, cfg, cfg->output, err);
-	if (r < 0)
-		goto out;
-	if (opts->plan_hash)
-		r = results_set_plan(&h.res, opts->plan_hash, plan_run_count(cfg), err);
 	bvhlab_set_pinning(cfg->pin);
-	if (r == 0 && opts->resume)
-		r = resume(&h, err);
-	for (size_t b = 0; r == 0 && !h.only && b < cfg->builder_count; b++) {
-		size_t n;
-		const uint32_t *threads = builder_threads(&h, h.builders[b].cb, &n);
-		if ((r = harness_note_not_applicable(&h.builders[b], threads, n, &h.res,
-		                                     opts->quiet)) < 0)
-			error_set(err, "out of memory");
-	}
+	/* Every builder's plugin and options first, before the folder is touched. */
+	int r = harness_open_sweep_builders(cfg, &h.builders, err);
 	if (r == 0)
-		r = results_write(&h.res, err);
-	if (r == 0)
-		harness_rounds_sweep(cfg->output);
-	h.progress.total = count_runs(&h);
+		r = start(&h, opts, err);
+	h.progress.total = r == 0 ? count_runs(&h) : 0;
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
 		run_scene(&h, &cfg->scenes[s], s);
 	progress_finish(&h.progress);
+	if (opts->tally)
+		*opts->tally = h.tally;
 	harness_rounds_finish(&h.rounds);
 	results_finish(&h.res);
-out:
 	harness_close_builders(cfg, h.builders);
 	return r < 0 ? r : h.all_ok ? 0 : 1;
 }

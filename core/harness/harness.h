@@ -28,12 +28,21 @@ int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab
 int harness_probe_scene(const struct config *cfg, const struct config_scene *cs,
                         bvhlab_error *err);
 
+/* What went wrong in a sweep, for its last line. */
+struct harness_tally {
+	size_t not_ok;   /* runs of this process that did not end ok */
+	size_t untraced; /* ok runs without ray figures (their "rays": "error" says why) */
+	size_t unsaved;  /* runs that finished but could not be written */
+};
+
 struct harness_options {
 	bool quiet;  /* no progress lines on stderr */
 	bool resume; /* keep the finished runs of the output's results.json, skip them */
 	bool force;  /* without resume: move an earlier results.json aside, not refuse */
+	bool retry_failed; /* with resume: runs kept that did not end ok run again */
 	const bool *only;      /* [plan_run_count]: run just these ids; NULL: all */
 	const char *plan_hash; /* run from a plan: recorded so merge can match parts */
+	struct harness_tally *tally; /* filled when not NULL */
 };
 
 /*

@@ -10,7 +10,11 @@
 #include <string.h>
 
 #include "harness/harness_builders.h"
+#include <cJSON.h>
+
 #include "harness/isolate.h"
+#include "output/results.h"
+#include "plan/plan.h"
 #include "util/util.h"
 
 /* What the probe child sends back. */
@@ -31,39 +35,58 @@ struct isolate_limits harness_run_limits(const struct config *cfg,
  * since the child ends with _exit anyway. */
 static void probe_work(void *arg, void *report, size_t size)
 {
-	const struct config_builder *cb = arg;
+	const char *name = arg;
 	struct probe_report *rep = report;
 	bvhlab_plugin *plugin = NULL;
 	bvhlab_error err = {{0}};
 	(void)size;
-	rep->ok = bvhlab_plugin_open(cb->plugin, &plugin, &err) == 0;
+	rep->ok = bvhlab_plugin_open(name, &plugin, &err) == 0;
 	if (!rep->ok)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
 }
 
-/* 0 when the plugin loaded in a child; else the builder's status and error. */
-static int probe(const struct config *cfg, struct harness_builder *hb)
+int harness_probe_plugin(const char *plugin, double timeout_s, const char **status,
+                         bvhlab_error *err)
 {
 	struct probe_report rep = {0};
 	char why[sizeof(rep.error)] = "";
 	/* The timeout only: the limit is on the builds, and a child's address
 	 * space starts at the parent's (its libraries), which can exceed it. */
-	struct isolate_limits limits = {.timeout_s = harness_run_limits(cfg, hb->cb).timeout_s};
-	int outcome = isolate_call(probe_work, (void *)hb->cb, &rep, sizeof(rep), &limits, why,
+	struct isolate_limits limits = {.timeout_s = timeout_s};
+	int outcome = isolate_call(probe_work, (void *)plugin, &rep, sizeof(rep), &limits, why,
 	                           sizeof(why));
+	*status = "failed";
 	if (outcome == ISOLATE_REPORTED && rep.ok)
 		return 0;
 	rep.error[sizeof(rep.error) - 1] = '\0';
 	if (outcome == ISOLATE_REPORTED) { /* not there, or not a bvhlab plugin */
-		error_set(&hb->error, "%s", rep.error);
-		hb->bad_config = true;
+		error_set(err, "%s", rep.error);
 		return -EINVAL;
 	}
-	hb->status = outcome == ISOLATE_TIMEOUT ? "timeout" : outcome < 0 ? "failed" : "crashed";
-	error_set(&hb->error, "plugin %s: %s while loading (library constructor or entry "
-	          "point): %s", hb->cb->plugin, outcome == ISOLATE_TIMEOUT ? "hung" : "died",
-	          why);
-	return -EINVAL;
+	*status = outcome == ISOLATE_TIMEOUT ? "timeout" : outcome < 0 ? "failed" : "crashed";
+	error_set(err, "plugin %s: %s while loading (library constructor or entry point): %s",
+	          plugin, outcome == ISOLATE_TIMEOUT ? "hung" : "died", why);
+	return -ECHILD;
+}
+
+/* 0 when the builder's plugin and every refine stage's loaded in a child
+ * each; else the builder's status and error, naming the stage. One that is
+ * not there or not a plugin is a config error; one that died or hung is not
+ * (its runs record it). */
+static int probe(const struct config *cfg, struct harness_builder *hb)
+{
+	double timeout_s = harness_run_limits(cfg, hb->cb).timeout_s;
+	int r = harness_probe_plugin(hb->cb->plugin, timeout_s, &hb->status, &hb->error);
+	for (size_t k = 0; r == 0 && k < hb->cb->refine_count; k++) {
+		bvhlab_error err = {{0}};
+		r = harness_probe_plugin(hb->cb->refine[k].plugin, timeout_s, &hb->status, &err);
+		if (r < 0) {
+			hb->stage_failed = true;
+			error_set(&hb->error, "refine stage %zu: %s", k + 1, err.message);
+		}
+	}
+	hb->bad_config = r == -EINVAL;
+	return r < 0 ? -EINVAL : 0;
 }
 
 /* Opens a builder's refinement stages; *ok false (hb->error set) when one
@@ -91,11 +114,40 @@ static int open_stages(const struct config *cfg, struct harness_builder *hb, boo
 	return 0;
 }
 
+/*
+ * The hash of what a builder's runs are made with beyond its name: its
+ * plugin and resolved options, each stage's plugin and options. Part of a
+ * run's identity: --resume runs again what was made with other options,
+ * and merge refuses parts that disagree.
+ */
+static int hash_options(struct harness_builder *hb)
+{
+	struct strbuf sb = {0};
+	for (size_t k = 0; k <= hb->cb->refine_count; k++) {
+		const bvhlab_options *opts = k ? &hb->stages[k - 1].opts : &hb->opts;
+		const char *plugin = k ? hb->cb->refine[k - 1].plugin : hb->cb->plugin;
+		cJSON *o = results_options_json(opts);
+		char *text = o ? cJSON_PrintUnformatted(o) : NULL;
+		cJSON_Delete(o);
+		if (text)
+			sb_printf(&sb, "%s%s %s", k ? " | " : "", plugin, text);
+		free(text);
+		if (!text)
+			return free(sb_take(&sb)), -ENOMEM;
+	}
+	char *all = sb_take(&sb);
+	if (!all)
+		return -ENOMEM;
+	plan_hash_text(all, hb->options_hash);
+	free(all);
+	return 0;
+}
+
 /* 0, -EINVAL with hb's error set, or -ENOMEM. */
-static int open_one(const struct config *cfg, struct harness_builder *hb)
+static int open_one(const struct config *cfg, bool probed, struct harness_builder *hb)
 {
 	hb->status = "failed";
-	int r = cfg->isolate ? probe(cfg, hb) : 0;
+	int r = probed ? probe(cfg, hb) : 0;
 	if (r == 0 && bvhlab_plugin_open(hb->cb->plugin, &hb->plugin, &hb->error) < 0)
 		r = -EINVAL, hb->bad_config = true;
 	if (r < 0) {
@@ -106,6 +158,8 @@ static int open_one(const struct config *cfg, struct harness_builder *hb)
 		return -ENOMEM;
 	hb->opts_ok = config_apply_options(cfg, hb->cb, &hb->opts, &hb->error) == 0;
 	if (hb->opts_ok && open_stages(cfg, hb, &hb->opts_ok) < 0)
+		return -ENOMEM;
+	if (hb->opts_ok && hash_options(hb) < 0)
 		return -ENOMEM;
 	hb->bad_config = !hb->opts_ok;
 	return hb->opts_ok ? 0 : -EINVAL;
@@ -134,8 +188,8 @@ static bool said_before(const struct harness_builder *builders, size_t b)
 	return false;
 }
 
-int harness_open_builders(const struct config *cfg, struct harness_builder **out,
-                          size_t *bad_configs)
+int harness_open_builders(const struct config *cfg, bool probed,
+                          struct harness_builder **out, size_t *bad_configs)
 {
 	*bad_configs = 0;
 	struct harness_builder *builders = calloc(cfg->builder_count ? cfg->builder_count : 1,
@@ -146,10 +200,10 @@ int harness_open_builders(const struct config *cfg, struct harness_builder **out
 	for (size_t b = 0; b < cfg->builder_count; b++) {
 		struct harness_builder *hb = &builders[b];
 		hb->cb = &cfg->builders[b];
-		int r = open_one(cfg, hb);
+		int r = open_one(cfg, probed, hb);
 		if (r == -ENOMEM)
 			return r;
-		hb->skipped = r < 0 && !hb->plugin && hb->cb->optional;
+		hb->skipped = r < 0 && !hb->plugin && !hb->stage_failed && hb->cb->optional;
 		hb->bad_config = hb->bad_config && !hb->skipped;
 		*bad_configs += hb->bad_config;
 		if (r == 0 || said_before(builders, b))
@@ -175,4 +229,17 @@ void harness_close_builders(const struct config *cfg, struct harness_builder *bu
 		}
 	}
 	free(builders);
+}
+
+int harness_open_sweep_builders(const struct config *cfg, struct harness_builder **out,
+                                bvhlab_error *err)
+{
+	size_t bad = 0;
+	int r = harness_open_builders(cfg, cfg->isolate, out, &bad);
+	if (r < 0)
+		error_set(err, "out of memory opening plugins");
+	else if (bad)
+		r = -EINVAL, error_set(err, "%s: %zu builder%s cannot run as configured (above); "
+		                       "nothing was run", cfg->path, bad, bad == 1 ? "" : "s");
+	return r;
 }

@@ -80,8 +80,9 @@ void harness_rounds_sweep(const char *dir)
 	struct dirent *e;
 	while (d && (e = readdir(d)) != NULL) {
 		size_t len = strlen(e->d_name);
-		if (strncmp(e->d_name, ".tree-", 6) != 0 || len < 10 ||
-		    strcmp(e->d_name + len - 4, ".raw") != 0)
+		bool ours = !strncmp(e->d_name, ".tree-", 6) || !strncmp(e->d_name, ".heat-", 6) ||
+		            !strncmp(e->d_name, ".shade-", 7);
+		if (!ours || len < 10 || strcmp(e->d_name + len - 4, ".raw") != 0)
 			continue;
 		if (snprintf(path, sizeof(path), "%s/%s", dir, e->d_name) < (int)sizeof(path))
 			unlink(path);
@@ -369,6 +370,7 @@ static void take(struct rounds_entry *entries, size_t count, const struct rounds
 			m->diffuse[k].stats = d;
 		}
 		m->rounds = rounds;
+		m->provisional = false;
 		entries[i].timed = true;
 	}
 }
@@ -438,11 +440,12 @@ void harness_rounds_end(struct harness_rounds *r, struct results *res,
 	int rc = rounds_run(r, cfg, scene, prims, &err);
 	bool some = false;
 	for (size_t i = 0; i < r->count; i++) {
-		const struct rounds_entry *e = &r->entries[i];
-		int u = e->timed ? results_set_run_rays(res, scene->name, e->builder, e->threads,
-		                                        &e->rays)
-		                 : 0;
-		some = some || e->timed;
+		/* Not timed in the rounds (they failed): the run's slice is final,
+		 * not a figure a resumed sweep must replace. */
+		struct rounds_entry *e = &r->entries[i];
+		e->rays.provisional = false;
+		int u = results_set_run_rays(res, scene->name, e->builder, e->threads, &e->rays);
+		some = true;
 		rc = rc < 0 ? rc : u;
 	}
 	int w = some ? results_write(res, &err) : 0;

@@ -59,7 +59,9 @@ void harness_rounds_end(struct harness_rounds *r, struct results *res,
 int harness_rounds_path(char *buf, size_t size, const char *dir, size_t scene, uint32_t run);
 
 /* Deletes the tree files an interrupted sweep left in dir (they can be
- * large: a tree of a 1M-triangle scene takes about 70 MB). */
+ * large: a tree of a 1M-triangle scene takes about 70 MB), and its heat
+ * and shade data: images are drawn only from the runs of the sweep that
+ * draws them. Safe under the folder's lock only. */
 void harness_rounds_sweep(const char *dir);
 
 /* In the run's child: the tree to path. 0 or a negative errno. */

@@ -16,29 +16,6 @@
 #include "output/safe_file.h"
 #include "util/util.h"
 
-int results_make_dirs(const char *path, bvhlab_error *err)
-{
-	char buf[4096];
-	if ((size_t)snprintf(buf, sizeof(buf), "%s", path) >= sizeof(buf)) {
-		error_set(err, "output folder name too long: %s", path);
-		return -ENAMETOOLONG;
-	}
-	for (char *p = buf + 1;; p++) {
-		char c = *p;
-		if (c != '/' && c != '\0')
-			continue;
-		*p = '\0';
-		if (mkdir(buf, 0777) < 0 && errno != EEXIST) {
-			int e = errno;
-			error_set(err, "cannot create output folder %s: %s", buf, strerror(e));
-			return -e;
-		}
-		*p = c;
-		if (c == '\0')
-			return 0;
-	}
-}
-
 static cJSON *machine_json(void)
 {
 	struct machine_info m;
@@ -84,6 +61,7 @@ int results_init(struct results *res, const struct config *cfg, const char *dir,
 	res->doc = cJSON_CreateObject();
 	if (!res->dir || !res->doc)
 		goto nomem;
+	results_normalise_dir(res->dir);
 	cJSON_AddStringToObject(res->doc, "bvhlab_version", bvhlab_version());
 	add_created(res->doc);
 	cJSON_AddItemToObject(res->doc, "machine", machine_json());
@@ -101,6 +79,8 @@ nomem:
 
 void results_finish(struct results *res)
 {
+	results_unlock(res);
+	free(res->stale);
 	cJSON_Delete(res->doc);
 	free(res->dir);
 	memset(res, 0, sizeof(*res));
@@ -137,7 +117,7 @@ int results_add_scene(struct results *res, const char *name, const char *source,
 	return 0;
 }
 
-static cJSON *options_json(const bvhlab_options *opts)
+cJSON *results_options_json(const bvhlab_options *opts)
 {
 	cJSON *o = cJSON_CreateObject();
 	for (uint32_t k = 0; opts && k < opts->builder->option_count; k++) {
@@ -208,6 +188,24 @@ static cJSON *validation_json(const struct run_record *run)
 	return o;
 }
 
+static cJSON *find_any(const struct results *res, const char *scene, const char *builder,
+                       uint32_t threads, bool stale);
+
+/* A run made again takes its stale record's place (which stayed on disk
+ * until now); any other is appended. */
+static void replace_or_add(struct results *res, const struct run_record *run, cJSON *o)
+{
+	cJSON *old = find_any(res, run->scene ? run->scene : "", run->builder, run->threads, true);
+	if (!old) {
+		cJSON_AddItemToArray(res->runs, o);
+		return;
+	}
+	for (size_t k = 0; k < res->stale_count; k++)
+		if (res->stale[k] == old)
+			res->stale[k] = res->stale[--res->stale_count];
+	cJSON_ReplaceItemViaPointer(res->runs, old, o);
+}
+
 int results_add_run(struct results *res, const struct run_record *run)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -218,7 +216,9 @@ int results_add_run(struct results *res, const struct run_record *run)
 	cJSON_AddStringToObject(o, "builder", run->builder);
 	cJSON_AddStringToObject(o, "plugin", run->plugin ? run->plugin : "");
 	cJSON_AddNumberToObject(o, "threads", run->threads);
-	cJSON_AddItemToObject(o, "options", options_json(run->opts));
+	cJSON_AddItemToObject(o, "options", results_options_json(run->opts));
+	if (run->options_hash)
+		cJSON_AddStringToObject(o, "options_hash", run->options_hash);
 	cJSON_AddStringToObject(o, "status", run->status);
 	if (run->error)
 		cJSON_AddStringToObject(o, "error", run->error);
@@ -250,7 +250,7 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddNumberToObject(o, "load_before", run->load_before);
 		cJSON_AddNumberToObject(o, "load_after", run->load_after);
 	}
-	cJSON_AddItemToArray(res->runs, o);
+	replace_or_add(res, run, o);
 	return 0;
 }
 
@@ -275,7 +275,7 @@ static int write_rendering(const struct results *res, const char *name, char *te
 static const char *const renderings[] = {"results.json", "results.csv", "report.md",
                                          "report.html"};
 
-static int write_renderings(const struct results *res, bvhlab_error *err)
+int results_write_renderings(const struct results *res, bvhlab_error *err)
 {
 	int r = write_rendering(res, renderings[0], cJSON_Print(res->doc), err);
 	if (r == 0)
@@ -287,63 +287,6 @@ static int write_renderings(const struct results *res, bvhlab_error *err)
 	if (r == 0) /* animated scenes' frames, long form: results_frames.c */
 		r = results_frames_csv(res->doc, res->dir, err);
 	return r;
-}
-
-/* Removes dir/name if it is there (cleaning up a folder that failed). */
-static void remove_in(const char *dir, const char *name)
-{
-	char path[4096];
-	if ((size_t)snprintf(path, sizeof(path), "%s/%s", dir, name) < sizeof(path))
-		unlink(path);
-}
-
-/*
- * A new results folder appears whole: written as a temporary sibling and
- * renamed into place (over an empty folder too). A sweep killed while it
- * starts (GNU parallel stopping its jobs) leaves no folder, or one with a
- * results.json that says which plan it belongs to, never a bare folder
- * that `bvhlab merge` must refuse.
- */
-static int write_fresh(const struct results *res, bvhlab_error *err)
-{
-	char tmp[4096], *slash;
-	if ((size_t)snprintf(tmp, sizeof(tmp), "%s.new-XXXXXX", res->dir) >= sizeof(tmp)) {
-		error_set(err, "output folder name too long: %s", res->dir);
-		return -ENAMETOOLONG;
-	}
-	int r = 0;
-	if ((slash = strrchr(tmp, '/')) && slash != tmp) {
-		*slash = '\0';
-		r = results_make_dirs(tmp, err);
-		*slash = '/';
-	}
-	if (r == 0 && !mkdtemp(tmp)) {
-		r = -errno;
-		error_set(err, "cannot create output folder %s: %s", res->dir, strerror(-r));
-	}
-	if (r < 0)
-		return r;
-	struct results t = *res;
-	t.dir = tmp;
-	r = write_renderings(&t, err);
-	if (r == 0 && rename(tmp, res->dir) < 0) {
-		r = -errno;
-		error_set(err, "cannot create output folder %s: %s", res->dir, strerror(-r));
-	}
-	if (r < 0) {
-		for (size_t k = 0; k < sizeof(renderings) / sizeof(renderings[0]); k++)
-			remove_in(tmp, renderings[k]);
-		rmdir(tmp);
-	}
-	return r;
-}
-
-int results_write(const struct results *res, bvhlab_error *err)
-{
-	struct stat st;
-	if (stat(res->dir, &st) < 0 && errno == ENOENT)
-		return write_fresh(res, err);
-	return write_renderings(res, err);
 }
 
 /* ---- resuming ---------------------------------------------------------------- */
@@ -373,20 +316,89 @@ static bool run_matches(const cJSON *run, const char *scene, const char *builder
 }
 
 /* The document's run of scene x builder x threads, or NULL. */
-static cJSON *find_run(const struct results *res, const char *scene, const char *builder,
-                       uint32_t threads)
+static bool is_stale(const struct results *res, const cJSON *run)
+{
+	for (size_t k = 0; k < res->stale_count; k++)
+		if (res->stale[k] == run)
+			return true;
+	return false;
+}
+
+/* The document's run of scene x builder x threads, or NULL; one to be
+ * made again (stale) only when `stale`. */
+static cJSON *find_any(const struct results *res, const char *scene, const char *builder,
+                       uint32_t threads, bool stale)
 {
 	cJSON *run;
 	cJSON_ArrayForEach(run, res->runs)
-		if (run_matches(run, scene, builder, threads))
+		if (run_matches(run, scene, builder, threads) && stale == is_stale(res, run))
 			return run;
 	return NULL;
+}
+
+static cJSON *find_run(const struct results *res, const char *scene, const char *builder,
+                       uint32_t threads)
+{
+	return find_any(res, scene, builder, threads, false);
 }
 
 bool results_has_run(const struct results *res, const char *scene, const char *builder,
                      uint32_t threads)
 {
 	return find_run(res, scene, builder, threads) != NULL;
+}
+
+/* Marks a run to be made again; it stays in the document (and the file)
+ * until its new record replaces it. 0, or 1 when it was not marked yet. */
+static size_t mark_stale(struct results *res, cJSON *run)
+{
+	if (is_stale(res, run))
+		return 0;
+	cJSON **grown = realloc(res->stale, (res->stale_count + 1) * sizeof(*grown));
+	if (!grown)
+		return 0; /* kept as it is: a run not made again, not one lost */
+	res->stale = grown;
+	res->stale[res->stale_count++] = run;
+	return 1;
+}
+
+size_t results_forget_runs(struct results *res, const char *builder, const char *options_hash,
+                           bool not_ok)
+{
+	size_t n = 0;
+	cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
+		const char *b = string_of(run, "builder"), *h = string_of(run, "options_hash");
+		const char *status = string_of(run, "status");
+		bool other_options = options_hash && h && strcmp(h, options_hash) != 0;
+		bool failed = not_ok && (!status || strcmp(status, "ok") != 0);
+		if (b && strcmp(b, builder) == 0 && (other_options || failed))
+			n += mark_stale(res, run);
+	}
+	return n;
+}
+
+size_t results_forget_provisional(struct results *res)
+{
+	size_t n = 0;
+	cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
+		const cJSON *rays = cJSON_GetObjectItemCaseSensitive(run, "rays");
+		if (cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(rays, "provisional")))
+			n += mark_stale(res, run);
+	}
+	return n;
+}
+
+bool results_all_ok(const struct results *res)
+{
+	const cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
+		const char *status = string_of(run, "status");
+		if (!is_stale(res, run) && (!status || strcmp(status, "ok") != 0))
+			return false;
+	}
+	return true;
 }
 
 /* The file's text; -ENOENT quietly when there is none. */
@@ -430,6 +442,26 @@ static void take_over(struct results *res, cJSON *old, size_t *kept, size_t *not
 	}
 }
 
+static const char *plan_hash(const cJSON *doc)
+{
+	return string_of(cJSON_GetObjectItemCaseSensitive(doc, "plan"), "hash");
+}
+
+/* Runs of one plan are resumed by that plan only (and a sweep's by a sweep):
+ * the hash is the runs' identity in a merge, and must not be stamped anew. */
+static int same_plan(const cJSON *doc, const cJSON *old, const char *path, bvhlab_error *err)
+{
+	const char *now = plan_hash(doc), *then = plan_hash(old);
+	if ((!now && !then) || (now && then && strcmp(now, then) == 0))
+		return 0;
+	char a[40], b[40];
+	snprintf(a, sizeof(a), then ? "from plan %s" : "without a plan", then);
+	snprintf(b, sizeof(b), now ? "from plan %s" : "not from a plan", now);
+	error_set(err, "cannot resume from %s: its runs were made %s, this sweep is %s: "
+	          "resume it with what made it, or write to another folder", path, a, b);
+	return -EINVAL;
+}
+
 int results_resume(struct results *res, const struct config *cfg, size_t *kept, size_t *not_ok,
                    bvhlab_error *err)
 {
@@ -451,6 +483,8 @@ int results_resume(struct results *res, const struct config *cfg, size_t *kept, 
 	} else {
 		r = results_check_runs(cJSON_GetObjectItemCaseSensitive(old, "runs"), cfg, path, err);
 	}
+	if (r == 0)
+		r = same_plan(res->doc, old, path, err);
 	if (r == 0)
 		take_over(res, old, kept, not_ok);
 	cJSON_Delete(old);
@@ -507,6 +541,24 @@ int results_set_run_rays(struct results *res, const char *scene, const char *bui
 	return 0;
 }
 
+/* The reports of a folder describe its results.json: another document's
+ * are not written there. */
+static int own_reports(const char *json_path, const char *dir, bvhlab_error *err)
+{
+	char path[4096];
+	struct stat mine, theirs;
+	if ((size_t)snprintf(path, sizeof(path), "%s/results.json", dir) >= sizeof(path)) {
+		error_set(err, "path too long: %s/results.json", dir);
+		return -ENAMETOOLONG;
+	}
+	if (stat(path, &theirs) < 0 || (stat(json_path, &mine) == 0 &&
+	                                mine.st_dev == theirs.st_dev && mine.st_ino == theirs.st_ino))
+		return 0;
+	error_set(err, "%s holds the results.json of another sweep, whose reports these would "
+	          "replace: nothing written; render into another folder", dir);
+	return -EEXIST;
+}
+
 int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err)
 {
 	char *text = NULL;
@@ -525,6 +577,10 @@ int results_render_saved(const char *json_path, const char *dir, bvhlab_error *e
 	if (r == 0)
 		r = results_make_dirs(dir, err);
 	if (r == 0)
+		r = results_lock(&res, err);
+	if (r == 0)
+		r = own_reports(json_path, dir, err);
+	if (r == 0)
 		r = write_rendering(&res, "results.csv", report_csv(res.doc), err);
 	if (r == 0)
 		r = write_rendering(&res, "report.md", report_markdown(res.doc), err);
@@ -532,6 +588,7 @@ int results_render_saved(const char *json_path, const char *dir, bvhlab_error *e
 		r = write_rendering(&res, "report.html", report_html(res.doc), err);
 	if (r == 0)
 		r = results_frames_csv(res.doc, dir, err);
+	results_unlock(&res);
 	cJSON_Delete(res.doc);
 	return r;
 }

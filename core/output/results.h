@@ -22,6 +22,11 @@ struct results {
 	struct cJSON *scenes;
 	struct cJSON *runs;
 	char *dir;
+	struct cJSON **stale; /* [stale_count] runs of runs[] to be made again: not
+	                       * found as done, replaced by their new record */
+	size_t stale_count;
+	bool locked;  /* lock_fd holds the folder's lock (results_dir.c) */
+	int lock_fd;
 };
 
 /* Traversal counters and timings of one run's primary and diffuse rays,
@@ -33,6 +38,9 @@ struct ray_metrics {
 	int main;              /* the traversal "primary"/"diffuse" report */
 	uint32_t rounds;       /* interleaved rounds the timings are spread over
 	                        * (harness_rounds.c); 1: one stretch in the run's child */
+	bool provisional;      /* one slice, timed in the run's child while the rounds
+	                        * that replace it are still to come ("provisional":
+	                        * true; a resumed sweep runs such a run again) */
 	/* by enum bvhlab_traversal */
 	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
 	uint64_t disagreements; /* rays whose hits differ from the main traversal's */
@@ -80,6 +88,8 @@ struct run_record {
 	const char *plugin;    /* the descriptor's name */
 	uint32_t threads;      /* resolved thread count */
 	const bvhlab_options *opts; /* resolved options, or NULL */
+	const char *options_hash; /* of opts and the refine stages' (part of the
+	                           * run's identity), or NULL */
 	const char *status;    /* "ok", "invalid", "failed", ... */
 	const char *error;     /* message when status is not "ok", or NULL */
 	const double *samples_ms;
@@ -173,14 +183,58 @@ int results_resume(struct results *res, const struct config *cfg, size_t *kept, 
  */
 int results_check_runs(const struct cJSON *runs, const struct config *cfg, const char *path,
                        bvhlab_error *err);
+/*
+ * Marks the runs of `builder` that were made with other options (their
+ * "options_hash" is not options_hash; runs without one, or options_hash
+ * NULL, stay) and, when not_ok, those whose status is not "ok", to be made
+ * again: results_has_run no longer finds them, and each stays in the
+ * document until results_add_run replaces it (a kill in between loses
+ * nothing). How many were marked.
+ */
+size_t results_forget_runs(struct results *res, const char *builder, const char *options_hash,
+                           bool not_ok);
+/* Marks the runs whose rays are provisional (their sweep was killed before
+ * the rounds replaced them) to be made again, as results_forget_runs does. */
+size_t results_forget_provisional(struct results *res);
+/* Whether every run of the document is "ok" (those to be made again aside). */
+bool results_all_ok(const struct results *res);
+/* "options": {name: value, ...} of resolved options (NULL: {}). */
+struct cJSON *results_options_json(const bvhlab_options *opts);
+
 /* Whether the document holds a run of scene x builder x threads. */
 bool results_has_run(const struct results *res, const char *scene, const char *builder,
                      uint32_t threads);
 
-/* Rewrites results.json, results.csv, report.md and report.html, each
+/* ---- the output folder (results_dir.c) ---------------------------------- */
+
+/*
+ * Rewrites results.json, results.csv, report.md and report.html, each
  * atomically; a folder that does not exist yet is made with all four in it
- * at once (a temporary sibling renamed into place), parents as needed. */
-int results_write(const struct results *res, bvhlab_error *err);
+ * at once (a hidden temporary sibling, .bvhlab-new-XXXXXX, renamed into
+ * place), parents as needed. The folder's lock is taken first if res does
+ * not hold it (a new folder comes with it held): -EBUSY, err naming the
+ * holder's pid, when another process writes there.
+ */
+int results_write(struct results *res, bvhlab_error *err);
+/* The four files into res->dir as it is (results_write's second half). */
+int results_write_renderings(const struct results *res, bvhlab_error *err);
+
+/*
+ * One writer per output folder: takes res->dir's advisory lock
+ * (.bvhlab.lock, flock) for as long as res lives, and writes this pid
+ * into it. 0 (also when the folder does not exist yet: results_write takes
+ * it when it makes the folder), or -EBUSY with err naming the folder and
+ * the pid of the process that holds it.
+ */
+int results_lock(struct results *res, bvhlab_error *err);
+void results_unlock(struct results *res);
+
+/* Removes the temporary folders (.bvhlab-new-*) in parent that no living
+ * process is making (their lock is free). */
+void results_sweep_temps(const char *parent);
+
+/* "out/", "out/." and "out//" become "out", in place. */
+void results_normalise_dir(char *dir);
 
 /* Writes `text` to dir/name through dir/.name.tmp and rename. */
 int results_write_file(const char *dir, const char *name, const char *text, bvhlab_error *err);

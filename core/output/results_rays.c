@@ -39,6 +39,8 @@ cJSON *results_rays_json(const struct ray_metrics *m)
 	cJSON_AddNumberToObject(o, "threads", m->threads);
 	cJSON_AddStringToObject(o, "traversal", bvhlab_traversal_name(m->main));
 	cJSON_AddNumberToObject(o, "rounds", m->rounds ? m->rounds : 1);
+	if (m->provisional)
+		cJSON_AddBoolToObject(o, "provisional", true);
 	if (m->device[0])
 		cJSON_AddStringToObject(o, "device", m->device);
 	/* Why there are no figures, or none of one traversal: never silent. */

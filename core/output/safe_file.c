@@ -2,6 +2,7 @@
  * Creating, replacing and moving aside the files of an output folder
  * without following links and without losing a complete file.
  */
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdbool.h>
@@ -104,29 +105,55 @@ static bool exists(const char *path)
 	return lstat(path, &st) == 0 || errno != ENOENT;
 }
 
-/* The smallest N for which no dir/NAME.N exists. */
-static unsigned free_generation(const char *dir, const char *const *names)
+/* The smallest N for which no dir/LAST.N exists, LAST the commit name. */
+static unsigned free_generation(const char *dir, const char *last)
 {
 	char path[PATH_SIZE];
 	for (unsigned n = 1; n < MAX_GENERATION; n++) {
-		bool taken = false;
-		for (const char *const *p = names; *p && !taken; p++) {
-			snprintf(path, sizeof(path), "%s/%s.%u", dir, *p, n);
-			taken = exists(path);
-		}
-		if (!taken)
+		snprintf(path, sizeof(path), "%s/%s.%u", dir, last, n);
+		if (!exists(path))
 			return n;
 	}
 	return 0;
 }
 
-/* Files by link + unlink (link never overwrites); folders by rename. */
+static int move_one(const char *from, const char *to);
+
+/* A folder onto one an interrupted move began: its entries one by one. */
+static int merge_dir(const char *from, const char *to)
+{
+	char a[PATH_SIZE], b[PATH_SIZE];
+	DIR *d = opendir(from);
+	int r = d ? 0 : -errno;
+	for (struct dirent *e; r >= 0 && d && (e = readdir(d));) {
+		if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+			continue;
+		if ((size_t)snprintf(a, sizeof(a), "%s/%s", from, e->d_name) >= sizeof(a) ||
+		    (size_t)snprintf(b, sizeof(b), "%s/%s", to, e->d_name) >= sizeof(b))
+			r = -ENAMETOOLONG;
+		else
+			r = move_one(a, b);
+	}
+	if (d)
+		closedir(d);
+	return r < 0 ? r : rmdir(from) < 0 ? -errno : 1;
+}
+
+/*
+ * Files by link + unlink (link never overwrites), folders by rename. A
+ * target already there is what an interrupted move of the same
+ * generation left (its commit file had not moved yet, so nothing newer
+ * was written): a file is replaced, a folder joined.
+ */
 static int move_one(const char *from, const char *to)
 {
-	struct stat st;
+	struct stat st, old;
 	if (lstat(from, &st) < 0)
 		return errno == ENOENT ? 0 : -errno;
-	if (S_ISDIR(st.st_mode))
+	bool there = lstat(to, &old) == 0;
+	if (S_ISDIR(st.st_mode) && there && S_ISDIR(old.st_mode))
+		return merge_dir(from, to);
+	if (S_ISDIR(st.st_mode) || there)
 		return rename(from, to) < 0 ? -errno : 1;
 	if (link(from, to) < 0 || unlink(from) < 0)
 		return -errno;
@@ -137,7 +164,10 @@ int safe_move_aside(const char *dir, const char *const *names, unsigned *moved_t
                     bvhlab_error *err)
 {
 	char from[PATH_SIZE], to[PATH_SIZE];
-	unsigned n = free_generation(dir, names);
+	const char *const *last = names;
+	while (last[0] && last[1])
+		last++;
+	unsigned n = *last ? free_generation(dir, *last) : 1;
 	*moved_to = 0;
 	if (n == 0) {
 		error_set(err, "%s: no free NAME.N to move the old results to", dir);
@@ -171,8 +201,10 @@ static bool is_root(const char *dir)
 
 int safe_claim_output(const char *dir, bool force, bvhlab_error *err)
 {
-	static const char *const old[] = {"results.json", "results.csv", "report.md",
-	                                  "report.html", "images", NULL};
+	/* results.json last: while it is in place the folder still holds the
+	 * old sweep, so a kill in between leaves nothing a new sweep writes over. */
+	static const char *const old[] = {"results.csv", "report.md", "report.html", "images",
+	                                  "results.json", NULL};
 	char path[PATH_SIZE];
 	unsigned moved;
 	if (is_root(dir)) {

@@ -48,9 +48,12 @@ int safe_write_file(const char *dir, const char *name, const void *data, size_t 
 
 /*
  * Moves the files `names` (NULL-terminated; missing ones are skipped) of
- * dir aside to NAME.N, one N for all of them, the smallest that none of
- * them uses yet. Nothing is overwritten (link + unlink). *moved_to gets N,
- * or 0 when there was nothing to move.
+ * dir aside to NAME.N, one N for all of them, in order. The last name is
+ * the commit point, moved last: N is the smallest that it does not use
+ * yet, and a NAME.N of another name already there is what an interrupted
+ * move of this generation left, replaced (a file) or joined (a folder).
+ * Otherwise nothing is overwritten (link + unlink). *moved_to gets N, or 0
+ * when there was nothing to move.
  */
 int safe_move_aside(const char *dir, const char *const *names, unsigned *moved_to,
                     bvhlab_error *err);

@@ -32,6 +32,15 @@ struct plan_run {
 /* The builder's thread counts: its own list or the config's. */
 const uint32_t *plan_builder_threads(const struct config *cfg, const struct config_builder *b,
                                      size_t *count);
+/*
+ * A run's thread count is resolved once, when the run list is made: 0
+ * becomes this machine's hardware threads. plan_check_threads refuses
+ * (-EINVAL, err naming the list and "duplicate thread count N") a list in
+ * which 0 resolves to a count it already has; plan_resolve_threads checks
+ * and then resolves every list of cfg in place (ids do not change).
+ */
+int plan_check_threads(const struct config *cfg, bvhlab_error *err);
+int plan_resolve_threads(struct config *cfg, bvhlab_error *err);
 size_t plan_run_count(const struct config *cfg);
 /* The id of scene x builder x thread_index. */
 uint32_t plan_run_id(const struct config *cfg, size_t scene, size_t builder,
@@ -75,14 +84,25 @@ int plan_read_file(const char *path, char **out, bvhlab_error *err);
 bool plan_file_detect(const char *path);
 
 /*
- * Reads plan.json and checks it: its hash against its config copy, and the
- * config file it was planned from against the hash recorded then (changed:
- * an error, -ESTALE; gone: fine, the copy is complete). With cfg non-NULL,
- * also parses the copy into it.
+ * Reads plan.json and checks it: its hash against its config copy (and
+ * scene files' record), and the config file it was planned from against
+ * the hash recorded then (changed: an error, -ESTALE; gone: fine, the copy
+ * is complete). With cfg non-NULL, also parses the copy into it and checks
+ * the scene files here against the record (plan_check_scene_files).
  */
 int plan_file_load(struct plan_file *plan, const char *path, struct config *cfg,
                    bvhlab_error *err);
 void plan_file_finish(struct plan_file *plan);
+
+/* ---- scene files (plan_scenes.c) ------------------------------------------- */
+
+/* "scene_files": [{"path", "size", "hash"}] of every file cfg's scenes
+ * read (in config order; size and hash missing for one not readable here). */
+struct cJSON *plan_scene_files(const struct config *cfg);
+/* The files cfg (parsed from the plan) reads against the plan's record:
+ * -ESTALE, err naming the file, when one here has other content. */
+int plan_check_scene_files(const struct plan_file *plan, const struct config *cfg,
+                           bvhlab_error *err);
 
 /* ---- merging parts (plan_merge.c) ------------------------------------------- */
 

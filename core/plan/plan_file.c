@@ -99,6 +99,25 @@ static cJSON *config_copy(const struct config *cfg)
 	return NULL;
 }
 
+/* The plan's identity: its config copy and, when recorded, the content of
+ * its scene files. */
+static int doc_hash(const cJSON *config, const cJSON *files, char out[17])
+{
+	struct strbuf sb = {0};
+	char *c = cJSON_PrintUnformatted(config);
+	char *f = files ? cJSON_PrintUnformatted(files) : NULL;
+	if (c && (f || !files))
+		sb_printf(&sb, "%s%s%s", c, f ? "\n" : "", f ? f : "");
+	free(c);
+	free(f);
+	char *text = sb_take(&sb);
+	if (!text)
+		return -ENOMEM;
+	plan_hash_text(text, out);
+	free(text);
+	return 0;
+}
+
 static cJSON *runs_json(const struct config *cfg)
 {
 	struct plan_run *runs;
@@ -139,7 +158,7 @@ static int adopt(struct plan_file *plan, const char *path, cJSON *doc)
 	return plan->path ? 0 : -ENOMEM;
 }
 
-static cJSON *plan_doc(const struct config *cfg, cJSON *copy, const char *hash)
+static cJSON *plan_doc(const struct config *cfg, cJSON *copy, cJSON *files, const char *hash)
 {
 	char source_hash[17], stamp[32];
 	char *source = absolute(cfg->path);
@@ -155,6 +174,7 @@ static cJSON *plan_doc(const struct config *cfg, cJSON *copy, const char *hash)
 	cJSON_AddStringToObject(src, "hash", source_hash);
 	cJSON_AddStringToObject(doc, "created", stamp);
 	cJSON_AddItemToObject(doc, "config", copy);
+	cJSON_AddItemToObject(doc, "scene_files", files);
 	cJSON_AddItemToObject(doc, "runs", runs_json(cfg));
 	free(source);
 	return doc;
@@ -195,24 +215,22 @@ int plan_file_write(const struct config *cfg, const char *dir, struct plan_file 
 {
 	char hash[17], path[4096];
 	memset(plan, 0, sizeof(*plan));
-	cJSON *copy = config_copy(cfg);
-	char *text = copy ? cJSON_PrintUnformatted(copy) : NULL;
-	int r = text ? 0 : -ENOMEM;
+	cJSON *copy = config_copy(cfg), *files = plan_scene_files(cfg);
+	int r = copy && files ? doc_hash(copy, files, hash) : -ENOMEM;
 	if (r == 0 && (size_t)snprintf(path, sizeof(path), "%s/plan.json", dir) >= sizeof(path))
 		r = -ENAMETOOLONG;
-	if (r == 0)
-		plan_hash_text(text, hash);
-	free(text);
 	if (r < 0) {
 		cJSON_Delete(copy);
+		cJSON_Delete(files);
 		error_set(err, r == -ENOMEM ? "out of memory" : "path too long: %s", dir);
 		return r;
 	}
 	if ((r = existing_plan(cfg, path, hash, plan, err)) <= 0) {
 		cJSON_Delete(copy);
+		cJSON_Delete(files);
 		return r;
 	}
-	cJSON *doc = plan_doc(cfg, copy, hash);
+	cJSON *doc = plan_doc(cfg, copy, files, hash);
 	char *out = doc ? cJSON_Print(doc) : NULL;
 	r = out ? results_make_dirs(dir, err) : -ENOMEM;
 	if (r == 0)
@@ -244,13 +262,11 @@ static int check_doc(const char *path, const cJSON *doc, bvhlab_error *err)
 		          "config and runs)", path);
 		return -EINVAL;
 	}
-	char *text = cJSON_PrintUnformatted(config), now[17];
-	if (!text) {
+	char now[17];
+	if (doc_hash(config, cJSON_GetObjectItemCaseSensitive(doc, "scene_files"), now) < 0) {
 		error_set(err, "out of memory");
 		return -ENOMEM;
 	}
-	plan_hash_text(text, now);
-	free(text);
 	if (strcmp(now, hash) != 0) {
 		error_set(err, "%s: its config no longer matches its hash (%s, now %s): the plan was "
 		          "edited after planning; plan again", path, hash, now);
@@ -330,6 +346,8 @@ int plan_file_load(struct plan_file *plan, const char *path, struct config *cfg,
 		config_finish(cfg);
 		r = -EINVAL;
 	}
+	if (r == 0 && cfg && (r = plan_check_scene_files(plan, cfg, err)) < 0)
+		config_finish(cfg);
 	if (r < 0)
 		plan_file_finish(plan);
 	return r;

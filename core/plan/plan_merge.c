@@ -154,17 +154,52 @@ static int collect(struct merge *m, const char *const *dirs, bvhlab_error *err)
 	return 0;
 }
 
-/* ---- the merged document --------------------------------------------------------- */
-
-/* A copy of the run with its part's machine, unless it carries its own. */
-static cJSON *run_copy(const cJSON *run, const cJSON *part_doc)
+static bool same_string(const cJSON *a, const cJSON *b, const char *key)
 {
-	cJSON *copy = cJSON_Duplicate(run, 1);
-	const cJSON *machine = cJSON_GetObjectItemCaseSensitive(part_doc, "machine");
-	if (copy && machine && !cJSON_GetObjectItemCaseSensitive(copy, "machine"))
-		cJSON_AddItemToObject(copy, "machine", cJSON_Duplicate(machine, 1));
-	return copy;
+	const char *x = string_at(a, key), *y = string_at(b, key);
+	return x && y && strcmp(x, y) == 0;
 }
+
+/* Two runs of one scene and builder are one run when their thread counts
+ * resolved alike (0 on a machine with that many): the merge would count it
+ * twice. Runs of one builder made with other options come from another
+ * configuration of it. */
+static int check_pair(const struct merge *m, size_t a, size_t b, bvhlab_error *err)
+{
+	const cJSON *x = m->owner_run[a], *y = m->owner_run[b];
+	const cJSON *tx = cJSON_GetObjectItemCaseSensitive(x, "threads");
+	const cJSON *ty = cJSON_GetObjectItemCaseSensitive(y, "threads");
+	const char *hx = string_at(x, "options_hash"), *hy = string_at(y, "options_hash");
+	if (!same_string(x, y, "builder"))
+		return 0;
+	if (hx && hy && strcmp(hx, hy) != 0) {
+		error_set(err, "runs %zu (part %s) and %zu (part %s) of builder '%s' were made with "
+		          "other options (hash %s and %s): parts of another configuration; nothing "
+		          "merged", a, m->parts[m->owner_part[a]].dir, b, m->parts[m->owner_part[b]].dir,
+		          string_at(x, "builder"), hx, hy);
+		return -EINVAL;
+	}
+	if (same_string(x, y, "scene") && cJSON_IsNumber(tx) && cJSON_IsNumber(ty) &&
+	    tx->valuedouble == ty->valuedouble) {
+		error_set(err, "runs %zu (part %s) and %zu (part %s) are the same run (%s, %s, %g "
+		          "threads, a count of 0 resolved on its machine): remove one of them", a,
+		          m->parts[m->owner_part[a]].dir, b, m->parts[m->owner_part[b]].dir,
+		          string_at(x, "scene"), string_at(x, "builder"), tx->valuedouble);
+		return -EINVAL;
+	}
+	return 0;
+}
+
+static int check_identities(const struct merge *m, bvhlab_error *err)
+{
+	for (size_t a = 0; a < m->plan->run_count; a++)
+		for (size_t b = a + 1; m->owner_run[a] && b < m->plan->run_count; b++)
+			if (m->owner_run[b] && check_pair(m, a, b, err) < 0)
+				return -EINVAL;
+	return 0;
+}
+
+/* ---- the merged document --------------------------------------------------------- */
 
 static const cJSON *find_named(const cJSON *array, const char *name)
 {
@@ -177,6 +212,52 @@ static const cJSON *find_named(const cJSON *array, const char *name)
 	return NULL;
 }
 
+/* A copy of the run with its part's machine, unless it carries its own,
+ * and the colour scale its heat map was drawn with in its part. */
+static cJSON *run_copy(const cJSON *run, const cJSON *part_doc)
+{
+	cJSON *copy = cJSON_Duplicate(run, 1);
+	const cJSON *machine = cJSON_GetObjectItemCaseSensitive(part_doc, "machine");
+	if (copy && machine && !cJSON_GetObjectItemCaseSensitive(copy, "machine"))
+		cJSON_AddItemToObject(copy, "machine", cJSON_Duplicate(machine, 1));
+	const char *scene = string_at(run, "scene");
+	const cJSON *images = cJSON_GetObjectItemCaseSensitive(
+		scene ? find_named(cJSON_GetObjectItemCaseSensitive(part_doc, "scenes"), scene) : NULL,
+		"images");
+	const cJSON *lo = cJSON_GetObjectItemCaseSensitive(images, "heat_min");
+	const cJSON *hi = cJSON_GetObjectItemCaseSensitive(images, "heat_max");
+	if (copy && string_at(run, "heat_image") && cJSON_IsNumber(lo) && cJSON_IsNumber(hi) &&
+	    !cJSON_GetObjectItemCaseSensitive(copy, "heat_scale")) {
+		cJSON *scale = cJSON_AddObjectToObject(copy, "heat_scale");
+		cJSON_AddNumberToObject(scale, "min", lo->valuedouble);
+		cJSON_AddNumberToObject(scale, "max", hi->valuedouble);
+	}
+	return copy;
+}
+
+static bool same_number(const cJSON *a, const cJSON *b, const char *key)
+{
+	const cJSON *x = cJSON_GetObjectItemCaseSensitive(a, key);
+	const cJSON *y = cJSON_GetObjectItemCaseSensitive(b, key);
+	return cJSON_IsNumber(x) && cJSON_IsNumber(y) && x->valuedouble == y->valuedouble;
+}
+
+/* Parts draw a scene's heat maps each on its own scale: when they differ
+ * the merged scene states none (each run keeps its own, "heat_scale"). */
+static void join_heat_scales(cJSON *kept, const cJSON *other)
+{
+	cJSON *a = cJSON_GetObjectItemCaseSensitive(kept, "images");
+	const cJSON *b = cJSON_GetObjectItemCaseSensitive(other, "images");
+	if (!cJSON_GetObjectItemCaseSensitive(a, "legend") ||
+	    !cJSON_GetObjectItemCaseSensitive(b, "legend") ||
+	    (same_number(a, b, "heat_min") && same_number(a, b, "heat_max")))
+		return;
+	cJSON_DeleteItemFromObjectCaseSensitive(a, "legend");
+	cJSON_DeleteItemFromObjectCaseSensitive(a, "heat_min");
+	cJSON_DeleteItemFromObjectCaseSensitive(a, "heat_max");
+	cJSON_AddBoolToObject(a, "heat_scales_differ", true);
+}
+
 /* Every scene any part loaded, one entry each; one with images wins. */
 static void add_scenes(cJSON *scenes, const struct merge *m)
 {
@@ -185,6 +266,8 @@ static void add_scenes(cJSON *scenes, const struct merge *m)
 		cJSON_ArrayForEach(s, cJSON_GetObjectItemCaseSensitive(m->parts[p].doc, "scenes")) {
 			const char *name = string_at(s, "name");
 			cJSON *old = name ? (cJSON *)find_named(scenes, name) : NULL;
+			if (old)
+				join_heat_scales(old, s);
 			if (!name || (old && (cJSON_GetObjectItemCaseSensitive(old, "images") ||
 			                      !cJSON_GetObjectItemCaseSensitive(s, "images"))))
 				continue;
@@ -303,7 +386,10 @@ static int copy_file(const char *from, const char *dir, const char *name, bvhlab
 		return -ENAMETOOLONG;
 	}
 	unlink(tmp);
-	FILE *in = fopen(from, "rb");
+	int from_fd = open(from, O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+	FILE *in = from_fd >= 0 ? fdopen(from_fd, "rb") : NULL;
+	if (from_fd >= 0 && !in)
+		close(from_fd);
 	int fd = in ? open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW, 0644) : -1;
 	FILE *out = fd >= 0 ? fdopen(fd, "wb") : NULL;
 	bool ok = out != NULL;
@@ -337,8 +423,11 @@ static int copy_images(const struct merge *m, const char *dir, bvhlab_error *err
 		for (struct dirent *e; r == 0 && (e = readdir(d));) {
 			if (e->d_name[0] == '.')
 				continue; /* ., .. and temporary files */
+			struct stat st;
 			if ((size_t)snprintf(file, sizeof(file), "%s/%s", from, e->d_name) >= sizeof(file))
 				continue; /* not a name bvhlab writes */
+			if (lstat(file, &st) < 0 || !S_ISREG(st.st_mode))
+				continue; /* bvhlab writes plain files: a link is not followed */
 			r = copy_file(file, to, e->d_name, err);
 		}
 		closedir(d);
@@ -367,9 +456,12 @@ static int write_merged(const struct merge *m, const char *dir, struct merge_sum
 	if (r == 0)
 		r = results_make_dirs(dir, err);
 	if (r == 0)
+		r = results_lock(&res, err); /* one writer: a run or another merge */
+	if (r == 0)
 		r = copy_images(m, dir, err);
 	if (r == 0)
 		r = results_write(&res, err);
+	results_unlock(&res);
 	cJSON_Delete(res.doc);
 	return r;
 }
@@ -391,6 +483,8 @@ int plan_merge(const struct plan_file *plan, const char *const *parts, size_t pa
 	}
 	if (r == 0)
 		r = collect(&m, parts, err);
+	if (r == 0)
+		r = check_identities(&m, err);
 	if (r == 0)
 		r = check_target(plan, dir, err);
 	if (r == 0)

@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <bvhlab/machine.h>
+
 #include "plan/plan.h"
 #include "util/util.h"
 
@@ -15,6 +17,54 @@ const uint32_t *plan_builder_threads(const struct config *cfg, const struct conf
 {
 	*count = b->threads ? b->thread_count : cfg->thread_count;
 	return b->threads ? b->threads : cfg->threads;
+}
+
+/* A list whose 0 (all cores) resolves to a count it already has: the two
+ * would be one run twice. 0 when it is fine; else err names the list. */
+static int check_list(const uint32_t *list, size_t n, const char *where, bvhlab_error *err)
+{
+	uint32_t all = bvhlab_hardware_threads();
+	for (size_t i = 0; i < n; i++)
+		for (size_t j = 0; j < i; j++) {
+			uint32_t a = list[i] ? list[i] : all, b = list[j] ? list[j] : all;
+			if (a != b)
+				continue;
+			error_set(err, "%s: duplicate thread count %u (0 means all %u hardware threads "
+			          "of this machine): drop one of them", where, a, all);
+			return -EINVAL;
+		}
+	return 0;
+}
+
+int plan_check_threads(const struct config *cfg, bvhlab_error *err)
+{
+	char where[320];
+	int r = check_list(cfg->threads, cfg->thread_count, "'threads'", err);
+	for (size_t b = 0; r == 0 && b < cfg->builder_count; b++) {
+		const struct config_builder *cb = &cfg->builders[b];
+		snprintf(where, sizeof(where), "builder '%s': 'threads'", cb->name);
+		if (cb->threads)
+			r = check_list(cb->threads, cb->thread_count, where, err);
+	}
+	return r;
+}
+
+static void resolve_list(uint32_t *list, size_t n)
+{
+	for (size_t k = 0; k < n; k++)
+		list[k] = list[k] ? list[k] : bvhlab_hardware_threads();
+}
+
+int plan_resolve_threads(struct config *cfg, bvhlab_error *err)
+{
+	int r = plan_check_threads(cfg, err);
+	if (r < 0)
+		return r;
+	resolve_list(cfg->threads, cfg->thread_count);
+	for (size_t b = 0; b < cfg->builder_count; b++)
+		if (cfg->builders[b].threads)
+			resolve_list(cfg->builders[b].threads, cfg->builders[b].thread_count);
+	return 0;
 }
 
 /* Runs of one scene: every builder's thread counts. */
