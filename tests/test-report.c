@@ -106,6 +106,17 @@ static cJSON *document(const char *reference)
 	cJSON_AddNumberToObject(mid, "load_before", 1.5); /* 1.5 - 1 <= 1: not busy */
 	cJSON_AddNumberToObject(mid, "load_after", 1.9);
 	cJSON_AddItemToObject(mid, "build_phases", cJSON_Parse("{\"upload\": 0.5, \"device\": 1.5}"));
+	/* load_other, where there, decides: the sweep's own 2 threads keep the
+	 * 1-minute average at 2, but others used 0.1 of a CPU (not busy); on
+	 * 1 thread, others using 1.6 CPUs leave it less than its free core. */
+	int n = cJSON_GetArraySize(runs);
+	cJSON *par1 = cJSON_GetArrayItem(runs, n - 2), *par2 = cJSON_GetArrayItem(runs, n - 1);
+	cJSON_AddNumberToObject(par2, "load_before", 2.0);
+	cJSON_AddNumberToObject(par2, "load_after", 2.0);
+	cJSON_AddNumberToObject(par2, "load_other", 0.1);
+	cJSON_AddNumberToObject(par1, "load_before", 0.5);
+	cJSON_AddNumberToObject(par1, "load_after", 0.5);
+	cJSON_AddNumberToObject(par1, "load_other", 1.6);
 	return doc;
 }
 
@@ -146,7 +157,9 @@ static void test_markdown_fallback(void)
 	CHECK_CONTAINS(md, "noisy: build repeats spread 20.0 %");
 	CHECK_CONTAINS(md, "noisy: same tree as twin x1, Mrays/s 25 % apart");
 	CHECK_CONTAINS(md, "busy: load 3.50 before, 3.00 after; 1 core left free");
-	CHECK_CONTAINS(md, "**Busy machine:** 1 of 2 runs");
+	CHECK_CONTAINS(md, "busy: others kept 1.60 CPUs busy during the run; 1 core left free");
+	CHECK(strstr(md, "others kept 0.10") == NULL);
+	CHECK_CONTAINS(md, "**Busy machine:** 2 of 4 runs");
 	/* No sah_seq: no thesis table of dashes. */
 	CHECK(!strstr(md, "Parallel builders against"));
 	/* Speedup: fast 2 / 1.5 = 1.33 on 2 threads; mid ran on 1 thread only. */

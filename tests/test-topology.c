@@ -156,6 +156,25 @@ out:
 	bvhlab_scene_destroy(scene);
 }
 
+/* The CPUs others used over an interval: the machine's busy time less this
+ * process's, over the wall time; nothing to say over too short an interval
+ * or without /proc/stat; never negative (ticks against microseconds). */
+static void test_other_load(void)
+{
+	struct machine_cpu_mark a = {.wall_s = 10, .machine_s = 100, .own_s = 5, .ok = true};
+	struct machine_cpu_mark b = {.wall_s = 12, .machine_s = 103, .own_s = 7, .ok = true};
+	CHECK(machine_other_load(&a, &b) == 0.5);
+	b.own_s = 9;
+	CHECK(machine_other_load(&a, &b) == 0);
+	b.wall_s = 10.01;
+	CHECK(machine_other_load(&a, &b) == -1);
+	b.wall_s = 12;
+	b.ok = false;
+	CHECK(machine_other_load(&a, &b) == -1);
+	machine_cpu_mark(&a);
+	CHECK(a.ok && a.machine_s > 0 && a.own_s > 0 && a.wall_s > 0);
+}
+
 int main(void)
 {
 	if (sched_getaffinity(0, sizeof(original), &original) < 0) {
@@ -166,5 +185,6 @@ int main(void)
 	test_restricted();
 	test_plan();
 	test_build();
+	test_other_load();
 	return test_finish();
 }

@@ -357,12 +357,16 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	char why[sizeof(rep->error)] = "", limited[sizeof(rep->error) + 64];
 	int outcome = ISOLATE_REPORTED;
 	struct isolate_limits limits = harness_run_limits(h->cfg, job->hb->cb);
+	struct machine_cpu_mark m0, m1;
 	run->load_before = machine_load_average();
+	machine_cpu_mark(&m0);
 	if (h->cfg->isolate)
 		outcome = isolate_call(series_work, job, rep, size, &limits, why, sizeof(why));
 	else
 		series_work(job, rep, size);
+	machine_cpu_mark(&m1);
 	run->load_after = machine_load_average();
+	run->load_other = machine_other_load(&m0, &m1);
 	run->load_read = true;
 	if (outcome == ISOLATE_REPORTED) {
 		report_to_run(rep, h->cfg->repeat, h->anim.frames, run);

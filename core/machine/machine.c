@@ -1,5 +1,7 @@
 /* The machine the results record: CPU model, core count and topology. */
 #include <stdio.h>
+#include <sys/resource.h>
+#include <time.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -46,4 +48,50 @@ double machine_load_average(void)
 		load = -1;
 	fclose(f);
 	return load;
+}
+
+static double tv_s(struct timeval t)
+{
+	return (double)t.tv_sec + (double)t.tv_usec * 1e-6;
+}
+
+/* Busy seconds of all CPUs from /proc/stat's first line, or -1. */
+static double machine_busy_s(void)
+{
+	unsigned long long v[8] = {0};
+	FILE *f = fopen("/proc/stat", "r");
+	if (!f)
+		return -1;
+	int n = fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2],
+	               &v[3], &v[4], &v[5], &v[6], &v[7]);
+	fclose(f);
+	long hz = sysconf(_SC_CLK_TCK);
+	if (n < 8 || hz <= 0)
+		return -1;
+	/* user nice system idle iowait irq softirq steal: all but idle, iowait */
+	return (double)(v[0] + v[1] + v[2] + v[5] + v[6] + v[7]) / (double)hz;
+}
+
+void machine_cpu_mark(struct machine_cpu_mark *m)
+{
+	struct rusage self, children;
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	m->wall_s = (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+	m->machine_s = machine_busy_s();
+	getrusage(RUSAGE_SELF, &self);
+	getrusage(RUSAGE_CHILDREN, &children);
+	m->own_s = tv_s(self.ru_utime) + tv_s(self.ru_stime) + tv_s(children.ru_utime) +
+	           tv_s(children.ru_stime);
+	m->ok = m->machine_s >= 0;
+}
+
+double machine_other_load(const struct machine_cpu_mark *before,
+                          const struct machine_cpu_mark *after)
+{
+	double wall = after->wall_s - before->wall_s;
+	if (!before->ok || !after->ok || wall < 0.05)
+		return -1;
+	double other = (after->machine_s - before->machine_s) - (after->own_s - before->own_s);
+	return other > 0 ? other / wall : 0;
 }

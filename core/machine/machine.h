@@ -57,6 +57,28 @@ int machine_cl_devices(struct machine_cl_device **devices, size_t *count, char *
 /* The 1-minute load average from /proc/loadavg, or -1 when unreadable. */
 double machine_load_average(void);
 
+/*
+ * CPU time of the whole machine and of this process, to tell how much of
+ * the machine others used over an interval: take one before and one after,
+ * then machine_other_load(). The 1-minute load average cannot say this: a
+ * 2-thread run keeps it near 2 for a minute after, so the next run of a
+ * sweep on an idle 2-core machine would look busy.
+ */
+struct machine_cpu_mark {
+	double wall_s;    /* monotonic clock */
+	double machine_s; /* busy time of all CPUs (/proc/stat: all but idle and iowait;
+	                   * steal too: a hypervisor's other guests) */
+	double own_s;     /* this process's CPU time and its waited-for children's */
+	bool ok;          /* /proc/stat was read */
+};
+void machine_cpu_mark(struct machine_cpu_mark *m);
+/* The average number of CPUs kept busy by anything but this process and
+ * its children between the two marks, or -1 when either is unreadable or
+ * the interval is too short to say (under 50 ms: /proc/stat counts 10 ms
+ * ticks). */
+double machine_other_load(const struct machine_cpu_mark *before,
+                          const struct machine_cpu_mark *after);
+
 /* 0, or -ENODEV when hwloc could not load (t is then filled from the mask). */
 int machine_topology_read(struct machine_topology *t);
 

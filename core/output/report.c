@@ -359,7 +359,7 @@ char *report_markdown(const cJSON *doc)
 	               "binary tree's, counted by the stack traversal, whichever is timed. "
 	               "Marks: noisy where the build repeats spread more than 5 %% or a run "
 	               "of the same tree traced more than 5 %% faster or slower; busy where "
-	               "the load average exceeded the cores the run left free.\n",
+	               "other processes kept more CPUs busy than the run left free.\n",
 	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);

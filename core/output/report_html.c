@@ -388,8 +388,8 @@ char *report_html(const cJSON *doc)
 	               "nodes); nodes and triangles per ray are the binary tree's, counted "
 	               "by the stack traversal, whichever is timed. Marks: ≈ noisy where the "
 	               "build repeats spread more than 5 %% or a run of the same tree traced "
-	               "more than 5 %% faster or slower; ⚠ busy where the load average "
-	               "exceeded the cores the run left free.</p>\n",
+	               "more than 5 %% faster or slower; ⚠ busy where other processes "
+	               "kept more CPUs busy than the run left free.</p>\n",
 	          report_num(doc, "machine.cores"));
 	const char *asked, *ref = report_reference(doc, &asked, &(bool){false});
 	report_load_warning(&sb, doc, true);

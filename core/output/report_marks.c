@@ -5,9 +5,13 @@
  * (same SAH cost, node count and nodes per ray) while its measured Mrays/s
  * differs from that run's by more than NOISE: the same tree should trace
  * at the same speed, so the difference is the machine's. Load: a run
- * whose 1-minute load average, before or after, exceeded the cores the
- * run left free plus the one thread the sweep itself keeps busy (the
- * average counts the sweep's own previous work too).
+ * during which other processes kept more CPUs busy on average
+ * (load_other: the machine's busy time less the sweep's own) than the
+ * cores the run left free, by more than OTHER_SLACK. Results written
+ * before load_other existed fall back to the 1-minute load average
+ * before or after, less the one thread the sweep itself keeps busy; that
+ * average also counts the sweep's own previous runs, which is why it is
+ * only the fallback.
  */
 #include <math.h>
 #include <stdio.h>
@@ -17,6 +21,8 @@
 
 #define NOISE REPORT_NOISE
 #define SWEEP_OWN_LOAD 1.0
+/* A quarter of a CPU: kernel threads and /proc/stat's 10 ms ticks. */
+#define OTHER_SLACK 0.25
 
 static bool is_ok(const cJSON *run)
 {
@@ -99,8 +105,18 @@ bool report_busy(const cJSON *doc, const cJSON *run, char *buf, size_t size)
 	double before = report_num(run, "load_before"), after = report_num(run, "load_after");
 	double free_cores = machine_cpus(doc, run) - report_num(run, "threads");
 	double load = fmax(isfinite(before) ? before : -1, isfinite(after) ? after : -1);
+	double other = report_num(run, "load_other");
 	buf[0] = '\0';
-	if (!(free_cores >= 0) || !(load - SWEEP_OWN_LOAD > free_cores))
+	if (!(free_cores >= 0))
+		return false;
+	if (isfinite(other)) {
+		if (!(other > free_cores + OTHER_SLACK))
+			return false;
+		snprintf(buf, size, "others kept %.2f CPUs busy during the run; %.0f core%s left free",
+		         other, free_cores, free_cores == 1 ? "" : "s");
+		return true;
+	}
+	if (!(load - SWEEP_OWN_LOAD > free_cores))
 		return false;
 	snprintf(buf, size, "load %.2f before, %.2f after; %.0f core%s left free", before, after,
 	         free_cores, free_cores == 1 ? "" : "s");
@@ -108,9 +124,10 @@ bool report_busy(const cJSON *doc, const cJSON *run, char *buf, size_t size)
 }
 
 static const char load_rule[] =
-	"the machine's 1-minute load average before or after the run, less the one "
-	"thread the sweep itself keeps busy, exceeded the cores the run left free, so "
-	"other work may have shared its cores and its times are suspect";
+	"during the run, other processes kept more CPUs busy on average than the "
+	"cores the run left free (the machine's busy time less the sweep's own; for "
+	"results without that figure, the 1-minute load average less the sweep's own "
+	"thread), so other work may have shared its cores and its times are suspect";
 
 void report_load_warning(struct strbuf *sb, const cJSON *doc, bool html)
 {

@@ -249,6 +249,8 @@ int results_add_run(struct results *res, const struct run_record *run)
 	if (run->load_read) {
 		cJSON_AddNumberToObject(o, "load_before", run->load_before);
 		cJSON_AddNumberToObject(o, "load_after", run->load_after);
+		if (run->load_other >= 0)
+			cJSON_AddNumberToObject(o, "load_other", run->load_other);
 	}
 	replace_or_add(res, run, o);
 	return 0;

@@ -114,6 +114,9 @@ struct run_record {
 	 * recorded when load_read. */
 	bool load_read;
 	double load_before, load_after;
+	/* CPUs others kept busy during the series, on average
+	 * (machine_other_load), or -1: not measurable. */
+	double load_other;
 };
 
 
