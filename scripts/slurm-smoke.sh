@@ -117,12 +117,16 @@ start_munge
 write_conf
 start_slurm
 
-# A small plan: 2 scenes x sah_seq with a grid of 2 bin counts x threads 1, 2.
+# A small plan: 2 scenes x sah_tasks with a grid of 2 bin counts x threads
+# 1, 2. A parallel builder: for one without the PARALLEL flag (sah_seq)
+# `bvhlab run` skips the thread counts past its first while the plan still
+# numbers them, so plan + merge would hold runs that one run does not (an
+# open defect of the run list, not of Slurm: docs/sweeps.md).
 mkdir -p "$tmp/sweep"
 cat >"$tmp/smoke.json" <<'EOF'
 { "repeat": 1, "threads": [1, 2], "validate_rays": 32, "rays": { "width": 8, "height": 8 },
   "scenes": [ { "generator": "icosphere", "frequency": 6 }, { "generator": "soup", "count": 300 } ],
-  "builders": [ { "plugin": "sah_seq", "options": { "method": "binned", "bins": { "grid": [4, 8] } } } ] }
+  "builders": [ { "plugin": "sah_tasks", "options": { "method": "binned", "bins": { "grid": [4, 8] } } } ] }
 EOF
 "$bvhlab" plan "$tmp/smoke.json" --out "$tmp/sweep" --format slurm --jobs 2 ||
 	fail "bvhlab plan --format slurm"
