@@ -16,7 +16,7 @@
 
 #include "config/config.h"
 #include "config/json_locate.h"
-#include "harness/harness.h"
+#include "harness/harness_rays.h"
 #include "trace/trace_cl.h"
 #include "testutil.h"
 

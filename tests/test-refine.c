@@ -23,7 +23,7 @@
 #include <bvhlab/bvhlab.h>
 
 #include "config/config.h"
-#include "harness/harness.h"
+#include "harness/harness_series.h"
 #include "testutil.h"
 
 #define FIXTURE_SEED 18

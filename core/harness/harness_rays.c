@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/harness.h"
+#include "harness/harness_rays.h"
 #include "output/image.h"
 #include "output/results.h"
 #include "trace/trace_series.h"
