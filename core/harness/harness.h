@@ -9,7 +9,7 @@
 #include <stdint.h>
 
 #include <bvhlab/bvhlab.h>
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "config/config.h"
 #include "harness/refine_stage.h"
