@@ -12,7 +12,7 @@
 
 #include <cJSON.h>
 
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "config/config.h"
 #include "config/json_locate.h"

@@ -26,7 +26,7 @@
 #include "harness/progress.h"
 #include "machine/machine.h"
 #include "output/results.h"
-#include "output/scene_images.h"
+#include "output/images.h"
 #include "output/safe_file.h"
 #include "plan/plan.h"
 #include "util/util.h"

@@ -4,7 +4,7 @@
  * build thread count: traversal numbers then compare trees, not thread
  * counts. Each batch is timed over repeated passes (bvhlab_trace_measure),
  * with one or both traversals. The per-pixel data they give becomes images
- * in output/scene_images.c.
+ * in output/images.c.
  */
 #include <errno.h>
 #include <stdio.h>

@@ -6,7 +6,7 @@
 #include <stdint.h>
 
 #include <bvhlab/bvhlab.h>
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "config/config.h"
 #include "output/results.h"

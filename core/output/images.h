@@ -1,9 +1,9 @@
 /*
- * A scene's images (scene_images.c): the raw per-pixel files a run's child
+ * A scene's images (images.c): the raw per-pixel files a run's child
  * writes, and the PNGs the parent makes of them.
  */
-#ifndef BVHLAB_CORE_SCENE_IMAGES_H
-#define BVHLAB_CORE_SCENE_IMAGES_H
+#ifndef BVHLAB_CORE_IMAGES_H
+#define BVHLAB_CORE_IMAGES_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -38,4 +38,4 @@ struct scene_images {
  * removes the temporary files and records the names in the results. */
 int images_write_scene(struct results *res, const struct scene_images *si, bvhlab_error *err);
 
-#endif /* BVHLAB_CORE_SCENE_IMAGES_H */
+#endif /* BVHLAB_CORE_IMAGES_H */

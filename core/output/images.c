@@ -15,7 +15,7 @@
 #include "output/image.h"
 #include "output/results.h"
 #include "output/safe_file.h"
-#include "output/scene_images.h"
+#include "output/images.h"
 #include "util/util.h"
 
 #define LEGEND_W 256
