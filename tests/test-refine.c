@@ -355,7 +355,7 @@ static void test_subtree_moves(void)
 
 	refiner_options = "batch=0.25\0iterations=3\0children=false\0";
 	test_improves();
-	if (!UNDER_TSAN)
+	if (!UNDER_SANITIZER)
 		test_scene("soup", generate("soup", 10000, 0, 0), RAYS);
 	refiner_options = saved;
 }
