@@ -1,8 +1,8 @@
 /*
- * Test fixture for the config tests: a config written to a temporary
- * folder and loaded from there, and the checks that a load fails with
- * "PATH:LINE:COL: " at a given place. Static inline so that each test
- * takes only what it uses.
+ * Test fixture for the config tests: a config written to the temporary
+ * folder of scene_files.h and loaded from there, and the checks that a
+ * load fails with "PATH:LINE:COL: " at a given place. Static inline so
+ * that each test takes only what it uses.
  */
 #ifndef BVHLAB_CONFIG_FIXTURE_H
 #define BVHLAB_CONFIG_FIXTURE_H
@@ -11,20 +11,19 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "config/config.h"
+#include "scene_files.h"
 #include "testutil.h"
 
 #define SCENES "\"scenes\": [ { \"generator\": \"icosphere\" } ]"
 #define BUILDERS "\"builders\": [ { \"plugin\": \"sah_seq\" } ]"
 
-static char tmp_dir[64];
-static char cfg_path[128];
+static const char *cfg_path; /* tmpdir/c.json, rewritten by every load */
 
-static inline void write_file(const char *path, const char *data, size_t size)
+static inline void write_config(const char *data, size_t size)
 {
-	FILE *f = fopen(path, "wb");
+	FILE *f = fopen(cfg_path, "wb");
 	CHECK(f && fwrite(data, 1, size, f) == size);
 	if (f)
 		fclose(f);
@@ -32,7 +31,7 @@ static inline void write_file(const char *path, const char *data, size_t size)
 
 static inline int load(struct config *cfg, const char *text, bvhlab_error *err)
 {
-	write_file(cfg_path, text, strlen(text));
+	write_config(text, strlen(text));
 	return config_load(cfg, cfg_path, err);
 }
 
@@ -88,31 +87,11 @@ static inline void expect_error_near(const char *file, int caller, const char *t
 #define EXPECT_ERROR_AT(text, at, n, needle) \
 	expect_error_near(__FILE__, __LINE__, text, at, n, needle)
 
-static inline char *in_dir(const char *rel)
+/* The temporary folder (/tmp/bvhlab-test-TAG-XXXXXX) and the config path in it. */
+static inline void config_fixture_open(const char *tag)
 {
-	static char buf[8][256];
-	static int next;
-	char *out = buf[next++ % 8];
-	snprintf(out, sizeof(buf[0]), "%s/%s", tmp_dir, rel);
-	return out;
-}
-
-/* The temporary folder and the config path in it; 0, or 1 with a message. */
-static inline int config_fixture_open(const char *test)
-{
-	snprintf(tmp_dir, sizeof(tmp_dir), "/tmp/bvhlab-%s-XXXXXX", test);
-	if (!mkdtemp(tmp_dir)) {
-		perror("mkdtemp");
-		return 1;
-	}
-	snprintf(cfg_path, sizeof(cfg_path), "%s/c.json", tmp_dir);
-	return 0;
-}
-
-static inline void config_fixture_close(void)
-{
-	unlink(cfg_path);
-	rmdir(tmp_dir);
+	tmp_begin(tag);
+	cfg_path = tmp_file("c.json");
 }
 
 #endif /* BVHLAB_CONFIG_FIXTURE_H */

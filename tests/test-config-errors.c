@@ -10,6 +10,7 @@
 #include "testutil.h"
 
 #include "config_fixture.h"
+#include "scene_files.h"
 
 static void test_syntax(void)
 {
@@ -32,10 +33,10 @@ static void test_syntax(void)
 
 	struct config cfg;
 	bvhlab_error err = { "" };
-	write_file(cfg_path, "{\n \0 }", 6);
+	write_config("{\n \0 }", 6);
 	CHECK_INT(config_load(&cfg, cfg_path, &err), -EINVAL);
 	CHECK_CONTAINS(err.message, ":2:2: NUL byte");
-	CHECK_INT(config_load(&cfg, in_dir("missing.json"), &err), -ENOENT);
+	CHECK_INT(config_load(&cfg, tmp_path("missing.json"), &err), -ENOENT);
 	CHECK_CONTAINS(err.message, "missing.json: cannot open");
 }
 
@@ -165,12 +166,11 @@ static void test_structure(void)
 
 int main(void)
 {
-	if (config_fixture_open("test-config-errors"))
-		return 1;
+	config_fixture_open("config-errors");
 	test_syntax();
 	test_unknown_keys();
 	test_types();
 	test_structure();
-	config_fixture_close();
+	tmp_end();
 	return test_finish();
 }

@@ -15,6 +15,7 @@
 #include "testutil.h"
 
 #include "config_fixture.h"
+#include "scene_files.h"
 
 static const bvhlab_option_decl fake_options[] = {
 	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT, .help = "leaf size", .def_int = 4,
@@ -108,9 +109,8 @@ static void test_options(void)
 
 int main(void)
 {
-	if (config_fixture_open("test-config-options"))
-		return 1;
+	config_fixture_open("config-options");
 	test_options();
-	config_fixture_close();
+	tmp_end();
 	return test_finish();
 }

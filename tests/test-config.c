@@ -20,6 +20,7 @@
 #include "testutil.h"
 
 #include "config_fixture.h"
+#include "scene_files.h"
 
 static void test_full(void)
 {
@@ -52,8 +53,8 @@ static void test_full(void)
 		fprintf(stderr, "%s\n", err.message);
 		return;
 	}
-	CHECK(strcmp(cfg.path, cfg_path) == 0 && strcmp(cfg.dir, tmp_dir) == 0);
-	CHECK(cfg.format_version == 1 && strcmp(cfg.output, in_dir("out/run1")) == 0);
+	CHECK(strcmp(cfg.path, cfg_path) == 0 && strcmp(cfg.dir, tmpdir) == 0);
+	CHECK(cfg.format_version == 1 && strcmp(cfg.output, tmp_path("out/run1")) == 0);
 	CHECK(cfg.repeat == 7 && cfg.warmup == 0 && cfg.thread_count == 3);
 	CHECK(cfg.threads[0] == 0 && cfg.threads[1] == 2 && cfg.threads[2] == 4);
 	CHECK(!cfg.validate && cfg.images && cfg.validate_rays == 100);
@@ -69,7 +70,7 @@ static void test_full(void)
 	CHECK(s[0].path == NULL && s[0].gen.frequency == 12 && s[0].line == 10 && s[0].column == 5);
 	CHECK(s[0].gen.seed == UINT64_MAX); /* exact, not rounded through a double */
 	CHECK(strcmp(s[1].name, "ogre") == 0 && s[1].generator == NULL && s[1].subdivide == 2);
-	CHECK(strcmp(s[1].path, in_dir("../meshes/ogre.obj")) == 0);
+	CHECK(strcmp(s[1].path, tmp_path("../meshes/ogre.obj")) == 0);
 	CHECK(s[1].line == 11 && s[1].column == 5);
 	CHECK(strcmp(s[2].name, "soup") == 0 && s[2].gen.count == 1000 && s[2].gen.size == 8);
 
@@ -78,7 +79,7 @@ static void test_full(void)
 	CHECK(strcmp(b[0].plugin, "sah_seq") == 0 && strcmp(b[0].name, "sweep") == 0);
 	CHECK(b[0].thread_count == 2 && b[0].threads[0] == 1 && b[0].threads[1] == 8);
 	CHECK(cJSON_IsObject(b[0].options) && b[0].line == 14 && b[0].column == 5);
-	CHECK(strcmp(b[1].plugin, in_dir("plugins/custom.so")) == 0);
+	CHECK(strcmp(b[1].plugin, tmp_path("plugins/custom.so")) == 0);
 	CHECK(strcmp(b[1].name, "custom") == 0 && b[1].options == NULL);
 	CHECK(b[1].threads == NULL && b[1].thread_count == 0);
 	CHECK(strcmp(b[2].plugin, "/abs/other.so") == 0 && strcmp(b[2].name, "other") == 0);
@@ -103,7 +104,7 @@ static void test_defaults(void)
 	CHECK_INT(rc, 0);
 	if (rc)
 		return;
-	CHECK(cfg.format_version == 1 && strcmp(cfg.output, in_dir("results")) == 0);
+	CHECK(cfg.format_version == 1 && strcmp(cfg.output, tmp_path("results")) == 0);
 	CHECK(cfg.repeat == 5 && cfg.warmup == 1 && cfg.thread_count == 1 && cfg.threads[0] == 1);
 	CHECK(cfg.validate && !cfg.images && cfg.validate_rays == 256);
 	CHECK(cfg.ray_width == 256 && cfg.ray_height == 256 && cfg.ray_diffuse == 1);
@@ -330,8 +331,7 @@ static void test_animation(void)
 
 int main(void)
 {
-	if (config_fixture_open("test-config"))
-		return 1;
+	config_fixture_open("config");
 	test_full();
 	test_defaults();
 	test_traversal();
@@ -339,6 +339,6 @@ int main(void)
 	test_scene_camera();
 	test_isolation_keys();
 	test_animation();
-	config_fixture_close();
+	tmp_end();
 	return test_finish();
 }
