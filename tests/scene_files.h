@@ -44,6 +44,18 @@ static inline const char *tmp_file(const char *name)
 	return path;
 }
 
+/* tmpdir/name for a path the caller only compares or makes itself (a
+ * folder, a file that must not exist); tmp_end leaves it. Eight rotate, so
+ * one expression may hold several. */
+static inline const char *tmp_path(const char *name)
+{
+	static char buf[8][256];
+	static int next;
+	char *out = buf[next++ % 8];
+	snprintf(out, sizeof(buf[0]), "%s/%s", tmpdir, name);
+	return out;
+}
+
 /* Writes data to tmpdir/name and returns the path (valid until tmp_end). */
 static inline const char *write_file(const char *name, const void *data, size_t len)
 {

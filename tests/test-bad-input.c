@@ -21,15 +21,6 @@
 #include "scene_files.h"
 #include "testutil.h"
 
-static const char *in_tmp(const char *name)
-{
-	static char buf[8][256];
-	static int next;
-	char *out = buf[next++ % 8];
-	snprintf(out, sizeof(buf[0]), "%s/%s", tmpdir, name);
-	return out;
-}
-
 #define PLY_XYZ "property float x\nproperty float y\nproperty float z\n"
 #define PLY_FACE "element face 1\nproperty list uchar int vertex_indices\n"
 
@@ -98,10 +89,10 @@ static void test_degenerate_ply(void)
 
 static void test_paths(void)
 {
-	const char *dir = in_tmp("folder.obj");
+	const char *dir = tmp_path("folder.obj");
 	CHECK_INT(mkdir(dir, 0755), 0);
 	expect_scene_error(dir, -EISDIR, ": not a regular file");
-	expect_scene_error(in_tmp("missing.ply"), -ENOENT, ": cannot open: No such file");
+	expect_scene_error(tmp_path("missing.ply"), -ENOENT, ": cannot open: No such file");
 
 	struct config cfg;
 	bvhlab_error err = { "" };

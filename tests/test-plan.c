@@ -9,8 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <cJSON.h>
-
 #include "config/config.h"
 #include "plan/plan.h"
 #include "testutil.h"

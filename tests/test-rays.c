@@ -11,7 +11,6 @@
 
 #include <bvhlab/bvhlab.h>
 
-#include "harness/harness.h"
 #include "output/image.h"
 #include "testutil.h"
 
