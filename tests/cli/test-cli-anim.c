@@ -22,19 +22,6 @@
 
 #include "cliutil.h"
 
-static const cJSON *find_run(const cJSON *doc, const char *scene, const char *builder,
-                             int threads)
-{
-	const cJSON *run;
-	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs")) {
-		const cJSON *t = cJSON_GetObjectItem(run, "threads");
-		if (!strcmp(run_str(run, "scene"), scene) && !strcmp(run_str(run, "builder"), builder) &&
-		    cJSON_IsNumber(t) && t->valueint == threads)
-			return run;
-	}
-	return NULL;
-}
-
 static const cJSON *frame(const cJSON *run, int f)
 {
 	return cJSON_GetArrayItem(cJSON_GetObjectItem(run, "frames"), f);
@@ -240,18 +227,6 @@ static void test_errors(void)
 	         "\"lbvh\" } } ] }\n", ico);
 	CHECK_INT(run(ARGS("run", write_config("noupd.json", text))), 1);
 	CHECK_CONTAINS(err_text, "animation update: plugin 'lbvh' has no update function (ABI 1.4)");
-}
-
-static int wait_for_runs(const char *dir)
-{
-	const struct timespec pause = {.tv_nsec = 10 * 1000 * 1000};
-	int n = -1;
-	for (int k = 0; k < 6000 && n < 1; k++) {
-		n = runs_written(dir);
-		if (n < 1)
-			nanosleep(&pause, NULL);
-	}
-	return n;
 }
 
 /* The "gated" builder blocks until a file appears, so the kill lands mid-sweep. */

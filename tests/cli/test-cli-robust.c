@@ -16,19 +16,6 @@
 
 #include "cliutil.h"
 
-static const cJSON *find_run(const cJSON *doc, const char *scene, const char *builder,
-                             int threads)
-{
-	const cJSON *run;
-	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs")) {
-		const cJSON *t = cJSON_GetObjectItem(run, "threads");
-		if (!strcmp(run_str(run, "scene"), scene) && !strcmp(run_str(run, "builder"), builder) &&
-		    cJSON_IsNumber(t) && t->valueint == threads)
-			return run;
-	}
-	return NULL;
-}
-
 static bool run_valid(const cJSON *run)
 {
 	return run && !strcmp(run_str(run, "status"), "ok") &&
@@ -39,15 +26,7 @@ static bool run_valid(const cJSON *run)
  * Sanitizer builds would turn a plugin's segfault into their own report
  * and check the crashed children for leaks; here the signal is the point.
  */
-static void append_option(const char *var, const char *more)
-{
-	const char *old = getenv(var);
-	char opts[512];
-	snprintf(opts, sizeof(opts), "%s%s%s", old ? old : "", old && *old ? ":" : "", more);
-	setenv(var, opts, 1);
-}
-
-static void plain_crashes(void)
+static void crashes_unreported(void)
 {
 	append_option("ASAN_OPTIONS", "handle_segv=0:detect_leaks=0:allocator_may_return_null=1");
 	append_option("TSAN_OPTIONS", "handle_segv=0");
@@ -156,19 +135,6 @@ static void test_unvalidated_dag(void)
 	CHECK(dag && !cJSON_GetObjectItem(dag, "rays"));
 	CHECK(run_valid(find_run(doc, "soup", "fake_good", 1)));
 	cJSON_Delete(doc);
-}
-
-/* Polls (bounded) until the sweep has written at least one run. */
-static int wait_for_runs(const char *dir)
-{
-	const struct timespec pause = {.tv_nsec = 10 * 1000 * 1000};
-	int n = -1;
-	for (int k = 0; k < 6000 && n < 1; k++) {
-		n = runs_written(dir);
-		if (n < 1)
-			nanosleep(&pause, NULL);
-	}
-	return n;
 }
 
 static bool same_run(const cJSON *a, const cJSON *b)
@@ -325,7 +291,7 @@ int main(int argc, char **argv)
 {
 	if (!cli_begin(argc, argv))
 		return 2;
-	plain_crashes();
+	crashes_unreported();
 	test_misbehaving();
 	test_in_process();
 	test_unvalidated_dag();
