@@ -7,6 +7,7 @@
 #define BVHLAB_TEST_CLIUTIL_H
 
 #include <fcntl.h>
+#include <signal.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -102,6 +103,8 @@ static int run(const char *const *args)
 	return finish(start(args));
 }
 
+#define ARGS(...) ((const char *const[]){__VA_ARGS__, NULL})
+
 static char *write_config(const char *name, const char *text)
 {
 	static char path[512];
@@ -177,6 +180,48 @@ static inline int wait_for_runs(const char *dir)
 	return n;
 }
 
+/*
+ * A sweep killed mid-way and resumed: its config kill.json has a builder
+ * "gated" that blocks until the file `gate` appears, so the kill surely
+ * lands mid-sweep; its output folder is out-kill.
+ */
+struct kill_sweep {
+	char gate[512], dir[512], cfg[512];
+};
+
+/* Writes kill.json from `format` (its one %s: the gate file), runs it until
+ * it has written a run, then kills it with SIGKILL (checked): the runs
+ * written before, -1 if none ever was. */
+static inline int kill_sweep_start(struct kill_sweep *k, const char *format)
+{
+	char text[2048];
+	snprintf(k->gate, sizeof(k->gate), "%s/gate", tmpdir);
+	snprintf(k->dir, sizeof(k->dir), "%s/out-kill", tmpdir);
+	snprintf(text, sizeof(text), format, k->gate);
+	snprintf(k->cfg, sizeof(k->cfg), "%s", write_config("kill.json", text));
+	pid_t pid = start(ARGS("run", k->cfg));
+	int before = wait_for_runs(k->dir);
+	kill(pid, SIGKILL);
+	CHECK_INT(finish(pid), 128 + SIGKILL);
+	return before;
+}
+
+/* Opens the gate (checked) and runs the sweep with --resume: its status. */
+static inline int kill_sweep_resume(const struct kill_sweep *k)
+{
+	FILE *f = fopen(k->gate, "w");
+	CHECK(f != NULL);
+	if (f)
+		fclose(f);
+	return run(ARGS("run", k->cfg, "--resume"));
+}
+
+/* A run's member `key` as compact JSON text (to free), NULL for no run. */
+static inline char *run_item_text(const cJSON *run, const char *key)
+{
+	return run ? cJSON_PrintUnformatted(cJSON_GetObjectItem(run, key)) : NULL;
+}
+
 /* Appends `more` to the colon-separated options in environment variable
  * `var`, for the children started after. */
 static inline void append_option(const char *var, const char *more)
@@ -192,8 +237,6 @@ static inline void plain_crashes(void)
 {
 	append_option("ASAN_OPTIONS", "handle_segv=0");
 }
-
-#define ARGS(...) ((const char *const[]){__VA_ARGS__, NULL})
 
 /* Long enough for any run of the tests on a loaded machine; a hang ends here. */
 #define CLI_LIMIT_S 60

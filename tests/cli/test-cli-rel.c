@@ -60,6 +60,17 @@ static void check_run(const cJSON *doc, const char *builder, int threads, const 
 		CHECK_CONTAINS(run_str(r, "error"), error);
 }
 
+/* `bvhlab plan --out out` on one scene of 100 triangles and `builders`
+ * (a JSON list's items), written as `name`: must exit with `status`. */
+static void plan_builders(const char *name, const char *builders, const char *out, int status)
+{
+	char text[1024];
+	snprintf(text, sizeof(text),
+	         "{ \"repeat\": 1, \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+	         "  \"builders\": [ %s ] }\n", builders);
+	CHECK_INT(run_in(tmpdir, ARGS("plan", write_config(name, text), "--out", out)), status);
+}
+
 /* 1. Refine stages that crash or hang while loading cost their builder's
  * runs only; plan and list probe too, and plan checks stages' options. */
 static void test_probe(void)
@@ -90,17 +101,15 @@ static void test_probe(void)
 	CHECK_CONTAINS(err_text, "died while loading");
 	CHECK(!exists(path_in("plan-probe/plan.json")));
 
-	const char *bad_opt = write_config("refopt.json",
-		"{ \"repeat\": 1, \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\",\n"
-		"    \"refine\": [ { \"plugin\": \"reinsert\", \"options\": { \"nope\": 1 } } ] } ] }\n");
-	CHECK_INT(run_in(tmpdir, ARGS("plan", bad_opt, "--out", "plan-opt")), 2);
+	plan_builders("refopt.json",
+	              "{ \"plugin\": \"fake_good\",\n"
+	              "    \"refine\": [ { \"plugin\": \"reinsert\", \"options\": { \"nope\": 1 } } ] }",
+	              "plan-opt", 2);
 	CHECK_CONTAINS(err_text, "nope");
-	const char *optional = write_config("optional.json",
-		"{ \"repeat\": 1, \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
-		"    { \"plugin\": \"not_built_here\", \"optional\": true } ] }\n");
-	CHECK_INT(run_in(tmpdir, ARGS("plan", optional, "--out", "plan-optional")), 0);
+	plan_builders("optional.json",
+	              "{ \"plugin\": \"fake_good\" },\n"
+	              "    { \"plugin\": \"not_built_here\", \"optional\": true }",
+	              "plan-optional", 0);
 	CHECK_CONTAINS(err_text, "optional builder skipped");
 	CHECK_CONTAINS(err_text, "builder 'not_built_here'");
 
