@@ -116,6 +116,82 @@ static inline bvhlab_scene *load_shared(const char *file)
 	return scene;
 }
 
+/* Leaves of at most `most` primitives; the first larger one is reported. */
+static inline void check_leaf_sizes(const bvhlab_tree *tree, uint32_t most)
+{
+	for (uint32_t i = 0; i < tree->node_count; i++)
+		if (tree->nodes[i].count > most) {
+			fprintf(stderr, "node %u: leaf of %u > %u\n", i, tree->nodes[i].count, most);
+			CHECK(!"leaf within max_leaf");
+			return;
+		}
+}
+
+/* `tree`, built with `threads` threads, is `ref` (built with 1): equal for
+ * bvhlab_tree_compare, and the same arrays, node order included. */
+static inline void check_same_tree(const char *name, const bvhlab_tree *ref,
+                                   const bvhlab_tree *tree, uint32_t threads)
+{
+	bvhlab_error err = { { 0 } };
+
+	if (bvhlab_tree_compare(ref, tree, &err) != 0) {
+		fprintf(stderr, "%s: threads=%u vs 1: %s\n", name, threads, err.message);
+		CHECK(!"same tree");
+		return;
+	}
+	CHECK_INT(tree->node_count, ref->node_count);
+	CHECK_INT(tree->index_count, ref->index_count);
+	CHECK(trees_identical(ref, tree));
+}
+
+/* A test's build of its setup (the plugin's option values) with `threads`
+ * threads, validated: 0, or the failure, reported with a failed check. */
+typedef int (*setup_build_fn)(const char *name, const bvhlab_build_input *in,
+                              const void *setup, uint32_t threads, bvhlab_tree *tree);
+
+/* One setup of a deterministic builder, for check_threads_same. */
+struct setup_check {
+	setup_build_fn build;
+	const void *setup;
+	bool collapse;         /* false: one primitive a leaf, 2n - 1 nodes */
+	uint32_t most;         /* the largest leaf allowed */
+	const uint32_t *threads; /* the builds that must give the 1-thread tree again */
+	size_t thread_count;
+	uint64_t ray_seed;
+};
+
+/*
+ * One setup on one scene: the 1-thread tree is checked in full (structure,
+ * rays against brute force, leaves), then every count of c->threads must
+ * build it again, node for node. Returns its SAH cost.
+ */
+static inline double check_threads_same(const char *name, const bvhlab_scene *scene,
+                                        const bvhlab_build_input *in,
+                                        const struct setup_check *c, uint32_t rays)
+{
+	bvhlab_tree ref = { 0 }, tree = { 0 };
+	bvhlab_tree_stats stats = { 0 };
+	bvhlab_error err = { { 0 } };
+	uint64_t mismatches = 1;
+
+	if (c->build(name, in, c->setup, 1, &ref) != 0)
+		goto out;
+	CHECK_INT(ref.index_count, in->prim_count);
+	if (!c->collapse)
+		CHECK_INT(ref.node_count, 2 * in->prim_count - 1);
+	CHECK_INT(bvhlab_validate_rays(&ref, scene, rays, c->ray_seed, &mismatches, &err), 0);
+	CHECK_INT(mismatches, 0);
+	check_leaf_sizes(&ref, c->most);
+	bvhlab_tree_stats_compute(&ref, &stats);
+	for (size_t t = 0; t < c->thread_count; t++)
+		if (c->build(name, in, c->setup, c->threads[t], &tree) == 0)
+			check_same_tree(name, &ref, &tree, c->threads[t]);
+out:
+	bvhlab_tree_finish(&ref);
+	bvhlab_tree_finish(&tree);
+	return stats.sah_cost;
+}
+
 /* The SAH cost of the builds of one setup (option value, collapse) on a
  * scene, after the test's checks of them. */
 typedef double (*collapse_check_fn)(const char *name, const bvhlab_scene *scene,

@@ -82,10 +82,12 @@ static int make_options(bvhlab_options *opts, const struct setup *s)
 	return rc;
 }
 
-/* Builds and checks the structure; 0 or the failure (reported). */
-static int build_valid(const char *name, const bvhlab_build_input *in, const struct setup *s,
+/* Builds setup (a struct setup) and checks the structure; 0 or the
+ * failure (reported). A setup_build_fn. */
+static int build_valid(const char *name, const bvhlab_build_input *in, const void *setup,
                        uint32_t threads, bvhlab_tree *tree)
 {
+	const struct setup *s = setup;
 	bvhlab_options opts;
 	bvhlab_error err = { { 0 } };
 	int rc = make_options(&opts, s);
@@ -105,75 +107,24 @@ static int build_valid(const char *name, const bvhlab_build_input *in, const str
 }
 
 /* Leaves: one primitive without collapse, at most max_leaf with. */
-static void check_leaves(const bvhlab_tree *tree, const struct setup *s)
+static uint32_t most_leaf(const struct setup *s)
 {
-	uint32_t most = !s->collapse ? 1 : s->max_leaf ? s->max_leaf : 8;
-
-	for (uint32_t i = 0; i < tree->node_count; i++)
-		if (tree->nodes[i].count > most) {
-			fprintf(stderr, "node %u: leaf of %u > %u\n", i, tree->nodes[i].count, most);
-			CHECK(!"leaf within max_leaf");
-			return;
-		}
+	return !s->collapse ? 1 : s->max_leaf ? s->max_leaf : 8;
 }
 
-/* The same tree, and the same arrays: node order included. */
-static void check_same(const char *name, const bvhlab_tree *ref, const bvhlab_tree *tree,
-                       const char *what)
-{
-	bvhlab_error err = { { 0 } };
-
-	if (bvhlab_tree_compare(ref, tree, &err) != 0) {
-		fprintf(stderr, "%s: %s: %s\n", name, what, err.message);
-		CHECK(!"same tree");
-		return;
-	}
-	CHECK_INT(tree->node_count, ref->node_count);
-	CHECK_INT(tree->index_count, ref->index_count);
-	CHECK(trees_identical(ref, tree));
-}
-
-/*
- * One setup on one scene: the single-thread tree is checked in full
- * (structure, rays, leaves), every other thread count and a repeat must
- * give it again. Returns its SAH cost.
- */
-static double check_setup(const char *name, const bvhlab_scene *scene,
-                          const bvhlab_build_input *in, const struct setup *s, uint32_t rays)
-{
-	bvhlab_tree ref = { 0 }, tree = { 0 };
-	bvhlab_tree_stats stats = { 0 };
-	bvhlab_error err = { { 0 } };
-	uint64_t mismatches = 1;
-
-	if (build_valid(name, in, s, 1, &ref) != 0)
-		goto out;
-	CHECK_INT(ref.index_count, in->prim_count);
-	if (!s->collapse)
-		CHECK_INT(ref.node_count, 2 * in->prim_count - 1);
-	CHECK_INT(bvhlab_validate_rays(&ref, scene, rays, RAY_SEED, &mismatches, &err), 0);
-	CHECK_INT(mismatches, 0);
-	check_leaves(&ref, s);
-	bvhlab_tree_stats_compute(&ref, &stats);
-	for (size_t t = 0; t < THREAD_COUNTS; t++) {
-		char what[64];
-		snprintf(what, sizeof(what), "threads=%u vs 1", thread_counts[t]);
-		if (build_valid(name, in, s, thread_counts[t], &tree) == 0)
-			check_same(name, &ref, &tree, what);
-	}
-out:
-	bvhlab_tree_finish(&ref);
-	bvhlab_tree_finish(&tree);
-	return stats.sah_cost;
-}
-
+/* One bit count on one scene: the single-thread tree checked in full
+ * (structure, rays, leaves), every other thread count and a repeat (1
+ * again) must give it again. Returns its SAH cost. */
 static double check_bits(const char *name, const bvhlab_scene *scene,
                          const bvhlab_build_input *in, uint32_t bits, bool collapse,
                          uint32_t rays)
 {
 	struct setup s = { .bits = bits, .collapse = collapse };
+	struct setup_check c = { .build = build_valid, .setup = &s, .collapse = collapse,
+	                         .most = most_leaf(&s), .threads = thread_counts,
+	                         .thread_count = THREAD_COUNTS, .ray_seed = RAY_SEED };
 
-	return check_setup(name, scene, in, &s, rays);
+	return check_threads_same(name, scene, in, &c, rays);
 }
 
 static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)
@@ -258,7 +209,7 @@ static void test_max_leaf_binds(void)
 		                   .extra = "c_trav=1000" };
 		if (build_valid("icosphere c_trav=1000", &prims.input, &s, 2, &tree) != 0)
 			continue;
-		check_leaves(&tree, &s);
+		check_leaf_sizes(&tree, most_leaf(&s));
 		bvhlab_tree_stats_compute(&tree, &stats);
 		CHECK(stats.leaf_histogram[max_leaf - 1] > 0);
 	}
@@ -311,7 +262,7 @@ static void test_all_cores(void)
 	}
 	if (build_valid("stadium", &prims.input, &s, 1, &ref) == 0 &&
 	    build_valid("stadium", &prims.input, &s, 0, &tree) == 0)
-		check_same("stadium", &ref, &tree, "threads=0 vs 1");
+		check_same_tree("stadium", &ref, &tree, 0);
 	bvhlab_tree_finish(&ref);
 	bvhlab_tree_finish(&tree);
 	bvhlab_prims_finish(&prims);
