@@ -100,6 +100,30 @@ static inline bvhlab_scene *identical_scene(uint32_t n)
 	return scene;
 }
 
+/* The sizes of the generated scenes a builder test runs (for_generated). */
+struct scene_sizes {
+	uint32_t soup;      /* triangles */
+	uint32_t icosphere; /* frequency */
+	uint32_t stadium;   /* triangles */
+	uint32_t terrain;   /* size */
+	uint32_t identical; /* triangles */
+};
+
+/* test(name, scene) on the generated scenes every builder test runs: a
+ * soup, an icosphere, a stadium and a terrain of the given sizes,
+ * `identical` copies of one triangle, and soups of 1 and 2 triangles. */
+static inline void for_generated(const struct scene_sizes *sizes,
+                                 void (*test)(const char *name, bvhlab_scene *scene))
+{
+	test("soup", generate("soup", sizes->soup, 0, 0));
+	test("icosphere", generate("icosphere", 0, sizes->icosphere, 0));
+	test("stadium", generate("stadium", sizes->stadium, 0, 0));
+	test("terrain", generate("terrain", 0, 0, sizes->terrain));
+	test("identical", identical_scene(sizes->identical));
+	test("one", generate("soup", 1, 0, 0));
+	test("two", generate("soup", 2, 0, 0));
+}
+
 /* A mesh of ../shared/scenes by file name; NULL (a failed check) if it
  * does not load. */
 static inline bvhlab_scene *load_shared(const char *file)
@@ -114,6 +138,26 @@ static inline bvhlab_scene *load_shared(const char *file)
 		CHECK(!"shared mesh loads");
 	}
 	return scene;
+}
+
+/* Builds with `opts` and validates the tree's structure, then finishes
+ * opts: 0, or the failure, reported as "`what` threads=N: why" with a
+ * failed check. */
+static inline int build_validated(const bvhlab_plugin *plugin, bvhlab_options *opts,
+                                  const bvhlab_build_input *in, uint32_t threads,
+                                  bvhlab_tree *tree, const char *what)
+{
+	bvhlab_error err = { { 0 } };
+	int rc = bvhlab_build(plugin, opts, in, threads, tree, &err);
+
+	if (rc == 0)
+		rc = bvhlab_validate_tree(tree, in, false, &err);
+	if (rc != 0) {
+		fprintf(stderr, "%s threads=%u: %s\n", what, threads, err.message);
+		CHECK(!"valid build");
+	}
+	bvhlab_options_finish(opts);
+	return rc;
 }
 
 /* Leaves of at most `most` primitives; the first larger one is reported. */
