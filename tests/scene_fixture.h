@@ -140,6 +140,25 @@ static inline bvhlab_scene *load_shared(const char *file)
 	return scene;
 }
 
+/* Builds with `plugin` and the options `items` ("key=value" texts, NULL-
+ * terminated), parsed in turn: 0, or the first failure, in err. */
+static inline int build_with(const bvhlab_plugin *plugin, const char *const *items,
+                             const bvhlab_build_input *in, uint32_t threads, bvhlab_tree *tree,
+                             bvhlab_error *err)
+{
+	bvhlab_options opts;
+	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin));
+
+	if (rc < 0)
+		return rc;
+	for (size_t k = 0; rc == 0 && items[k]; k++)
+		rc = bvhlab_options_parse(&opts, items[k], err);
+	if (rc == 0)
+		rc = bvhlab_build(plugin, &opts, in, threads, tree, err);
+	bvhlab_options_finish(&opts);
+	return rc;
+}
+
 /* Builds with `opts` and validates the tree's structure, then finishes
  * opts: 0, or the failure, reported as "`what` threads=N: why" with a
  * failed check. */
