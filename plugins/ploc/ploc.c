@@ -205,11 +205,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return build_team(host, ctx, &p, output);
 }
 
-BVHLAB_PLUGIN(
-	.name = "ploc",
+BVHLAB_PLUGIN(.name = "ploc", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "parallel locally-ordered clustering (Meister & Bittner 2018) from Morton "
 	           "order, SAH collapse",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.option_count = OPTION_COUNT,
-	.options = options,
-	.build = build)
+	.option_count = OPTION_COUNT, .options = options, .build = build)
