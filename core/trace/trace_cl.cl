@@ -186,6 +186,18 @@ static void store(__global uint4 *hits, __global uint2 *counts, uint i, const hi
 	uint index_count, uint tri_count, __global const float4 *rays, uint ray_count,     \
 	uint any, __global uint4 *hits, __global uint2 *counts
 
+/* Enters `node`: its first and count, counted in *visited; false past
+ * node_total entries (a cycle in a broken tree: the walk ends). */
+static bool enter_node(__global const float4 *nodes, uint node, uint node_total, uint *visited,
+                       uint *first, uint *count)
+{
+	if (++*visited > node_total)
+		return false;
+	*first = node_first(nodes, node);
+	*count = node_count(nodes, node);
+	return true;
+}
+
 /* The start of both traversals for ray i: no hit yet, the ray prepared;
  * false when there is nothing to trace (past the last ray, or a ray that
  * misses the root box, whose miss is stored). */
@@ -210,7 +222,7 @@ static bool ray_begin(__global const float4 *nodes, uint node_total,
  * entry distance, popped only while it still beats the closest hit. */
 __kernel void trace_stack(TRACE_KERNEL_ARGS)
 {
-	uint i = get_global_id(0), visited = 0, tests = 0, sp = 0, node = 0;
+	uint i = get_global_id(0), visited = 0, tests = 0, sp = 0, node = 0, first, count;
 	uint st_node[STACK_SIZE];
 	float st_t[STACK_SIZE];
 	hit h;
@@ -218,10 +230,7 @@ __kernel void trace_stack(TRACE_KERNEL_ARGS)
 	(void)parents;
 	if (!ray_begin(nodes, node_total, rays, ray_count, i, hits, counts, &p, &h))
 		return;
-	for (;;) {
-		if (++visited > node_total)
-			break;
-		uint first = node_first(nodes, node), count = node_count(nodes, node);
+	while (enter_node(nodes, node, node_total, &visited, &first, &count)) {
 		if (count) {
 			if (leaf(&p, tris, prim_index, first, count, index_count, tri_count, any, &h,
 			         &tests))
@@ -282,15 +291,12 @@ static uint near_child(const prep *p, __global const float4 *nodes, uint first)
  * parent links (Hapala et al. 2011). */
 __kernel void trace_stackless(TRACE_KERNEL_ARGS)
 {
-	uint i = get_global_id(0), visited = 0, tests = 0, node = 0;
+	uint i = get_global_id(0), visited = 0, tests = 0, node = 0, first, count;
 	hit h;
 	prep p;
 	if (!ray_begin(nodes, node_total, rays, ray_count, i, hits, counts, &p, &h))
 		return;
-	for (;;) {
-		if (++visited > node_total)
-			break;
-		uint first = node_first(nodes, node), count = node_count(nodes, node);
+	while (enter_node(nodes, node, node_total, &visited, &first, &count)) {
 		if (count == 0) {
 			uint near = near_child(&p, nodes, first);
 			uint far = near == first ? first + 1 : first;
