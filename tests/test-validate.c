@@ -26,8 +26,7 @@ static void expect(const bvhlab_tree *t, bool allow_duplicates, const char *need
 }
 
 /* expect(t, false, the message printf would make of fmt and the rest). */
-static void expectf(const bvhlab_tree *t, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
+static void expectf(const bvhlab_tree *t, const char *fmt, ...) BVHLAB_PRINTF(2, 3);
 
 static void expectf(const bvhlab_tree *t, const char *fmt, ...)
 {
