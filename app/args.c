@@ -8,7 +8,7 @@
 
 #include "cli.h"
 #include "config/config.h"
-#include "harness/harness.h"
+#include "harness/harness_scene.h"
 
 int cli_parse_uint(const char *opt, const char *text, unsigned long max, unsigned long *out)
 {

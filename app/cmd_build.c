@@ -4,7 +4,8 @@
 #include <stdlib.h>
 
 #include "cli.h"
-#include "harness/harness.h"
+#include "harness/harness_measure.h"
+#include "harness/harness_series.h"
 #include "util/util.h"
 
 #define MAX_OPTIONS 64
@@ -29,13 +30,11 @@ static const char usage[] =
 	"\n"
 	"exit status: 0 valid tree, 1 build failed or tree invalid, 2 bad arguments.\n";
 
-#define MAX_STAGES 8
-
 struct build_args {
 	unsigned long threads, repeat, subdivide, rays;
 	const char *options[MAX_OPTIONS];
 	int option_count;
-	const char *refine[MAX_STAGES];
+	const char *refine[HARNESS_MAX_STAGES];
 	int refine_count;
 	const char *refine_options[MAX_OPTIONS];
 	int refine_option_stage[MAX_OPTIONS]; /* which stage each -R is for */
@@ -45,7 +44,7 @@ struct build_args {
 /* --refine and -R; -1 when there are too many or -R has no stage. */
 static int parse_refine(int c, struct build_args *a)
 {
-	if (c == 'f' && a->refine_count < MAX_STAGES) {
+	if (c == 'f' && a->refine_count < HARNESS_MAX_STAGES) {
 		a->refine[a->refine_count++] = optarg;
 		return 0;
 	}
@@ -106,35 +105,37 @@ static void print_stats(const bvhlab_tree_stats *st)
 	printf("\n");
 }
 
-/* Validates and prints; returns the exit status. */
+/* Measures the tree as a sweep's run does and prints; the exit status. */
 static int check(const bvhlab_scene *scene, const bvhlab_prims *prims, const bvhlab_builder *b,
                  const bvhlab_tree *tree, unsigned long rays)
 {
 	bvhlab_error err = {{0}};
+	struct tree_measure m;
 	bool dup = b->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
-	if (bvhlab_validate_tree(tree, &prims->input, dup, &err) < 0) {
+	enum tree_verdict v = harness_measure_tree(tree, scene, &prims->input, dup, (uint32_t)rays,
+	                                           &m, &err);
+	if (!m.valid && !m.mismatches) {
 		printf("valid:      NO: %s\n", err.message);
 		return EXIT_RUNS_FAILED;
 	}
-	uint64_t mismatches = 0;
-	if (rays && bvhlab_validate_rays(tree, scene, (uint32_t)rays, 0x5eed, &mismatches, &err) < 0) {
+	if (v == TREE_FAILED) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		return EXIT_RUNS_FAILED;
 	}
 	printf("valid:      %s (structure; %llu of %lu rays disagree with brute force)\n",
-	       mismatches ? "NO" : "yes", (unsigned long long)mismatches, rays);
-	bvhlab_tree_stats st;
-	bvhlab_tree_stats_compute(tree, &st);
-	print_stats(&st);
-	return mismatches ? EXIT_RUNS_FAILED : 0;
+	       m.mismatches ? "NO" : "yes", (unsigned long long)m.mismatches, rays);
+	print_stats(&m.stats);
+	if (m.has_epo)
+		printf("EPO:        %.4f\n", m.epo);
+	return v == TREE_OK ? 0 : EXIT_RUNS_FAILED;
 }
 
 /* The refinement stages of --refine, with their -R options. */
 struct stages {
-	bvhlab_plugin *plugin[MAX_STAGES];
-	bvhlab_options opts[MAX_STAGES];
-	struct refine_stage stage[MAX_STAGES];
-	struct stage_metrics out[MAX_STAGES];
+	bvhlab_plugin *plugin[HARNESS_MAX_STAGES];
+	bvhlab_options opts[HARNESS_MAX_STAGES];
+	struct refine_stage stage[HARNESS_MAX_STAGES];
+	struct stage_metrics out[HARNESS_MAX_STAGES];
 	int count;
 };
 
@@ -198,7 +199,7 @@ static int build_and_check(bvhlab_plugin *p, const bvhlab_options *opts,
 	printf("builder:    %s, %u thread(s)\nscene:      %s, %u triangles\n"
 	       "build:      %.3f ms median (min %.3f, max %.3f, %u timed), %.2f Mtris/s\n"
 	       "cold:       %.3f ms (the first build: fresh output and scratch)\n",
-	       bvhlab_plugin_builder(p)->name, s.threads ? s.threads : bvhlab_hardware_threads(),
+	       bvhlab_plugin_builder(p)->name, s.threads,
 	       scene->name, scene->triangle_count, med, mn, mx, s.repeat,
 	       scene->triangle_count / (med * 1e3), s.cold_ms);
 	print_phases(&s);
@@ -215,7 +216,10 @@ int cmd_build(int argc, char **argv)
 {
 	struct build_args a = {.threads = 1, .repeat = 1, .rays = 256};
 	struct cli_target t;
-	if (parse(argc, argv, &a) < 0 || a.repeat == 0 ||
+	int r = parse(argc, argv, &a);
+	/* Resolved once: the build and what is printed use this count. */
+	a.threads = a.threads ? a.threads : bvhlab_hardware_threads();
+	if (r < 0 || a.repeat == 0 ||
 	    cli_target_open(&t, argv[optind], argv[optind + 1], (unsigned)a.subdivide, a.options,
 	                    a.option_count) < 0)
 		return EXIT_USAGE;

@@ -12,6 +12,7 @@
 #include "cli.h"
 #include "config/config.h"
 #include "harness/harness_builders.h"
+#include "harness/harness_threads.h"
 #include "output/results.h"
 #include "plan/plan.h"
 #include "util/util.h"
@@ -21,7 +22,8 @@ static const char usage[] =
 	"       bvhlab plan --missing DIR [--format lines|slurm|json] [options]\n"
 	"\n"
 	"Splits a sweep into its runs (scene x builder x thread count, ids from 0 in\n"
-	"the order `bvhlab run` takes them) so that other engines can spread them\n"
+	"the order `bvhlab run` takes them; a builder without the parallel flag once\n"
+	"per scene, at 1 thread, as run does) so that other engines can spread them\n"
 	"over machines. Checks every builder's plugin, refine stages and options\n"
 	"(each plugin opened first in a forked probe; an optional builder whose\n"
 	"plugin is missing is kept, as run keeps it) and the thread counts, writes\n"
@@ -125,21 +127,27 @@ static int parse(int argc, char **argv, struct plan_args *a)
  * probe, and applies their options: a plan that cannot run is refused
  * (every reason printed). An optional builder whose plugin is not here is
  * kept, as `run` keeps it: the machines that run the parts may have it.
+ * Then the run list, as `run` makes it from the same builders.
  */
-static int check_builders(const struct config *cfg)
+static int make_list(const struct config *cfg, struct run_list *list)
 {
 	struct harness_builder *builders = NULL;
+	struct plan_builder *pb = calloc(cfg->builder_count + 1, sizeof(*pb));
 	bvhlab_error err = {{0}};
 	size_t bad_configs = 0;
-	int bad = harness_open_builders(cfg, true, &builders, &bad_configs) < 0 ? -1 : 0;
-	for (size_t b = 0; bad == 0 && b < cfg->builder_count; b++)
+	int bad = !pb || harness_open_builders(cfg, true, &builders, &bad_configs) < 0 ? -1 : 0;
+	for (size_t b = 0; bad == 0 && b < cfg->builder_count; b++) {
 		if (!builders[b].skipped && (!builders[b].plugin || !builders[b].opts_ok))
 			bad = -1;
-	harness_close_builders(cfg, builders);
-	if (bad == 0 && plan_check_threads(cfg, &err) < 0) {
+		pb[b] = harness_plan_builder(&builders[b]);
+		pb[b].options_hash = NULL; /* closed with the builders; the parts record it */
+	}
+	if (bad == 0 && plan_list_make(list, cfg, pb, &err) < 0) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		bad = -1;
 	}
+	harness_close_builders(cfg, builders);
+	free(pb);
 	return bad;
 }
 
@@ -306,12 +314,14 @@ static int load_plan(const struct plan_args *a, struct plan_file *plan, char *di
 {
 	struct config cfg = {0};
 	bvhlab_error err = {{0}};
+	struct run_list list = {0};
 	const char *d = a->missing ? a->missing : a->out;
 	char path[PATH_MAX + 16];
 	int r = 0;
 	if (!a->missing && (r = config_load(&cfg, a->config, &err)) == 0 &&
-	    (r = check_builders(&cfg)) == 0)
-		r = plan_file_write(&cfg, d, plan, &err);
+	    (r = make_list(&cfg, &list)) == 0)
+		r = plan_file_write(&list, d, plan, &err);
+	plan_list_finish(&list);
 	config_finish(&cfg);
 	if (r == 0 && !realpath(d, dir)) {
 		error_set(&err, "cannot resolve %s: %s", d, strerror(errno));

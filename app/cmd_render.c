@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "cli.h"
-#include "harness/harness.h"
+#include "harness/harness_rays.h"
 #include "output/image.h"
 
 #define MAX_OPTIONS 64

@@ -45,7 +45,8 @@ static const char usage[] =
 	"  --threads LIST   thread counts, e.g. 1,2,0 (0 = all cores; overrides \"threads\")\n"
 	"  --repeat N       timed builds per run (overrides \"repeat\")\n"
 	"  --only IDS       run just these runs (ids as `bvhlab plan` lists them: the\n"
-	"                   order scenes x builders x thread counts, from 0), e.g. 3,7,10-12\n"
+	"                   order scenes x builders x thread counts, one for a serial\n"
+	"                   builder, from 0), e.g. 3,7,10-12\n"
 	"  --quiet          no progress lines\n"
 	"  -h, --help       this text\n"
 	"\n"
@@ -125,7 +126,7 @@ static int parse(int argc, char **argv, struct run_args *a)
 }
 
 /* Command-line overrides; --out is taken as given (relative to the cwd).
- * Thread counts are resolved here, once, for every later step. */
+ * Thread counts stay as given: the run list resolves them (plan_runs.c). */
 static int apply_overrides(struct config *cfg, const struct run_args *a, bvhlab_error *err)
 {
 	if (a->out) {
@@ -139,7 +140,7 @@ static int apply_overrides(struct config *cfg, const struct run_args *a, bvhlab_
 		return error_set(err, "out of memory"), -1;
 	if (a->repeat)
 		cfg->repeat = (uint32_t)a->repeat;
-	return plan_resolve_threads(cfg, err);
+	return 0;
 }
 
 /* The config, or a plan's (checked, its hash kept for the results). */
@@ -151,22 +152,16 @@ static int load(struct config *cfg, struct plan_file *plan, const struct run_arg
 	return config_load(cfg, a->config, err);
 }
 
-/* --only against the config's runs: an id it does not have is bad input. */
-static int select_runs(const struct config *cfg, struct run_args *a, bool **only,
-                       bvhlab_error *err)
+/* --only goes to the harness, which checks it against its run list. */
+static int select_runs(struct run_args *a, bvhlab_error *err)
 {
-	*only = NULL;
-	if (a->thread_count && (a->only || a->opts.plan_hash)) {
+	if (a->thread_count && (a->only || a->opts.plan)) {
 		/* Thread counts are part of a run's identity: other ones renumber the runs. */
 		error_set(err, "--threads cannot be combined with --only or a plan: it changes the "
 		          "runs and their ids (edit the config and plan again)");
 		return -1;
 	}
-	if (!a->only)
-		return 0;
-	if (plan_parse_only(a->only, plan_run_count(cfg), only, err) < 0)
-		return -1;
-	a->opts.only = *only;
+	a->opts.only = a->only;
 	return 0;
 }
 
@@ -192,13 +187,12 @@ int cmd_run(int argc, char **argv)
 	struct config cfg = {0};
 	struct plan_file plan = {0};
 	bvhlab_error err = {{0}};
-	bool *only = NULL;
 	if (parse(argc, argv, &a) < 0)
 		return EXIT_USAGE;
 	int status = EXIT_USAGE;
 	int r = load(&cfg, &plan, &a, &err);
-	a.opts.plan_hash = r == 0 && plan.doc ? plan.hash : NULL;
-	if (r < 0 || select_runs(&cfg, &a, &only, &err) < 0) {
+	a.opts.plan = r == 0 && plan.doc ? &plan : NULL;
+	if (r < 0 || select_runs(&a, &err) < 0) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
 		goto out;
 	}
@@ -217,7 +211,6 @@ int cmd_run(int argc, char **argv)
 		print_outcome(cfg.output, r, &tally);
 	status = r ? EXIT_RUNS_FAILED : 0;
 out:
-	free(only);
 	plan_file_finish(&plan);
 	config_finish(&cfg);
 	return status;

@@ -29,8 +29,7 @@
 #include <time.h>
 
 #include <bvhlab/bvhlab.h>
-#include <bvhlab/rays.h>
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "util/util.h"
 

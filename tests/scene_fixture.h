@@ -287,11 +287,11 @@ static inline void compare_collapse(const char *name, bvhlab_scene *scene, uint3
 
 /*
  * test(file, scene) on the first `count` shared meshes of files (the first
- * `tsan_count` under TSan, where the rest are too slow), scene NULL for one
+ * `small_count` under a sanitizer, where the rest are too slow), scene NULL for one
  * that does not load. False, and a line saying so, when the shared meshes
  * are not there, so the test can report itself skipped.
  */
-static inline bool for_shared(const char *const *files, size_t count, size_t tsan_count,
+static inline bool for_shared(const char *const *files, size_t count, size_t small_count,
                               void (*test)(const char *file, bvhlab_scene *scene))
 {
 	struct stat st;
@@ -300,7 +300,7 @@ static inline bool for_shared(const char *const *files, size_t count, size_t tsa
 		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
 		return false;
 	}
-	for (size_t i = 0; i < (UNDER_TSAN ? tsan_count : count); i++)
+	for (size_t i = 0; i < (UNDER_SANITIZER ? small_count : count); i++)
 		test(files[i], load_shared(files[i]));
 	return true;
 }

@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "config/config.h"
-#include "harness/harness.h"
+#include "harness/harness_scene.h"
 #include "testutil.h"
 
 #define BUILDERS "\"builders\": [ { \"plugin\": \"sah_seq\" } ]"

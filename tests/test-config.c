@@ -12,11 +12,11 @@
 
 #include <cJSON.h>
 
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "config/config.h"
 #include "config/json_locate.h"
-#include "harness/harness.h"
+#include "harness/harness_rays.h"
 #include "trace/trace_cl.h"
 #include "testutil.h"
 

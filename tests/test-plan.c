@@ -65,17 +65,30 @@ static void test_product(void)
 		bvhlab_options_finish(&opts);
 	}
 	/* 2 scenes x 5 builders x 2 thread counts, ids in run order. */
-	CHECK_INT(plan_run_count(&cfg), 20);
-	struct plan_run *runs;
-	size_t n;
-	CHECK_INT(plan_runs(&cfg, &runs, &n), 0);
-	for (size_t k = 0; k < n; k++) {
-		CHECK_INT(runs[k].id, k);
-		CHECK_INT(plan_run_id(&cfg, runs[k].scene, runs[k].builder, k % 2), k);
-		CHECK_INT(runs[k].threads, k % 2 + 1);
+	struct run_list list;
+	CHECK_INT(plan_list_make(&list, &cfg, NULL, &err), 0);
+	CHECK_INT(list.count, 20);
+	for (size_t k = 0; k < list.count; k++) {
+		const struct plan_run *run = &list.runs[k];
+		CHECK_INT(run->key.id, k);
+		CHECK(plan_list_find(&list, run->scene, run->builder, k % 2) == run);
+		CHECK_INT(run->threads, k % 2 + 1);
+		CHECK_INT(run->key.threads, k % 2 + 1);
+		CHECK(!strcmp(run->key.builder, cfg.builders[run->builder].name));
 	}
-	CHECK(runs[10].scene == 1 && runs[10].builder == 0);
-	free(runs);
+	CHECK(list.runs[10].scene == 1 && list.runs[10].builder == 0);
+	plan_list_finish(&list);
+	/* A serial builder runs once per scene, at its count of 1: the ids
+	 * after it close up, and its 2 has no run. */
+	struct plan_builder pb[5] = {{.serial = true}};
+	CHECK_INT(plan_list_make(&list, &cfg, pb, &err), 0);
+	CHECK_INT(list.count, 18);
+	CHECK(list.runs[0].builder == 0 && list.runs[0].key.threads == 1);
+	CHECK(list.runs[1].builder == 1 && list.runs[1].key.id == 1);
+	CHECK(plan_list_find(&list, 1, 0, 1) == NULL);
+	CHECK(plan_list_first(&list, 1, 0) == &list.runs[9]);
+	CHECK(list.threads[0].serial && list.threads[0].first == 0);
+	plan_list_finish(&list);
 	config_finish(&cfg);
 }
 

@@ -23,7 +23,7 @@
 #include <bvhlab/bvhlab.h>
 
 #include "config/config.h"
-#include "harness/harness.h"
+#include "harness/harness_series.h"
 #include "testutil.h"
 
 #define FIXTURE_SEED 18
@@ -355,7 +355,7 @@ static void test_subtree_moves(void)
 
 	refiner_options = "batch=0.25\0iterations=3\0children=false\0";
 	test_improves();
-	if (!UNDER_TSAN)
+	if (!UNDER_SANITIZER)
 		test_scene("soup", generate("soup", 10000, 0, 0), RAYS);
 	refiner_options = saved;
 }

@@ -9,7 +9,11 @@
  * 3 threads asked for (2 started on the larger trees). The host refuses
  * an update over another triangle count (fewer or more) naming both
  * counts, refit refuses a tree with a cycle, a refit-only plugin builds
- * nothing and a builder has no update.
+ * nothing and a builder has no update. And refit then reinsert every
+ * frame of the exploding horse (configs/animation.json's), as the harness
+ * runs the strategy: every frame's tree valid (reinsert once left frame
+ * 4's with a box smaller than its child's, when it took back a children
+ * move whose place was an ancestor of the moved node).
  */
 #include <errno.h>
 #include <math.h>
@@ -20,6 +24,7 @@
 #include <bvhlab/aabb.h>
 #include <bvhlab/bvhlab.h>
 
+#include "scene/scene_anim.h"
 #include "testutil.h"
 
 static bvhlab_plugin *refit;
@@ -224,6 +229,90 @@ static void test_cycle(void)
 	bvhlab_tree_finish(&t);
 }
 
+/* The horse's explosion in configs/animation.json: its amplitude, frames
+ * and the harness's seed for a scene's first mesh. */
+#define EXPLODE_AMPLITUDE 0.15
+#define EXPLODE_FRAMES 16
+#define EXPLODE_SEED 0xe8910deULL
+/* Frames checked: all of them, or under a sanitizer (ten times slower) up
+ * to frame 5, past the frame 4 that reinsert once left invalid. */
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define EXPLODE_CHECKED 6
+#else
+#define EXPLODE_CHECKED EXPLODE_FRAMES
+#endif
+
+/* Frame f of the exploding horse, its primitives into *prims. */
+static bvhlab_scene *explode_frame(const bvhlab_scene *rest, uint32_t f, bvhlab_prims *prims)
+{
+	struct scene_motion m = {.deform = SCENE_DEFORM_EXPLODE, .amplitude = EXPLODE_AMPLITUDE,
+	                         .seed = EXPLODE_SEED, .scale = 1};
+	bvhlab_scene *s = NULL;
+	bvhlab_error err = {{0}};
+	bvhlab_transform_init(&m.rest);
+	CHECK_INT(scene_anim_pose(rest, &m, (double)f / (EXPLODE_FRAMES - 1), &s, &err), 0);
+	if (s)
+		CHECK_INT(bvhlab_prims_init(prims, s, &err), 0);
+	return s;
+}
+
+/* lbvh's tree of frame 0, then per frame refit and reinsert (2 threads),
+ * validated every frame and traced against brute force on the last one
+ * checked. */
+static void explode_frames(const bvhlab_scene *rest, bvhlab_plugin *lbvh, bvhlab_plugin *reinsert)
+{
+	bvhlab_options lo, ro;
+	bvhlab_tree t = {0};
+	bvhlab_error err = {{0}};
+	CHECK_INT(bvhlab_options_init(&lo, bvhlab_plugin_builder(lbvh)), 0);
+	CHECK_INT(bvhlab_options_init(&ro, bvhlab_plugin_builder(reinsert)), 0);
+	for (uint32_t f = 0; f < EXPLODE_CHECKED; f++) {
+		bvhlab_prims prims = {0};
+		bvhlab_scene *s = explode_frame(rest, f, &prims);
+		int r = !s ? -1
+		        : f == 0 ? bvhlab_build(lbvh, &lo, &prims.input, 2, &t, &err)
+		                 : update(&prims.input, 2, &t, &err);
+		CHECK_INT(r, 0);
+		if (r == 0 && f > 0)
+			CHECK_INT(r = bvhlab_refine(reinsert, &ro, &prims.input, 2, &t, &err), 0);
+		if (r == 0 && (r = bvhlab_validate_tree(&t, &prims.input, false, &err)) < 0)
+			fprintf(stderr, "frame %u: %s\n", f, err.message);
+		CHECK_INT(r, 0);
+		if (r == 0 && f == EXPLODE_CHECKED - 1) {
+			uint64_t mismatches = 1;
+			CHECK_INT(bvhlab_validate_rays(&t, s, 64, 33, &mismatches, &err), 0);
+			CHECK_INT(mismatches, 0);
+		}
+		bvhlab_prims_finish(&prims);
+		bvhlab_scene_destroy(s);
+		if (r < 0)
+			break;
+	}
+	bvhlab_tree_finish(&t);
+	bvhlab_options_finish(&lo);
+	bvhlab_options_finish(&ro);
+}
+
+static void test_explode_reinsert(void)
+{
+	bvhlab_scene *mesh = NULL, *rest = NULL;
+	bvhlab_plugin *lbvh = NULL, *reinsert = NULL;
+	bvhlab_error err = {{0}};
+	if (bvhlab_scene_load(BVHLAB_SHARED_SCENES "/horse.ply", &mesh, &err) < 0) {
+		printf("no %s/horse.ply: the exploding horse skipped\n", BVHLAB_SHARED_SCENES);
+		return;
+	}
+	CHECK_INT(scene_anim_unshare(mesh, &rest, &err), 0);
+	CHECK_INT(bvhlab_plugin_open("lbvh", &lbvh, &err), 0);
+	CHECK_INT(bvhlab_plugin_open("reinsert", &reinsert, &err), 0);
+	if (rest && lbvh && reinsert)
+		explode_frames(rest, lbvh, reinsert);
+	bvhlab_plugin_close(reinsert);
+	bvhlab_plugin_close(lbvh);
+	bvhlab_scene_destroy(rest);
+	bvhlab_scene_destroy(mesh);
+}
+
 int main(void)
 {
 	bvhlab_gen_params gp;
@@ -246,6 +335,7 @@ int main(void)
 	check_scene("lbvh", "terrain", &gp, false);
 	test_counts();
 	test_cycle();
+	test_explode_reinsert();
 	bvhlab_plugin_close(refit);
 	return test_finish();
 }

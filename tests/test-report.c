@@ -3,7 +3,9 @@
  * with every figure computed by hand: the Pareto front and who dominates
  * whom, the break-even ray counts, the reference's fallback when the one
  * asked for did not run, the noise and load marks, no empty tables, no
- * speedup for a builder that ran on 1 thread only, and build_phases.
+ * speedup for a builder that ran on 1 thread only, and build_phases; a
+ * merged sweep's machines never compared with each other, and heat maps
+ * drawn on different scales each stated with its own.
  */
 #include <math.h>
 
@@ -232,6 +234,89 @@ static void test_nothing_ok(void)
 	cJSON_Delete(doc);
 }
 
+/* The last run added was measured on the machine named host. */
+static void on_machine(cJSON *runs, const char *host)
+{
+	char text[160];
+	snprintf(text, sizeof(text), "{\"hostname\": \"%s\", \"cpu\": \"cpu-%s\", "
+	         "\"cores\": 2}", host, host);
+	cJSON_AddItemToObject(cJSON_GetArrayItem(runs, cJSON_GetArraySize(runs) - 1), "machine",
+	                      cJSON_Parse(text));
+}
+
+/* A merged sweep from two machines: the reference ran on a only, par on 1
+ * thread on a and on 2 on b, fast on b only. Every comparison that
+ * crosses machines would compare the machines: none is made. */
+static cJSON *merged_document(void)
+{
+	cJSON *doc = cJSON_Parse("{\"machine\": {\"hostname\": \"a\", \"cpu\": \"cpu-a\", "
+	                         "\"cores\": 2}, \"config\": {\"report\": {\"reference\": "
+	                         "\"ref\"}}, \"scenes\": [{\"name\": \"s\", \"triangles\": 100}], "
+	                         "\"runs\": []}");
+	cJSON *runs = cJSON_GetObjectItem(doc, "runs");
+	add_run(runs, "ref", "sah_seq", 1, (double[]){10, 10, 10}, 50, 10, 10, 5);
+	on_machine(runs, "a");
+	add_run(runs, "par", "sah_queue", 1, (double[]){20, 20, 20}, 45, 9, 12, 6);
+	on_machine(runs, "a");
+	add_run(runs, "par", "sah_queue", 2, (double[]){4, 4, 4}, 45, 9, 12, 6);
+	on_machine(runs, "b");
+	add_run(runs, "fast", "lbvh", 1, (double[]){2, 2, 2}, 50, 10, 10, 5);
+	on_machine(runs, "b");
+	return doc;
+}
+
+static void test_merged_machines(void)
+{
+	cJSON *doc = merged_document();
+	char *md = report_markdown(doc), *html = report_html(doc);
+	/* No speedup of b's 2-thread par over a's 1-thread one (20 / 4). */
+	CHECK_CONTAINS(md, "| par | 2 | ok | 4.00 | 4.00 | 4.00 |  |  |  |");
+	/* Summary: a row per machine, fast (b) has no reference on b. */
+	CHECK_CONTAINS(md, "| builder | threads | machine | scenes |");
+	CHECK_CONTAINS(md, "| par | 1 | M1 | 1 | 2.00× | 0.90× |");
+	CHECK_CONTAINS(md, "| fast | 1 | M2 | 0 | n/a | n/a | n/a | n/a | n/a | — |");
+	CHECK(!strstr(md, "0.20×") && !strstr(md, "0.40×"));
+	/* Pareto: fast on b does not dominate ref on a. */
+	CHECK_CONTAINS(md, "| ref | 1 on M1 | 10.0 | 50.000 | front |");
+	CHECK_CONTAINS(md, "| fast | 1 on M2 | 2.00 | 50.000 | front |");
+	CHECK(!strstr(md, "dominated by fast"));
+	/* Break-even and the thesis table: said, not computed. */
+	CHECK_CONTAINS(md, "| fast | 1 | 2.00 | — | not compared: the reference ran on another "
+	                   "machine |");
+	CHECK_CONTAINS(md, "| s (M1) | 10.00 | — | — | — |");
+	CHECK_CONTAINS(md, "| s (M2) | — | 4.00 | — | — |");
+	CHECK(!strstr(md, "2.50"));
+	CHECK_CONTAINS(html, "<td>M2</td>");
+	CHECK_CONTAINS(html, "not compared: the reference ran on another machine");
+	CHECK_CONTAINS(html, "SAH cost vs. build time, 1 thread on M2");
+	CHECK(!strstr(html, "dominated by fast") && !strstr(html, "Speedup over 1 thread"));
+	free(md);
+	free(html);
+	cJSON_Delete(doc);
+}
+
+/* A merged scene whose parts drew heat maps on 0-35 and 0-45: each map
+ * is stated with its own scale, never one for all. */
+static void test_heat_scales(void)
+{
+	cJSON *doc = cJSON_Parse(
+		"{\"scenes\": [{\"name\": \"s\", \"images\": {\"shaded\": \"images/s.png\", "
+		"\"heat_scale\": \"log\", \"heat_scales_differ\": true}}], \"runs\": ["
+		"{\"scene\": \"s\", \"builder\": \"a\", \"threads\": 1, \"status\": \"ok\", "
+		"\"heat_image\": \"images/s--a.png\", \"heat_scale\": {\"min\": 0, \"max\": 35}}, "
+		"{\"scene\": \"s\", \"builder\": \"b\", \"threads\": 1, \"status\": \"ok\", "
+		"\"heat_image\": \"images/s--b.png\", \"heat_scale\": {\"min\": 0, \"max\": 45}}]}");
+	char *md = report_markdown(doc), *html = report_html(doc);
+	CHECK_CONTAINS(md, "drawn on different scales, each its own: a x1 0 to 35, b x1 0 to 45.");
+	CHECK_CONTAINS(html, "<figcaption>a x1, 0–35</figcaption>");
+	CHECK_CONTAINS(html, "<figcaption>b x1, 0–45</figcaption>");
+	CHECK_CONTAINS(html, "the maps were drawn on different scales");
+	CHECK(!strstr(html, "one log scale for every builder"));
+	free(md);
+	free(html);
+	cJSON_Delete(doc);
+}
+
 int main(void)
 {
 	test_front_points();
@@ -240,5 +325,7 @@ int main(void)
 	test_reference_kept();
 	test_html();
 	test_nothing_ok();
+	test_merged_machines();
+	test_heat_scales();
 	return test_finish();
 }

@@ -151,7 +151,7 @@ static void check_variant(const struct variant *v, const char *scene, const bvhl
 
 static void test_scene(const char *name, bvhlab_scene *scene, bool generated)
 {
-	const struct plan *plan = generated ? &full_plan : UNDER_TSAN ? &tsan_mesh_plan
+	const struct plan *plan = generated ? &full_plan : UNDER_SANITIZER ? &tsan_mesh_plan
 	                                                              : &mesh_plan;
 	bvhlab_prims prims;
 	bvhlab_error err = { { 0 } };

@@ -12,8 +12,7 @@
 #include <sys/stat.h>
 
 #include <bvhlab/bvhlab.h>
-#include <bvhlab/rays.h>
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "testutil.h"
 #include "trace/trace_series.h"

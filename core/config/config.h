@@ -18,7 +18,6 @@
 #include <bvhlab/host.h>
 #include <bvhlab/trace.h>
 #include <bvhlab/scene.h>
-#include <bvhlab/traversal.h>
 
 struct cJSON;
 struct json_locations;

@@ -1,6 +1,7 @@
 /*
- * The experiment harness. Scenes are the outer loop so only one scene is in
- * memory at a time; plugins are opened once. Whatever fails (a scene, a
+ * The experiment harness: it walks the run list (plan/plan.h), whose
+ * scenes are the outer loop so only one scene is in memory at a time;
+ * plugins are opened once. Whatever fails (a scene, a
  * plugin, a build, a tree) is recorded as a run with its status and message,
  * and the sweep goes on.
  */
@@ -10,31 +11,30 @@
 #include <string.h>
 #include <unistd.h>
 
-#include <bvhlab/epo.h>
-
 #include "harness/harness.h"
 #include "harness/harness_builders.h"
 #include "harness/harness_frames.h"
+#include "harness/harness_measure.h"
+#include "harness/harness_memory.h"
+#include "harness/harness_rays.h"
 #include "harness/harness_resume.h"
 #include "harness/harness_rounds.h"
+#include "harness/harness_scene.h"
+#include "harness/harness_series.h"
+#include "harness/harness_threads.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
 #include "machine/machine.h"
 #include "output/results.h"
-#include "output/scene_images.h"
+#include "output/images.h"
 #include "output/safe_file.h"
 #include "plan/plan.h"
 #include "util/util.h"
 
-#define RAY_SEED 0x5eedULL
-/* EPO points: a relative standard error of a few per mille on the scenes
- * tried, in tens of milliseconds. Fixed seed: reruns give the same value. */
-#define EPO_SAMPLES 16384
-#define EPO_SEED 0xe90ULL
-
 struct harness {
 	const struct config *cfg;
-	const bool *only; /* [run id]: the runs to do; NULL: all */
+	struct run_list list; /* every run of the sweep, made once */
+	bool *only; /* [run id]: the runs to do; NULL: all */
 	struct results res;
 	struct harness_builder *builders;
 	struct progress progress;
@@ -56,11 +56,8 @@ struct series_report {
 	uint32_t status;       /* enum series_status */
 	uint32_t sample_count; /* repeat, or 0 when the builds failed */
 	double cold_ms;        /* the first build */
-	bool has_stats, validated, valid;
-	uint64_t rays_checked, mismatches;
-	bvhlab_tree_stats stats;
-	bool has_epo;
-	double epo;
+	bool validated;
+	struct tree_measure tree;
 	struct build_memory memory;
 	struct ray_metrics rays;
 	bool heat_written, shade_written;
@@ -80,16 +77,11 @@ struct series_job {
 	const bvhlab_scene *scene;
 	const bvhlab_prims *prims;
 	const struct harness_builder *hb;
-	uint32_t threads;
+	const struct plan_run *run;
 	const char *heat_path;  /* where the child leaves nodes per pixel, or NULL */
 	const char *shade_path; /* where it leaves the shaded render, or NULL */
 	const char *tree_path;  /* where it leaves its tree for the rounds, or NULL */
 };
-
-static uint32_t resolve_threads(uint32_t t)
-{
-	return t ? t : bvhlab_hardware_threads();
-}
 
 /* Records a run and rewrites the files, so nothing finished is ever lost. */
 static void record(struct harness *h, struct run_record *run)
@@ -110,70 +102,56 @@ static void record(struct harness *h, struct run_record *run)
 	}
 }
 
-static const uint32_t *builder_threads(const struct harness *h, const struct config_builder *b,
-                                       size_t *count)
+/* A run of the list this sweep makes: named by --only (or all of them), of
+ * a builder that is not skipped (optional, its plugin missing). */
+static bool wanted(const struct harness *h, const struct plan_run *run)
 {
-	const uint32_t *threads = plan_builder_threads(h->cfg, b, count);
-	if (h->builders && h->builders[b - h->cfg->builders].skipped)
-		*count = 0;
-	return threads;
+	return (!h->only || h->only[run->key.id]) && !h->builders[run->builder].skipped;
 }
 
-/* The runs a builder gets: harness_threads.c (one for a serial builder). */
-static bool applicable(const struct harness *h, const struct harness_builder *hb, size_t t)
+/* A run not wanted, or kept from the results resumed (counted as done). */
+static bool skip_run(struct harness *h, const struct plan_run *run)
 {
-	size_t n;
-	const uint32_t *threads = builder_threads(h, hb->cb, &n);
-	return harness_thread_applies(hb, threads, n, t, h->only != NULL);
-}
-
-/* A run left out by --only, or kept from the results resumed (counted as done). */
-static bool skip_run(struct harness *h, uint32_t id, const char *scene, const char *builder,
-                     uint32_t threads)
-{
-	if (h->only && !h->only[id])
+	if (!wanted(h, run))
 		return true;
-	if (!results_has_run(&h->res, scene, builder, threads))
+	if (!results_has_run(&h->res, &run->key))
 		return false;
 	h->progress.index++;
 	return true;
 }
 
-/* Every run of a builder fails the same way (plugin or scene unusable). */
-static void record_all_failed(struct harness *h, size_t scene_index, const char *scene,
-                              struct harness_builder *hb, const char *status, const char *error)
+/* A run's record as far as its identity and builder tell. */
+static struct run_record run_record_of(const struct plan_run *run,
+                                       const struct harness_builder *hb)
 {
-	size_t n, b = (size_t)(hb - h->builders);
-	const uint32_t *threads = builder_threads(h, hb->cb, &n);
-	for (size_t k = 0; k < n; k++) {
-		if (!applicable(h, hb, k))
-			continue;
-		struct run_record run = {.id = plan_run_id(h->cfg, scene_index, b, k),
-		                         .scene = scene, .builder = hb->cb->name,
-		                         .plugin = hb->cb->plugin, .threads = resolve_threads(threads[k]),
-		                         .opts = hb->opts_ok ? &hb->opts : NULL,
-		                         .options_hash = hb->opts_ok ? hb->options_hash : NULL,
-		                         .status = status, .error = error};
-		if (!skip_run(h, run.id, run.scene, run.builder, run.threads))
-			record(h, &run);
-	}
+	return (struct run_record){.id = run->key.id, .scene = run->key.scene,
+	                           .builder = run->key.builder, .plugin = hb->cb->plugin,
+	                           .threads = run->key.threads,
+	                           .opts = hb->opts_ok ? &hb->opts : NULL,
+	                           .options_hash = hb->opts_ok ? hb->options_hash : NULL};
+}
+
+/* A run that fails before it starts (its plugin or scene unusable). */
+static void record_failed(struct harness *h, const struct plan_run *run, const char *status,
+                          const char *error)
+{
+	struct run_record rec = run_record_of(run, &h->builders[run->builder]);
+	rec.status = status;
+	rec.error = error;
+	if (!skip_run(h, run))
+		record(h, &rec);
 }
 
 /* Resumed runs already hold every run of the scene: no need to load it. */
-static bool scene_done(struct harness *h, const struct config_scene *cs, size_t scene_index)
+static bool scene_done(struct harness *h, size_t s)
 {
 	uint32_t done = 0, total = 0;
-	for (size_t b = 0; b < h->cfg->builder_count; b++) {
-		size_t n;
-		const uint32_t *threads = builder_threads(h, &h->cfg->builders[b], &n);
-		for (size_t t = 0; t < n; t++) {
-			if ((h->only && !h->only[plan_run_id(h->cfg, scene_index, b, t)]) ||
-			    !applicable(h, &h->builders[b], t))
-				continue;
-			total++;
-			done += results_has_run(&h->res, cs->name, h->cfg->builders[b].name,
-			                        resolve_threads(threads[t]));
-		}
+	for (size_t k = h->list.scene_first[s]; k < h->list.scene_first[s + 1]; k++) {
+		const struct plan_run *run = &h->list.runs[k];
+		if (!wanted(h, run))
+			continue;
+		total++;
+		done += results_has_run(&h->res, &run->key);
 	}
 	if (done < total)
 		return false;
@@ -188,33 +166,17 @@ static bool spatial_splits(const struct series_job *job)
 	return bvhlab_plugin_builder(job->hb->plugin)->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
 }
 
-/*
- * Structure is always checked: the metrics are meaningless (and a cyclic tree
- * unsafe to walk) otherwise. The brute-force ray check is what "validate"
- * switches, since it is the expensive part.
- */
-static void validate(const struct series_job *job, const bvhlab_tree *tree,
-                     struct series_report *rep, bvhlab_error *err)
+/* Validation, statistics and EPO (harness_measure.c), into the report. */
+static void measure(const struct series_job *job, const bvhlab_tree *tree,
+                    struct series_report *rep, bvhlab_error *err)
 {
 	const struct config *cfg = job->h->cfg;
+	static const uint32_t status[] = {SERIES_OK, SERIES_INVALID, SERIES_FAILED};
 	rep->validated = true;
-	rep->valid = bvhlab_validate_tree(tree, &job->prims->input, spatial_splits(job), err) == 0;
-	if (!rep->valid) {
-		rep->status = SERIES_INVALID;
-		return;
-	}
-	if (!cfg->validate)
-		return;
-	rep->rays_checked = cfg->validate_rays;
-	if (bvhlab_validate_rays(tree, job->scene, cfg->validate_rays, RAY_SEED, &rep->mismatches,
-	                         err) < 0) {
-		rep->status = SERIES_FAILED;
-	} else if (rep->mismatches) {
-		rep->valid = false;
-		rep->status = SERIES_INVALID;
-		error_set(err, "%llu of %llu sampled rays disagree with brute force",
-		          (unsigned long long)rep->mismatches, (unsigned long long)rep->rays_checked);
-	}
+	rep->status = status[harness_measure_tree(tree, job->scene, &job->prims->input,
+	                                          spatial_splits(job),
+	                                          cfg->validate ? cfg->validate_rays : 0,
+	                                          &rep->tree, err)];
 }
 
 /* Per-pixel buffers of the images this run draws; NULL when it draws none. */
@@ -272,7 +234,7 @@ static void series_work(void *arg, void *report, size_t size)
 	struct series_report *rep = report;
 	const struct config *cfg = job->h->cfg;
 	struct build_series s = {.warmup = cfg->warmup, .repeat = cfg->repeat,
-	                         .threads = job->threads, .samples_ms = rep->samples,
+	                         .threads = job->run->key.threads, .samples_ms = rep->samples,
 	                         .stages = job->hb->refine,
 	                         .stage_count = (uint32_t)job->hb->cb->refine_count,
 	                         .stage_out = rep->stages};
@@ -290,17 +252,11 @@ static void series_work(void *arg, void *report, size_t size)
 		rep->stage_count = s.stage_count;
 		rep->phase_count = s.phase_count;
 		memcpy(rep->phases, s.phases, sizeof(rep->phases));
-		validate(job, &s.tree, rep, &err);
-		rep->has_stats = rep->valid || (rep->mismatches && rep->rays_checked);
-		if (rep->has_stats)
-			bvhlab_tree_stats_compute(&s.tree, &rep->stats);
-		if (rep->status == SERIES_OK)
-			rep->has_epo = bvhlab_tree_epo(&s.tree, job->scene, EPO_SAMPLES, EPO_SEED,
-			                               &rep->epo) == 0;
+		measure(job, &s.tree, rep, &err);
 		if (rep->status == SERIES_OK)
 			trace_rays(job, &s.tree, rep);
 		int f = rep->status != SERIES_OK ? 0 : harness_frames_after_series(cfg, job->hb,
-			&job->h->anim, job->scene, job->threads, rep->samples, s.repeat, &s.tree,
+			&job->h->anim, job->scene, job->run->key.threads, rep->samples, s.repeat, &s.tree,
 			&rep->frame_count, &err); /* an animated scene's frames: harness_frames.c */
 		rep->status = f > 0 ? SERIES_INVALID : f < 0 ? SERIES_FAILED : rep->status;
 	}
@@ -327,13 +283,13 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, uint32_t f
 	run->samples_ms = rep->samples;
 	run->sample_count = rep->sample_count;
 	run->cold_ms = rep->cold_ms;
-	run->stats = rep->has_stats ? &rep->stats : NULL;
-	run->epo = rep->has_epo ? &rep->epo : NULL;
+	run->stats = rep->tree.has_stats ? &rep->tree.stats : NULL;
+	run->epo = rep->tree.has_epo ? &rep->tree.epo : NULL;
 	run->memory = rep->memory.measured ? &rep->memory : NULL;
 	run->validated = rep->validated;
-	run->valid = rep->valid;
-	run->rays_checked = rep->rays_checked;
-	run->mismatches = rep->mismatches;
+	run->valid = rep->tree.valid;
+	run->rays_checked = rep->tree.rays_checked;
+	run->mismatches = rep->tree.mismatches;
 	rep->rays.error[sizeof(rep->rays.error) - 1] = '\0';
 	rep->rays.device[sizeof(rep->rays.device) - 1] = '\0';
 	run->rays = rep->rays.measured || rep->rays.error[0] ? &rep->rays : NULL;
@@ -410,24 +366,21 @@ static void queue_tree(struct harness *h, const struct series_job *job,
 	if (!job->tree_path)
 		return;
 	if (!rep->tree_written || strcmp(run->status, "ok") != 0 || !run->rays ||
-	    harness_rounds_add(&h->rounds, job->tree_path, run->builder, run->threads,
-	                       spatial_splits(job), &rep->rays) < 0)
+	    harness_rounds_add(&h->rounds, job->tree_path, &job->run->key, spatial_splits(job),
+	                       &rep->rays) < 0)
 		unlink(job->tree_path);
 }
 
-static void run_one(struct harness *h, struct series_job *job, size_t scene_index,
-                    size_t builder_index, size_t thread_index)
+static void run_one(struct harness *h, struct series_job *job)
 {
-	const bvhlab_builder *desc = bvhlab_plugin_builder(job->hb->plugin);
-	bool first = thread_index == 0;
-	struct run_record run = {.id = plan_run_id(h->cfg, scene_index, builder_index, thread_index),
-	                         .scene = job->scene->name, .builder = job->hb->cb->name,
-	                         .plugin = desc->name, .threads = resolve_threads(job->threads),
-	                         .opts = &job->hb->opts, .options_hash = job->hb->options_hash,
-	                         .status = "failed",
-	                         .triangles = job->scene->triangle_count};
+	const struct plan_run *pr = job->run;
+	bool first = pr == plan_list_first(&h->list, pr->scene, pr->builder);
+	struct run_record run = run_record_of(pr, job->hb);
 	char paths[2][4096], tree_path[4096];
-	if (skip_run(h, run.id, run.scene, run.builder, run.threads))
+	run.plugin = bvhlab_plugin_builder(job->hb->plugin)->name;
+	run.status = "failed";
+	run.triangles = job->scene->triangle_count;
+	if (skip_run(h, pr))
 		return;
 	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double) +
 	              harness_frames_size(&h->anim);
@@ -437,9 +390,9 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 		record(h, &run);
 		return;
 	}
-	image_paths(h, job, scene_index, builder_index, first, paths);
+	image_paths(h, job, pr->scene, pr->builder, first, paths);
 	if (h->rounds_on && harness_rounds_path(tree_path, sizeof(tree_path), h->cfg->output,
-	                                        scene_index, run.id) == 0)
+	                                        pr->scene, run.id) == 0)
 		job->tree_path = tree_path;
 	progress_start(&h->progress, &run);
 	run_series(h, job, &run, rep, size);
@@ -448,46 +401,34 @@ static void run_one(struct harness *h, struct series_job *job, size_t scene_inde
 	free(rep);
 }
 
-/* Every builder's runs on one loaded scene. */
-static void run_builders(struct harness *h, const bvhlab_scene *scene,
-                         const bvhlab_prims *prims, size_t scene_index)
+/* The scene's runs of the list, on the loaded scene. */
+static void run_list_scene(struct harness *h, const bvhlab_scene *scene,
+                           const bvhlab_prims *prims, size_t s)
 {
-	for (size_t b = 0; b < h->cfg->builder_count; b++) {
-		struct harness_builder *hb = &h->builders[b];
-		if (!hb->plugin || !hb->opts_ok) {
-			record_all_failed(h, scene_index, scene->name, hb, hb->status, hb->error.message);
-			continue;
-		}
-		size_t n;
-		const uint32_t *threads = builder_threads(h, hb->cb, &n);
-		for (size_t t = 0; t < n; t++) {
-			if (!applicable(h, hb, t))
-				continue;
-			struct series_job job = {.h = h, .scene = scene, .prims = prims, .hb = hb,
-			                         .threads = threads[t]};
-			run_one(h, &job, scene_index, b, t);
-		}
+	for (size_t k = h->list.scene_first[s]; k < h->list.scene_first[s + 1]; k++) {
+		const struct plan_run *run = &h->list.runs[k];
+		struct harness_builder *hb = &h->builders[run->builder];
+		struct series_job job = {.h = h, .scene = scene, .prims = prims, .hb = hb,
+		                         .run = run};
+		if (!hb->plugin || !hb->opts_ok)
+			record_failed(h, run, hb->status, hb->error.message);
+		else
+			run_one(h, &job);
 	}
 }
 
 /* Turns the children's raw files into the scene's PNGs. */
-static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t scene_index)
+static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t s)
 {
 	size_t nb = h->cfg->builder_count;
-	const char **names = calloc(nb ? nb : 1, sizeof(*names));
-	uint32_t *threads = calloc(nb ? nb : 1, sizeof(*threads));
+	const struct run_identity **heat_runs = calloc(nb ? nb : 1, sizeof(*heat_runs));
 	bvhlab_error err = {{0}};
-	int r = names && threads ? 0 : -ENOMEM;
-	for (size_t b = 0; r == 0 && b < nb; b++) {
-		size_t n;
-		names[b] = h->cfg->builders[b].name;
-		const uint32_t *list = builder_threads(h, &h->cfg->builders[b], &n);
-		threads[b] = resolve_threads(list[harness_first_run(&h->builders[b], list, n)]);
-	}
-	struct scene_images si = {.dir = h->cfg->output, .scene_index = scene_index,
-	                          .scene = scene->name, .width = h->cfg->ray_width,
-	                          .height = h->cfg->ray_height, .builders = names,
-	                          .threads = threads, .builder_count = nb};
+	int r = heat_runs ? 0 : -ENOMEM;
+	for (size_t b = 0; r == 0 && b < nb; b++)
+		heat_runs[b] = &plan_list_first(&h->list, s, b)->key;
+	struct scene_images si = {.dir = h->cfg->output, .scene_index = s, .scene = scene->name,
+	                          .width = h->cfg->ray_width, .height = h->cfg->ray_height,
+	                          .heat_runs = heat_runs, .builder_count = nb};
 	if (r == 0)
 		r = images_write_scene(&h->res, &si, &err);
 	if (r == 0)
@@ -495,16 +436,15 @@ static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t sc
 	if (r < 0)
 		fprintf(stderr, "%sbvhlab: images of scene '%s': %s\n", h->progress.tty ? "\n" : "",
 		        scene->name, err.message[0] ? err.message : strerror(-r));
-	free(names);
-	free(threads);
+	free(heat_runs);
 }
 
-static void run_scene(struct harness *h, const struct config_scene *cs, size_t scene_index)
+static void run_scene(struct harness *h, const struct config_scene *cs, size_t s)
 {
 	bvhlab_scene *scene = NULL;
 	bvhlab_prims prims = {0};
 	bvhlab_error err = {{0}};
-	if (scene_done(h, cs, scene_index))
+	if (scene_done(h, s))
 		return;
 	int r = h->cfg->isolate ? harness_probe_scene(h->cfg, cs, &err) : 0;
 	if (r == 0) /* an animated scene's frame 0 (harness_anim.c) */
@@ -514,8 +454,8 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (r < 0) {
 		results_add_scene(&h->res, cs->name, cs->path ? cs->path : cs->generator, 0,
 		                  err.message);
-		for (size_t b = 0; b < h->cfg->builder_count; b++)
-			record_all_failed(h, scene_index, cs->name, &h->builders[b], "failed", err.message);
+		for (size_t k = h->list.scene_first[s]; k < h->list.scene_first[s + 1]; k++)
+			record_failed(h, &h->list.runs[k], "failed", err.message);
 		goto out;
 	}
 	char *shown = cs->path ? util_path_shown(h->cfg->dir, cs->path) : NULL;
@@ -524,11 +464,11 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	free(shown);
 	h->shade_done = false;
 	h->rounds_on = harness_rounds_start(h->cfg, scene, h->progress.tty);
-	run_builders(h, scene, &prims, scene_index);
+	run_list_scene(h, scene, &prims, s);
 	harness_rounds_end(&h->rounds, &h->res, h->cfg, scene, &prims, h->progress.tty);
 	h->rounds_on = false;
 	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)
-		scene_images(h, scene, scene_index);
+		scene_images(h, scene, s);
 out:
 	harness_anim_close(&h->anim);
 	bvhlab_prims_finish(&prims);
@@ -537,29 +477,28 @@ out:
 
 static uint32_t count_runs(const struct harness *h)
 {
-	size_t chosen = 0, n;
-	for (size_t s = 0; s < h->cfg->scene_count; s++) {
-		for (size_t b = 0; b < h->cfg->builder_count; b++) {
-			builder_threads(h, &h->cfg->builders[b], &n);
-			for (size_t t = 0; t < n; t++)
-				chosen += (!h->only || h->only[plan_run_id(h->cfg, s, b, t)]) &&
-				          applicable(h, &h->builders[b], t);
-		}
-	}
-	return (uint32_t)chosen;
+	uint32_t chosen = 0;
+	for (size_t k = 0; k < h->list.count; k++)
+		chosen += wanted(h, &h->list.runs[k]);
+	return chosen;
 }
 
-
-/* Which thread counts of each builder do not apply, noted in the document. */
-static int note_not_applicable(struct harness *h, bool quiet, bvhlab_error *err)
+/* The run list of the opened builders (a plan's must be the same), and
+ * the runs --only names in it. */
+static int make_list(struct harness *h, const struct harness_options *opts, bvhlab_error *err)
 {
-	int r = 0;
-	for (size_t b = 0; r == 0 && !h->only && b < h->cfg->builder_count; b++) {
-		size_t n;
-		const uint32_t *threads = builder_threads(h, h->builders[b].cb, &n);
-		if ((r = harness_note_not_applicable(&h->builders[b], threads, n, &h->res, quiet)) < 0)
-			error_set(err, "out of memory");
-	}
+	const struct config *cfg = h->cfg;
+	struct plan_builder *pb = calloc(cfg->builder_count + 1, sizeof(*pb));
+	if (!pb)
+		return error_set(err, "out of memory"), -ENOMEM;
+	for (size_t b = 0; b < cfg->builder_count; b++)
+		pb[b] = harness_plan_builder(&h->builders[b]);
+	int r = plan_list_make(&h->list, cfg, pb, err);
+	free(pb);
+	if (r == 0 && opts->plan)
+		r = plan_check_list(opts->plan, &h->list, err);
+	if (r == 0 && opts->only)
+		r = plan_parse_only(opts->only, h->list.count, &h->only, err);
 	return r;
 }
 
@@ -574,15 +513,15 @@ static int start(struct harness *h, const struct harness_options *opts, bvhlab_e
 	r = results_lock(&h->res, err);
 	if (r == 0 && !opts->resume)
 		r = safe_claim_output(h->res.dir, opts->force, err);
-	if (r == 0 && opts->plan_hash)
-		r = results_set_plan(&h->res, opts->plan_hash, plan_run_count(cfg), err);
+	if (r == 0 && opts->plan)
+		r = results_set_plan(&h->res, opts->plan->hash, h->list.count, err);
 	if (r == 0 && opts->resume)
-		r = harness_resume(&h->res, cfg, h->progress.quiet, &h->all_ok, err);
+		r = harness_resume(&h->res, &h->list, h->progress.quiet, &h->all_ok, err);
 	if (r == 0 && opts->resume)
 		r = harness_forget_stale(&h->res, cfg, h->builders, opts->retry_failed,
 		                         h->progress.quiet, &h->all_ok, err);
 	if (r == 0)
-		r = note_not_applicable(h, opts->quiet, err);
+		r = harness_note_not_applicable(&h->list, &h->res, opts->quiet, err);
 	if (r == 0)
 		r = results_write(&h->res, err);
 	if (r == 0)
@@ -593,11 +532,13 @@ static int start(struct harness *h, const struct harness_options *opts, bvhlab_e
 int harness_run(const struct config *cfg, const struct harness_options *opts,
                 bvhlab_error *err)
 {
-	struct harness h = {.cfg = cfg, .only = opts->only, .all_ok = true};
+	struct harness h = {.cfg = cfg, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
 	bvhlab_set_pinning(cfg->pin);
 	/* Every builder's plugin and options first, before the folder is touched. */
 	int r = harness_open_sweep_builders(cfg, &h.builders, err);
+	if (r == 0)
+		r = make_list(&h, opts, err);
 	if (r == 0)
 		r = start(&h, opts, err);
 	h.progress.total = r == 0 ? count_runs(&h) : 0;
@@ -608,6 +549,8 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 		*opts->tally = h.tally;
 	harness_rounds_finish(&h.rounds);
 	results_finish(&h.res);
+	plan_list_finish(&h.list);
+	free(h.only);
 	harness_close_builders(cfg, h.builders);
 	return r < 0 ? r : h.all_ok ? 0 : 1;
 }

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/harness.h"
+#include "harness/harness_scene.h"
 #include "harness/harness_anim.h"
 #include "util/util.h"
 

@@ -70,21 +70,4 @@ int harness_open_sweep_builders(const struct config *cfg, struct harness_builder
                                 bvhlab_error *err);
 void harness_close_builders(const struct config *cfg, struct harness_builder *builders);
 
-/*
- * Runs of a builder without the PARALLEL flag (harness_threads.c): it
- * ignores its thread count, so it runs once per scene, at the first of its
- * thread counts `threads[n]` that resolves to 1 (else its first); the
- * others are not applicable. A builder whose plugin did not load keeps all
- * its runs (to record them), and so do runs picked by id (`by_id`: a plan
- * lists every run of its config).
- */
-size_t harness_first_run(const struct harness_builder *hb, const uint32_t *threads, size_t n);
-bool harness_thread_applies(const struct harness_builder *hb, const uint32_t *threads,
-                            size_t n, size_t t, bool by_id);
-/* Says which thread counts are not applicable to hb, on stderr (unless
- * quiet) and in results.json's "not_applicable". 0, or -ENOMEM. */
-struct results;
-int harness_note_not_applicable(const struct harness_builder *hb, const uint32_t *threads,
-                                size_t n, struct results *res, bool quiet);
-
 #endif

@@ -10,8 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/harness.h"
 #include "harness/harness_frames.h"
+#include "harness/harness_rays.h"
 #include "util/util.h"
 
 /* The brute-force check's rays: the same seed as a static run's. */

@@ -11,7 +11,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "harness/harness.h"
+#include "harness/harness_memory.h"
+#include "output/results.h"
 
 /* A "Name:   123 kB" line of /proc/self/status, in bytes; 0 if absent. */
 static uint64_t status_bytes(const char *name)

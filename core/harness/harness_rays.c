@@ -4,14 +4,14 @@
  * build thread count: traversal numbers then compare trees, not thread
  * counts. Each batch is timed over repeated passes (bvhlab_trace_measure),
  * with one or both traversals. The per-pixel data they give becomes images
- * in output/scene_images.c.
+ * in output/images.c.
  */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/harness.h"
+#include "harness/harness_rays.h"
 #include "output/image.h"
 #include "output/results.h"
 #include "trace/trace_series.h"

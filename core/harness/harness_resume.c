@@ -5,14 +5,23 @@
  */
 #include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "harness/harness_resume.h"
+#include "util/util.h"
 
-int harness_resume(struct results *res, const struct config *cfg, bool quiet, bool *all_ok,
+int harness_resume(struct results *res, const struct run_list *list, bool quiet, bool *all_ok,
                    bvhlab_error *err)
 {
+	const struct config *cfg = list->cfg;
 	size_t kept = 0, not_ok = 0;
-	int r = results_resume(res, cfg, &kept, &not_ok, err);
+	struct run_identity *keys = calloc(list->count + 1, sizeof(*keys));
+	if (!keys)
+		return error_set(err, "out of memory"), -ENOMEM;
+	for (size_t k = 0; k < list->count; k++)
+		keys[k] = list->runs[k].key;
+	int r = results_resume(res, keys, list->count, &kept, &not_ok, err);
+	free(keys);
 	if (r == -ENOENT) {
 		if (!quiet)
 			fprintf(stderr, "bvhlab: nothing to resume in %s/; starting afresh\n",

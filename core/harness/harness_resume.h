@@ -10,11 +10,12 @@
 #include "config/config.h"
 #include "harness/harness_builders.h"
 #include "output/results.h"
+#include "plan/plan.h"
 
 /* Takes over the finished runs of res's folder (none there: a fresh start,
- * said unless quiet); *all_ok whether all of them are ok. 0 or a negative
- * errno with err set (results_resume). */
-int harness_resume(struct results *res, const struct config *cfg, bool quiet, bool *all_ok,
+ * said unless quiet), each one a run of the list; *all_ok whether all of
+ * them are ok. 0 or a negative errno with err set (results_resume). */
+int harness_resume(struct results *res, const struct run_list *list, bool quiet, bool *all_ok,
                    bvhlab_error *err);
 
 /*

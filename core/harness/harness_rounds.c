@@ -14,7 +14,7 @@
 
 #include <bvhlab/trace.h>
 
-#include "harness/harness.h"
+#include "harness/harness_rays.h"
 #include "harness/harness_rounds.h"
 #include "harness/isolate.h"
 #include "output/safe_file.h"
@@ -103,8 +103,9 @@ int harness_rounds_write_tree(const char *path, const bvhlab_tree *tree)
 	return safe_write_parts(path, parts, 3);
 }
 
-int harness_rounds_add(struct harness_rounds *r, const char *path, const char *builder,
-                       uint32_t threads, bool duplicates, const struct ray_metrics *rays)
+int harness_rounds_add(struct harness_rounds *r, const char *path,
+                       const struct run_identity *run, bool duplicates,
+                       const struct ray_metrics *rays)
 {
 	if (r->count == r->cap) {
 		size_t cap = r->cap ? 2 * r->cap : 16;
@@ -117,8 +118,7 @@ int harness_rounds_add(struct harness_rounds *r, const char *path, const char *b
 	char *copy = strdup(path);
 	if (!copy)
 		return -ENOMEM;
-	r->entries[r->count++] = (struct rounds_entry){.path = copy, .builder = builder,
-	                                               .threads = threads,
+	r->entries[r->count++] = (struct rounds_entry){.path = copy, .run = run,
 	                                               .duplicates = duplicates, .rays = *rays};
 	return 0;
 }
@@ -444,7 +444,7 @@ void harness_rounds_end(struct harness_rounds *r, struct results *res,
 		 * not a figure a resumed sweep must replace. */
 		struct rounds_entry *e = &r->entries[i];
 		e->rays.provisional = false;
-		int u = results_set_run_rays(res, scene->name, e->builder, e->threads, &e->rays);
+		int u = results_set_run_rays(res, e->run, &e->rays);
 		some = true;
 		rc = rc < 0 ? rc : u;
 	}

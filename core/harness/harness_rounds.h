@@ -28,8 +28,7 @@
 /* One run waiting for the rounds. */
 struct rounds_entry {
 	char *path;            /* its tree file */
-	const char *builder;   /* the config's label */
-	uint32_t threads;      /* resolved build thread count */
+	const struct run_identity *run; /* from the sweep's run list */
 	bool duplicates;       /* spatial splits: validated as such */
 	struct ray_metrics rays; /* the run's own; timings replaced by the rounds */
 	bool timed;            /* rays now hold the rounds' timings */
@@ -68,8 +67,9 @@ void harness_rounds_sweep(const char *dir);
 int harness_rounds_write_tree(const char *path, const bvhlab_tree *tree);
 
 /* A run whose tree is in path; its rays were measured in its child. */
-int harness_rounds_add(struct harness_rounds *r, const char *path, const char *builder,
-                       uint32_t threads, bool duplicates, const struct ray_metrics *rays);
+int harness_rounds_add(struct harness_rounds *r, const char *path,
+                       const struct run_identity *run, bool duplicates,
+                       const struct ray_metrics *rays);
 
 void harness_rounds_finish(struct harness_rounds *r);
 

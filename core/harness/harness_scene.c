@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/harness.h"
+#include "harness/harness_scene.h"
 #include "harness/isolate.h"
 #include "util/util.h"
 

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "harness/harness.h"
+#include "harness/harness_series.h"
 #include "util/util.h"
 
 /* The stages after one build: their times into ms[stage * repeat + k]

@@ -1,7 +1,7 @@
 /*
  * A refinement stage as the harness runs it: a plugin with refine (ABI 1.2)
  * and its options, after every build of a series. Its own header because
- * both the series (harness.h) and the opened builders (harness_builders.h)
+ * both the series (harness_series.h) and the opened builders (harness_builders.h)
  * hold stages, and neither should include the other.
  */
 #ifndef BVHLAB_CORE_HARNESS_REFINE_STAGE_H

@@ -1,7 +1,7 @@
 /*
  * Renderings of a results document: results.csv (one row per run) and
- * report.md (one table per scene). Both read only the document, so a saved
- * results.json can be rendered again later.
+ * report.md (one table per scene). Both read only the document (through
+ * report_doc.h), so a saved results.json can be rendered again later.
  */
 #include <math.h>
 #include <stdio.h>
@@ -13,66 +13,14 @@
 #include "output/report.h"
 #include "util/util.h"
 
-/* The number at a dotted path ("build_ms.median"), or NULL. */
-static const cJSON *at(const cJSON *o, const char *path)
-{
-	char key[64];
-	while (o && *path) {
-		size_t len = strcspn(path, ".");
-		if (len >= sizeof(key))
-			return NULL;
-		memcpy(key, path, len);
-		key[len] = '\0';
-		o = cJSON_GetObjectItemCaseSensitive(o, key);
-		path += len + (path[len] == '.');
-	}
-	return o;
-}
-
-static const char *str(const cJSON *o, const char *path)
-{
-	const cJSON *v = at(o, path);
-	return cJSON_IsString(v) ? v->valuestring : "";
-}
-
 /* Formats a number at path with fmt, or "" when absent. */
 static const char *num(char *buf, size_t size, const cJSON *o, const char *path, const char *fmt)
 {
-	const cJSON *v = at(o, path);
+	const cJSON *v = report_at(o, path);
 	if (!cJSON_IsNumber(v))
 		return "";
 	snprintf(buf, size, fmt, v->valuedouble);
 	return buf;
-}
-
-const cJSON *report_at(const cJSON *o, const char *path)
-{
-	return at(o, path);
-}
-
-const char *report_str(const cJSON *o, const char *path)
-{
-	return str(o, path);
-}
-
-double report_num(const cJSON *o, const char *path)
-{
-	const cJSON *v = at(o, path);
-	return cJSON_IsNumber(v) ? v->valuedouble : NAN;
-}
-
-void report_escape(struct strbuf *sb, const char *text)
-{
-	for (const char *p = text; *p; p++) {
-		switch (*p) {
-		case '&': sb_printf(sb, "&amp;"); break;
-		case '<': sb_printf(sb, "&lt;"); break;
-		case '>': sb_printf(sb, "&gt;"); break;
-		case '"': sb_printf(sb, "&quot;"); break;
-		case '\'': sb_printf(sb, "&#39;"); break;
-		default: sb_printf(sb, "%c", *p);
-		}
-	}
 }
 
 /* CSV field: quoted when it holds a separator, quote or newline. */
@@ -161,18 +109,18 @@ static void csv_phases(struct strbuf *sb, const cJSON *phases)
 static void csv_row(struct strbuf *sb, const cJSON *run)
 {
 	char buf[64];
-	csv_field(sb, str(run, "scene"), false);
-	csv_field(sb, str(run, "builder"), false);
-	csv_field(sb, str(run, "plugin"), false);
-	csv_field(sb, str(run, "status"), false);
+	csv_field(sb, report_str(run, "scene"), false);
+	csv_field(sb, report_str(run, "builder"), false);
+	csv_field(sb, report_str(run, "plugin"), false);
+	csv_field(sb, report_str(run, "status"), false);
 	for (size_t k = 0; k < sizeof(csv_numbers) / sizeof(csv_numbers[0]); k++)
 		csv_field(sb, num(buf, sizeof(buf), run, csv_numbers[k][0], csv_numbers[k][1]), false);
-	const cJSON *trav = at(run, "rays.traversal");
+	const cJSON *trav = report_at(run, "rays.traversal");
 	csv_field(sb, cJSON_IsString(trav) ? trav->valuestring : "", false);
-	const cJSON *valid = at(run, "validation.valid");
+	const cJSON *valid = report_at(run, "validation.valid");
 	csv_field(sb, cJSON_IsBool(valid) ? (cJSON_IsTrue(valid) ? "true" : "false") : "", false);
 	csv_phases(sb, cJSON_GetObjectItemCaseSensitive(run, "build_phases"));
-	csv_field(sb, str(run, "error"), true);
+	csv_field(sb, report_str(run, "error"), true);
 }
 
 char *report_csv(const cJSON *doc)
@@ -186,58 +134,6 @@ char *report_csv(const cJSON *doc)
 	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
 		csv_row(&sb, run);
 	return sb_take(&sb);
-}
-
-/* Decimals for a magnitude: three significant digits, at least. */
-static int plain_decimals(double a)
-{
-	return a >= 100 ? 0 : a >= 10 ? 1 : a >= 1 ? 2 : 3;
-}
-
-const char *report_plain(char *buf, size_t size, double v)
-{
-	if (!isfinite(v)) {
-		snprintf(buf, size, "%s", "");
-		return buf;
-	}
-	int d = plain_decimals(fabs(v));
-	double scale = pow(10, d);
-	d = plain_decimals(fabs(round(v * scale) / scale)); /* 9.996 is "10.0", not "10.00" */
-	snprintf(buf, size, "%.*f", d, v);
-	return buf;
-}
-
-const char *report_phases(char *buf, size_t size, const cJSON *run)
-{
-	const cJSON *p;
-	size_t len = 0;
-	buf[0] = '\0';
-	cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(run, "build_phases")) {
-		char v[32];
-		if (!cJSON_IsNumber(p) || !p->string || len >= size)
-			continue;
-		int n = snprintf(buf + len, size - len, "%s%s %s", len ? ", " : "", p->string,
-		                 report_plain(v, sizeof(v), p->valuedouble));
-		len += n > 0 ? (size_t)n : 0;
-	}
-	return buf;
-}
-
-bool report_any_phases(const cJSON *const *runs, size_t n)
-{
-	for (size_t k = 0; k < n; k++)
-		if (cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(runs[k], "build_phases")) > 0)
-			return true;
-	return false;
-}
-
-/* Markdown cell text: pipes and newlines would break the table. */
-void report_md_cell(struct strbuf *sb, const char *s)
-{
-	sb_printf(sb, " ");
-	for (const char *p = s; *p; p++)
-		sb_printf(sb, *p == '|' ? "\\|" : *p == '\n' ? " " : "%c", *p);
-	sb_printf(sb, " |");
 }
 
 /* The Markdown run table's number columns (key, format), before the
@@ -279,9 +175,9 @@ static void md_run_row(struct strbuf *sb, const struct report_index *ix, const c
 {
 	char buf[400];
 	sb_printf(sb, "|");
-	report_md_cell(sb, str(run, "builder"));
+	report_md_cell(sb, report_str(run, "builder"));
 	report_md_cell(sb, num(buf, sizeof(buf), run, "threads", "%.0f"));
-	report_md_cell(sb, str(run, "status"));
+	report_md_cell(sb, report_str(run, "status"));
 	md_numbers(sb, run, md_times, sizeof(md_times) / sizeof(md_times[0]));
 	double speedup = report_speedup(ix, run);
 	snprintf(buf, sizeof(buf), "%.2f", speedup);
@@ -290,33 +186,58 @@ static void md_run_row(struct strbuf *sb, const struct report_index *ix, const c
 	report_md_cell(sb, md_marks(buf, sizeof(buf), ix, run));
 	if (phases)
 		report_md_cell(sb, report_phases(buf, sizeof(buf), run));
-	report_md_cell(sb, str(run, "error"));
+	report_md_cell(sb, report_str(run, "error"));
 	sb_printf(sb, "\n");
 }
 
-/* The scene's images, when the run drew them (paths relative to the report). */
-static void md_images(struct strbuf *sb, const cJSON *scene)
+/* "a 0 to 35, b 0 to 45": each heat map's own scale. */
+static void md_own_scales(struct strbuf *sb, const cJSON *scene, const cJSON *const *runs,
+                          size_t n)
 {
-	const char *shaded = str(scene, "images.shaded"), *legend = str(scene, "images.legend");
+	const char *sep = "";
+	for (size_t k = 0; k < n; k++) {
+		double lo, hi;
+		if (!*report_str(runs[k], "heat_image") || !report_heat_scale(scene, runs[k], &lo, &hi))
+			continue;
+		sb_printf(sb, "%s%s x%.0f %.0f to %.0f", sep, report_str(runs[k], "builder"),
+		          report_num(runs[k], "threads"), lo, hi);
+		sep = ", ";
+	}
+}
+
+/* The scene's images, when the run drew them (paths relative to the
+ * report). Heat maps drawn on different scales (a merged sweep's parts)
+ * each get theirs: one stated scale would misread the others. */
+static void md_images(struct strbuf *sb, const cJSON *scene, const cJSON *const *runs, size_t n)
+{
+	const char *shaded = report_str(scene, "images.shaded");
+	const char *legend = report_str(scene, "images.legend");
+	const char *kind = strcmp(report_str(scene, "images.heat_scale"), "log") == 0 ? "log"
+	                                                                              : "linear";
 	if (*shaded)
-		sb_printf(sb, "\n![%s](%s)\n", str(scene, "name"), shaded);
-	if (*legend)
+		sb_printf(sb, "\n![%s](%s)\n", report_str(scene, "name"), shaded);
+	if (report_heat_scales_differ(scene, runs, n)) {
+		sb_printf(sb, "\nHeat maps (nodes visited per primary ray, %s scale) per builder in "
+		              "report.html, drawn on different scales, each its own: ", kind);
+		md_own_scales(sb, scene, runs, n);
+		sb_printf(sb, ".\n");
+	} else if (*legend) {
 		sb_printf(sb, "\nHeat maps (nodes visited per primary ray, %.0f to %.0f, %s scale): "
 		              "![scale](%s) and per builder in report.html.\n",
 		          report_num(scene, "images.heat_min"), report_num(scene, "images.heat_max"),
-		          strcmp(str(scene, "images.heat_scale"), "log") == 0 ? "log" : "linear",
-		          legend);
+		          kind, legend);
+	}
 }
 
 static void md_scene(struct strbuf *sb, const struct report_index *ix, const char *ref,
                      const cJSON *scene)
 {
-	const char *name = str(scene, "name");
+	const char *name = report_str(scene, "name");
 	char buf[64];
-	sb_printf(sb, "\n## %s\n\n%s, %s triangles", name, str(scene, "source"),
+	sb_printf(sb, "\n## %s\n\n%s, %s triangles", name, report_str(scene, "source"),
 	          num(buf, sizeof(buf), scene, "triangles", "%.0f"));
-	if (*str(scene, "error"))
-		sb_printf(sb, ". **Could not be loaded:** %s", str(scene, "error"));
+	if (*report_str(scene, "error"))
+		sb_printf(sb, ". **Could not be loaded:** %s", report_str(scene, "error"));
 	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | cold ms "
 	              "| Mtris/s | speedup | SAH cost | EPO | peak bytes | primary Mrays/s (best tile) "
 	              "| primary nodes/ray | diffuse Mrays/s (best tile) | diffuse nodes/ray | nodes "
@@ -329,9 +250,9 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	          phases ? " build phases ms |" : "", phases ? "---|" : "");
 	for (size_t k = 0; k < n; k++)
 		md_run_row(sb, ix, runs[k], phases);
-	report_front_md(sb, runs, n);
+	report_front_md(sb, ix, runs, n);
 	report_breakeven_md(sb, ix, ref, runs, n);
-	md_images(sb, scene);
+	md_images(sb, scene, runs, n);
 	report_frames_md(sb, ix, scene); /* an animated scene's frames */
 }
 
@@ -342,7 +263,7 @@ char *report_markdown(const cJSON *doc)
 	int total = cJSON_GetArraySize(runs), ok = 0;
 	const cJSON *run, *scene;
 	cJSON_ArrayForEach(run, runs)
-		ok += strcmp(str(run, "status"), "ok") == 0;
+		ok += strcmp(report_str(run, "status"), "ok") == 0;
 	sb_printf(&sb, "# bvhlab report\n\nbvhlab %s, %s. Machine: %s, %s cores, %s available "
 	               "to this process.\n\n%d runs, %d ok. Times are build times in ms over "
 	               "the timed repeats; SAH cost with c_trav = c_isect = 1, normalised by "
@@ -360,7 +281,7 @@ char *report_markdown(const cJSON *doc)
 	               "Marks: noisy where the build repeats spread more than 5 %% or a run "
 	               "of the same tree traced more than 5 %% faster or slower; busy where "
 	               "other processes kept more CPUs busy than the run left free.\n",
-	          str(doc, "bvhlab_version"), str(doc, "created"), str(doc, "machine.cpu"),
+	          report_str(doc, "bvhlab_version"), report_str(doc, "created"), report_str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);
 	struct report_index ix;
@@ -368,7 +289,7 @@ char *report_markdown(const cJSON *doc)
 		sb.failed = true;
 	const char *asked, *ref = report_reference(doc, &asked, &(bool){false});
 	report_load_warning(&sb, doc, false);
-	report_summary_md(&sb, doc);
+	report_summary_md(&sb, &ix);
 	report_machines_md(&sb, doc);
 	report_thesis(&sb, doc, &ix);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))

@@ -1,7 +1,7 @@
 /*
  * The renderings of a results document (results.csv, report.md,
- * report.html; results.c writes them) and the pieces they share: document
- * access and the inline SVG charts.
+ * report.html; results.c writes them) and the sections they share. Reading
+ * the document is report_doc.h's.
  */
 #ifndef BVHLAB_CORE_REPORT_H
 #define BVHLAB_CORE_REPORT_H
@@ -10,6 +10,7 @@
 
 #include <cJSON.h>
 
+#include "output/report_doc.h"
 #include "util/util.h"
 
 /* The CSV and Markdown renderings of a results document (malloc'd text). */
@@ -18,13 +19,6 @@ char *report_markdown(const struct cJSON *doc);
 /* report.html: self-contained but for the PNGs it names (images/...). */
 char *report_html(const struct cJSON *doc);
 
-
-/* The member at a dotted path ("build_ms.median"), or NULL. */
-const cJSON *report_at(const cJSON *o, const char *path);
-/* The string at path, or "". */
-const char *report_str(const cJSON *o, const char *path);
-/* The number at path, or NaN. */
-double report_num(const cJSON *o, const char *path);
 /* A document's runs by scene, for rendering in time linear in their
  * number (report_index.c). */
 struct report_slot;
@@ -32,7 +26,8 @@ struct report_index {
 	struct report_slot *scenes, *pairs; /* open-addressed tables of cap slots */
 	struct report_slot *names;          /* builder labels, numbered */
 	const cJSON **order;                /* every run, grouped by scene */
-	size_t cap, builder_count;
+	const cJSON **machines;             /* distinct machines, first seen first */
+	size_t cap, builder_count, machine_count;
 	const cJSON *doc;
 };
 
@@ -45,8 +40,11 @@ const cJSON *const *report_scene_runs(const struct report_index *ix, const char 
 /* The builder's number in order of first appearance (its colour in every
  * chart), or -1 when no run has it. */
 long report_builder_number(const struct report_index *ix, const char *builder);
+/* The number of the machine the run was measured on (0 for M1), in order
+ * of first appearance; a document from one machine has only 0. */
+long report_machine_number(const struct report_index *ix, const cJSON *run);
 /* Build-time speedup of a run over the same builder's 1-thread run on
- * the same scene, or NaN when there is none or the builder never ran on
+ * the same scene and machine, or NaN when there is none or the builder never ran on
  * more than 1 thread (a builder without the PARALLEL flag). */
 double report_speedup(const struct report_index *ix, const cJSON *run);
 
@@ -66,18 +64,6 @@ void report_machines_html(struct strbuf *sb, const cJSON *doc);
  * frames as charts; nothing for a scene without frames. */
 void report_frames_md(struct strbuf *sb, const struct report_index *ix, const cJSON *scene);
 void report_frames_html(struct strbuf *sb, const struct report_index *ix, const cJSON *scene);
-
-/* Text with & < > " ' escaped for HTML and SVG. */
-void report_escape(struct strbuf *sb, const char *text);
-/* A run's build_phases as "upload 1.50, device 2.50" ("" when none). */
-const char *report_phases(char *buf, size_t size, const cJSON *run);
-/* Whether some run has build_phases (the tables then add their column). */
-bool report_any_phases(const cJSON *const *runs, size_t n);
-/* " text |": a Markdown table cell, pipes escaped and newlines flattened. */
-void report_md_cell(struct strbuf *sb, const char *text);
-/* A plain number with the decimals its size needs ("2140", "21.4", "2.14"),
- * never an exponent; "" for NaN. Returns buf. */
-const char *report_plain(char *buf, size_t size, double v);
 
 /* ---- Pareto fronts (report_front.c) -------------------------------------- */
 
@@ -104,19 +90,25 @@ struct front_entry {
 	const cJSON *run;
 	double threads; /* the front it competes on */
 	size_t order;   /* the run's place in the scene */
+	long machine;   /* report_machine_number's: fronts never mix machines */
 };
-/* The scene's entries by thread count, then run order (malloc'd; NULL on
- * no memory). */
-struct front_entry *report_front_entries(const cJSON *const *runs, size_t n, size_t *count);
+/* The scene's entries by machine, thread count, then run order (malloc'd;
+ * NULL on no memory). */
+struct front_entry *report_front_entries(const struct report_index *ix,
+                                         const cJSON *const *runs, size_t n, size_t *count);
+/* The front_point group of a machine's thread count. */
+long report_front_group(long machine, double threads);
 /* The entries as points of the figure at a dotted path (runs not ok are
- * not compared), grouped by thread count, and their verdicts. */
+ * not compared), grouped by machine and thread count, and their verdicts. */
 void report_entries_front(const struct front_entry *e, size_t m, const char *figure,
                           struct front_point *p, long *by);
 /* The distinct thread counts of the runs, ascending, at most max. */
 size_t report_thread_counts(const cJSON *const *runs, size_t n, double *out, size_t max);
 /* The scene's front table (both views: SAH cost, primary nodes per ray). */
-void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n);
-void report_front_html(struct strbuf *sb, const cJSON *const *runs, size_t n);
+void report_front_md(struct strbuf *sb, const struct report_index *ix,
+                     const cJSON *const *runs, size_t n);
+void report_front_html(struct strbuf *sb, const struct report_index *ix,
+                       const cJSON *const *runs, size_t n);
 
 /* One point or bar: a label and its values. */
 struct svg_point {
@@ -197,6 +189,7 @@ void report_load_warning(struct strbuf *sb, const cJSON *doc, bool html);
 struct summary_row {
 	const char *builder; /* points into the document */
 	double threads;
+	long machine;        /* report_machine_number's: rows never mix machines */
 	int scenes;          /* scenes with ok runs of both */
 	double ratio[SUMMARY_METRICS];
 };
@@ -206,18 +199,20 @@ struct summary_row {
  * first builder with an ok run (*fallback true). NULL when no run is ok.
  * *asked: the name the config asked for. */
 const char *report_reference(const cJSON *doc, const char **asked, bool *fallback);
-/* The reference's ok run on a scene with `threads` threads, else its ok
- * run with the fewest; NULL when it has none there. */
+/* The reference's ok run on a scene and machine (report_machine_number's;
+ * -1: any) with `threads` threads, else its ok run with the fewest; NULL
+ * when it has none there. */
 const cJSON *report_reference_run(const struct report_index *ix, const char *ref,
-                                  const char *scene, double threads);
-/* The rows (malloc'd, in run order) and the reference builder's label;
- * 0 rows (and *ref NULL) when no run is ok. */
-int report_summary(const cJSON *doc, struct summary_row **rows, const char **ref);
+                                  const char *scene, long machine, double threads);
+/* The rows (malloc'd, in run order; one per builder, thread count and
+ * machine) and the reference builder's label; 0 rows (and *ref NULL) when
+ * no run is ok. */
+int report_summary(const struct report_index *ix, struct summary_row **rows, const char **ref);
 /* The column name of metric m. */
 const char *report_summary_metric(int m);
 /* The summary section of report.md / report.html. */
-void report_summary_md(struct strbuf *sb, const cJSON *doc);
-void report_summary_html(struct strbuf *sb, const cJSON *doc);
+void report_summary_md(struct strbuf *sb, const struct report_index *ix);
+void report_summary_html(struct strbuf *sb, const struct report_index *ix);
 /* The summary rows as points of build time against SAH cost (ratios),
  * compared among the rows of one thread count over as many scenes, and
  * their verdicts (report_front_points). */

@@ -107,34 +107,49 @@ static void run_texts(const cJSON *run, const cJSON *base, char (*out)[96])
 	}
 }
 
-/* The ok traced runs of a scene and the reference run each is set against. */
-static const cJSON *base_of(const struct report_index *ix, const char *ref, const cJSON *run)
+/* The reference run an ok traced run is set against: the reference's on
+ * the same scene and machine. *elsewhere: the reference ran on the scene
+ * only on other machines, whose times say nothing about this one's. */
+static const cJSON *base_of(const struct report_index *ix, const char *ref, const cJSON *run,
+                            bool *elsewhere)
 {
+	const char *scene = report_str(run, "scene");
+	double threads = report_num(run, "threads");
+	*elsewhere = false;
 	if (strcmp(report_str(run, "status"), "ok") != 0 ||
 	    !isfinite(report_num(run, "rays.primary.mrays_per_s")))
 		return NULL;
-	return report_reference_run(ix, ref, report_str(run, "scene"), report_num(run, "threads"));
+	const cJSON *base = report_reference_run(ix, ref, scene, report_machine_number(ix, run),
+	                                         threads);
+	*elsewhere = !base && report_reference_run(ix, ref, scene, -1, threads);
+	return base;
 }
+
+static const char other_machine[] = "not compared: the reference ran on another machine";
 
 void report_breakeven_md(struct strbuf *sb, const struct report_index *ix, const char *ref,
                          const cJSON *const *runs, size_t n)
 {
 	char texts[2][96], buf[32];
-	bool header = false;
+	bool header = false, elsewhere;
 	for (size_t k = 0; ref && k < n; k++) {
-		const cJSON *base = base_of(ix, ref, runs[k]);
-		if (!base || base == runs[k])
+		const cJSON *base = base_of(ix, ref, runs[k], &elsewhere);
+		if ((!base && !elsewhere) || base == runs[k])
 			continue;
 		if (!header)
 			sb_printf(sb, "\n### Break-even against %s\n\n%s\n\n| builder | threads "
 			              "| median ms | reference ms | primary rays | diffuse rays |\n"
 			              "|---|---:|---:|---:|---|---|\n", ref, intro);
 		header = true;
-		run_texts(runs[k], base, texts);
 		sb_printf(sb, "|");
 		report_md_cell(sb, report_str(runs[k], "builder"));
 		sb_printf(sb, " %.0f | %s |", report_num(runs[k], "threads"),
 		          report_plain(buf, sizeof(buf), report_num(runs[k], "build_ms.median")));
+		if (!base) {
+			sb_printf(sb, " — | %s | %s |\n", other_machine, other_machine);
+			continue;
+		}
+		run_texts(runs[k], base, texts);
 		sb_printf(sb, " %s | %s | %s |\n",
 		          report_plain(buf, sizeof(buf), report_num(base, "build_ms.median")),
 		          texts[0], texts[1]);
@@ -145,10 +160,10 @@ void report_breakeven_html(struct strbuf *sb, const struct report_index *ix, con
                            const cJSON *const *runs, size_t n)
 {
 	char texts[2][96], a[32], b[32];
-	bool header = false;
+	bool header = false, elsewhere;
 	for (size_t k = 0; ref && k < n; k++) {
-		const cJSON *base = base_of(ix, ref, runs[k]);
-		if (!base || base == runs[k])
+		const cJSON *base = base_of(ix, ref, runs[k], &elsewhere);
+		if ((!base && !elsewhere) || base == runs[k])
 			continue;
 		if (!header) {
 			sb_printf(sb, "<h3>Break-even against ");
@@ -159,14 +174,17 @@ void report_breakeven_html(struct strbuf *sb, const struct report_index *ix, con
 			              "</th></tr>\n", intro);
 		}
 		header = true;
-		run_texts(runs[k], base, texts);
+		if (base)
+			run_texts(runs[k], base, texts);
+		else
+			snprintf(texts[0], sizeof(texts[0]), "%s", other_machine);
 		sb_printf(sb, "<tr><td class=\"l\">");
 		report_escape(sb, report_str(runs[k], "builder"));
 		sb_printf(sb, "</td><td>%.0f</td><td>%s</td><td>%s</td><td class=\"l\">%s</td>"
 		              "<td class=\"l\">%s</td></tr>\n", report_num(runs[k], "threads"),
 		          report_plain(a, sizeof(a), report_num(runs[k], "build_ms.median")),
-		          report_plain(b, sizeof(b), report_num(base, "build_ms.median")), texts[0],
-		          texts[1]);
+		          base ? report_plain(b, sizeof(b), report_num(base, "build_ms.median")) : "—",
+		          texts[0], base ? texts[1] : texts[0]);
 	}
 	if (header)
 		sb_printf(sb, "</table>\n");

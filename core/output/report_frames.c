@@ -20,6 +20,7 @@ struct strategy {
 	bool all_valid, updates; /* every frame valid; some frame updated, not rebuilt */
 	double update_ms, cost_ms, sah_mean, sah_last; /* SAH of the valid frames */
 	int pays_off;       /* first frame where the rebuild run's cost was lower; -1 */
+	long machine;       /* report_machine_number's */
 };
 
 static const cJSON *frame_list(const cJSON *run)
@@ -58,12 +59,14 @@ static void sum_up(const cJSON *run, struct strategy *s)
 	s->sah_last = measured ? s->sah_last : NAN;
 }
 
-/* The run that rebuilds every frame with the same plugin and threads. */
+/* The run that rebuilds every frame with the same plugin and threads, on
+ * the same machine (another machine's costs are its own). */
 static const struct strategy *rebuild_of(const struct strategy *s, size_t n,
                                          const struct strategy *u)
 {
 	for (size_t k = 0; k < n; k++)
 		if (!s[k].updates && s[k].all_valid && s[k].count == u->count &&
+		    s[k].machine == u->machine &&
 		    strcmp(report_str(s[k].run, "plugin"), report_str(u->run, "plugin")) == 0 &&
 		    report_num(s[k].run, "threads") == report_num(u->run, "threads"))
 			return &s[k];
@@ -90,8 +93,10 @@ static struct strategy *strategies(const struct report_index *ix, const char *sc
 	const cJSON *const *runs = report_scene_runs(ix, scene, &count);
 	struct strategy *s = count ? calloc(count, sizeof(*s)) : NULL;
 	for (size_t k = 0; s && k < count; k++)
-		if (frame_list(runs[k]))
-			sum_up(runs[k], &s[m++]);
+		if (frame_list(runs[k])) {
+			sum_up(runs[k], &s[m]);
+			s[m++].machine = report_machine_number(ix, runs[k]);
+		}
 	*n = m;
 	if (m == 0) {
 		free(s);
@@ -149,27 +154,6 @@ static void md_row(struct strbuf *sb, const struct strategy *s)
 	          report_str(s->run, "builder"), report_num(s->run, "threads"), s->count,
 	          s->all_valid ? "yes" : "**no**", s->update_ms, s->sah_mean, s->sah_last,
 	          s->cost_ms, off);
-}
-
-void report_frames_md(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
-{
-	size_t n;
-	struct strategy *s = strategies(ix, report_str(scene, "name"), &n);
-	if (!s)
-		return;
-	sb_printf(sb, "\n### Animation\n\nPer run, over the frames: update ms sums each "
-	              "frame's rebuild or update with its stages (frame 0: the build), cost ms "
-	              "sums each frame's update and rays_per_frame rays at its measured rate; "
-	              "\"rebuild pays off\": the first updated frame that cost more than the same "
-	              "plugin's rebuild of it. frames.csv has every frame.\n\n|");
-	for (size_t k = 0; k < sizeof(head) / sizeof(head[0]); k++)
-		sb_printf(sb, " %s |", head[k]);
-	sb_printf(sb, "\n|---|---:|---:|---|---:|---:|---:|---:|---|\n");
-	for (size_t k = 0; k < n; k++)
-		md_row(sb, &s[k]);
-	sb_printf(sb, "\n");
-	cheapest_line(sb, s, n, false);
-	free(s);
 }
 
 /* ---- HTML ----------------------------------------------------------------- */
@@ -240,24 +224,41 @@ static void all_charts(struct strbuf *sb, const struct report_index *ix,
 	}
 }
 
-void report_frames_html(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
+static const char explain[] =
+	"Per run, over the frames: update ms sums each frame's rebuild or update with its "
+	"stages (frame 0: the build), cost ms sums each frame's update and rays_per_frame "
+	"rays at its measured rate; \"rebuild pays off\": the first updated frame that cost "
+	"more than the same plugin's rebuild of it. frames.csv has every frame.";
+
+/* The section in either rendering: what it shows, the table, the cheapest
+ * strategy, and in HTML the charts. */
+static void frames_section(struct strbuf *sb, const struct report_index *ix,
+                           const cJSON *scene, bool html)
 {
 	size_t n;
 	struct strategy *s = strategies(ix, report_str(scene, "name"), &n);
 	if (!s)
 		return;
-	sb_printf(sb, "<h3>Animation</h3>\n<p>Per run, over the frames: update ms sums each "
-	              "frame's rebuild or update with its stages (frame 0: the build); cost ms "
-	              "sums each frame's update and rays_per_frame rays at its measured rate; "
-	              "\"rebuild pays off\": the first updated frame that cost more than the same "
-	              "plugin's rebuild of it. frames.csv has every frame.</p>\n<table><tr>");
+	sb_printf(sb, html ? "<h3>Animation</h3>\n<p>%s</p>\n<table><tr>"
+	                   : "\n### Animation\n\n%s\n\n|", explain);
 	for (size_t k = 0; k < sizeof(head) / sizeof(head[0]); k++)
-		sb_printf(sb, "<th>%s</th>", head[k]);
-	sb_printf(sb, "</tr>\n");
+		sb_printf(sb, html ? "<th>%s</th>" : " %s |", head[k]);
+	sb_printf(sb, html ? "</tr>\n" : "\n|---|---:|---:|---|---:|---:|---:|---:|---|\n");
 	for (size_t k = 0; k < n; k++)
-		html_row(sb, &s[k]);
-	sb_printf(sb, "</table>\n");
-	cheapest_line(sb, s, n, true);
-	all_charts(sb, ix, s, n);
+		(html ? html_row : md_row)(sb, &s[k]);
+	sb_printf(sb, html ? "</table>\n" : "\n");
+	cheapest_line(sb, s, n, html);
+	if (html)
+		all_charts(sb, ix, s, n);
 	free(s);
+}
+
+void report_frames_md(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
+{
+	frames_section(sb, ix, scene, false);
+}
+
+void report_frames_html(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
+{
+	frames_section(sb, ix, scene, true);
 }

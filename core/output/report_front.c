@@ -1,6 +1,6 @@
 /*
- * Pareto fronts: which builders are worth considering at all. Per scene
- * and thread count, a run is on the front of build time against a tree
+ * Pareto fronts: which builders are worth considering at all. Per scene,
+ * machine and thread count, a run is on the front of build time against a tree
  * figure (SAH cost, primary nodes per ray; lower is better for both) when
  * no other run is at least as fast and at least as good with one of the
  * two strictly better (figures within 0.05 % count as equal). A run off
@@ -82,11 +82,14 @@ void report_front_text(char *buf, size_t size, const struct front_point *p, long
 	snprintf(buf, size, "dominated by %s (%.2f× time, %s)", by_name, t, change);
 }
 
-/* Whether the scene holds a run of the builder with more than 1 thread. */
-static bool ran_parallel(const cJSON *const *runs, size_t n, const char *builder)
+/* Whether the scene holds a run of the builder with more than 1 thread on
+ * the machine. */
+static bool ran_parallel(const struct report_index *ix, const cJSON *const *runs, size_t n,
+                         const char *builder, long machine)
 {
 	for (size_t k = 0; k < n; k++)
 		if (report_num(runs[k], "threads") > 1 &&
+		    report_machine_number(ix, runs[k]) == machine &&
 		    strcmp(report_str(runs[k], "builder"), builder) == 0)
 			return true;
 	return false;
@@ -95,29 +98,35 @@ static bool ran_parallel(const cJSON *const *runs, size_t n, const char *builder
 static int by_threads(const void *a, const void *b)
 {
 	const struct front_entry *x = a, *y = b;
+	if (x->machine != y->machine)
+		return (x->machine > y->machine) - (x->machine < y->machine);
 	if (x->threads != y->threads)
 		return (x->threads > y->threads) - (x->threads < y->threads);
 	return (x->order > y->order) - (x->order < y->order);
 }
 
 /* Whether run k competes at thread count t: its own, or any for the
- * 1-thread run of a builder that ran on 1 thread only. */
-static bool competes(const cJSON *const *runs, size_t n, size_t k, double t)
+ * 1-thread run of a builder that ran on 1 thread only (on its machine). */
+static bool competes(const struct report_index *ix, const cJSON *const *runs, size_t n,
+                     size_t k, double t)
 {
 	double own = report_num(runs[k], "threads");
-	return own == t ||
-	       (own == 1 && t > 1 && !ran_parallel(runs, n, report_str(runs[k], "builder")));
+	return own == t || (own == 1 && t > 1 &&
+	                    !ran_parallel(ix, runs, n, report_str(runs[k], "builder"),
+	                                  report_machine_number(ix, runs[k])));
 }
 
-struct front_entry *report_front_entries(const cJSON *const *runs, size_t n, size_t *count)
+struct front_entry *report_front_entries(const struct report_index *ix,
+                                         const cJSON *const *runs, size_t n, size_t *count)
 {
 	double t[64];
 	size_t nt = report_thread_counts(runs, n, t, 64), m = 0;
 	struct front_entry *e = calloc(n * nt + 1, sizeof(*e));
 	for (size_t i = 0; e && i < nt; i++)
 		for (size_t k = 0; k < n; k++)
-			if (competes(runs, n, k, t[i]))
-				e[m++] = (struct front_entry){runs[k], t[i], k};
+			if (competes(ix, runs, n, k, t[i]))
+				e[m++] = (struct front_entry){runs[k], t[i], k,
+				                              report_machine_number(ix, runs[k])};
 	if (e)
 		qsort(e, m, sizeof(*e), by_threads);
 	*count = m;
@@ -147,7 +156,8 @@ void report_entries_front(const struct front_entry *e, size_t m, const char *fig
 	for (size_t k = 0; k < m; k++) {
 		bool ok = strcmp(report_str(e[k].run, "status"), "ok") == 0;
 		p[k] = (struct front_point){ok ? report_num(e[k].run, "build_ms.median") : NAN,
-		                            report_num(e[k].run, figure), (long)e[k].threads};
+		                            report_num(e[k].run, figure),
+		                            report_front_group(e[k].machine, e[k].threads)};
 	}
 	report_front_points(p, m, by);
 }
@@ -163,10 +173,11 @@ struct front_table {
 	long *by[2];
 };
 
-static int table_init(struct front_table *t, const cJSON *const *runs, size_t n)
+static int table_init(struct front_table *t, const struct report_index *ix,
+                      const cJSON *const *runs, size_t n)
 {
 	memset(t, 0, sizeof(*t));
-	t->e = report_front_entries(runs, n, &t->n);
+	t->e = report_front_entries(ix, runs, n, &t->n);
 	for (int v = 0; t->e && v < 2; v++) {
 		t->p[v] = calloc(t->n + 1, sizeof(*t->p[v]));
 		t->by[v] = calloc(t->n + 1, sizeof(*t->by[v]));
@@ -203,15 +214,25 @@ static void verdict(const struct front_table *t, int v, size_t k, char *buf, siz
 	report_front_text(buf, size, t->p[v], by, k, name, figure_names[v]);
 }
 
-/* "2", or "2 (ran on 1)" for a 1-thread run standing in at 2 threads. */
-static const char *threads_text(char *buf, size_t size, const struct front_entry *e)
+/* "2", or "2 (ran on 1)" for a 1-thread run standing in at 2 threads;
+ * " on M2" after it when the runs come from several machines. */
+static const char *threads_text(char *buf, size_t size, const struct report_index *ix,
+                                const struct front_entry *e)
 {
 	double own = report_num(e->run, "threads");
+	char on[32] = "";
+	if (ix->machine_count > 1)
+		snprintf(on, sizeof(on), " on M%ld", e->machine + 1);
 	if (own == e->threads)
-		snprintf(buf, size, "%.0f", own);
+		snprintf(buf, size, "%.0f%s", own, on);
 	else
-		snprintf(buf, size, "%.0f (ran on %.0f)", e->threads, own);
+		snprintf(buf, size, "%.0f (ran on %.0f)%s", e->threads, own, on);
 	return buf;
+}
+
+long report_front_group(long machine, double threads)
+{
+	return machine * 100000 + (long)threads;
 }
 
 static const char intro[] =
@@ -222,11 +243,12 @@ static const char intro[] =
 	"this one's and the change in the figure. A builder that ran on 1 thread only "
 	"competes with its 1-thread run at every thread count.";
 
-void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n)
+void report_front_md(struct strbuf *sb, const struct report_index *ix,
+                     const cJSON *const *runs, size_t n)
 {
 	struct front_table t;
 	char buf[256];
-	if (table_init(&t, runs, n) == 0 && any_compared(&t)) {
+	if (table_init(&t, ix, runs, n) == 0 && any_compared(&t)) {
 		sb_printf(sb, "\n### Pareto fronts\n\n%s\n\n| builder | threads | median ms | SAH cost "
 		              "| time × SAH | primary nodes/ray | time × nodes/ray |\n"
 		              "|---|---:|---:|---:|---|---:|---|\n", intro);
@@ -235,7 +257,7 @@ void report_front_md(struct strbuf *sb, const cJSON *const *runs, size_t n)
 				continue;
 			sb_printf(sb, "|");
 			report_md_cell(sb, report_str(t.e[k].run, "builder"));
-			report_md_cell(sb, threads_text(buf, sizeof(buf), &t.e[k]));
+			report_md_cell(sb, threads_text(buf, sizeof(buf), ix, &t.e[k]));
 			sb_printf(sb, " %s | %.3f |", report_plain(buf, sizeof(buf), t.p[0][k].time),
 			          t.p[0][k].figure);
 			verdict(&t, 0, k, buf, sizeof(buf));
@@ -258,13 +280,14 @@ static void html_verdict(struct strbuf *sb, const struct front_table *t, int v, 
 	sb_printf(sb, "</td>");
 }
 
-static void html_row(struct strbuf *sb, const struct front_table *t, size_t k)
+static void html_row(struct strbuf *sb, const struct report_index *ix,
+                     const struct front_table *t, size_t k)
 {
 	char buf[64], ms[32];
 	sb_printf(sb, "<tr><td class=\"l\">");
 	report_escape(sb, report_str(t->e[k].run, "builder"));
 	sb_printf(sb, "</td><td>%s</td><td>%s</td><td>%.3f</td>",
-	          threads_text(buf, sizeof(buf), &t->e[k]),
+	          threads_text(buf, sizeof(buf), ix, &t->e[k]),
 	          report_plain(ms, sizeof(ms), t->p[0][k].time), t->p[0][k].figure);
 	html_verdict(sb, t, 0, k);
 	sb_printf(sb, "<td>%.1f</td>", t->p[1][k].figure);
@@ -272,17 +295,18 @@ static void html_row(struct strbuf *sb, const struct front_table *t, size_t k)
 	sb_printf(sb, "</tr>\n");
 }
 
-void report_front_html(struct strbuf *sb, const cJSON *const *runs, size_t n)
+void report_front_html(struct strbuf *sb, const struct report_index *ix,
+                       const cJSON *const *runs, size_t n)
 {
 	struct front_table t;
-	if (table_init(&t, runs, n) == 0 && any_compared(&t)) {
+	if (table_init(&t, ix, runs, n) == 0 && any_compared(&t)) {
 		sb_printf(sb, "<h3>Pareto fronts</h3>\n<p>%s</p>\n<table><tr><th class=\"l\">builder"
 		              "</th><th>threads</th><th>median ms</th><th>SAH cost</th>"
 		              "<th class=\"l\">time × SAH</th><th>primary nodes/ray</th>"
 		              "<th class=\"l\">time × nodes/ray</th></tr>\n", intro);
 		for (size_t k = 0; k < t.n; k++)
 			if (t.by[0][k] != FRONT_NONE)
-				html_row(sb, &t, k);
+				html_row(sb, ix, &t, k);
 		sb_printf(sb, "</table>\n");
 	}
 	table_finish(&t);

@@ -202,19 +202,32 @@ static void table(struct strbuf *sb, const struct report_index *ix, const char *
 	sb_printf(sb, "</table></div>\n");
 }
 
+/* " on M2" when the runs come from several machines, else "". */
+static const char *machine_text(char *buf, size_t size, const struct report_index *ix,
+                                long machine)
+{
+	buf[0] = '\0';
+	if (ix->machine_count > 1)
+		snprintf(buf, size, " on M%ld", machine + 1);
+	return buf;
+}
+
 /* A chart point of a run: its builder's colour, "builder x2" as its label. */
 static struct svg_point run_point(const struct report_index *ix, const cJSON *run, char *label,
                                   size_t size, double x, double y)
 {
-	snprintf(label, size, "%s x%.0f", report_str(run, "builder"), report_num(run, "threads"));
+	char on[32];
+	snprintf(label, size, "%s x%.0f%s", report_str(run, "builder"), report_num(run, "threads"),
+	         machine_text(on, sizeof(on), ix, report_machine_number(ix, run)));
 	return (struct svg_point){label, report_str(run, "builder"), x, y,
 	                          svg_colour(report_builder_number(ix, report_str(run, "builder"))),
 	                          false};
 }
 
-/* One view's Pareto charts, one per thread count: build time against the
- * figure, the front joined by a line. The verdicts are computed once for
- * every thread count (a 1-thread-only builder is on each). */
+/* One view's Pareto charts, one per machine and thread count: build time
+ * against the figure, the front joined by a line. The verdicts are
+ * computed once for every thread count (a 1-thread-only builder is on
+ * each). */
 static void front_charts(struct strbuf *sb, const struct report_index *ix,
                          const struct front_entry *e, size_t n, const double *threads,
                          size_t nt, int view, struct svg_point *p, char (*labels)[96])
@@ -225,18 +238,20 @@ static void front_charts(struct strbuf *sb, const struct report_index *ix,
 	long *by = calloc(n + 1, sizeof(*by));
 	if (fp && by)
 		report_entries_front(e, n, figures[view], fp, by);
-	for (size_t t = 0; fp && by && t < nt; t++) {
-		size_t m = 0;
+	for (size_t g = 0; fp && by && g < nt * ix->machine_count; g++) {
+		size_t m = 0, t = g % nt;
+		long machine = (long)(g / nt);
 		for (size_t k = 0; k < n; k++) {
-			if (by[k] == FRONT_NONE || e[k].threads != threads[t])
+			if (by[k] == FRONT_NONE || e[k].threads != threads[t] || e[k].machine != machine)
 				continue;
 			p[m] = run_point(ix, e[k].run, labels[m], sizeof(labels[m]), fp[k].time,
 			                 fp[k].figure);
 			p[m++].front = by[k] == FRONT_ON;
 		}
-		char title[96];
-		snprintf(title, sizeof(title), "%s vs. build time, %.0f thread%s", names[view],
-		         threads[t], threads[t] == 1 ? "" : "s");
+		char title[128], on[32];
+		snprintf(title, sizeof(title), "%s vs. build time, %.0f thread%s%s", names[view],
+		         threads[t], threads[t] == 1 ? "" : "s",
+		         machine_text(on, sizeof(on), ix, machine));
 		if (m > 0)
 			svg_scatter(sb, title, "build time (ms)", names[view], p, m);
 	}
@@ -257,16 +272,21 @@ static void bars_and_speedups(struct strbuf *sb, const struct report_index *ix,
 		}
 	if (n > 0)
 		svg_bars(sb, "Build time (median)", "ms", q, n);
-	for (size_t k = 0; k < count; k++) {
-		double s = report_speedup(ix, runs[k]);
-		if (isfinite(s)) {
-			q[m] = run_point(ix, runs[k], labels[m], sizeof(labels[m]),
-			                 report_num(runs[k], "threads"), s);
-			m++;
+	for (long machine = 0; machine < (long)ix->machine_count; machine++, m = 0) {
+		char title[64], on[32];
+		for (size_t k = 0; k < count; k++) {
+			double s = report_speedup(ix, runs[k]);
+			if (isfinite(s) && report_machine_number(ix, runs[k]) == machine) {
+				q[m] = run_point(ix, runs[k], labels[m], sizeof(labels[m]),
+				                 report_num(runs[k], "threads"), s);
+				m++;
+			}
 		}
+		snprintf(title, sizeof(title), "Speedup over 1 thread%s",
+		         machine_text(on, sizeof(on), ix, machine));
+		if (m > 0) /* one chart per machine: a line joins one machine's runs */
+			svg_lines(sb, title, "threads", "speedup", q, m);
 	}
-	if (m > 0)
-		svg_lines(sb, "Speedup over 1 thread", "threads", "speedup", q, m);
 }
 
 static void charts(struct strbuf *sb, const struct report_index *ix, const char *scene)
@@ -274,7 +294,7 @@ static void charts(struct strbuf *sb, const struct report_index *ix, const char 
 	size_t count, nt, ne = 0;
 	double threads[16];
 	const cJSON *const *runs = report_scene_runs(ix, scene, &count);
-	struct front_entry *e = report_front_entries(runs, count, &ne);
+	struct front_entry *e = report_front_entries(ix, runs, count, &ne);
 	struct svg_point *p = calloc(ne + count + 1, sizeof(*p));
 	char (*labels)[96] = calloc(ne + count + 1, sizeof(*labels));
 	if (!e || !p || !labels || count == 0)
@@ -317,21 +337,45 @@ static void heat_legend(struct strbuf *sb, const cJSON *scene, const char *legen
 	sb_printf(sb, "</p>\n");
 }
 
+/* A heat map drawn on a scale of its own: "b x2, 0–45" under it. */
+static void own_scale_figure(struct strbuf *sb, const cJSON *scene, const cJSON *run)
+{
+	char caption[256];
+	double lo, hi;
+	if (report_heat_scale(scene, run, &lo, &hi))
+		snprintf(caption, sizeof(caption), "%s x%.0f, %.0f–%.0f", report_str(run, "builder"),
+		         report_num(run, "threads"), lo, hi);
+	else
+		snprintf(caption, sizeof(caption), "%s x%.0f, scale unknown",
+		         report_str(run, "builder"), report_num(run, "threads"));
+	figure(sb, report_str(run, "heat_image"), caption);
+}
+
 static void images(struct strbuf *sb, const struct report_index *ix, const cJSON *scene)
 {
 	const char *name = report_str(scene, "name"), *legend = report_str(scene, "images.legend");
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
-	if (!*report_str(scene, "images.shaded") && !*legend)
+	bool own = report_heat_scales_differ(scene, runs, n);
+	if (!*report_str(scene, "images.shaded") && !*legend && !own)
 		return;
 	sb_printf(sb, "<div class=\"images\">\n");
 	if (*report_str(scene, "images.shaded"))
 		figure(sb, report_str(scene, "images.shaded"), name);
 	for (size_t k = 0; k < n; k++)
-		if (*report_str(runs[k], "heat_image"))
+		if (*report_str(runs[k], "heat_image") && own)
+			own_scale_figure(sb, scene, runs[k]);
+		else if (*report_str(runs[k], "heat_image"))
 			figure(sb, report_str(runs[k], "heat_image"), report_str(runs[k], "builder"));
 	sb_printf(sb, "</div>\n");
-	if (*legend)
+	if (own)
+		sb_printf(sb, "<p class=\"warn\">Nodes visited per primary ray, %s scale; the maps "
+		              "were drawn on different scales (the parts of a merged sweep), each "
+		              "named under its map: compare colours only between maps of one "
+		              "scale.</p>\n",
+		          strcmp(report_str(scene, "images.heat_scale"), "log") == 0 ? "log"
+		                                                                   : "linear");
+	else if (*legend)
 		heat_legend(sb, scene, legend);
 }
 
@@ -353,7 +397,7 @@ static void scene_section(struct strbuf *sb, const struct report_index *ix, cons
 	charts(sb, ix, name);
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
-	report_front_html(sb, runs, n);
+	report_front_html(sb, ix, runs, n);
 	report_breakeven_html(sb, ix, ref, runs, n);
 	images(sb, ix, scene);
 	report_frames_html(sb, ix, scene); /* an animated scene's frames */
@@ -393,7 +437,7 @@ char *report_html(const cJSON *doc)
 	          report_num(doc, "machine.cores"));
 	const char *asked, *ref = report_reference(doc, &asked, &(bool){false});
 	report_load_warning(&sb, doc, true);
-	report_summary_html(&sb, doc);
+	report_summary_html(&sb, &ix);
 	report_machines_html(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		scene_section(&sb, &ix, ref, scene);

@@ -48,8 +48,9 @@ bool report_same_tree(const cJSON *a, const cJSON *b)
 	return true;
 }
 
-/* The largest relative Mrays/s difference to a run with the same tree, and
- * that run. The SAH cost is compared first: it tells trees apart at once. */
+/* The largest relative Mrays/s difference to a run with the same tree on
+ * the same machine (another machine traces at its own speed), and that
+ * run. The SAH cost is compared first: it tells trees apart at once. */
 static double same_tree_gap(const struct report_index *ix, const cJSON *run,
                             const cJSON **other)
 {
@@ -60,7 +61,8 @@ static double same_tree_gap(const struct report_index *ix, const cJSON *run,
 	*other = NULL;
 	for (size_t k = 0; k < n && mine > 0 && isfinite(sah); k++) {
 		if (runs[k] == run || report_num(runs[k], "tree.sah_cost") != sah ||
-		    !is_ok(runs[k]) || !report_same_tree(run, runs[k]))
+		    !is_ok(runs[k]) || !report_same_tree(run, runs[k]) ||
+		    report_machine_number(ix, runs[k]) != report_machine_number(ix, run))
 			continue;
 		double theirs = report_num(runs[k], "rays.primary.mrays_per_s");
 		double gap = theirs > 0 ? fabs(mine - theirs) / fmin(mine, theirs) : 0;

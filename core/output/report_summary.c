@@ -63,12 +63,13 @@ const char *report_reference(const cJSON *doc, const char **asked, bool *fallbac
 }
 
 const cJSON *report_reference_run(const struct report_index *ix, const char *ref,
-                                  const char *scene, double threads)
+                                  const char *scene, long machine, double threads)
 {
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, scene, &n), *best = NULL;
 	for (size_t k = 0; ref && k < n; k++) {
-		if (!is_ok(runs[k]) || strcmp(report_str(runs[k], "builder"), ref) != 0)
+		if (!is_ok(runs[k]) || strcmp(report_str(runs[k], "builder"), ref) != 0 ||
+		    (machine >= 0 && report_machine_number(ix, runs[k]) != machine))
 			continue;
 		double t = report_num(runs[k], "threads");
 		if (t == threads)
@@ -79,36 +80,25 @@ const cJSON *report_reference_run(const struct report_index *ix, const char *ref
 	return best;
 }
 
-/* The reference's ok run on a scene with the fewest threads, or NULL. */
-static const cJSON *reference_run(const cJSON *runs, const char *ref, const char *scene)
-{
-	const cJSON *run, *best = NULL;
-	cJSON_ArrayForEach(run, runs) {
-		if (!is_ok(run) || strcmp(report_str(run, "builder"), ref) != 0 ||
-		    strcmp(report_str(run, "scene"), scene) != 0)
-			continue;
-		if (!best || report_num(run, "threads") < report_num(best, "threads"))
-			best = run;
-	}
-	return best;
-}
-
-/* Whether an earlier run already has this builder and thread count. */
-static bool seen_before(const cJSON *runs, const cJSON *upto)
+/* Whether an earlier run already has this builder, thread count and machine. */
+static bool seen_before(const struct report_index *ix, const cJSON *runs, const cJSON *upto)
 {
 	const cJSON *run;
 	cJSON_ArrayForEach(run, runs) {
 		if (run == upto)
 			return false;
 		if (strcmp(report_str(run, "builder"), report_str(upto, "builder")) == 0 &&
-		    report_num(run, "threads") == report_num(upto, "threads"))
+		    report_num(run, "threads") == report_num(upto, "threads") &&
+		    report_machine_number(ix, run) == report_machine_number(ix, upto))
 			return true;
 	}
 	return false;
 }
 
-/* Geometric means over scenes for the builder and thread count of `first`. */
-static void summarise(const cJSON *runs, const char *ref, const cJSON *first,
+/* Geometric means over scenes for the builder, thread count and machine of
+ * `first`, each run against the reference's on its scene and machine: a
+ * ratio of two machines' times would measure the machines. */
+static void summarise(const struct report_index *ix, const char *ref, const cJSON *first,
                       struct summary_row *row)
 {
 	double logs[SUMMARY_METRICS] = {0};
@@ -117,11 +107,14 @@ static void summarise(const cJSON *runs, const char *ref, const cJSON *first,
 	memset(row, 0, sizeof(*row));
 	row->builder = report_str(first, "builder");
 	row->threads = report_num(first, "threads");
-	cJSON_ArrayForEach(run, runs) {
+	row->machine = report_machine_number(ix, first);
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(ix->doc, "runs")) {
 		if (!is_ok(run) || strcmp(report_str(run, "builder"), row->builder) != 0 ||
-		    report_num(run, "threads") != row->threads)
+		    report_num(run, "threads") != row->threads ||
+		    report_machine_number(ix, run) != row->machine)
 			continue;
-		const cJSON *base = reference_run(runs, ref, report_str(run, "scene"));
+		const cJSON *base = report_reference_run(ix, ref, report_str(run, "scene"),
+		                                         row->machine, NAN);
 		row->scenes += base != NULL;
 		for (int m = 0; base && m < SUMMARY_METRICS; m++) {
 			double r = report_num(run, metric_paths[m]) / report_num(base, metric_paths[m]);
@@ -135,22 +128,22 @@ static void summarise(const cJSON *runs, const char *ref, const cJSON *first,
 		row->ratio[m] = counts[m] ? exp(logs[m] / counts[m]) : NAN;
 }
 
-int report_summary(const cJSON *doc, struct summary_row **rows, const char **ref)
+int report_summary(const struct report_index *ix, struct summary_row **rows, const char **ref)
 {
-	const cJSON *runs = cJSON_GetObjectItem(doc, "runs"), *run;
+	const cJSON *runs = cJSON_GetObjectItem(ix->doc, "runs"), *run;
 	const char *asked;
 	bool fallback;
 	int n = 0;
 	*rows = NULL;
-	*ref = report_reference(doc, &asked, &fallback);
+	*ref = report_reference(ix->doc, &asked, &fallback);
 	if (!*ref)
 		return 0;
 	*rows = calloc((size_t)cJSON_GetArraySize(runs) + 1, sizeof(**rows));
 	if (!*rows)
 		return 0;
 	cJSON_ArrayForEach(run, runs)
-		if (!seen_before(runs, run))
-			summarise(runs, *ref, run, &(*rows)[n++]);
+		if (!seen_before(ix, runs, run))
+			summarise(ix, *ref, run, &(*rows)[n++]);
 	return n;
 }
 
@@ -168,18 +161,21 @@ static const char *ratio_text(char *buf, size_t size, double r)
 	return buf;
 }
 
-/* Whether the builder has a row with more than 1 thread. */
-static bool has_parallel_row(const struct summary_row *rows, int n, const char *builder)
+/* Whether the row's builder has a row with more than 1 thread on its machine. */
+static bool has_parallel_row(const struct summary_row *rows, int n, const struct summary_row *r)
 {
 	for (int i = 0; i < n; i++)
-		if (rows[i].threads > 1 && strcmp(rows[i].builder, builder) == 0)
+		if (rows[i].threads > 1 && rows[i].machine == r->machine &&
+		    strcmp(rows[i].builder, r->builder) == 0)
 			return true;
 	return false;
 }
 
+/* Rows compete within one machine, thread count and scene count. */
 static struct front_point row_point(const struct summary_row *r, double threads)
 {
-	return (struct front_point){r->ratio[0], r->ratio[1], (long)threads * 100000 + r->scenes};
+	long group = report_front_group(r->machine, threads) * 100000 + r->scenes;
+	return (struct front_point){r->ratio[0], r->ratio[1], group};
 }
 
 /* The rows' points, then a stand-in at every other thread count for each
@@ -193,10 +189,11 @@ static size_t with_stand_ins(const struct summary_row *rows, int n, struct front
 		q[m] = row_point(&rows[i], rows[i].threads), map[m] = i;
 	for (int t = 0; t < n; t++) {
 		bool first = rows[t].threads > 1;
-		for (int j = 0; j < t && first; j++) /* each thread count once */
-			first = rows[j].threads != rows[t].threads;
+		for (int j = 0; j < t && first; j++) /* each thread count and machine once */
+			first = rows[j].threads != rows[t].threads || rows[j].machine != rows[t].machine;
 		for (int i = 0; first && i < n; i++)
-			if (rows[i].threads == 1 && !has_parallel_row(rows, n, rows[i].builder))
+			if (rows[i].threads == 1 && rows[i].machine == rows[t].machine &&
+			    !has_parallel_row(rows, n, &rows[i]))
 				q[m] = row_point(&rows[i], rows[t].threads), map[m++] = i;
 	}
 	return m;
@@ -229,6 +226,11 @@ static const char intro[] =
 	"every thread count), on the front of build time against SAH cost, or the fastest "
 	"row on it that is at least as fast and as good.\n\n";
 
+static const char machines_note[] =
+	"The runs come from %zu machines (see Machines): a row holds one machine's runs, "
+	"each set against the reference's run on the same scene and machine, never "
+	"another machine's; n/a where the reference did not run on that machine.";
+
 /* Where the configured reference did not run: which builder stands in. */
 static void fallback_note(struct strbuf *sb, const cJSON *doc, const char *ref, bool html)
 {
@@ -260,11 +262,13 @@ struct summary {
 	int n;
 	struct front_point *p;
 	long *by;
+	bool machines; /* runs from several machines: a machine column */
 };
 
-static bool summary_init(struct summary *s, const cJSON *doc)
+static bool summary_init(struct summary *s, const struct report_index *ix)
 {
-	s->n = report_summary(doc, &s->rows, &s->ref);
+	s->machines = ix->machine_count > 1;
+	s->n = report_summary(ix, &s->rows, &s->ref);
 	s->p = calloc((size_t)s->n + 1, sizeof(*s->p));
 	s->by = calloc((size_t)s->n + 1, sizeof(*s->by));
 	if (s->n > 0 && s->p && s->by)
@@ -279,26 +283,34 @@ static void summary_finish(struct summary *s)
 	free(s->by);
 }
 
-void report_summary_md(struct strbuf *sb, const cJSON *doc)
+void report_summary_md(struct strbuf *sb, const struct report_index *ix)
 {
 	struct summary s;
 	char buf[256];
 	sb_printf(sb, "\n## Summary\n\n");
-	if (!summary_init(&s, doc)) {
+	if (!summary_init(&s, ix)) {
 		sb_printf(sb, "No ok run, so no summary.\n");
 		summary_finish(&s);
 		return;
 	}
-	fallback_note(sb, doc, s.ref, false);
+	fallback_note(sb, ix->doc, s.ref, false);
 	sb_printf(sb, intro, s.ref);
-	sb_printf(sb, "| builder | threads | scenes |");
+	if (s.machines) {
+		sb_printf(sb, machines_note, ix->machine_count);
+		sb_printf(sb, "\n\n");
+	}
+	sb_printf(sb, "| builder | threads |%s scenes |", s.machines ? " machine |" : "");
 	for (int m = 0; m < SUMMARY_METRICS; m++)
 		sb_printf(sb, " %s |", metric_names[m]);
-	sb_printf(sb, " Pareto (time × SAH) |\n|---|---:|---:|---:|---:|---:|---:|---:|---|\n");
+	sb_printf(sb, " Pareto (time × SAH) |\n|---|---:|%s---:|---:|---:|---:|---:|---:|---|\n",
+	          s.machines ? "---|" : "");
 	for (int i = 0; i < s.n; i++) {
 		sb_printf(sb, "|");
 		report_md_cell(sb, s.rows[i].builder);
-		sb_printf(sb, " %.0f | %d |", s.rows[i].threads, s.rows[i].scenes);
+		sb_printf(sb, " %.0f |", s.rows[i].threads);
+		if (s.machines)
+			sb_printf(sb, " M%ld |", s.rows[i].machine + 1);
+		sb_printf(sb, " %d |", s.rows[i].scenes);
 		for (int m = 0; m < SUMMARY_METRICS; m++)
 			sb_printf(sb, " %s |", ratio_text(buf, sizeof(buf), s.rows[i].ratio[m]));
 		report_md_cell(sb, front_text(buf, sizeof(buf), s.rows, s.p, s.by, i));
@@ -312,7 +324,10 @@ static void html_row(struct strbuf *sb, const struct summary *s, int i)
 	char buf[256];
 	sb_printf(sb, "<tr><td class=\"l\">");
 	report_escape(sb, s->rows[i].builder);
-	sb_printf(sb, "</td><td>%.0f</td><td>%d</td>", s->rows[i].threads, s->rows[i].scenes);
+	sb_printf(sb, "</td><td>%.0f</td>", s->rows[i].threads);
+	if (s->machines)
+		sb_printf(sb, "<td>M%ld</td>", s->rows[i].machine + 1);
+	sb_printf(sb, "<td>%d</td>", s->rows[i].scenes);
 	for (int m = 0; m < SUMMARY_METRICS; m++) {
 		double r = s->rows[i].ratio[m];
 		sb_printf(sb, "<td%s>%s</td>",
@@ -325,16 +340,16 @@ static void html_row(struct strbuf *sb, const struct summary *s, int i)
 	sb_printf(sb, "</td></tr>\n");
 }
 
-void report_summary_html(struct strbuf *sb, const cJSON *doc)
+void report_summary_html(struct strbuf *sb, const struct report_index *ix)
 {
 	struct summary s;
 	sb_printf(sb, "<h2 id=\"summary\">Summary</h2>\n");
-	if (!summary_init(&s, doc)) {
+	if (!summary_init(&s, ix)) {
 		sb_printf(sb, "<p>No ok run, so no summary.</p>\n");
 		summary_finish(&s);
 		return;
 	}
-	fallback_note(sb, doc, s.ref, true);
+	fallback_note(sb, ix->doc, s.ref, true);
 	sb_printf(sb, "<p>Geometric mean over scenes of each figure relative to the reference "
 	              "builder <b>");
 	report_escape(sb, s.ref);
@@ -343,9 +358,14 @@ void report_summary_html(struct strbuf *sb, const cJSON *doc)
 	              "visited per ray. Pareto: among the rows of the same thread count over "
 	              "as many scenes (a builder that ran on 1 thread only counts at every "
 	              "thread count), on the front of build time against SAH cost, or the "
-	              "fastest row on it at least as fast and as good.</p>\n"
-	              "<table class=\"summary\">"
-	              "<tr><th class=\"l\">builder</th><th>threads</th><th>scenes</th>");
+	              "fastest row on it at least as fast and as good.</p>\n");
+	if (s.machines) {
+		sb_printf(sb, "<p class=\"warn\">");
+		sb_printf(sb, machines_note, ix->machine_count);
+		sb_printf(sb, "</p>\n");
+	}
+	sb_printf(sb, "<table class=\"summary\"><tr><th class=\"l\">builder</th><th>threads</th>"
+	              "%s<th>scenes</th>", s.machines ? "<th>machine</th>" : "");
 	for (int m = 0; m < SUMMARY_METRICS; m++)
 		sb_printf(sb, "<th>%s</th>", metric_names[m]);
 	sb_printf(sb, "<th class=\"l\">Pareto (time × SAH)</th></tr>\n");

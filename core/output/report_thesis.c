@@ -2,11 +2,15 @@
  * The thesis's table shape in report.md: for each thread count above 1,
  * one row per scene with the sequential build time and, for every other
  * builder, its time, its gain (t_seq - t) / t_seq and its speedup
- * t_seq / t. The sequential time is the first ok run of plugin sah_seq
- * with 1 thread. Only ok runs count; a missing one shows as "—". When a
- * thread count appears twice for a builder (threads 0 resolving to a
- * count also listed), the first ok run is used. A table that would hold
- * only dashes is left out: no sah_seq time, or no builder at that count.
+ * t_seq / t. The sequential time is the first ok 1-thread run of the
+ * report's reference builder (report.reference, default sah_seq; no table
+ * when the one asked for did not run). Only ok runs count; a missing one
+ * shows as "—". When a thread count appears twice for a builder (threads
+ * 0 resolving to a count also listed), the first ok run is used. A table
+ * that would hold only dashes is left out: no sequential time, or no
+ * builder at that count. Runs from several machines (a merged sweep) give
+ * one row per scene and machine: a time is only set against the same
+ * machine's sequential time.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -16,7 +20,6 @@
 #include "output/report.h"
 #include "util/util.h"
 
-#define SEQ_PLUGIN "sah_seq"
 #define MAX_COLUMNS 32
 #define MAX_THREAD_COUNTS 32
 #define MISSING "—"
@@ -33,11 +36,12 @@ static double number(const cJSON *o, const char *key, double fallback)
 	return cJSON_IsNumber(v) ? v->valuedouble : fallback;
 }
 
-/* Median build time of the scene's first ok run that matches, or a
- * negative number. Only the scene's runs are looked at (the index), so a
- * table costs the run count times its columns and thread counts. */
-static double median_ms(const struct report_index *ix, const char *scene, const char *key,
-                        const char *value, double threads)
+/* Median build time of the scene's first ok run of the builder on the
+ * machine (-1: any) that matches, or a negative number. Only the scene's
+ * runs are looked at (the index), so a table costs the run count times
+ * its columns and thread counts. */
+static double median_ms(const struct report_index *ix, const char *scene, long machine,
+                        const char *builder, double threads)
 {
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
@@ -45,7 +49,8 @@ static double median_ms(const struct report_index *ix, const char *scene, const 
 	for (size_t k = 0; k < n; k++) {
 		const cJSON *run = runs[k];
 		if (strcmp(text(run, "status"), "ok") != 0 || number(run, "threads", -1) != threads ||
-		    strcmp(text(run, key), value) != 0)
+		    strcmp(text(run, "builder"), builder) != 0 ||
+		    (machine >= 0 && report_machine_number(ix, run) != machine))
 			continue;
 		double ms = number(cJSON_GetObjectItemCaseSensitive(run, "build_ms"), "median", -1);
 		if (ms > 0)
@@ -54,15 +59,15 @@ static double median_ms(const struct report_index *ix, const char *scene, const 
 	return -1;
 }
 
-/* Labels of the builders compared with sah_seq, in order of appearance. */
-static int columns(const cJSON *runs, const char **out)
+/* Labels of the builders compared with the reference, in order of appearance. */
+static int columns(const cJSON *runs, const char *ref, const char **out)
 {
 	const cJSON *run;
 	int n = 0;
 
 	cJSON_ArrayForEach(run, runs) {
 		const char *label = text(run, "builder");
-		bool seen = strcmp(text(run, "plugin"), SEQ_PLUGIN) == 0 || !*label;
+		bool seen = strcmp(label, ref) == 0 || !*label;
 		for (int i = 0; i < n && !seen; i++)
 			seen = strcmp(out[i], label) == 0;
 		if (!seen && n < MAX_COLUMNS)
@@ -95,9 +100,10 @@ static int thread_counts(const cJSON *runs, double *out)
 	return n;
 }
 
-static void header(struct strbuf *sb, double threads, const char **cols, int n)
+static void header(struct strbuf *sb, const char *ref, double threads, const char **cols,
+                   int n)
 {
-	sb_printf(sb, "\n### %.0f threads\n\n| scene | " SEQ_PLUGIN " 1 thread ms |", threads);
+	sb_printf(sb, "\n### %.0f threads\n\n| scene | %s 1 thread ms |", threads, ref);
 	for (int i = 0; i < n; i++)
 		sb_printf(sb, " %s ms | gain | speedup |", cols[i]);
 	sb_printf(sb, "\n|---|---:|");
@@ -106,17 +112,33 @@ static void header(struct strbuf *sb, double threads, const char **cols, int n)
 	sb_printf(sb, "\n");
 }
 
-static void row(struct strbuf *sb, const struct report_index *ix, const char *scene,
-                double threads, const char **cols, int n)
+/* Whether the machine measured some run of the scene. */
+static bool measured_on(const struct report_index *ix, const char *scene, long machine)
 {
-	double seq = median_ms(ix, scene, "plugin", SEQ_PLUGIN, 1);
+	size_t n;
+	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
+	for (size_t k = 0; k < n; k++)
+		if (report_machine_number(ix, runs[k]) == machine)
+			return true;
+	return false;
+}
 
-	if (seq > 0)
-		sb_printf(sb, "| %s | %.2f |", scene, seq);
+/* The scene's row of one machine; "scene (M2)" when there are several. */
+static void row(struct strbuf *sb, const struct report_index *ix, const char *ref,
+                const char *scene, long machine, double threads, const char **cols, int n)
+{
+	double seq = median_ms(ix, scene, machine, ref, 1);
+
+	if (ix->machine_count > 1)
+		sb_printf(sb, "| %s (M%ld) |", scene, machine + 1);
 	else
-		sb_printf(sb, "| %s | " MISSING " |", scene);
+		sb_printf(sb, "| %s |", scene);
+	if (seq > 0)
+		sb_printf(sb, " %.2f |", seq);
+	else
+		sb_printf(sb, " " MISSING " |");
 	for (int i = 0; i < n; i++) {
-		double t = median_ms(ix, scene, "builder", cols[i], threads);
+		double t = median_ms(ix, scene, machine, cols[i], threads);
 		if (t <= 0)
 			sb_printf(sb, " " MISSING " | " MISSING " | " MISSING " |");
 		else if (seq <= 0)
@@ -127,13 +149,13 @@ static void row(struct strbuf *sb, const struct report_index *ix, const char *sc
 	sb_printf(sb, "\n");
 }
 
-/* Whether some scene has a time for the builder (key = value) at threads. */
-static bool any_time(const cJSON *doc, const struct report_index *ix, const char *key,
-                     const char *value, double threads)
+/* Whether some scene has a time for the builder at threads. */
+static bool any_time(const cJSON *doc, const struct report_index *ix, const char *builder,
+                     double threads)
 {
 	const cJSON *scene;
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItemCaseSensitive(doc, "scenes"))
-		if (median_ms(ix, text(scene, "name"), key, value, threads) > 0)
+		if (median_ms(ix, text(scene, "name"), -1, builder, threads) > 0)
 			return true;
 	return false;
 }
@@ -145,35 +167,53 @@ static int columns_at(const cJSON *doc, const struct report_index *ix, double th
 {
 	int m = 0;
 	for (int i = 0; i < n; i++)
-		if (any_time(doc, ix, "builder", cols[i], threads))
+		if (any_time(doc, ix, cols[i], threads))
 			out[m++] = cols[i];
 	return m;
+}
+
+/* The title and what the table holds. */
+static void intro(struct strbuf *sb, const char *ref)
+{
+	sb_printf(sb, "\n## Parallel builders against %s\n\nThe thesis's table: median build "
+	              "times in ms; the sequential time is %s on 1 thread; gain = (t_seq − t) / "
+	              "t_seq, speedup = t_seq / t. Only ok runs count; " MISSING " marks a missing "
+	              "one.\n", ref, ref);
+}
+
+/* The rows of one thread count: per scene, one per machine that measured it. */
+static void rows(struct strbuf *sb, const cJSON *doc, const struct report_index *ix,
+                 const char *ref, double threads, const char **cols, int n)
+{
+	const cJSON *scene;
+	cJSON_ArrayForEach(scene, cJSON_GetObjectItemCaseSensitive(doc, "scenes"))
+		for (long m = 0; m < (long)ix->machine_count; m++)
+			if (ix->machine_count == 1 || measured_on(ix, text(scene, "name"), m))
+				row(sb, ix, ref, text(scene, "name"), m, threads, cols, n);
 }
 
 void report_thesis(struct strbuf *sb, const cJSON *doc, const struct report_index *ix)
 {
 	const cJSON *runs = cJSON_GetObjectItemCaseSensitive(doc, "runs");
-	const cJSON *scene;
-	const char *cols[MAX_COLUMNS], *shown[MAX_COLUMNS];
+	const char *cols[MAX_COLUMNS], *shown[MAX_COLUMNS], *asked;
 	double counts[MAX_THREAD_COUNTS];
-	int ncols = columns(runs, cols), ncounts = thread_counts(runs, counts);
-	bool titled = false;
+	bool titled = false, fallback;
+	const char *ref = report_reference(doc, &asked, &fallback);
+	if (!ref || fallback) /* the builder asked for did not run: no sequential time */
+		return;
+	int ncols = columns(runs, ref, cols), ncounts = thread_counts(runs, counts);
 
 	/* Without a sequential time every gain and speedup would be a dash. */
-	if (ncols == 0 || ncounts == 0 || !any_time(doc, ix, "plugin", SEQ_PLUGIN, 1))
+	if (ncols == 0 || ncounts == 0 || !any_time(doc, ix, ref, 1))
 		return;
 	for (int k = 0; k < ncounts; k++) {
 		int nshown = columns_at(doc, ix, counts[k], cols, ncols, shown);
 		if (nshown == 0)
 			continue;
 		if (!titled)
-			sb_printf(sb, "\n## Parallel builders against " SEQ_PLUGIN "\n\n"
-			              "The thesis's table: median build times in ms; the sequential time "
-			              "is " SEQ_PLUGIN " on 1 thread; gain = (t_seq − t) / t_seq, speedup "
-			              "= t_seq / t. Only ok runs count; " MISSING " marks a missing one.\n");
+			intro(sb, ref);
 		titled = true;
-		header(sb, counts[k], shown, nshown);
-		cJSON_ArrayForEach(scene, cJSON_GetObjectItemCaseSensitive(doc, "scenes"))
-			row(sb, ix, text(scene, "name"), counts[k], shown, nshown);
+		header(sb, ref, counts[k], shown, nshown);
+		rows(sb, doc, ix, ref, counts[k], shown, nshown);
 	}
 }

@@ -344,10 +344,9 @@ static cJSON *find_run(const struct results *res, const char *scene, const char 
 	return find_any(res, scene, builder, threads, false);
 }
 
-bool results_has_run(const struct results *res, const char *scene, const char *builder,
-                     uint32_t threads)
+bool results_has_run(const struct results *res, const struct run_identity *key)
 {
-	return find_run(res, scene, builder, threads) != NULL;
+	return find_run(res, key->scene, key->builder, key->threads) != NULL;
 }
 
 /* Marks a run to be made again; it stays in the document (and the file)
@@ -464,8 +463,8 @@ static int same_plan(const cJSON *doc, const cJSON *old, const char *path, bvhla
 	return -EINVAL;
 }
 
-int results_resume(struct results *res, const struct config *cfg, size_t *kept, size_t *not_ok,
-                   bvhlab_error *err)
+int results_resume(struct results *res, const struct run_identity *keys, size_t key_count,
+                   size_t *kept, size_t *not_ok, bvhlab_error *err)
 {
 	char path[4096], *text = NULL;
 	*kept = *not_ok = 0;
@@ -483,7 +482,8 @@ int results_resume(struct results *res, const struct config *cfg, size_t *kept, 
 		          "to start afresh)", path);
 		r = -EINVAL;
 	} else {
-		r = results_check_runs(cJSON_GetObjectItemCaseSensitive(old, "runs"), cfg, path, err);
+		r = results_check_runs(cJSON_GetObjectItemCaseSensitive(old, "runs"), keys, key_count,
+		                       path, err);
 	}
 	if (r == 0)
 		r = same_plan(res->doc, old, path, err);
@@ -517,20 +517,20 @@ int results_set_scene_image(struct results *res, const char *scene, const char *
 	return 0;
 }
 
-int results_set_run_image(struct results *res, const char *scene, const char *builder,
-                          uint32_t threads, const char *name)
+int results_set_run_image(struct results *res, const struct run_identity *key,
+                          const char *name)
 {
-	cJSON *run = find_run(res, scene, builder, threads);
+	cJSON *run = find_run(res, key->scene, key->builder, key->threads);
 	if (!run)
 		return -ENOENT;
 	cJSON_DeleteItemFromObjectCaseSensitive(run, "heat_image");
 	return cJSON_AddStringToObject(run, "heat_image", name) ? 0 : -ENOMEM;
 }
 
-int results_set_run_rays(struct results *res, const char *scene, const char *builder,
-                         uint32_t threads, const struct ray_metrics *m)
+int results_set_run_rays(struct results *res, const struct run_identity *key,
+                         const struct ray_metrics *m)
 {
-	cJSON *run = find_run(res, scene, builder, threads);
+	cJSON *run = find_run(res, key->scene, key->builder, key->threads);
 	cJSON *rays = run ? results_rays_json(m) : NULL;
 	if (!run)
 		return -ENOENT;

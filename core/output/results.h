@@ -29,6 +29,16 @@ struct results {
 	int lock_fd;
 };
 
+/* Who a run is: made once, in the run list (plan/plan.h), and the key a
+ * sweep, --resume and merge find its results by. */
+struct run_identity {
+	uint32_t id;              /* position in the run list */
+	const char *scene;
+	const char *builder;      /* the config's label for the builder */
+	uint32_t threads;         /* resolved thread count, >= 1 */
+	const char *options_hash; /* of its options and refine stages, or NULL */
+};
+
 /* Traversal counters and timings of one run's primary and diffuse rays,
  * by traversal (harness/harness_rays.c measures them). */
 struct ray_metrics {
@@ -159,13 +169,13 @@ int results_frames_csv(const struct cJSON *doc, const char *dir, bvhlab_error *e
 int results_set_scene_image(struct results *res, const char *scene, const char *kind,
                             const char *name, uint32_t lo, uint32_t hi);
 /* The run's "heat_image": name. */
-int results_set_run_image(struct results *res, const char *scene, const char *builder,
-                          uint32_t threads, const char *name);
+int results_set_run_image(struct results *res, const struct run_identity *key,
+                          const char *name);
 
 /* Replaces the run's "rays" (the interleaved rounds' timings come after
  * the run was recorded). -ENOENT when there is no such run. */
-int results_set_run_rays(struct results *res, const char *scene, const char *builder,
-                         uint32_t threads, const struct ray_metrics *m);
+int results_set_run_rays(struct results *res, const struct run_identity *key,
+                         const struct ray_metrics *m);
 
 /*
  * Takes over the finished runs (any status of docs/design.md's list) and the
@@ -174,18 +184,19 @@ int results_set_run_rays(struct results *res, const char *scene, const char *bui
  * file; another negative errno, with err naming the file, when it cannot be
  * read, is not a results document or fails results_check_runs.
  */
-int results_resume(struct results *res, const struct config *cfg, size_t *kept, size_t *not_ok,
-                   bvhlab_error *err);
+int results_resume(struct results *res, const struct run_identity *keys, size_t key_count,
+                   size_t *kept, size_t *not_ok, bvhlab_error *err);
 
 /*
- * The runs of a results.json to resume, against cfg: each an object with
- * a known status, a whole thread count up to CONFIG_MAX_THREADS, its
- * optional members of the right types, and an identity (scene, builder,
- * resolved thread count) that the config has and no other run repeats.
- * 0, or -EINVAL with err naming the file and the first bad run.
+ * The runs of a results.json to resume, against the sweep's run list
+ * (keys[key_count]): each an object with a known status, a whole thread
+ * count up to CONFIG_MAX_THREADS, its optional members of the right types,
+ * and an identity (scene, builder, resolved thread count) that one run of
+ * the list has and no other run repeats. 0, or -EINVAL with err naming the
+ * file and the first bad run.
  */
-int results_check_runs(const struct cJSON *runs, const struct config *cfg, const char *path,
-                       bvhlab_error *err);
+int results_check_runs(const struct cJSON *runs, const struct run_identity *keys,
+                       size_t key_count, const char *path, bvhlab_error *err);
 /*
  * Marks the runs of `builder` that were made with other options (their
  * "options_hash" is not options_hash; runs without one, or options_hash
@@ -204,9 +215,8 @@ bool results_all_ok(const struct results *res);
 /* "options": {name: value, ...} of resolved options (NULL: {}). */
 struct cJSON *results_options_json(const bvhlab_options *opts);
 
-/* Whether the document holds a run of scene x builder x threads. */
-bool results_has_run(const struct results *res, const char *scene, const char *builder,
-                     uint32_t threads);
+/* Whether the document holds the run (found by scene, builder and threads). */
+bool results_has_run(const struct results *res, const struct run_identity *key);
 
 /* ---- the output folder (results_dir.c) ---------------------------------- */
 

@@ -1,7 +1,7 @@
 /*
  * What --resume accepts from an earlier results.json. Its runs are taken
- * over as they are and the sweep skips every combination they cover, so a
- * run that is duplicated, belongs to no combination of the config, or has
+ * over as they are and the sweep skips every run of its list they cover, so
+ * a run that is duplicated, belongs to no run of the list, or has
  * fields of the wrong type or range would be kept forever and shown in
  * every report. Such a file is refused with the run named; the harness
  * has written nothing yet, so the file stays as it was.
@@ -18,65 +18,20 @@
 #include "output/results.h"
 #include "util/util.h"
 
-/* The config's scene x builder x thread count combinations, numbered. */
-struct combos {
-	const struct config *cfg;
-	size_t *offset;     /* [builder_count]: first thread slot of each builder */
-	size_t per_scene;   /* thread slots of all builders */
-	unsigned char *seen; /* [scene_count * per_scene] */
+/* The sweep's runs, each to be claimed by one kept run at most. */
+struct claims {
+	const struct run_identity *keys;
+	size_t count;
+	unsigned char *seen; /* [count] */
 };
 
-static const uint32_t *thread_list(const struct config *cfg, size_t b, size_t *n)
+/* The run of the list with this identity, or -1. */
+static long find_key(const struct claims *c, const char *scene, const char *builder,
+                     double threads)
 {
-	const struct config_builder *cb = &cfg->builders[b];
-	*n = cb->threads ? cb->thread_count : cfg->thread_count;
-	return cb->threads ? cb->threads : cfg->threads;
-}
-
-static int combos_init(struct combos *c, const struct config *cfg)
-{
-	c->cfg = cfg;
-	c->per_scene = 0;
-	c->offset = calloc(cfg->builder_count + 1, sizeof(*c->offset));
-	for (size_t b = 0; c->offset && b < cfg->builder_count; b++) {
-		size_t n;
-		thread_list(cfg, b, &n);
-		c->offset[b] = c->per_scene;
-		c->per_scene += n;
-	}
-	c->seen = calloc(cfg->scene_count * c->per_scene + 1, 1);
-	return c->offset && c->seen ? 0 : -ENOMEM;
-}
-
-static void combos_finish(struct combos *c)
-{
-	free(c->offset);
-	free(c->seen);
-}
-
-static long find_scene(const struct config *cfg, const char *name)
-{
-	for (size_t s = 0; s < cfg->scene_count; s++)
-		if (strcmp(cfg->scenes[s].name, name) == 0)
-			return (long)s;
-	return -1;
-}
-
-static long find_builder(const struct config *cfg, const char *name)
-{
-	for (size_t b = 0; b < cfg->builder_count; b++)
-		if (strcmp(cfg->builders[b].name, name) == 0)
-			return (long)b;
-	return -1;
-}
-
-/* The slot of thread count t among builder b's (0 resolved), or -1. */
-static long find_threads(const struct config *cfg, size_t b, double t)
-{
-	size_t n;
-	const uint32_t *list = thread_list(cfg, b, &n);
-	for (size_t k = 0; k < n; k++)
-		if ((list[k] ? list[k] : bvhlab_hardware_threads()) == t)
+	for (size_t k = 0; k < c->count; k++)
+		if (c->keys[k].threads == threads && strcmp(c->keys[k].scene, scene) == 0 &&
+		    strcmp(c->keys[k].builder, builder) == 0)
 			return (long)k;
 	return -1;
 }
@@ -160,7 +115,7 @@ static const char *optional_fields(const cJSON *run)
 }
 
 /* NULL when run is acceptable and new; else what is wrong with it. */
-static const char *check_run(struct combos *c, const cJSON *run, char *why, size_t size)
+static const char *check_run(struct claims *c, const cJSON *run, char *why, size_t size)
 {
 	const char *scene = string_of(run, "scene"), *builder = string_of(run, "builder");
 	const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
@@ -170,26 +125,24 @@ static const char *check_run(struct combos *c, const cJSON *run, char *why, size
 		return "\"threads\" is not a whole number from 1 to the limit of 1024";
 	if (!known_status(string_of(run, "status")))
 		return "\"status\" is none of ok, invalid, failed, crashed, timeout";
-	long s = find_scene(c->cfg, scene), b = find_builder(c->cfg, builder);
-	long k = b < 0 ? -1 : find_threads(c->cfg, (size_t)b, t->valuedouble);
-	if (s < 0 || b < 0 || k < 0)
+	long k = find_key(c, scene, builder, t->valuedouble);
+	if (k < 0)
 		return "is not a run of this config (scene, builder or thread count unknown)";
 	const char *field = optional_fields(run);
 	if (*field) {
 		snprintf(why, size, "\"%s\" has the wrong type or a value out of range", field);
 		return why;
 	}
-	size_t slot = (size_t)s * c->per_scene + c->offset[b] + (size_t)k;
-	if (c->seen[slot])
+	if (c->seen[k])
 		return "repeats an earlier run of the same scene, builder and thread count";
-	c->seen[slot] = 1;
+	c->seen[k] = 1;
 	return NULL;
 }
 
-int results_check_runs(const cJSON *runs, const struct config *cfg, const char *path,
-                       bvhlab_error *err)
+int results_check_runs(const cJSON *runs, const struct run_identity *keys, size_t key_count,
+                       const char *path, bvhlab_error *err)
 {
-	struct combos c;
+	struct claims c = {.keys = keys, .count = key_count, .seen = calloc(key_count + 1, 1)};
 	char why[128];
 	int k = 0, r = 0;
 	const cJSON *run;
@@ -198,8 +151,7 @@ int results_check_runs(const cJSON *runs, const struct config *cfg, const char *
 		          path);
 		return -EINVAL;
 	}
-	if (combos_init(&c, cfg) < 0) {
-		combos_finish(&c);
+	if (!c.seen) {
 		error_set(err, "cannot resume from %s: out of memory", path);
 		return -ENOMEM;
 	}
@@ -214,6 +166,6 @@ int results_check_runs(const cJSON *runs, const struct config *cfg, const char *
 		}
 		k++;
 	}
-	combos_finish(&c);
+	free(c.seen);
 	return r;
 }

@@ -3,10 +3,11 @@
  * the runs of a config with stable ids, plan.json, and joining the
  * results folders of a plan's parts into one.
  *
- * A run's id is its position in the order `bvhlab run` takes the runs:
- * scenes outermost, then builders (grids expanded), then the builder's
- * thread counts as configured. Ids depend on the config alone, never on
- * the machine (threads 0 stays 0 until a run resolves it).
+ * A run's id is its position in the run list, the order `bvhlab run`
+ * takes the runs: scenes outermost, then builders (grids expanded), then
+ * the builder's thread counts as configured, one for a serial builder. Ids
+ * depend on the config and the builders' PARALLEL flags, never on the
+ * machine's thread count.
  */
 #ifndef BVHLAB_CORE_PLAN_H
 #define BVHLAB_CORE_PLAN_H
@@ -18,35 +19,71 @@
 #include <bvhlab/types.h>
 
 #include "config/config.h"
+#include "output/results.h"
 
 struct cJSON;
 
-/* ---- runs (plan_runs.c) ------------------------------------------------------ */
+/* ---- the run list (plan_runs.c) ---------------------------------------------- */
 
+/* What the run list needs of a config builder (harness_builders.c opens them). */
+struct plan_builder {
+	bool serial;              /* its plugin loaded without the PARALLEL flag */
+	const char *options_hash; /* of its resolved options and stages, or NULL */
+};
+
+/* One run: its identity (results.h) and where it comes from in the config. */
 struct plan_run {
-	uint32_t id;
-	size_t scene, builder; /* indexes into the config's arrays */
-	uint32_t threads;      /* as configured: 0 = all cores of the machine that runs it */
+	struct run_identity key;  /* id, scene, builder, resolved threads, options_hash */
+	size_t scene, builder;    /* indexes into the config's arrays */
+	uint32_t threads;         /* as configured: 0 = all cores of the machine */
+};
+
+/* A builder's thread counts in the list: configured, resolved, and which one
+ * a serial builder runs at (the others are not applicable). */
+struct plan_threads {
+	const uint32_t *configured;
+	uint32_t *resolved;       /* [count] */
+	size_t count;
+	bool serial;
+	size_t first;             /* serial: the index of the one count it runs at */
+};
+
+struct run_list {
+	const struct config *cfg;
+	struct plan_run *runs;    /* [count], in id order */
+	size_t count;
+	size_t *scene_first;      /* [scene_count + 1]: scene s has runs [first[s], first[s + 1]) */
+	struct plan_threads *threads; /* [builder_count] */
 };
 
 /* The builder's thread counts: its own list or the config's. */
 const uint32_t *plan_builder_threads(const struct config *cfg, const struct config_builder *b,
                                      size_t *count);
 /*
- * A run's thread count is resolved once, when the run list is made: 0
- * becomes this machine's hardware threads. plan_check_threads refuses
- * (-EINVAL, err naming the list and "duplicate thread count N") a list in
- * which 0 resolves to a count it already has; plan_resolve_threads checks
- * and then resolves every list of cfg in place (ids do not change).
+ * Refuses (-EINVAL, err naming the list and "duplicate thread count N") a
+ * thread list of cfg in which 0 (all cores) resolves to a count it
+ * already has: the two would be one run twice.
  */
 int plan_check_threads(const struct config *cfg, bvhlab_error *err);
-int plan_resolve_threads(struct config *cfg, bvhlab_error *err);
-size_t plan_run_count(const struct config *cfg);
-/* The id of scene x builder x thread_index. */
-uint32_t plan_run_id(const struct config *cfg, size_t scene, size_t builder,
-                     size_t thread_index);
-/* Every run in id order; *runs is malloc'd ([plan_run_count]). */
-int plan_runs(const struct config *cfg, struct plan_run **runs, size_t *count);
+/*
+ * The config's runs, made once: scenes outermost, then builders (grids
+ * expanded), then the builder's thread counts as configured, ids from 0 in
+ * that order. Thread counts are resolved here and nowhere else (0 becomes
+ * this machine's hardware threads; plan_check_threads first). A builder
+ * with `serial` runs once per scene, at the first of its counts that
+ * resolves to 1 (else its first): its other counts are not in the list.
+ * builders ([builder_count]) NULL: every builder parallel, no hashes.
+ * 0, -EINVAL (err set) or -ENOMEM.
+ */
+int plan_list_make(struct run_list *list, const struct config *cfg,
+                   const struct plan_builder *builders, bvhlab_error *err);
+void plan_list_finish(struct run_list *list);
+/* The run of scene x builder at its configured thread index, or NULL. */
+const struct plan_run *plan_list_find(const struct run_list *list, size_t scene,
+                                      size_t builder, size_t thread_index);
+/* A builder's first run in scene s, or NULL. */
+const struct plan_run *plan_list_first(const struct run_list *list, size_t scene,
+                                       size_t builder);
 
 /*
  * "3,7,10-12" into a selection of ids: (*only)[id] is true for the chosen
@@ -69,12 +106,13 @@ struct plan_file {
 };
 
 /*
- * Writes DIR/plan.json for a loaded config: the config with every path
- * made absolute, its hash, the source file's hash and the run list. An
+ * Writes DIR/plan.json for a loaded config's run list: the config with
+ * every path made absolute, its hash, the source file's hash and the runs
+ * (threads as configured). An
  * existing plan.json is kept when it is the same plan and refused (-EEXIST,
  * err naming it) when it is another. *plan is filled as plan_file_load would.
  */
-int plan_file_write(const struct config *cfg, const char *dir, struct plan_file *plan,
+int plan_file_write(const struct run_list *list, const char *dir, struct plan_file *plan,
                     bvhlab_error *err);
 
 /* The whole file's text (malloc'd); err names the file. */
@@ -93,6 +131,10 @@ bool plan_file_detect(const char *path);
 int plan_file_load(struct plan_file *plan, const char *path, struct config *cfg,
                    bvhlab_error *err);
 void plan_file_finish(struct plan_file *plan);
+/* The run list made here against the plan's: the same runs under the same
+ * ids, or -EINVAL with err saying where they part (plan again). */
+int plan_check_list(const struct plan_file *plan, const struct run_list *list,
+                    bvhlab_error *err);
 
 /* ---- scene files (plan_scenes.c) ------------------------------------------- */
 

@@ -118,25 +118,22 @@ static int doc_hash(const cJSON *config, const cJSON *files, char out[17])
 	return 0;
 }
 
-static cJSON *runs_json(const struct config *cfg)
+/* The run list as planned: threads as configured (0 resolves where it runs). */
+static cJSON *runs_json(const struct run_list *list)
 {
-	struct plan_run *runs;
-	size_t n;
 	cJSON *array = cJSON_CreateArray();
-	if (!array || plan_runs(cfg, &runs, &n) < 0) {
-		cJSON_Delete(array);
-		return NULL;
-	}
-	for (size_t k = 0; k < n; k++) {
+	for (size_t k = 0; array && k < list->count; k++) {
+		const struct plan_run *run = &list->runs[k];
 		cJSON *o = cJSON_CreateObject();
 		cJSON_AddItemToArray(array, o);
-		cJSON_AddNumberToObject(o, "id", runs[k].id);
-		cJSON_AddStringToObject(o, "scene", cfg->scenes[runs[k].scene].name);
-		cJSON_AddStringToObject(o, "builder", cfg->builders[runs[k].builder].name);
-		cJSON_AddStringToObject(o, "plugin", cfg->builders[runs[k].builder].plugin);
-		cJSON_AddNumberToObject(o, "threads", runs[k].threads);
+		cJSON_AddNumberToObject(o, "id", run->key.id);
+		cJSON_AddStringToObject(o, "scene", run->key.scene);
+		cJSON_AddStringToObject(o, "builder", run->key.builder);
+		cJSON_AddStringToObject(o, "plugin", list->cfg->builders[run->builder].plugin);
+		cJSON_AddNumberToObject(o, "threads", run->threads);
+		if (run->key.options_hash)
+			cJSON_AddStringToObject(o, "options_hash", run->key.options_hash);
 	}
-	free(runs);
 	return array;
 }
 
@@ -158,8 +155,10 @@ static int adopt(struct plan_file *plan, const char *path, cJSON *doc)
 	return plan->path ? 0 : -ENOMEM;
 }
 
-static cJSON *plan_doc(const struct config *cfg, cJSON *copy, cJSON *files, const char *hash)
+static cJSON *plan_doc(const struct run_list *list, cJSON *copy, cJSON *files,
+                       const char *hash)
 {
+	const struct config *cfg = list->cfg;
 	char source_hash[17], stamp[32];
 	char *source = absolute(cfg->path);
 	time_t now = time(NULL);
@@ -175,7 +174,7 @@ static cJSON *plan_doc(const struct config *cfg, cJSON *copy, cJSON *files, cons
 	cJSON_AddStringToObject(doc, "created", stamp);
 	cJSON_AddItemToObject(doc, "config", copy);
 	cJSON_AddItemToObject(doc, "scene_files", files);
-	cJSON_AddItemToObject(doc, "runs", runs_json(cfg));
+	cJSON_AddItemToObject(doc, "runs", runs_json(list));
 	free(source);
 	return doc;
 }
@@ -210,9 +209,10 @@ static int existing_plan(const struct config *cfg, const char *path, const char 
 	return r;
 }
 
-int plan_file_write(const struct config *cfg, const char *dir, struct plan_file *plan,
+int plan_file_write(const struct run_list *list, const char *dir, struct plan_file *plan,
                     bvhlab_error *err)
 {
+	const struct config *cfg = list->cfg;
 	char hash[17], path[4096];
 	memset(plan, 0, sizeof(*plan));
 	cJSON *copy = config_copy(cfg), *files = plan_scene_files(cfg);
@@ -230,7 +230,7 @@ int plan_file_write(const struct config *cfg, const char *dir, struct plan_file 
 		cJSON_Delete(files);
 		return r;
 	}
-	cJSON *doc = plan_doc(cfg, copy, files, hash);
+	cJSON *doc = plan_doc(list, copy, files, hash);
 	char *out = doc ? cJSON_Print(doc) : NULL;
 	r = out ? results_make_dirs(dir, err) : -ENOMEM;
 	if (r == 0)
@@ -340,17 +340,41 @@ int plan_file_load(struct plan_file *plan, const char *path, struct config *cfg,
 		r = text ? config_parse(cfg, path, text, err) : -ENOMEM;
 	}
 	free(text);
-	if (r == 0 && cfg && plan_run_count(cfg) != plan->run_count) {
-		error_set(err, "%s: its config makes %zu runs but it lists %zu; plan again", path,
-		          plan_run_count(cfg), plan->run_count);
-		config_finish(cfg);
-		r = -EINVAL;
-	}
 	if (r == 0 && cfg && (r = plan_check_scene_files(plan, cfg, err)) < 0)
 		config_finish(cfg);
 	if (r < 0)
 		plan_file_finish(plan);
 	return r;
+}
+
+/* One run of the plan against the list's run of its id. */
+static bool same_run(const cJSON *want, const struct plan_run *run)
+{
+	const cJSON *id = cJSON_GetObjectItemCaseSensitive(want, "id");
+	const cJSON *threads = cJSON_GetObjectItemCaseSensitive(want, "threads");
+	const char *scene = string_at(want, "scene"), *builder = string_at(want, "builder");
+	return cJSON_IsNumber(id) && id->valuedouble == run->key.id && cJSON_IsNumber(threads) &&
+	       threads->valuedouble == run->threads && scene && !strcmp(scene, run->key.scene) &&
+	       builder && !strcmp(builder, run->key.builder);
+}
+
+int plan_check_list(const struct plan_file *plan, const struct run_list *list,
+                    bvhlab_error *err)
+{
+	const cJSON *runs = cJSON_GetObjectItemCaseSensitive(plan->doc, "runs"), *want;
+	size_t k = 0;
+	cJSON_ArrayForEach(want, runs) {
+		if (k >= list->count || !same_run(want, &list->runs[k]))
+			break;
+		k++;
+	}
+	if (k == list->count && k == plan->run_count)
+		return 0;
+	error_set(err, "%s: this machine makes %zu runs of its config and the plan lists %zu, "
+	          "%s at run %zu (a builder's plugin here differs: its PARALLEL flag?); plan again "
+	          "here", plan->path, list->count, plan->run_count,
+	          k < list->count && k < plan->run_count ? "differing" : "ending", k);
+	return -EINVAL;
 }
 
 void plan_file_finish(struct plan_file *plan)

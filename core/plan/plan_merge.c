@@ -279,6 +279,28 @@ static void add_scenes(cJSON *scenes, const struct merge *m)
 	}
 }
 
+/* Every part notes the thread counts its run list left out (a serial
+ * builder's): the merge states each builder's once, as one run does. */
+static void add_not_applicable(cJSON *doc, const struct merge *m)
+{
+	cJSON *list = NULL;
+	for (size_t p = 0; p < m->part_count; p++) {
+		const cJSON *e;
+		cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(m->parts[p].doc,
+		                                                      "not_applicable")) {
+			const char *builder = string_at(e, "builder");
+			const cJSON *seen;
+			bool known = false;
+			cJSON_ArrayForEach(seen, list)
+				known = known || (builder && same_string(seen, e, "builder"));
+			if (!builder || known ||
+			    (!list && !(list = cJSON_AddArrayToObject(doc, "not_applicable"))))
+				continue;
+			cJSON_AddItemToArray(list, cJSON_Duplicate(e, 1));
+		}
+	}
+}
+
 static cJSON *merged_header(const struct merge *m)
 {
 	char stamp[32];
@@ -449,6 +471,7 @@ static int write_merged(const struct merge *m, const char *dir, struct merge_sum
 	}
 	if (r == 0) {
 		add_scenes(res.scenes, m);
+		add_not_applicable(res.doc, m);
 		r = build_runs(m, res.runs, sum);
 	}
 	if (r == -ENOMEM)

@@ -1,6 +1,7 @@
 /*
- * The runs of a config with their ids: the order `bvhlab run` takes them,
- * so a plan's ids, `--only` and `--resume` all name the same runs.
+ * The run list: the runs of a config with their ids and identities, made
+ * once, in the order `bvhlab run` takes them, so a plan's ids, `--only`,
+ * `--resume` and merge all name the same runs.
  */
 #include <errno.h>
 #include <stdio.h>
@@ -49,69 +50,107 @@ int plan_check_threads(const struct config *cfg, bvhlab_error *err)
 	return r;
 }
 
-static void resolve_list(uint32_t *list, size_t n)
+/* The one place a thread count of 0 becomes this machine's. A serial
+ * builder ignores its count, so it runs once: at 1 thread when it can. */
+static int resolve(struct plan_threads *t, const struct config *cfg,
+                   const struct config_builder *cb, bool serial)
 {
-	for (size_t k = 0; k < n; k++)
-		list[k] = list[k] ? list[k] : bvhlab_hardware_threads();
+	t->configured = plan_builder_threads(cfg, cb, &t->count);
+	t->resolved = calloc(t->count ? t->count : 1, sizeof(*t->resolved));
+	if (!t->resolved)
+		return -ENOMEM;
+	t->serial = serial;
+	t->first = 0;
+	for (size_t k = 0; k < t->count; k++)
+		t->resolved[k] = t->configured[k] ? t->configured[k] : bvhlab_hardware_threads();
+	for (size_t k = t->count; serial && k-- > 0;)
+		t->first = t->resolved[k] == 1 ? k : t->first;
+	return 0;
 }
 
-int plan_resolve_threads(struct config *cfg, bvhlab_error *err)
+static bool listed(const struct plan_threads *t, size_t k)
 {
+	return !t->serial || k == t->first;
+}
+
+/* Every builder's runs of scene s, appended to the list. */
+static void add_scene(struct run_list *list, size_t s, const struct plan_builder *builders)
+{
+	const struct config *cfg = list->cfg;
+	list->scene_first[s] = list->count;
+	for (size_t b = 0; b < cfg->builder_count; b++) {
+		const struct plan_threads *t = &list->threads[b];
+		for (size_t k = 0; k < t->count; k++) {
+			if (!listed(t, k))
+				continue;
+			struct plan_run *run = &list->runs[list->count];
+			*run = (struct plan_run){.scene = s, .builder = b, .threads = t->configured[k]};
+			run->key = (struct run_identity){
+				.id = (uint32_t)list->count, .scene = cfg->scenes[s].name,
+				.builder = cfg->builders[b].name, .threads = t->resolved[k],
+				.options_hash = builders ? builders[b].options_hash : NULL};
+			list->count++;
+		}
+	}
+	list->scene_first[s + 1] = list->count;
+}
+
+int plan_list_make(struct run_list *list, const struct config *cfg,
+                   const struct plan_builder *builders, bvhlab_error *err)
+{
+	size_t per_scene = 0;
+	memset(list, 0, sizeof(*list));
+	list->cfg = cfg;
 	int r = plan_check_threads(cfg, err);
 	if (r < 0)
 		return r;
-	resolve_list(cfg->threads, cfg->thread_count);
-	for (size_t b = 0; b < cfg->builder_count; b++)
-		if (cfg->builders[b].threads)
-			resolve_list(cfg->builders[b].threads, cfg->builders[b].thread_count);
-	return 0;
-}
-
-/* Runs of one scene: every builder's thread counts. */
-static size_t runs_per_scene(const struct config *cfg)
-{
-	size_t total = 0, n;
-	for (size_t b = 0; b < cfg->builder_count; b++) {
-		plan_builder_threads(cfg, &cfg->builders[b], &n);
-		total += n;
+	list->threads = calloc(cfg->builder_count + 1, sizeof(*list->threads));
+	list->scene_first = calloc(cfg->scene_count + 1, sizeof(*list->scene_first));
+	r = list->threads && list->scene_first ? 0 : -ENOMEM;
+	for (size_t b = 0; r == 0 && b < cfg->builder_count; b++) {
+		r = resolve(&list->threads[b], cfg, &cfg->builders[b], builders && builders[b].serial);
+		per_scene += list->threads[b].serial ? 1 : list->threads[b].count;
 	}
-	return total;
-}
-
-size_t plan_run_count(const struct config *cfg)
-{
-	return runs_per_scene(cfg) * cfg->scene_count;
-}
-
-uint32_t plan_run_id(const struct config *cfg, size_t scene, size_t builder,
-                     size_t thread_index)
-{
-	size_t id = scene * runs_per_scene(cfg), n;
-	for (size_t b = 0; b < builder; b++) {
-		plan_builder_threads(cfg, &cfg->builders[b], &n);
-		id += n;
+	if (r == 0 && !(list->runs = calloc(per_scene * cfg->scene_count + 1, sizeof(*list->runs))))
+		r = -ENOMEM;
+	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
+		add_scene(list, s, builders);
+	if (r < 0) {
+		plan_list_finish(list);
+		error_set(err, "out of memory");
 	}
-	return (uint32_t)(id + thread_index);
+	return r;
 }
 
-int plan_runs(const struct config *cfg, struct plan_run **runs, size_t *count)
+void plan_list_finish(struct run_list *list)
 {
-	size_t total = plan_run_count(cfg), k = 0;
-	*runs = calloc(total ? total : 1, sizeof(**runs));
-	*count = 0;
-	if (!*runs)
-		return -ENOMEM;
-	for (size_t s = 0; s < cfg->scene_count; s++) {
-		for (size_t b = 0; b < cfg->builder_count; b++) {
-			size_t n;
-			const uint32_t *threads = plan_builder_threads(cfg, &cfg->builders[b], &n);
-			for (size_t t = 0; t < n; t++, k++)
-				(*runs)[k] = (struct plan_run){.id = (uint32_t)k, .scene = s, .builder = b,
-				                               .threads = threads[t]};
-		}
+	for (size_t b = 0; list->threads && b < list->cfg->builder_count; b++)
+		free(list->threads[b].resolved);
+	free(list->threads);
+	free(list->scene_first);
+	free(list->runs);
+	memset(list, 0, sizeof(*list));
+}
+
+const struct plan_run *plan_list_find(const struct run_list *list, size_t scene,
+                                      size_t builder, size_t thread_index)
+{
+	for (size_t k = list->scene_first[scene]; k < list->scene_first[scene + 1]; k++) {
+		const struct plan_run *run = &list->runs[k];
+		if (run->builder == builder &&
+		    run->key.threads == list->threads[builder].resolved[thread_index])
+			return run;
 	}
-	*count = total;
-	return 0;
+	return NULL;
+}
+
+const struct plan_run *plan_list_first(const struct run_list *list, size_t scene,
+                                       size_t builder)
+{
+	for (size_t k = list->scene_first[scene]; k < list->scene_first[scene + 1]; k++)
+		if (list->runs[k].builder == builder)
+			return &list->runs[k];
+	return NULL;
 }
 
 /* One "N" or "N-M" of an --only list; *end past it. */

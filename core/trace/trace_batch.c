@@ -12,7 +12,6 @@
 
 #include <bvhlab/machine.h>
 #include <bvhlab/trace.h>
-#include <bvhlab/traversal.h>
 
 #include "util/util.h"
 

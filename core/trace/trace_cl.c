@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include <bvhlab/opencl.h>
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "trace/trace_cl.h"
 #include "trace/trace_cl_source.h"

@@ -16,7 +16,7 @@
 #include <string.h>
 
 #include <bvhlab/machine.h>
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "trace/trace_batch.h"
 #include "trace/trace_cl.h"

@@ -13,7 +13,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 struct trace_series;
 

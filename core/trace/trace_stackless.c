@@ -15,7 +15,7 @@
 #include <errno.h>
 #include <stdlib.h>
 
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "trace/trace_kernel.h"
 

@@ -1,6 +1,6 @@
 /*
  * The wide traversal: the tree collapsed into 4-child nodes
- * (trace_wide_build.c), four slab tests per node in one vector pass, the
+ * (wide_bvh.c), four slab tests per node in one vector pass, the
  * children entered nearest first and the others kept on a stack with their
  * entry distances. Each slab test performs box_enter()'s float operations
  * lane by lane, and a leaf's triangles go through isect()'s shear and sign

@@ -58,7 +58,7 @@ struct wide_bvh {
  * Collapses tree into *w: each wide node takes a binary inner node's two
  * children and keeps opening the inner child of largest surface area until
  * it has four. 0; -EINVAL for links that leave the node array or reach a
- * node twice (validate first); -ENOMEM.
+ * node twice (validate first); -ENOMEM. (wide_bvh.c)
  */
 int wide_bvh_init(struct wide_bvh *w, const bvhlab_tree *tree, const bvhlab_scene *scene);
 void wide_bvh_finish(struct wide_bvh *w);

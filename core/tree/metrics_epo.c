@@ -10,7 +10,7 @@
 #include <stdlib.h>
 
 #include <bvhlab/epo.h>
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "util/util.h"
 

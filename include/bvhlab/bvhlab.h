@@ -10,8 +10,7 @@
  *   builder.h  the plugin ABI
  *   scene.h    triangle scenes: loading, generators, per-primitive data
  *   tree.h     the tree, validation, metrics, canonical compare
- *   trace.h    traversal, cameras and rays, batch tracing
- *   traversal.h  the stackless traversal and timed batches (repeated passes)
+ *   trace.h    traversals (stack, stackless, wide), cameras and rays, timed batches
  *   epo.h      end-point overlap, the sampled tree metric beside SAH
  *   host.h     loading plugins, their options, running a build
  *   machine.h  what threads = 0 means, thread pinning
@@ -28,7 +27,6 @@
 #include "machine.h"
 #include "scene.h"
 #include "trace.h"
-#include "traversal.h"
 #include "tree.h"
 #include "types.h"
 

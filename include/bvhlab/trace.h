@@ -4,7 +4,16 @@
  * (single ray, stack-based, near child first), brute force for checking,
  * primary rays from a pinhole camera, diffuse secondary rays from their
  * hits, and a multithreaded batch traversal that counts what each ray
- * cost. Every builder's tree is measured by this code, with the same rays.
+ * cost; beside the stack traversal a stackless one (parent links) and a
+ * wide one for batches (the tree collapsed into 4-child nodes), and a
+ * timed batch that repeats until enough time has passed, so a throughput
+ * figure is over many passes rather than one short interval. Every
+ * builder's tree is measured by this code, with the same rays.
+ *
+ * Every traversal returns the same closest hit for any ray on a valid tree:
+ * the closest (t, prim) pair, ties in t broken by the smaller primitive id
+ * (as bvhlab_trace_closest and bvhlab_trace_brute do), whatever order the
+ * nodes are visited in.
  */
 #ifndef BVHLAB_TRACE_H
 #define BVHLAB_TRACE_H
@@ -105,6 +114,115 @@ int bvhlab_trace_batch(const bvhlab_tree *tree, const bvhlab_scene *scene,
                        const bvhlab_ray *rays, size_t count, bool any_hit, uint32_t threads,
                        bvhlab_hit *hits, uint32_t *nodes, bvhlab_trace_stats *stats,
                        double *seconds);
+
+/* Which traversal a batch uses. */
+enum bvhlab_traversal {
+	BVHLAB_TRAVERSAL_STACK = 0,     /* bvhlab_trace_closest: near child first, stack of far ones */
+	BVHLAB_TRAVERSAL_STACKLESS = 1, /* bvhlab_trace_stackless: parent links, no stack */
+	BVHLAB_TRAVERSAL_WIDE = 2,      /* the tree collapsed into 4-child nodes, four box
+	                                 * tests at once, nearest child first (batches only) */
+	BVHLAB_TRAVERSAL_CL_STACK = 3,  /* the stack traversal as an OpenCL kernel on a
+	                                 * device (batches only; needs OpenCL built) */
+	BVHLAB_TRAVERSAL_CL_STACKLESS = 4, /* the stackless one likewise */
+	BVHLAB_TRAVERSAL_COUNT = 5      /* how many there are */
+};
+
+/* "stack" / "stackless" / "wide" / "cl_stack" / "cl_stackless"; NULL for
+ * another value. */
+const char *bvhlab_traversal_name(int traversal);
+
+/*
+ * The parent of every node of a tree, for the stackless traversal:
+ * (*parents)[root] = UINT32_MAX. *parents is malloc'd ([node_count]).
+ * 0, -EINVAL for a tree whose child links leave the node array or give a
+ * node two parents (validate first), -ENOMEM.
+ */
+int bvhlab_tree_parents(const bvhlab_tree *tree, uint32_t **parents);
+
+/*
+ * Closest hit (any_hit false) or any hit without a stack (Hapala et al.,
+ * "Efficient Stack-less BVH Traversal for Ray Tracing", SCCG 2011): the
+ * walk goes down into the near child, and back up through the parent
+ * links; which child is near is decided per ray from the children's box
+ * centres, so it is the same on the way down and on the way up. Memory per
+ * ray is constant. Initialises *hit like bvhlab_trace_closest; stats (may
+ * be NULL) counts nodes entered (a node entered again on the way up is not
+ * counted again) and triangle tests. parents from bvhlab_tree_parents.
+ * Returns whether something was hit.
+ */
+bool bvhlab_trace_stackless(const bvhlab_tree *tree, const uint32_t *parents,
+                            const bvhlab_scene *scene, const bvhlab_ray *ray, bool any_hit,
+                            bvhlab_hit *hit, bvhlab_trace_stats *stats);
+
+/* How bvhlab_trace_measure traces a batch. */
+typedef struct bvhlab_trace_options {
+	int traversal;        /* enum bvhlab_traversal */
+	bool any_hit;         /* occlusion rays: the first hit ends a ray */
+	uint32_t threads;     /* tracing threads; 0: bvhlab_hardware_threads() */
+	double min_ms;        /* repeat the batch until the tracing threads have run this
+	                       * long (CPU time per thread: a busy machine stretches a
+	                       * measurement instead of cutting its passes short) */
+	uint64_t min_rays;    /* ... and at least this many rays were traced (0: no minimum) */
+	uint32_t min_repeats; /* ... and at least this many passes (0 counts as 1), unless
+	                       * the passes so far took 10 x min_ms */
+	uint32_t max_repeats; /* at most this many passes (0: 10000) */
+	const char *device;   /* the cl_ traversals' OpenCL device: "auto" (NULL), "gpu",
+	                       * "cpu" or "P:D" (platform and device indices) */
+} bvhlab_trace_options;
+
+/*
+ * What bvhlab_trace_measure measured. Two clocks per pass: the wall clock,
+ * and the CPU time of the tracing threads (CLOCK_THREAD_CPUTIME_ID), which
+ * leaves out the time they waited for a core while other processes ran.
+ * cpu figures are rays per CPU second times the thread count: the
+ * throughput the threads would give with a core each to themselves; wall
+ * figures are what the batch really took.
+ *
+ * mrays_best goes one step further for a shared machine, where even CPU
+ * time swings with what else runs (caches refilled after each switch to
+ * another process): every tile of rays is timed on its own in every pass,
+ * each tile keeps its least CPU time over the passes, and the batch's time
+ * is the sum of those. A tile lasts tens of microseconds, so most passes
+ * leave each tile undisturbed at least once: the figure is the traversal's
+ * own speed, and it repeats between runs where the medians do not.
+ */
+/*
+ * The device traversals (cl_stack, cl_stackless) have no tiles or thread
+ * CPU time: their mrays_best is from the least kernel time over the
+ * passes (OpenCL profiling events), median, min and max are over the
+ * passes' kernel times, and the wall figures time each launch to its
+ * completion (the tree and rays are uploaded once, before the passes).
+ */
+typedef struct bvhlab_trace_timing {
+	bvhlab_trace_stats stats; /* counters of ONE pass: exact per-ray averages */
+	uint32_t threads;         /* threads that traced */
+	uint32_t repeats;         /* passes timed */
+	double seconds_total;     /* wall time of all passes */
+	double mrays_best;        /* million rays per CPU second x threads, from the
+	                           * least time of every tile over the passes */
+	double mrays_median;      /* million rays per CPU second x threads: median over passes */
+	double mrays_min, mrays_max;
+	double wall_mrays_median; /* million rays per wall-clock second: median over passes */
+	double wall_mrays_min, wall_mrays_max;
+} bvhlab_trace_timing;
+
+/*
+ * Traces the batch of `count` rays once, then again until the minimums of
+ * *opts are met; every pass is timed on its
+ * own, on both clocks, and the figures are over passes. Threads take tiles of rays
+ * from a shared counter; per ray nothing is allocated or locked. hits and
+ * nodes (may be NULL) get each ray's hit and count of nodes entered, from
+ * the first pass. For BVHLAB_TRAVERSAL_WIDE the counters and nodes still
+ * count the binary tree's nodes, from an extra untimed pass of the stack
+ * traversal, so they mean the same whatever traversal is timed; hits come
+ * from the first wide pass. 0, -EINVAL (bad traversal, tree links for
+ * stackless or wide), -ENOMEM, -ENOTSUP (a cl_ traversal in a build
+ * without OpenCL), -ENODEV (no OpenCL device), -EIO; then nothing was
+ * measured.
+ */
+int bvhlab_trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                         const bvhlab_ray *rays, size_t count, const bvhlab_trace_options *opts,
+                         bvhlab_hit *hits, uint32_t *nodes, bvhlab_trace_timing *timing);
 
 BVHLAB_END_DECLS
 

@@ -38,6 +38,7 @@
 #include <bvhlab/builder.hpp>
 
 #include "peer_tree.hpp"
+#include "plugin_options.h"
 
 namespace {
 
@@ -73,33 +74,37 @@ const bvhlab_option_decl options[] = {
 	 nullptr, 1e-6, 1e6, nullptr},
 };
 
+// one_thread's choices, by index.
+enum OneThread { sequential, pool_of_one };
+
 struct Settings {
 	const char *builder = "medium";
-	bool reinsertion = false, pool_at_one = false;
+	bool reinsertion = false;
+	int one_thread = sequential; // OneThread
 	int64_t min_leaf = 1, max_leaf = 8;
 	double cost_ratio = 1;
 };
 
+// The options into Settings (plugin_options.h): the host has checked them.
+const plugin_field fields[] = {
+	PLUGIN_FIELD(Settings, builder, "builder", STRING),
+	PLUGIN_FIELD(Settings, reinsertion, "reinsertion", BOOL),
+	PLUGIN_FIELD(Settings, one_thread, "one_thread", CHOICE),
+	PLUGIN_FIELD(Settings, min_leaf, "min_leaf", I64),
+	PLUGIN_FIELD(Settings, max_leaf, "max_leaf", I64),
+	PLUGIN_FIELD(Settings, cost_ratio, "cost_ratio", DOUBLE),
+};
+
+// What no declaration can say: min_leaf within max_leaf.
 int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, Settings &s)
 {
-	const char *one = nullptr;
-	int rc;
-	if ((rc = host->option_string(ctx, "builder", &s.builder)) < 0 ||
-	    (rc = host->option_bool(ctx, "reinsertion", &s.reinsertion)) < 0 ||
-	    (rc = host->option_string(ctx, "one_thread", &one)) < 0 ||
-	    (rc = host->option_int(ctx, "min_leaf", &s.min_leaf)) < 0 ||
-	    (rc = host->option_int(ctx, "max_leaf", &s.max_leaf)) < 0 ||
-	    (rc = host->option_float(ctx, "cost_ratio", &s.cost_ratio)) < 0) {
-		host->set_error(ctx, "cannot read the options (%s)", std::strerror(-rc));
-		return rc;
-	}
-	if (s.min_leaf > s.max_leaf) {
+	int rc = plugin_options_fill(host, ctx, options, fields, s);
+	if (rc == 0 && s.min_leaf > s.max_leaf) {
 		host->set_error(ctx, "min_leaf %lld exceeds max_leaf %lld",
 		                static_cast<long long>(s.min_leaf), static_cast<long long>(s.max_leaf));
 		return -EINVAL;
 	}
-	s.pool_at_one = std::strcmp(one, "pool") == 0;
-	return 0;
+	return rc;
 }
 
 Default::Config config_of(const Settings &s)
@@ -179,14 +184,11 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 	// sweep and binned are single-threaded: a pool only for what uses one.
 	bool top_down = std::strcmp(s.builder, "sweep") == 0 || std::strcmp(s.builder, "binned") == 0;
 	std::optional<bvh::v2::ThreadPool> pool;
-	if ((in->threads > 1 || s.pool_at_one) && (!top_down || s.reinsertion))
+	if ((in->threads > 1 || s.one_thread == pool_of_one) && (!top_down || s.reinsertion))
 		pool.emplace(in->threads);
 	Bvh bvh = run_builder(s, pool ? &*pool : nullptr, boxes, centers);
 	pool.reset(); // joins the workers inside the call
-	auto t1 = clk::now();
-	int rc = peer::write_tree(host, ctx, View{bvh}, out);
-	peer::report_phase(host, ctx, "convert", peer::ms_since(t1));
-	return rc;
+	return peer::convert(host, ctx, View{bvh}, out);
 }
 
 int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
@@ -194,14 +196,10 @@ int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_inp
 {
 	Settings s;
 	int rc = read_settings(host, ctx, s);
-	if (rc < 0)
-		return rc;
 	// 28 bits of the node's index address children and primitives.
-	if (in->prim_count == 0 || in->prim_count > Node::Index::max_first_id / 2) {
-		host->set_error(ctx, "cannot build over %u primitives", in->prim_count);
-		return -EINVAL;
-	}
-	return build_tree(host, ctx, in, s, out);
+	if (rc == 0)
+		rc = peer::check_prims(host, ctx, in, Node::Index::max_first_id / 2);
+	return rc < 0 ? rc : build_tree(host, ctx, in, s, out);
 }
 
 // Any exception out of build() becomes the run's error (bvhlab::guarded_build).

@@ -96,7 +96,19 @@ double reinsert_try(reinsert *r, uint32_t x, uint32_t d)
  * into slot d; then the other (B) beside Y (slot e), Y into A's old slot
  * and their parent into slot e. A place given as s means S, now at p.
  * Every slot written is logged first; taking the move back restores them
- * and refits the same paths, which restores the boxes above.
+ * and refits every path from a slot given to the undo up to the root.
+ *
+ * Those refits cannot stop early as refit_up does: a log entry holds a
+ * box as it was when the slot was logged, and a slot logged after an
+ * earlier step of the same move refitted it (a place that is an
+ * ancestor of P, or a child of one whose parent changes) comes back with
+ * that step's box, the tree with N taken out. Its children come back
+ * with their old boxes, so the restored box is too small, and a refit
+ * starting above it, or stopping below it at an unchanged box, leaves it
+ * so (the exploding horse after refit, frame 4: a place 3 levels above
+ * N). Every such slot is on the path of a slot given to the undo, so
+ * refitting those paths whole, each node from its children, gives every
+ * box back; in a tight tree the very boxes it had before the move.
  */
 static void log_slot(reinsert *r, uint32_t slot)
 {
@@ -133,17 +145,27 @@ static void insert_beside(reinsert *r, uint32_t c, uint32_t into, uint32_t d, ui
 	refit_up(r, r->parent[d], delta);
 }
 
+/* Slot's box (an inner node's) and every box above it, from the children,
+ * up to the root without stopping. */
+static void refit_path(reinsert *r, uint32_t slot)
+{
+	for (; slot != NO_NODE; slot = r->parent[slot]) {
+		bvhlab_node *n = &r->nodes[slot];
+
+		if (n->count == 0)
+			box_union(&r->nodes[n->first], &r->nodes[n->first + 1], n->lo, n->hi);
+	}
+}
+
 static void undo_all(reinsert *r, const uint32_t *from, unsigned count)
 {
-	double ignored = 0;
-
 	while (r->log_count) {
 		const struct undo *u = &r->log[--r->log_count];
 		r->nodes[u->slot] = u->node;
 		r->parent[u->slot] = u->parent;
 	}
 	for (unsigned k = 0; k < count; k++)
-		refit_up(r, r->parent[from[k]], &ignored);
+		refit_path(r, from[k]);
 }
 
 double reinsert_try_children(reinsert *r, uint32_t x, uint32_t d, uint32_t e)

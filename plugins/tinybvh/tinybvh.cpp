@@ -33,6 +33,7 @@
 #include <bvhlab/builder.hpp>
 
 #include "peer_tree.hpp"
+#include "plugin_options.h"
 #include "tinybvh_cpus.h"
 
 namespace {
@@ -62,34 +63,25 @@ const bvhlab_option_decl options[] = {
 	 HQBVHBINS, 0.0, nullptr, 2, MAXHQBINS, nullptr},
 };
 
-enum class Method { quick, binned, avx, sweep, hq };
+// builder's choices, by index.
+enum Method { quick, binned, avx, sweep, hq };
 
 struct Settings {
-	Method method = Method::avx;
+	int method = avx; // Method
 	int64_t optimize = 0, hq_bins = HQBVHBINS;
 	bool extreme = false;
 	double c_trav = 1, c_int = 1;
 };
 
-int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, Settings &s)
-{
-	const char *b = nullptr;
-	int rc;
-	if ((rc = host->option_string(ctx, "builder", &b)) < 0 ||
-	    (rc = host->option_int(ctx, "optimize", &s.optimize)) < 0 ||
-	    (rc = host->option_bool(ctx, "optimize_extreme", &s.extreme)) < 0 ||
-	    (rc = host->option_float(ctx, "c_trav", &s.c_trav)) < 0 ||
-	    (rc = host->option_float(ctx, "c_int", &s.c_int)) < 0 ||
-	    (rc = host->option_int(ctx, "hq_bins", &s.hq_bins)) < 0) {
-		host->set_error(ctx, "cannot read the options (%s)", std::strerror(-rc));
-		return rc;
-	}
-	const char *names[] = {"quick", "binned", "avx", "sweep", "hq"};
-	for (int k = 0; k < 5; k++)
-		if (std::strcmp(b, names[k]) == 0)
-			s.method = static_cast<Method>(k);
-	return 0;
-}
+// The options into Settings (plugin_options.h): the host has checked them.
+const plugin_field fields[] = {
+	PLUGIN_FIELD(Settings, method, "builder", CHOICE),
+	PLUGIN_FIELD(Settings, optimize, "optimize", I64),
+	PLUGIN_FIELD(Settings, extreme, "optimize_extreme", BOOL),
+	PLUGIN_FIELD(Settings, c_trav, "c_trav", DOUBLE),
+	PLUGIN_FIELD(Settings, c_int, "c_int", DOUBLE),
+	PLUGIN_FIELD(Settings, hq_bins, "hq_bins", I64),
+};
 
 // Three 16-byte vertices per triangle, in primitive order.
 std::unique_ptr<bvhvec4[]> soup(const bvhlab_build_input *in)
@@ -124,11 +116,11 @@ template struct Reach<CounterTag, &BVH::atomicNewNodePtr>;
 void run_builder(BVH &bvh, const Settings &s, const bvhvec4 *v, uint32_t n)
 {
 	switch (s.method) {
-	case Method::quick: bvh.BuildQuick(v, n); break;
-	case Method::binned: bvh.Build(v, n); break;
-	case Method::avx: bvh.BuildAVX(v, n); break;
-	case Method::sweep: bvh.useFullSweep = true; bvh.Build(v, n); break;
-	case Method::hq: bvh.BuildHQ(v, n); break;
+	case quick: bvh.BuildQuick(v, n); break;
+	case binned: bvh.Build(v, n); break;
+	case avx: bvh.BuildAVX(v, n); break;
+	case sweep: bvh.useFullSweep = true; bvh.Build(v, n); break;
+	case hq: bvh.BuildHQ(v, n); break;
 	}
 	if (!bvh.threadedBuild) {
 		std::atomic<uint32_t> *&counter = bvh.*counter_member(CounterTag{});
@@ -192,25 +184,18 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 	}
 	if (s.optimize > 0)
 		optimize(bvh, s);
-	auto t1 = clk::now();
-	int rc = peer::write_tree(host, ctx, View{bvh}, out);
-	peer::report_phase(host, ctx, "convert", peer::ms_since(t1));
-	return rc;
+	return peer::convert(host, ctx, View{bvh}, out);
 }
 
 int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
           bvhlab_build_output *out)
 {
 	Settings s;
-	int rc = read_settings(host, ctx, s);
-	if (rc < 0)
-		return rc;
+	int rc = plugin_options_fill(host, ctx, options, fields, s);
 	// tinybvh's counts are 32-bit and hq keeps 3 nodes per triangle.
-	if (in->prim_count == 0 || in->prim_count > UINT32_MAX / 8) {
-		host->set_error(ctx, "cannot build over %u primitives", in->prim_count);
-		return -EINVAL;
-	}
-	return build_tree(host, ctx, in, s, out);
+	if (rc == 0)
+		rc = peer::check_prims(host, ctx, in, UINT32_MAX / 8);
+	return rc < 0 ? rc : build_tree(host, ctx, in, s, out);
 }
 
 // Any exception out of build() becomes the run's error (bvhlab::guarded_build).

@@ -146,17 +146,6 @@ static void check_setup(struct pair *p, const struct setup *s, const char *name,
 	bvhlab_tree_finish(&dev);
 }
 
-/* The sanitizer builds run the CPU references 3 to 10 times slower: they
- * take smaller generated scenes and no mesh (the release build checks the
- * trees on every mesh; the sanitizers look for memory errors and races,
- * which the small scenes reach as well: several blocks, many iterations). */
-#if defined(__SANITIZE_ADDRESS__) || UNDER_TSAN
-#define UNDER_SANITIZER 1
-#else
-#define UNDER_SANITIZER 0
-#endif
-#define SAN(full, small) (UNDER_SANITIZER ? (small) : (full))
-
 /* The first `setups` setups of every pair on one scene; destroys it. */
 static void test_setups(const char *name, bvhlab_scene *scene, size_t setups)
 {
@@ -309,10 +298,10 @@ int main(void)
 	test_scene("one", generate("soup", 1, 0, 0));
 	test_scene("two", generate("soup", 2, 0, 0));
 	test_scene("three", generate("soup", 3, 0, 0));
-	test_scene("identical", identical_scene(SAN(3000, 1000)));
-	test_scene("needles", needle_scene(SAN(5000, 1500)));
-	test_scene("zero-area", zero_area_scene(SAN(4000, 1500)));
-	test_scene("soup", generate("soup", SAN(20000, 4000), 0, 0));
+	test_scene("identical", identical_scene(SCALE(3000, 1000)));
+	test_scene("needles", needle_scene(SCALE(5000, 1500)));
+	test_scene("zero-area", zero_area_scene(SCALE(4000, 1500)));
+	test_scene("soup", generate("soup", SCALE(20000, 4000), 0, 0));
 	if (!UNDER_SANITIZER)
 		(void)for_shared(shared, sizeof(shared) / sizeof(shared[0]), 0, test_shared);
 	else

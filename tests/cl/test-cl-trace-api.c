@@ -16,7 +16,7 @@
 #include <string.h>
 
 #include <bvhlab/opencl.h>
-#include <bvhlab/traversal.h>
+#include <bvhlab/trace.h>
 
 #include "../testutil.h"
 #include "trace/trace_series.h"

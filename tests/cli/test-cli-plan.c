@@ -1,7 +1,7 @@
 /*
  * Sweeps split across machines: option grids, `bvhlab plan`, `run --only`
  * and `bvhlab merge`, through GNU parallel as a user would drive them.
- * Usage: test-cli-plan BVHLAB_EXE grid|errors|parallel
+ * Usage: test-cli-plan BVHLAB_EXE grid|errors|parallel|serial
  */
 #include <limits.h>
 #include <stdbool.h>
@@ -14,14 +14,15 @@
 
 #include "cliutil.h"
 
-/* 2 scenes x 3 builders (a grid of two bin counts, and sweep) x 2 thread counts. */
+/* 2 scenes x (a parallel grid of two bin counts x 2 thread counts, and a
+ * serial sweep once): 10 runs. */
 static const char sweep_config[] =
 	"{ \"repeat\": 1, \"threads\": [1, 2], \"validate_rays\": 64, \"images\": true,\n"
 	"  \"rays\": { \"width\": 16, \"height\": 16 },\n"
 	"  \"scenes\": [ { \"generator\": \"icosphere\", \"frequency\": 6 },\n"
 	"              { \"generator\": \"soup\", \"count\": 400 } ],\n"
 	"  \"builders\": [\n"
-	"    { \"plugin\": \"sah_seq\", \"options\": { \"method\": \"binned\",\n"
+	"    { \"plugin\": \"sah_tasks\", \"options\": { \"method\": \"binned\",\n"
 	"                                              \"bins\": { \"grid\": [4, 8] } } },\n"
 	"    { \"plugin\": \"sah_seq\", \"name\": \"sweep\", \"options\": { \"method\": \"sweep\" } } ] }\n";
 
@@ -163,10 +164,11 @@ static void test_grid_syntax(void)
 
 /* ---- bad input ------------------------------------------------------------------ */
 
+/* A parallel builder: its two thread counts are two runs. */
 static const char small_config[] =
 	"{ \"repeat\": 1, \"threads\": [1, 2], \"validate_rays\": 16, \"rays\": { \"width\": 8, \"height\": 8 },\n"
 	"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 200 } ],\n"
-	"  \"builders\": [ { \"plugin\": \"sah_seq\" } ] }\n";
+	"  \"builders\": [ { \"plugin\": \"sah_tasks\" } ] }\n";
 
 /* A part of the plan in DIR: `run DIR/plan.json --only ID --out PART`. */
 static int run_part(const char *dir, const char *id, const char *part)
@@ -191,7 +193,7 @@ static void test_changed_config(void)
 	write_config("changed.json",
 	             "{ \"repeat\": 1, \"threads\": [2, 1],\n"
 	             "  \"scenes\": [ { \"generator\": \"soup\", \"count\": 200 } ],\n"
-	             "  \"builders\": [ { \"plugin\": \"sah_seq\" } ] }\n");
+	             "  \"builders\": [ { \"plugin\": \"sah_tasks\" } ] }\n");
 	CHECK_INT(run_part("chg", "0", "chg/parts/0"), 2);
 	CHECK_CONTAINS(err_text, "changed.json has changed since planning");
 	CHECK(!exists(path_in("chg/parts/0")));
@@ -217,7 +219,7 @@ static void test_bad_only(void)
 	                   "--out", path_in("only"))), 2);
 	CHECK_CONTAINS(err_text, "--threads cannot be combined with --only");
 	CHECK(!exists(path_in("only")));
-	/* One run of a config, by id: the second (sah_seq, 2 threads). */
+	/* One run of a config, by id: the second (sah_tasks, 2 threads). */
 	CHECK_INT(run(ARGS("run", "--quiet", cfg, "--only", "1", "--out", path_in("only"))), 0);
 	cJSON *doc = load_results(path_in("only"));
 	const cJSON *r = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
@@ -241,7 +243,7 @@ static void test_bad_parts(void)
 	CHECK_INT(run_part("m", "0", "m/again"), 0);
 	CHECK_INT(run(ARGS("merge", path_in("m/parts/0"), path_in("m/again"), "--out",
 	                   path_in("m"))), 2);
-	CHECK_CONTAINS(err_text, "run 0 (soup, sah_seq) is claimed by two parts");
+	CHECK_CONTAINS(err_text, "run 0 (soup, sah_tasks) is claimed by two parts");
 	CHECK_CONTAINS(err_text, "m/again: remove one of them");
 	write_config("other.json", "{ \"repeat\": 2, \"scenes\": [ { \"generator\": \"soup\", "
 	             "\"count\": 200 } ], \"builders\": [ { \"plugin\": \"sah_seq\" } ] }\n");
@@ -272,7 +274,7 @@ static void test_partial(void)
 {
 	CHECK_INT(run(ARGS("merge", path_in("m/parts/0"), "--out", path_in("m"))), 1);
 	CHECK_CONTAINS(err_text, "merged 1 of the plan's 2 runs");
-	CHECK_CONTAINS(err_text, "missing: run 1 (soup, sah_seq, 2 threads)");
+	CHECK_CONTAINS(err_text, "missing: run 1 (soup, sah_tasks, 2 threads)");
 	cJSON *doc = load_results(path_in("m"));
 	const cJSON *runs = cJSON_GetObjectItem(doc, "runs");
 	CHECK_INT(cJSON_GetArraySize(runs), 1);
@@ -364,7 +366,7 @@ static void test_slurm_file(void)
 	CHECK_INT(cJSON_GetArraySize(runs), 2);
 	const cJSON *second = cJSON_GetArrayItem(runs, 1);
 	CHECK(num(second, "id", NULL) == 1 && num(second, "threads", NULL) == 2);
-	CHECK(!strcmp(run_str(second, "builder"), "sah_seq"));
+	CHECK(!strcmp(run_str(second, "builder"), "sah_tasks"));
 	CHECK_CONTAINS(run_str(second, "command"), "/m/plan.json --only 1 --out ");
 	cJSON_Delete(runs);
 }
@@ -387,7 +389,7 @@ static bool have_parallel(void)
 }
 
 /*
- * Twelve runs through GNU parallel with two jobs, stopped after six have
+ * Ten runs through GNU parallel with two jobs, stopped after six have
  * finished (--halt now,done=6 kills the rest), then completed from
  * `plan --missing`; the merge equals one `bvhlab run` of the config.
  */
@@ -395,34 +397,95 @@ static void test_parallel(void)
 {
 	const char *cfg = write_config("sweep.json", sweep_config);
 	CHECK_INT(run(ARGS("plan", cfg, "--out", path_in("sweep"))), 0);
-	CHECK_INT(count_lines(out_text), 12);
-	CHECK_CONTAINS(out_text, "--only 11 --out ");
+	CHECK_INT(count_lines(out_text), 10);
+	CHECK_CONTAINS(out_text, "--only 9 --out ");
 	/* A stopped parallel exits non-zero: that is the point here. */
 	shell("'%s' plan sweep.json --out sweep | parallel --will-cite --jobs 2 "
 	      "--halt now,done=6 >/dev/null 2>&1%s", exe, "");
 	CHECK_INT(run(ARGS("plan", "--missing", path_in("sweep"))), 0);
 	int missing = count_lines(out_text);
-	CHECK(missing >= 4 && missing <= 6); /* at most two were running when it stopped */
+	CHECK(missing >= 2 && missing <= 4); /* at most two were running when it stopped */
 	CHECK_INT(shell("'%s' merge sweep/parts/* --out sweep%s", exe, " 2>merge.err"), 1);
 	char *err = read_file(tmpdir, "merge.err");
 	CHECK_CONTAINS(err, "runs missing");
 	free(err);
 	cJSON *partial = load_results(path_in("sweep"));
-	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(partial, "runs")), 12 - missing);
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(partial, "runs")), 10 - missing);
 	cJSON_Delete(partial);
 	CHECK_INT(shell("'%s' plan --missing sweep | parallel --will-cite --jobs 2%s", exe,
 	                " >/dev/null"), 0);
 	CHECK_INT(run(ARGS("plan", "--missing", path_in("sweep"))), 0);
 	CHECK_INT(count_lines(out_text), 0);
 	CHECK_INT(shell("'%s' merge sweep/parts/* --out sweep%s", exe, ""), 0);
-	/* Runs picked by id run as asked, a serial builder's (sah_seq's) 2-thread
-	 * ones too, since a plan lists every run of its config: the single run
-	 * picks all 12 ids (without --only it would run sah_seq at 1 thread only). */
-	CHECK_INT(run(ARGS("run", "--quiet", cfg, "--only", "0-11", "--out", path_in("single"))), 0);
+	/* The plan and one run share the run list: the serial sweep once per scene. */
+	CHECK_INT(run(ARGS("run", "--quiet", cfg, "--out", path_in("single"))), 0);
 	cJSON *merged = load_results(path_in("sweep")), *single = load_results(path_in("single"));
 	check_same_runs(merged, single);
-	CHECK(exists(path_in("sweep/images/icosphere--sah_seq_bins_4_-35e1f366--heat.png")));
+	char heat[400];
+	snprintf(heat, sizeof(heat), "sweep/%.380s",
+	         run_str(cJSON_GetArrayItem(cJSON_GetObjectItem(merged, "runs"), 0), "heat_image"));
+	CHECK_CONTAINS(heat, "icosphere--sah_tasks_bins_4_");
+	CHECK(exists(path_in(heat)));
 	CHECK(exists(path_in("sweep/report.html")) && exists(path_in("sweep/results.csv")));
+	cJSON_Delete(merged);
+	cJSON_Delete(single);
+}
+
+/* ---- a serial builder in a plan ------------------------------------------------ */
+
+/* sah_seq has no PARALLEL flag: once per scene, its 2 threads not applicable. */
+static const char serial_config[] =
+	"{ \"repeat\": 1, \"threads\": [1, 2], \"validate_rays\": 16,\n"
+	"  \"rays\": { \"width\": 8, \"height\": 8, \"min_ms\": 1 },\n"
+	"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 200 },\n"
+	"              { \"generator\": \"icosphere\", \"frequency\": 4 } ],\n"
+	"  \"builders\": [ { \"plugin\": \"sah_seq\" }, { \"plugin\": \"sah_tasks\" } ] }\n";
+
+/* "id scene builder threads" of every run, one per line, in order. */
+static char *identities(const cJSON *doc)
+{
+	static char buf[4096];
+	size_t used = 0;
+	const cJSON *r;
+	buf[0] = '\0';
+	cJSON_ArrayForEach(r, cJSON_GetObjectItem(doc, "runs"))
+		used += (size_t)snprintf(buf + used, sizeof(buf) - used, "%g %s %s %g %s\n",
+		                         num(r, "id", NULL), run_str(r, "scene"), run_str(r, "builder"),
+		                         num(r, "threads", NULL), run_str(r, "options_hash"));
+	return buf;
+}
+
+/* Planned into parts, each part run, merged: the runs and not_applicable of
+ * one `bvhlab run` of the same config, no more. */
+static void test_serial(void)
+{
+	const char *cfg = write_config("serial.json", serial_config);
+	CHECK_INT(run(ARGS("plan", cfg, "--out", path_in("ser"))), 0);
+	int planned = count_lines(out_text);
+	CHECK_INT(planned, 6); /* 2 scenes x (sah_seq once + sah_tasks at 1 and 2) */
+	for (int id = 0; id < planned; id++) {
+		char ids[16], part[64];
+		snprintf(ids, sizeof(ids), "%d", id);
+		snprintf(part, sizeof(part), "ser/parts/%d", id);
+		CHECK_INT(run_part("ser", ids, part), 0);
+	}
+	CHECK_INT(shell("'%s' merge ser/parts/* --out ser%s", exe, " 2>/dev/null"), 0);
+	CHECK_INT(run(ARGS("run", "--quiet", cfg, "--out", path_in("ser-single"))), 0);
+	cJSON *merged = load_results(path_in("ser")), *single = load_results(path_in("ser-single"));
+	char *want = strdup(identities(single));
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(single, "runs")), 6);
+	CHECK(want && !strcmp(identities(merged), want));
+	CHECK_CONTAINS(want, "0 soup sah_seq 1 ");
+	CHECK(!strstr(want, "sah_seq 2 "));
+	const cJSON *na = cJSON_GetObjectItem(single, "not_applicable");
+	CHECK_INT(cJSON_GetArraySize(na), 1);
+	char *a = cJSON_PrintUnformatted(na);
+	char *b = cJSON_PrintUnformatted(cJSON_GetObjectItem(merged, "not_applicable"));
+	CHECK(a && b && !strcmp(a, b));
+	CHECK_CONTAINS(a, "\"builder\":\"sah_seq\",\"threads\":[2]");
+	free(a);
+	free(b);
+	free(want);
 	cJSON_Delete(merged);
 	cJSON_Delete(single);
 }
@@ -430,7 +493,8 @@ static void test_parallel(void)
 int main(int argc, char **argv)
 {
 	if (!cli_begin(argc, argv))
-		return fprintf(stderr, "usage: test-cli-plan BVHLAB_EXE grid|errors|parallel\n"), 2;
+		return fprintf(stderr, "usage: test-cli-plan BVHLAB_EXE grid|errors|parallel|serial\n"),
+		       2;
 	const char *mode = argv[2];
 	static char abs_exe[4096];
 	/* The shell pipelines run in tmpdir: the command's path must not be relative. */
@@ -442,6 +506,8 @@ int main(int argc, char **argv)
 		test_grid_syntax();
 	} else if (!strcmp(mode, "errors")) {
 		test_errors();
+	} else if (!strcmp(mode, "serial")) {
+		test_serial();
 	} else if (!strcmp(mode, "parallel")) {
 		if (!have_parallel()) {
 			printf("skipped: GNU parallel is not installed (scripts/setup.sh installs it)\n");

@@ -13,6 +13,11 @@
  *     rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
  *                              FIELD_COUNT, &opt);
  *
+ * C++ plugins (the peers) use the same table: PLUGIN_FIELD initialises by
+ * position, which C11 and C++17 both take (C++17 has no designated
+ * initializers), and the template at the end counts both arrays and
+ * checks that the struct is one offsetof may be used on.
+ *
  * A static library linked into each plugin that uses it.
  */
 #ifndef BVHLAB_PLUGIN_OPTIONS_H
@@ -22,6 +27,8 @@
 #include <stdint.h>
 
 #include <bvhlab/builder.h>
+
+BVHLAB_BEGIN_DECLS
 
 /* The C type of the field an option goes to. */
 enum plugin_field_type {
@@ -41,8 +48,9 @@ typedef struct plugin_field {
 	int type;         /* enum plugin_field_type */
 } plugin_field;
 
+/* By position, in the order of plugin_field's members. */
 #define PLUGIN_FIELD(struct_type, member, option_name, field_type) \
-	{ .name = option_name, .offset = offsetof(struct_type, member), .type = PLUGIN_##field_type }
+	{ option_name, offsetof(struct_type, member), PLUGIN_##field_type }
 
 /*
  * Fills *out from this build's options, one field per entry. 0, or a
@@ -53,5 +61,24 @@ typedef struct plugin_field {
 int plugin_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                         const bvhlab_option_decl *decls, size_t decl_count,
                         const plugin_field *fields, size_t field_count, void *out);
+
+BVHLAB_END_DECLS
+
+#ifdef __cplusplus
+#include <type_traits>
+
+/* The C++ form: the counts from the arrays, and only a struct whose
+ * offsets offsetof gives (standard layout; default member initialisers
+ * are fine, every field of the table is filled anyway). */
+template <class Options, size_t DeclCount, size_t FieldCount>
+int plugin_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                        const bvhlab_option_decl (&decls)[DeclCount],
+                        const plugin_field (&fields)[FieldCount], Options &out)
+{
+	static_assert(std::is_standard_layout<Options>::value,
+	              "plugin_options_fill: offsetof needs a standard-layout struct");
+	return plugin_options_fill(host, ctx, decls, DeclCount, fields, FieldCount, &out);
+}
+#endif
 
 #endif /* BVHLAB_PLUGIN_OPTIONS_H */

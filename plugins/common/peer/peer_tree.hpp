@@ -106,6 +106,30 @@ int write_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const View &view,
 	return 0;
 }
 
+// The tail of every peer build: the library's tree written out
+// (write_tree), its time reported as phase "convert" (inside build_ms, as
+// everything in the call is).
+template <class View>
+int convert(const bvhlab_host *host, bvhlab_build_ctx *ctx, const View &view,
+            bvhlab_build_output *out)
+{
+	auto t0 = std::chrono::steady_clock::now();
+	int rc = write_tree(host, ctx, view, out);
+	report_phase(host, ctx, "convert", ms_since(t0));
+	return rc;
+}
+
+// 0 when the library can take the build's primitives (1 to `max`), else
+// -EINVAL after host->set_error.
+inline int check_prims(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                       const bvhlab_build_input *in, uint64_t max)
+{
+	if (in->prim_count != 0 && in->prim_count <= max)
+		return 0;
+	host->set_error(ctx, "cannot build over %u primitives", in->prim_count);
+	return -EINVAL;
+}
+
 } // namespace peer
 
 #endif

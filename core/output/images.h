@@ -1,9 +1,9 @@
 /*
- * A scene's images (scene_images.c): the raw per-pixel files a run's child
+ * A scene's images (images.c): the raw per-pixel files a run's child
  * writes, and the PNGs the parent makes of them.
  */
-#ifndef BVHLAB_CORE_SCENE_IMAGES_H
-#define BVHLAB_CORE_SCENE_IMAGES_H
+#ifndef BVHLAB_CORE_IMAGES_H
+#define BVHLAB_CORE_IMAGES_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -21,14 +21,16 @@ void images_name(char *buf, size_t size, const char *scene, const char *builder,
                         const char *what);
 
 struct results;
+struct run_identity;
 /* What the parent needs to turn a scene's temporary files into PNGs. */
 struct scene_images {
 	const char *dir;
 	size_t scene_index;
 	const char *scene;
 	uint32_t width, height;
-	const char *const *builders; /* [builder_count]: labels, by config index */
-	const uint32_t *threads;     /* [builder_count]: the run that drew each heat map */
+	/* [builder_count], by config index: the run that drew each heat map
+	 * (each builder's first of the scene, from the run list) */
+	const struct run_identity *const *heat_runs;
 	size_t builder_count;
 };
 
@@ -36,4 +38,4 @@ struct scene_images {
  * removes the temporary files and records the names in the results. */
 int images_write_scene(struct results *res, const struct scene_images *si, bvhlab_error *err);
 
-#endif /* BVHLAB_CORE_SCENE_IMAGES_H */
+#endif /* BVHLAB_CORE_IMAGES_H */

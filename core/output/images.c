@@ -15,7 +15,7 @@
 #include "output/image.h"
 #include "output/results.h"
 #include "output/safe_file.h"
-#include "output/scene_images.h"
+#include "output/images.h"
 #include "util/util.h"
 
 #define LEGEND_W 256
@@ -173,11 +173,11 @@ static int heat_images(struct results *res, const struct scene_images *si, bvhla
 	for (size_t b = 0; r == 0 && b < si->builder_count; b++) {
 		if (!heat[b])
 			continue;
-		images_name(name, sizeof(name), si->scene, si->builders[b], "heat");
+		images_name(name, sizeof(name), si->scene, si->heat_runs[b]->builder, "heat");
 		image_heat(heat[b], n, lo, hi, rgb);
 		r = write_png(si->dir, name, si->width, si->height, rgb, err);
 		if (r == 0)
-			r = results_set_run_image(res, si->scene, si->builders[b], si->threads[b], name);
+			r = results_set_run_image(res, si->heat_runs[b], name);
 		written++;
 	}
 	if (r == 0 && written) {

@@ -1,0 +1,52 @@
+/* Rays and images of a run (harness_rays.c): primary and diffuse rays traced
+ * through a tree with every traversal the config asks for. */
+#ifndef BVHLAB_CORE_HARNESS_RAYS_H
+#define BVHLAB_CORE_HARNESS_RAYS_H
+
+#include <stdint.h>
+
+#include <bvhlab/bvhlab.h>
+#include <bvhlab/trace.h>
+
+#include "config/config.h"
+#include "output/results.h"
+
+/* Each tile keeps its best of at least this many passes (see
+ * bvhlab_trace_timing): enough chances to run undisturbed. */
+#define HARNESS_MIN_REPEATS 10
+/* Diffuse rays: the same for every builder of a scene. */
+#define HARNESS_DIFFUSE_SEED 0xd1ff05eULL
+
+/* What rays a run is measured with: the config's "rays". */
+struct ray_settings {
+	uint32_t width, height; /* primary rays: one per pixel */
+	uint32_t diffuse;       /* bounces per primary hit */
+	uint32_t threads;       /* tracing threads; 0: all hardware threads */
+	double min_ms;          /* each batch is repeated for at least this long */
+	uint32_t min_repeats;   /* ... and at least this many passes */
+	uint32_t rounds;        /* slices min_ms is spread over (harness_rounds.c) */
+	unsigned traversals;    /* bit (1 << enum bvhlab_traversal) for each one measured */
+	int main;               /* the traversal whose hits feed images and diffuse rays */
+	const char *device;     /* the cl_ traversals' OpenCL device spec (NULL: auto) */
+};
+
+/* The config's settings (cfg NULL: one quick stack pass, all threads). */
+void harness_ray_settings(const struct config *cfg, struct ray_settings *rs);
+
+/* The config's camera, or the automatic framing of the scene. */
+void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam);
+
+/*
+ * Primary rays (width x height) and `diffuse` bounces per primary hit,
+ * each batch timed (bvhlab_trace_measure) with every traversal of rs.
+ * nodes ([width * height], may be NULL) gets nodes visited per pixel,
+ * shade ([3 * width * height], may be NULL) the shaded render, both from
+ * the main traversal. 0 or a negative errno, with m->error saying why (it
+ * also names a traversal other than the main one that could not run: that
+ * one is left out of m and the others are measured).
+ */
+int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                       const bvhlab_camera *cam, const struct ray_settings *rs,
+                       struct ray_metrics *m, uint32_t *nodes, uint8_t *shade);
+
+#endif
