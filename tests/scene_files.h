@@ -98,6 +98,38 @@ static inline bool triangle_is(const bvhlab_scene *s, uint32_t t, uint32_t a, ui
 	return i[0] == a && i[1] == b && i[2] == c;
 }
 
+/* What a loaded mesh must hold: its vertex count (0: not checked), its
+ * triangle count, and up to 4 vertices and 4 triangles by index. */
+struct mesh_expect {
+	uint32_t vertices, triangles;
+	struct {
+		uint32_t at;
+		float x, y, z;
+	} v[4];
+	uint32_t nv;
+	struct {
+		uint32_t at, a, b, c;
+	} t[4];
+	uint32_t nt;
+};
+
+/* s against e; false when s is NULL (its load already failed a check). */
+static inline bool expect_mesh(const bvhlab_scene *s, const struct mesh_expect *e)
+{
+	if (!s)
+		return false;
+	if (e->vertices)
+		CHECK_INT(s->vertex_count, e->vertices);
+	CHECK_INT(s->triangle_count, e->triangles);
+	for (uint32_t k = 0; k < e->nv; k++)
+		CHECK(e->v[k].at < s->vertex_count &&
+		      vertex_is(s, e->v[k].at, e->v[k].x, e->v[k].y, e->v[k].z));
+	for (uint32_t k = 0; k < e->nt; k++)
+		CHECK(e->t[k].at < s->triangle_count &&
+		      triangle_is(s, e->t[k].at, e->t[k].a, e->t[k].b, e->t[k].c));
+	return true;
+}
+
 /* The scene at path, which must load (NULL, a failed check, if not). */
 static inline bvhlab_scene *load_ok(const char *path)
 {

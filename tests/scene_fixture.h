@@ -100,6 +100,30 @@ static inline bvhlab_scene *identical_scene(uint32_t n)
 	return scene;
 }
 
+/* The sizes of the generated scenes a builder test runs (for_generated). */
+struct scene_sizes {
+	uint32_t soup;      /* triangles */
+	uint32_t icosphere; /* frequency */
+	uint32_t stadium;   /* triangles */
+	uint32_t terrain;   /* size */
+	uint32_t identical; /* triangles */
+};
+
+/* test(name, scene) on the generated scenes every builder test runs: a
+ * soup, an icosphere, a stadium and a terrain of the given sizes,
+ * `identical` copies of one triangle, and soups of 1 and 2 triangles. */
+static inline void for_generated(const struct scene_sizes *sizes,
+                                 void (*test)(const char *name, bvhlab_scene *scene))
+{
+	test("soup", generate("soup", sizes->soup, 0, 0));
+	test("icosphere", generate("icosphere", 0, sizes->icosphere, 0));
+	test("stadium", generate("stadium", sizes->stadium, 0, 0));
+	test("terrain", generate("terrain", 0, 0, sizes->terrain));
+	test("identical", identical_scene(sizes->identical));
+	test("one", generate("soup", 1, 0, 0));
+	test("two", generate("soup", 2, 0, 0));
+}
+
 /* A mesh of ../shared/scenes by file name; NULL (a failed check) if it
  * does not load. */
 static inline bvhlab_scene *load_shared(const char *file)
@@ -114,6 +138,121 @@ static inline bvhlab_scene *load_shared(const char *file)
 		CHECK(!"shared mesh loads");
 	}
 	return scene;
+}
+
+/* Builds with `plugin` and the options `items` ("key=value" texts, NULL-
+ * terminated), parsed in turn: 0, or the first failure, in err. */
+static inline int build_with(const bvhlab_plugin *plugin, const char *const *items,
+                             const bvhlab_build_input *in, uint32_t threads, bvhlab_tree *tree,
+                             bvhlab_error *err)
+{
+	bvhlab_options opts;
+	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin));
+
+	if (rc < 0)
+		return rc;
+	for (size_t k = 0; rc == 0 && items[k]; k++)
+		rc = bvhlab_options_parse(&opts, items[k], err);
+	if (rc == 0)
+		rc = bvhlab_build(plugin, &opts, in, threads, tree, err);
+	bvhlab_options_finish(&opts);
+	return rc;
+}
+
+/* Builds with `opts` and validates the tree's structure, then finishes
+ * opts: 0, or the failure, reported as "`what` threads=N: why" with a
+ * failed check. */
+static inline int build_validated(const bvhlab_plugin *plugin, bvhlab_options *opts,
+                                  const bvhlab_build_input *in, uint32_t threads,
+                                  bvhlab_tree *tree, const char *what)
+{
+	bvhlab_error err = { { 0 } };
+	int rc = bvhlab_build(plugin, opts, in, threads, tree, &err);
+
+	if (rc == 0)
+		rc = bvhlab_validate_tree(tree, in, false, &err);
+	if (rc != 0) {
+		fprintf(stderr, "%s threads=%u: %s\n", what, threads, err.message);
+		CHECK(!"valid build");
+	}
+	bvhlab_options_finish(opts);
+	return rc;
+}
+
+/* Leaves of at most `most` primitives; the first larger one is reported. */
+static inline void check_leaf_sizes(const bvhlab_tree *tree, uint32_t most)
+{
+	for (uint32_t i = 0; i < tree->node_count; i++)
+		if (tree->nodes[i].count > most) {
+			fprintf(stderr, "node %u: leaf of %u > %u\n", i, tree->nodes[i].count, most);
+			CHECK(!"leaf within max_leaf");
+			return;
+		}
+}
+
+/* `tree`, built with `threads` threads, is `ref` (built with 1): equal for
+ * bvhlab_tree_compare, and the same arrays, node order included. */
+static inline void check_same_tree(const char *name, const bvhlab_tree *ref,
+                                   const bvhlab_tree *tree, uint32_t threads)
+{
+	bvhlab_error err = { { 0 } };
+
+	if (bvhlab_tree_compare(ref, tree, &err) != 0) {
+		fprintf(stderr, "%s: threads=%u vs 1: %s\n", name, threads, err.message);
+		CHECK(!"same tree");
+		return;
+	}
+	CHECK_INT(tree->node_count, ref->node_count);
+	CHECK_INT(tree->index_count, ref->index_count);
+	CHECK(trees_identical(ref, tree));
+}
+
+/* A test's build of its setup (the plugin's option values) with `threads`
+ * threads, validated: 0, or the failure, reported with a failed check. */
+typedef int (*setup_build_fn)(const char *name, const bvhlab_build_input *in,
+                              const void *setup, uint32_t threads, bvhlab_tree *tree);
+
+/* One setup of a deterministic builder, for check_threads_same. */
+struct setup_check {
+	setup_build_fn build;
+	const void *setup;
+	bool collapse;         /* false: one primitive a leaf, 2n - 1 nodes */
+	uint32_t most;         /* the largest leaf allowed */
+	const uint32_t *threads; /* the builds that must give the 1-thread tree again */
+	size_t thread_count;
+	uint64_t ray_seed;
+};
+
+/*
+ * One setup on one scene: the 1-thread tree is checked in full (structure,
+ * rays against brute force, leaves), then every count of c->threads must
+ * build it again, node for node. Returns its SAH cost.
+ */
+static inline double check_threads_same(const char *name, const bvhlab_scene *scene,
+                                        const bvhlab_build_input *in,
+                                        const struct setup_check *c, uint32_t rays)
+{
+	bvhlab_tree ref = { 0 }, tree = { 0 };
+	bvhlab_tree_stats stats = { 0 };
+	bvhlab_error err = { { 0 } };
+	uint64_t mismatches = 1;
+
+	if (c->build(name, in, c->setup, 1, &ref) != 0)
+		goto out;
+	CHECK_INT(ref.index_count, in->prim_count);
+	if (!c->collapse)
+		CHECK_INT(ref.node_count, 2 * in->prim_count - 1);
+	CHECK_INT(bvhlab_validate_rays(&ref, scene, rays, c->ray_seed, &mismatches, &err), 0);
+	CHECK_INT(mismatches, 0);
+	check_leaf_sizes(&ref, c->most);
+	bvhlab_tree_stats_compute(&ref, &stats);
+	for (size_t t = 0; t < c->thread_count; t++)
+		if (c->build(name, in, c->setup, c->threads[t], &tree) == 0)
+			check_same_tree(name, &ref, &tree, c->threads[t]);
+out:
+	bvhlab_tree_finish(&ref);
+	bvhlab_tree_finish(&tree);
+	return stats.sah_cost;
 }
 
 /* The SAH cost of the builds of one setup (option value, collapse) on a

@@ -14,6 +14,9 @@
 
 #include "testutil.h"
 
+#define FIXTURE_SEED 3
+#include "scene_fixture.h"
+
 #define RAYS 256
 #define MAX_LEAF 8
 
@@ -24,16 +27,11 @@ static bvhlab_plugin *plugin;
 static int build(const bvhlab_prims *prims, const char *quality, uint32_t threads,
                  bvhlab_tree *tree, bvhlab_error *err)
 {
-	bvhlab_options opts;
 	char q[32];
-	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin));
-	if (rc < 0)
-		return rc;
+
 	snprintf(q, sizeof(q), "quality=%s", quality);
-	if ((rc = bvhlab_options_parse(&opts, q, err)) == 0)
-		rc = bvhlab_build(plugin, &opts, &prims->input, threads, tree, err);
-	bvhlab_options_finish(&opts);
-	return rc;
+	return build_with(plugin, (const char *const[]){ q, NULL }, &prims->input, threads, tree,
+	                  err);
 }
 
 static void check_leaves(const bvhlab_tree *t, const char *what)
@@ -116,14 +114,7 @@ static uint32_t check_scene(const bvhlab_scene *s)
 
 static void check_generated(const char *gen, uint32_t count, bool expect_splits)
 {
-	bvhlab_gen_params gp;
-	bvhlab_scene *s = NULL;
-	bvhlab_error err = {{0}};
-	bvhlab_gen_params_init(&gp);
-	gp.frequency = 16;
-	gp.count = count;
-	gp.seed = 3;
-	CHECK_INT(bvhlab_scene_generate(gen, &gp, &s, &err), 0);
+	bvhlab_scene *s = generate(gen, count, 16, 0);
 	if (!s)
 		return;
 	uint32_t refs = check_scene(s);

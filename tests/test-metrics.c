@@ -17,29 +17,32 @@ static bvhlab_node box_node(float x0, float y0, float z0, float x1, float y1, fl
 	return (bvhlab_node){ { x0, y0, z0 }, first, { x1, y1, z1 }, count };
 }
 
-/* A tree over caller-filled nodes; prim_index is 0, 1, ... (unchecked here). */
-static void hand_tree(bvhlab_tree *t, const bvhlab_node *nodes, uint32_t n, uint32_t refs)
+/* The stats of a tree over caller-filled nodes, prim_index 0, 1, ...
+ * (unchecked here). */
+static bvhlab_tree_stats hand_stats(const bvhlab_node *nodes, uint32_t n, uint32_t refs)
 {
-	uint32_t i;
+	bvhlab_tree_stats s;
+	bvhlab_tree t;
 
-	if (bvhlab_tree_init(t, n, refs) < 0)
+	if (bvhlab_tree_init(&t, n, refs) < 0)
 		exit(1);
-	memcpy(t->nodes, nodes, n * sizeof(bvhlab_node));
-	for (i = 0; i < refs; i++)
-		t->prim_index[i] = i;
-	t->node_count = n;
-	t->index_count = refs;
+	memcpy(t.nodes, nodes, n * sizeof(bvhlab_node));
+	for (uint32_t i = 0; i < refs; i++)
+		t.prim_index[i] = i;
+	t.node_count = n;
+	t.index_count = refs;
+	bvhlab_tree_stats_compute(&t, &s);
+	bvhlab_tree_finish(&t);
+	return s;
 }
 
 static void test_single_leaf(void)
 {
 	bvhlab_node nodes[1] = { box_node(0, 0, 0, 1, 2, 3, 0, 5) };
 	bvhlab_tree_stats s;
-	bvhlab_tree t;
 	uint32_t k;
 
-	hand_tree(&t, nodes, 1, 5);
-	bvhlab_tree_stats_compute(&t, &s);
+	s = hand_stats(nodes, 1, 5);
 	CHECK(s.sah_cost == 5.0); /* SA(leaf) * 5 / SA(root) */
 	CHECK_INT(s.nodes, 1);
 	CHECK_INT(s.leaves, 1);
@@ -48,7 +51,6 @@ static void test_single_leaf(void)
 	CHECK_INT(s.memory_bytes, 32 + 5 * 4);
 	for (k = 0; k < BVHLAB_LEAF_HISTOGRAM; k++)
 		CHECK_INT(s.leaf_histogram[k], k == 4);
-	bvhlab_tree_finish(&t);
 }
 
 /* Root [0,2]x[0,1]x[0,1] (area 10) over two unit cubes (area 6 each) with
@@ -61,10 +63,8 @@ static void test_two_boxes(void)
 		box_node(1, 0, 0, 2, 1, 1, 1, 3),
 	};
 	bvhlab_tree_stats s;
-	bvhlab_tree t;
 
-	hand_tree(&t, nodes, 3, 4);
-	bvhlab_tree_stats_compute(&t, &s);
+	s = hand_stats(nodes, 3, 4);
 	CHECK(CLOSE(s.sah_cost, 3.4));
 	CHECK_INT(s.nodes, 3);
 	CHECK_INT(s.leaves, 2);
@@ -73,7 +73,6 @@ static void test_two_boxes(void)
 	CHECK_INT(s.leaf_histogram[0], 1);
 	CHECK_INT(s.leaf_histogram[2], 1);
 	CHECK_INT(s.memory_bytes, 3 * 32 + 4 * 4);
-	bvhlab_tree_finish(&t);
 }
 
 /*
@@ -93,10 +92,8 @@ static void test_three_levels(void)
 		box_node(0, 0, 0, 2, 1, 1, 1, 0),  /* A */
 	};
 	bvhlab_tree_stats s;
-	bvhlab_tree t;
 
-	hand_tree(&t, nodes, 5, 23);
-	bvhlab_tree_stats_compute(&t, &s);
+	s = hand_stats(nodes, 5, 23);
 	CHECK(CLOSE(s.sah_cost, 170.0 / 18.0));
 	CHECK_INT(s.leaves, 3);
 	CHECK_INT(s.max_depth, 2);
@@ -105,7 +102,6 @@ static void test_three_levels(void)
 	CHECK_INT(s.leaf_histogram[1], 1);
 	CHECK_INT(s.leaf_histogram[15], 0);
 	CHECK_INT(s.leaf_histogram[16], 1); /* more than 16 */
-	bvhlab_tree_finish(&t);
 }
 
 /* A root of zero area: every node counts with ratio 1, cost = inner + refs.
@@ -128,21 +124,14 @@ static void test_zero_area(void)
 		box_node(1, 0, 0, 2, 1, 0, 2, 3),
 	};
 	bvhlab_tree_stats s;
-	bvhlab_tree t;
 
-	hand_tree(&t, point, 3, 5);
-	bvhlab_tree_stats_compute(&t, &s);
+	s = hand_stats(point, 3, 5);
 	CHECK(s.sah_cost == 6.0);
-	bvhlab_tree_finish(&t);
-	hand_tree(&t, line, 3, 5);
-	bvhlab_tree_stats_compute(&t, &s);
+	s = hand_stats(line, 3, 5);
 	CHECK(s.sah_cost == 6.0);
 	CHECK(isfinite(s.sah_cost));
-	bvhlab_tree_finish(&t);
-	hand_tree(&t, flat, 3, 5);
-	bvhlab_tree_stats_compute(&t, &s);
+	s = hand_stats(flat, 3, 5);
 	CHECK(CLOSE(s.sah_cost, (4.0 + 2.0 * 2 + 2.0 * 3) / 4.0));
-	bvhlab_tree_finish(&t);
 }
 
 static void test_chain(void)

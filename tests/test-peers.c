@@ -24,6 +24,9 @@
 #include "peer_threads.h"
 #include "testutil.h"
 
+#define FIXTURE_SEED 3
+#include "scene_fixture.h"
+
 #define RAYS 64
 #define ANY (-1) /* some threads, how many is the library's business */
 
@@ -63,22 +66,17 @@ static bool big; /* the current scene is the 50,000-triangle one */
 static int build(const bvhlab_prims *prims, const char *builder, const char *extra,
                  const char *extra2, uint32_t threads, bvhlab_tree *tree, bvhlab_error *err)
 {
-	bvhlab_options opts;
 	char text[96];
-	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin));
-	if (rc < 0)
-		return rc;
+	const char *items[4] = { text };
+	size_t n = 1;
+
 	snprintf(text, sizeof(text), "builder=%s", builder);
-	rc = bvhlab_options_parse(&opts, text, err);
-	if (rc == 0 && extra)
-		rc = bvhlab_options_parse(&opts, extra, err);
-	if (rc == 0 && extra2)
-		rc = bvhlab_options_parse(&opts, extra2, err);
+	if (extra)
+		items[n++] = extra;
+	if (extra2)
+		items[n++] = extra2;
 	peer_threads_reset();
-	if (rc == 0)
-		rc = bvhlab_build(plugin, &opts, &prims->input, threads, tree, err);
-	bvhlab_options_finish(&opts);
-	return rc;
+	return build_with(plugin, items, &prims->input, threads, tree, err);
 }
 
 static bool has_convert_phase(const bvhlab_tree *t)
@@ -207,14 +205,7 @@ static void check_mesh(const row *rows, size_t n)
 static void check_scene(const char *gen, uint32_t frequency, uint32_t count, const row *rows,
                         size_t n)
 {
-	bvhlab_gen_params gp;
-	bvhlab_scene *s = NULL;
-	bvhlab_error err = {{0}};
-	bvhlab_gen_params_init(&gp);
-	gp.frequency = frequency;
-	gp.count = count;
-	gp.seed = 3;
-	CHECK_INT(bvhlab_scene_generate(gen, &gp, &s, &err), 0);
+	bvhlab_scene *s = generate(gen, count, frequency, 0);
 	if (s)
 		check_rows(s, rows, n, false);
 	bvhlab_scene_destroy(s);

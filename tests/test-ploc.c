@@ -21,7 +21,8 @@
 #define RAYS 256
 #define RAY_SEED 1515
 
-static const uint32_t thread_counts[] = { 1, 2, 8 };
+/* After the 1-thread tree: 1 again, 2 and 8, and 2 once more. */
+static const uint32_t thread_counts[] = { 1, 2, 8, 2 };
 #define THREAD_COUNTS (sizeof(thread_counts) / sizeof(thread_counts[0]))
 
 static bvhlab_plugin *plugin;
@@ -31,9 +32,11 @@ struct setup {
 	bool collapse;
 };
 
-static int build_valid(const char *name, const bvhlab_build_input *in, const struct setup *s,
+/* A setup_build_fn: setup is a struct setup. */
+static int build_valid(const char *name, const bvhlab_build_input *in, const void *setup,
                        uint32_t threads, bvhlab_tree *tree)
 {
+	const struct setup *s = setup;
 	bvhlab_options opts;
 	bvhlab_error err = { { 0 } };
 	int rc = bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin));
@@ -55,57 +58,18 @@ static int build_valid(const char *name, const bvhlab_build_input *in, const str
 	return rc;
 }
 
-static void check_same(const char *name, const bvhlab_tree *ref, const bvhlab_tree *tree,
-                       uint32_t threads)
-{
-	CHECK_INT(tree->node_count, ref->node_count);
-	CHECK_INT(tree->index_count, ref->index_count);
-	if (tree->node_count != ref->node_count || tree->index_count != ref->index_count)
-		return;
-	if (!trees_identical(ref, tree)) {
-		fprintf(stderr, "%s: %u threads built another tree than 1\n", name, threads);
-		CHECK(!"same tree for every thread count");
-	}
-}
-
-/* The 1-thread tree in full, every other thread count (twice for 2)
- * against it; returns its SAH cost. */
-static double check_setup(const char *name, const bvhlab_scene *scene,
-                          const bvhlab_build_input *in, const struct setup *s, uint32_t rays)
-{
-	bvhlab_tree ref = { 0 }, tree = { 0 };
-	bvhlab_tree_stats stats = { 0 };
-	bvhlab_error err = { { 0 } };
-	uint64_t mismatches = 1;
-
-	if (build_valid(name, in, s, 1, &ref) != 0)
-		goto out;
-	CHECK_INT(ref.index_count, in->prim_count);
-	if (!s->collapse)
-		CHECK_INT(ref.node_count, 2 * in->prim_count - 1);
-	CHECK_INT(bvhlab_validate_rays(&ref, scene, rays, RAY_SEED, &mismatches, &err), 0);
-	CHECK_INT(mismatches, 0);
-	bvhlab_tree_stats_compute(&ref, &stats);
-	for (uint32_t i = 0; i < ref.node_count; i++)
-		CHECK(ref.nodes[i].count <= (s->collapse ? 8u : 1u));
-	for (size_t t = 0; t <= THREAD_COUNTS; t++) {
-		uint32_t threads = t < THREAD_COUNTS ? thread_counts[t] : 2;
-		if (build_valid(name, in, s, threads, &tree) == 0)
-			check_same(name, &ref, &tree, threads);
-	}
-out:
-	bvhlab_tree_finish(&ref);
-	bvhlab_tree_finish(&tree);
-	return stats.sah_cost;
-}
-
+/* The 1-thread tree in full, every other thread count against it;
+ * returns its SAH cost. */
 static double check_radius(const char *name, const bvhlab_scene *scene,
                            const bvhlab_build_input *in, uint32_t radius, bool collapse,
                            uint32_t rays)
 {
 	struct setup s = { .radius = radius, .collapse = collapse };
+	struct setup_check c = { .build = build_valid, .setup = &s, .collapse = collapse,
+	                         .most = collapse ? 8 : 1, .threads = thread_counts,
+	                         .thread_count = THREAD_COUNTS, .ray_seed = RAY_SEED };
 
-	return check_setup(name, scene, in, &s, rays);
+	return check_threads_same(name, scene, in, &c, rays);
 }
 
 static void test_scene(const char *name, bvhlab_scene *scene, uint32_t rays)

@@ -77,19 +77,17 @@ static const char ascii_ply[] =
 static void test_ascii(void)
 {
 	const char *path = write_text("ascii.ply", ascii_ply);
+	static const struct mesh_expect e = {
+		.vertices = 5, .triangles = 3,
+		.v = { { 0, 0.5f, -1.25f, 3.0f }, { 4, 2e-3f, 4.0f, -8.0f } }, .nv = 2,
+		.t = { { 0, 0, 1, 2 }, { 1, 0, 2, 3 }, { 2, 2, 3, 4 } }, .nt = 3,
+	};
 	bvhlab_scene *s = load_ok(path);
 
-	if (!s)
-		return;
-	CHECK_INT(s->vertex_count, 5);
-	CHECK_INT(s->triangle_count, 3);
-	CHECK(vertex_is(s, 0, 0.5f, -1.25f, 3.0f));
-	CHECK(vertex_is(s, 4, 2e-3f, 4.0f, -8.0f));
-	CHECK(triangle_is(s, 0, 0, 1, 2));
-	CHECK(triangle_is(s, 1, 0, 2, 3));
-	CHECK(triangle_is(s, 2, 2, 3, 4));
-	CHECK(strcmp(s->name, "ascii") == 0);
-	CHECK(strcmp(s->source, path) == 0);
+	if (expect_mesh(s, &e)) {
+		CHECK(strcmp(s->name, "ascii") == 0);
+		CHECK(strcmp(s->source, path) == 0);
+	}
 	bvhlab_scene_destroy(s);
 }
 
@@ -118,19 +116,17 @@ static void build_le(struct buf *b)
 
 static void test_binary_le(void)
 {
+	static const struct mesh_expect e = {
+		.vertices = 4, .triangles = 3,
+		.v = { { 1, 1.5f, 0, 0 }, { 2, 0, -2.75f, 0 }, { 3, 0, 0, 1e-7f } }, .nv = 3,
+		.t = { { 2, 0, 2, 3 } }, .nt = 1,
+	};
 	struct buf b;
 	bvhlab_scene *s;
 
 	build_le(&b);
 	s = load_ok(write_buf("le.ply", &b));
-	if (!s)
-		return;
-	CHECK_INT(s->vertex_count, 4);
-	CHECK_INT(s->triangle_count, 3);
-	CHECK(vertex_is(s, 1, 1.5f, 0, 0));
-	CHECK(vertex_is(s, 2, 0, -2.75f, 0));
-	CHECK(vertex_is(s, 3, 0, 0, 1e-7f));
-	CHECK(triangle_is(s, 2, 0, 2, 3));
+	expect_mesh(s, &e);
 	bvhlab_scene_destroy(s);
 }
 
@@ -138,6 +134,11 @@ static void test_binary_le(void)
  * order, faces "list int ushort vertex_index", an element with lists after. */
 static void test_binary_be(void)
 {
+	static const struct mesh_expect e = {
+		.vertices = 3, .triangles = 1,
+		.v = { { 0, 1.0f, 2.0f, 3.0f }, { 1, 1e10f, -0.5f, (float)0.1 } }, .nv = 2,
+		.t = { { 0, 2, 1, 0 } }, .nt = 1,
+	};
 	struct buf b = { .big = true };
 	bvhlab_scene *s;
 
@@ -155,19 +156,16 @@ static void test_binary_be(void)
 	put_u16(&b, 2), put_u32(&b, 0), put_u32(&b, 1), put_u8(&b, 9);
 	put_u16(&b, 1), put_u32(&b, 2), put_u8(&b, 9);
 	s = load_ok(write_buf("be.ply", &b));
-	if (!s)
-		return;
-	CHECK_INT(s->vertex_count, 3);
-	CHECK_INT(s->triangle_count, 1);
-	CHECK(vertex_is(s, 0, 1.0f, 2.0f, 3.0f));
-	CHECK(vertex_is(s, 1, 1e10f, -0.5f, (float)0.1));
-	CHECK(triangle_is(s, 0, 2, 1, 0));
+	expect_mesh(s, &e);
 	bvhlab_scene_destroy(s);
 }
 
 /* Integer coordinate types, faces "list uint16 int". */
 static void test_integer_coords(void)
 {
+	static const struct mesh_expect e = {
+		.triangles = 1, .v = { { 0, -300.0f, 200.0f, -70000.0f } }, .nv = 1,
+	};
 	struct buf b = { .big = false };
 	bvhlab_scene *s;
 
@@ -179,10 +177,7 @@ static void test_integer_coords(void)
 	put_i16(&b, 0), put_u8(&b, 1), put_i32(&b, 0);
 	put_u16(&b, 3), put_i32(&b, 0), put_i32(&b, 1), put_i32(&b, 2);
 	s = load_ok(write_buf("ints.ply", &b));
-	if (!s)
-		return;
-	CHECK(vertex_is(s, 0, -300.0f, 200.0f, -70000.0f));
-	CHECK_INT(s->triangle_count, 1);
+	expect_mesh(s, &e);
 	bvhlab_scene_destroy(s);
 }
 
@@ -193,13 +188,12 @@ static const int32_t strip[] = { 0, 1, 2, 3, -1, 4, 5, 6, 6, 7, 5 };
 
 static void check_strips(bvhlab_scene *s)
 {
-	if (!s)
-		return;
-	CHECK_INT(s->triangle_count, 4);
-	CHECK(triangle_is(s, 0, 0, 1, 2));
-	CHECK(triangle_is(s, 1, 2, 1, 3));
-	CHECK(triangle_is(s, 2, 4, 5, 6));
-	CHECK(triangle_is(s, 3, 7, 6, 5));
+	static const struct mesh_expect e = {
+		.triangles = 4,
+		.t = { { 0, 0, 1, 2 }, { 1, 2, 1, 3 }, { 2, 4, 5, 6 }, { 3, 7, 6, 5 } }, .nt = 4,
+	};
+
+	expect_mesh(s, &e);
 	bvhlab_scene_destroy(s);
 }
 
@@ -319,37 +313,37 @@ static void test_ascii_errors(void)
 	const char *head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
 	                   "property float y\nproperty float z\nelement face 1\n"
 	                   "property list uchar int vertex_indices\nend_header\n";
+	static const struct {
+		const char *file, *body, *error;
+	} cases[] = {
+		{ "a-range.ply", "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", ":13: vertex index 3 out of range" },
+		{ "a-neg.ply", "0 0 0\n1 0 0\n0 1 0\n3 0 -2 1\n", ":13: negative vertex index" },
+		{ "a-num.ply", "0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n", ":11: malformed number" },
+		{ "a-inf.ply", "0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n", ":11: vertex 1: coordinate y is NaN" },
+		{ "a-cut.ply", "0 0 0\n1 0 0\n0 1 0\n3 0 1\n", ":13: truncated file" },
+		{ "a-short.ply", "0 0 0\n1 0 0\n0 1 0\n2 0 1\n", ":13: face 0 has 2 vertices" },
+		{ "a-count.ply", "0 0 0\n1 0 0\n0 1 0\n300 0 1 2\n", ":13: value out of range" },
+	};
 	char text[512];
 
-	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", head);
-	expect_scene_error(write_text("a-range.ply", text), -EINVAL, ":13: vertex index 3 out of range");
-	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n3 0 -2 1\n", head);
-	expect_scene_error(write_text("a-neg.ply", text), -EINVAL, ":13: negative vertex index");
-	snprintf(text, sizeof(text), "%s0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n", head);
-	expect_scene_error(write_text("a-num.ply", text), -EINVAL, ":11: malformed number");
-	snprintf(text, sizeof(text), "%s0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n", head);
-	expect_scene_error(write_text("a-inf.ply", text), -EINVAL, ":11: vertex 1: coordinate y is NaN");
-	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n3 0 1\n", head);
-	expect_scene_error(write_text("a-cut.ply", text), -EINVAL, ":13: truncated file");
-	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n2 0 1\n", head);
-	expect_scene_error(write_text("a-short.ply", text), -EINVAL, ":13: face 0 has 2 vertices");
-	snprintf(text, sizeof(text), "%s0 0 0\n1 0 0\n0 1 0\n300 0 1 2\n", head);
-	expect_scene_error(write_text("a-count.ply", text), -EINVAL, ":13: value out of range");
+	for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+		snprintf(text, sizeof(text), "%s%s", head, cases[k].body);
+		expect_scene_error(write_text(cases[k].file, text), -EINVAL, cases[k].error);
+	}
 }
 
 /* Faces may come before the vertices they index. */
 static void test_faces_first(void)
 {
+	static const struct mesh_expect e = {
+		.triangles = 1, .v = { { 2, 0, 1.0f, 0 } }, .nv = 1, .t = { { 0, 2, 0, 1 } }, .nt = 1,
+	};
 	bvhlab_scene *s = load_ok(write_text("facesfirst.ply",
 		"ply\nformat ascii 1.0\nelement face 1\nproperty list uchar uint vertex_indices\n"
 		"element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
 		"end_header\n3 2 0 1\n0 0 0\n1 0 0\n0 1 0\n"));
 
-	if (!s)
-		return;
-	CHECK_INT(s->triangle_count, 1);
-	CHECK(triangle_is(s, 0, 2, 0, 1));
-	CHECK(vertex_is(s, 2, 0, 1.0f, 0));
+	expect_mesh(s, &e);
 	bvhlab_scene_destroy(s);
 }
 

@@ -5,6 +5,7 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 
 #include "testutil.h"
 #include "tree_fixture.h"
@@ -22,6 +23,20 @@ static void expect(const bvhlab_tree *t, bool allow_duplicates, const char *need
 
 	CHECK_INT(validate(t, allow_duplicates, &err), -EINVAL);
 	CHECK_CONTAINS(err.message, needle);
+}
+
+/* expect(t, false, the message printf would make of fmt and the rest). */
+static void expectf(const bvhlab_tree *t, const char *fmt, ...) BVHLAB_PRINTF(2, 3);
+
+static void expectf(const bvhlab_tree *t, const char *fmt, ...)
+{
+	char needle[256];
+	va_list ap;
+
+	va_start(ap, fmt);
+	vsnprintf(needle, sizeof(needle), fmt, ap);
+	va_end(ap);
+	expect(t, false, needle);
 }
 
 /* The n-th leaf (in node order) with at least min_count primitives. */
@@ -116,7 +131,7 @@ static void test_duplicate(void)
 {
 	bvhlab_tree t;
 	bvhlab_error err;
-	char needle[128], ab[64], ba[64];
+	char ab[64], ba[64];
 	uint32_t last = 0, other, prim, i;
 
 	tree_copy(&t, &fx.tree, 4);
@@ -129,8 +144,7 @@ static void test_duplicate(void)
 	t.prim_index[t.index_count++] = prim;
 	t.nodes[last].count++;
 	fixture_refit_node(&t, &fx.input, 0);
-	snprintf(needle, sizeof(needle), "primitive %u referenced twice (leaves ", prim);
-	expect(&t, false, needle);
+	expectf(&t, "primitive %u referenced twice (leaves ", prim);
 	validate(&t, false, &err);
 	snprintf(ab, sizeof(ab), "leaves %u and %u)", other, last);
 	snprintf(ba, sizeof(ba), "leaves %u and %u)", last, other);
@@ -142,7 +156,6 @@ static void test_duplicate(void)
 static void test_box_one_ulp(void)
 {
 	bvhlab_tree t;
-	char needle[128];
 	uint32_t leaf, s, prim = UINT32_MAX, child;
 	float old;
 
@@ -152,30 +165,26 @@ static void test_box_one_ulp(void)
 		if (fx.boxes[t.prim_index[s]].hi[0] == t.nodes[leaf].hi[0])
 			prim = t.prim_index[s];
 	t.nodes[leaf].hi[0] = nextafterf(t.nodes[leaf].hi[0], -INFINITY);
-	snprintf(needle, sizeof(needle), "node %u: box does not contain primitive %u", leaf, prim);
-	expect(&t, false, needle);
+	expectf(&t, "node %u: box does not contain primitive %u", leaf, prim);
 	bvhlab_tree_finish(&t);
 
 	tree_copy(&t, &fx.tree, 0);
 	old = t.nodes[0].lo[1];
 	t.nodes[0].lo[1] = nextafterf(old, INFINITY);
 	child = t.nodes[t.nodes[0].first].lo[1] == old ? t.nodes[0].first : t.nodes[0].first + 1;
-	snprintf(needle, sizeof(needle), "node 0: box does not contain child %u", child);
-	expect(&t, false, needle);
+	expectf(&t, "node 0: box does not contain child %u", child);
 	bvhlab_tree_finish(&t);
 }
 
 static void test_nan(void)
 {
 	bvhlab_tree t;
-	char needle[64];
 	uint32_t leaf;
 
 	tree_copy(&t, &fx.tree, 0);
 	leaf = find_leaf(&t, 1, 5);
 	t.nodes[leaf].lo[2] = NAN;
-	snprintf(needle, sizeof(needle), "node %u: box has NaN", leaf);
-	expect(&t, false, needle);
+	expectf(&t, "node %u: box has NaN", leaf);
 	bvhlab_tree_finish(&t);
 
 	/* An infinite root box contains every child, yet makes the SAH cost NaN. */
@@ -188,7 +197,6 @@ static void test_nan(void)
 static void test_cycle_and_sharing(void)
 {
 	bvhlab_tree t;
-	char needle[128];
 	uint32_t x, y;
 
 	tree_copy(&t, &fx.tree, 0);
@@ -200,8 +208,7 @@ static void test_cycle_and_sharing(void)
 	tree_copy(&t, &fx.tree, 0);
 	x = find_inner(&t, 6);
 	t.nodes[x].first = t.nodes[0].first; /* an ancestor's children */
-	snprintf(needle, sizeof(needle), "node %u reachable twice", t.nodes[0].first);
-	expect(&t, false, needle);
+	expectf(&t, "node %u reachable twice", t.nodes[0].first);
 	bvhlab_tree_finish(&t);
 
 	tree_copy(&t, &fx.tree, 0);
@@ -210,51 +217,42 @@ static void test_cycle_and_sharing(void)
 	CHECK(t.nodes[x].count == 0 && t.nodes[y].count == 0);
 	t.nodes[y].first = t.nodes[x].first; /* shared children */
 	fixture_refit_node(&t, &fx.input, 0); /* boxes right: only the sharing is wrong */
-	snprintf(needle, sizeof(needle), "node %u reachable twice", t.nodes[x].first);
-	expect(&t, false, needle);
+	expectf(&t, "node %u reachable twice", t.nodes[x].first);
 	bvhlab_tree_finish(&t);
 }
 
 static void test_orphan(void)
 {
 	bvhlab_tree t;
-	char needle[128];
 
 	tree_copy(&t, &fx.tree, 4);
 	t.nodes[t.node_count] = t.nodes[find_leaf(&t, 1, 0)];
 	t.node_count++;
-	snprintf(needle, sizeof(needle), "node %u is not reachable from the root (orphan)",
-	         t.node_count - 1);
-	expect(&t, false, needle);
+	expectf(&t, "node %u is not reachable from the root (orphan)", t.node_count - 1);
 	bvhlab_tree_finish(&t);
 }
 
 static void test_ranges(void)
 {
 	bvhlab_tree t;
-	char needle[160];
 	uint32_t x, leaf;
 
 	tree_copy(&t, &fx.tree, 0);
 	x = find_inner(&t, 3);
 	t.nodes[x].first = t.node_count - 1; /* second child just past the end */
-	snprintf(needle, sizeof(needle), "node %u: child index %u out of range", x, t.node_count);
-	expect(&t, false, needle);
+	expectf(&t, "node %u: child index %u out of range", x, t.node_count);
 	expect(&t, false, "is the second one counted in node_count?");
 	t.nodes[x].first = UINT32_MAX;
-	snprintf(needle, sizeof(needle), "node %u: child index %u out of range", x, UINT32_MAX);
-	expect(&t, false, needle);
+	expectf(&t, "node %u: child index %u out of range", x, UINT32_MAX);
 	bvhlab_tree_finish(&t);
 
 	tree_copy(&t, &fx.tree, 0);
 	leaf = find_leaf(&t, 2, 2);
 	t.nodes[leaf].first = t.index_count - 1;
-	snprintf(needle, sizeof(needle), "node %u: leaf range [%u, %u) exceeds index_count %u",
-	         leaf, t.index_count - 1, t.index_count - 1 + t.nodes[leaf].count, t.index_count);
-	expect(&t, false, needle);
+	expectf(&t, "node %u: leaf range [%u, %u) exceeds index_count %u", leaf,
+	        t.index_count - 1, t.index_count - 1 + t.nodes[leaf].count, t.index_count);
 	t.nodes[leaf].first = UINT32_MAX; /* no wrap-around */
-	snprintf(needle, sizeof(needle), "node %u: leaf range", leaf);
-	expect(&t, false, needle);
+	expectf(&t, "node %u: leaf range", leaf);
 	bvhlab_tree_finish(&t);
 
 	/* The likely causes: index_count never set; a range one too long. */
@@ -267,25 +265,21 @@ static void test_ranges(void)
 			break;
 	CHECK(leaf < t.node_count);
 	t.nodes[leaf].count++;
-	snprintf(needle, sizeof(needle), "node %u: leaf range [%u, %u) exceeds index_count %u: "
-	         "a leaf range off by one?", leaf, t.nodes[leaf].first, t.index_count + 1,
-	         t.index_count);
-	expect(&t, false, needle);
+	expectf(&t, "node %u: leaf range [%u, %u) exceeds index_count %u: a leaf range off by one?",
+	        leaf, t.nodes[leaf].first, t.index_count + 1, t.index_count);
 	bvhlab_tree_finish(&t);
 
 	tree_copy(&t, &fx.tree, 0);
 	leaf = find_leaf(&t, 1, 4);
 	t.prim_index[t.nodes[leaf].first] = fx.input.prim_count + 7;
-	snprintf(needle, sizeof(needle), "node %u: prim_index[%u] = %u out of range", leaf,
-	         t.nodes[leaf].first, fx.input.prim_count + 7);
-	expect(&t, false, needle);
+	expectf(&t, "node %u: prim_index[%u] = %u out of range", leaf, t.nodes[leaf].first,
+	        fx.input.prim_count + 7);
 	bvhlab_tree_finish(&t);
 }
 
 static void test_slots(void)
 {
 	bvhlab_tree t;
-	char needle[128];
 	uint32_t a, b;
 
 	tree_copy(&t, &fx.tree, 4);
@@ -294,16 +288,12 @@ static void test_slots(void)
 	t.nodes[b].first = t.nodes[a].first;
 	t.nodes[b].count = 1;
 	fixture_refit_node(&t, &fx.input, 0);
-	snprintf(needle, sizeof(needle), "prim_index slot %u used by two leaves",
-	         t.nodes[a].first);
-	expect(&t, false, needle);
+	expectf(&t, "prim_index slot %u used by two leaves", t.nodes[a].first);
 	bvhlab_tree_finish(&t);
 
 	tree_copy(&t, &fx.tree, 4);
 	t.prim_index[t.index_count++] = 0;
-	snprintf(needle, sizeof(needle), "prim_index slot %u is used by no leaf",
-	         t.index_count - 1);
-	expect(&t, false, needle);
+	expectf(&t, "prim_index slot %u is used by no leaf", t.index_count - 1);
 	bvhlab_tree_finish(&t);
 }
 

@@ -23,30 +23,6 @@ static int out_of_memory(const struct config *cfg, bvhlab_error *err)
 	return -ENOMEM;
 }
 
-/* A [x, y, z] array of finite numbers into out; absent keeps out. */
-static int get_dvec3(const struct config *cfg, const cJSON *obj, const char *key,
-                     const char *prefix, double out[3], bvhlab_error *err)
-{
-	const cJSON *item = config_member(obj, key), *e;
-	char got[48];
-	double v[3];
-	int k = 0;
-	if (!item)
-		return 0;
-	if (cJSON_IsArray(item) && cJSON_GetArraySize(item) == 3)
-		cJSON_ArrayForEach(e, item) {
-			if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1e30)
-				break;
-			v[k++] = e->valuedouble;
-		}
-	if (k != 3)
-		return config_error(cfg, item, false, err,
-		                    "'%s%s' must be an array of 3 finite numbers, not %s", prefix, key,
-		                    config_describe(cfg, item, got, sizeof(got)));
-	memcpy(out, v, sizeof(v));
-	return 0;
-}
-
 /* The one conversion of a frame pattern: %d, %Nd or %0Nd, nothing else
  * but %%. */
 static bool pattern_ok(const char *p)
@@ -155,9 +131,9 @@ static int parse_animate(struct config *cfg, const cJSON *item, const char *pref
 	m->scale = 1;
 	int rc = config_check_keys(cfg, item, keys, where, err);
 	if (!rc)
-		rc = get_dvec3(cfg, item, "rotate", sub, m->rotate, err);
+		rc = config_get_dvec3(cfg, item, "rotate", sub, m->rotate, err);
 	if (!rc)
-		rc = get_dvec3(cfg, item, "translate", sub, m->translate, err);
+		rc = config_get_dvec3(cfg, item, "translate", sub, m->translate, err);
 	if (!rc)
 		rc = config_get_positive(cfg, item, "scale", sub, &m->scale, err);
 	return rc;

@@ -311,22 +311,22 @@ int config_get_string(const struct config *cfg, const cJSON *obj, const char *ke
 	return 0;
 }
 
-int config_get_vec3(const struct config *cfg, const cJSON *obj, const char *key,
-                    const char *prefix, float out[3], bvhlab_error *err)
+int config_get_dvec3(const struct config *cfg, const cJSON *obj, const char *key,
+                     const char *prefix, double out[3], bvhlab_error *err)
 {
 	const cJSON *item = config_member(obj, key);
 	char got[48];
 	if (!item)
 		return 0;
 	if (cJSON_IsArray(item) && cJSON_GetArraySize(item) == 3) {
-		float v[3];
+		double v[3];
 		int k = 0;
 		const cJSON *e;
 		cJSON_ArrayForEach(e, item) {
 			if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) ||
 			    fabs(e->valuedouble) > 1e30)
 				break;
-			v[k++] = (float)e->valuedouble;
+			v[k++] = e->valuedouble;
 		}
 		if (k == 3) {
 			memcpy(out, v, sizeof(v));
@@ -336,6 +336,17 @@ int config_get_vec3(const struct config *cfg, const cJSON *obj, const char *key,
 	return config_error(cfg, item, false, err,
 	                    "'%s%s' must be an array of 3 finite numbers, not %s", prefix, key,
 	                    config_describe(cfg, item, got, sizeof(got)));
+}
+
+int config_get_vec3(const struct config *cfg, const cJSON *obj, const char *key,
+                    const char *prefix, float out[3], bvhlab_error *err)
+{
+	double v[3] = { out[0], out[1], out[2] };
+	int rc = config_get_dvec3(cfg, obj, key, prefix, v, err);
+
+	for (int k = 0; rc == 0 && k < 3; k++)
+		out[k] = (float)v[k];
+	return rc;
 }
 
 static int thread_entries(const struct config *cfg, const cJSON *array, const char *name,

@@ -106,7 +106,11 @@ int config_get_positive(const struct config *cfg, const cJSON *obj, const char *
 /* A non-empty string, copied into *out (freeing what was there). */
 int config_get_string(const struct config *cfg, const cJSON *obj, const char *key,
                       const char *prefix, char **out, bvhlab_error *err);
-/* A [x, y, z] array of finite numbers (magnitude <= 1e30) into out. */
+/* A [x, y, z] array of finite numbers (magnitude <= 1e30) into out; absent
+ * keeps out. */
+int config_get_dvec3(const struct config *cfg, const cJSON *obj, const char *key,
+                     const char *prefix, double out[3], bvhlab_error *err);
+/* The same into floats. */
 int config_get_vec3(const struct config *cfg, const cJSON *obj, const char *key,
                     const char *prefix, float out[3], bvhlab_error *err);
 /* A non-empty array of distinct thread counts (0 = all hardware threads). */

@@ -12,33 +12,6 @@
 
 #include "config/config_internal.h"
 
-/* A [x, y, z] array of finite numbers (|v| <= 1e30) into out; absent keeps out. */
-static int get_vec3(const struct config *cfg, const cJSON *obj, const char *key,
-                    const char *prefix, double out[3], bvhlab_error *err)
-{
-	const cJSON *item = config_member(obj, key), *e;
-	char got[48];
-	double v[3];
-	int k = 0;
-
-	if (!item)
-		return 0;
-	if (cJSON_IsArray(item) && cJSON_GetArraySize(item) == 3) {
-		cJSON_ArrayForEach(e, item) {
-			if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) ||
-			    fabs(e->valuedouble) > 1e30)
-				break;
-			v[k++] = e->valuedouble;
-		}
-	}
-	if (k != 3)
-		return config_error(cfg, item, false, err,
-		                    "'%s%s' must be an array of 3 finite numbers, not %s", prefix,
-		                    key, config_describe(cfg, item, got, sizeof(got)));
-	memcpy(out, v, sizeof(v));
-	return 0;
-}
-
 static int part_path(struct config *cfg, struct config_scene *src, bvhlab_error *err)
 {
 	char *resolved;
@@ -74,9 +47,9 @@ static int parse_part(struct config *cfg, const cJSON *obj, const char *scene_pr
 	if (!rc)
 		rc = config_scene_source(cfg, obj, prefix, config_part_keys, &part->src, err);
 	if (!rc)
-		rc = get_vec3(cfg, obj, "rotate", prefix, part->xf.rotate, err);
+		rc = config_get_dvec3(cfg, obj, "rotate", prefix, part->xf.rotate, err);
 	if (!rc)
-		rc = get_vec3(cfg, obj, "translate", prefix, part->xf.translate, err);
+		rc = config_get_dvec3(cfg, obj, "translate", prefix, part->xf.translate, err);
 	if (!rc)
 		rc = config_parse_motion(cfg, obj, prefix, &part->motion, err);
 	return rc ? rc : part_path(cfg, &part->src, err);

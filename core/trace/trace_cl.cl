@@ -179,32 +179,58 @@ static void store(__global uint4 *hits, __global uint2 *counts, uint i, const hi
 	counts[i] = (uint2)(nodes, tests);
 }
 
+/* The arguments of both traversal kernels, in the order the host sets them. */
+#define TRACE_KERNEL_ARGS                                                                  \
+	__global const float4 *nodes, __global const float *tris,                          \
+	__global const uint *prim_index, __global const uint *parents, uint node_total,    \
+	uint index_count, uint tri_count, __global const float4 *rays, uint ray_count,     \
+	uint any, __global uint4 *hits, __global uint2 *counts
+
+/* Enters `node`: its first and count, counted in *visited; false past
+ * node_total entries (a cycle in a broken tree: the walk ends). */
+static bool enter_node(__global const float4 *nodes, uint node, uint node_total, uint *visited,
+                       uint *first, uint *count)
+{
+	if (++*visited > node_total)
+		return false;
+	*first = node_first(nodes, node);
+	*count = node_count(nodes, node);
+	return true;
+}
+
+/* The start of both traversals for ray i: no hit yet, the ray prepared;
+ * false when there is nothing to trace (past the last ray, or a ray that
+ * misses the root box, whose miss is stored). */
+static bool ray_begin(__global const float4 *nodes, uint node_total,
+                      __global const float4 *rays, uint ray_count, uint i,
+                      __global uint4 *hits, __global uint2 *counts, prep *p, hit *h)
+{
+	if (i >= ray_count)
+		return false;
+	float4 o = rays[2 * i], d = rays[2 * i + 1];
+	h->t = d.w;
+	h->u = 0.0f;
+	h->v = 0.0f;
+	h->prim = NO_HIT;
+	if (prep_ray(o, d, p) && node_total != 0 && box_enter(p, nodes, 0, h->t) != INFINITY)
+		return true;
+	store(hits, counts, i, h, 0, 0);
+	return false;
+}
+
 /* trace.c's traverse(): near child first, far ones on a stack with their
  * entry distance, popped only while it still beats the closest hit. */
-__kernel void trace_stack(__global const float4 *nodes, __global const float *tris,
-                          __global const uint *prim_index, __global const uint *parents,
-                          uint node_total, uint index_count, uint tri_count,
-                          __global const float4 *rays, uint ray_count, uint any,
-                          __global uint4 *hits, __global uint2 *counts)
+__kernel void trace_stack(TRACE_KERNEL_ARGS)
 {
-	uint i = get_global_id(0);
-	if (i >= ray_count)
-		return;
-	(void)parents;
-	float4 o = rays[2 * i], d = rays[2 * i + 1];
-	hit h = {d.w, 0.0f, 0.0f, NO_HIT};
-	uint visited = 0, tests = 0, sp = 0, node = 0;
+	uint i = get_global_id(0), visited = 0, tests = 0, sp = 0, node = 0, first, count;
 	uint st_node[STACK_SIZE];
 	float st_t[STACK_SIZE];
+	hit h;
 	prep p;
-	if (!prep_ray(o, d, &p) || node_total == 0 || box_enter(&p, nodes, 0, h.t) == INFINITY) {
-		store(hits, counts, i, &h, 0, 0);
+	(void)parents;
+	if (!ray_begin(nodes, node_total, rays, ray_count, i, hits, counts, &p, &h))
 		return;
-	}
-	for (;;) {
-		if (++visited > node_total)
-			break;
-		uint first = node_first(nodes, node), count = node_count(nodes, node);
+	while (enter_node(nodes, node, node_total, &visited, &first, &count)) {
 		if (count) {
 			if (leaf(&p, tris, prim_index, first, count, index_count, tri_count, any, &h,
 			         &tests))
@@ -263,27 +289,14 @@ static uint near_child(const prep *p, __global const float4 *nodes, uint first)
 
 /* trace_stackless.c's walk(): down into the near child, up through the
  * parent links (Hapala et al. 2011). */
-__kernel void trace_stackless(__global const float4 *nodes, __global const float *tris,
-                              __global const uint *prim_index, __global const uint *parents,
-                              uint node_total, uint index_count, uint tri_count,
-                              __global const float4 *rays, uint ray_count, uint any,
-                              __global uint4 *hits, __global uint2 *counts)
+__kernel void trace_stackless(TRACE_KERNEL_ARGS)
 {
-	uint i = get_global_id(0);
-	if (i >= ray_count)
-		return;
-	float4 o = rays[2 * i], d = rays[2 * i + 1];
-	hit h = {d.w, 0.0f, 0.0f, NO_HIT};
-	uint visited = 0, tests = 0, node = 0;
+	uint i = get_global_id(0), visited = 0, tests = 0, node = 0, first, count;
+	hit h;
 	prep p;
-	if (!prep_ray(o, d, &p) || node_total == 0 || box_enter(&p, nodes, 0, h.t) == INFINITY) {
-		store(hits, counts, i, &h, 0, 0);
+	if (!ray_begin(nodes, node_total, rays, ray_count, i, hits, counts, &p, &h))
 		return;
-	}
-	for (;;) {
-		if (++visited > node_total)
-			break;
-		uint first = node_first(nodes, node), count = node_count(nodes, node);
+	while (enter_node(nodes, node, node_total, &visited, &first, &count)) {
 		if (count == 0) {
 			uint near = near_child(&p, nodes, first);
 			uint far = near == first ? first + 1 : first;

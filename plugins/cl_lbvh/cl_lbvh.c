@@ -36,10 +36,21 @@ static const bvhlab_option_decl options[] = {
 
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
+/* Where the options go in the build's struct. */
+static const plugin_field fields[] = {
+	CL_BUILDER_FIELDS(cl_lbvh),
+	PLUGIN_FIELD(cl_lbvh, leaf_block, "leaf_block", U32),
+	PLUGIN_FIELD(cl_lbvh, hierarchy, "hierarchy", STRING),
+};
+
+#define FIELD_COUNT (sizeof(fields) / sizeof(fields[0]))
+
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "gather_leaves", "prefixes",
 	"karras_scan",
 };
+
+static const cl_builder program = CL_BUILDER(cl_lbvh_src, kernel_names, UINT32_MAX / 2);
 
 /* Kept between builds (one build at a time, ABI rule); released when the
  * plugin is unloaded. */
@@ -56,38 +67,6 @@ __attribute__((destructor)) static void release_device(void)
 	cl_dev_close(&S.dev);
 }
 
-static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_lbvh *b)
-{
-	static const plugin_field fields[] = {
-		PLUGIN_FIELD(cl_lbvh, device, "device", STRING),
-		PLUGIN_FIELD(cl_lbvh, leaf_block, "leaf_block", U32),
-		PLUGIN_FIELD(cl_lbvh, hierarchy, "hierarchy", STRING),
-	};
-	morton_options o;
-	int rc;
-
-	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, &o)) < 0 ||
-	    (rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
-	                              sizeof(fields) / sizeof(fields[0]), b)) < 0)
-		return rc;
-	b->collapse = o.collapse;
-	b->bits = o.bits;
-	b->max_leaf = o.max_leaf;
-	b->c_trav = o.c_trav;
-	b->c_isect = o.c_isect;
-	return 0;
-}
-
-static void report(const bvhlab_host *host, bvhlab_build_ctx *ctx, const cl_lbvh *b)
-{
-	static const char *const names[] = { "upload", "device", "download", "convert" };
-
-	if (!BVHLAB_HOST_HAS(host, phase))
-		return;
-	for (int k = 0; k < 4; k++)
-		host->phase(ctx, names[k], b->ms[k]);
-}
-
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
@@ -96,28 +75,15 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	char err[BVHLAB_CL_ERROR_SIZE];
 	int rc;
 
-	if (b.n == 0 || b.n > UINT32_MAX / 2) {
-		host->set_error(ctx, "cannot build over %u primitives", b.n);
-		return -EINVAL;
-	}
-	if ((rc = read_options(host, ctx, &b)) < 0 ||
-	    (rc = morton_ensure_capacity(host, ctx, b.n, 0, output)) < 0)
-		return rc;
-	rc = cl_dev_open(&S.dev, b.device, cl_lbvh_src, cl_lbvh_src_LEN, kernel_names,
-	                 sizeof(kernel_names) / sizeof(kernel_names[0]), err, sizeof(err));
-	if (rc < 0) {
-		host->set_error(ctx, "%s", err);
-		return rc;
-	}
-	if (b.n == 1) {
-		morton_single_leaf(input, output);
-		return 0;
-	}
+	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, fields, FIELD_COUNT,
+	                              &b)) < 0 ||
+	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
+		return rc < 0 ? rc : 0;
 	if ((rc = cl_lbvh_run(&b, output, err, sizeof(err))) < 0) {
 		host->set_error(ctx, "%s", err);
 		return rc;
 	}
-	report(host, ctx, &b);
+	cl_report_phases(host, ctx, b.ms);
 	return 0;
 }
 

@@ -25,7 +25,7 @@ typedef struct cl_lbvh {
 	cl_dev *dev;
 	cl_sort *sort;
 	cl_buf *b;           /* [LB_COUNT] */
-	double ms[4];        /* upload, device, download, convert */
+	double ms[CL_PHASES]; /* upload, device, download, convert */
 } cl_lbvh;
 
 /* Builds the tree of n >= 2 primitives into out (room for 2n - 1 nodes and

@@ -35,10 +35,21 @@ static const bvhlab_option_decl options[] = {
 
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
+/* Where the options go in the build's struct. */
+static const plugin_field fields[] = {
+	CL_BUILDER_FIELDS(cl_ploc),
+	PLUGIN_FIELD(cl_ploc, radius, "radius", U32),
+	PLUGIN_FIELD(cl_ploc, nn_block, "nn_block", U32),
+};
+
+#define FIELD_COUNT (sizeof(fields) / sizeof(fields[0]))
+
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "first_clusters", "nearest", "count_chunks", "prefix",
 	"write_chunks", "nearest_blocks",
 };
+
+static const cl_builder program = CL_BUILDER(cl_ploc_src, kernel_names, REC_PRIMS);
 
 /* Kept between builds (one build at a time, ABI rule), with the host's
  * copy of the merge tree; released when the plugin is unloaded. */
@@ -60,28 +71,6 @@ __attribute__((destructor)) static void release_device(void)
 	free(S.desc);
 }
 
-static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_ploc *b)
-{
-	static const plugin_field fields[] = {
-		PLUGIN_FIELD(cl_ploc, radius, "radius", U32),
-		PLUGIN_FIELD(cl_ploc, nn_block, "nn_block", U32),
-		PLUGIN_FIELD(cl_ploc, device, "device", STRING),
-	};
-	morton_options o;
-	int rc;
-
-	if ((rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
-	                              sizeof(fields) / sizeof(fields[0]), b)) < 0 ||
-	    (rc = morton_options_fill(host, ctx, options, OPTION_COUNT, &o)) < 0)
-		return rc;
-	b->collapse = o.collapse;
-	b->bits = o.bits;
-	b->max_leaf = o.max_leaf;
-	b->c_trav = o.c_trav;
-	b->c_isect = o.c_isect;
-	return 0;
-}
-
 /* The host's copy of the merge tree, kept between builds. */
 static int host_tree(cl_ploc *b)
 {
@@ -99,16 +88,6 @@ static int host_tree(cl_ploc *b)
 	b->tree = S.tree;
 	b->desc = S.desc;
 	return 0;
-}
-
-static void report(const bvhlab_host *host, bvhlab_build_ctx *ctx, const cl_ploc *b)
-{
-	static const char *const names[] = { "upload", "device", "download", "convert" };
-
-	if (!BVHLAB_HOST_HAS(host, phase))
-		return;
-	for (int k = 0; k < 4; k++)
-		host->phase(ctx, names[k], b->ms[k]);
 }
 
 static int run(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_ploc *b,
@@ -132,7 +111,7 @@ static int run(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_ploc *b,
 	b->ms[3] = cl_now_ms() - t0;
 	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims, %u iterations on %s", b->n, b->iterations,
 	          S.dev.cl.name);
-	report(host, ctx, b);
+	cl_report_phases(host, ctx, b->ms);
 	return 0;
 }
 
@@ -141,26 +120,12 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 {
 	cl_ploc b = { .in = input, .n = input->prim_count, .dev = &S.dev, .sort = &S.sort,
 	              .b = S.b };
-	char err[BVHLAB_CL_ERROR_SIZE];
 	int rc;
 
-	if (b.n == 0 || b.n > REC_PRIMS) {
-		host->set_error(ctx, "cannot build over %u primitives", b.n);
-		return -EINVAL;
-	}
-	if ((rc = read_options(host, ctx, &b)) < 0 ||
-	    (rc = morton_ensure_capacity(host, ctx, b.n, 0, output)) < 0)
-		return rc;
-	rc = cl_dev_open(&S.dev, b.device, cl_ploc_src, cl_ploc_src_LEN, kernel_names,
-	                 sizeof(kernel_names) / sizeof(kernel_names[0]), err, sizeof(err));
-	if (rc < 0) {
-		host->set_error(ctx, "%s", err);
-		return rc;
-	}
-	if (b.n == 1) {
-		morton_single_leaf(input, output);
-		return 0;
-	}
+	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, fields, FIELD_COUNT,
+	                              &b)) < 0 ||
+	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
+		return rc < 0 ? rc : 0;
 	return run(host, ctx, &b, output);
 }
 

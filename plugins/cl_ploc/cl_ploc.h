@@ -37,7 +37,7 @@ typedef struct cl_ploc {
 	bvhlab_node *tree;      /* [2n - 1] the merge tree's records, downloaded */
 	uint32_t *desc;         /* [2n - 1] output nodes below each record */
 	uint32_t iterations;
-	double ms[4];           /* upload, device, download, convert */
+	double ms[CL_PHASES];   /* upload, device, download, convert */
 } cl_ploc;
 
 /* Builds the merge tree of n >= 2 primitives into b->tree and b->desc

@@ -16,20 +16,12 @@ static const bvhlab_option_decl options[] = { MORTON_OPTION_DECLS };
 
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
-static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, lbvh *b)
-{
-	morton_options o;
-	int rc = morton_options_fill(host, ctx, options, OPTION_COUNT, &o);
+/* Where the options go in the build's struct. */
+static const plugin_field fields[] = {
+	MORTON_FIELDS(lbvh, bits),
+};
 
-	if (rc < 0)
-		return rc;
-	b->collapse = o.collapse;
-	b->bits = o.bits;
-	b->max_leaf = o.max_leaf;
-	b->c_trav = o.c_trav;
-	b->c_isect = o.c_isect;
-	return 0;
-}
+#define FIELD_COUNT (sizeof(fields) / sizeof(fields[0]))
 
 /* Nodes past the tree's 2n - 1 that hold the hierarchy's scratch (see
  * scratch_alloc()); 0 when that would not fit a uint32_t count. */
@@ -174,7 +166,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = read_options(host, ctx, &b)) < 0 ||
+	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, fields, FIELD_COUNT,
+	                              &b)) < 0 ||
 	    (rc = ensure_capacity(host, ctx, &b, output)) < 0)
 		return rc;
 	if (input->prim_count == 1) {

@@ -23,22 +23,13 @@ static const bvhlab_option_decl options[] = {
 
 #define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
 
-static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p)
-{
-	static const plugin_field radius[] = { PLUGIN_FIELD(ploc, radius, "radius", U32) };
-	morton_options o;
-	int rc;
+/* Where the options go in the build's struct. */
+static const plugin_field fields[] = {
+	PLUGIN_FIELD(ploc, radius, "radius", U32),
+	MORTON_FIELDS(ploc, sort.bits),
+};
 
-	if ((rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, radius, 1, p)) < 0 ||
-	    (rc = morton_options_fill(host, ctx, options, OPTION_COUNT, &o)) < 0)
-		return rc;
-	p->collapse = o.collapse;
-	p->sort.bits = o.bits;
-	p->max_leaf = o.max_leaf;
-	p->c_trav = o.c_trav;
-	p->c_isect = o.c_isect;
-	return 0;
-}
+#define FIELD_COUNT (sizeof(fields) / sizeof(fields[0]))
 
 /* ---- scratch ------------------------------------------------------------ */
 
@@ -203,7 +194,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = read_options(host, ctx, &p)) < 0 ||
+	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, fields, FIELD_COUNT,
+	                              &p)) < 0 ||
 	    (rc = morton_ensure_capacity(host, ctx, p.n, spare_nodes(p.n), output)) < 0)
 		return rc;
 	if (input->prim_count == 1) {
@@ -213,11 +205,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return build_team(host, ctx, &p, output);
 }
 
-BVHLAB_PLUGIN(
-	.name = "ploc",
+BVHLAB_PLUGIN(.name = "ploc", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "parallel locally-ordered clustering (Meister & Bittner 2018) from Morton "
 	           "order, SAH collapse",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.option_count = OPTION_COUNT,
-	.options = options,
-	.build = build)
+	.option_count = OPTION_COUNT, .options = options, .build = build)

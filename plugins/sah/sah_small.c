@@ -17,41 +17,21 @@
  */
 #include <string.h>
 
-#include "sah_box.h"
-#include "sah_nodes.h"
-#include "sah_split.h"
-#include "sah_simd.h"
+#include "sah_small.h"
 
 typedef struct small {
-	sah_builder *b;
-	uint32_t begin;                   /* the subtree's first position */
-	v4 lo[SAH_SMALL_MAX];             /* boxes, by local index */
-	v4 hi[SAH_SMALL_MAX];
-	float cen[3][SAH_SMALL_MAX];      /* centroids, by axis and local index */
-	uint32_t id[SAH_SMALL_MAX];
+	small_copy l;
 	/* Local indices sorted by centroid along each axis (ties by index); a
 	 * node's primitives occupy the same slots [lb, le) of all three. */
 	uint8_t order[3][SAH_SMALL_MAX];
 	uint8_t side[SAH_SMALL_MAX];      /* by local index: 0 left, 1 right */
 	uint8_t tmp[SAH_SMALL_MAX];
-	float right[SAH_SMALL_MAX];       /* A_R * N_R of the slots from j on */
 } small;
-
-typedef struct small_node {
-	uint32_t node, lb, le; /* node slot; its slots [lb, le) */
-	bvhlab_aabb box;
-} small_node;
 
 static void load(small *s, const sah_prim *prims, uint32_t n)
 {
-	for (uint32_t k = 0; k < n; k++) {
-		const sah_prim *p = &prims[s->begin + k];
-		s->lo[k] = v4_load3(p->lo);
-		s->hi[k] = v4_load3(p->hi);
-		for (int a = 0; a < 3; a++)
-			s->cen[a][k] = prim_centroid(p, a);
-		s->id[k] = p->id;
-	}
+	for (uint32_t k = 0; k < n; k++)
+		small_load_prim(&s->l, &prims[s->l.begin + k], k);
 }
 
 #if defined(__SSE2__) && !defined(SAH_NO_SIMD)
@@ -67,7 +47,7 @@ static void load(small *s, const sah_prim *prims, uint32_t n)
  */
 static void sort_axis(small *s, int a, uint32_t n)
 {
-	float *c = s->cen[a];
+	float *c = s->l.cen[a];
 	uint8_t *o = s->order[a];
 	uint32_t n4 = (n + 3) & ~3u;
 	static const int32_t below[4][4] = {
@@ -98,7 +78,7 @@ static void sort_axis(small *s, int a, uint32_t n)
 /* Stable insertion sort of the identity by centroid (the plain C build). */
 static void sort_axis(small *s, int a, uint32_t n)
 {
-	const float *c = s->cen[a];
+	const float *c = s->l.cen[a];
 	uint8_t *o = s->order[a];
 
 	for (uint32_t k = 0; k < n; k++) {
@@ -118,56 +98,15 @@ static void sort_axis(small *s, int a, uint32_t n)
  * kernel's by-id side marks, which only this job's primitives use now. */
 static void take_presorted(small *s, uint32_t n)
 {
-	sah_builder *b = s->b;
+	sah_builder *b = s->l.b;
 
 	for (uint32_t k = 0; k < n; k++) {
 		s->order[0][k] = (uint8_t)k;
-		b->side[s->id[k]] = (uint8_t)k;
+		b->side[s->l.id[k]] = (uint8_t)k;
 	}
 	for (int a = 1; a < 3; a++)
 		for (uint32_t k = 0; k < n; k++)
-			s->order[a][k] = b->side[b->prims[a][s->begin + k].id];
-}
-
-/* Lowest cost of one axis' planes below best, first position in *pos. */
-static float eval_axis(small *s, int a, uint32_t lb, uint32_t le, float best, uint32_t *pos)
-{
-	const uint8_t *o = s->order[a];
-	const float *c = s->cen[a];
-	v4 lo = v4_set1(INFINITY), hi = v4_set1(-INFINITY);
-
-	for (uint32_t j = le - 1; j > lb; j--) {
-		lo = v4_min(lo, s->lo[o[j]]);
-		hi = v4_max(hi, s->hi[o[j]]);
-		s->right[j] = v4_half_area(lo, hi) * (float)(le - j);
-	}
-	lo = v4_set1(INFINITY);
-	hi = v4_set1(-INFINITY);
-	for (uint32_t j = lb + 1; j < le; j++) {
-		lo = v4_min(lo, s->lo[o[j - 1]]);
-		hi = v4_max(hi, s->hi[o[j - 1]]);
-		if (!(c[o[j - 1]] < c[o[j]]))
-			continue;
-		float cost = v4_half_area(lo, hi) * (float)(j - lb) + s->right[j];
-		if (cost < best) {
-			best = cost;
-			*pos = j;
-		}
-	}
-	return best;
-}
-
-static void write_leaf(small *s, const small_node *c)
-{
-	sah_builder *b = s->b;
-	bvhlab_node *node = &b->nodes[c->node];
-
-	memcpy(node->lo, c->box.lo, sizeof(node->lo));
-	memcpy(node->hi, c->box.hi, sizeof(node->hi));
-	node->first = s->begin + c->lb;
-	node->count = c->le - c->lb;
-	for (uint32_t k = c->lb; k < c->le; k++)
-		b->ids[s->begin + k] = s->id[s->order[0][k]];
+			s->order[a][k] = b->side[b->prims[a][s->l.begin + k].id];
 }
 
 /* Marks the sides by slot of the split axis and takes the children's boxes. */
@@ -180,8 +119,8 @@ static void mark(small *s, int axis, const small_node *c, uint32_t pos, small_no
 		v4 lo = v4_set1(INFINITY), hi = v4_set1(-INFINITY);
 		for (uint32_t k = from; k < to; k++) {
 			s->side[o[k]] = (uint8_t)h;
-			lo = v4_min(lo, s->lo[o[k]]);
-			hi = v4_max(hi, s->hi[o[k]]);
+			lo = v4_min(lo, s->l.lo[o[k]]);
+			hi = v4_max(hi, s->l.hi[o[k]]);
 		}
 		child[h].lb = from;
 		child[h].le = to;
@@ -217,19 +156,20 @@ static float eval_pair(const small *s, const small_node *c, int *axis, uint32_t 
 	uint32_t i = s->order[0][c->lb], j = s->order[0][c->lb + 1];
 
 	for (int a = 0; a < 3; a++) {
-		if (s->cen[a][i] == s->cen[a][j])
+		if (s->l.cen[a][i] == s->l.cen[a][j])
 			continue;
 		*axis = a;
 		*pos = c->lb + 1;
-		return v4_half_area(s->lo[i], s->hi[i]) * 1.0f +
-		       v4_half_area(s->lo[j], s->hi[j]) * 1.0f;
+		return v4_half_area(s->l.lo[i], s->l.hi[i]) * 1.0f +
+		       v4_half_area(s->l.lo[j], s->l.hi[j]) * 1.0f;
 	}
 	return INFINITY;
 }
 
 /* Decides one node; returns 2 and fills child[] when it splits. */
-static unsigned split_node(small *s, const small_node *c, small_node child[2])
+static unsigned split_node(void *state, const small_node *c, small_node child[2])
 {
+	small *s = state;
 	uint32_t n = c->le - c->lb, pos = 0;
 	float best = INFINITY;
 	int axis = -1;
@@ -238,16 +178,16 @@ static unsigned split_node(small *s, const small_node *c, small_node child[2])
 		best = eval_pair(s, c, &axis, &pos);
 	for (int a = 0; n > 2 && a < 3; a++) {
 		const uint8_t *o = s->order[a];
-		if (!(s->cen[a][o[c->lb]] < s->cen[a][o[c->le - 1]]))
+		if (!(s->l.cen[a][o[c->lb]] < s->l.cen[a][o[c->le - 1]]))
 			continue;
-		float cost = eval_axis(s, a, c->lb, c->le, best, &pos);
+		float cost = small_sweep(&s->l, o, a, c->lb, c->le, best, &pos);
 		if (cost < best) {
 			best = cost;
 			axis = a;
 		}
 	}
-	if (n == 1 || sah_leaf_rule(&s->b->opt, n, &c->box, axis >= 0, best)) {
-		write_leaf(s, c);
+	if (n == 1 || sah_leaf_rule(&s->l.b->opt, n, &c->box, axis >= 0, best)) {
+		small_write_leaf(&s->l, c, s->order[0]);
 		return 0;
 	}
 	if (axis < 0) { /* every centroid coincides: split the x order's middle */
@@ -256,32 +196,20 @@ static unsigned split_node(small *s, const small_node *c, small_node child[2])
 	}
 	mark(s, axis, c, pos, child);
 	partition(s, axis, c, pos);
-	sah_write_node(s->b, c->node, &c->box, &child[0].node);
-	child[1].node = child[0].node + 1;
-	return 2;
+	return small_write_inner(&s->l, c, child);
 }
 
 void sah_small_subtree(sah_builder *b, const sah_job *job)
 {
 	small s;
-	small_node stack[SAH_SMALL_MAX], child[2];
-	uint32_t n = job->end - job->begin, sp = 0;
+	uint32_t n = job->end - job->begin;
 
-	s.b = b;
-	s.begin = job->begin;
-	load(&s, sah_job_prims(b, job), n);
+	load(&s, small_begin(&s.l, b, job), n);
 	if (b->opt.method == SAH_SWEEP) {
 		take_presorted(&s, n);
 	} else {
 		for (int a = 0; a < 3; a++)
 			sort_axis(&s, a, n);
 	}
-	stack[sp++] = (small_node){ .node = job->node, .lb = 0, .le = n, .box = job->box };
-	while (sp > 0) {
-		small_node cur = stack[--sp];
-		if (split_node(&s, &cur, child) == 2) {
-			stack[sp++] = child[1];
-			stack[sp++] = child[0];
-		}
-	}
+	small_walk(job, n, &s, split_node);
 }

@@ -7,11 +7,13 @@
 #define BVHLAB_TEST_CLIUTIL_H
 
 #include <fcntl.h>
+#include <signal.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cJSON.h>
@@ -101,6 +103,8 @@ static int run(const char *const *args)
 	return finish(start(args));
 }
 
+#define ARGS(...) ((const char *const[]){__VA_ARGS__, NULL})
+
 static char *write_config(const char *name, const char *text)
 {
 	static char path[512];
@@ -147,7 +151,102 @@ static int count_runs(const cJSON *doc, const char *builder, const char *status)
 	return n;
 }
 
-#define ARGS(...) ((const char *const[]){__VA_ARGS__, NULL})
+/* The run of `builder` on `scene` with `threads` threads in a results
+ * document; NULL when there is none (or its threads are not a number). */
+static inline const cJSON *find_run(const cJSON *doc, const char *scene, const char *builder,
+                                    int threads)
+{
+	const cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs")) {
+		const cJSON *t = cJSON_GetObjectItem(run, "threads");
+		if (!strcmp(run_str(run, "scene"), scene) && !strcmp(run_str(run, "builder"), builder) &&
+		    cJSON_IsNumber(t) && t->valueint == threads)
+			return run;
+	}
+	return NULL;
+}
+
+/* Polls (bounded: about a minute) until the sweep has written at least one
+ * run to dir/results.json; that count, or -1 when it never did. */
+static inline int wait_for_runs(const char *dir)
+{
+	const struct timespec pause = {.tv_nsec = 10 * 1000 * 1000};
+	int n = -1;
+	for (int k = 0; k < 6000 && n < 1; k++) {
+		n = runs_written(dir);
+		if (n < 1)
+			nanosleep(&pause, NULL);
+	}
+	return n;
+}
+
+/*
+ * A sweep killed mid-way and resumed: its config kill.json has a builder
+ * "gated" that blocks until the file `gate` appears, so the kill surely
+ * lands mid-sweep; its output folder is out-kill.
+ */
+struct kill_sweep {
+	char gate[512], dir[512], cfg[512];
+};
+
+/* Writes kill.json from `format` (its one %s: the gate file), runs it until
+ * it has written a run, then kills it with SIGKILL (checked): the runs
+ * written before, -1 if none ever was. */
+static inline int kill_sweep_start(struct kill_sweep *k, const char *format)
+{
+	char text[2048];
+	snprintf(k->gate, sizeof(k->gate), "%s/gate", tmpdir);
+	snprintf(k->dir, sizeof(k->dir), "%s/out-kill", tmpdir);
+	snprintf(text, sizeof(text), format, k->gate);
+	snprintf(k->cfg, sizeof(k->cfg), "%s", write_config("kill.json", text));
+	pid_t pid = start(ARGS("run", k->cfg));
+	int before = wait_for_runs(k->dir);
+	kill(pid, SIGKILL);
+	CHECK_INT(finish(pid), 128 + SIGKILL);
+	return before;
+}
+
+/* Opens the gate (checked) and runs the sweep with --resume: its status. */
+static inline int kill_sweep_resume(const struct kill_sweep *k)
+{
+	FILE *f = fopen(k->gate, "w");
+	CHECK(f != NULL);
+	if (f)
+		fclose(f);
+	return run(ARGS("run", k->cfg, "--resume"));
+}
+
+/* A run's member `key` as compact JSON text (to free), NULL for no run. */
+static inline char *run_item_text(const cJSON *run, const char *key)
+{
+	return run ? cJSON_PrintUnformatted(cJSON_GetObjectItem(run, key)) : NULL;
+}
+
+/* Appends `more` to the colon-separated options in environment variable
+ * `var`, for the children started after. */
+static inline void append_option(const char *var, const char *more)
+{
+	const char *old = getenv(var);
+	char opts[512];
+	snprintf(opts, sizeof(opts), "%s%s%s", old ? old : "", old && *old ? ":" : "", more);
+	setenv(var, opts, 1);
+}
+
+/* ASan's own SEGV handler would turn the plugins' crashes into aborts. */
+static inline void plain_crashes(void)
+{
+	append_option("ASAN_OPTIONS", "handle_segv=0");
+}
+
+/* Long enough for any run of the tests on a loaded machine; a hang ends here. */
+#define CLI_LIMIT_S 60
+
+/* Runs bvhlab with args (NULL-terminated) in `cwd` (NULL: here), killed
+ * after CLI_LIMIT_S; stdout/stderr into the buffers. */
+static inline int run_in(const char *cwd, const char *const *args)
+{
+	return finish(start_in(cwd, CLI_LIMIT_S, args));
+}
 
 /* Makes tmpdir and takes the command's path; false on bad arguments. */
 static bool cli_begin(int argc, char **argv)
@@ -169,6 +268,32 @@ static int cli_end(void)
 		fprintf(stderr, "files kept in %s\n", tmpdir);
 	}
 	return test_finish();
+}
+
+/* A test program's modes: the one named on its command line runs. */
+struct cli_mode {
+	const char *name;
+	void (*fn)(void);
+};
+
+/* main() of a program run as `PROGRAM BVHLAB_EXE MODE`: runs MODE from
+ * `modes` with the command's absolute path (modes may run it from other
+ * folders); the exit status, 2 on bad arguments or an unknown mode. */
+static inline int cli_main_modes(int argc, char **argv, const char *program,
+                                 const struct cli_mode *modes, size_t n)
+{
+	static char absolute[4096];
+	if (!cli_begin(argc, argv))
+		return fprintf(stderr, "usage: %s BVHLAB_EXE MODE\n", program), 2;
+	if (realpath(argv[1], absolute))
+		exe = absolute;
+	for (size_t k = 0; k < n; k++)
+		if (!strcmp(argv[2], modes[k].name)) {
+			modes[k].fn();
+			return cli_end();
+		}
+	fprintf(stderr, "%s: unknown mode %s\n", program, argv[2]);
+	return 2;
 }
 
 #endif

@@ -17,23 +17,8 @@
  *           no finished run lost, none run again.
  */
 #include <math.h>
-#include <signal.h>
-#include <time.h>
 
 #include "cliutil.h"
-
-static const cJSON *find_run(const cJSON *doc, const char *scene, const char *builder,
-                             int threads)
-{
-	const cJSON *run;
-	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs")) {
-		const cJSON *t = cJSON_GetObjectItem(run, "threads");
-		if (!strcmp(run_str(run, "scene"), scene) && !strcmp(run_str(run, "builder"), builder) &&
-		    cJSON_IsNumber(t) && t->valueint == threads)
-			return run;
-	}
-	return NULL;
-}
 
 static const cJSON *frame(const cJSON *run, int f)
 {
@@ -242,57 +227,35 @@ static void test_errors(void)
 	CHECK_CONTAINS(err_text, "animation update: plugin 'lbvh' has no update function (ABI 1.4)");
 }
 
-static int wait_for_runs(const char *dir)
-{
-	const struct timespec pause = {.tv_nsec = 10 * 1000 * 1000};
-	int n = -1;
-	for (int k = 0; k < 6000 && n < 1; k++) {
-		n = runs_written(dir);
-		if (n < 1)
-			nanosleep(&pause, NULL);
-	}
-	return n;
-}
+/* Two animated scenes, the "gated" builder on both (struct kill_sweep). */
+static const char kill_config[] =
+	"{ \"output\": \"out-kill\", \"repeat\": 1, \"warmup\": 0, \"threads\": [1],\n"
+	"  \"rays\": { \"min_ms\": 1, \"width\": 8, \"height\": 8, \"rounds\": 1 },\n"
+	"  \"scenes\": [ { \"name\": \"a\", \"generator\": \"soup\", \"count\": 200,\n"
+	"      \"frames\": 3, \"deform\": \"explode\" },\n"
+	"    { \"name\": \"b\", \"generator\": \"icosphere\", \"frequency\": 4,\n"
+	"      \"frames\": 2, \"deform\": \"wave\" } ],\n"
+	"  \"builders\": [ { \"plugin\": \"sah_seq\", \"threads\": [1],\n"
+	"      \"animation\": { \"update\": \"refit\" } },\n"
+	"    { \"plugin\": \"fake_good\", \"name\": \"gated\",\n"
+	"      \"options\": { \"wait_for\": \"%s\" } } ] }\n";
 
-/* The "gated" builder blocks until a file appears, so the kill lands mid-sweep. */
 static void test_kill(void)
 {
-	char gate[512], dir[512], text[2048];
-	snprintf(gate, sizeof(gate), "%s/gate", tmpdir);
-	snprintf(dir, sizeof(dir), "%s/out-kill", tmpdir);
-	snprintf(text, sizeof(text),
-	         "{ \"output\": \"out-kill\", \"repeat\": 1, \"warmup\": 0, \"threads\": [1],\n"
-	         "  \"rays\": { \"min_ms\": 1, \"width\": 8, \"height\": 8, \"rounds\": 1 },\n"
-	         "  \"scenes\": [ { \"name\": \"a\", \"generator\": \"soup\", \"count\": 200,\n"
-	         "      \"frames\": 3, \"deform\": \"explode\" },\n"
-	         "    { \"name\": \"b\", \"generator\": \"icosphere\", \"frequency\": 4,\n"
-	         "      \"frames\": 2, \"deform\": \"wave\" } ],\n"
-	         "  \"builders\": [ { \"plugin\": \"sah_seq\", \"threads\": [1],\n"
-	         "      \"animation\": { \"update\": \"refit\" } },\n"
-	         "    { \"plugin\": \"fake_good\", \"name\": \"gated\",\n"
-	         "      \"options\": { \"wait_for\": \"%s\" } } ] }\n", gate);
-	const char *cfg = write_config("kill.json", text);
-	pid_t pid = start(ARGS("run", cfg));
-	int before = wait_for_runs(dir);
-	kill(pid, SIGKILL);
-	CHECK_INT(finish(pid), 128 + SIGKILL);
-	CHECK_INT(before, 1);
-	cJSON *doc = load_results(dir);
+	struct kill_sweep k;
+	CHECK_INT(kill_sweep_start(&k, kill_config), 1);
+	cJSON *doc = load_results(k.dir);
 	const cJSON *first = doc ? find_run(doc, "a", "sah_seq+refit", 1) : NULL;
 	check_frames(first, "100");
-	char *frames = first ? cJSON_PrintUnformatted(cJSON_GetObjectItem(first, "frames")) : NULL;
+	char *frames = run_item_text(first, "frames");
 	cJSON_Delete(doc);
-	FILE *f = fopen(gate, "w");
-	CHECK(f != NULL);
-	if (f)
-		fclose(f);
-	CHECK_INT(run(ARGS("run", cfg, "--resume")), 0);
+	CHECK_INT(kill_sweep_resume(&k), 0);
 	CHECK_CONTAINS(err_text, "1 finished run kept");
-	doc = load_results(dir);
+	doc = load_results(k.dir);
 	if (doc) {
 		CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 4);
 		first = find_run(doc, "a", "sah_seq+refit", 1);
-		char *again = first ? cJSON_PrintUnformatted(cJSON_GetObjectItem(first, "frames")) : NULL;
+		char *again = run_item_text(first, "frames");
 		CHECK(frames && again && !strcmp(frames, again)); /* kept, not run again */
 		CHECK_INT(count_runs(doc, "gated", "ok"), 2);
 		check_frames(find_run(doc, "b", "gated", 1), "11");

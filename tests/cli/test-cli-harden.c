@@ -21,14 +21,6 @@
 #define LOADCRASH_DIR BVHLAB_TEST_BUILDDIR "/fake/loadcrash"
 #define FAKE_DIR BVHLAB_TEST_BUILDDIR "/fake"
 #define SHIM BVHLAB_TEST_BUILDDIR "/fake/shim/rename_fault.so"
-/* Long enough for any of these runs on a loaded machine; a hang ends here. */
-#define LIMIT_S 60
-
-static int run_in(const char *cwd, const char *const *args)
-{
-	return finish(start_in(cwd, LIMIT_S, args));
-}
-
 static void path_in(char *buf, size_t size, const char *name)
 {
 	snprintf(buf, size, "%s/%s", tmpdir, name);
@@ -49,17 +41,6 @@ static cJSON *run_config(const char *name, const char *text, int status, const c
 {
 	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", config_out(name, text, out, dir))), status);
 	return load_results(dir);
-}
-
-static const cJSON *find_run(const cJSON *doc, const char *scene, const char *builder,
-                             int threads)
-{
-	const cJSON *r;
-	cJSON_ArrayForEach(r, cJSON_GetObjectItem(doc, "runs"))
-		if (!strcmp(run_str(r, "scene"), scene) && !strcmp(run_str(r, "builder"), builder) &&
-		    cJSON_GetObjectItem(r, "threads")->valueint == threads)
-			return r;
-	return NULL;
 }
 
 static void check_run(const cJSON *doc, const char *scene, const char *builder, int threads,
@@ -91,15 +72,6 @@ static void test_fifo(void)
 	check_run(doc, "f", "fake_good", 1, "failed", "f.obj: not a regular file");
 	check_run(doc, "soup", "fake_good", 1, "ok", NULL);
 	cJSON_Delete(doc);
-}
-
-/* ASan's own SEGV handler would turn the plugins' crashes into aborts. */
-static void plain_crashes(void)
-{
-	const char *old = getenv("ASAN_OPTIONS");
-	char opts[512];
-	snprintf(opts, sizeof(opts), "%s%shandle_segv=0", old ? old : "", old && *old ? ":" : "");
-	setenv("ASAN_OPTIONS", opts, 1);
 }
 
 /* 2. Crashes and a hang while loading: recorded per run, the sweep goes on. */
@@ -441,26 +413,11 @@ static void test_crashsafe(void)
 
 int main(int argc, char **argv)
 {
-	static const struct {
-		const char *mode;
-		void (*fn)(void);
-	} modes[] = {
+	static const struct cli_mode modes[] = {
 		{"fifo", test_fifo},       {"loadcrash", test_loadcrash}, {"output", test_output},
 		{"symlink", test_symlink}, {"images", test_images},       {"threads", test_threads},
 		{"search", test_search},   {"resume", test_resume},       {"limits", test_limits},
 		{"crashsafe", test_crashsafe},
 	};
-	if (!cli_begin(argc, argv))
-		return fprintf(stderr, "usage: test-cli-harden BVHLAB_EXE MODE\n"), 2;
-	/* Absolute: some modes run it from other folders. */
-	static char absolute[4096];
-	if (realpath(argv[1], absolute))
-		exe = absolute;
-	for (size_t k = 0; k < sizeof(modes) / sizeof(modes[0]); k++)
-		if (!strcmp(argv[2], modes[k].mode)) {
-			modes[k].fn();
-			return cli_end();
-		}
-	fprintf(stderr, "test-cli-harden: unknown mode %s\n", argv[2]);
-	return 2;
+	return cli_main_modes(argc, argv, "test-cli-harden", modes, sizeof(modes) / sizeof(modes[0]));
 }

@@ -21,14 +21,6 @@
 #include "cliutil.h"
 
 #define LOADCRASH_DIR BVHLAB_TEST_BUILDDIR "/fake/loadcrash"
-/* Long enough for any of these runs on a loaded machine; a hang ends here. */
-#define LIMIT_S 60
-
-static int run_in(const char *cwd, const char *const *args)
-{
-	return finish(start_in(cwd, LIMIT_S, args));
-}
-
 static const char *path_in(const char *name)
 {
 	static char buf[4][600];
@@ -42,15 +34,6 @@ static bool exists(const char *path)
 {
 	struct stat st;
 	return lstat(path, &st) == 0;
-}
-
-/* ASan's own SEGV handler would turn the plugins' crashes into aborts. */
-static void plain_crashes(void)
-{
-	const char *old = getenv("ASAN_OPTIONS");
-	char opts[512];
-	snprintf(opts, sizeof(opts), "%s%shandle_segv=0", old ? old : "", old && *old ? ":" : "");
-	setenv("ASAN_OPTIONS", opts, 1);
 }
 
 static const cJSON *run_of(const cJSON *doc, const char *builder, int threads)
@@ -75,6 +58,17 @@ static void check_run(const cJSON *doc, const char *builder, int threads, const 
 	CHECK_CONTAINS(run_str(r, "status"), status);
 	if (error)
 		CHECK_CONTAINS(run_str(r, "error"), error);
+}
+
+/* `bvhlab plan --out out` on one scene of 100 triangles and `builders`
+ * (a JSON list's items), written as `name`: must exit with `status`. */
+static void plan_builders(const char *name, const char *builders, const char *out, int status)
+{
+	char text[1024];
+	snprintf(text, sizeof(text),
+	         "{ \"repeat\": 1, \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+	         "  \"builders\": [ %s ] }\n", builders);
+	CHECK_INT(run_in(tmpdir, ARGS("plan", write_config(name, text), "--out", out)), status);
 }
 
 /* 1. Refine stages that crash or hang while loading cost their builder's
@@ -107,17 +101,15 @@ static void test_probe(void)
 	CHECK_CONTAINS(err_text, "died while loading");
 	CHECK(!exists(path_in("plan-probe/plan.json")));
 
-	const char *bad_opt = write_config("refopt.json",
-		"{ \"repeat\": 1, \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\",\n"
-		"    \"refine\": [ { \"plugin\": \"reinsert\", \"options\": { \"nope\": 1 } } ] } ] }\n");
-	CHECK_INT(run_in(tmpdir, ARGS("plan", bad_opt, "--out", "plan-opt")), 2);
+	plan_builders("refopt.json",
+	              "{ \"plugin\": \"fake_good\",\n"
+	              "    \"refine\": [ { \"plugin\": \"reinsert\", \"options\": { \"nope\": 1 } } ] }",
+	              "plan-opt", 2);
 	CHECK_CONTAINS(err_text, "nope");
-	const char *optional = write_config("optional.json",
-		"{ \"repeat\": 1, \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
-		"    { \"plugin\": \"not_built_here\", \"optional\": true } ] }\n");
-	CHECK_INT(run_in(tmpdir, ARGS("plan", optional, "--out", "plan-optional")), 0);
+	plan_builders("optional.json",
+	              "{ \"plugin\": \"fake_good\" },\n"
+	              "    { \"plugin\": \"not_built_here\", \"optional\": true }",
+	              "plan-optional", 0);
 	CHECK_CONTAINS(err_text, "optional builder skipped");
 	CHECK_CONTAINS(err_text, "builder 'not_built_here'");
 
@@ -148,14 +140,21 @@ static const char small[] =
 	"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
 	"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n";
 
+/* `small` with output folder `out`, written as `name`: its path; the
+ * output folder's path into dir. */
+static const char *write_small(const char *name, const char *out, char dir[static 600])
+{
+	char text[1024];
+	snprintf(text, sizeof(text), small, out);
+	snprintf(dir, 600, "%s", path_in(out));
+	return write_config(name, text);
+}
+
 /* 2. A second writer is refused, naming the first, and nothing is lost. */
 static void test_lock(void)
 {
-	char text[1024];
-	snprintf(text, sizeof(text), small, "out-lock");
-	const char *cfg = write_config("lock.json", text);
 	char dir[600];
-	snprintf(dir, sizeof(dir), "%s", path_in("out-lock"));
+	const char *cfg = write_small("lock.json", "out-lock", dir);
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--only", "0", cfg)), 0);
 	char *before = read_file(dir, "results.json");
 	int fd = hold_lock(dir, "4242\n");
@@ -440,11 +439,8 @@ static void test_measure(void)
  * written over them, and the next --force finishes the move. */
 static void test_force(void)
 {
-	char text[1024];
-	snprintf(text, sizeof(text), small, "out-force");
-	const char *cfg = write_config("force.json", text);
 	char dir[600];
-	snprintf(dir, sizeof(dir), "%s", path_in("out-force"));
+	const char *cfg = write_small("force.json", "out-force", dir);
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 0);
 	char *json = read_file(dir, "results.json"), *csv = read_file(dir, "results.csv");
 	CHECK_INT(killed_at("/report.md.1", "1", ARGS("run", "--quiet", "--force", cfg)),
@@ -574,25 +570,10 @@ static void test_misc(void)
 
 int main(int argc, char **argv)
 {
-	static const struct {
-		const char *mode;
-		void (*fn)(void);
-	} modes[] = {
+	static const struct cli_mode modes[] = {
 		{"probe", test_probe},     {"lock", test_lock}, {"threads", test_threads},
 		{"temps", test_temps},     {"identity", test_identity}, {"measure", test_measure},
 		{"force", test_force},     {"misc", test_misc},
 	};
-	if (!cli_begin(argc, argv))
-		return fprintf(stderr, "usage: test-cli-rel BVHLAB_EXE MODE\n"), 2;
-	/* Absolute: the modes run it in tmpdir. */
-	static char absolute[4096];
-	if (realpath(argv[1], absolute))
-		exe = absolute;
-	for (size_t k = 0; k < sizeof(modes) / sizeof(modes[0]); k++)
-		if (!strcmp(argv[2], modes[k].mode)) {
-			modes[k].fn();
-			return cli_end();
-		}
-	fprintf(stderr, "test-cli-rel: unknown mode %s\n", argv[2]);
-	return 2;
+	return cli_main_modes(argc, argv, "test-cli-rel", modes, sizeof(modes) / sizeof(modes[0]));
 }

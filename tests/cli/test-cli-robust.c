@@ -3,31 +3,16 @@
  * or return broken trees, a sweep killed mid-way and resumed, bad input.
  * Usage: test-cli-robust BVHLAB_EXE all
  */
-#include <signal.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <cJSON.h>
 
 #include "cliutil.h"
-
-static const cJSON *find_run(const cJSON *doc, const char *scene, const char *builder,
-                             int threads)
-{
-	const cJSON *run;
-	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs")) {
-		const cJSON *t = cJSON_GetObjectItem(run, "threads");
-		if (!strcmp(run_str(run, "scene"), scene) && !strcmp(run_str(run, "builder"), builder) &&
-		    cJSON_IsNumber(t) && t->valueint == threads)
-			return run;
-	}
-	return NULL;
-}
 
 static bool run_valid(const cJSON *run)
 {
@@ -39,15 +24,7 @@ static bool run_valid(const cJSON *run)
  * Sanitizer builds would turn a plugin's segfault into their own report
  * and check the crashed children for leaks; here the signal is the point.
  */
-static void append_option(const char *var, const char *more)
-{
-	const char *old = getenv(var);
-	char opts[512];
-	snprintf(opts, sizeof(opts), "%s%s%s", old ? old : "", old && *old ? ":" : "", more);
-	setenv(var, opts, 1);
-}
-
-static void plain_crashes(void)
+static void crashes_unreported(void)
 {
 	append_option("ASAN_OPTIONS", "handle_segv=0:detect_leaks=0:allocator_may_return_null=1");
 	append_option("TSAN_OPTIONS", "handle_segv=0");
@@ -158,19 +135,6 @@ static void test_unvalidated_dag(void)
 	cJSON_Delete(doc);
 }
 
-/* Polls (bounded) until the sweep has written at least one run. */
-static int wait_for_runs(const char *dir)
-{
-	const struct timespec pause = {.tv_nsec = 10 * 1000 * 1000};
-	int n = -1;
-	for (int k = 0; k < 6000 && n < 1; k++) {
-		n = runs_written(dir);
-		if (n < 1)
-			nanosleep(&pause, NULL);
-	}
-	return n;
-}
-
 static bool same_run(const cJSON *a, const cJSON *b)
 {
 	return !strcmp(run_str(a, "scene"), run_str(b, "scene")) &&
@@ -189,61 +153,51 @@ static void check_no_duplicates(const cJSON *doc)
 	CHECK_INT(dups, 0);
 }
 
+/* Three scenes, the "gated" builder among three (struct kill_sweep). rounds
+ * 1: a run is finished when it is recorded (with rounds its ray figures are
+ * provisional until the scene's rounds, and a resumed sweep measures it
+ * again: cli-rel-measure). */
+static const char kill_config[] =
+	"{ \"output\": \"out-kill\", \"repeat\": 3, \"threads\": [1, 2],\n"
+	"  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64, \"rounds\": 1 },\n"
+	"  \"scenes\": [ { \"name\": \"a\", \"generator\": \"soup\", \"count\": 200 },\n"
+	"    { \"name\": \"b\", \"generator\": \"icosphere\", \"frequency\": 4 },\n"
+	"    { \"name\": \"c\", \"generator\": \"soup\", \"count\": 300, \"seed\": 5 } ],\n"
+	"  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
+	"    { \"plugin\": \"fake_good\", \"name\": \"gated\",\n"
+	"      \"options\": { \"wait_for\": \"%s\" } },\n"
+	"    { \"plugin\": \"sah_seq\", \"threads\": [1] } ] }\n";
+
 /*
  * A sweep killed mid-way keeps valid results with its finished runs, and
- * --resume completes it without running those again. The "gated" builder
- * blocks until a file appears, so the kill surely lands mid-sweep.
+ * --resume completes it without running those again.
  */
 static void test_kill_and_resume(void)
 {
-	char gate[512], dir[512], text[2048];
-	snprintf(gate, sizeof(gate), "%s/gate", tmpdir);
-	snprintf(dir, sizeof(dir), "%s/out-kill", tmpdir);
-	snprintf(text, sizeof(text),
-	         "{ \"output\": \"out-kill\", \"repeat\": 3, \"threads\": [1, 2],\n"
-	         "  \"rays\": { \"min_ms\": 1, \"width\": 64, \"height\": 64, \"rounds\": 1 },\n"
-	         "  \"scenes\": [ { \"name\": \"a\", \"generator\": \"soup\", \"count\": 200 },\n"
-	         "    { \"name\": \"b\", \"generator\": \"icosphere\", \"frequency\": 4 },\n"
-	         "    { \"name\": \"c\", \"generator\": \"soup\", \"count\": 300, \"seed\": 5 } ],\n"
-	         "  \"builders\": [ { \"plugin\": \"fake_good\" },\n"
-	         "    { \"plugin\": \"fake_good\", \"name\": \"gated\",\n"
-	         "      \"options\": { \"wait_for\": \"%s\" } },\n"
-	         "    { \"plugin\": \"sah_seq\", \"threads\": [1] } ] }\n", gate);
-	/* rounds 1: a run is finished when it is recorded (with rounds its ray
-	 * figures are provisional until the scene's rounds, and a resumed sweep
-	 * measures it again: cli-rel-measure). */
-	const char *cfg = write_config("kill.json", text);
-	pid_t pid = start(ARGS("run", cfg));
-	int before = wait_for_runs(dir);
-	kill(pid, SIGKILL);
-	CHECK_INT(finish(pid), 128 + SIGKILL);
-	CHECK(before >= 1);
+	struct kill_sweep k;
+	CHECK(kill_sweep_start(&k, kill_config) >= 1);
 
-	cJSON *doc = load_results(dir);
+	cJSON *doc = load_results(k.dir);
 	if (!doc)
 		return;
 	int kept = cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs"));
 	CHECK_INT(kept, 1); /* fake_good's run of scene a (not PARALLEL: at 1 thread only) */
 	const cJSON *first = find_run(doc, "a", "fake_good", 1);
 	CHECK(run_valid(first));
-	char *samples = first ? cJSON_PrintUnformatted(cJSON_GetObjectItem(first, "build_ms")) : NULL;
+	char *samples = run_item_text(first, "build_ms");
 	char *created = strdup(run_str(doc, "created"));
 	cJSON_Delete(doc);
 
-	FILE *f = fopen(gate, "w");
-	CHECK(f != NULL);
-	if (f)
-		fclose(f);
-	CHECK_INT(run(ARGS("run", cfg, "--resume")), 0);
+	CHECK_INT(kill_sweep_resume(&k), 0);
 	CHECK_CONTAINS(err_text, "bvhlab: resuming");
-	doc = load_results(dir);
+	doc = load_results(k.dir);
 	if (doc) {
 		CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 9);
 		check_no_duplicates(doc);
 		CHECK_INT(count_runs(doc, "gated", "ok"), 3);
 		/* The finished run was kept, not run again. */
 		first = find_run(doc, "a", "fake_good", 1);
-		char *again = first ? cJSON_PrintUnformatted(cJSON_GetObjectItem(first, "build_ms")) : NULL;
+		char *again = run_item_text(first, "build_ms");
 		CHECK(samples && again && !strcmp(samples, again));
 		CHECK(!strcmp(run_str(doc, "created"), created));
 		CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "scenes")), 3);
@@ -253,9 +207,9 @@ static void test_kill_and_resume(void)
 	free(samples);
 	free(created);
 	/* Nothing left to run: every run is kept. */
-	CHECK_INT(run(ARGS("run", cfg, "--resume")), 0);
+	CHECK_INT(run(ARGS("run", k.cfg, "--resume")), 0);
 	CHECK_CONTAINS(err_text, "9 finished runs kept");
-	CHECK_INT(runs_written(dir), 9);
+	CHECK_INT(runs_written(k.dir), 9);
 }
 
 static void test_resume_errors(void)
@@ -325,7 +279,7 @@ int main(int argc, char **argv)
 {
 	if (!cli_begin(argc, argv))
 		return 2;
-	plain_crashes();
+	crashes_unreported();
 	test_misbehaving();
 	test_in_process();
 	test_unvalidated_dag();

@@ -9,7 +9,8 @@
  *   - cl_buf: device buffers that grow, all sized before any kernel runs;
  *   - cl_events: the kernels' events, summed into the phase "device";
  *   - the Morton codes and their radix sort (cl_sort.c, kernels in
- *     morton_sort.cl), mirroring plugins/common/morton.
+ *     morton_sort.cl), mirroring plugins/common/morton;
+ *   - the start of a build and the report of its phases (cl_build.c).
  */
 #ifndef BVHLAB_CL_DEV_H
 #define BVHLAB_CL_DEV_H
@@ -121,5 +122,47 @@ void cl_sort_sizes(uint32_t n, size_t want[SB_COUNT]);
  */
 int cl_sort_run(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned bits,
                 cl_events *ev, double *ms_upload, char *err, size_t err_size);
+
+/* ---- a build's start and phases (cl_build.c) ------------------------- */
+
+/* The fields (plugin_options.h) of the options every device builder has,
+ * CL_DEVICE_OPTION_DECL and MORTON_OPTION_DECLS (morton_front.h), for its
+ * struct `type` with a member of each option's name. */
+#define CL_BUILDER_FIELDS(type) \
+	PLUGIN_FIELD(type, device, "device", STRING), MORTON_FIELDS(type, bits)
+
+/* A device builder's program and the most primitives it builds over. */
+typedef struct cl_builder {
+	const char *src; /* morton_sort.cl, then the builder's kernels */
+	size_t len;
+	const char *const *kernels; /* CL_SORT_KERNEL_NAMES first */
+	unsigned kernel_count;
+	uint32_t max_prims;
+} cl_builder;
+
+/* The cl_builder of the program array `prog` (its length prog##_LEN, as
+ * scripts/embed-cl.py writes it) and the array of kernel names `names`. */
+#define CL_BUILDER(prog, names, most)                                                    \
+	{ .src = prog, .len = prog##_LEN, .kernels = names,                                \
+	  .kernel_count = sizeof(names) / sizeof(names[0]), .max_prims = most }
+
+/*
+ * The start of a device builder's build, after its options: the count of
+ * primitives checked, the output's room, the device `spec` opened with
+ * cb's program (kept in d between builds). 0 to go on (two primitives or
+ * more), 1 when that was the build (one primitive: its leaf written), or a
+ * negative errno after host->set_error.
+ */
+int cl_build_begin(const cl_builder *cb, cl_dev *d, const char *spec, const bvhlab_host *host,
+                   bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+                   bvhlab_build_output *out);
+
+/* The phases every device builder reports, in this order. */
+enum { CL_PHASE_UPLOAD, CL_PHASE_DEVICE, CL_PHASE_DOWNLOAD, CL_PHASE_CONVERT, CL_PHASES };
+
+/* Reports ms[] as the phases upload, device, download and convert, where
+ * the host takes phases. */
+void cl_report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                      const double ms[CL_PHASES]);
 
 #endif /* BVHLAB_CL_DEV_H */

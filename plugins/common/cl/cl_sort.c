@@ -1,13 +1,13 @@
 /*
  * Morton codes and their radix sort on the device (kernels in
- * morton_sort.cl), giving the order plugins/common/morton gives: the same
- * quantiser (computed here by the same arithmetic as its quantiser_init),
- * then stable LSD passes over the 8-bit digits in which some code differs
+ * morton_sort.cl), giving the order plugins/common/morton gives: its
+ * cells (morton_cells_init) and its spread (morton_spread.h), then stable LSD passes over the 8-bit digits in which some code differs
  * from the first (the rest would move nothing).
  */
 #include <errno.h>
 
 #include "cl_dev.h"
+#include "morton.h"
 
 enum { K_CODES, K_VARYING, K_HIST, K_SCAN, K_SCATTER };
 
@@ -34,31 +34,13 @@ void cl_sort_sizes(uint32_t n, size_t want[SB_COUNT])
 	want[SB_PART] = 8 * (size_t)chunks;
 }
 
-/* morton_sort.c's quantiser_init: cell scale per axis, 0 for a flat one. */
-struct quant {
-	float lo[3], scale[3], top;
-};
-
-static void quant_init(struct quant *q, const bvhlab_aabb *cb, unsigned bits)
-{
-	unsigned axis_bits = bits / 3;
-
-	q->top = (float)((1u << axis_bits) - 1);
-	for (int k = 0; k < 3; k++) {
-		float extent = cb->hi[k] - cb->lo[k];
-		float s = (float)(1u << axis_bits) / extent;
-		q->lo[k] = cb->lo[k];
-		q->scale[k] = extent > 0 && s < 1e30f ? s : 0.0f;
-	}
-}
-
 static int codes(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned bits,
                  cl_events *ev, char *err, size_t err_size)
 {
-	struct quant q;
+	morton_cells q;
 	uint32_t n = in->prim_count;
 
-	quant_init(&q, &in->centroid_bounds, bits);
+	morton_cells_init(&q, &in->centroid_bounds, bits);
 	cl_arg args[] = {
 		CL_ARG(s->b[SB_CENTROIDS].mem), CL_ARG(n), CL_ARG(q.lo[0]), CL_ARG(q.lo[1]),
 		CL_ARG(q.lo[2]), CL_ARG(q.scale[0]), CL_ARG(q.scale[1]), CL_ARG(q.scale[2]),

@@ -7,6 +7,9 @@
  * gives the CPU builders' (code, primitive) order: values start as the
  * primitive ids in order and every pass is stable.
  *
+ * morton_spread21 comes from plugins/common/morton/morton_spread.h, which
+ * the build puts before this file.
+ *
  * A pass over one 8-bit digit: radix_hist counts each chunk's digits,
  * radix_scan turns the counts (digit-major: all chunks of digit 0 first)
  * into each chunk's first output position per digit, radix_scatter moves
@@ -17,25 +20,13 @@
 
 #define RADIX 256u
 
-/* The bits of x spread out to every third bit, 21 bits into 63. */
-static ulong spread21(ulong x)
-{
-	x &= 0x1ffffful;
-	x = (x | x << 32) & 0x001f00000000fffful;
-	x = (x | x << 16) & 0x001f0000ff0000fful;
-	x = (x | x << 8) & 0x100f00f00f00f00ful;
-	x = (x | x << 4) & 0x10c30c30c30c30c3ul;
-	x = (x | x << 2) & 0x1249249249249249ul;
-	return x;
-}
-
 /* As morton_sort.c's axis(): clamped, NaN to cell 0, truncated. */
 static ulong axis_cell(float c, float lo, float scale, float top)
 {
 	float x = (c - lo) * scale;
 	x = x > 0 ? x : 0;
 	x = x < top ? x : top;
-	return spread21((ulong)(uint)(int)x);
+	return morton_spread21((ulong)(uint)(int)x);
 }
 
 __kernel void morton_codes(__global const float *centroids, uint n, float lo0, float lo1,

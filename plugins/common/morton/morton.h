@@ -61,6 +61,16 @@ typedef struct morton_sort {
 /* The packing for s->n and s->bits; every member may call it. */
 void morton_sort_init(morton_sort *s);
 
+/* Centroid bounds to cells, per axis: the cell of c is (c - lo) * scale,
+ * clamped to 0 .. top (a flat axis has scale 0: every centroid in cell 0).
+ * The device sort (plugins/common/cl) takes the same. */
+typedef struct morton_cells {
+	float lo[3], scale[3], top;
+} morton_cells;
+
+/* The cells of codes of `bits` (30 or 63) over the centroid bounds cb. */
+void morton_cells_init(morton_cells *q, const bvhlab_aabb *cb, unsigned bits);
+
 /* The codes of member t's chunk of the primitives, and its digit counts. */
 void morton_codes(morton_sort *s, unsigned threads, unsigned t);
 

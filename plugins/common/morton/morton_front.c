@@ -1,6 +1,7 @@
 /* The Morton builders' shared front end (see morton_front.h). */
 #include <errno.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "big_alloc.h"
@@ -12,22 +13,21 @@
 #define MIN_PRIMS_PER_THREAD 512
 
 int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                        const bvhlab_option_decl *decls, size_t count, morton_options *o)
+                        const bvhlab_option_decl *decls, size_t decl_count,
+                        const plugin_field *fields, size_t field_count, void *out)
 {
-	static const plugin_field fields[] = {
-		PLUGIN_FIELD(morton_options, bits, "bits", U32),
-		PLUGIN_FIELD(morton_options, collapse, "collapse", BOOL),
-		PLUGIN_FIELD(morton_options, max_leaf, "max_leaf", U32),
-		PLUGIN_FIELD(morton_options, c_trav, "c_trav", FLOAT),
-		PLUGIN_FIELD(morton_options, c_isect, "c_isect", FLOAT),
-	};
+	int rc = plugin_options_fill(host, ctx, decls, decl_count, fields, field_count, out);
 
-	int rc = plugin_options_fill(host, ctx, decls, count, fields,
-	                             sizeof(fields) / sizeof(fields[0]), o);
-	/* The one thing the declared range 30..63 does not say. */
-	if (rc == 0 && o->bits != 30 && o->bits != 63) {
-		host->set_error(ctx, "option bits: %u, expected 30 or 63", o->bits);
-		rc = -EINVAL;
+	for (size_t k = 0; rc == 0 && k < field_count; k++) {
+		unsigned bits;
+
+		if (strcmp(fields[k].name, "bits") != 0)
+			continue;
+		memcpy(&bits, (const char *)out + fields[k].offset, sizeof(bits));
+		if (bits != 30 && bits != 63) {
+			host->set_error(ctx, "option bits: %u, expected 30 or 63", bits);
+			rc = -EINVAL;
+		}
 	}
 	return rc;
 }

@@ -14,6 +14,7 @@
 #include <bvhlab/builder.h>
 
 #include "morton.h"
+#include "plugin_options.h"
 #include "team.h"
 
 /* The options of the code length and the SAH collapse, in an option array. */
@@ -35,18 +36,22 @@
 	  .help = "SAH cost of intersecting one primitive (> 0), for collapse",              \
 	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }
 
-/* MORTON_OPTION_DECLS as the host checked them. */
-typedef struct morton_options {
-	uint32_t bits, max_leaf;
-	bool collapse;
-	float c_trav, c_isect;
-} morton_options;
+/* The entries of MORTON_OPTION_DECLS in a plugin's table of fields
+ * (plugin_options.h), for its struct `type`: the code length into
+ * `bits_member` (unsigned), the rest into the members of their names. */
+#define MORTON_FIELDS(type, bits_member)                       \
+	PLUGIN_FIELD(type, bits_member, "bits", U32),          \
+	PLUGIN_FIELD(type, collapse, "collapse", BOOL),        \
+	PLUGIN_FIELD(type, max_leaf, "max_leaf", U32),         \
+	PLUGIN_FIELD(type, c_trav, "c_trav", FLOAT),           \
+	PLUGIN_FIELD(type, c_isect, "c_isect", FLOAT)
 
-/* Fills o from MORTON_OPTION_DECLS among a plugin's `decls`
- * (plugin_options.h) and checks what the declarations cannot say (bits
- * 30 or 63): 0, or a negative errno after host->set_error. */
+/* plugin_options_fill() by a table holding MORTON_FIELDS, then what the
+ * declarations cannot say: bits 30 or 63. 0, or a negative errno after
+ * host->set_error. */
 int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                        const bvhlab_option_decl *decls, size_t count, morton_options *o);
+                        const bvhlab_option_decl *decls, size_t decl_count,
+                        const plugin_field *fields, size_t field_count, void *out);
 
 /* Monotonic clock in milliseconds, for the phase times in the debug log. */
 double morton_now_ms(void);

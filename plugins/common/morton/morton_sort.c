@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "morton.h"
+#include "morton_spread.h"
 #include "team.h"
 
 /* Digits of the sort inside a bucket: 8 bits, so that the counts of all
@@ -20,32 +21,11 @@
 /* Top digits handed out at a time in the bucket sort. */
 #define BUCKET_BLOCK 16
 
-/* The bits of x spread out to every third bit, 21 bits into 63. */
-static inline uint64_t spread21(uint64_t x)
-{
-	x &= 0x1fffffu;
-	x = (x | x << 32) & 0x001f00000000ffffull;
-	x = (x | x << 16) & 0x001f0000ff0000ffull;
-	x = (x | x << 8) & 0x100f00f00f00f00full;
-	x = (x | x << 4) & 0x10c30c30c30c30c3ull;
-	x = (x | x << 2) & 0x1249249249249249ull;
-	return x;
-}
-
 #define SPREAD_BITS 11
 
-/* Centroid bounds to cells, per axis (a flat axis puts every centroid in
- * cell 0), and spread21 by table, 11 bits at a time: two loads instead of
- * fifteen operations per axis, from 16 KiB that stay in L1. */
-struct quantiser {
-	float lo[3], scale[3], top;
-	uint64_t spread[1u << SPREAD_BITS];
-};
-
-static void quantiser_init(struct quantiser *q, const morton_sort *s)
+void morton_cells_init(morton_cells *q, const bvhlab_aabb *cb, unsigned bits)
 {
-	const bvhlab_aabb *cb = &s->centroid_bounds;
-	unsigned axis_bits = s->bits / 3;
+	unsigned axis_bits = bits / 3;
 
 	q->top = (float)((1u << axis_bits) - 1);
 	for (int k = 0; k < 3; k++) {
@@ -54,8 +34,20 @@ static void quantiser_init(struct quantiser *q, const morton_sort *s)
 		q->lo[k] = cb->lo[k];
 		q->scale[k] = extent > 0 && s < 1e30f ? s : 0.0f;
 	}
+}
+
+/* The cells, and morton_spread21 by table, 11 bits at a time: two loads
+ * instead of fifteen operations per axis, from 16 KiB that stay in L1. */
+struct quantiser {
+	morton_cells c;
+	uint64_t spread[1u << SPREAD_BITS];
+};
+
+static void quantiser_init(struct quantiser *q, const morton_sort *s)
+{
+	morton_cells_init(&q->c, &s->centroid_bounds, s->bits);
 	for (uint32_t v = 0; v < (1u << SPREAD_BITS); v++)
-		q->spread[v] = spread21(v);
+		q->spread[v] = morton_spread21(v);
 }
 
 /* Clamped because c - lo can round up to the top edge; a NaN goes to
@@ -63,11 +55,11 @@ static void quantiser_init(struct quantiser *q, const morton_sort *s)
  * whose conversion is one instruction (uint64_t's is a branch). */
 static inline uint64_t axis(const struct quantiser *q, const float *c, int k)
 {
-	float x = (c[k] - q->lo[k]) * q->scale[k];
+	float x = (c[k] - q->c.lo[k]) * q->c.scale[k];
 	uint32_t cell;
 
 	x = x > 0 ? x : 0;
-	x = x < q->top ? x : q->top;
+	x = x < q->c.top ? x : q->c.top;
 	cell = (uint32_t)(int32_t)x;
 	return q->spread[cell & ((1u << SPREAD_BITS) - 1)] |
 	       q->spread[cell >> SPREAD_BITS] << (3 * SPREAD_BITS);
