@@ -5,7 +5,8 @@
  * binned tree, with the same SAH cost, at quality high and fast (each
  * against sah_seq at that quality). A low parallel_min makes even the
  * small scenes run the team split over several levels; the meshes also
- * run with the default. Under ThreadSanitizer the generated scenes shrink
+ * run with the default. Option sample gives its own tree, valid and the
+ * same on every thread count, close to the full binning's. Under ThreadSanitizer the generated scenes shrink
  * and builds repeat less.
  */
 #include <errno.h>
@@ -48,8 +49,14 @@ static int build_valid(bvhlab_plugin *plugin, const char *extra, const bvhlab_sc
 		rc = bvhlab_options_parse(&opts, "method=binned", &err);
 	if (rc == 0)
 		rc = bvhlab_options_parse(&opts, quality, &err);
-	if (rc == 0 && extra)
-		rc = bvhlab_options_parse(&opts, extra, &err);
+	if (rc == 0 && extra) {
+		char buf[128], *save = NULL;
+
+		snprintf(buf, sizeof(buf), "%s", extra);
+		for (char *kv = strtok_r(buf, " ", &save); kv && rc == 0;
+		     kv = strtok_r(NULL, " ", &save))
+			rc = bvhlab_options_parse(&opts, kv, &err);
+	}
 	if (rc == 0)
 		rc = bvhlab_build(plugin, &opts, in, threads, tree, &err);
 	if (rc == 0)
@@ -107,6 +114,35 @@ static void check_scene(const char *name, const bvhlab_scene *scene,
 	bvhlab_tree_finish(&tree);
 }
 
+/*
+ * Option sample: not sah_seq's tree, but valid, the same on every thread
+ * count, and within 10 % of the full binning's SAH cost (ref's). The team
+ * splits (over parallel_min=4096) bin everything; the kernel's splits below
+ * them bin 32 of the primitives of nodes over 128.
+ */
+static void check_sampled(const char *name, const bvhlab_scene *scene,
+                          const bvhlab_build_input *in, const bvhlab_tree *ref)
+{
+	static const char extra[] = "parallel_min=4096 sample=32";
+	bvhlab_tree one = { 0 }, tree = { 0 };
+	bvhlab_tree_stats a, b;
+
+	if (build_valid(tasks, extra, scene, in, 1, &one) == 0) {
+		bvhlab_tree_stats_compute(ref, &a);
+		bvhlab_tree_stats_compute(&one, &b);
+		if (b.sah_cost > 1.10 * a.sah_cost)
+			fprintf(stderr, "%s: sample=32 SAH %g, full binning %g\n", name,
+			        b.sah_cost, a.sah_cost);
+		CHECK(b.sah_cost <= 1.10 * a.sah_cost);
+		for (size_t t = 1; t < sizeof(thread_counts) / sizeof(thread_counts[0]); t++)
+			if (build_valid(tasks, extra, scene, in, thread_counts[t], &tree) == 0)
+				check_same(name, extra, thread_counts[t], &one, &tree,
+				           "its 1-thread tree");
+	}
+	bvhlab_tree_finish(&one);
+	bvhlab_tree_finish(&tree);
+}
+
 static void test_scene(const char *name, bvhlab_scene *scene, bool mesh)
 {
 	bvhlab_prims prims;
@@ -127,6 +163,8 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool mesh)
 			check_scene(name, scene, &prims.input, &ref, "parallel_min=128");
 			if (mesh && !q)
 				check_scene(name, scene, &prims.input, &ref, NULL);
+			if (q)
+				check_sampled(name, scene, &prims.input, &ref);
 		}
 	}
 	printf("%-18s %8u triangles: done\n", name, scene->triangle_count);
@@ -158,8 +196,8 @@ static void test_descriptor(void)
 	CHECK(strcmp(b->name, "sah_tasks") == 0);
 	CHECK(b->flags & BVHLAB_BUILDER_PARALLEL);
 	CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
-	CHECK_INT(b->option_count, 8);
-	if (b->option_count == 8) {
+	CHECK_INT(b->option_count, 9);
+	if (b->option_count == 9) {
 		CHECK(strcmp(b->options[0].def_string, "binned") == 0);
 		CHECK(strcmp(b->options[5].name, "parallel_min") == 0);
 		CHECK(strcmp(b->options[6].name, "simd") == 0);

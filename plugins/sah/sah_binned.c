@@ -4,6 +4,13 @@
  * three axes and the node's range is partitioned into the builder's other
  * array (sah_job.alt). All bin storage is on the stack of the call, so
  * concurrent jobs share nothing.
+ *
+ * With option sample (sah_tasks), a node of more than 4 * sample
+ * primitives bins only `sample` of them, evenly spaced in its range: the
+ * bins then choose the plane but know neither the children's counts nor
+ * their boxes, so the scatter finds both (left side from the front, right
+ * side from the back, which reverses its order: still a function of the
+ * range alone, so the tree stays the same for every thread count).
  */
 #include <math.h>
 
@@ -76,6 +83,85 @@ static void range_bounds(const sah_prim *prims, sah_job *c)
 	v4_store3(c->box.hi, hi);
 }
 
+/*
+ * scatter's counterpart for sampled bins: the same plane, but both sides
+ * grow from the range's ends and each child's box and centroid bounds are
+ * gathered on the way, as the sampled bins hold neither. Returns the first
+ * right position.
+ */
+static uint32_t scatter_both(const sah_grid *g, const sah_prim *src, sah_prim *dst,
+                             const sah_job *job, int a, uint32_t split, sah_job child[2])
+{
+	const v4 half = v4_set1(0.5f);
+	v4 clo[2] = { v4_set1(INFINITY), v4_set1(INFINITY) };
+	v4 chi[2] = { v4_set1(-INFINITY), v4_set1(-INFINITY) };
+	v4 blo[2] = { clo[0], clo[0] }, bhi[2] = { chi[0], chi[0] };
+	uint32_t l = job->begin, r = job->end;
+
+	for (uint32_t i = job->begin; i < job->end; i++) {
+		uint32_t right = sah_grid_bin(g, a, &src[i]) >= split, mask = 0u - right;
+		v4 lo = v4_load3(src[i].lo), hi = v4_load3(src[i].hi);
+		v4 cen = v4_mul(v4_add(lo, hi), half);
+		dst[((r - 1) & mask) | (l & ~mask)] = src[i];
+		r -= right;
+		l += right ^ 1;
+		clo[right] = v4_min(clo[right], cen);
+		chi[right] = v4_max(chi[right], cen);
+		blo[right] = v4_min(blo[right], lo);
+		bhi[right] = v4_max(bhi[right], hi);
+	}
+	for (int c = 0; c < 2; c++) {
+		v4_store3(child[c].cbox.lo, clo[c]);
+		v4_store3(child[c].cbox.hi, chi[c]);
+		v4_store3(child[c].box.lo, blo[c]);
+		v4_store3(child[c].box.hi, bhi[c]);
+	}
+	return l;
+}
+
+/* The bins of `count` primitives evenly spaced over the job's range. */
+static void fill_sample(sah_bins *bins, const sah_grid *grid, const sah_prim *src,
+                        const sah_job *job, uint32_t count, int simd)
+{
+	sah_prim pick[SAH_MAX_SAMPLE];
+	uint64_t n = job->end - job->begin;
+
+	for (uint32_t k = 0; k < count; k++)
+		pick[k] = src[job->begin + (uint32_t)((uint64_t)k * n / count)];
+	sah_bins_fill(bins, grid, pick, 0, count, simd);
+}
+
+/* A split decided on a sample (the sample's plane separates two of the
+ * node's primitives, so neither child is empty). */
+static unsigned sampled_split(sah_builder *b, const sah_job *job, sah_job child[2])
+{
+	sah_grid grid;
+	sah_bins bins;
+	sah_job kids[2];
+	float best;
+	uint32_t split = 0;
+	const sah_prim *src = sah_job_prims(b, job);
+
+	sah_grid_init(&grid, job, b->opt.bins);
+	fill_sample(&bins, &grid, src, job, b->opt.sample, b->opt.simd);
+	int axis = sah_bins_choose(&bins, &grid, &split, &best);
+	if (axis < 0) {
+		sah_write_inner(b, job, job->begin + (job->end - job->begin) / 2, child);
+		range_bounds(src, &child[0]);
+		range_bounds(src, &child[1]);
+		return 2;
+	}
+	uint32_t mid = scatter_both(&grid, src, job->alt ? b->prims[0] : b->alt, job, axis,
+	                            split, kids);
+	sah_write_inner(b, job, mid, child);
+	for (int c = 0; c < 2; c++) {
+		child[c].alt = !job->alt;
+		child[c].box = kids[c].box;
+		child[c].cbox = kids[c].cbox;
+	}
+	return 2;
+}
+
 unsigned sah_binned_split(sah_builder *b, const sah_job *job, sah_job child[2])
 {
 	sah_grid grid;
@@ -83,6 +169,8 @@ unsigned sah_binned_split(sah_builder *b, const sah_job *job, sah_job child[2])
 	float best;
 	uint32_t split = 0, mid;
 
+	if (b->opt.sample && job->end - job->begin > 4 * b->opt.sample)
+		return sampled_split(b, job, child);
 	sah_grid_init(&grid, job, b->opt.bins);
 	const sah_prim *src = sah_job_prims(b, job);
 

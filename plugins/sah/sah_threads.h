@@ -47,7 +47,7 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,                   \
 	                 const bvhlab_build_input *input, bvhlab_build_output *output)     \
 	{                                                                                  \
-		options_type o;                                                            \
+		options_type o = { 0 };                                                    \
 		int rc = plugin_options_fill(host, ctx, options,                           \
 		                             sizeof(options) / sizeof(options[0]), fields,  \
 		                             sizeof(fields) / sizeof(fields[0]), &o);      \

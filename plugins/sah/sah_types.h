@@ -54,7 +54,12 @@ typedef struct sah_options {
 	uint32_t max_leaf; /* largest leaf, >= 1 (except coincident centroids) */
 	float c_trav;      /* cost of visiting an inner node, > 0 */
 	float c_isect;     /* cost of one primitive test, > 0 */
+	uint32_t sample;   /* binned: nodes over 4 * sample primitives bin only
+	                    * `sample` of them, evenly spaced; 0 bins all (the
+	                    * only choice of the plugins without the option) */
 } sah_options;
+
+#define SAH_MAX_SAMPLE 1024
 
 #define SAH_MAX_BINS 256
 
