@@ -317,6 +317,81 @@ static void test_heat_scales(void)
 	cJSON_Delete(doc);
 }
 
+/* Whether some leader line of the chart passes through a point other than
+ * the one it starts from (closer to its centre than its radius, 4.5 px). */
+static bool leader_hides_point(const char *svg)
+{
+	for (const char *l = svg; (l = strstr(l, "<line x1=")) != NULL; l++) {
+		double x1, y1, x2, y2;
+		if (sscanf(l, "<line x1=\"%lf\" y1=\"%lf\" x2=\"%lf\" y2=\"%lf\"", &x1, &y1, &x2,
+		           &y2) != 4 || !strstr(l, "stroke=\"#999\""))
+			continue;
+		for (const char *c = svg; (c = strstr(c, "<circle cx=")) != NULL; c++) {
+			double cx, cy;
+			if (sscanf(c, "<circle cx=\"%lf\" cy=\"%lf\"", &cx, &cy) != 2 ||
+			    (fabs(cx - x1) < 0.05 && fabs(cy - y1) < 0.05))
+				continue;
+			double dx = x2 - x1, dy = y2 - y1;
+			double t = ((cx - x1) * dx + (cy - y1) * dy) / (dx * dx + dy * dy);
+			t = t < 0 ? 0 : t > 1 ? 1 : t;
+			if (hypot(x1 + t * dx - cx, y1 + t * dy - cy) < 4.5)
+				return true;
+		}
+	}
+	return false;
+}
+
+/* Whether some name on the chart covers a point: a box of 6.2 px a
+ * character and a 12 px line, its text's baseline 2.5 px above its foot. */
+static bool label_hides_point(const char *svg)
+{
+	for (const char *l = svg; (l = strstr(l, "<text x=")) != NULL; l++) {
+		double x, y;
+		char name[64];
+		if (sscanf(l, "<text x=\"%lf\" y=\"%lf\" text-anchor=\"start\">%63[^<]", &x, &y,
+		           name) != 3)
+			continue;
+		double x1 = x + 6.2 * (double)strlen(name), y0 = y + 2.5 - 12, y1 = y + 2.5;
+		for (const char *c = svg; (c = strstr(c, "<circle cx=")) != NULL; c++) {
+			double cx, cy;
+			if (sscanf(c, "<circle cx=\"%lf\" cy=\"%lf\"", &cx, &cy) == 2 && cx > x - 4.5 &&
+			    cx < x1 + 4.5 && cy > y0 - 4.5 && cy < y1 + 4.5)
+				return true;
+		}
+	}
+	return false;
+}
+
+/* The default sweep's icosphere on 2 threads: sah_queue's label has no room beside
+ * its point (neighbours right, the plot's edge below), and the first free
+ * slot above is reached past sah_binned's point: its leader must not
+ * cross it, or the name reads as sah_binned's. */
+static void test_leader_lines(void)
+{
+	const struct svg_point p[] = {
+		{"", "sah_sweep", 22.34, 38.132, "#1f77b4", false},
+		{"", "sah_binned", 19.97, 38.362, "#ff7f0e", true},
+		{"", "sah_even", 30.88, 38.132, "#2ca02c", false},
+		{"", "sah_uneven", 23.09, 38.132, "#d62728", false},
+		{"", "sah_queue", 20.02, 38.132, "#9467bd", true},
+		{"", "sah_tasks", 33.04, 38.362, "#8c564b", false},
+		{"", "lbvh", 5.83, 43.294, "#e377c2", true},
+		{"", "ploc", 10.48, 41.150, "#7f7f7f", true},
+		{"", "lbvh+reinsert", 53.84, 40.493, "#bcbd22", false},
+		{"", "lbvh+treelet", 259.0, 39.178, "#17becf", false},
+		{"", "sbvh", 448.1, 38.367, "#000000", false},
+		{"", "embree", 47.93, 38.635, "#aec7e8", false}};
+	struct strbuf sb = {0};
+	svg_scatter(&sb, "SAH cost vs. build time, 2 threads", "build time (ms)", "SAH cost", p,
+	            sizeof(p) / sizeof(p[0]));
+	char *svg = sb_take(&sb);
+	CHECK(svg != NULL);
+	CHECK(strstr(svg, "stroke=\"#999\"") != NULL); /* some label was displaced */
+	CHECK(!leader_hides_point(svg));
+	CHECK(!label_hides_point(svg));
+	free(svg);
+}
+
 int main(void)
 {
 	test_front_points();
@@ -327,5 +402,6 @@ int main(void)
 	test_nothing_ok();
 	test_merged_machines();
 	test_heat_scales();
+	test_leader_lines();
 	return test_finish();
 }

@@ -290,27 +290,78 @@ static bool free_slot(const struct placed *taken, size_t n, const struct placed 
 	return true;
 }
 
+/* Whether the segment from (x0, y0) to (x1, y1) passes through box b
+ * (Liang-Barsky: clip the segment's parameter range to each slab). */
+static bool crosses(const struct placed *b, double x0, double y0, double x1, double y1)
+{
+	const double d[2] = {x1 - x0, y1 - y0};
+	const double lo[2] = {b->x0 - x0, b->y0 - y0}, hi[2] = {b->x1 - x0, b->y1 - y0};
+	double t0 = 0, t1 = 1;
+	for (int a = 0; a < 2; a++) {
+		if (d[a] == 0) {
+			if (lo[a] > 0 || hi[a] < 0)
+				return false;
+			continue;
+		}
+		double ta = fmin(lo[a] / d[a], hi[a] / d[a]), tb = fmax(lo[a] / d[a], hi[a] / d[a]);
+		t0 = fmax(t0, ta);
+		t1 = fmin(t1, tb);
+		if (t0 > t1)
+			return false;
+	}
+	return true;
+}
+
+/* Whether the leader from the point (x, y) to label box b passes through
+ * another point or label: it would tie the name to the wrong point. The
+ * boxes holding (x, y), the point's own, do not count. */
+static bool leader_blocked(const struct placed *taken, size_t n, double x, double y,
+                           const struct placed *b)
+{
+	double ax = b->x0 < x ? b->x1 : b->x0, ay = (b->y0 + b->y1) / 2;
+	for (size_t i = 0; i < n; i++) {
+		const struct placed *t = &taken[i];
+		bool own = t->x0 <= x && x <= t->x1 && t->y0 <= y && y <= t->y1;
+		if (!own && crosses(t, x, y, ax, ay))
+			return true;
+	}
+	return false;
+}
+
+/* Label box number `side` (right, left) of a point at (x, y), `step`
+ * lines down and `far` units of 20 px further out. */
+static struct placed slot(double x, double y, double w, int side, int step, int far)
+{
+	double gap = 7 + 20 * far;
+	struct placed b = {side ? x - gap - w : x + gap, y - LINE_H / 2 + step * LINE_H, 0, 0};
+	b.x1 = b.x0 + w;
+	b.y1 = b.y0 + LINE_H;
+	return b;
+}
+
 /* The first free slot for a label near (x, y): right of the point, then
- * left of it, moving down (then up) a line at a time; *moved when it is
- * not beside the point. Every point is taken too, so no label hides one. */
+ * left of it, moving down (then up) a line at a time and, where a leader
+ * straight up or down would graze a neighbour, further out; *moved when it
+ * is not beside the point, and then its leader line must pass no other
+ * point or label. Every point is taken too, so no label hides one. */
 static struct placed place(const struct placed *taken, size_t n, double x, double y,
                            size_t len, bool *moved)
 {
 	double w = CHAR_W * (double)len;
 	for (int k = 0; k < 40; k++) {
 		int step = k % 2 ? (k + 1) / 2 : -(k / 2);
-		for (int side = 0; side < 2; side++) {
-			struct placed b = {side ? x - 7 - w : x + 7, y - LINE_H / 2 + step * LINE_H, 0, 0};
-			b.x1 = b.x0 + w;
-			b.y1 = b.y0 + LINE_H;
-			if (free_slot(taken, n, &b)) {
-				*moved = k > 0;
-				return b;
+		for (int far = 0; far < (k ? 3 : 1); far++)
+			for (int side = 0; side < 2; side++) {
+				struct placed b = slot(x, y, w, side, step, far);
+				if (free_slot(taken, n, &b) &&
+				    (k == 0 || !leader_blocked(taken, n, x, y, &b))) {
+					*moved = k > 0;
+					return b;
+				}
 			}
-		}
 	}
 	*moved = false;
-	return (struct placed){x + 7, y - LINE_H / 2, x + 7 + w, y + LINE_H / 2};
+	return slot(x, y, w, 0, 0, 0);
 }
 
 static int by_x(const void *a, const void *b)
