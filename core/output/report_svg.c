@@ -20,6 +20,7 @@
 #define LEGEND_H 16 /* a row of the legend under a plot */
 #define CHAR_W 6.2  /* the width of a character of the 11 px font, about */
 #define LINE_H 12.0
+#define MARKER_R 4.5 /* a scatter point's radius */
 
 /* One colour per builder in every chart of the report: ten strong hues
  * first (Tableau 10, told apart by most colour-blind readers too), then
@@ -272,6 +273,7 @@ static double plot_frame(struct strbuf *sb, const char *title, const char *xname
 /* Text boxes already placed, to keep labels apart. */
 struct placed {
 	double x0, y0, x1, y1;
+	bool point; /* a marker's box, not a label's */
 };
 
 static bool overlaps(const struct placed *a, const struct placed *b)
@@ -312,17 +314,33 @@ static bool crosses(const struct placed *b, double x0, double y0, double x1, dou
 	return true;
 }
 
-/* Whether the leader from the point (x, y) to label box b passes through
- * another point or label: it would tie the name to the wrong point. The
- * boxes holding (x, y), the point's own, do not count. */
+/* The distance from (cx, cy) to the segment from (x0, y0) to (x1, y1). */
+static double segment_distance(double x0, double y0, double x1, double y1, double cx, double cy)
+{
+	double dx = x1 - x0, dy = y1 - y0, l2 = dx * dx + dy * dy;
+	double t = l2 > 0 ? ((cx - x0) * dx + (cy - y0) * dy) / l2 : 0;
+	t = fmax(0, fmin(1, t));
+	return hypot(x0 + t * dx - cx, y0 + t * dy - cy);
+}
+
+/* Whether the leader from the point (x, y) to label box b passes over
+ * another marker or label: it would tie the name to the wrong point. It
+ * is seen from the edge of its own marker on; unless strict, markers that
+ * overlap its own are passed over too (no leader avoids them all). */
 static bool leader_blocked(const struct placed *taken, size_t n, double x, double y,
-                           const struct placed *b)
+                           const struct placed *b, bool strict)
 {
 	double ax = b->x0 < x ? b->x1 : b->x0, ay = (b->y0 + b->y1) / 2;
+	double len = hypot(ax - x, ay - y);
+	if (len <= MARKER_R)
+		return false;
+	double sx = x + (ax - x) * MARKER_R / len, sy = y + (ay - y) * MARKER_R / len;
 	for (size_t i = 0; i < n; i++) {
 		const struct placed *t = &taken[i];
-		bool own = t->x0 <= x && x <= t->x1 && t->y0 <= y && y <= t->y1;
-		if (!own && crosses(t, x, y, ax, ay))
+		double cx = (t->x0 + t->x1) / 2, cy = (t->y0 + t->y1) / 2, d = hypot(cx - x, cy - y);
+		if (!t->point ? crosses(t, sx, sy, ax, ay)
+		              : d > 0 && (strict || d >= 2 * MARKER_R) &&
+		                        segment_distance(sx, sy, ax, ay, cx, cy) < MARKER_R + 0.5)
 			return true;
 	}
 	return false;
@@ -333,7 +351,7 @@ static bool leader_blocked(const struct placed *taken, size_t n, double x, doubl
 static struct placed slot(double x, double y, double w, int side, int step, int far)
 {
 	double gap = 7 + 20 * far;
-	struct placed b = {side ? x - gap - w : x + gap, y - LINE_H / 2 + step * LINE_H, 0, 0};
+	struct placed b = {side ? x - gap - w : x + gap, y - LINE_H / 2 + step * LINE_H, 0, 0, false};
 	b.x1 = b.x0 + w;
 	b.y1 = b.y0 + LINE_H;
 	return b;
@@ -344,22 +362,37 @@ static struct placed slot(double x, double y, double w, int side, int step, int 
  * straight up or down would graze a neighbour, further out; *moved when it
  * is not beside the point, and then its leader line must pass no other
  * point or label. Every point is taken too, so no label hides one. */
+static bool first_slot(const struct placed *taken, size_t n, double x, double y, double w,
+                       bool strict, struct placed *out, bool *moved)
+{
+	for (int k = 0; k < 40; k++) {
+		int step = k % 2 ? (k + 1) / 2 : -(k / 2);
+		for (int far = 0; far < 3; far++)
+			for (int side = 0; side < 2; side++) {
+				struct placed b = slot(x, y, w, side, step, far);
+				bool away = k > 0 || far > 0;
+				if (free_slot(taken, n, &b) &&
+				    (!away || !leader_blocked(taken, n, x, y, &b, strict))) {
+					*out = b;
+					*moved = away;
+					return true;
+				}
+			}
+	}
+	return false;
+}
+
+/* A label's box for the point (x, y): the first free slot whose leader
+ * passes no other marker, else one whose leader passes only markers that
+ * overlap the point's own, else beside the point whatever it covers. */
 static struct placed place(const struct placed *taken, size_t n, double x, double y,
                            size_t len, bool *moved)
 {
 	double w = CHAR_W * (double)len;
-	for (int k = 0; k < 40; k++) {
-		int step = k % 2 ? (k + 1) / 2 : -(k / 2);
-		for (int far = 0; far < (k ? 3 : 1); far++)
-			for (int side = 0; side < 2; side++) {
-				struct placed b = slot(x, y, w, side, step, far);
-				if (free_slot(taken, n, &b) &&
-				    (k == 0 || !leader_blocked(taken, n, x, y, &b))) {
-					*moved = k > 0;
-					return b;
-				}
-			}
-	}
+	struct placed b;
+	if (first_slot(taken, n, x, y, w, true, &b, moved) ||
+	    first_slot(taken, n, x, y, w, false, &b, moved))
+		return b;
 	*moved = false;
 	return slot(x, y, w, 0, 0, 0);
 }
@@ -393,8 +426,8 @@ static void front_line(struct strbuf *sb, const struct frame *f, const struct sv
 /* A point with its label as a tooltip; front points are ringed. */
 static void marker(struct strbuf *sb, const struct frame *f, const struct svg_point *p)
 {
-	sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4.5\" fill=\"%s\"%s><title>",
-	          px(f, p->x), py(f, p->y), p->colour,
+	sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\" fill=\"%s\"%s><title>",
+	          px(f, p->x), py(f, p->y), MARKER_R, p->colour,
 	          p->front ? " stroke=\"#222\" stroke-width=\"1.5\"" : "");
 	report_escape(sb, p->label);
 	sb_printf(sb, "</title></circle>");
@@ -414,7 +447,7 @@ void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const 
 		marker(sb, &f, &p[i]);
 		double x = px(&f, p[i].x), y = py(&f, p[i].y);
 		if (nt < sizeof(taken) / sizeof(taken[0]))
-			taken[nt++] = (struct placed){x - 5, y - 5, x + 5, y + 5};
+			taken[nt++] = (struct placed){x - 5, y - 5, x + 5, y + 5, true};
 	}
 	/* Only the front is named on the plot: the legend names every colour,
 	 * and a name beside every point of a cluster would only collide. */
