@@ -403,6 +403,25 @@ static void test_leader_lines(void)
 	check_cluster(1);
 }
 
+/* Thread counts 1 and 2 on the x axis: whole ticks only, no "1.5 threads";
+ * the speedups on the y axis keep their fractional ticks. */
+static void test_whole_ticks(void)
+{
+	const struct svg_point p[] = {{"", "a", 1, 1, "#1f77b4", false},
+	                              {"", "a", 2, 1.33, "#1f77b4", false},
+	                              {"", "b", 1, 1, "#ff7f0e", false},
+	                              {"", "b", 2, 2, "#ff7f0e", false}};
+	struct strbuf sb = {0};
+	svg_lines(&sb, "Speedup over 1 thread", "threads", "speedup", p, 4);
+	char *svg = sb_take(&sb);
+	CHECK(svg != NULL);
+	CHECK_CONTAINS(svg, "text-anchor=\"middle\">1</text>");
+	CHECK_CONTAINS(svg, "text-anchor=\"middle\">2</text>");
+	CHECK(!strstr(svg, "text-anchor=\"middle\">1.5</text>"));
+	CHECK_CONTAINS(svg, "text-anchor=\"end\">1.5</text>");
+	free(svg);
+}
+
 int main(void)
 {
 	test_front_points();
@@ -414,5 +433,6 @@ int main(void)
 	test_merged_machines();
 	test_heat_scales();
 	test_leader_lines();
+	test_whole_ticks();
 	return test_finish();
 }

@@ -98,10 +98,11 @@ void svg_bars(struct strbuf *sb, const char *title, const char *unit,
 	sb_printf(sb, "</svg>\n");
 }
 
-/* One axis: its range and whether it is logarithmic. */
+/* One axis: its range, whether it is logarithmic and whether every value
+ * on it is a whole number (thread counts: no tick between 1 and 2). */
 struct axis {
 	double lo, hi;
-	bool log;
+	bool log, whole;
 };
 
 /* Values spanning more than this factor get a log axis: a linear one
@@ -112,11 +113,13 @@ struct axis {
 static void range(const struct svg_point *p, size_t n, bool y, struct axis *a)
 {
 	double lo = INFINITY, hi = -INFINITY;
+	a->whole = true;
 	for (size_t i = 0; i < n; i++) {
 		double v = y ? p[i].y : p[i].x;
 		if (isfinite(v)) {
 			lo = v < lo ? v : lo;
 			hi = v > hi ? v : hi;
+			a->whole = a->whole && v == floor(v);
 		}
 	}
 	if (!(lo <= hi))
@@ -188,6 +191,10 @@ static int ticks(const struct axis *a, double *v, int *decimals, int max)
 		return n;
 	}
 	double step = tick_step(a->lo, a->hi, decimals);
+	if (a->whole && step < 1) {
+		step = 1;
+		*decimals = 0;
+	}
 	for (double t = ceil(a->lo / step) * step; t <= a->hi && n < max; t += step)
 		v[n++] = fabs(t) < step * 1e-9 ? 0 : t;
 	return n;
