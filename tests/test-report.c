@@ -4,8 +4,9 @@
  * whom, the break-even ray counts, the reference's fallback when the one
  * asked for did not run, the noise and load marks, no empty tables, no
  * speedup for a builder that ran on 1 thread only, and build_phases; a
- * merged sweep's machines never compared with each other, and heat maps
- * drawn on different scales each stated with its own.
+ * merged sweep's machines never compared with each other, heat maps
+ * drawn on different scales each stated with its own, and the charts: no
+ * name or leader line over another point, whole ticks for thread counts.
  */
 #include <math.h>
 
