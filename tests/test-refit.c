@@ -234,13 +234,11 @@ static void test_cycle(void)
 #define EXPLODE_AMPLITUDE 0.15
 #define EXPLODE_FRAMES 16
 #define EXPLODE_SEED 0xe8910deULL
-/* Frames checked: all of them, or under a sanitizer (ten times slower) up
- * to frame 5, past the frame 4 that reinsert once left invalid. */
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define EXPLODE_CHECKED 6
-#else
-#define EXPLODE_CHECKED EXPLODE_FRAMES
-#endif
+/* Frames checked: all of them, or under ASan up to frame 4, the one that
+ * reinsert once left invalid. Not under TSan, where it took 158 s: the
+ * fault was in reinsert's one-thread undo, not a race, and the stage's
+ * threads are raced in test-refine. */
+#define EXPLODE_CHECKED (UNDER_ASAN ? 5 : EXPLODE_FRAMES)
 
 /* Frame f of the exploding horse, its primitives into *prims. */
 static bvhlab_scene *explode_frame(const bvhlab_scene *rest, uint32_t f, bvhlab_prims *prims)
@@ -298,6 +296,10 @@ static void test_explode_reinsert(void)
 	bvhlab_scene *mesh = NULL, *rest = NULL;
 	bvhlab_plugin *lbvh = NULL, *reinsert = NULL;
 	bvhlab_error err = {{0}};
+	if (UNDER_TSAN) {
+		printf("ThreadSanitizer: the exploding horse skipped (release and ASan run it)\n");
+		return;
+	}
 	if (bvhlab_scene_load(BVHLAB_SHARED_SCENES "/horse.ply", &mesh, &err) < 0) {
 		printf("no %s/horse.ply: the exploding horse skipped\n", BVHLAB_SHARED_SCENES);
 		return;
