@@ -262,7 +262,11 @@ typedef struct bvhlab_build_output {
 
 enum bvhlab_builder_flags {
 	BVHLAB_BUILDER_PARALLEL = 1u << 0,      /* uses input->threads > 1 */
-	BVHLAB_BUILDER_DETERMINISTIC = 1u << 1, /* same tree for any thread count and run */
+	/* Same tree for any thread count and run, as bvhlab_tree_compare judges
+	 * it: the same shape, bit-identical boxes and leaf contents; the order
+	 * of nodes in the array may differ (parallel builders place subtrees as
+	 * their tasks finish). */
+	BVHLAB_BUILDER_DETERMINISTIC = 1u << 1,
 	/* may reference a primitive more than once, and give a leaf a box that
 	 * holds only the part of a triangle inside it (judged by coverage) */
 	BVHLAB_BUILDER_SPATIAL_SPLITS = 1u << 2,
