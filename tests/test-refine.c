@@ -11,7 +11,8 @@
  * leaves kept. treelet on scenes of at most 8 triangles, where one
  * treelet holds them all, must find the least SAH of every binary tree
  * over them, found here by enumerating the trees. reinsert runs with
- * its children moves (Bittner et al.) and, on a few scenes, without.
+ * its children moves (Bittner et al.) and, on a few scenes, without, and
+ * with its batch chosen by area.
  */
 #include <errno.h>
 #include <math.h>
@@ -360,6 +361,18 @@ static void test_subtree_moves(void)
 	refiner_options = saved;
 }
 
+/* reinsert choosing its batch by area (the largest nodes, madmann91/bvh's
+ * rule) instead of Bittner et al.'s measure: the same checks. */
+static void test_area_measure(void)
+{
+	const char *saved = refiner_options;
+
+	refiner_options = "batch=0.05\0iterations=3\0measure=area\0leaves=false\0";
+	test_improves();
+	test_scene("soup", generate("soup", SCALE(10000, 2000), 0, 0), RAYS);
+	refiner_options = saved;
+}
+
 /* Every test of one stage, with the options it is tested with. */
 static void test_stage(const char *name, const char *options)
 {
@@ -385,8 +398,10 @@ static void test_stage(const char *name, const char *options)
 	if (strcmp(name, "treelet") == 0)
 		for (uint32_t n = 3; n <= 8; n++)
 			test_optimal(n);
-	if (strcmp(name, "reinsert") == 0)
+	if (strcmp(name, "reinsert") == 0) {
 		test_subtree_moves();
+		test_area_measure();
+	}
 	bvhlab_plugin_close(refiner);
 	refiner = NULL;
 }

@@ -22,6 +22,11 @@ static const bvhlab_option_decl options[] = {
 	  .help = "stop after an iteration that lowers the SAH by less than this fraction "
 	          "of it (0: run every iteration)",
 	  .def_float = 0.001, .min = 0.0, .max = 1.0 },
+	{ .name = "measure", .type = BVHLAB_OPTION_STRING,
+	  .help = "which nodes a batch takes: bittner (those that hold their children worst, "
+	          "Bittner et al.'s measure) or area (the largest, as madmann91/bvh's "
+	          "reinsertion optimiser: the top of the tree first)",
+	  .def_string = "bittner", .choices = "bittner|area" },
 	{ .name = "children", .type = BVHLAB_OPTION_BOOL,
 	  .help = "also try Bittner et al.'s move for each inner candidate: take it and its "
 	          "parent out and put its two children back apart, where each costs least",
@@ -37,6 +42,7 @@ static const bvhlab_option_decl options[] = {
 struct params {
 	double batch, min_gain;
 	int64_t iterations, max_visits, max_leaf;
+	int measure; /* enum reinsert_measure */
 	bool leaves, children;
 };
 
@@ -47,6 +53,7 @@ static const plugin_field fields[] = {
 	PLUGIN_FIELD(struct params, max_visits, "max_visits", I64),
 	PLUGIN_FIELD(struct params, leaves, "leaves", BOOL),
 	PLUGIN_FIELD(struct params, children, "children", BOOL),
+	PLUGIN_FIELD(struct params, measure, "measure", CHOICE),
 	PLUGIN_FIELD(struct params, max_leaf, "max_leaf", I64),
 };
 
@@ -77,6 +84,8 @@ static double inefficiency(const reinsert *r, uint32_t x)
 	const bvhlab_node *n = &r->nodes[x];
 	double a, l, h;
 
+	if (r->measure == MEASURE_AREA)
+		return node_area(n);
 	if (n->count)
 		return cost_of(n);
 	a = node_area(n);
@@ -223,7 +232,8 @@ static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct
                     const bvhlab_build_input *input, bvhlab_build_output *tree)
 {
 	reinsert r = { .nodes = tree->nodes, .node_count = tree->node_count,
-	               .max_visits = (uint32_t)o->max_visits, .children = o->children };
+	               .max_visits = (uint32_t)o->max_visits, .children = o->children,
+	               .measure = o->measure };
 	size_t n = tree->node_count;
 	team_host th;
 	int rc;

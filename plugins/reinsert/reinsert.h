@@ -60,6 +60,9 @@ struct undo {
 	bvhlab_node node;
 };
 
+/* Option measure's choices, in order. */
+enum reinsert_measure { MEASURE_BITTNER = 0, MEASURE_AREA = 1 };
+
 typedef struct reinsert {
 	bvhlab_node *nodes;
 	uint32_t node_count;
@@ -71,6 +74,7 @@ typedef struct reinsert {
 	uint32_t *hist;         /* [65536] scratch of the selection */
 	uint32_t max_visits;    /* nodes a search may take from its queue */
 	bool children;          /* children moves searched too */
+	int measure;            /* enum reinsert_measure: how the batch is chosen */
 	struct undo log[UNDO_MAX]; /* what a children move wrote, to take it back */
 	uint32_t log_count;
 	atomic_uint next;       /* candidates handed out in the search */

@@ -52,6 +52,19 @@ void sah_write_inner(sah_builder *b, const sah_job *job, uint32_t mid, sah_job c
 	child[0].alt = child[1].alt = job->alt;
 }
 
+void sah_place_scratch(sah_builder *b, uint32_t root, const bvhlab_node *scratch, uint32_t used)
+{
+	uint32_t base = atomic_fetch_add_explicit(&b->node_counter, used - 1,
+	                                          memory_order_relaxed) - 1;
+
+	for (uint32_t i = 0; i < used; i++) {
+		bvhlab_node n = scratch[i];
+		if (n.count == 0)
+			n.first += base;
+		b->nodes[i ? base + i : root] = n;
+	}
+}
+
 bool sah_leaf_rule(const sah_options *opt, uint32_t n, const bvhlab_aabb *box, bool found,
                    float best)
 {

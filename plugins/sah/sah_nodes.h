@@ -27,6 +27,15 @@ void sah_write_inner(sah_builder *b, const sah_job *job, uint32_t mid, sah_job c
 void sah_write_node(sah_builder *b, uint32_t node, const bvhlab_aabb *box, uint32_t *first);
 
 /*
+ * Copies a subtree built into scratch (slot 0 its root, then its nodes in
+ * allocation order, `used` of them) into the tree: the root into slot
+ * `root`, the others into one range claimed from the node counter, child
+ * links moved with them. Pairs stay adjacent, and with one thread the
+ * slots are those the shared counter would have handed out.
+ */
+void sah_place_scratch(sah_builder *b, uint32_t root, const bvhlab_node *scratch, uint32_t used);
+
+/*
  * The leaf rule for a node of n primitives with box, given `found` (a
  * candidate split exists) and its best weighted area sum A_L*N_L + A_R*N_R.
  */

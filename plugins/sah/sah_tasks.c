@@ -29,6 +29,7 @@
 #include <bvhlab/builder.h>
 
 #include "sah_kernel.h"
+#include "sah_nodes.h"
 #include "sah_threads.h"
 #include "tasks_split.h"
 #include "team.h"
@@ -92,28 +93,8 @@ struct crew {
 };
 
 /*
- * Copies a task's nodes from its scratch (slot 0 its root, then its nodes
- * in allocation order) into the tree: the root into the slot the top
- * phase gave it, the others into one range claimed at the end, child
- * links moved with them. Pairs stay adjacent, and with one thread the
- * slots are those the shared counter would have handed out.
- */
-static void place_task(sah_builder *b, const sah_job *task, const bvhlab_node *scratch,
-                       uint32_t used)
-{
-	uint32_t base = atomic_fetch_add_explicit(&b->node_counter, used - 1,
-	                                          memory_order_relaxed) - 1;
-	for (uint32_t i = 0; i < used; i++) {
-		bvhlab_node n = scratch[i];
-		if (n.count == 0)
-			n.first += base;
-		b->nodes[i ? base + i : task->node] = n;
-	}
-}
-
-/*
  * Each task builds into a scratch array of its own, with a counter of its
- * own, and is copied into the tree when done: the shared counter is then
+ * own, and is copied into the tree when done (sah_place_scratch): the shared counter is then
  * touched once per task instead of once per split, and two threads share
  * a cache line of nodes only at the ends of a task's range. With the
  * shared counter, the atomic's cache line and the interleaved node writes
@@ -138,8 +119,8 @@ static void run_tasks(struct crew *tm)
 		job.node = 0;
 		atomic_init(&local.node_counter, 1);
 		sah_build_subtree(&local, &job);
-		place_task(tm->b, &tm->tasks[i], scratch,
-		           atomic_load_explicit(&local.node_counter, memory_order_relaxed));
+		sah_place_scratch(tm->b, tm->tasks[i].node, scratch,
+		                  atomic_load_explicit(&local.node_counter, memory_order_relaxed));
 	}
 	free(scratch);
 }
