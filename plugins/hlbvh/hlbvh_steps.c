@@ -150,8 +150,10 @@ static void bottom_init(hlbvh *h, uint32_t top_nodes)
 int hlbvh_top(hlbvh *h)
 {
 	uint32_t cc = h->cluster_count, *ids = malloc(cc * sizeof(*ids));
+	/* Exactly the top's nodes: past them lie the bottom's slots and the
+	 * sorted records, not room for the top builder's arrays. */
 	bvhlab_build_output out = { .struct_size = sizeof(out), .nodes = h->out->nodes,
-	                            .node_capacity = h->out->node_capacity,
+	                            .node_capacity = 2 * cc - 1,
 	                            .prim_index = ids, .index_capacity = cc };
 	sah_options opt = h->opt.sah;
 	bvhlab_build_input in;

@@ -4,6 +4,7 @@
  * subtree builder. Node writing and the leaf rule are in sah_nodes.c.
  */
 #include <errno.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -39,19 +40,52 @@ static bool input_ok(const sah_options *opt, const bvhlab_build_input *in,
 	return out->node_capacity >= 2 * n - 1 && out->index_capacity >= n;
 }
 
-static int alloc_sweep(sah_builder *b, const bvhlab_build_input *input)
+/*
+ * The record arrays: 4 for sweep (prims[0..2], temp), 2 for binned
+ * (prims[0], alt). Past the tree in the output when the host gave the room
+ * (sah_scratch_nodes), which it keeps between builds: fresh mappings
+ * would be paged in and zeroed by the kernel at every build (on igea
+ * subdivided once, 128 MB for sweep). Else mapped for this build.
+ */
+static int alloc_records(sah_builder *b, const bvhlab_build_output *out, unsigned count,
+                         sah_prim **dst[4])
 {
-	size_t n = b->prim_count;
+	size_t bytes = ((size_t)b->prim_count * sizeof(sah_prim) + 63) & ~(size_t)63;
+	uint64_t tree = 2 * (uint64_t)b->prim_count - 1;
+	char *room = NULL;
 
-	for (int a = 0; a < 3; a++)
-		b->prims[a] = big_alloc(n * sizeof(sah_prim));
-	b->temp = big_alloc(n * sizeof(sah_prim));
+	if (out->node_capacity >= tree + sah_scratch_nodes(b->opt.method, b->prim_count))
+		room = (char *)(((uintptr_t)(out->nodes + tree) + 63) & ~(uintptr_t)63);
+	b->in_output = room != NULL;
+	for (unsigned k = 0; k < count; k++) {
+		*dst[k] = room ? (sah_prim *)(void *)(room + k * bytes) : big_alloc(bytes);
+		if (!*dst[k])
+			return -ENOMEM;
+	}
+	return 0;
+}
+
+static int alloc_sweep(sah_builder *b, const bvhlab_build_input *input,
+                       const bvhlab_build_output *out)
+{
+	sah_prim **dst[4] = { &b->prims[0], &b->prims[1], &b->prims[2], &b->temp };
+	size_t n = b->prim_count;
+	int rc = alloc_records(b, out, 4, dst);
+
 	b->area = malloc(n * sizeof(float));
 	b->side = malloc(n);
-	if (!b->prims[0] || !b->prims[1] || !b->prims[2] || !b->temp || !b->area || !b->side)
+	if (rc < 0 || !b->area || !b->side)
 		return -ENOMEM;
 	sah_copy_prims(b, input, b->temp);
 	return sah_presort(b);
+}
+
+uint32_t sah_scratch_nodes(int method, uint32_t n)
+{
+	uint64_t bytes = (method == SAH_SWEEP ? 4 : 2) * ((uint64_t)n * sizeof(sah_prim) + 63);
+	uint64_t nodes = (bytes + 64 + sizeof(bvhlab_node) - 1) / sizeof(bvhlab_node);
+
+	return 2 * (uint64_t)n - 1 + nodes > UINT32_MAX ? UINT32_MAX : (uint32_t)nodes;
 }
 
 int sah_builder_init(sah_builder *b, const sah_options *opt,
@@ -71,13 +105,12 @@ int sah_builder_init(sah_builder *b, const sah_options *opt,
 	b->ids = output->prim_index;
 	atomic_init(&b->node_counter, 1);
 	if (opt->method == SAH_SWEEP) {
-		rc = alloc_sweep(b, input);
+		rc = alloc_sweep(b, input, output);
 		if (rc < 0)
 			goto fail;
 	} else {
-		b->prims[0] = big_alloc((size_t)b->prim_count * sizeof(sah_prim));
-		b->alt = big_alloc((size_t)b->prim_count * sizeof(sah_prim));
-		if (!b->prims[0] || !b->alt)
+		sah_prim **dst[4] = { &b->prims[0], &b->alt };
+		if (alloc_records(b, output, 2, dst) < 0)
 			goto fail;
 		sah_copy_prims(b, input, b->prims[0]);
 	}
@@ -90,11 +123,14 @@ fail:
 void sah_builder_free(sah_builder *b)
 {
 	for (int a = 0; a < 3; a++) {
-		big_free(b->prims[a]);
+		if (!b->in_output)
+			big_free(b->prims[a]);
 		b->prims[a] = NULL;
 	}
-	big_free(b->temp);
-	big_free(b->alt);
+	if (!b->in_output) {
+		big_free(b->temp);
+		big_free(b->alt);
+	}
 	b->alt = NULL;
 	free(b->area);
 	free(b->side);

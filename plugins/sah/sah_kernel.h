@@ -137,6 +137,14 @@ int sah_builder_init(sah_builder *b, const sah_options *opt,
                      const bvhlab_build_input *input, bvhlab_build_output *output,
                      const team_host *th);
 
+/*
+ * Nodes past a tree of n primitives (2n - 1 nodes) that hold the record
+ * arrays of a build with `method`, when the output has that room: ask the
+ * host for it before sah_builder_init (fine if refused; the arrays are
+ * then mapped for the build). UINT32_MAX when it would not fit a count.
+ */
+uint32_t sah_scratch_nodes(int method, uint32_t n);
+
 /* The job that builds the whole tree into node 0. */
 void sah_builder_root(const sah_builder *b, sah_job *root);
 

@@ -8,6 +8,7 @@
 #define BVHLAB_SAH_TYPES_H
 
 #include <stdatomic.h>
+#include <stdbool.h>
 #include <stdint.h>
 
 #include <bvhlab/builder.h>
@@ -123,6 +124,8 @@ typedef struct sah_builder {
 	sah_prim *temp;  /* sweep: [prim_count] stable-partition target, by position */
 	float *area;     /* sweep: [prim_count] right-side areas, by position */
 	uint8_t *side;   /* sweep: [prim_count] left(0)/right(1) mark, by primitive id */
+	bool in_output;  /* the record arrays lie past the tree in the output
+	                  * (not to be unmapped) */
 } sah_builder;
 
 /*
