@@ -1,41 +1,42 @@
 /*
- * plugin_options_fill (plugins/common/options), against a host table of
- * its own: every field type lands in its field at its offset with the
- * value the host gives (a choice as its index, a float rounded as a cast
- * rounds), and a table that does not match the declarations (an
- * undeclared name, a type that does not fit, a U32 field for a range past
- * 32 bits) fails with -EINVAL and says so through set_error.
+ * plugin_options.h (plugins/common/options), as a plugin uses it: this
+ * test is a plugin of its own (PLUGIN_WITH_OPTIONS) with a fake host.
+ * The entry point returns the descriptor with the table's declarations,
+ * in order, field for field (the field's type where an entry leaves it
+ * out), to any thread (several ask at once, the first time); build()
+ * fills every field type at its offset with the value the host gives (a
+ * choice as its index, a float rounded as a cast rounds); an entry whose
+ * field does not fit its declaration (a type that does not fit, a U32 for
+ * a range past 32 bits, a CHOICE without choices) fails with -EINVAL and
+ * a message naming the option.
  */
 #include <errno.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include <bvhlab/builder.h>
 
 #include "plugin_options.h"
 #include "testutil.h"
 
-static const bvhlab_option_decl decls[] = {
-	{ .name = "on", .type = BVHLAB_OPTION_BOOL },
-	{ .name = "count", .type = BVHLAB_OPTION_INT, .min = 1, .max = 64 },
-	{ .name = "big", .type = BVHLAB_OPTION_INT, .min = 0, .max = 1e12 },
-	{ .name = "cost", .type = BVHLAB_OPTION_FLOAT, .min = 0, .max = 10 },
-	{ .name = "method", .type = BVHLAB_OPTION_STRING, .choices = "sweep|binned|grid" },
-	{ .name = "label", .type = BVHLAB_OPTION_STRING },
-};
-#define DECL_COUNT (sizeof(decls) / sizeof(decls[0]))
-
-/* The values the fake host hands out, whatever the name's type. */
 static int errors;
+static char last_error[256];
 
 static void set_error(bvhlab_build_ctx *ctx, const char *fmt, ...)
 {
+	va_list ap;
+
 	(void)ctx;
-	(void)fmt;
+	va_start(ap, fmt);
+	vsnprintf(last_error, sizeof(last_error), fmt, ap);
+	va_end(ap);
 	errors++;
 }
 
+/* The values the fake host hands out, whatever the name's type. */
 static int get_bool(bvhlab_build_ctx *ctx, const char *name, bool *out)
 {
 	(void)ctx;
@@ -83,54 +84,129 @@ struct opts {
 	const char *label;
 };
 
-static void test_fill(void)
-{
-	static const plugin_field fields[] = {
-		PLUGIN_FIELD(struct opts, on, "on", BOOL),
-		PLUGIN_FIELD(struct opts, count, "count", U32),
-		PLUGIN_FIELD(struct opts, big, "big", I64),
-		PLUGIN_FIELD(struct opts, cost_f, "cost", FLOAT),
-		PLUGIN_FIELD(struct opts, cost_d, "cost", DOUBLE),
-		PLUGIN_FIELD(struct opts, method, "method", CHOICE),
-		PLUGIN_FIELD(struct opts, label, "label", STRING),
-	};
-	struct opts o = { .pad = 'x' };
+static const plugin_option options[] = {
+	PLUGIN_OPTION(struct opts, on, BOOL, .name = "on", .type = BVHLAB_OPTION_BOOL,
+	              .help = "a bool, its type given", .def_bool = true),
+	PLUGIN_OPTION(struct opts, count, U32, .name = "count", .def_int = 3, .min = 1, .max = 64),
+	PLUGIN_OPTION(struct opts, big, I64, .name = "big", .min = 0, .max = 1e12),
+	PLUGIN_OPTION(struct opts, cost_f, FLOAT, .name = "cost_f", .def_float = 0.5, .max = 10),
+	PLUGIN_OPTION(struct opts, cost_d, DOUBLE, .name = "cost_d", .min = 0, .max = 10),
+	PLUGIN_OPTION(struct opts, method, CHOICE, .name = "method", .def_string = "sweep",
+	              .choices = "sweep|binned|grid"),
+	PLUGIN_OPTION(struct opts, label, STRING, .name = "label", .help = "free text"),
+};
 
-	errors = 0;
-	CHECK_INT(plugin_options_fill(&host, NULL, decls, DECL_COUNT, fields, 7, &o), 0);
-	CHECK_INT(errors, 0);
-	CHECK(o.pad == 'x' && o.on);
-	CHECK_INT(o.count, 42);
-	CHECK_INT(o.big, 5000000000LL);
-	CHECK(o.cost_f == (float)0.1 && o.cost_d == 0.1);
-	CHECK_INT(o.method, 2);
-	CHECK(o.label && strcmp(o.label, "hello") == 0);
+/* What the last build read. */
+static struct opts filled;
+
+static int build(const bvhlab_host *h, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+                 bvhlab_build_output *out)
+{
+	(void)in;
+	(void)out;
+	filled = (struct opts){ .pad = 'x' };
+	return plugin_options_fill(h, ctx, options, PLUGIN_OPTION_COUNT(options), &filled);
 }
 
-/* Each bad table alone: -EINVAL, one message, nothing else read. */
-static void test_bad_tables(void)
+PLUGIN_WITH_OPTIONS(options, .name = "options_probe", .summary = "plugin_options.h's test",
+                    .build = build)
+
+#define ASKERS 4
+
+static void *ask(void *arg)
 {
-	static const plugin_field bad[][1] = {
-		{ PLUGIN_FIELD(struct opts, count, "no_such", U32) },
-		{ PLUGIN_FIELD(struct opts, count, "cost", U32) },
-		{ PLUGIN_FIELD(struct opts, on, "count", BOOL) },
-		{ PLUGIN_FIELD(struct opts, count, "big", U32) },
-		{ PLUGIN_FIELD(struct opts, method, "label", CHOICE) },
+	*(const bvhlab_builder **)arg = bvhlab_plugin_entry(BVHLAB_ABI_MAJOR);
+	return NULL;
+}
+
+/* All but the type, which the table leaves to the field. */
+static bool same_decl(const bvhlab_option_decl *a, const bvhlab_option_decl *b)
+{
+	return a->name == b->name && a->help == b->help &&
+	       a->def_bool == b->def_bool && a->def_int == b->def_int &&
+	       a->def_float == b->def_float && a->def_string == b->def_string &&
+	       a->min == b->min && a->max == b->max && a->choices == b->choices;
+}
+
+/* The first calls race: each must see the declarations filled. */
+static void test_entry(void)
+{
+	static const uint32_t types[] = {
+		BVHLAB_OPTION_BOOL, BVHLAB_OPTION_INT, BVHLAB_OPTION_INT, BVHLAB_OPTION_FLOAT,
+		BVHLAB_OPTION_FLOAT, BVHLAB_OPTION_STRING, BVHLAB_OPTION_STRING,
+	};
+	pthread_t t[ASKERS];
+	const bvhlab_builder *got[ASKERS] = { 0 };
+	const bvhlab_builder *d;
+
+	for (int k = 0; k < ASKERS; k++)
+		CHECK_INT(pthread_create(&t[k], NULL, ask, &got[k]), 0);
+	for (int k = 0; k < ASKERS; k++)
+		pthread_join(t[k], NULL);
+	d = got[0];
+	CHECK(d != NULL);
+	for (int k = 1; k < ASKERS; k++)
+		CHECK(got[k] == d);
+	if (!d)
+		return;
+	CHECK_INT(d->abi_version, BVHLAB_ABI_CURRENT);
+	CHECK_INT(d->struct_size, sizeof(bvhlab_builder));
+	CHECK(strcmp(d->name, "options_probe") == 0 && d->build == build);
+	CHECK_INT(d->option_count, PLUGIN_OPTION_COUNT(options));
+	for (uint32_t k = 0; k < d->option_count && k < PLUGIN_OPTION_COUNT(options); k++) {
+		CHECK(same_decl(&d->options[k], &options[k].decl));
+		CHECK_INT(d->options[k].type, types[k]);
+	}
+	CHECK(strcmp(d->options[5].choices, "sweep|binned|grid") == 0);
+	CHECK(bvhlab_plugin_entry(BVHLAB_ABI_MAJOR + 1) == NULL);
+}
+
+static void test_fill(void)
+{
+	const bvhlab_builder *d = bvhlab_plugin_entry(BVHLAB_ABI_MAJOR);
+
+	errors = 0;
+	CHECK_INT(d->build(&host, NULL, NULL, NULL), 0);
+	CHECK_INT(errors, 0);
+	CHECK(filled.pad == 'x' && filled.on);
+	CHECK_INT(filled.count, 42);
+	CHECK_INT(filled.big, 5000000000LL);
+	CHECK(filled.cost_f == (float)0.1 && filled.cost_d == 0.1);
+	CHECK_INT(filled.method, 2);
+	CHECK(filled.label && strcmp(filled.label, "hello") == 0);
+}
+
+/* Each bad entry alone: -EINVAL, one message naming it, nothing else read. */
+static void test_bad_entries(void)
+{
+	static const plugin_option bad[][1] = {
+		{ PLUGIN_OPTION(struct opts, count, U32, .name = "as_float",
+		                .type = BVHLAB_OPTION_FLOAT, .min = 1, .max = 2) },
+		{ PLUGIN_OPTION(struct opts, on, BOOL, .name = "as_int", .type = BVHLAB_OPTION_INT) },
+		{ PLUGIN_OPTION(struct opts, count, U32, .name = "wide", .type = BVHLAB_OPTION_INT,
+		                .min = 0, .max = 1e12) },
+		{ PLUGIN_OPTION(struct opts, method, CHOICE, .name = "no_choices",
+		                .type = BVHLAB_OPTION_STRING) },
+		{ PLUGIN_OPTION(struct opts, label, STRING, .name = "as_bool",
+		                .type = BVHLAB_OPTION_BOOL) },
 	};
 	struct opts o = { 0 };
 
 	for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
 		errors = 0;
-		CHECK_INT(plugin_options_fill(&host, NULL, decls, DECL_COUNT, bad[k], 1, &o),
-		          -EINVAL);
+		last_error[0] = '\0';
+		CHECK_INT(plugin_options_fill(&host, NULL, bad[k], 1, &o), -EINVAL);
 		CHECK_INT(errors, 1);
+		CHECK_CONTAINS(last_error, bad[k][0].decl.name);
+		CHECK_CONTAINS(last_error, "does not fit its declaration");
 	}
-	CHECK(o.count == 0 && !o.on && o.method == 0);
+	CHECK(o.count == 0 && !o.on && o.method == 0 && !o.label);
 }
 
 int main(void)
 {
+	test_entry();
 	test_fill();
-	test_bad_tables();
+	test_bad_entries();
 	return test_finish();
 }

@@ -52,28 +52,6 @@ using clk = std::chrono::steady_clock;
 // The node's 4-bit primitive count caps a leaf at 15.
 constexpr int64_t max_leaf_cap = Node::Index::max_prim_count;
 
-const bvhlab_option_decl options[] = {
-	// name, type, help, def_bool, def_int, def_float, def_string, min, max, choices
-	{"builder", BVHLAB_OPTION_STRING,
-	 "low, medium, high (DefaultBuilder: mini-tree on a pool of the run's threads; at 1 "
-	 "thread the library's single-thread path), sweep, binned (top-down SAH, 1 thread)",
-	 false, 0, 0.0, "medium", 1, 0, "low|medium|high|sweep|binned"},
-	{"reinsertion", BVHLAB_OPTION_BOOL,
-	 "run its ReinsertionOptimizer after the build (high already runs it once)", false, 0,
-	 0.0, nullptr, 1, 0, nullptr},
-	{"one_thread", BVHLAB_OPTION_STRING,
-	 "low/medium/high at 1 thread: sequential (the library's single-thread path) or pool "
-	 "(the mini-tree builder on a one-thread pool)",
-	 false, 0, 0.0, "sequential", 1, 0, "sequential|pool"},
-	{"min_leaf", BVHLAB_OPTION_INT, "nodes this small are never split", false, 1, 0.0, nullptr,
-	 1, max_leaf_cap, nullptr},
-	{"max_leaf", BVHLAB_OPTION_INT, "larger nodes are split even against the SAH", false, 8,
-	 0.0, nullptr, 1, max_leaf_cap, nullptr},
-	{"cost_ratio", BVHLAB_OPTION_FLOAT,
-	 "SAH cost of a node over that of a primitive (the library's cost_ratio)", false, 0, 1.0,
-	 nullptr, 1e-6, 1e6, nullptr},
-};
-
 // one_thread's choices, by index.
 enum OneThread { sequential, pool_of_one };
 
@@ -85,20 +63,44 @@ struct Settings {
 	double cost_ratio = 1;
 };
 
-// The options into Settings (plugin_options.h): the host has checked them.
-const plugin_field fields[] = {
-	PLUGIN_FIELD(Settings, builder, "builder", STRING),
-	PLUGIN_FIELD(Settings, reinsertion, "reinsertion", BOOL),
-	PLUGIN_FIELD(Settings, one_thread, "one_thread", CHOICE),
-	PLUGIN_FIELD(Settings, min_leaf, "min_leaf", I64),
-	PLUGIN_FIELD(Settings, max_leaf, "max_leaf", I64),
-	PLUGIN_FIELD(Settings, cost_ratio, "cost_ratio", DOUBLE),
+// The options and where they go (plugin_options.h): the host has checked them.
+const plugin_option options[] = {
+	PLUGIN_OPTION(Settings, builder, STRING,
+	              bvhlab::string_option("builder",
+	                                    "low, medium, high (DefaultBuilder: mini-tree on a pool "
+	                                    "of the run's threads; at 1 thread the library's "
+	                                    "single-thread path), sweep, binned (top-down SAH, 1 "
+	                                    "thread)",
+	                                    "medium", "low|medium|high|sweep|binned")),
+	PLUGIN_OPTION(Settings, reinsertion, BOOL,
+	              bvhlab::bool_option("reinsertion",
+	                                  "run its ReinsertionOptimizer after the build (high "
+	                                  "already runs it once)",
+	                                  false)),
+	PLUGIN_OPTION(Settings, one_thread, CHOICE,
+	              bvhlab::string_option("one_thread",
+	                                    "low/medium/high at 1 thread: sequential (the library's "
+	                                    "single-thread path) or pool (the mini-tree builder on "
+	                                    "a one-thread pool)",
+	                                    "sequential", "sequential|pool")),
+	PLUGIN_OPTION(Settings, min_leaf, I64,
+	              bvhlab::int_option("min_leaf", "nodes this small are never split", 1, 1,
+	                                 max_leaf_cap)),
+	PLUGIN_OPTION(Settings, max_leaf, I64,
+	              bvhlab::int_option("max_leaf", "larger nodes are split even against the SAH",
+	                                 8, 1, max_leaf_cap)),
+	PLUGIN_OPTION(Settings, cost_ratio, DOUBLE,
+	              bvhlab::float_option("cost_ratio",
+	                                   "SAH cost of a node over that of a primitive (the "
+	                                   "library's cost_ratio)",
+	                                   1.0, 1e-6, 1e6)),
 };
+PLUGIN_DECLS(options)
 
 // What no declaration can say: min_leaf within max_leaf.
 int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, Settings &s)
 {
-	int rc = plugin_options_fill(host, ctx, options, fields, s);
+	int rc = plugin_options_fill(host, ctx, options, s);
 	if (rc == 0 && s.min_leaf > s.max_leaf) {
 		host->set_error(ctx, "min_leaf %lld exceeds max_leaf %lld",
 		                static_cast<long long>(s.min_leaf), static_cast<long long>(s.max_leaf));
@@ -208,8 +210,8 @@ const bvhlab_builder descriptor = bvhlab::make_builder(
 	"madmann91/bvh v2 (ac41ab8): DefaultBuilder low/medium/high (mini-tree on a pool of the "
 	"run's threads), sweep and binned SAH, optional reinsertion",
 	BVHLAB_BUILDER_PARALLEL,
-	options, bvhlab::guarded_build<build>);
+	plugin_decls, bvhlab::guarded_build<build>);
 
 } // namespace
 
-BVHLAB_PLUGIN_EXPORT(descriptor)
+PLUGIN_EXPORT(descriptor)

@@ -20,30 +20,19 @@
 #include "morton_front.h"
 #include "plugin_options.h"
 
-static const bvhlab_option_decl options[] = {
-	MORTON_OPTION_DECLS,
-	CL_DEVICE_OPTION_DECL,
-	{ .name = "leaf_block", .type = BVHLAB_OPTION_INT,
-	  .help = "leaves per work-item of the bounds kernel (0: 512 on a CPU device, "
-	          "1 on a GPU); the tree is the same for every value",
-	  .def_int = 0, .min = 0, .max = 1 << 20 },
-	{ .name = "hierarchy", .type = BVHLAB_OPTION_STRING,
-	  .help = "how each node's range and split are found: search (Karras's searches), "
-	          "scan (lbvh's prefix scans), auto (scan on a CPU device, search on a GPU); "
-	          "the tree is the same",
-	  .def_string = "auto", .choices = "auto|search|scan" },
+static const plugin_option options[] = {
+	MORTON_OPTIONS(cl_lbvh, bits),
+	CL_DEVICE_OPTION(cl_lbvh),
+	PLUGIN_OPTION(cl_lbvh, leaf_block, U32, .name = "leaf_block",
+	              .help = "leaves per work-item of the bounds kernel (0: 512 on a CPU "
+	                      "device, 1 on a GPU); the tree is the same for every value",
+	              .def_int = 0, .min = 0, .max = 1 << 20),
+	PLUGIN_OPTION(cl_lbvh, hierarchy, STRING, .name = "hierarchy",
+	              .help = "how each node's range and split are found: search (Karras's "
+	                      "searches), scan (lbvh's prefix scans), auto (scan on a CPU "
+	                      "device, search on a GPU); the tree is the same",
+	              .def_string = "auto", .choices = "auto|search|scan"),
 };
-
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
-/* Where the options go in the build's struct. */
-static const plugin_field fields[] = {
-	CL_BUILDER_FIELDS(cl_lbvh),
-	PLUGIN_FIELD(cl_lbvh, leaf_block, "leaf_block", U32),
-	PLUGIN_FIELD(cl_lbvh, hierarchy, "hierarchy", STRING),
-};
-
-#define FIELD_COUNT (sizeof(fields) / sizeof(fields[0]))
 
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "gather_leaves", "prefixes",
@@ -75,7 +64,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	char err[BVHLAB_CL_ERROR_SIZE];
 	int rc;
 
-	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, fields, FIELD_COUNT,
+	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
 	                              &b)) < 0 ||
 	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
 		return rc < 0 ? rc : 0;
@@ -87,6 +76,6 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return 0;
 }
 
-BVHLAB_PLUGIN(.name = "cl_lbvh", .flags = BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_WITH_OPTIONS(options, .name = "cl_lbvh", .flags = BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "LBVH on an OpenCL device (Karras 2012): the lbvh plugin's tree, built by kernels",
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+	.build = build)

@@ -20,29 +20,18 @@
 #include "morton_front.h"
 #include "plugin_options.h"
 
-static const bvhlab_option_decl options[] = {
-	{ .name = "radius", .type = BVHLAB_OPTION_INT,
-	  .help = "search radius: clusters on either side, in Morton order, that each "
-	          "cluster compares with",
-	  .def_int = 16, .min = 1, .max = CL_PLOC_MAX_RADIUS },
-	MORTON_OPTION_DECLS,
-	CL_DEVICE_OPTION_DECL,
-	{ .name = "nn_block", .type = BVHLAB_OPTION_INT,
-	  .help = "clusters per work-item of the nearest-neighbour search (0: 256 on a CPU "
-	          "device, 1 on a GPU); the tree is the same for every value",
-	  .def_int = 0, .min = 0, .max = CL_PLOC_MAX_NN_BLOCK },
+static const plugin_option options[] = {
+	PLUGIN_OPTION(cl_ploc, radius, U32, .name = "radius",
+	              .help = "search radius: clusters on either side, in Morton order, that "
+	                      "each cluster compares with",
+	              .def_int = 16, .min = 1, .max = CL_PLOC_MAX_RADIUS),
+	MORTON_OPTIONS(cl_ploc, bits),
+	CL_DEVICE_OPTION(cl_ploc),
+	PLUGIN_OPTION(cl_ploc, nn_block, U32, .name = "nn_block",
+	              .help = "clusters per work-item of the nearest-neighbour search (0: 256 "
+	                      "on a CPU device, 1 on a GPU); the tree is the same for every value",
+	              .def_int = 0, .min = 0, .max = CL_PLOC_MAX_NN_BLOCK),
 };
-
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
-/* Where the options go in the build's struct. */
-static const plugin_field fields[] = {
-	CL_BUILDER_FIELDS(cl_ploc),
-	PLUGIN_FIELD(cl_ploc, radius, "radius", U32),
-	PLUGIN_FIELD(cl_ploc, nn_block, "nn_block", U32),
-};
-
-#define FIELD_COUNT (sizeof(fields) / sizeof(fields[0]))
 
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "first_clusters", "nearest", "count_chunks", "prefix",
@@ -122,14 +111,14 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	              .b = S.b };
 	int rc;
 
-	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, fields, FIELD_COUNT,
+	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
 	                              &b)) < 0 ||
 	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
 		return rc < 0 ? rc : 0;
 	return run(host, ctx, &b, output);
 }
 
-BVHLAB_PLUGIN(.name = "cl_ploc", .flags = BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_WITH_OPTIONS(options, .name = "cl_ploc", .flags = BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "PLOC on an OpenCL device (Meister & Bittner 2018): the ploc plugin's tree, "
 	           "built by kernels",
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+	.build = build)

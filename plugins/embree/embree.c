@@ -34,28 +34,6 @@
 /* Embree's recursion depth limit; larger leaves are split before it. */
 #define MAX_DEPTH 64
 
-static const bvhlab_option_decl options[] = {
-	{.name = "quality", .type = BVHLAB_OPTION_STRING,
-	 .help = "low (Morton), medium (binned SAH) or high (SAH with spatial splits)",
-	 .def_string = "medium", .choices = "low|medium|high"},
-	{.name = "max_leaf", .type = BVHLAB_OPTION_INT,
-	 .help = "most primitives in a leaf (Embree allows up to 32)",
-	 .def_int = 8, .min = 1, .max = RTC_BUILD_MAX_PRIMITIVES_PER_LEAF},
-	{.name = "min_leaf", .type = BVHLAB_OPTION_INT,
-	 .help = "always a leaf at this size or below; low (Morton) makes every leaf this small",
-	 .def_int = 1, .min = 1, .max = RTC_BUILD_MAX_PRIMITIVES_PER_LEAF},
-	{.name = "c_trav", .type = BVHLAB_OPTION_FLOAT,
-	 .help = "SAH cost of traversing an inner node (Embree's traversalCost)",
-	 .def_float = 1.0, .min = 1e-6, .max = 1e6},
-	{.name = "c_isect", .type = BVHLAB_OPTION_FLOAT,
-	 .help = "SAH cost of intersecting one primitive (Embree's intersectionCost)",
-	 .def_float = 1.0, .min = 1e-6, .max = 1e6},
-	{.name = "split_factor", .type = BVHLAB_OPTION_FLOAT,
-	 .help = "high: room for references, in triangles (Embree's own default 1.2)",
-	 .def_float = 1.2, .min = 1.0, .max = 4.0},
-};
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
 /* The cached device; build() holds the lock throughout. */
 static struct {
 	pthread_mutex_t lock;
@@ -93,13 +71,29 @@ typedef struct settings {
 	double c_trav, c_isect, split_factor;
 } settings;
 
-static const plugin_field fields[] = {
-	PLUGIN_FIELD(settings, quality_choice, "quality", CHOICE),
-	PLUGIN_FIELD(settings, max_leaf, "max_leaf", I64),
-	PLUGIN_FIELD(settings, min_leaf, "min_leaf", I64),
-	PLUGIN_FIELD(settings, c_trav, "c_trav", DOUBLE),
-	PLUGIN_FIELD(settings, c_isect, "c_isect", DOUBLE),
-	PLUGIN_FIELD(settings, split_factor, "split_factor", DOUBLE),
+static const plugin_option options[] = {
+	PLUGIN_OPTION(settings, quality_choice, CHOICE, .name = "quality",
+	              .help = "low (Morton), medium (binned SAH) or high (SAH with spatial "
+	                      "splits)",
+	              .def_string = "medium", .choices = "low|medium|high"),
+	PLUGIN_OPTION(settings, max_leaf, I64, .name = "max_leaf",
+	              .help = "most primitives in a leaf (Embree allows up to 32)",
+	              .def_int = 8, .min = 1, .max = RTC_BUILD_MAX_PRIMITIVES_PER_LEAF),
+	PLUGIN_OPTION(settings, min_leaf, I64, .name = "min_leaf",
+	              .help = "always a leaf at this size or below; low (Morton) makes every "
+	                      "leaf this small",
+	              .def_int = 1, .min = 1, .max = RTC_BUILD_MAX_PRIMITIVES_PER_LEAF),
+	PLUGIN_OPTION(settings, c_trav, DOUBLE, .name = "c_trav",
+	              .help = "SAH cost of traversing an inner node (Embree's traversalCost)",
+	              .def_float = 1.0, .min = 1e-6, .max = 1e6),
+	PLUGIN_OPTION(settings, c_isect, DOUBLE, .name = "c_isect",
+	              .help = "SAH cost of intersecting one primitive (Embree's "
+	                      "intersectionCost)",
+	              .def_float = 1.0, .min = 1e-6, .max = 1e6),
+	PLUGIN_OPTION(settings, split_factor, DOUBLE, .name = "split_factor",
+	              .help = "high: room for references, in triangles (Embree's own default "
+	                      "1.2)",
+	              .def_float = 1.2, .min = 1.0, .max = 4.0),
 };
 
 static int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, settings *s)
@@ -107,8 +101,7 @@ static int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, setting
 	static const enum RTCBuildQuality quality[] = {
 		RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH,
 	};
-	int rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
-	                             sizeof(fields) / sizeof(fields[0]), s);
+	int rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), s);
 	if (rc < 0)
 		return rc;
 	/* What the declarations cannot say: one option bounded by another. */
@@ -229,7 +222,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return rc;
 }
 
-BVHLAB_PLUGIN(.name = "embree", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_SPATIAL_SPLITS,
+PLUGIN_WITH_OPTIONS(options, .name = "embree",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_SPATIAL_SPLITS,
 	.summary = "Intel Embree 3 rtcBuildBVH: low (Morton), "
 	           "medium (binned SAH), high (spatial splits)",
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+	.build = build)

@@ -10,17 +10,12 @@
 #include "morton_front.h"
 #include "sah_split.h"
 
-static const bvhlab_option_decl options[] = {
-	SAH_OPTION_DECLS,
-	{ .name = "cluster", .type = BVHLAB_OPTION_INT,
-	  .help = "most primitives in a Morton cluster: each is built whole by exact SAH, "
-	          "and the clusters are the primitives of the SAH top",
-	  .def_int = 32, .min = 2, .max = SAH_SMALL_MAX },
-};
-
-static const plugin_field fields[] = {
-	SAH_OPTION_FIELDS(hlbvh_options),
-	PLUGIN_FIELD(hlbvh_options, cluster, "cluster", U32),
+static const plugin_option options[] = {
+	SAH_OPTIONS(hlbvh_options),
+	PLUGIN_OPTION(hlbvh_options, cluster, U32, .name = "cluster",
+	              .help = "most primitives in a Morton cluster: each is built whole by exact "
+	                      "SAH, and the clusters are the primitives of the SAH top",
+	              .def_int = 32, .min = 2, .max = SAH_SMALL_MAX),
 };
 
 /* ---- scratch ------------------------------------------------------------ */
@@ -163,8 +158,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = plugin_options_fill(host, ctx, options, sizeof(options) / sizeof(options[0]),
-	                              fields, sizeof(fields) / sizeof(fields[0]), &h.opt)) < 0 ||
+	if ((rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
+	                              &h.opt)) < 0 ||
 	    (rc = sah_options_resolve(host, ctx, &h.opt.sah)) < 0 ||
 	    (rc = morton_ensure_capacity(host, ctx, h.n, spare_nodes(h.n), output)) < 0)
 		return rc;
@@ -175,8 +170,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return build_team(host, ctx, &h);
 }
 
-BVHLAB_PLUGIN(.name = "hlbvh", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_WITH_OPTIONS(options, .name = "hlbvh",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "SAH over Morton clusters (HLBVH, Garanzha et al. 2011): each cluster "
 	           "built whole by exact SAH, the SAH top over the clusters",
-	.option_count = sizeof(options) / sizeof(options[0]), .options = options,
 	.build = build)

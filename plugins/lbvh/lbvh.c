@@ -12,16 +12,7 @@
 #include "lbvh.h"
 #include "morton_front.h"
 
-static const bvhlab_option_decl options[] = { MORTON_OPTION_DECLS };
-
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
-/* Where the options go in the build's struct. */
-static const plugin_field fields[] = {
-	MORTON_FIELDS(lbvh, bits),
-};
-
-#define FIELD_COUNT (sizeof(fields) / sizeof(fields[0]))
+static const plugin_option options[] = { MORTON_OPTIONS(lbvh, bits) };
 
 /* Nodes past the tree's 2n - 1 that hold the hierarchy's scratch (see
  * scratch_alloc()); 0 when that would not fit a uint32_t count. */
@@ -166,7 +157,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, fields, FIELD_COUNT,
+	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
 	                              &b)) < 0 ||
 	    (rc = ensure_capacity(host, ctx, &b, output)) < 0)
 		return rc;
@@ -179,6 +170,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return build_team(host, ctx, &b, output);
 }
 
-BVHLAB_PLUGIN(.name = "lbvh", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_WITH_OPTIONS(options, .name = "lbvh",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "parallel LBVH: Morton codes, radix sort, Karras 2012 emission, SAH collapse",
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+	.build = build)

@@ -13,23 +13,13 @@
 #include "ploc.h"
 #include "plugin_options.h"
 
-static const bvhlab_option_decl options[] = {
-	{ .name = "radius", .type = BVHLAB_OPTION_INT,
-	  .help = "search radius: clusters on either side, in Morton order, that each "
-	          "cluster compares with",
-	  .def_int = 16, .min = 1, .max = PLOC_MAX_RADIUS },
-	MORTON_OPTION_DECLS,
+static const plugin_option options[] = {
+	PLUGIN_OPTION(ploc, radius, U32, .name = "radius",
+	              .help = "search radius: clusters on either side, in Morton order, that "
+	                      "each cluster compares with",
+	              .def_int = 16, .min = 1, .max = PLOC_MAX_RADIUS),
+	MORTON_OPTIONS(ploc, sort.bits),
 };
-
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
-/* Where the options go in the build's struct. */
-static const plugin_field fields[] = {
-	PLUGIN_FIELD(ploc, radius, "radius", U32),
-	MORTON_FIELDS(ploc, sort.bits),
-};
-
-#define FIELD_COUNT (sizeof(fields) / sizeof(fields[0]))
 
 /* ---- scratch ------------------------------------------------------------ */
 
@@ -194,7 +184,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = morton_options_fill(host, ctx, options, OPTION_COUNT, fields, FIELD_COUNT,
+	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
 	                              &p)) < 0 ||
 	    (rc = morton_ensure_capacity(host, ctx, p.n, spare_nodes(p.n), output)) < 0)
 		return rc;
@@ -205,7 +195,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return build_team(host, ctx, &p, output);
 }
 
-BVHLAB_PLUGIN(.name = "ploc", .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_WITH_OPTIONS(options, .name = "ploc",
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "parallel locally-ordered clustering (Meister & Bittner 2018) from Morton "
 	           "order, SAH collapse",
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+	.build = build)

@@ -10,35 +10,6 @@
 #include "plugin_options.h"
 #include "reinsert.h"
 
-static const bvhlab_option_decl options[] = {
-	{ .name = "batch", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "fraction of the nodes, those that hold their children worst (Bittner et "
-	          "al.'s measure), searched for a better place in each iteration",
-	  .def_float = 0.05, .min = 1e-6, .max = 1.0 },
-	{ .name = "iterations", .type = BVHLAB_OPTION_INT,
-	  .help = "most iterations (candidates chosen anew in each)",
-	  .def_int = 8, .min = 1, .max = 1000 },
-	{ .name = "min_gain", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "stop after an iteration that lowers the SAH by less than this fraction "
-	          "of it (0: run every iteration)",
-	  .def_float = 0.001, .min = 0.0, .max = 1.0 },
-	{ .name = "measure", .type = BVHLAB_OPTION_STRING,
-	  .help = "which nodes a batch takes: bittner (those that hold their children worst, "
-	          "Bittner et al.'s measure) or area (the largest, as madmann91/bvh's "
-	          "reinsertion optimiser: the top of the tree first)",
-	  .def_string = "bittner", .choices = "bittner|area" },
-	{ .name = "children", .type = BVHLAB_OPTION_BOOL,
-	  .help = "also try Bittner et al.'s move for each inner candidate: take it and its "
-	          "parent out and put its two children back apart, where each costs least",
-	  .def_bool = true },
-	LEAVES_OPTION_DECLS,
-	{ .name = "max_visits", .type = BVHLAB_OPTION_INT,
-	  .help = "most nodes one candidate's search may look at",
-	  .def_int = 4096, .min = 16, .max = 1 << 24 },
-};
-
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
 struct params {
 	double batch, min_gain;
 	int64_t iterations, max_visits, max_leaf;
@@ -46,22 +17,34 @@ struct params {
 	bool leaves, children;
 };
 
-static const plugin_field fields[] = {
-	PLUGIN_FIELD(struct params, batch, "batch", DOUBLE),
-	PLUGIN_FIELD(struct params, iterations, "iterations", I64),
-	PLUGIN_FIELD(struct params, min_gain, "min_gain", DOUBLE),
-	PLUGIN_FIELD(struct params, max_visits, "max_visits", I64),
-	PLUGIN_FIELD(struct params, leaves, "leaves", BOOL),
-	PLUGIN_FIELD(struct params, children, "children", BOOL),
-	PLUGIN_FIELD(struct params, measure, "measure", CHOICE),
-	PLUGIN_FIELD(struct params, max_leaf, "max_leaf", I64),
+static const plugin_option options[] = {
+	PLUGIN_OPTION(struct params, batch, DOUBLE, .name = "batch",
+	              .help = "fraction of the nodes (chosen by measure) searched for a better "
+	                      "place in each iteration",
+	              .def_float = 0.05, .min = 1e-6, .max = 1.0),
+	PLUGIN_OPTION(struct params, iterations, I64, .name = "iterations",
+	              .help = "most iterations (candidates chosen anew in each)",
+	              .def_int = 8, .min = 1, .max = 1000),
+	PLUGIN_OPTION(struct params, min_gain, DOUBLE, .name = "min_gain",
+	              .help = "stop after an iteration that lowers the SAH by less than this "
+	                      "fraction of it (0: run every iteration)",
+	              .def_float = 0.001, .min = 0.0, .max = 1.0),
+	PLUGIN_OPTION(struct params, measure, CHOICE, .name = "measure",
+	              .help = "which nodes a batch takes: bittner (those that hold their "
+	                      "children worst, Bittner et al.'s measure) or area (the largest, "
+	                      "as madmann91/bvh's reinsertion optimiser: the top of the tree "
+	                      "first)",
+	              .def_string = "bittner", .choices = "bittner|area"),
+	PLUGIN_OPTION(struct params, children, BOOL, .name = "children",
+	              .help = "also try Bittner et al.'s move for each inner candidate: take it "
+	                      "and its parent out and put its two children back apart, where "
+	                      "each costs least",
+	              .def_bool = true),
+	LEAVES_OPTIONS(struct params),
+	PLUGIN_OPTION(struct params, max_visits, I64, .name = "max_visits",
+	              .help = "most nodes one candidate's search may look at",
+	              .def_int = 4096, .min = 16, .max = 1 << 24),
 };
-
-static int read_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, struct params *o)
-{
-	return plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
-	                           sizeof(fields) / sizeof(fields[0]), o);
-}
 
 /* ---- candidates --------------------------------------------------------- */
 
@@ -283,19 +266,17 @@ static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	struct stage st = { .host = host, .ctx = ctx, .o = &o, .input = input };
 	int rc;
 
-	if ((rc = read_options(host, ctx, &o)) < 0)
+	if ((rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), &o)) < 0)
 		return rc;
 	if (tree->node_count < 3 && !(o.leaves && tree->node_count == 1 && tree->nodes[0].count > 1))
 		return 0; /* nothing can move */
 	return leaves_run(host, ctx, input, tree, o.leaves, false, (uint32_t)o.max_leaf, stage, &st);
 }
 
-BVHLAB_PLUGIN(
+PLUGIN_WITH_OPTIONS(options,
 	.name = "reinsert",
 	.summary = "refinement: parallel search, exact one-thread application of subtree "
 	           "reinsertions (Bittner et al. 2013, Meister & Bittner 2018)",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.option_count = OPTION_COUNT,
-	.options = options,
 	.build = NULL,
 	.refine = refine)

@@ -6,7 +6,7 @@
  *
  * Use:
  *     sah_options opt;  sah_builder b;  sah_job root;
- *     plugin_options_fill(..., &opt);  (SAH_OPTION_FIELDS, then
+ *     plugin_options_fill(..., &opt);  (a table holding SAH_OPTIONS), then
  *     sah_options_resolve(host, ctx, &opt.sah);
  *     sah_builder_init(&b, &opt, input, output);    (allocates, presorts)
  *     sah_builder_root(&b, &root);
@@ -69,53 +69,44 @@
 #include "sah_types.h"
 
 /*
- * The option declarations of the kernel, to put first into a plugin's
- * option array: static const bvhlab_option_decl o[] = { SAH_OPTION_DECLS,
- * { ...the plugin's own... } }; SAH_OPTION_COUNT of them.
+ * The kernel's options (plugin_options.h), each with its field in the
+ * sah_options member `sah` of a plugin's option struct `owner`, to put
+ * first into the plugin's table:
+ *     static const plugin_option o[] = { SAH_OPTIONS(owner), ...the plugin's own... };
+ * A plugin with its own `method` (sah_tasks) takes the groups below it.
  */
-#define SAH_OPTION_DECLS \
-	{ .name = "method", .type = BVHLAB_OPTION_STRING, \
-	  .help = "split search: sweep (exact SAH, presorted) or binned", \
-	  .def_string = "sweep", .choices = "sweep|binned" }, \
-	{ .name = "bins", .type = BVHLAB_OPTION_INT, \
-	  .help = "bins per axis for method binned", \
-	  .def_int = 32, .min = 2, .max = SAH_MAX_BINS }, \
-	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT, \
-	  .help = "most primitives in a leaf (unless all their centroids coincide)", \
-	  .def_int = 8, .min = 1, .max = 64 }, \
-	{ .name = "c_trav", .type = BVHLAB_OPTION_FLOAT, \
-	  .help = "SAH cost of traversing an inner node (> 0)", \
-	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }, \
-	{ .name = "c_isect", .type = BVHLAB_OPTION_FLOAT, \
-	  .help = "SAH cost of intersecting one primitive (> 0)", \
-	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }, \
-	SAH_SIMD_DECL, \
-	SAH_QUALITY_DECL
-#define SAH_OPTION_COUNT 7
-/* Last, so that plugins with their own copy of the others can add them. */
-#define SAH_QUALITY_DECL \
-	{ .name = "quality", .type = BVHLAB_OPTION_STRING, \
-	  .help = "high (every axis, exact SAH on small jobs) or fast (the longest " \
-	          "centroid axis only: a cheaper search, a slightly worse tree)", \
-	  .def_string = "high", .choices = "high|fast" }
-#define SAH_SIMD_DECL \
-	{ .name = "simd", .type = BVHLAB_OPTION_STRING, \
-	  .help = "binning vectors: auto (avx2 where the CPU has it), avx2 or sse; " \
-	          "the tree is the same", \
-	  .def_string = "auto", .choices = "auto|avx2|sse" }
+#define SAH_OPTIONS(owner)                                                            \
+	PLUGIN_OPTION(owner, sah.method, CHOICE, .name = "method",                    \
+	              .help = "split search: sweep (exact SAH, presorted) or binned", \
+	              .def_string = "sweep", .choices = "sweep|binned"),              \
+	SAH_SPLIT_OPTIONS(owner), SAH_SIMD_OPTION(owner), SAH_QUALITY_OPTION(owner)
 
-/*
- * Where SAH_OPTION_DECLS go (plugin_options.h): into the sah_options
- * member `sah` of a plugin's option struct `type`.
- */
-#define SAH_OPTION_FIELDS(type) \
-	PLUGIN_FIELD(type, sah.method, "method", CHOICE), \
-	PLUGIN_FIELD(type, sah.bins, "bins", U32), \
-	PLUGIN_FIELD(type, sah.max_leaf, "max_leaf", U32), \
-	PLUGIN_FIELD(type, sah.c_trav, "c_trav", FLOAT), \
-	PLUGIN_FIELD(type, sah.c_isect, "c_isect", FLOAT), \
-	PLUGIN_FIELD(type, sah.simd_asked, "simd", CHOICE), \
-	PLUGIN_FIELD(type, sah.quality, "quality", CHOICE)
+/* The split rule's parameters. */
+#define SAH_SPLIT_OPTIONS(owner)                                                                 \
+	PLUGIN_OPTION(owner, sah.bins, U32, .name = "bins",                                      \
+	              .help = "bins per axis for method binned",                                 \
+	              .def_int = 32, .min = 2, .max = SAH_MAX_BINS),                             \
+	PLUGIN_OPTION(owner, sah.max_leaf, U32, .name = "max_leaf",                              \
+	              .help = "most primitives in a leaf (unless all their centroids coincide)", \
+	              .def_int = 8, .min = 1, .max = 64),                                        \
+	PLUGIN_OPTION(owner, sah.c_trav, FLOAT, .name = "c_trav",                                \
+	              .help = "SAH cost of traversing an inner node (> 0)",                      \
+	              .def_float = 1.0, .min = 1e-6, .max = 1e6),                                \
+	PLUGIN_OPTION(owner, sah.c_isect, FLOAT, .name = "c_isect",                              \
+	              .help = "SAH cost of intersecting one primitive (> 0)",                    \
+	              .def_float = 1.0, .min = 1e-6, .max = 1e6)
+
+#define SAH_SIMD_OPTION(owner)                                                                   \
+	PLUGIN_OPTION(owner, sah.simd_asked, CHOICE, .name = "simd",                             \
+	              .help = "binning vectors: auto (avx2 where the CPU has it), avx2 or sse; " \
+	                      "the tree is the same",                                            \
+	              .def_string = "auto", .choices = "auto|avx2|sse")
+
+#define SAH_QUALITY_OPTION(owner)                                                                \
+	PLUGIN_OPTION(owner, sah.quality, CHOICE, .name = "quality",                             \
+	              .help = "high (every axis, exact SAH on small jobs) or fast (the longest " \
+	                      "centroid axis only: a cheaper search, a slightly worse tree)",    \
+	              .def_string = "high", .choices = "high|fast")
 
 /*
  * Decides opt->simd from opt->simd_asked, the one thing about the options

@@ -31,20 +31,6 @@
 
 #define AUTO_QUEUE_FROM 500000u
 
-static const bvhlab_option_decl options[] = {
-	SAH_OPTION_DECLS,
-	{ .name = "policy", .type = BVHLAB_OPTION_STRING,
-	  .help = "when to stop queueing: queue2t (queue below 2T jobs), depth, or "
-	          "auto (depth under 500K primitives, else queue2t)",
-	  .def_string = "auto", .choices = "queue2t|depth|auto" },
-	{ .name = "depth", .type = BVHLAB_OPTION_INT,
-	  .help = "policy depth: deepest queued node (root 0); deeper subtrees are built whole",
-	  .def_int = 4, .min = 0, .max = 30 },
-	{ .name = "min_job", .type = BVHLAB_OPTION_INT,
-	  .help = "jobs with fewer primitives are never queued, whatever the policy",
-	  .def_int = 1024, .min = 1, .max = 1 << 30 },
-};
-
 /* The choices of option policy, in order. */
 enum policy { POLICY_QUEUE2T, POLICY_DEPTH, POLICY_AUTO };
 
@@ -53,6 +39,21 @@ struct queue_config {
 	sah_options sah;
 	int policy;
 	uint32_t depth, min_job;
+};
+
+static const plugin_option options[] = {
+	SAH_OPTIONS(struct queue_config),
+	PLUGIN_OPTION(struct queue_config, policy, CHOICE, .name = "policy",
+	              .help = "when to stop queueing: queue2t (queue below 2T jobs), depth, or "
+	                      "auto (depth under 500K primitives, else queue2t)",
+	              .def_string = "auto", .choices = "queue2t|depth|auto"),
+	PLUGIN_OPTION(struct queue_config, depth, U32, .name = "depth",
+	              .help = "policy depth: deepest queued node (root 0); deeper subtrees are "
+	                      "built whole",
+	              .def_int = 4, .min = 0, .max = 30),
+	PLUGIN_OPTION(struct queue_config, min_job, U32, .name = "min_job",
+	              .help = "jobs with fewer primitives are never queued, whatever the policy",
+	              .def_int = 1024, .min = 1, .max = 1 << 30),
 };
 
 /* The shared queue: a max-heap by primitive count, so idle workers get
@@ -272,13 +273,6 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 	queue_destroy(&q);
 	return 0;
 }
-
-static const plugin_field fields[] = {
-	SAH_OPTION_FIELDS(struct queue_config),
-	PLUGIN_FIELD(struct queue_config, policy, "policy", CHOICE),
-	PLUGIN_FIELD(struct queue_config, depth, "depth", U32),
-	PLUGIN_FIELD(struct queue_config, min_job, "min_job", U32),
-};
 
 SAH_PLUGIN("sah_queue", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	"parallel SAH, thesis node queue: workers share a job queue, exact termination",

@@ -34,41 +34,32 @@
 #include "tasks_split.h"
 #include "team.h"
 
-/* SAH_OPTION_DECLS in the same order, but binned by default: the team
- * split exists for binned only. */
-static const bvhlab_option_decl options[] = {
-	{ .name = "method", .type = BVHLAB_OPTION_STRING,
-	  .help = "split search: binned (team-parallel top splits) or sweep (exact SAH, "
-	          "top splits on one thread)",
-	  .def_string = "binned", .choices = "sweep|binned" },
-	{ .name = "bins", .type = BVHLAB_OPTION_INT, .help = "bins per axis for method binned",
-	  .def_int = 32, .min = 2, .max = SAH_MAX_BINS },
-	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,
-	  .help = "most primitives in a leaf (unless all their centroids coincide)",
-	  .def_int = 8, .min = 1, .max = 64 },
-	{ .name = "c_trav", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "SAH cost of traversing an inner node (> 0)",
-	  .def_float = 1.0, .min = 1e-6, .max = 1e6 },
-	{ .name = "c_isect", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "SAH cost of intersecting one primitive (> 0)",
-	  .def_float = 1.0, .min = 1e-6, .max = 1e6 },
-	{ .name = "parallel_min", .type = BVHLAB_OPTION_INT,
-	  .help = "nodes with more primitives are split by all threads together; "
-	          "smaller ones are tasks built by one thread each",
-	  .def_int = 65536, .min = 128, .max = 1 << 30 },
-	SAH_SIMD_DECL,
-	SAH_QUALITY_DECL,
-	{ .name = "sample", .type = BVHLAB_OPTION_INT,
-	  .help = "0: bin every primitive; else a node of over 4 * sample primitives "
-	          "bins `sample` of them, evenly spaced (fewer passes' worth of binning "
-	          "at the top, a slightly worse tree; same for every thread count)",
-	  .def_int = 0, .min = 0, .max = SAH_MAX_SAMPLE },
-};
-
 /* Where the options go. */
 struct tasks_options {
 	sah_options sah;
 	uint32_t parallel_min;
+};
+
+/* SAH_OPTIONS in the same order, parallel_min among them, but binned by
+ * default: the team split exists for binned only. */
+static const plugin_option options[] = {
+	PLUGIN_OPTION(struct tasks_options, sah.method, CHOICE, .name = "method",
+	              .help = "split search: binned (team-parallel top splits) or sweep (exact "
+	                      "SAH, top splits on one thread)",
+	              .def_string = "binned", .choices = "sweep|binned"),
+	SAH_SPLIT_OPTIONS(struct tasks_options),
+	PLUGIN_OPTION(struct tasks_options, parallel_min, U32, .name = "parallel_min",
+	              .help = "nodes with more primitives are split by all threads together; "
+	                      "smaller ones are tasks built by one thread each",
+	              .def_int = 65536, .min = 128, .max = 1 << 30),
+	SAH_SIMD_OPTION(struct tasks_options),
+	SAH_QUALITY_OPTION(struct tasks_options),
+	PLUGIN_OPTION(struct tasks_options, sah.sample, U32, .name = "sample",
+	              .help = "0: bin every primitive; else a node of over 4 * sample primitives "
+	                      "bins `sample` of them, evenly spaced (fewer passes' worth of "
+	                      "binning at the top, a slightly worse tree; same for every thread "
+	                      "count)",
+	              .def_int = 0, .min = 0, .max = SAH_MAX_SAMPLE),
 };
 
 /* A node larger than 64 (the most max_leaf allows) is never a leaf, which
@@ -281,12 +272,6 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 		th->host->set_error(th->ctx, "sah_tasks: cannot set up the build (%d)", rc);
 	return rc;
 }
-
-static const plugin_field fields[] = {
-	SAH_OPTION_FIELDS(struct tasks_options),
-	PLUGIN_FIELD(struct tasks_options, parallel_min, "parallel_min", U32),
-	PLUGIN_FIELD(struct tasks_options, sah.sample, "sample", U32),
-};
 
 SAH_PLUGIN("sah_tasks", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	"parallel binned SAH: large nodes split by all threads, small ones as tasks",

@@ -6,7 +6,7 @@
  * kernel needs.
  *
  * The frame does the checks, resolves the options the plugin filled
- * (SAH_OPTION_FIELDS), ensures the output
+ * (SAH_OPTIONS), ensures the output
  * capacity, sets the kernel up and tears it down, and hands the root job to
  * the scheduler, which
  * must have processed every job of the tree, with every thread it started
@@ -31,7 +31,7 @@ typedef int (*sah_scheduler_fn)(team_host *th, sah_builder *b, const sah_job *ro
                                 uint32_t threads, void *arg);
 
 /* The whole build() of a SAH plugin around `schedule`, with the options
- * as filled from SAH_OPTION_FIELDS: 0, or a negative errno after
+ * as filled from SAH_OPTIONS: 0, or a negative errno after
  * host->set_error. */
 int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *output,
@@ -39,24 +39,22 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 
 /*
  * build() and the entry point of a SAH plugin, at file scope after its
- * `options` (declarations), `fields` (where they go, plugin_options.h) and
+ * `options` (a plugin_option table holding SAH_OPTIONS or its groups) and
  * `schedule`: the options fill a `struct options_type`, whose first member
  * is `sah_options sah`, and the schedule gets that struct as its argument.
  */
-#define SAH_PLUGIN(plugin_name, plugin_flags, plugin_summary, options_type)                \
-	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,                   \
-	                 const bvhlab_build_input *input, bvhlab_build_output *output)     \
-	{                                                                                  \
-		options_type o = { 0 };                                                    \
-		int rc = plugin_options_fill(host, ctx, options,                           \
-		                             sizeof(options) / sizeof(options[0]), fields,  \
-		                             sizeof(fields) / sizeof(fields[0]), &o);      \
-		return rc < 0 ? rc : sah_run_build(host, ctx, input, output, &o.sah,       \
-		                                   schedule, &o);                          \
-	}                                                                                  \
-	BVHLAB_PLUGIN(.name = plugin_name, .flags = plugin_flags, .summary = plugin_summary, \
-	              .option_count = sizeof(options) / sizeof(options[0]),                \
-	              .options = options, .build = build)
+#define SAH_PLUGIN(plugin_name, plugin_flags, plugin_summary, options_type)            \
+	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,               \
+	                 const bvhlab_build_input *input, bvhlab_build_output *output) \
+	{                                                                              \
+		options_type o = { 0 };                                                \
+		int rc = plugin_options_fill(host, ctx, options,                       \
+		                             PLUGIN_OPTION_COUNT(options), &o);        \
+		return rc < 0 ? rc : sah_run_build(host, ctx, input, output, &o.sah,   \
+		                                   schedule, &o);                      \
+	}                                                                              \
+	PLUGIN_WITH_OPTIONS(options, .name = plugin_name, .flags = plugin_flags,       \
+	                    .summary = plugin_summary, .build = build)
 
 /* The option struct of a plugin with the shared options only. */
 struct sah_plain_options {
@@ -65,11 +63,8 @@ struct sah_plain_options {
 
 /* SAH_PLUGIN for a plugin with the shared options only (its schedule's
  * argument is then of no use to it). */
-#define SAH_PLAIN_PLUGIN(plugin_name, plugin_flags, plugin_summary)                      \
-	static const bvhlab_option_decl options[] = { SAH_OPTION_DECLS };                  \
-	static const plugin_field fields[] = { SAH_OPTION_FIELDS(struct sah_plain_options) }; \
-	_Static_assert(sizeof(options) / sizeof(options[0]) == SAH_OPTION_COUNT,           \
-	               "SAH_OPTION_COUNT matches SAH_OPTION_DECLS");                       \
+#define SAH_PLAIN_PLUGIN(plugin_name, plugin_flags, plugin_summary)                       \
+	static const plugin_option options[] = { SAH_OPTIONS(struct sah_plain_options) }; \
 	SAH_PLUGIN(plugin_name, plugin_flags, plugin_summary, struct sah_plain_options)
 
 /* A job built whole by sah_build_subtree on a thread of its own. */

@@ -26,49 +26,40 @@
 #include "plugin_options.h"
 #include "sbvh.h"
 
-static const bvhlab_option_decl options[] = {
-	{ .name = "split_factor", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "most references, in triangles: room for spatial splits' duplicates",
-	  .def_float = 1.3, .min = 1.0, .max = 8.0 },
-	{ .name = "alpha", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "try spatial splits where the object split's children overlap by more "
-	          "than alpha * root area (Stich's alpha; 1 turns them off)",
-	  .def_float = 1e-5, .min = 0.0, .max = 1.0 },
-	{ .name = "overlap", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "try spatial splits only where those children also overlap by at least "
-	          "this share of the node's own area (0: alpha alone)",
-	  .def_float = 0.1, .min = 0.0, .max = 1.0 },
-	{ .name = "bins", .type = BVHLAB_OPTION_INT,
-	  .help = "object and spatial bins per axis",
-	  .def_int = 32, .min = 2, .max = SBVH_MAX_BINS },
-	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,
-	  .help = "most references in a leaf", .def_int = 8, .min = 1, .max = SBVH_MAX_LEAF },
-	{ .name = "parallel_min", .type = BVHLAB_OPTION_INT,
-	  .help = "nodes of at least this many references are split by all threads "
-	          "together; smaller ones are built as one-thread tasks",
-	  .def_int = 32768, .min = 2, .max = UINT32_MAX },
-	{ .name = "presplit", .type = BVHLAB_OPTION_FLOAT,
-	  .help = "share of the budget's room spent before the build cutting the references "
-	          "with the largest boxes in two (early split clipping); the rest is left "
-	          "to spatial splits",
-	  .def_float = 0.0, .min = 0.0, .max = 1.0 },
-	{ .name = "lookahead", .type = BVHLAB_OPTION_INT,
-	  .help = "nodes of at least this many references (and split by all threads "
-	          "together) also take a spatial split that the greedy SAH turns down when "
-	          "its children, split once more, cost less than the object split's",
-	  .def_int = 65536, .min = 2, .max = UINT32_MAX },
-};
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
-static const plugin_field fields[] = {
-	PLUGIN_FIELD(sbvh_options, split_factor, "split_factor", DOUBLE),
-	PLUGIN_FIELD(sbvh_options, alpha, "alpha", DOUBLE),
-	PLUGIN_FIELD(sbvh_options, overlap, "overlap", DOUBLE),
-	PLUGIN_FIELD(sbvh_options, bins, "bins", U32),
-	PLUGIN_FIELD(sbvh_options, max_leaf, "max_leaf", U32),
-	PLUGIN_FIELD(sbvh_options, parallel_min, "parallel_min", U32),
-	PLUGIN_FIELD(sbvh_options, presplit, "presplit", DOUBLE),
-	PLUGIN_FIELD(sbvh_options, lookahead, "lookahead", U32),
+static const plugin_option options[] = {
+	PLUGIN_OPTION(sbvh_options, split_factor, DOUBLE, .name = "split_factor",
+	              .help = "most references, in triangles: room for spatial splits' "
+	                      "duplicates",
+	              .def_float = 1.3, .min = 1.0, .max = 8.0),
+	PLUGIN_OPTION(sbvh_options, alpha, DOUBLE, .name = "alpha",
+	              .help = "try spatial splits where the object split's children overlap by "
+	                      "more than alpha * root area (Stich's alpha; 1 turns them off)",
+	              .def_float = 1e-5, .min = 0.0, .max = 1.0),
+	PLUGIN_OPTION(sbvh_options, overlap, DOUBLE, .name = "overlap",
+	              .help = "try spatial splits only where those children also overlap by at "
+	                      "least this share of the node's own area (0: alpha alone)",
+	              .def_float = 0.1, .min = 0.0, .max = 1.0),
+	PLUGIN_OPTION(sbvh_options, bins, U32, .name = "bins",
+	              .help = "object and spatial bins per axis",
+	              .def_int = 32, .min = 2, .max = SBVH_MAX_BINS),
+	PLUGIN_OPTION(sbvh_options, max_leaf, U32, .name = "max_leaf",
+	              .help = "most references in a leaf",
+	              .def_int = 8, .min = 1, .max = SBVH_MAX_LEAF),
+	PLUGIN_OPTION(sbvh_options, parallel_min, U32, .name = "parallel_min",
+	              .help = "nodes of at least this many references are split by all threads "
+	                      "together; smaller ones are built as one-thread tasks",
+	              .def_int = 32768, .min = 2, .max = UINT32_MAX),
+	PLUGIN_OPTION(sbvh_options, presplit, DOUBLE, .name = "presplit",
+	              .help = "share of the budget's room spent before the build cutting the "
+	                      "references with the largest boxes in two (early split clipping); "
+	                      "the rest is left to spatial splits",
+	              .def_float = 0.0, .min = 0.0, .max = 1.0),
+	PLUGIN_OPTION(sbvh_options, lookahead, U32, .name = "lookahead",
+	              .help = "nodes of at least this many references (and split by all threads "
+	                      "together) also take a spatial split that the greedy SAH turns "
+	                      "down when its children, split once more, cost less than the "
+	                      "object split's",
+	              .def_int = 65536, .min = 2, .max = UINT32_MAX),
 };
 
 /* Room for the whole budget: at most 2 * refs - 1 nodes and refs slots. */
@@ -119,8 +110,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	sbvh_build B = { .in = input, .threads = input->threads ? input->threads : 1 };
 	sbvh_job root;
 	double want;
-	int rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
-	                             sizeof(fields) / sizeof(fields[0]), &B.opt);
+	int rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), &B.opt);
 
 	if (rc < 0)
 		return rc;
@@ -171,9 +161,9 @@ out:
 	return rc;
 }
 
-BVHLAB_PLUGIN(.name = "sbvh",
+PLUGIN_WITH_OPTIONS(options, .name = "sbvh",
 	.summary = "SAH with object and spatial splits (Stich et al. 2009): exact triangle "
 	           "clipping, reference unsplitting, split_factor budget; parallel, deterministic",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
 	         BVHLAB_BUILDER_SPATIAL_SPLITS,
-	.option_count = OPTION_COUNT, .options = options, .build = build)
+	.build = build)

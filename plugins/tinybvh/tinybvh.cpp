@@ -42,27 +42,6 @@ using tinybvh::BVH;
 using tinybvh::bvhvec4;
 using clk = std::chrono::steady_clock;
 
-const bvhlab_option_decl options[] = {
-	// name, type, help, def_bool, def_int, def_float, def_string, min, max, choices
-	{"builder", BVHLAB_OPTION_STRING,
-	 "quick (BuildQuick, 1 thread), binned (Build), avx (BuildAVX), sweep (full-sweep SAH), "
-	 "hq (BuildHQ, spatial splits); threads: the caller's CPU affinity is narrowed to the "
-	 "run's count around the call (the threads tinybvh spawns inherit it), and at 1 thread "
-	 "its threaded path is off",
-	 false, 0, 0.0, "avx", 1, 0, "quick|binned|avx|sweep|hq"},
-	{"optimize", BVHLAB_OPTION_INT,
-	 "iterations of tinybvh's Optimize (reinsertion, one thread) after the build; 0: off",
-	 false, 0, 0.0, nullptr, 0, 1000, nullptr},
-	{"optimize_extreme", BVHLAB_OPTION_BOOL, "Optimize's 'extreme' mode (more candidates)",
-	 false, 0, 0.0, nullptr, 1, 0, nullptr},
-	{"c_trav", BVHLAB_OPTION_FLOAT, "SAH cost of a traversal step (tinybvh's c_trav)", false,
-	 0, 1.0, nullptr, 1e-6, 1e6, nullptr},
-	{"c_int", BVHLAB_OPTION_FLOAT, "SAH cost of a triangle test (tinybvh's c_int)", false, 0,
-	 1.0, nullptr, 1e-6, 1e6, nullptr},
-	{"hq_bins", BVHLAB_OPTION_INT, "hq: bins per axis for object and spatial splits", false,
-	 HQBVHBINS, 0.0, nullptr, 2, MAXHQBINS, nullptr},
-};
-
 // builder's choices, by index.
 enum Method { quick, binned, avx, sweep, hq };
 
@@ -73,15 +52,36 @@ struct Settings {
 	double c_trav = 1, c_int = 1;
 };
 
-// The options into Settings (plugin_options.h): the host has checked them.
-const plugin_field fields[] = {
-	PLUGIN_FIELD(Settings, method, "builder", CHOICE),
-	PLUGIN_FIELD(Settings, optimize, "optimize", I64),
-	PLUGIN_FIELD(Settings, extreme, "optimize_extreme", BOOL),
-	PLUGIN_FIELD(Settings, c_trav, "c_trav", DOUBLE),
-	PLUGIN_FIELD(Settings, c_int, "c_int", DOUBLE),
-	PLUGIN_FIELD(Settings, hq_bins, "hq_bins", I64),
+// The options and where they go (plugin_options.h): the host has checked them.
+const plugin_option options[] = {
+	PLUGIN_OPTION(Settings, method, CHOICE,
+	              bvhlab::string_option("builder",
+	                                    "quick (BuildQuick, 1 thread), binned (Build), avx "
+	                                    "(BuildAVX), sweep (full-sweep SAH), hq (BuildHQ, "
+	                                    "spatial splits); threads: the caller's CPU affinity "
+	                                    "is narrowed to the run's count around the call (the "
+	                                    "threads tinybvh spawns inherit it), and at 1 thread "
+	                                    "its threaded path is off",
+	                                    "avx", "quick|binned|avx|sweep|hq")),
+	PLUGIN_OPTION(Settings, optimize, I64,
+	              bvhlab::int_option("optimize",
+	                                 "iterations of tinybvh's Optimize (reinsertion, one "
+	                                 "thread) after the build; 0: off",
+	                                 0, 0, 1000)),
+	PLUGIN_OPTION(Settings, extreme, BOOL,
+	              bvhlab::bool_option("optimize_extreme",
+	                                  "Optimize's 'extreme' mode (more candidates)", false)),
+	PLUGIN_OPTION(Settings, c_trav, DOUBLE,
+	              bvhlab::float_option("c_trav", "SAH cost of a traversal step (tinybvh's "
+	                                   "c_trav)", 1.0, 1e-6, 1e6)),
+	PLUGIN_OPTION(Settings, c_int, DOUBLE,
+	              bvhlab::float_option("c_int", "SAH cost of a triangle test (tinybvh's c_int)",
+	                                   1.0, 1e-6, 1e6)),
+	PLUGIN_OPTION(Settings, hq_bins, I64,
+	              bvhlab::int_option("hq_bins", "hq: bins per axis for object and spatial "
+	                                 "splits", HQBVHBINS, 2, MAXHQBINS)),
 };
+PLUGIN_DECLS(options)
 
 // Three 16-byte vertices per triangle, in primitive order.
 std::unique_ptr<bvhvec4[]> soup(const bvhlab_build_input *in)
@@ -191,7 +191,7 @@ int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_inp
           bvhlab_build_output *out)
 {
 	Settings s;
-	int rc = plugin_options_fill(host, ctx, options, fields, s);
+	int rc = plugin_options_fill(host, ctx, options, s);
 	// tinybvh's counts are 32-bit and hq keeps 3 nodes per triangle.
 	if (rc == 0)
 		rc = peer::check_prims(host, ctx, in, UINT32_MAX / 8);
@@ -204,8 +204,8 @@ const bvhlab_builder descriptor = bvhlab::make_builder(
 	"jbikker/tinybvh 1.6.7: quick, binned, avx, sweep, hq (spatial splits), optional "
 	"Optimize; thread count held by CPU affinity (see the builder option)",
 	BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_SPATIAL_SPLITS,
-	options, bvhlab::guarded_build<build>);
+	plugin_decls, bvhlab::guarded_build<build>);
 
 } // namespace
 
-BVHLAB_PLUGIN_EXPORT(descriptor)
+PLUGIN_EXPORT(descriptor)

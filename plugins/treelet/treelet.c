@@ -9,19 +9,6 @@
 #include "plugin_options.h"
 #include "treelet.h"
 
-static const bvhlab_option_decl options[] = {
-	{ .name = "size", .type = BVHLAB_OPTION_INT,
-	  .help = "leaves of a treelet: every binary tree over them is tried (7, as Karras "
-	          "& Aila; 8 takes three times as long)",
-	  .def_int = 7, .min = 3, .max = TREELET_MAX },
-	{ .name = "rounds", .type = BVHLAB_OPTION_INT,
-	  .help = "most passes over every node (a pass that rewrites nothing ends it)",
-	  .def_int = 3, .min = 1, .max = 100 },
-	LEAVES_OPTION_DECLS,
-};
-
-#define OPTION_COUNT (sizeof(options) / sizeof(options[0]))
-
 /* Tasks: subtrees of at most this share of the nodes, so that two threads
  * get dozens each, but never tiny ones. */
 #define TASK_SHARE 256
@@ -110,11 +97,15 @@ out:
 	return rc;
 }
 
-static const plugin_field fields[] = {
-	PLUGIN_FIELD(struct params, size, "size", I64),
-	PLUGIN_FIELD(struct params, rounds, "rounds", I64),
-	PLUGIN_FIELD(struct params, leaves, "leaves", BOOL),
-	PLUGIN_FIELD(struct params, max_leaf, "max_leaf", I64),
+static const plugin_option options[] = {
+	PLUGIN_OPTION(struct params, size, I64, .name = "size",
+	              .help = "leaves of a treelet: every binary tree over them is tried (7, as "
+	                      "Karras & Aila; 8 takes three times as long)",
+	              .def_int = 7, .min = 3, .max = TREELET_MAX),
+	PLUGIN_OPTION(struct params, rounds, I64, .name = "rounds",
+	              .help = "most passes over every node (a pass that rewrites nothing ends it)",
+	              .def_int = 3, .min = 1, .max = 100),
+	LEAVES_OPTIONS(struct params),
 };
 
 static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
@@ -123,20 +114,17 @@ static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	struct params o = { .host = host, .ctx = ctx, .input = input };
 	int rc;
 
-	if ((rc = plugin_options_fill(host, ctx, options, OPTION_COUNT, fields,
-	                              sizeof(fields) / sizeof(fields[0]), &o)) < 0)
+	if ((rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), &o)) < 0)
 		return rc;
 	/* the costs assume the final cut, so it is made with or without splitting */
 	return leaves_run(host, ctx, input, tree, o.leaves, true, (uint32_t)o.max_leaf, optimise,
 	                  &o);
 }
 
-BVHLAB_PLUGIN(
+PLUGIN_WITH_OPTIONS(options,
 	.name = "treelet",
 	.summary = "refinement: every shape of small treelets tried by dynamic programming, "
 	           "the best kept (Karras & Aila 2013); parallel over subtrees, deterministic",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.option_count = OPTION_COUNT,
-	.options = options,
 	.build = NULL,
 	.refine = refine)

@@ -21,6 +21,8 @@
 #include <bvhlab/opencl.h>
 #include <bvhlab/builder.h>
 
+#include "plugin_options.h"
+
 /* Build option of every device builder's program where the device has
  * it: correctly rounded division and square root, as the CPU's. (The
  * kernels also turn contraction into fma off, by pragma; none divides
@@ -28,12 +30,14 @@
 #define CL_DEV_OPTIONS "-cl-fp32-correctly-rounded-divide-sqrt"
 #define CL_DEV_MAX_KERNELS 16
 
-/* The option every device builder has. */
-#define CL_DEVICE_OPTION_DECL                                                         \
-	{ .name = "device", .type = BVHLAB_OPTION_STRING,                              \
-	  .help = "OpenCL device: auto (the first GPU, else the first device), gpu, "   \
-	          "cpu, or P:D (platform and device indices, as clinfo -l lists them)", \
-	  .def_string = "auto" }
+/* The option every device builder has, in its table (plugin_options.h),
+ * into the member `device` (const char *) of its struct `owner`. */
+#define CL_DEVICE_OPTION(owner)                                                              \
+	PLUGIN_OPTION(owner, device, STRING, .name = "device",                               \
+	              .help = "OpenCL device: auto (the first GPU, else the first device), " \
+	                      "gpu, cpu, or P:D (platform and device indices, as clinfo -l " \
+	                      "lists them)",                                                 \
+	              .def_string = "auto")
 
 typedef struct cl_dev {
 	bvhlab_cl cl;
@@ -125,12 +129,6 @@ int cl_sort_run(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned bi
 
 /* ---- a build's start and phases (cl_build.c) ------------------------- */
 
-/* The fields (plugin_options.h) of the options every device builder has,
- * CL_DEVICE_OPTION_DECL and MORTON_OPTION_DECLS (morton_front.h), for its
- * struct `type` with a member of each option's name. */
-#define CL_BUILDER_FIELDS(type) \
-	PLUGIN_FIELD(type, device, "device", STRING), MORTON_FIELDS(type, bits)
-
 /* A device builder's program and the most primitives it builds over. */
 typedef struct cl_builder {
 	const char *src; /* morton_sort.cl, then the builder's kernels */
@@ -142,8 +140,8 @@ typedef struct cl_builder {
 
 /* The cl_builder of the program array `prog` (its length prog##_LEN, as
  * scripts/embed-cl.py writes it) and the array of kernel names `names`. */
-#define CL_BUILDER(prog, names, most)                                                    \
-	{ .src = prog, .len = prog##_LEN, .kernels = names,                                \
+#define CL_BUILDER(prog, names, most)                       \
+	{ .src = prog, .len = prog##_LEN, .kernels = names, \
 	  .kernel_count = sizeof(names) / sizeof(names[0]), .max_prims = most }
 
 /*

@@ -15,16 +15,19 @@
 
 #include <bvhlab/builder.h>
 
-/* The options `leaves` and `max_leaf`, in a stage's option array. */
-#define LEAVES_OPTION_DECLS                                                                 \
-	{ .name = "leaves", .type = BVHLAB_OPTION_BOOL,                                     \
-	  .help = "split leaves of several primitives first, so that their primitives can " \
-	          "be rearranged too, and cut the tree into leaves by the SAH afterwards "  \
-	          "(kept only if the SAH fell)",                                            \
-	  .def_bool = true },                                                               \
-	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,                                    \
-	  .help = "most primitives in a leaf of that final cut (8, as the builders)",       \
-	  .def_int = 8, .min = 1, .max = 64 }
+/* The options `leaves` and `max_leaf`, in a stage's table (plugin_options.h,
+ * which the stage includes), into the members `leaves` (bool) and
+ * `max_leaf` (int64_t) of its struct `owner`. */
+#define LEAVES_OPTIONS(owner)                                                             \
+	PLUGIN_OPTION(owner, leaves, BOOL, .name = "leaves",                              \
+	              .help = "split leaves of several primitives first, so that their "  \
+	                      "primitives can be rearranged too, and cut the tree into "  \
+	                      "leaves by the SAH afterwards (kept only if the SAH fell)", \
+	              .def_bool = true),                                                  \
+	PLUGIN_OPTION(owner, max_leaf, I64, .name = "max_leaf",                           \
+	              .help = "most primitives in a leaf of that final cut (8, as the "   \
+	                      "builders)",                                                \
+	              .def_int = 8, .min = 1, .max = 64)
 
 /* A stage's own work between the split and the cut: 0, or a negative
  * errno after host->set_error. */

@@ -13,17 +13,16 @@
 #define MIN_PRIMS_PER_THREAD 512
 
 int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                        const bvhlab_option_decl *decls, size_t decl_count,
-                        const plugin_field *fields, size_t field_count, void *out)
+                        const plugin_option *table, size_t count, void *out)
 {
-	int rc = plugin_options_fill(host, ctx, decls, decl_count, fields, field_count, out);
+	int rc = plugin_options_fill(host, ctx, table, count, out);
 
-	for (size_t k = 0; rc == 0 && k < field_count; k++) {
+	for (size_t k = 0; rc == 0 && k < count; k++) {
 		unsigned bits;
 
-		if (strcmp(fields[k].name, "bits") != 0)
+		if (strcmp(table[k].decl.name, "bits") != 0)
 			continue;
-		memcpy(&bits, (const char *)out + fields[k].offset, sizeof(bits));
+		memcpy(&bits, (const char *)out + table[k].offset, sizeof(bits));
 		if (bits != 30 && bits != 63) {
 			host->set_error(ctx, "option bits: %u, expected 30 or 63", bits);
 			rc = -EINVAL;

@@ -17,41 +17,33 @@
 #include "plugin_options.h"
 #include "team.h"
 
-/* The options of the code length and the SAH collapse, in an option array. */
-#define MORTON_OPTION_DECLS                                                                  \
-	{ .name = "bits", .type = BVHLAB_OPTION_INT,                                         \
-	  .help = "Morton code length: 30 (10 bits per axis) or 63 (21 bits per axis)",      \
-	  .def_int = 63, .min = 30, .max = 63 },                                             \
-	{ .name = "collapse", .type = BVHLAB_OPTION_BOOL,                                    \
-	  .help = "turn subtrees of at most max_leaf primitives into leaves where the SAH "  \
-	          "says a leaf is cheaper (off: one primitive per leaf)",                    \
-	  .def_bool = true },                                                                \
-	{ .name = "max_leaf", .type = BVHLAB_OPTION_INT,                                     \
-	  .help = "most primitives in a collapsed leaf (8, as the SAH builders)",            \
-	  .def_int = 8, .min = 1, .max = 64 },                                               \
-	{ .name = "c_trav", .type = BVHLAB_OPTION_FLOAT,                                     \
-	  .help = "SAH cost of traversing an inner node (> 0), for collapse",                \
-	  .def_float = 1.0, .min = 1e-6, .max = 1e6 },                                       \
-	{ .name = "c_isect", .type = BVHLAB_OPTION_FLOAT,                                    \
-	  .help = "SAH cost of intersecting one primitive (> 0), for collapse",              \
-	  .def_float = 1.0, .min = 1e-6, .max = 1e6 }
+/* The options of the code length and the SAH collapse, in a plugin's
+ * table (plugin_options.h), for its struct `owner`: the code length into
+ * `bits_member` (uint32_t), the rest into the members of their names. */
+#define MORTON_OPTIONS(owner, bits_member)                                                      \
+	PLUGIN_OPTION(owner, bits_member, U32, .name = "bits",                                  \
+	              .help = "Morton code length: 30 (10 bits per axis) or 63 (21 bits per "   \
+	                      "axis)",                                                          \
+	              .def_int = 63, .min = 30, .max = 63),                                     \
+	PLUGIN_OPTION(owner, collapse, BOOL, .name = "collapse",                                \
+	              .help = "turn subtrees of at most max_leaf primitives into leaves where " \
+	                      "the SAH says a leaf is cheaper (off: one primitive per leaf)",   \
+	              .def_bool = true),                                                        \
+	PLUGIN_OPTION(owner, max_leaf, U32, .name = "max_leaf",                                 \
+	              .help = "most primitives in a collapsed leaf (8, as the SAH builders)",   \
+	              .def_int = 8, .min = 1, .max = 64),                                       \
+	PLUGIN_OPTION(owner, c_trav, FLOAT, .name = "c_trav",                                   \
+	              .help = "SAH cost of traversing an inner node (> 0), for collapse",       \
+	              .def_float = 1.0, .min = 1e-6, .max = 1e6),                               \
+	PLUGIN_OPTION(owner, c_isect, FLOAT, .name = "c_isect",                                 \
+	              .help = "SAH cost of intersecting one primitive (> 0), for collapse",     \
+	              .def_float = 1.0, .min = 1e-6, .max = 1e6)
 
-/* The entries of MORTON_OPTION_DECLS in a plugin's table of fields
- * (plugin_options.h), for its struct `type`: the code length into
- * `bits_member` (unsigned), the rest into the members of their names. */
-#define MORTON_FIELDS(type, bits_member)                       \
-	PLUGIN_FIELD(type, bits_member, "bits", U32),          \
-	PLUGIN_FIELD(type, collapse, "collapse", BOOL),        \
-	PLUGIN_FIELD(type, max_leaf, "max_leaf", U32),         \
-	PLUGIN_FIELD(type, c_trav, "c_trav", FLOAT),           \
-	PLUGIN_FIELD(type, c_isect, "c_isect", FLOAT)
-
-/* plugin_options_fill() by a table holding MORTON_FIELDS, then what the
+/* plugin_options_fill() by a table holding MORTON_OPTIONS, then what the
  * declarations cannot say: bits 30 or 63. 0, or a negative errno after
  * host->set_error. */
 int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                        const bvhlab_option_decl *decls, size_t decl_count,
-                        const plugin_field *fields, size_t field_count, void *out);
+                        const plugin_option *table, size_t count, void *out);
 
 /* Monotonic clock in milliseconds, for the phase times in the debug log. */
 double morton_now_ms(void);

@@ -5,16 +5,8 @@
 
 #include "plugin_options.h"
 
-static const bvhlab_option_decl *find_decl(const bvhlab_option_decl *decls, size_t count,
-                                           const char *name)
-{
-	for (size_t k = 0; k < count; k++)
-		if (strcmp(decls[k].name, name) == 0)
-			return &decls[k];
-	return NULL;
-}
-
-/* The declared option type a field type is read from. */
+/* The declared option type a field type is read from (and, where an
+ * entry leaves it 0, declared as). */
 static uint32_t source_type(int type)
 {
 	switch (type) {
@@ -46,19 +38,19 @@ static int choice_index(const char *choices, const char *s)
 }
 
 static int read_string(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                       const bvhlab_option_decl *d, const plugin_field *f, char *dst)
+                       const plugin_option *o, char *dst)
 {
 	const char *s;
-	int rc = host->option_string(ctx, f->name, &s);
+	int rc = host->option_string(ctx, o->decl.name, &s);
 	int k;
 
 	if (rc < 0)
 		return rc;
-	if (f->type == PLUGIN_STRING) {
+	if (o->field == PLUGIN_STRING) {
 		memcpy(dst, &s, sizeof(s));
 		return 0;
 	}
-	if (!d->choices || (k = choice_index(d->choices, s)) < 0)
+	if (!o->decl.choices || (k = choice_index(o->decl.choices, s)) < 0)
 		return -EINVAL;
 	memcpy(dst, &k, sizeof(k));
 	return 0;
@@ -66,24 +58,25 @@ static int read_string(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 
 /* One field; memcpy, since the plugin's struct is not ours to alias. */
 static int read_field(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                      const bvhlab_option_decl *d, const plugin_field *f, char *dst)
+                      const plugin_option *o, char *dst)
 {
+	const bvhlab_option_decl *d = &o->decl;
 	int64_t i;
 	double x;
 	int rc;
 
-	switch (f->type) {
+	switch (o->field) {
 	case PLUGIN_BOOL: {
 		bool b;
-		if ((rc = host->option_bool(ctx, f->name, &b)) == 0)
+		if ((rc = host->option_bool(ctx, d->name, &b)) == 0)
 			memcpy(dst, &b, sizeof(b));
 		return rc;
 	}
 	case PLUGIN_I64:
 	case PLUGIN_U32:
-		if ((rc = host->option_int(ctx, f->name, &i)) < 0)
+		if ((rc = host->option_int(ctx, d->name, &i)) < 0)
 			return rc;
-		if (f->type == PLUGIN_I64) {
+		if (o->field == PLUGIN_I64) {
 			memcpy(dst, &i, sizeof(i));
 			return 0;
 		}
@@ -93,32 +86,40 @@ static int read_field(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		return 0;
 	case PLUGIN_DOUBLE:
 	case PLUGIN_FLOAT:
-		if ((rc = host->option_float(ctx, f->name, &x)) < 0)
+		if ((rc = host->option_float(ctx, d->name, &x)) < 0)
 			return rc;
-		if (f->type == PLUGIN_DOUBLE)
+		if (o->field == PLUGIN_DOUBLE)
 			memcpy(dst, &x, sizeof(x));
 		else
 			memcpy(dst, &(float){ (float)x }, sizeof(float));
 		return 0;
 	default:
-		return read_string(host, ctx, d, f, dst);
+		return read_string(host, ctx, o, dst);
+	}
+}
+
+void plugin_options_decls(const plugin_option *table, size_t count, bvhlab_option_decl *decls)
+{
+	for (size_t k = 0; k < count; k++) {
+		decls[k] = table[k].decl;
+		if (decls[k].type == 0)
+			decls[k].type = source_type(table[k].field);
 	}
 }
 
 int plugin_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                        const bvhlab_option_decl *decls, size_t decl_count,
-                        const plugin_field *fields, size_t field_count, void *out)
+                        const plugin_option *table, size_t count, void *out)
 {
-	for (size_t k = 0; k < field_count; k++) {
-		const plugin_field *f = &fields[k];
-		const bvhlab_option_decl *d = find_decl(decls, decl_count, f->name);
-		int rc = d && d->type == source_type(f->type) ? 0 : -EINVAL;
+	for (size_t k = 0; k < count; k++) {
+		const plugin_option *o = &table[k];
+		uint32_t want = source_type(o->field);
+		int rc = want && (o->decl.type == 0 || o->decl.type == want) ? 0 : -EINVAL;
 
 		if (rc == 0)
-			rc = read_field(host, ctx, d, f, (char *)out + f->offset);
+			rc = read_field(host, ctx, o, (char *)out + o->offset);
 		if (rc < 0) {
-			host->set_error(ctx, "option \"%s\": the plugin's table does not match "
-			                "its declarations (%d)", f->name, rc);
+			host->set_error(ctx, "option \"%s\": the plugin's field does not fit "
+			                "its declaration (%d)", o->decl.name, rc);
 			return rc;
 		}
 	}
