@@ -1,0 +1,158 @@
+#!/usr/bin/env python3
+"""Tables of one run of bench/peers.json, for README and docs/benchmarks.md.
+
+Usage: bench/peers_table.py RESULTS_DIR [--scene NAME]
+
+RESULTS_DIR holds the run's results.json and the report.md that bvhlab
+wrote beside it. Prints Markdown:
+
+  1. per scene, one row per builder: build ms, SAH cost and primary nodes
+     per ray at 1 and 2 threads, and whether the run is on the Pareto front
+     of time x SAH, as the report's "Pareto fronts" table says (the front
+     is the report's own verdict, read from report.md, not recomputed);
+  2. per scene and thread count, every peer run (plugins tinybvh, bvh2,
+     embree) against the fastest bvhlab run whose SAH cost is no higher,
+     with the peer's time taken without its `convert` phase (the library's
+     own build, the strictest reading): the ratio, and whether it is at
+     most 0.9. A peer run that failed validation has nothing to beat and
+     is listed with its reason.
+"""
+import argparse
+import json
+import os
+import re
+import sys
+
+PEERS = ("tinybvh", "bvh2", "embree")
+
+
+def load(path):
+    with open(os.path.join(path, "results.json")) as f:
+        results = json.load(f)
+    with open(os.path.join(path, "report.md")) as f:
+        report = f.read()
+    return results, report
+
+
+def report_fronts(report):
+    """(scene, builder, threads) -> 'front' or the report's dominance text."""
+    fronts = {}
+    scene = None
+    in_table = False
+    for line in report.splitlines():
+        m = re.match(r"^## (.+)$", line)
+        if m:
+            scene = m.group(1)
+            in_table = False
+            continue
+        if line.startswith("### Pareto fronts"):
+            in_table = True
+            continue
+        if line.startswith("### "):
+            in_table = False
+        if not in_table or not line.startswith("| ") or line.startswith("| builder"):
+            continue
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if len(cells) < 5 or not cells[1].split()[0].isdigit():
+            continue
+        fronts[(scene, cells[0], int(cells[1].split()[0]))] = cells[4]
+    return fronts
+
+
+def fmt_ms(ms):
+    return f"{ms:.0f}" if ms >= 100 else f"{ms:.1f}"
+
+
+def scene_table(runs, fronts, scene):
+    rows = {}
+    for r in runs:
+        if r["scene"] == scene:
+            rows.setdefault(r["builder"], {})[r["threads"]] = r
+    out = [f"#### {scene}", "",
+           "| builder | 1T ms | 1T SAH | 1T nodes/ray | 1T front | 2T ms | 2T SAH | 2T front |",
+           "|---|---:|---:|---:|---|---:|---:|---|"]
+    for builder, by in rows.items():
+        cells = [builder]
+        for t in (1, 2):
+            r = by.get(t)
+            if r is None:
+                cells += ["", ""] + ([""] if t == 1 else []) + [""]
+                continue
+            if r["status"] != "ok":
+                cells += [r["status"], "", ""] if t == 1 else [r["status"], ""]
+                cells.append("")
+                continue
+            verdict = fronts.get((scene, builder, t), "")
+            short = "**front**" if verdict == "front" else (
+                "dominated by " + verdict.split("dominated by ")[1].split(" (")[0]
+                if "dominated by" in verdict else verdict)
+            cells += [fmt_ms(r["build_ms"]["median"]), f"{r['tree']['sah_cost']:.3f}"]
+            if t == 1:
+                cells.append(f"{r['rays']['primary']['nodes_per_ray']:.1f}")
+            cells.append(short)
+        out.append("| " + " | ".join(cells) + " |")
+    return out
+
+
+def own_ms(run):
+    return run["build_ms"]["median"] - run.get("build_phases", {}).get("convert", 0.0)
+
+
+def verdicts(runs, scenes):
+    out = ["| scene | threads | peer | peer ms (no convert) | peer SAH | fastest bvhlab builder with SAH <= | its ms | its SAH | ratio | <= 0.9 |",
+           "|---|---:|---|---:|---:|---|---:|---:|---:|---|"]
+    misses = 0
+    for scene in scenes:
+        for t in (1, 2):
+            ours = [r for r in runs if r["scene"] == scene and r["threads"] == t and
+                    r["plugin"] not in PEERS and r["status"] == "ok"]
+            for p in runs:
+                if p["scene"] != scene or p["threads"] != t or p["plugin"] not in PEERS:
+                    continue
+                if p["status"] != "ok":
+                    reason = p.get("error", p["status"])
+                    out.append(f"| {scene} | {t} | {p['builder']} | {p['status']}: {reason} | | | | | | nothing to beat |")
+                    continue
+                sah = p["tree"]["sah_cost"]
+                best = min((r for r in ours if r["tree"]["sah_cost"] <= sah),
+                           key=lambda r: r["build_ms"]["median"], default=None)
+                pm = own_ms(p)
+                if best is None:
+                    misses += 1
+                    out.append(f"| {scene} | {t} | {p['builder']} | {fmt_ms(pm)} | {sah:.3f} | none | | | | **no** |")
+                    continue
+                ratio = best["build_ms"]["median"] / pm
+                ok = ratio <= 0.9
+                misses += not ok
+                out.append(f"| {scene} | {t} | {p['builder']} | {fmt_ms(pm)} | {sah:.3f} | {best['builder']} | "
+                           f"{fmt_ms(best['build_ms']['median'])} | {best['tree']['sah_cost']:.3f} | "
+                           f"{ratio:.2f} | {'yes' if ok else '**no**'} |")
+    out.append("")
+    out.append(f"Peer runs not dominated at <= 0.9x: {misses}.")
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("results_dir")
+    ap.add_argument("--scene", help="only this scene's builder table")
+    args = ap.parse_args()
+    try:
+        results, report = load(args.results_dir)
+    except OSError as e:
+        sys.exit(f"peers_table: {e}")
+    runs = results["runs"]
+    scenes = [s["name"] for s in results["scenes"]]
+    fronts = report_fronts(report)
+    m = results["machine"]
+    print(f"Machine: {m.get('cpu', '?')}, {m.get('cores', '?')} cores; bvhlab {results.get('bvhlab_version', '?')}, {results.get('created', '?')}.")
+    print()
+    for scene in ([args.scene] if args.scene else scenes):
+        print("\n".join(scene_table(runs, fronts, scene)))
+        print()
+    if not args.scene:
+        print("\n".join(verdicts(runs, scenes)))
+
+
+if __name__ == "__main__":
+    main()
