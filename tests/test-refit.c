@@ -1,19 +1,25 @@
 /*
  * The refit plugin and the host's update (ABI 1.4). After the vertices
- * of a scene move, refitting a tree (lbvh's, walked by subtrees;
- * sah_seq's and sah_tasks', swept in array order) keeps its topology
- * (node count, every node's children or leaf range, prim_index, all
- * unchanged), gives every node exactly the union of its children's (a
- * leaf: its primitives') new boxes, passes validation and brute-force
- * rays on the moved scene, and is the same tree bit for bit for 1, 2 and
- * 3 threads asked for (2 started on the larger trees). The host refuses
- * an update over another triangle count (fewer or more) naming both
- * counts, refit refuses a tree with a cycle, a refit-only plugin builds
- * nothing and a builder has no update. And refit then reinsert every
- * frame of the exploding horse (configs/animation.json's), as the harness
- * runs the strategy: every frame's tree valid (reinsert once left frame
- * 4's with a box smaller than its child's, when it took back a children
- * move whose place was an ancestor of the moved node).
+ * of a scene move, refitting a tree (lbvh's, whose inner nodes often have
+ * their children before them; sah_seq's and sah_tasks', whose do not)
+ * keeps its topology (node and reference counts, the same tree as
+ * bvhlab_tree_compare judges it: shape, leaf contents), gives every node
+ * exactly the union of its children's (a leaf: its primitives') new
+ * boxes, bit for bit as a fresh computation on the tree before, passes
+ * validation and brute-force rays on the moved scene, leaves the tree in
+ * refit's layout (children after their parents, references in node
+ * order), and is the same tree bit for bit, node order included, for 1, 2
+ * and 3 threads asked for (2 started on the larger trees). Over frames,
+ * the layout refit gave the tree is kept; trees broken out of it (a
+ * node's children before it, subtrees out of pre-order, references out
+ * of node order) are refitted as exactly. The host refuses an update over
+ * another triangle count (fewer or more) naming both counts, refit
+ * refuses a tree with a cycle, a refit-only plugin builds nothing and a
+ * builder has no update. And refit then reinsert every frame of the
+ * exploding horse (configs/animation.json's), as the harness runs the
+ * strategy: every frame's tree valid (reinsert once left frame 4's with a
+ * box smaller than its child's, when it took back a children move whose
+ * place was an ancestor of the moved node).
  */
 #include <errno.h>
 #include <math.h>
@@ -85,27 +91,8 @@ static int update(const bvhlab_build_input *in, uint32_t threads, bvhlab_tree *t
 	return r;
 }
 
-/* Topology and boxes of a refitted tree against the tree it came from. */
-static void check_refitted(const bvhlab_tree *before, const bvhlab_tree *t,
-                           const bvhlab_build_input *in)
-{
-	CHECK_INT(t->node_count, before->node_count);
-	CHECK_INT(t->index_count, before->index_count);
-	CHECK(!memcmp(t->prim_index, before->prim_index, t->index_count * sizeof(uint32_t)));
-	int shape = 0, boxes = 0;
-	for (uint32_t i = 0; i < t->node_count; i++) {
-		float lo[3], hi[3];
-		shape += t->nodes[i].first != before->nodes[i].first ||
-		         t->nodes[i].count != before->nodes[i].count;
-		reference(t, in->prim_bounds, i, lo, hi);
-		boxes += memcmp(lo, t->nodes[i].lo, sizeof(lo)) || memcmp(hi, t->nodes[i].hi, sizeof(hi));
-	}
-	CHECK_INT(shape, 0);
-	CHECK_INT(boxes, 0);
-}
-
-/* Whether every inner node's children come after it: refit then sweeps
- * the array, else walks subtrees. Both ways are tested. */
+/* Whether every inner node's children come after it: refit's own layout
+ * does, lbvh's does not (both kinds are refitted here). */
 static bool children_after(const bvhlab_tree *t)
 {
 	for (uint32_t i = 0; i < t->node_count; i++)
@@ -114,8 +101,60 @@ static bool children_after(const bvhlab_tree *t)
 	return true;
 }
 
+/* Whether the leaves' references follow their nodes' order, each leaf's
+ * starting where the previous leaf's end: refit's layout. */
+static bool refs_in_order(const bvhlab_tree *t)
+{
+	uint32_t at = 0;
+	for (uint32_t i = 0; i < t->node_count; i++) {
+		if (t->nodes[i].count && t->nodes[i].first != at)
+			return false;
+		at += t->nodes[i].count;
+	}
+	return at == t->index_count;
+}
+
+/* What refitting `before` for `boxes` must give: its shape and leaves,
+ * every node's box the union of its subtree's primitives' boxes, computed
+ * here from scratch on before's own node order. */
+static void expected_tree(bvhlab_tree *exp, const bvhlab_tree *before, const bvhlab_aabb *boxes)
+{
+	tree_dup(exp, before);
+	for (uint32_t i = 0; i < exp->node_count; i++)
+		reference(before, boxes, i, exp->nodes[i].lo, exp->nodes[i].hi);
+}
+
+/* A refitted tree against the tree it came from: the same counts, the
+ * same tree as bvhlab_tree_compare judges it (shape, leaf contents,
+ * boxes bit for bit) as the fresh union computation, every node in its
+ * own order the exact union of its subtree's boxes, and refit's layout:
+ * children after their parents, references in node order. */
+static void check_refitted(const bvhlab_tree *before, const bvhlab_tree *t,
+                           const bvhlab_build_input *in)
+{
+	bvhlab_tree exp = {0};
+	bvhlab_error err = {{0}};
+	int boxes = 0;
+	CHECK_INT(t->node_count, before->node_count);
+	CHECK_INT(t->index_count, before->index_count);
+	CHECK(children_after(t));
+	CHECK(refs_in_order(t));
+	expected_tree(&exp, before, in->prim_bounds);
+	int r = bvhlab_tree_compare(&exp, t, &err);
+	if (r != 0)
+		fprintf(stderr, "refitted tree differs: %s\n", err.message);
+	CHECK_INT(r, 0);
+	for (uint32_t i = 0; i < t->node_count; i++) {
+		float lo[3], hi[3];
+		reference(t, in->prim_bounds, i, lo, hi);
+		boxes += memcmp(lo, t->nodes[i].lo, sizeof(lo)) || memcmp(hi, t->nodes[i].hi, sizeof(hi));
+	}
+	CHECK_INT(boxes, 0);
+	bvhlab_tree_finish(&exp);
+}
+
 static void check_scene(const char *builder, const char *gen, const bvhlab_gen_params *gp,
-                        bool swept)
+                        bool ordered)
 {
 	bvhlab_scene *s = NULL;
 	bvhlab_plugin *b = NULL;
@@ -130,7 +169,7 @@ static void check_scene(const char *builder, const char *gen, const bvhlab_gen_p
 	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(b)), 0);
 	CHECK_INT(bvhlab_prims_init(&prims, s, &err), 0);
 	CHECK_INT(bvhlab_build(b, &opts, &prims.input, 1, &t0, &err), 0);
-	CHECK_INT(children_after(&t0), swept);
+	CHECK_INT(children_after(&t0), ordered);
 	move(s);
 	CHECK_INT(bvhlab_prims_init(&moved, s, &err), 0);
 	/* The old tree no longer holds the moved triangles: the point of it. */
@@ -144,10 +183,12 @@ static void check_scene(const char *builder, const char *gen, const bvhlab_gen_p
 		check_refitted(&t0, &t, &moved.input);
 		CHECK_INT(bvhlab_validate_rays(&t, s, 64, 33, &mismatches, &err), 0);
 		CHECK_INT(mismatches, 0);
-		if (threads == 1)
+		if (threads == 1) {
 			tree_dup(&first, &t);
-		else
+		} else {
 			CHECK(!memcmp(first.nodes, t.nodes, t.node_count * sizeof(bvhlab_node)));
+			CHECK(!memcmp(first.prim_index, t.prim_index, t.index_count * sizeof(uint32_t)));
+		}
 		bvhlab_tree_finish(&t);
 	}
 	bvhlab_tree_finish(&first);
@@ -156,6 +197,158 @@ static void check_scene(const char *builder, const char *gen, const bvhlab_gen_p
 	bvhlab_prims_finish(&prims);
 	bvhlab_options_finish(&opts);
 	bvhlab_plugin_close(b);
+	bvhlab_scene_destroy(s);
+}
+
+/* Node i's slot and the slots of its children pair, swapped with j's:
+ * the tree stays valid, its node order no longer refit's. */
+static void swap_pairs(bvhlab_tree *t, uint32_t i, uint32_t j)
+{
+	uint32_t a = t->nodes[i].first, b = t->nodes[j].first;
+	for (uint32_t k = 0; k < 2; k++) {
+		bvhlab_node n = t->nodes[a + k];
+		t->nodes[a + k] = t->nodes[b + k];
+		t->nodes[b + k] = n;
+	}
+	t->nodes[i].first = b;
+	t->nodes[j].first = a;
+}
+
+/* The leaves' references rewritten into node order (refit's), each leaf
+ * keeping its primitives. */
+static void renumber(bvhlab_tree *t)
+{
+	uint32_t *old = malloc(t->index_count * sizeof(*old)), at = 0;
+	if (!old)
+		return;
+	memcpy(old, t->prim_index, t->index_count * sizeof(*old));
+	for (uint32_t i = 0; i < t->node_count; i++) {
+		bvhlab_node *n = &t->nodes[i];
+		if (!n->count)
+			continue;
+		memcpy(t->prim_index + at, old + n->first, n->count * sizeof(*old));
+		n->first = at;
+		at += n->count;
+	}
+	free(old);
+}
+
+/* The last two inner nodes whose children are both leaves, j's pair
+ * before i. */
+static bool leaf_parents(const bvhlab_tree *t, uint32_t *i, uint32_t *j)
+{
+	uint32_t found = 0;
+	for (uint32_t k = t->node_count; k-- > 0 && found < 2;) {
+		const bvhlab_node *n = &t->nodes[k];
+		if (!n->count && t->nodes[n->first].count && t->nodes[n->first + 1].count &&
+		    (found == 0 || n->first < *i))
+			*(found++ ? j : i) = k;
+	}
+	return found == 2;
+}
+
+/* Refits t for the scene moved once more and checks it against the tree
+ * it was (fresh unions on that one's node order). */
+static void refit_frame(bvhlab_scene *s, bvhlab_tree *t, uint32_t threads)
+{
+	bvhlab_prims moved = {0};
+	bvhlab_tree before = {0};
+	bvhlab_error err = {{0}};
+	tree_dup(&before, t);
+	move(s);
+	CHECK_INT(bvhlab_prims_init(&moved, s, &err), 0);
+	CHECK_INT(update(&moved.input, threads, t, &err), 0);
+	CHECK_INT(bvhlab_validate_tree(t, &moved.input, false, &err), 0);
+	check_refitted(&before, t, &moved.input);
+	bvhlab_tree_finish(&before);
+	bvhlab_prims_finish(&moved);
+}
+
+/* Five frames: the first update rewrites lbvh's tree into refit's layout,
+ * the later ones sweep that layout and keep it (the same node order and
+ * prim_index every frame). */
+static void frames_keep_layout(bvhlab_scene *s, bvhlab_tree *t)
+{
+	bvhlab_tree kept = {0};
+	CHECK(!children_after(t));
+	for (uint32_t f = 1; f <= 5; f++) {
+		refit_frame(s, t, 2);
+		if (f == 1)
+			tree_dup(&kept, t);
+		for (uint32_t k = 0; k < t->node_count; k++)
+			CHECK(t->nodes[k].first == kept.nodes[k].first &&
+			      t->nodes[k].count == kept.nodes[k].count);
+		CHECK(!memcmp(t->prim_index, kept.prim_index, t->index_count * sizeof(uint32_t)));
+	}
+	bvhlab_tree_finish(&kept);
+}
+
+/* The references of leaf i and of the last leaf (which end prim_index)
+ * swapped, each leaf keeping its primitives. */
+static void swap_refs(bvhlab_tree *t, uint32_t i)
+{
+	bvhlab_node *a = &t->nodes[i], *b = &t->nodes[t->node_count - 1];
+	for (uint32_t k = 0; k < a->count; k++) {
+		uint32_t p = t->prim_index[a->first + k];
+		t->prim_index[a->first + k] = t->prim_index[b->first + k];
+		t->prim_index[b->first + k] = p;
+	}
+	uint32_t first = a->first;
+	a->first = b->first;
+	b->first = first;
+}
+
+/* A tree in refit's layout but for two pairs of leaves swapped (a node's
+ * children before it, the references renumbered into node order), then
+ * for the root's children swapped (its subtrees out of pre-order), then
+ * for two leaves' references swapped (which only a sweep sees): each
+ * refitted exactly all the same, back into refit's layout. */
+static void frames_broken_layout(bvhlab_scene *s, bvhlab_tree *t)
+{
+	uint32_t i = 0, j = 0;
+	CHECK(leaf_parents(t, &i, &j));
+	swap_pairs(t, i, j);
+	renumber(t);
+	CHECK(!children_after(t) && refs_in_order(t));
+	refit_frame(s, t, 2);
+	bvhlab_node left = t->nodes[1];
+	t->nodes[1] = t->nodes[2];
+	t->nodes[2] = left;
+	CHECK(children_after(t));
+	refit_frame(s, t, 2);
+	for (i = 0; t->nodes[i].count != t->nodes[t->node_count - 1].count; i++)
+		;
+	swap_refs(t, i);
+	CHECK(children_after(t) && !refs_in_order(t));
+	refit_frame(s, t, 3);
+}
+
+/* lbvh's tree (half its inner nodes have their children before them)
+ * refitted over frames, then in layouts broken on purpose. */
+static void test_frames(void)
+{
+	bvhlab_gen_params gp;
+	bvhlab_scene *s = NULL;
+	bvhlab_plugin *lbvh = NULL;
+	bvhlab_options opts;
+	bvhlab_prims prims = {0};
+	bvhlab_tree t = {0};
+	bvhlab_error err = {{0}};
+	bvhlab_gen_params_init(&gp);
+	gp.frequency = 32;
+	CHECK_INT(bvhlab_scene_generate("icosphere", &gp, &s, &err), 0);
+	CHECK_INT(bvhlab_plugin_open("lbvh", &lbvh, &err), 0);
+	if (!s || !lbvh)
+		return;
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(lbvh)), 0);
+	CHECK_INT(bvhlab_prims_init(&prims, s, &err), 0);
+	CHECK_INT(bvhlab_build(lbvh, &opts, &prims.input, 2, &t, &err), 0);
+	frames_keep_layout(s, &t);
+	frames_broken_layout(s, &t);
+	bvhlab_tree_finish(&t);
+	bvhlab_prims_finish(&prims);
+	bvhlab_options_finish(&opts);
+	bvhlab_plugin_close(lbvh);
 	bvhlab_scene_destroy(s);
 }
 
@@ -335,6 +528,7 @@ int main(void)
 	check_scene("lbvh", "soup", &gp, false);
 	gp.size = 12;
 	check_scene("lbvh", "terrain", &gp, false);
+	test_frames();
 	test_counts();
 	test_cycle();
 	test_explode_reinsert();

@@ -313,7 +313,9 @@ typedef struct bvhlab_builder {
 	 * layout (any builder's, counts set) over primitives of the same count
 	 * and order as `input`'s, which gives their new boxes and vertices
 	 * (the topology is kept; only positions changed). On return it must
-	 * hold a valid tree over `input`, with the counts updated; the
+	 * hold a valid tree over `input`, with the counts updated; it may
+	 * reorder the nodes and prim_index (refit does, into an order it
+	 * streams), so a caller keeps no node or slot index across it. The
 	 * capacity past the counts is scratch, and host->grow_output works as
 	 * in build(). A tree whose references do not fit input (another
 	 * triangle count) must be refused with host->set_error, not walked
