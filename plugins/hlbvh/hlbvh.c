@@ -37,22 +37,14 @@ static uint32_t spare_nodes(uint32_t n)
  * writes, after the gather read the sort for the last time. */
 static int scratch_alloc(hlbvh *h, morton_scratch *s, unsigned threads)
 {
-	const bvhlab_build_output *out = h->out;
-	uint32_t nodes = 2 * h->n - 1, spare = spare_nodes(h->n);
-	bool sort_out = (size_t)nodes * sizeof(bvhlab_node) >= morton_sort_bytes(h->n);
-	bool work_out = spare && out->node_capacity >= nodes + spare;
-	uintptr_t past = (uintptr_t)(out->nodes + nodes);
-	size_t work = work_size(h->n);
-	size_t region = (work_out ? 0 : work) + (sort_out ? 0 : morton_sort_bytes(h->n));
-	char *at;
+	uint32_t *counts;
+	char *at = morton_scratch_place(s, h->out, h->n, work_size(h->n), spare_nodes(h->n),
+	                                &h->sort, threads, 0, &counts, NULL);
 
-	if (!morton_scratch_alloc(s, region, &h->sort, threads, 0))
+	if (!at)
 		return -ENOMEM;
-	at = work_out ? (char *)((past + 63) & ~(uintptr_t)63) : (char *)s->region;
 	h->sorted = (sah_prim *)(void *)at;
 	h->bounds = (uint32_t *)(void *)(at + morton_align64(sizeof(sah_prim) * h->n));
-	morton_place_sort(&h->sort, sort_out ? (char *)out->nodes
-	                                     : (char *)s->region + (work_out ? 0 : work));
 	return 0;
 }
 

@@ -71,20 +71,13 @@ static void place_tree(lbvh *b, char *p)
  */
 static int scratch_alloc(lbvh *b, const bvhlab_build_output *out, morton_scratch *s)
 {
-	size_t sort = morton_sort_bytes(b->n), tree = tree_size(b->n, b->collapse);
-	uint32_t nodes = 2 * b->n - 1, spare = spare_nodes(b->n, b->collapse);
-	bool sort_out = (size_t)out->node_capacity * sizeof(bvhlab_node) >= sort;
-	bool tree_out = spare && out->node_capacity >= nodes + spare;
-	uintptr_t past = (uintptr_t)(out->nodes + nodes);
+	char *tree = morton_scratch_place(s, out, b->n, tree_size(b->n, b->collapse),
+	                                  spare_nodes(b->n, b->collapse), &b->sort, b->threads, 3,
+	                                  &b->count, &b->scratch_dirty);
 
-	size_t region = (tree_out ? 0 : tree) + (sort_out ? 0 : sort);
-
-	if (!(b->count = morton_scratch_alloc(s, region, &b->sort, b->threads, 3)))
+	if (!tree)
 		return -ENOMEM;
-	b->scratch_dirty = tree_out;
-	place_tree(b, tree_out ? (char *)((past + 63) & ~(uintptr_t)63) : (char *)s->region);
-	morton_place_sort(&b->sort,
-	                  sort_out ? (char *)out->nodes : (char *)s->region + (tree_out ? 0 : tree));
+	place_tree(b, tree);
 	return 0;
 }
 

@@ -73,18 +73,12 @@ static void place_work(ploc *p, char *at)
  * phase writes, after the sort is read for the last time. */
 static int scratch_alloc(ploc *p, const bvhlab_build_output *out, morton_scratch *s)
 {
-	size_t sort = morton_sort_bytes(p->n), work = work_size(p->n);
-	uint32_t nodes = 2 * p->n - 1, spare = spare_nodes(p->n);
-	bool sort_out = (size_t)nodes * sizeof(bvhlab_node) >= sort;
-	bool work_out = spare && out->node_capacity >= nodes + spare;
-	uintptr_t past = (uintptr_t)(out->nodes + nodes);
-	size_t region = (work_out ? 0 : work) + (sort_out ? 0 : sort);
+	char *work = morton_scratch_place(s, out, p->n, work_size(p->n), spare_nodes(p->n),
+	                                  &p->sort, p->threads, 2, &p->count, NULL);
 
-	if (!(p->count = morton_scratch_alloc(s, region, &p->sort, p->threads, 2)))
+	if (!work)
 		return -ENOMEM;
-	place_work(p, work_out ? (char *)((past + 63) & ~(uintptr_t)63) : (char *)s->region);
-	morton_place_sort(&p->sort,
-	                  sort_out ? (char *)out->nodes : (char *)s->region + (work_out ? 0 : work));
+	place_work(p, work);
 	return 0;
 }
 

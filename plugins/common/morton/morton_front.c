@@ -103,6 +103,26 @@ void morton_scratch_free(morton_scratch *scratch)
 	free(scratch->small);
 }
 
+char *morton_scratch_place(morton_scratch *scratch, const bvhlab_build_output *out, uint32_t n,
+                           size_t work, uint32_t spare, morton_sort *sort, unsigned threads,
+                           unsigned extra, uint32_t **counts, bool *work_in_output)
+{
+	uint32_t nodes = 2 * n - 1;
+	size_t sort_bytes = morton_sort_bytes(n);
+	bool sort_out = (size_t)nodes * sizeof(bvhlab_node) >= sort_bytes;
+	bool work_out = spare && out->node_capacity >= nodes + spare;
+	uintptr_t past = (uintptr_t)(out->nodes + nodes);
+	size_t region = (work_out ? 0 : work) + (sort_out ? 0 : sort_bytes);
+
+	if (work_in_output)
+		*work_in_output = work_out;
+	if (!(*counts = morton_scratch_alloc(scratch, region, sort, threads, extra)))
+		return NULL;
+	morton_place_sort(sort, sort_out ? (char *)out->nodes
+	                                 : (char *)scratch->region + (work_out ? 0 : work));
+	return work_out ? (char *)((past + 63) & ~(uintptr_t)63) : (char *)scratch->region;
+}
+
 void morton_sort_team(morton_sort *s, team *tm, unsigned t,
                       void (*done)(void *arg, uint32_t first, uint32_t end), void *arg)
 {

@@ -92,6 +92,20 @@ uint32_t *morton_scratch_alloc(morton_scratch *scratch, size_t region, morton_so
                                unsigned threads, unsigned extra);
 void morton_scratch_free(morton_scratch *scratch);
 
+/*
+ * A Morton build's scratch, placed: `work` bytes past the tree of n
+ * primitives in the output when it has the `spare` nodes of room asked
+ * for (morton_spare_nodes; then *work_in_output, if not NULL, is true), else at the start of a
+ * fresh mapping; the sort's buffers in the output's first nodes, which the
+ * tree is written over only after the sort, when they fit, else in the
+ * mapping after the work. The digit counts and `extra` words per thread as
+ * morton_scratch_alloc. Returns the work area, or NULL when out of memory
+ * (*counts then NULL too).
+ */
+char *morton_scratch_place(morton_scratch *scratch, const bvhlab_build_output *out, uint32_t n,
+                           size_t work, uint32_t spare, morton_sort *sort, unsigned threads,
+                           unsigned extra, uint32_t **counts, bool *work_in_output);
+
 /* By every member t of tm: the sort of morton.h, barriers included. */
 void morton_sort_team(morton_sort *s, team *tm, unsigned t,
                       void (*done)(void *arg, uint32_t first, uint32_t end), void *arg);
