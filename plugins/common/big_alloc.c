@@ -1,4 +1,5 @@
 /* Huge-page scratch mappings (see big_alloc.h). */
+#include <errno.h>
 #include <stdint.h>
 #include <sys/mman.h>
 
@@ -32,4 +33,27 @@ void big_free(void *p)
 		return;
 	const size_t *header = (const size_t *)(const void *)((char *)p - BIG_HEADER);
 	munmap((void *)(uintptr_t)header[0], header[1]);
+}
+
+uint32_t big_spare_nodes(uint32_t n, size_t bytes)
+{
+	uint64_t spare = (bytes + 64 + sizeof(bvhlab_node) - 1) / sizeof(bvhlab_node);
+
+	return 2 * (uint64_t)n - 1 + spare > UINT32_MAX ? 0 : (uint32_t)spare;
+}
+
+int big_ensure_output(const bvhlab_host *host, bvhlab_build_ctx *ctx, uint32_t n,
+                      uint32_t spare, bvhlab_build_output *out)
+{
+	uint32_t nodes = 2 * n - 1;
+
+	if (spare && out->node_capacity < nodes + spare)
+		(void)host->grow_output(ctx, out, nodes + spare, n); /* fine if refused */
+	if (out->node_capacity >= nodes && out->index_capacity >= n)
+		return 0;
+	if (host->grow_output(ctx, out, nodes, n) < 0) {
+		host->set_error(ctx, "cannot grow the output to %u nodes", nodes);
+		return -ENOMEM;
+	}
+	return 0;
 }

@@ -30,7 +30,7 @@ static size_t work_size(size_t n)
 
 static uint32_t spare_nodes(uint32_t n)
 {
-	return morton_spare_nodes(n, work_size(n));
+	return big_spare_nodes(n, work_size(n));
 }
 
 /* The sort's buffers go into the output's nodes, which only the top
@@ -153,7 +153,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	if ((rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
 	                              &h.opt)) < 0 ||
 	    (rc = sah_options_resolve(host, ctx, &h.opt.sah)) < 0 ||
-	    (rc = morton_ensure_capacity(host, ctx, h.n, spare_nodes(h.n), output)) < 0)
+	    (rc = big_ensure_output(host, ctx, h.n, spare_nodes(h.n), output)) < 0)
 		return rc;
 	if (input->prim_count == 1) {
 		morton_single_leaf(input, output);

@@ -20,13 +20,13 @@ static uint32_t spare_nodes(uint32_t n, bool collapse);
 
 /*
  * Room for the tree, and past it for the scratch of the hierarchy (see
- * morton_spare_nodes()). Without that room the scratch is mapped afresh
+ * big_spare_nodes()). Without that room the scratch is mapped afresh
  * (scratch_alloc()).
  */
 static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                            const lbvh *b, bvhlab_build_output *out)
 {
-	return morton_ensure_capacity(host, ctx, b->n, spare_nodes(b->n, b->collapse), out);
+	return big_ensure_output(host, ctx, b->n, spare_nodes(b->n, b->collapse), out);
 }
 
 /* ---- scratch ------------------------------------------------------------ */
@@ -40,7 +40,7 @@ static size_t tree_size(size_t n, bool collapse)
 
 static uint32_t spare_nodes(uint32_t n, bool collapse)
 {
-	return morton_spare_nodes(n, tree_size(n, collapse));
+	return big_spare_nodes(n, tree_size(n, collapse));
 }
 
 static void place_tree(lbvh *b, char *p)

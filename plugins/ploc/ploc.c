@@ -37,7 +37,7 @@ static size_t work_size(size_t n)
 
 static uint32_t spare_nodes(uint32_t n)
 {
-	return morton_spare_nodes(n, work_size(n));
+	return big_spare_nodes(n, work_size(n));
 }
 
 static char *take(char **at, size_t bytes)
@@ -180,7 +180,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	}
 	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
 	                              &p)) < 0 ||
-	    (rc = morton_ensure_capacity(host, ctx, p.n, spare_nodes(p.n), output)) < 0)
+	    (rc = big_ensure_output(host, ctx, p.n, spare_nodes(p.n), output)) < 0)
 		return rc;
 	if (input->prim_count == 1) {
 		morton_single_leaf(input, output);

@@ -52,9 +52,10 @@ static int alloc_records(sah_builder *b, const bvhlab_build_output *out, unsigne
 {
 	size_t bytes = ((size_t)b->prim_count * sizeof(sah_prim) + 63) & ~(size_t)63;
 	uint64_t tree = 2 * (uint64_t)b->prim_count - 1;
+	uint32_t spare = sah_scratch_nodes(b->opt.method, b->prim_count);
 	char *room = NULL;
 
-	if (out->node_capacity >= tree + sah_scratch_nodes(b->opt.method, b->prim_count))
+	if (spare && out->node_capacity >= tree + spare)
 		room = (char *)(((uintptr_t)(out->nodes + tree) + 63) & ~(uintptr_t)63);
 	b->in_output = room != NULL;
 	for (unsigned k = 0; k < count; k++) {
@@ -82,10 +83,8 @@ static int alloc_sweep(sah_builder *b, const bvhlab_build_input *input,
 
 uint32_t sah_scratch_nodes(int method, uint32_t n)
 {
-	uint64_t bytes = (method == SAH_SWEEP ? 4 : 2) * ((uint64_t)n * sizeof(sah_prim) + 63);
-	uint64_t nodes = (bytes + 64 + sizeof(bvhlab_node) - 1) / sizeof(bvhlab_node);
-
-	return 2 * (uint64_t)n - 1 + nodes > UINT32_MAX ? UINT32_MAX : (uint32_t)nodes;
+	return big_spare_nodes(n, (method == SAH_SWEEP ? 4 : 2) *
+	                          (((size_t)n * sizeof(sah_prim) + 63) & ~(size_t)63));
 }
 
 int sah_builder_init(sah_builder *b, const sah_options *opt,

@@ -132,7 +132,8 @@ int sah_builder_init(sah_builder *b, const sah_options *opt,
  * Nodes past a tree of n primitives (2n - 1 nodes) that hold the record
  * arrays of a build with `method`, when the output has that room: ask the
  * host for it before sah_builder_init (fine if refused; the arrays are
- * then mapped for the build). UINT32_MAX when it would not fit a count.
+ * then mapped for the build). 0 when it would not fit a count
+ * (big_spare_nodes).
  */
 uint32_t sah_scratch_nodes(int method, uint32_t n);
 

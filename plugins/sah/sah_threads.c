@@ -5,28 +5,8 @@
  */
 #include <errno.h>
 
+#include "big_alloc.h"
 #include "sah_threads.h"
-
-/* The host preallocates 2N-1 nodes and N indices; ask only if it did not. */
-static int ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                           const bvhlab_build_input *input, bvhlab_build_output *output,
-                           int method)
-{
-	uint64_t nodes = 2 * (uint64_t)input->prim_count - 1;
-	uint64_t room = nodes + sah_scratch_nodes(method, input->prim_count);
-
-	/* The record arrays past the tree (sah_scratch_nodes); fine if refused. */
-	if (room <= UINT32_MAX && output->node_capacity < room)
-		(void)host->grow_output(ctx, output, (uint32_t)room, input->prim_count);
-	if (output->node_capacity >= nodes && output->index_capacity >= input->prim_count)
-		return 0;
-	if (host->grow_output(ctx, output, (uint32_t)nodes, input->prim_count) < 0) {
-		host->set_error(ctx, "cannot grow the output to %llu nodes",
-		                (unsigned long long)nodes);
-		return -ENOMEM;
-	}
-	return 0;
-}
 
 int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *output,
@@ -42,7 +22,8 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		return -EINVAL;
 	}
 	if ((rc = sah_options_resolve(host, ctx, opt)) < 0 ||
-	    (rc = ensure_capacity(host, ctx, input, output, opt->method)) < 0)
+	    (rc = big_ensure_output(host, ctx, input->prim_count,
+	                            sah_scratch_nodes(opt->method, input->prim_count), output)) < 0)
 		return rc;
 	team_host_init(&th, host, ctx);
 	rc = sah_builder_init(&b, opt, input, output, &th);

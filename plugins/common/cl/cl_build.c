@@ -21,7 +21,7 @@ int cl_build_begin(const cl_builder *cb, cl_dev *d, const char *spec, const bvhl
 		host->set_error(ctx, "cannot build over %u primitives", n);
 		return -EINVAL;
 	}
-	if ((rc = morton_ensure_capacity(host, ctx, n, 0, out)) < 0)
+	if ((rc = big_ensure_output(host, ctx, n, 0, out)) < 0)
 		return rc;
 	rc = cl_dev_open(d, spec, cb->src, cb->len, cb->kernels, cb->kernel_count, err,
 	                 sizeof(err));

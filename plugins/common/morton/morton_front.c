@@ -47,29 +47,6 @@ unsigned morton_team_size(const bvhlab_build_input *in)
 	return want < 1 ? 1 : want > TEAM_MAX_THREADS ? TEAM_MAX_THREADS : want;
 }
 
-uint32_t morton_spare_nodes(uint32_t n, size_t bytes)
-{
-	uint64_t spare = (bytes + 64 + sizeof(bvhlab_node) - 1) / sizeof(bvhlab_node);
-
-	return 2 * (uint64_t)n - 1 + spare > UINT32_MAX ? 0 : (uint32_t)spare;
-}
-
-int morton_ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx, uint32_t n,
-                           uint32_t spare, bvhlab_build_output *out)
-{
-	uint32_t nodes = 2 * n - 1;
-
-	if (spare && out->node_capacity < nodes + spare)
-		(void)host->grow_output(ctx, out, nodes + spare, n); /* fine if refused */
-	if (out->node_capacity >= nodes && out->index_capacity >= n)
-		return 0;
-	if (host->grow_output(ctx, out, nodes, n) < 0) {
-		host->set_error(ctx, "cannot grow the output to %u nodes", nodes);
-		return -ENOMEM;
-	}
-	return 0;
-}
-
 void morton_place_sort(morton_sort *s, char *at)
 {
 	size_t k8 = morton_align64(8 * (size_t)s->n);

@@ -13,6 +13,7 @@
 
 #include <bvhlab/builder.h>
 
+#include "big_alloc.h"
 #include "morton.h"
 #include "plugin_options.h"
 #include "team.h"
@@ -56,20 +57,6 @@ static inline size_t morton_align64(size_t x)
 /* Threads for a build of in: in->threads, fewer on a small input. */
 unsigned morton_team_size(const bvhlab_build_input *in);
 
-/*
- * Nodes for `bytes` of scratch past a tree of n primitives (2n - 1 nodes),
- * which the host keeps between builds: a fresh mapping would be paged in
- * (and zeroed by the kernel) at every build. 0 when the count would not
- * fit a uint32_t.
- */
-uint32_t morton_spare_nodes(uint32_t n, size_t bytes);
-
-/* Room for the tree of n primitives, asking for `spare` nodes more (fine
- * if refused): 0, or -ENOMEM after host->set_error. */
-int morton_ensure_capacity(const bvhlab_host *host, bvhlab_build_ctx *ctx, uint32_t n,
-                           uint32_t spare, bvhlab_build_output *out);
-
-/* The sort's three buffers of n words, one after another at `at`. */
 static inline size_t morton_sort_bytes(size_t n)
 {
 	return 3 * morton_align64(8 * n);
@@ -95,7 +82,7 @@ void morton_scratch_free(morton_scratch *scratch);
 /*
  * A Morton build's scratch, placed: `work` bytes past the tree of n
  * primitives in the output when it has the `spare` nodes of room asked
- * for (morton_spare_nodes; then *work_in_output, if not NULL, is true), else at the start of a
+ * for (big_spare_nodes; then *work_in_output, if not NULL, is true), else at the start of a
  * fresh mapping; the sort's buffers in the output's first nodes, which the
  * tree is written over only after the sort, when they fit, else in the
  * mapping after the work. The digit counts and `extra` words per thread as
