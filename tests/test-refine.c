@@ -373,6 +373,19 @@ static void test_area_measure(void)
 	refiner_options = saved;
 }
 
+/* Trees of more nodes than reinsert's candidate choice takes in one block
+ * (65,536 keys): the blocks are shared out to the threads, each counts
+ * its keys in a histogram of its own and partitions its blocks in place,
+ * and the candidates still come out the same for 1 and 2 threads. */
+static void test_many_blocks(void)
+{
+	const char *saved = refiner_options;
+
+	refiner_options = "batch=0.02\0iterations=2\0measure=area\0leaves=false\0";
+	test_scene("soup", generate("soup", SCALE(200000, 100000), 0, 0), SCALE(RAYS, 16));
+	refiner_options = saved;
+}
+
 /* Every test of one stage, with the options it is tested with. */
 static void test_stage(const char *name, const char *options)
 {
@@ -401,6 +414,7 @@ static void test_stage(const char *name, const char *options)
 	if (strcmp(name, "reinsert") == 0) {
 		test_subtree_moves();
 		test_area_measure();
+		test_many_blocks();
 	}
 	bvhlab_plugin_close(refiner);
 	refiner = NULL;

@@ -1,6 +1,6 @@
 /*
  * reinsert: the refinement plugin (see reinsert.h). This file: options,
- * scratch, the choice of candidates, the iterations, refine().
+ * scratch, the iterations, refine().
  */
 #include <errno.h>
 #include <stdlib.h>
@@ -46,97 +46,6 @@ static const plugin_option options[] = {
 	              .def_int = 4096, .min = 16, .max = 1 << 24),
 };
 
-/* ---- candidates --------------------------------------------------------- */
-
-/* A node's cost: what it adds to the SAH, area times primitives for a leaf. */
-static double cost_of(const bvhlab_node *n)
-{
-	return node_area(n) * (n->count ? n->count : 1);
-}
-
-/*
- * Bittner et al.'s measure of how badly a node holds its children: its
- * area, times its area over their mean and over the least of theirs; a
- * leaf's is its cost. As the batch's key it beat the cost alone (lbvh on
- * igea subdivided once, 2 threads, batch 0.02 / 0.05 / 0.1 over 30 / 20 /
- * 10 iterations: SAH 47.66 / 46.91 / 46.33 against 48.38 / 47.57 / 46.83
- * in about the same time). A full batch takes every node either way.
- */
-static double inefficiency(const reinsert *r, uint32_t x)
-{
-	const bvhlab_node *n = &r->nodes[x];
-	double a, l, h;
-
-	if (r->measure == MEASURE_AREA)
-		return node_area(n);
-	if (n->count)
-		return cost_of(n);
-	a = node_area(n);
-	l = node_area(&r->nodes[n->first]);
-	h = node_area(&r->nodes[n->first + 1]);
-	return a * (a / (0.5 * (l + h) + 1e-30)) * (a / ((l < h ? l : h) + 1e-30));
-}
-
-static int descending(const void *a, const void *b)
-{
-	uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-
-	return (x < y) - (x > y);
-}
-
-/*
- * Puts the k largest of keys[0 .. n) first, in any order: a histogram of
- * the top 16 bits finds the bucket where the k-th largest lies; keys of
- * higher buckets are taken whole, that bucket's own are sorted to take
- * what is left. Linear, and deterministic.
- */
-static void select_largest(uint64_t *keys, uint32_t n, uint32_t k, uint32_t *hist)
-{
-	uint32_t at = 0, above = 0, split = 0, mid;
-
-	memset(hist, 0, 65536 * sizeof(*hist));
-	for (uint32_t j = 0; j < n; j++)
-		hist[keys[j] >> 48]++;
-	for (split = 65535; above + hist[split] < k; split--)
-		above += hist[split];
-	/* keys above the split bucket first, then the bucket's own */
-	for (uint32_t j = 0; j < n; j++)
-		if (keys[j] >> 48 > split) {
-			uint64_t t = keys[at];
-			keys[at++] = keys[j];
-			keys[j] = t;
-		}
-	mid = at;
-	for (uint32_t j = at; j < n; j++)
-		if (keys[j] >> 48 == split) {
-			uint64_t t = keys[at];
-			keys[at++] = keys[j];
-			keys[j] = t;
-		}
-	qsort(keys + mid, at - mid, sizeof(*keys), descending);
-}
-
-/* The batch: the nodes of largest inefficiency, ties to the lower slot.
- * Keys are its float bits (non-negative floats order as integers) above
- * the slot's complement. */
-static void choose(reinsert *r, double batch)
-{
-	uint32_t n = r->node_count - 1, k = (uint32_t)(batch * n);
-
-	k = k < 1 ? 1 : k > n ? n : k;
-	for (uint32_t x = 1; x < r->node_count; x++) {
-		float c = (float)inefficiency(r, x);
-		uint32_t bits;
-
-		memcpy(&bits, &c, sizeof(bits));
-		r->keys[x - 1] = (uint64_t)bits << 32 | (UINT32_MAX - x);
-	}
-	select_largest(r->keys, n, k, r->hist);
-	for (uint32_t j = 0; j < k; j++)
-		r->cand[j] = UINT32_MAX - (uint32_t)r->keys[j];
-	r->cand_count = k;
-}
-
 /* ---- iterations ----------------------------------------------------------- */
 
 static void find_parents(reinsert *r)
@@ -152,7 +61,7 @@ static double inner_area(const reinsert *r)
 	double sum = 0;
 
 	for (uint32_t x = 0; x < r->node_count; x++)
-		sum += cost_of(&r->nodes[x]);
+		sum += node_cost(&r->nodes[x]);
 	return sum;
 }
 
@@ -197,7 +106,8 @@ static int iterate(reinsert *r, const struct params *o, uint32_t threads, const 
 		double change;
 		int rc;
 
-		choose(r, o->batch);
+		if ((rc = reinsert_choose(r, o->batch, threads, th)) < 0)
+			return rc;
 		atomic_store_explicit(&r->next, 0, memory_order_relaxed);
 		if ((rc = team_run_on(&r->team, th, threads, search_member, r)) < 0)
 			return rc;
@@ -217,7 +127,8 @@ static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct
 	reinsert r = { .nodes = tree->nodes, .node_count = tree->node_count,
 	               .max_visits = (uint32_t)o->max_visits, .children = o->children,
 	               .measure = o->measure };
-	size_t n = tree->node_count;
+	size_t n = tree->node_count, blocks = n / CHOOSE_BLOCK + 1;
+	uint32_t members = input->threads ? input->threads : 1;
 	team_host th;
 	int rc;
 
@@ -226,14 +137,16 @@ static int optimise(const bvhlab_host *host, bvhlab_build_ctx *ctx, const struct
 	r.cand = malloc(n * sizeof(*r.cand));
 	r.moves = malloc(n * sizeof(*r.moves));
 	r.keys = malloc(n * sizeof(*r.keys));
-	r.hist = malloc(65536 * sizeof(*r.hist));
-	if (!r.parent || !r.cand || !r.moves || !r.keys || !r.hist) {
+	r.hist = malloc((size_t)members * 65536 * sizeof(*r.hist));
+	r.above = malloc(blocks * sizeof(*r.above));
+	r.equal = malloc(blocks * sizeof(*r.equal));
+	if (!r.parent || !r.cand || !r.moves || !r.keys || !r.hist || !r.above || !r.equal) {
 		host->set_error(ctx, "out of memory for %zu nodes", n);
 		rc = -ENOMEM;
 		goto out;
 	}
 	find_parents(&r);
-	if ((rc = iterate(&r, o, input->threads, &th)) < 0)
+	if ((rc = iterate(&r, o, members, &th)) < 0)
 		host->set_error(ctx, "cannot start the search threads");
 out:
 	free(r.parent);
@@ -241,6 +154,8 @@ out:
 	free(r.moves);
 	free(r.keys);
 	free(r.hist);
+	free(r.above);
+	free(r.equal);
 	return rc;
 }
 

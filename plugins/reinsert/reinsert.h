@@ -7,7 +7,7 @@
  *   1. candidates  the `batch` fraction of nodes that hold their children
  *                  worst: area x area / mean child area x area / least
  *                  child area (Bittner et al.), a leaf's cost for a leaf
- *                  (reinsert.c)
+ *                  (reinsert_choose.c, on the team)
  *   2. search      for every candidate, in parallel over the threads, the
  *                  node beside which it would cost least: what taking it
  *                  out saves (exactly) against what putting it back costs,
@@ -42,6 +42,9 @@
 
 #define NO_NODE UINT32_MAX
 
+/* Keys a member of the candidates' choice takes at a time (reinsert_choose.c) */
+#define CHOOSE_BLOCK 65536u
+
 /* A candidate's best move, saving `gain` (area units): the node beside
  * `dest`; or, when dest2 is a node, the node out and its children put
  * back apart, the one of larger area beside dest, the other beside dest2. */
@@ -71,13 +74,15 @@ typedef struct reinsert {
 	uint32_t cand_count;
 	struct move *moves;     /* [node_count] one per candidate */
 	uint64_t *keys;         /* [node_count] scratch of the selection */
-	uint32_t *hist;         /* [65536] scratch of the selection */
+	uint32_t *hist;         /* [65536 x threads] the members' histograms of keys */
+	uint32_t *above, *equal; /* per block of keys: how many above the split bucket, in it */
+	uint32_t split;         /* the bucket of the batch's smallest key */
 	uint32_t max_visits;    /* nodes a search may take from its queue */
 	bool children;          /* children moves searched too */
 	int measure;            /* enum reinsert_measure: how the batch is chosen */
 	struct undo log[UNDO_MAX]; /* what a children move wrote, to take it back */
 	uint32_t log_count;
-	atomic_uint next;       /* candidates handed out in the search */
+	atomic_uint next;       /* blocks of keys, then candidates, handed out to the team */
 	team team;
 } reinsert;
 
@@ -91,6 +96,12 @@ static inline double area_of(const float lo[3], const float hi[3])
 static inline double node_area(const bvhlab_node *n)
 {
 	return area_of(n->lo, n->hi);
+}
+
+/* A node's cost: what it adds to the SAH, area times primitives for a leaf. */
+static inline double node_cost(const bvhlab_node *n)
+{
+	return node_area(n) * (n->count ? n->count : 1);
 }
 
 static inline void box_union(const bvhlab_node *a, const bvhlab_node *b, float lo[3],
@@ -117,6 +128,10 @@ static inline uint32_t sibling_of(const reinsert *r, uint32_t x)
 
 	return x == first ? first + 1 : first;
 }
+
+/* The batch's candidates into cand[0 .. cand_count), on the team: 0 or a
+ * negative errno (no thread could run). hist must hold 65536 x threads. */
+int reinsert_choose(reinsert *r, double batch, unsigned threads, const team_host *th);
 
 /* Member t's share of the candidates: their best moves (reinsert_search.c). */
 void reinsert_search(reinsert *r);
