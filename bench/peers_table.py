@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Tables of one run of bench/peers.json, for README and docs/benchmarks.md.
 
-Usage: bench/peers_table.py RESULTS_DIR [--scene NAME]
+Usage: bench/peers_table.py RESULTS_DIR [--scene NAME | --summary]
 
 RESULTS_DIR holds the run's results.json and the report.md that bvhlab
 wrote beside it. Prints Markdown:
@@ -16,6 +16,10 @@ wrote beside it. Prints Markdown:
      own build, the strictest reading): the ratio, and whether it is at
      most 0.9. A peer run that failed validation has nothing to beat and
      is listed with its reason.
+
+With --summary, only one line per scene and thread count: how many valid
+peer runs are dominated at <= 0.9x, and the highest ratio (the closest
+call) with its peer and bvhlab builder.
 """
 import argparse
 import json
@@ -98,10 +102,10 @@ def own_ms(run):
     return run["build_ms"]["median"] - run.get("build_phases", {}).get("convert", 0.0)
 
 
-def verdicts(runs, scenes):
-    out = ["| scene | threads | peer | peer ms (no convert) | peer SAH | fastest bvhlab builder with SAH <= | its ms | its SAH | ratio | <= 0.9 |",
-           "|---|---:|---|---:|---:|---|---:|---:|---:|---|"]
-    misses = 0
+def comparisons(runs, scenes):
+    """Per scene, thread count and peer run: the fastest bvhlab run with
+    no higher SAH (None if there is none), the ratio of its time to the
+    peer's without conversion; a failed peer run carries its reason."""
     for scene in scenes:
         for t in (1, 2):
             ours = [r for r in runs if r["scene"] == scene and r["threads"] == t and
@@ -109,26 +113,58 @@ def verdicts(runs, scenes):
             for p in runs:
                 if p["scene"] != scene or p["threads"] != t or p["plugin"] not in PEERS:
                     continue
-                if p["status"] != "ok":
-                    reason = p.get("error", p["status"])
-                    out.append(f"| {scene} | {t} | {p['builder']} | {p['status']}: {reason} | | | | | | nothing to beat |")
-                    continue
-                sah = p["tree"]["sah_cost"]
-                best = min((r for r in ours if r["tree"]["sah_cost"] <= sah),
-                           key=lambda r: r["build_ms"]["median"], default=None)
-                pm = own_ms(p)
-                if best is None:
-                    misses += 1
-                    out.append(f"| {scene} | {t} | {p['builder']} | {fmt_ms(pm)} | {sah:.3f} | none | | | | **no** |")
-                    continue
-                ratio = best["build_ms"]["median"] / pm
-                ok = ratio <= 0.9
-                misses += not ok
-                out.append(f"| {scene} | {t} | {p['builder']} | {fmt_ms(pm)} | {sah:.3f} | {best['builder']} | "
-                           f"{fmt_ms(best['build_ms']['median'])} | {best['tree']['sah_cost']:.3f} | "
-                           f"{ratio:.2f} | {'yes' if ok else '**no**'} |")
+                c = {"scene": scene, "threads": t, "peer": p, "best": None, "ratio": None}
+                if p["status"] == "ok":
+                    sah = p["tree"]["sah_cost"]
+                    c["best"] = min((r for r in ours if r["tree"]["sah_cost"] <= sah),
+                                    key=lambda r: r["build_ms"]["median"], default=None)
+                    if c["best"] is not None:
+                        c["ratio"] = c["best"]["build_ms"]["median"] / own_ms(p)
+                yield c
+
+
+def met(c):
+    return c["ratio"] is not None and c["ratio"] <= 0.9
+
+
+def verdicts(runs, scenes):
+    out = ["| scene | threads | peer | peer ms (no convert) | peer SAH | fastest bvhlab builder with SAH <= | its ms | its SAH | ratio | <= 0.9 |",
+           "|---|---:|---|---:|---:|---|---:|---:|---:|---|"]
+    misses = 0
+    for c in comparisons(runs, scenes):
+        p, best, lead = c["peer"], c["best"], f"| {c['scene']} | {c['threads']} | {c['peer']['builder']} |"
+        if p["status"] != "ok":
+            out.append(f"{lead} {p['status']}: {p.get('error', p['status'])} | | | | | | nothing to beat |")
+            continue
+        misses += not met(c)
+        head = f"{lead} {fmt_ms(own_ms(p))} | {p['tree']['sah_cost']:.3f} |"
+        if best is None:
+            out.append(f"{head} none | | | | **no** |")
+            continue
+        out.append(f"{head} {best['builder']} | {fmt_ms(best['build_ms']['median'])} | "
+                   f"{best['tree']['sah_cost']:.3f} | {c['ratio']:.2f} | {'yes' if met(c) else '**no**'} |")
     out.append("")
     out.append(f"Peer runs not dominated at <= 0.9x: {misses}.")
+    return out
+
+
+def summary(runs, scenes):
+    """One row per scene and thread count: valid peer runs, how many are
+    dominated at <= 0.9x, and the closest call."""
+    out = ["| scene | threads | valid peer runs | dominated at <= 0.9x | highest ratio: peer, bvhlab builder |",
+           "|---|---:|---:|---:|---|"]
+    for scene in scenes:
+        for t in (1, 2):
+            cs = [c for c in comparisons(runs, [scene]) if c["threads"] == t and c["peer"]["status"] == "ok"]
+            if not cs:
+                continue
+            worst = max(cs, key=lambda c: float("inf") if c["ratio"] is None else c["ratio"])
+            close = (f"{worst['peer']['builder']}: none with SAH <=" if worst["best"] is None else
+                     f"{worst['ratio']:.2f}: {worst['peer']['builder']} "
+                     f"({fmt_ms(own_ms(worst['peer']))} ms, SAH {worst['peer']['tree']['sah_cost']:.3f}), "
+                     f"{worst['best']['builder']} ({fmt_ms(worst['best']['build_ms']['median'])} ms, "
+                     f"SAH {worst['best']['tree']['sah_cost']:.3f})")
+            out.append(f"| {scene} | {t} | {len(cs)} | {sum(map(met, cs))} | {close} |")
     return out
 
 
@@ -136,6 +172,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("results_dir")
     ap.add_argument("--scene", help="only this scene's builder table")
+    ap.add_argument("--summary", action="store_true",
+                    help="only one line per scene and thread count: peers dominated, the closest call")
     args = ap.parse_args()
     try:
         results, report = load(args.results_dir)
@@ -147,6 +185,9 @@ def main():
     m = results["machine"]
     print(f"Machine: {m.get('cpu', '?')}, {m.get('cores', '?')} cores; bvhlab {results.get('bvhlab_version', '?')}, {results.get('created', '?')}.")
     print()
+    if args.summary:
+        print("\n".join(summary(runs, scenes)))
+        return
     for scene in ([args.scene] if args.scene else scenes):
         print("\n".join(scene_table(runs, fronts, scene)))
         print()

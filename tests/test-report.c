@@ -423,6 +423,36 @@ static void test_whole_ticks(void)
 	free(svg);
 }
 
+/* One degenerate tree's SAH, thousands of times the others' (tinybvh quick
+ * on conference.obj): drawn as a triangle at the top edge with its value
+ * in the tooltip, the axis scaled to the others (linear, its highest tick
+ * near their highest value); without it the axis would be a log one up to
+ * 259,446. The same points without the outlier draw no triangle. */
+static void test_off_chart(void)
+{
+	struct svg_point p[] = {{"a x1", "a", 10, 31.2, "#1f77b4", true},
+	                        {"b x1", "b", 20, 30.1, "#ff7f0e", true},
+	                        {"c x1", "c", 30, 36.6, "#2ca02c", false},
+	                        {"q x1", "q", 7, 259446.2, "#d62728", true}};
+	struct strbuf sb = {0};
+	svg_scatter(&sb, "SAH cost vs. build time, 1 thread", "build time (ms)", "SAH cost", p, 4);
+	char *svg = sb_take(&sb);
+	CHECK(svg != NULL);
+	CHECK_CONTAINS(svg, "<polygon points=");
+	CHECK_CONTAINS(svg, "q x1: 259446, off the chart</title></polygon>");
+	CHECK_CONTAINS(svg, "off the chart, value in its tooltip");
+	CHECK(!strstr(svg, "log scale"));
+	CHECK_CONTAINS(svg, "text-anchor=\"end\">36</text>");
+	CHECK(!strstr(svg, "text-anchor=\"end\">100000</text>"));
+	free(svg);
+	svg_scatter(&sb, "SAH cost vs. build time, 1 thread", "build time (ms)", "SAH cost", p, 3);
+	svg = sb_take(&sb);
+	CHECK(svg != NULL);
+	CHECK(!strstr(svg, "<polygon"));
+	CHECK(!strstr(svg, "off the chart"));
+	free(svg);
+}
+
 int main(void)
 {
 	test_front_points();
@@ -435,5 +465,6 @@ int main(void)
 	test_heat_scales();
 	test_leader_lines();
 	test_whole_ticks();
+	test_off_chart();
 	return test_finish();
 }

@@ -109,14 +109,47 @@ struct axis {
  * would crush the small ones into the corner. */
 #define LOG_SPAN 20.0
 
-/* The range of the points' x or y, padded; never empty. */
-static void range(const struct svg_point *p, size_t n, bool y, struct axis *a)
+/* A scatter's y values above this many times their median are drawn at
+ * the plot's top edge, not scaled: one degenerate tree (tinybvh quick's
+ * SAH 259,446 on conference.obj, where the others lie between 30 and 70)
+ * otherwise squeezed every other point into one band. */
+#define OFF_CHART 10.0
+
+static int ascending(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+/* The value above which a scatter's y is off the chart: OFF_CHART times
+ * the median of the finite values; infinite when none is above or there
+ * are too few points to call one an outlier. */
+static double off_chart(const struct svg_point *p, size_t n)
+{
+	double *v = malloc((n ? n : 1) * sizeof(*v)), cap = INFINITY;
+	size_t m = 0;
+	for (size_t i = 0; v && i < n; i++)
+		if (isfinite(p[i].x) && isfinite(p[i].y))
+			v[m++] = p[i].y;
+	if (m >= 3) {
+		qsort(v, m, sizeof(*v), ascending);
+		double median = m % 2 ? v[m / 2] : 0.5 * (v[m / 2 - 1] + v[m / 2]);
+		if (median > 0 && v[m - 1] > OFF_CHART * median)
+			cap = OFF_CHART * median;
+	}
+	free(v);
+	return cap;
+}
+
+/* The range of the points' x or y (values above cap left out), padded;
+ * never empty. */
+static void range(const struct svg_point *p, size_t n, bool y, double cap, struct axis *a)
 {
 	double lo = INFINITY, hi = -INFINITY;
 	a->whole = true;
 	for (size_t i = 0; i < n; i++) {
 		double v = y ? p[i].y : p[i].x;
-		if (isfinite(v)) {
+		if (isfinite(v) && v <= cap) {
 			lo = v < lo ? v : lo;
 			hi = v > hi ? v : hi;
 			a->whole = a->whole && v == floor(v);
@@ -137,6 +170,7 @@ static void range(const struct svg_point *p, size_t n, bool y, struct axis *a)
 
 struct frame {
 	struct axis x, y;
+	double y_cap; /* y above this is drawn at the top edge (off_chart) */
 };
 
 /* Position along an axis in [0, 1]. */
@@ -153,6 +187,8 @@ static double px(const struct frame *f, double x)
 
 static double py(const struct frame *f, double y)
 {
+	if (y > f->y_cap)
+		return PAD_T;
 	return PAD_T + PLOT_H - unit(&f->y, y) * PLOT_H;
 }
 
@@ -220,7 +256,8 @@ static void axes(struct strbuf *sb, const struct frame *f, const char *xname, co
 	char name[160];
 	snprintf(name, sizeof(name), "%s%s", xname, f->x.log ? " (log scale)" : "");
 	text_at(sb, PLOT_X + 0.5 * (W - PLOT_X - PAD_R), PAD_T + PLOT_H + 32, "middle", name);
-	snprintf(name, sizeof(name), "%s%s", yname, f->y.log ? " (log scale)" : "");
+	snprintf(name, sizeof(name), "%s%s%s", yname, f->y.log ? " (log scale)" : "",
+	         isfinite(f->y_cap) ? " (\u25b2 at the top: off the chart, value in its tooltip)" : "");
 	text_at(sb, PLOT_X + 2, PAD_T - 8, "start", name); /* below the title's line */
 }
 
@@ -267,10 +304,12 @@ static int legend(struct strbuf *sb, const struct svg_point *p, size_t n, double
 }
 
 static double plot_frame(struct strbuf *sb, const char *title, const char *xname,
-                         const char *yname, const struct svg_point *p, size_t n, struct frame *f)
+                         const char *yname, const struct svg_point *p, size_t n, double y_cap,
+                         struct frame *f)
 {
-	range(p, n, false, &f->x);
-	range(p, n, true, &f->y);
+	f->y_cap = y_cap;
+	range(p, n, false, INFINITY, &f->x);
+	range(p, n, true, y_cap, &f->y);
 	int rows = legend(NULL, p, n, 0);
 	open_svg(sb, title, PAD_T + PLOT_H + PAD_B + 8 + rows * LEGEND_H);
 	axes(sb, f, xname, yname);
@@ -430,14 +469,24 @@ static void front_line(struct strbuf *sb, const struct frame *f, const struct sv
 	sb_printf(sb, "\"/>");
 }
 
-/* A point with its label as a tooltip; front points are ringed. */
+/* A point with its label as a tooltip; front points are ringed. One off
+ * the chart is a triangle at the top edge, its value in the tooltip. */
 static void marker(struct strbuf *sb, const struct frame *f, const struct svg_point *p)
 {
-	sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\" fill=\"%s\"%s><title>",
-	          px(f, p->x), py(f, p->y), MARKER_R, p->colour,
-	          p->front ? " stroke=\"#222\" stroke-width=\"1.5\"" : "");
+	const char *ring = p->front ? " stroke=\"#222\" stroke-width=\"1.5\"" : "";
+	double x = px(f, p->x), y = py(f, p->y);
+	bool off = p->y > f->y_cap;
+	if (off)
+		sb_printf(sb, "<polygon points=\"%.1f,%.1f %.1f,%.1f %.1f,%.1f\" fill=\"%s\"%s><title>",
+		          x, y - MARKER_R, x - MARKER_R, y + MARKER_R, x + MARKER_R, y + MARKER_R,
+		          p->colour, ring);
+	else
+		sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\" fill=\"%s\"%s><title>", x, y,
+		          MARKER_R, p->colour, ring);
 	report_escape(sb, p->label);
-	sb_printf(sb, "</title></circle>");
+	if (off)
+		sb_printf(sb, ": %.6g, off the chart", p->y);
+	sb_printf(sb, off ? "</title></polygon>" : "</title></circle>");
 }
 
 void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const char *yname,
@@ -446,7 +495,7 @@ void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const 
 	struct frame f;
 	struct placed taken[128];
 	size_t nt = 0;
-	double legend_top = plot_frame(sb, title, xname, yname, p, n, &f);
+	double legend_top = plot_frame(sb, title, xname, yname, p, n, off_chart(p, n), &f);
 	front_line(sb, &f, p, n);
 	for (size_t i = 0; i < n; i++) {
 		if (!isfinite(p[i].x) || !isfinite(p[i].y))
@@ -479,7 +528,7 @@ void svg_lines(struct strbuf *sb, const char *title, const char *xname, const ch
                const struct svg_point *p, size_t n)
 {
 	struct frame f;
-	double legend_top = plot_frame(sb, title, xname, yname, p, n, &f);
+	double legend_top = plot_frame(sb, title, xname, yname, p, n, INFINITY, &f);
 	for (size_t i = 0; i < n; i++) {
 		if (!opens_group(p, n, i))
 			continue; /* the legend names only what is drawn */

@@ -120,7 +120,9 @@ static void find_split(reinsert *r, unsigned members, uint32_t k)
 }
 
 /* The blocks' keys above the split to the candidates, in block order;
- * the split bucket's moved down to keys[0 ..), sorted, the largest taken. */
+ * the split bucket's moved down to keys[0 ..), sorted, the largest taken.
+ * The move never reaches a block not yet read: block b's bucket keys go
+ * below the end of block b, after its keys above were taken. */
 static void gather(reinsert *r, uint32_t k)
 {
 	uint32_t n = r->node_count - 1, blocks = (n + CHOOSE_BLOCK - 1) / CHOOSE_BLOCK, eq = 0;
