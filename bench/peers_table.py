@@ -154,8 +154,9 @@ def summary(runs, scenes):
     out = ["| scene | threads | valid peer runs | dominated at <= 0.9x | highest ratio: peer, bvhlab builder |",
            "|---|---:|---:|---:|---|"]
     for scene in scenes:
+        valid = [c for c in comparisons(runs, [scene]) if c["peer"]["status"] == "ok"]
         for t in (1, 2):
-            cs = [c for c in comparisons(runs, [scene]) if c["threads"] == t and c["peer"]["status"] == "ok"]
+            cs = [c for c in valid if c["threads"] == t]
             if not cs:
                 continue
             worst = max(cs, key=lambda c: float("inf") if c["ratio"] is None else c["ratio"])

@@ -157,12 +157,18 @@ bool refit_leaf(const refit *r, bvhlab_node *n)
 	return true;
 }
 
-/* An inner node's box from its two (refitted) children, first child first. */
-void refit_inner(const refit *r, bvhlab_node *n)
+/* n's box the union of the pair c[0], c[1], first child first; n's first
+ * and count kept. */
+static inline void union_pair(bvhlab_node *n, const bvhlab_node *c)
 {
-	const bvhlab_node *c = &r->nodes[n->first];
 	store4(n->lo, keep_fourth(min4(load4(c[0].lo), load4(c[1].lo)), load4(n->lo)));
 	store4(n->hi, keep_fourth(max4(load4(c[0].hi), load4(c[1].hi)), load4(n->hi)));
+}
+
+/* An inner node's box from its two (refitted) children. */
+void refit_inner(const refit *r, bvhlab_node *n)
+{
+	union_pair(n, &r->nodes[n->first]);
 }
 
 /* Nodes [a, b) of a span sorted by kind, from the end: the leaves to the
@@ -236,10 +242,8 @@ static unsigned inner(const refit *r, const uint32_t *idx, uint32_t from, uint32
 		uint32_t i = idx[j];
 		bvhlab_node *n = &r->nodes[i];
 		uint32_t first = n->first, ok = (first > i) & (first <= s.hi - 2);
-		const bvhlab_node *c = &r->nodes[pick(ok, first, s.hi - 2)];
 		bad |= ok ^ 1u;
-		store4(n->lo, keep_fourth(min4(load4(c[0].lo), load4(c[1].lo)), load4(n->lo)));
-		store4(n->hi, keep_fourth(max4(load4(c[0].hi), load4(c[1].hi)), load4(n->hi)));
+		union_pair(n, &r->nodes[pick(ok, first, s.hi - 2)]);
 	}
 	return bad;
 }

@@ -74,13 +74,13 @@ static struct entry pop(struct queue *q)
  * Node x's ancestors above its parent P, each with its box as it will
  * be once x and P are out; a children move's searches see those boxes
  * (found through a small hash set of the path's nodes, so the subtree
- * moves' queue stays as it was). With x's own boxes,
- * putting a child back anywhere under x's old ancestors looked free,
- * though it grows them again from what x's removal left: after sah_tasks
- * high on sponza subdivided twice (measure area, 2 threads), 82 % of the
- * children moves so predicted raised the SAH when carried out and were
- * undone, against 63 % now, and 3 iterations reach 75.724 instead of
- * 75.934 in 219 ms instead of 242. A path deeper than PATH_DEPTH is not
+ * moves' queue stays as it was). With x's own boxes, putting a child back
+ * anywhere under x's old ancestors looked free, though it grows them
+ * again from what x's removal left: after sah_tasks high on sponza
+ * subdivided twice (measure area, 2 threads), 82 % of the children moves
+ * so predicted raised the SAH when carried out and were undone, against
+ * 63 % now, and 3 iterations reach 75.724 instead of 75.934 in 219 ms
+ * instead of 242. A path deeper than PATH_DEPTH is not
  * kept: the searches then see x's boxes, as before, and the exact
  * bookkeeping settles it.
  */

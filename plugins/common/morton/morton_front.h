@@ -57,6 +57,7 @@ static inline size_t morton_align64(size_t x)
 /* Threads for a build of in: in->threads, fewer on a small input. */
 unsigned morton_team_size(const bvhlab_build_input *in);
 
+/* The sort's three buffers of n words, one after another at `at`. */
 static inline size_t morton_sort_bytes(size_t n)
 {
 	return 3 * morton_align64(8 * n);
@@ -82,8 +83,8 @@ void morton_scratch_free(morton_scratch *scratch);
 /*
  * A Morton build's scratch, placed: `work` bytes past the tree of n
  * primitives in the output when it has the `spare` nodes of room asked
- * for (big_spare_nodes; then *work_in_output, if not NULL, is true), else at the start of a
- * fresh mapping; the sort's buffers in the output's first nodes, which the
+ * for (big_spare_nodes; then *work_in_output, if not NULL, is true), else
+ * at the start of a fresh mapping; the sort's buffers in the output's first nodes, which the
  * tree is written over only after the sort, when they fit, else in the
  * mapping after the work. The digit counts and `extra` words per thread as
  * morton_scratch_alloc. Returns the work area, or NULL when out of memory
