@@ -17,7 +17,7 @@ missing_debs() {
 	if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists hwloc; then
 		missing="$missing libhwloc-dev"
 	fi
-	# Images (core/output/image_oiio.cpp): OpenImageIO and a C++ compiler for that one file.
+	# Images (core/output/images_oiio.cpp, the module bvhlab-images.so): OpenImageIO and a C++ compiler for that one file.
 	command -v c++ >/dev/null 2>&1 || missing="$missing g++"
 	if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists OpenImageIO; then
 		missing="$missing libopenimageio-dev"

@@ -26,6 +26,7 @@
 #include "harness/progress.h"
 #include "machine/machine.h"
 #include "output/results.h"
+#include "output/image.h"
 #include "output/images.h"
 #include "output/safe_file.h"
 #include "plan/plan.h"
@@ -40,6 +41,7 @@ struct harness {
 	struct progress progress;
 	bool all_ok;
 	struct harness_tally tally;
+	bool images;     /* images asked for, and the images module is there */
 	bool shade_done; /* this scene's shaded render is on its way */
 	bool rounds_on;  /* this scene's rays are timed in interleaved rounds */
 	struct harness_rounds rounds; /* this scene's trees waiting for them */
@@ -345,7 +347,7 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 static void image_paths(struct harness *h, struct series_job *job, size_t scene_index,
                         size_t builder_index, bool first, char (*paths)[4096])
 {
-	if (!h->cfg->images || h->cfg->ray_width == 0 || h->cfg->ray_height == 0)
+	if (!h->images)
 		return;
 	/* Unlinked first: a run that dies or times out leaves no data, and no
 	 * older run's is drawn in its place. */
@@ -467,7 +469,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	run_list_scene(h, scene, &prims, s);
 	harness_rounds_end(&h->rounds, &h->res, h->cfg, scene, &prims, h->progress.tty);
 	h->rounds_on = false;
-	if (h->cfg->images && h->cfg->ray_width && h->cfg->ray_height)
+	if (h->images)
 		scene_images(h, scene, s);
 out:
 	harness_anim_close(&h->anim);
@@ -500,6 +502,19 @@ static int make_list(struct harness *h, const struct harness_options *opts, bvhl
 	if (r == 0 && opts->only)
 		r = plan_parse_only(opts->only, h->list.count, &h->only, err);
 	return r;
+}
+
+/* Images when asked for and drawable; a bundle without the images module
+ * says so in one line and runs on. */
+static bool want_images(const struct config *cfg)
+{
+	const char *why;
+	if (!cfg->images || cfg->ray_width == 0 || cfg->ray_height == 0)
+		return false;
+	if (image_module_ready(&why))
+		return true;
+	fprintf(stderr, "bvhlab: images skipped (%s); the run goes on\n", why);
+	return false;
 }
 
 /* The folder locked and claimed, the document started (resumed). */
@@ -535,6 +550,7 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 	struct harness h = {.cfg = cfg, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
 	bvhlab_set_pinning(cfg->pin);
+	h.images = want_images(cfg);
 	/* Every builder's plugin and options first, before the folder is touched. */
 	int r = harness_open_sweep_builders(cfg, &h.builders, err);
 	if (r == 0)

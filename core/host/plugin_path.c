@@ -22,6 +22,8 @@
 
 #include <bvhlab/host.h>
 
+#include "host/plugin_search.h"
+
 /*
  * Where an install keeps its plugins, relative to the install prefix, and
  * where the bvhlab command and the library sit relative to it (meson's
@@ -140,6 +142,27 @@ static void install_plugins(char *out, size_t size)
 		out[0] = '\0';
 }
 
+/* The build tree's plugins/ when this binary runs from one, else the
+ * install's plugin folder. */
+static void home_plugins(char *out, size_t size)
+{
+	build_tree_plugins(out, size);
+	if (!*out)
+		install_plugins(out, size);
+}
+
+int plugin_home_file(const char *name, char *out, size_t size)
+{
+	char dir[PATH_MAX + 16];
+	home_plugins(dir, sizeof(dir));
+	char *slash = strrchr(dir, '/');
+	if (!slash)
+		return -ENOENT;
+	*slash = '\0';
+	int n = snprintf(out, size, "%s/%s", dir, name);
+	return n < 0 || (size_t)n >= size ? -ENAMETOOLONG : 0;
+}
+
 /* $BVHLAB_PLUGIN_PATH, then the build tree's plugins/ when this binary runs
  * from one, else the install's. */
 const char *bvhlab_plugin_search_path(void)
@@ -147,9 +170,7 @@ const char *bvhlab_plugin_search_path(void)
 	static char path[3 * PATH_MAX];
 	char tree[PATH_MAX + 16];
 	const char *env = getenv("BVHLAB_PLUGIN_PATH");
-	build_tree_plugins(tree, sizeof(tree));
-	if (!*tree)
-		install_plugins(tree, sizeof(tree));
+	home_plugins(tree, sizeof(tree));
 	snprintf(path, sizeof(path), "%s%s%s", env ? env : "", env && *env && *tree ? ":" : "",
 	         tree);
 	return path;

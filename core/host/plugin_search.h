@@ -17,4 +17,12 @@
  */
 int plugin_resolve(const char *name, char *out, size_t size, bvhlab_error *err);
 
+/*
+ * The file `name` in the plugin folder's parent, the build tree's root or
+ * the install's <libdir>/bvhlab: where bvhlab keeps its own optional
+ * modules (bvhlab-images.so), found as the plugins are, from the binary's
+ * own file. 0, -ENOENT (no folder) or -ENAMETOOLONG.
+ */
+int plugin_home_file(const char *name, char *out, size_t size);
+
 #endif /* BVHLAB_CORE_PLUGIN_SEARCH_H */

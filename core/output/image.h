@@ -1,11 +1,13 @@
 /*
  * Images: PNG (or any format OpenImageIO knows by the file's extension)
- * through image_oiio.cpp, and the C helpers that turn traced rays into
+ * through the optional module bvhlab-images.so (image_module.c loads
+ * images_oiio.cpp's build), and the C helpers that turn traced rays into
  * pixels: shading, heat-map colours, the legend's gradient, file names.
  */
 #ifndef BVHLAB_CORE_IMAGE_H
 #define BVHLAB_CORE_IMAGE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -15,10 +17,15 @@
 extern "C" {
 #endif
 
-/* Writes 8-bit RGB pixels, row-major from the top. 0 or -EIO with err set. */
+/* Whether bvhlab-images.so is there (opened on the first call); if not,
+ * *why (when why is not NULL) says what was tried. */
+bool image_module_ready(const char **why);
+/* Writes 8-bit RGB pixels, row-major from the top. 0, or -EIO (-ENOTSUP
+ * without the module) with err set. */
 int image_write_rgb8(const char *path, int width, int height, const uint8_t *rgb,
                      bvhlab_error *err);
-/* Reads an image as 8-bit RGB (*rgb malloc'd). 0 or -EIO / -ENOMEM with err set. */
+/* Reads an image as 8-bit RGB (*rgb malloc'd). 0 or -EIO / -ENOMEM /
+ * -ENOTSUP with err set. */
 int image_read_rgb8(const char *path, int *width, int *height, uint8_t **rgb,
                     bvhlab_error *err);
 

@@ -1,5 +1,7 @@
-// The core's one C++ file: OpenImageIO behind a C interface, so the rest of
-// the core stays C11 and OIIO's exceptions never cross into C.
+// The images module, bvhlab-images.so: OpenImageIO behind a C interface,
+// loaded by core/output/image_module.c only when images are drawn, so that
+// bvhlab itself links neither OIIO nor its ~250 libraries (a relocatable
+// bundle leaves the module out) and OIIO's exceptions never cross into C.
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -9,7 +11,7 @@
 
 #include <OpenImageIO/imageio.h>
 
-#include "output/image.h"
+#include <bvhlab/types.h>
 
 namespace {
 
@@ -33,8 +35,11 @@ void single_threaded()
 
 } // namespace
 
-extern "C" int image_write_rgb8(const char *path, int width, int height, const uint8_t *rgb,
-                                bvhlab_error *err)
+// What image_module.c looks up (its typedefs give the same signatures).
+#define EXPORT extern "C" __attribute__((visibility("default")))
+
+EXPORT int bvhlab_image_write_rgb8(const char *path, int width, int height,
+                                   const uint8_t *rgb, bvhlab_error *err)
 {
 	try {
 		single_threaded();
@@ -56,8 +61,8 @@ extern "C" int image_write_rgb8(const char *path, int width, int height, const u
 	}
 }
 
-extern "C" int image_read_rgb8(const char *path, int *width, int *height, uint8_t **rgb,
-                               bvhlab_error *err)
+EXPORT int bvhlab_image_read_rgb8(const char *path, int *width, int *height, uint8_t **rgb,
+                                  bvhlab_error *err)
 {
 	*rgb = nullptr;
 	try {
