@@ -4,8 +4,9 @@
 # drivers hidden (OCL_ICD_VENDORS at an empty folder) the cl_* runs are
 # `failed` with the message that says what to install and lbvh's run is
 # ok; with the machine's drivers, every run is ok and the device runs
-# carry build_phases (device no more than build_ms). Skips (77) when the
-# machine has no OpenCL device.
+# carry build_phases (device no more than build_ms); with the device's
+# memory capped low (BVHLAB_CL_MEM_CAP_MB) the cl_* runs fail with the
+# figures. Skips (77) when the machine has no OpenCL device.
 set -u
 bvhlab=$1
 dir=$(mktemp -d /tmp/bvhlab-cl-sweep-XXXXXX) || exit 1
@@ -18,7 +19,7 @@ cat > "$dir/sweep.json" <<JSON
 }
 JSON
 check() { # check RESULTS_DIR python-assertions...
-	python3 - "$1/results.json" "$2" <<'PY'
+	python3 - "$1/results.json" "$2" "${3:-}" <<'PY'
 import json, sys
 runs = json.load(open(sys.argv[1]))["runs"]
 by = {r["builder"]: r for r in runs}
@@ -34,6 +35,29 @@ for b in ("cl_lbvh", "cl_ploc"):
 assert by["lbvh"]["status"] == "ok", by["lbvh"]
 print("no drivers: cl_* failed with the message, lbvh ok")
 ' || { cat "$dir/log"; exit 1; }
+# Device memory sized before any kernel: with the limits capped low, both
+# device builders fail with the need and the limit, never a driver error.
+for cap in 0.2 0.05; do
+	BVHLAB_CL_MEM_CAP_MB=$cap "$bvhlab" run "$dir/sweep.json" --out "$dir/cap$cap" \
+		>"$dir/log" 2>&1
+	check "$dir/cap$cap" '
+cap = sys.argv[3]
+if "no OpenCL platform" in by["cl_lbvh"].get("error", "") or "no such OpenCL device" in by["cl_lbvh"].get("error", ""):
+    print("skip: no OpenCL device:", by["cl_lbvh"]["error"]); sys.exit(77)
+import re
+want = (r"the build needs (\d+\.\d\d) MiB of device memory, .* has 0\.20 MiB "
+        if cap == "0.2" else
+        r"a buffer of (\d+\.\d\d) MiB is more than .* allows in one allocation, 0\.05 MiB ")
+for b in ("cl_lbvh", "cl_ploc"):
+    assert by[b]["status"] == "failed", by[b]
+    m = re.search(want + r"\(capped by \$BVHLAB_CL_MEM_CAP_MB\)", by[b]["error"])
+    assert m and float(m.group(1)) > float(cap), by[b]["error"]
+assert by["lbvh"]["status"] == "ok", by["lbvh"]
+print("memory capped at", cap, "MiB:", by["cl_lbvh"]["error"])
+' "$cap"
+	rc=$?
+	[ $rc = 0 ] || { [ $rc = 77 ] || cat "$dir/log"; exit $rc; }
+done
 "$bvhlab" run "$dir/sweep.json" --out "$dir/dev" >"$dir/log" 2>&1
 check "$dir/dev" '
 if "no OpenCL platform" in by["cl_lbvh"].get("error", "") or "no such OpenCL device" in by["cl_lbvh"].get("error", ""):

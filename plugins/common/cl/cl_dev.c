@@ -1,5 +1,6 @@
 /* The device builders' device, buffers, launches and events (cl_dev.h). */
 #include <errno.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -83,23 +84,46 @@ static size_t rounded(size_t bytes)
 	return bytes < 4096 ? 4096 : (bytes + 65535) & ~(size_t)65535;
 }
 
+/* The device's memory and largest allocation, both capped at
+ * $BVHLAB_CL_MEM_CAP_MB MiB when that is set: how the tests make a small
+ * scene not fit. */
+static void mem_limits(const cl_dev *d, double *global, double *alloc, const char **cap_note)
+{
+	const char *cap = getenv("BVHLAB_CL_MEM_CAP_MB");
+	char *end = NULL;
+	double mb = cap ? strtod(cap, &end) : 0.0;
+
+	*global = (double)d->cl.global_mem;
+	*alloc = (double)d->cl.max_alloc;
+	*cap_note = "";
+	if (!cap || end == cap || *end || !(mb > 0.0))
+		return;
+	mb *= 1024.0 * 1024.0;
+	*cap_note = mb < *global || mb < *alloc ? " (capped by $BVHLAB_CL_MEM_CAP_MB)" : "";
+	*global = mb < *global ? mb : *global;
+	*alloc = mb < *alloc ? mb : *alloc;
+}
+
+#define MIB(x) ((double)(x) / (1024.0 * 1024.0))
+
 int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
                 size_t err_size)
 {
-	size_t total = 0;
+	double total = 0, global, alloc;
+	const char *note;
 
+	mem_limits(d, &global, &alloc, &note);
 	for (unsigned k = 0; k < count; k++) {
-		total += rounded(want[k]);
-		if (rounded(want[k]) > d->cl.max_alloc)
+		total += (double)rounded(want[k]);
+		if ((double)rounded(want[k]) > alloc)
 			return bvhlab_cl_fail(-ENOMEM, err, err_size,
-				"cl: a buffer of %zu MiB is more than %s allows in one allocation "
-				"(%llu MiB)", rounded(want[k]) >> 20, d->cl.name,
-				(unsigned long long)(d->cl.max_alloc >> 20));
+				"cl: a buffer of %.2f MiB is more than %s allows in one allocation, "
+				"%.2f MiB%s", MIB(rounded(want[k])), d->cl.name, MIB(alloc), note);
 	}
-	if (total > d->cl.global_mem)
+	if (total > global)
 		return bvhlab_cl_fail(-ENOMEM, err, err_size,
-			"cl: the build needs %zu MiB of device memory, %s has %llu MiB",
-			total >> 20, d->cl.name, (unsigned long long)(d->cl.global_mem >> 20));
+			"cl: the build needs %.2f MiB of device memory, %s has %.2f MiB%s",
+			MIB(total), d->cl.name, MIB(global), note);
 	return 0;
 }
 

@@ -62,8 +62,11 @@ typedef struct cl_buf {
 } cl_buf;
 
 /* Whether buffers of want[k] bytes fit the device (each its largest
- * allocation, the sum its memory): 0, or -ENOMEM saying how much was
- * needed. */
+ * allocation, the sum its global memory): 0, or -ENOMEM with a message
+ * giving both figures, the need and the device's. Every device builder
+ * calls it with all its buffers (its own and the sort's) before it makes
+ * any, so a scene too big fails here, never in the driver. For tests,
+ * $BVHLAB_CL_MEM_CAP_MB caps both limits. */
 int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
                 size_t err_size);
 /* Makes every buffer at least its wanted size (want[k] bytes), after
