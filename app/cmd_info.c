@@ -59,7 +59,8 @@ static void print_text(const bvhlab_scene *s)
 	       s->bounds.lo[2], s->bounds.hi[0], s->bounds.hi[1], s->bounds.hi[2]);
 }
 
-/* "opencl": {"devices": [...]} or {"error": why there are none}. */
+/* "opencl": {"icd": how the driver was found, "devices": [...]} or {"error":
+ * why there are none}. */
 static void add_opencl_json(cJSON *o)
 {
 	struct machine_cl_device *d;
@@ -68,6 +69,7 @@ static void add_opencl_json(cJSON *o)
 	cJSON *cl = cJSON_AddObjectToObject(o, "opencl");
 	int r = machine_cl_devices(&d, &n, why, sizeof(why));
 	cJSON_AddBoolToObject(cl, "built", r != -ENOTSUP);
+	cJSON_AddStringToObject(cl, "icd", machine_icd_how());
 	if (r < 0) {
 		cJSON_AddStringToObject(cl, "error", why);
 		return;
@@ -131,6 +133,7 @@ static void print_opencl_text(void)
 	size_t n;
 	char why[512];
 	int r = machine_cl_devices(&d, &n, why, sizeof(why));
+	printf("OpenCL ICD: %s\n", machine_icd_how());
 	if (r < 0) {
 		printf("OpenCL:     %s\n", why);
 		return;

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "machine/machine.h"
 
 static const char usage[] =
 	"usage: bvhlab COMMAND [ARGS]\n"
@@ -40,6 +41,8 @@ int main(int argc, char **argv)
 		return EXIT_USAGE;
 	}
 	const char *cmd = argv[1];
+	/* Before any command can start the OpenCL ICD loader. */
+	machine_icd_setup();
 	if (!strcmp(cmd, "help") || !strcmp(cmd, "--help") || !strcmp(cmd, "-h")) {
 		fputs(usage, stdout);
 		return 0;

@@ -54,6 +54,18 @@ struct machine_cl_device {
 int machine_cl_devices(struct machine_cl_device **devices, size_t *count, char *why,
                        size_t why_size);
 
+/*
+ * Before the OpenCL ICD loader first runs (bvhlab's main calls it first):
+ * with no OCL_ICD_VENDORS and no .icd file in /etc/OpenCL/vendors (or
+ * $BVHLAB_CL_VENDORS_DIR), looks for NVIDIA's, AMD's, Intel's and PoCL's
+ * OpenCL libraries on LD_LIBRARY_PATH, then in the usual driver folders
+ * (or $BVHLAB_CL_DRIVER_DIRS), and points OCL_ICD_VENDORS at a private
+ * folder of .icd files naming those found (machine_icd.c).
+ */
+void machine_icd_setup(void);
+/* Which ICD the loader gets and how it was found, for info --machine. */
+const char *machine_icd_how(void);
+
 /* The 1-minute load average from /proc/loadavg, or -1 when unreadable. */
 double machine_load_average(void);
 
