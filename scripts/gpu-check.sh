@@ -22,7 +22,7 @@ while [ $# -gt 0 ]; do
 	case "$1" in
 	--cpu) device=cpu ;;
 	--limit) limit=${2:-}; shift ;;
-	-h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+	-h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
 	-*) echo "gpu-check: unknown option $1 (--help)" >&2; exit 1 ;;
 	*) break ;;
 	esac
