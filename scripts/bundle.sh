@@ -89,6 +89,10 @@ for name in names:
 EOF
 cp "$root/scripts/gpu-check.sh" "$out/gpu-check.sh"
 
+# The newest C library symbol version any of it asks for: the oldest glibc
+# it runs on.
+glibc_min=$(objdump -T "$out/bin/bvhlab" "$plugins"/*.so "$libs"/* 2>/dev/null |
+	grep -o 'GLIBC_[0-9.]*' | sed 's/GLIBC_//' | sort -uV | tail -1)
 bytes=$(du -sb "$out" | cut -f1)
-echo "bundle: $out: $((bytes / 1024 / 1024)) MiB ($bytes bytes), $(ls "$plugins" | wc -l) plugins, $(ls "$libs" | wc -l) libraries"
+echo "bundle: $out: $((bytes / 1024 / 1024)) MiB ($bytes bytes), $(ls "$plugins" | wc -l) plugins, $(ls "$libs" | wc -l) libraries, needs glibc >= ${glibc_min:-?}"
 [ "$bytes" -le "$max_bytes" ] || die "$out is $bytes bytes, over 64 MiB"
