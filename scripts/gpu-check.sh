@@ -110,7 +110,7 @@ for scene in tris:
         parts.append("%s %s %.2f ms (device %s, %s Mtris/s)%s" % (
             scene, dev, med(d[0]),
             "%.2f ms" % dev_ms if dev_ms else "?",
-            "%.0f" % (tris[scene] / dev_ms / 1e3) if dev_ms else "?",
+            "%.3g" % (tris[scene] / dev_ms / 1e3) if dev_ms else "?",
             " = %.2fx %s@%d" % (med(d[0]) / med(best), twin, best["threads"]) if best else ""))
 state = "done" if rc == 0 else "stopped by the limit" if rc in (124, 130, 137) else "exit %d" % rc
 print("gpu-check: %s, %d runs ok, %s: %s" % (name, len(runs), state, "; ".join(parts)))
