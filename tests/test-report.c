@@ -461,6 +461,74 @@ static void test_off_chart(void)
 	free(svg);
 }
 
+/* Three builders whose cost lines cross at known ray counts, by hand:
+ * a (1 ms, 10 Mrays/s: 1e-7 s a ray), b (5 ms, 5e-8 s), c (25 ms,
+ * 2.5e-8 s). a and b cost the same at 0.004 / 5e-8 = 80,000 rays, b and
+ * c at 0.020 / 2.5e-8 = 800,000 (a and c only at 320,000, past b's
+ * lead). e (20 ms, 4e-8 s) is on the front (faster to build than c,
+ * faster rays than b) but never lowest: c undercuts it from 333,333 rays,
+ * before e would undercut b at 1.5 M. d (30 ms, 5e-8 s) is behind b;
+ * f traced nothing and g failed: neither is a candidate. */
+static cJSON *budget_document(void)
+{
+	cJSON *doc = cJSON_Parse("{\"machine\": {\"cpu\": \"test\", \"cores\": 2}, \"config\": {}, "
+	                         "\"scenes\": [{\"name\": \"s\", \"triangles\": 100}], "
+	                         "\"runs\": []}");
+	cJSON *runs = cJSON_GetObjectItem(doc, "runs");
+	add_run(runs, "a", "lbvh", 1, (double[]){1, 1, 1}, 50, 12, 10, 5);
+	add_run(runs, "b", "sah_tasks", 1, (double[]){5, 5, 5}, 45, 10, 20, 5);
+	add_run(runs, "c", "sbvh", 1, (double[]){25, 25, 25}, 40, 9, 40, 5);
+	add_run(runs, "d", "ploc", 1, (double[]){30, 30, 30}, 45, 10, 20, 5);
+	add_run(runs, "e", "embree", 1, (double[]){20, 20, 20}, 44, 10, 25, 5);
+	cJSON_AddItemToArray(runs, cJSON_Parse("{\"scene\": \"s\", \"builder\": \"f\", "
+	                                       "\"plugin\": \"lbvh\", \"threads\": 1, \"status\": "
+	                                       "\"ok\", \"build_ms\": {\"median\": 0.5}}"));
+	cJSON_AddItemToArray(runs, cJSON_Parse("{\"scene\": \"s\", \"builder\": \"g\", "
+	                                       "\"threads\": 1, \"status\": \"failed\"}"));
+	return doc;
+}
+
+static void test_budget(void)
+{
+	const double build[] = {1e-3, 5e-3, 25e-3, NAN, 20e-3}, ray[] = {1e-7, 5e-8, 2.5e-8, 1e-9, 4e-8};
+	struct budget_interval iv[5];
+	CHECK_INT(report_budget_intervals(build, ray, 5, iv), 3);
+	CHECK_INT(iv[0].index, 0);
+	CHECK_INT(iv[1].index, 1);
+	CHECK_INT(iv[2].index, 2);
+	CHECK(iv[0].from == 0 && fabs(iv[0].to - 8e4) < 1e-6);
+	CHECK(fabs(iv[1].from - 8e4) < 1e-6 && fabs(iv[1].to - 8e5) < 1e-6);
+	CHECK(fabs(iv[2].from - 8e5) < 1e-6 && isinf(iv[2].to));
+	CHECK_INT(report_budget_intervals(build, ray, 0, iv), 0);
+	cJSON *doc = budget_document();
+	char *md = report_markdown(doc), *html = report_html(doc);
+	CHECK_CONTAINS(md, "## Summary\n\n**Cheapest for a ray budget**");
+	CHECK_CONTAINS(md, "- s, 1 thread: up to 80.0 k rays: a; up to 800.0 k: b; beyond: c\n");
+	CHECK_CONTAINS(md, "| 1 thread | a | 1.00 | 10.0 | 0 | 80.0 k |\n"
+	                   "| 1 thread | b | 5.00 | 20.0 | 80.0 k | 800.0 k |\n"
+	                   "| 1 thread | e | 20.0 | 25.0 | never cheapest | — |\n"
+	                   "| 1 thread | c | 25.0 | 40.0 | 800.0 k | beyond |\n");
+	CHECK(!strstr(md, "| 1 thread | d |") && !strstr(md, "| 1 thread | f |"));
+	CHECK_CONTAINS(html, "<li>s, 1 thread: up to 80.0 k rays: a; up to 800.0 k: b; beyond: c"
+	                     "</li>");
+	CHECK_CONTAINS(html, "Cost of a ray budget, 1 thread");
+	CHECK_CONTAINS(html, "primary rays (log scale)");
+	free(md);
+	free(html);
+	/* No run traced rays: said, not guessed; nothing crashes. */
+	cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
+		cJSON_DeleteItemFromObject(run, "rays");
+	md = report_markdown(doc);
+	html = report_html(doc);
+	CHECK_CONTAINS(md, "- s, 1 thread: not measured (no run traced rays)");
+	CHECK_CONTAINS(md, "| 1 thread | not measured |");
+	CHECK(!strstr(html, "Cost of a ray budget"));
+	free(md);
+	free(html);
+	cJSON_Delete(doc);
+}
+
 int main(void)
 {
 	test_front_points();
@@ -474,5 +542,6 @@ int main(void)
 	test_leader_lines();
 	test_whole_ticks();
 	test_off_chart();
+	test_budget();
 	return test_finish();
 }
