@@ -171,7 +171,8 @@ void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const 
  * marker too, and a legend. */
 void svg_lines(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                const struct svg_point *p, size_t n);
-/* svg_lines without the markers: points that sample a curve. */
+/* svg_lines with a marker at each line's end only: points that sample a
+ * curve. */
 void svg_curves(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                 const struct svg_point *p, size_t n);
 

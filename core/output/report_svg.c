@@ -575,10 +575,17 @@ static void lines(struct strbuf *sb, const char *title, const char *xname, const
 			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y))
 				sb_printf(sb, "%.1f,%.1f ", px(&f, p[j].x), py(&f, p[j].y));
 		sb_printf(sb, "\"/>");
-		/* Markers too: a series of one point draws no line. */
-		for (size_t j = i; j < n && markers; j++)
-			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y))
-				marker(sb, &f, &p[j], 3.5);
+		/* Markers too: a series of one point draws no line. A curve's
+		 * only at its end: its shape and its marks must show there too. */
+		size_t last = n;
+		for (size_t j = i; j < n; j++)
+			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y)) {
+				if (markers)
+					marker(sb, &f, &p[j], 3.5);
+				last = j;
+			}
+		if (!markers && last < n)
+			marker(sb, &f, &p[last], 3.5);
 	}
 	legend(sb, p, n, legend_top);
 	sb_printf(sb, "</svg>\n");
