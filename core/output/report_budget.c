@@ -91,23 +91,38 @@ static void group_finish(struct budget_group *g)
 	free(g->iv);
 }
 
-/* A scene's groups: its front entries, sorted by machine and threads. */
-struct budget_scene {
-	struct front_entry *e;
-	size_t n;
+/* What a walk over a scene's groups hands each one: the sections below
+ * print their header on the first. */
+struct budget_walk {
+	struct strbuf *sb, *charts;
 	const struct report_index *ix;
+	const char *scene;
+	bool html, opened;
+	size_t *order; /* room for a group's entries */
 };
 
-/* The next group from entry *at on: its first entry and size; 0 at the end. */
-static size_t next_group(const struct budget_scene *s, size_t *at, size_t *first)
+typedef void (*group_visit)(struct budget_walk *w, const struct budget_group *g);
+
+/* Calls visit for each group (machine and thread count) of the scene's
+ * front entries, which come sorted by machine and threads. */
+static void each_group(struct budget_walk *w, group_visit visit)
 {
-	size_t k = *at;
-	*first = k;
-	while (k < s->n && s->e[k].machine == s->e[*first].machine &&
-	       s->e[k].threads == s->e[*first].threads)
-		k++;
-	*at = k;
-	return k - *first;
+	size_t count, n;
+	const cJSON *const *runs = report_scene_runs(w->ix, w->scene, &count);
+	struct front_entry *e = report_front_entries(w->ix, runs, count, &n);
+	w->order = calloc(n + 1, sizeof(*w->order));
+	for (size_t first = 0, k = 0; e && w->order && first < n; first = k) {
+		while (k < n && e[k].machine == e[first].machine && e[k].threads == e[first].threads)
+			k++;
+		struct budget_group g;
+		if (group_init(&g, &e[first], k - first) == 0)
+			visit(w, &g);
+		group_finish(&g);
+	}
+	if (!e || !w->order)
+		w->sb->failed = true;
+	free(w->order);
+	free(e);
 }
 
 /* "1.2 M" rays (report_breakeven.c's count, without the unit). */
@@ -147,57 +162,45 @@ static void verdict_line(struct strbuf *sb, const struct budget_group *g)
 	}
 }
 
-static int scene_init(struct budget_scene *s, const struct report_index *ix, const char *scene)
+/* The text in Markdown or, escaped, in HTML. */
+static void put(struct strbuf *sb, bool html, const char *text)
 {
-	size_t count;
-	const cJSON *const *runs = report_scene_runs(ix, scene, &count);
-	s->ix = ix;
-	s->e = report_front_entries(ix, runs, count, &s->n);
-	return s->e ? 0 : -1;
+	if (html)
+		report_escape(sb, text);
+	else
+		sb_printf(sb, "%s", text);
+}
+
+static void summary_line(struct budget_walk *w, const struct budget_group *g)
+{
+	char title[64];
+	if (!w->opened)
+		sb_printf(w->sb, w->html ? "<p><b>Cheapest for a ray budget</b> (build plus primary "
+		                           "rays at the measured Mrays/s; see each scene's table):"
+		                           "</p>\n<ul>\n"
+		                         : "**Cheapest for a ray budget** (build plus primary rays "
+		                           "at the measured Mrays/s; see each scene's table):\n\n");
+	w->opened = true;
+	sb_printf(w->sb, w->html ? "<li>" : "- ");
+	put(w->sb, w->html, w->scene);
+	sb_printf(w->sb, ", %s: ", group_title(title, sizeof(title), w->ix, &g->e[0]));
+	struct strbuf line = {0};
+	verdict_line(&line, g);
+	char *text = sb_take(&line);
+	put(w->sb, w->html, text ? text : "");
+	free(text);
+	sb_printf(w->sb, w->html ? "</li>\n" : "\n");
 }
 
 void report_budget_summary(struct strbuf *sb, const struct report_index *ix, bool html)
 {
 	const cJSON *scene;
-	bool any = false;
+	struct budget_walk w = {.sb = sb, .ix = ix, .html = html};
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(ix->doc, "scenes")) {
-		struct budget_scene s;
-		size_t at = 0, first, n;
-		if (scene_init(&s, ix, report_str(scene, "name")) < 0 || s.n == 0) {
-			free(s.e);
-			continue;
-		}
-		if (!any)
-			sb_printf(sb, html ? "<p><b>Cheapest for a ray budget</b> (build plus primary rays "
-			                     "at the measured Mrays/s; see each scene's table):</p>\n<ul>\n"
-			                   : "**Cheapest for a ray budget** (build plus primary rays at "
-			                     "the measured Mrays/s; see each scene's table):\n\n");
-		any = true;
-		while ((n = next_group(&s, &at, &first)) > 0) {
-			struct budget_group g;
-			char title[64];
-			if (group_init(&g, &s.e[first], n) == 0) {
-				sb_printf(sb, html ? "<li>" : "- ");
-				if (html)
-					report_escape(sb, report_str(scene, "name"));
-				else
-					sb_printf(sb, "%s", report_str(scene, "name"));
-				sb_printf(sb, ", %s: ", group_title(title, sizeof(title), ix, &s.e[first]));
-				struct strbuf line = {0};
-				verdict_line(&line, &g);
-				char *text = sb_take(&line);
-				if (html)
-					report_escape(sb, text ? text : "");
-				else
-					sb_printf(sb, "%s", text ? text : "");
-				free(text);
-				sb_printf(sb, html ? "</li>\n" : "\n");
-			}
-			group_finish(&g);
-		}
-		free(s.e);
+		w.scene = report_str(scene, "name");
+		each_group(&w, summary_line);
 	}
-	if (any)
+	if (w.opened)
 		sb_printf(sb, html ? "</ul>\n" : "\n");
 }
 
@@ -259,43 +262,32 @@ static void row_cells(const struct budget_group *g, size_t k, char (*cell)[48])
 	bound(cell[4], 48, iv->to);
 }
 
-static void group_md(struct strbuf *sb, const struct report_index *ix,
-                     const struct budget_group *g, size_t *order)
+static void group_md(struct budget_walk *w, const struct budget_group *g)
 {
 	char title[64], cell[5][48] = {{0}};
-	group_title(title, sizeof(title), ix, &g->e[0]);
+	if (!w->opened)
+		sb_printf(w->sb, "\n### Cheapest for a ray budget\n\n%s\n\n| threads | builder "
+		                 "| median ms | primary Mrays/s | cheapest from (rays) | up to (rays) |\n"
+		                 "|---|---|---:|---:|---:|---:|\n", intro);
+	w->opened = true;
+	group_title(title, sizeof(title), w->ix, &g->e[0]);
 	if (!g->traced) {
-		sb_printf(sb, "| %s | not measured | | | | |\n", title);
+		sb_printf(w->sb, "| %s | not measured | | | | |\n", title);
 		return;
 	}
-	size_t m = front_order(g, order);
+	size_t m = front_order(g, w->order);
 	for (size_t i = 0; i < m; i++) {
-		row_cells(g, order[i], cell);
-		sb_printf(sb, "| %s |", title);
-		report_md_cell(sb, report_str(g->e[order[i]].run, "builder"));
-		sb_printf(sb, " %s | %s | %s | %s |\n", cell[1], cell[2], cell[3], cell[4]);
+		row_cells(g, w->order[i], cell);
+		sb_printf(w->sb, "| %s |", title);
+		report_md_cell(w->sb, report_str(g->e[w->order[i]].run, "builder"));
+		sb_printf(w->sb, " %s | %s | %s | %s |\n", cell[1], cell[2], cell[3], cell[4]);
 	}
 }
 
 void report_budget_md(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
-	struct budget_scene s;
-	size_t at = 0, first, n;
-	size_t *order = NULL;
-	if (scene_init(&s, ix, scene) < 0 || s.n == 0 || !(order = calloc(s.n, sizeof(*order))))
-		goto out;
-	sb_printf(sb, "\n### Cheapest for a ray budget\n\n%s\n\n| threads | builder | median ms "
-	              "| primary Mrays/s | cheapest from (rays) | up to (rays) |\n"
-	              "|---|---|---:|---:|---:|---:|\n", intro);
-	while ((n = next_group(&s, &at, &first)) > 0) {
-		struct budget_group g;
-		if (group_init(&g, &s.e[first], n) == 0)
-			group_md(sb, ix, &g, order);
-		group_finish(&g);
-	}
-out:
-	free(order);
-	free(s.e);
+	struct budget_walk w = {.sb = sb, .ix = ix, .scene = scene};
+	each_group(&w, group_md);
 }
 
 /* The group's chart: each front builder's total cost (ms) against the
@@ -336,52 +328,42 @@ static void group_chart(struct strbuf *sb, const struct report_index *ix,
 	free(marks);
 }
 
-static void group_html(struct strbuf *sb, const struct report_index *ix,
-                       const struct budget_group *g, size_t *order, struct strbuf *charts)
+static void group_html(struct budget_walk *w, const struct budget_group *g)
 {
 	char title[64], cell[5][48] = {{0}};
-	group_title(title, sizeof(title), ix, &g->e[0]);
+	if (!w->opened)
+		sb_printf(w->sb, "<h3>Cheapest for a ray budget</h3>\n<p>%s</p>\n<table class=\"budget\">"
+		                 "<tr><th class=\"l\">threads</th><th class=\"l\">builder</th><th>median "
+		                 "ms</th><th>primary Mrays/s</th><th>cheapest from (rays)</th><th>up to "
+		                 "(rays)</th></tr>\n", intro);
+	w->opened = true;
+	group_title(title, sizeof(title), w->ix, &g->e[0]);
 	if (!g->traced) {
-		sb_printf(sb, "<tr><td class=\"l\">%s</td><td class=\"l\" colspan=\"5\">not measured"
-		              "</td></tr>\n", title);
+		sb_printf(w->sb, "<tr><td class=\"l\">%s</td><td class=\"l\" colspan=\"5\">not measured"
+		                 "</td></tr>\n", title);
 		return;
 	}
-	size_t m = front_order(g, order);
+	size_t m = front_order(g, w->order);
 	for (size_t i = 0; i < m; i++) {
-		row_cells(g, order[i], cell);
-		sb_printf(sb, "<tr><td class=\"l\">%s</td><td class=\"l%s\">", title,
-		          interval_of(g, order[i]) ? " front" : "");
-		report_escape(sb, report_str(g->e[order[i]].run, "builder"));
-		sb_printf(sb, "</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td></tr>\n", cell[1],
+		row_cells(g, w->order[i], cell);
+		sb_printf(w->sb, "<tr><td class=\"l\">%s</td><td class=\"l%s\">", title,
+		          interval_of(g, w->order[i]) ? " front" : "");
+		report_escape(w->sb, report_str(g->e[w->order[i]].run, "builder"));
+		sb_printf(w->sb, "</td><td>%s</td><td>%s</td><td>%s</td><td>%s</td></tr>\n", cell[1],
 		          cell[2], cell[3], cell[4]);
 	}
-	group_chart(charts, ix, g, order, m);
+	group_chart(w->charts, w->ix, g, w->order, m);
 }
 
 void report_budget_html(struct strbuf *sb, const struct report_index *ix, const char *scene)
 {
-	struct budget_scene s;
 	struct strbuf charts = {0};
-	size_t at = 0, first, n;
-	size_t *order = NULL;
-	if (scene_init(&s, ix, scene) < 0 || s.n == 0 || !(order = calloc(s.n, sizeof(*order))))
-		goto out;
-	sb_printf(sb, "<h3>Cheapest for a ray budget</h3>\n<p>%s</p>\n<table class=\"budget\"><tr>"
-	              "<th class=\"l\">threads</th><th class=\"l\">builder</th><th>median ms</th>"
-	              "<th>primary Mrays/s</th><th>cheapest from (rays)</th><th>up to (rays)</th>"
-	              "</tr>\n", intro);
-	while ((n = next_group(&s, &at, &first)) > 0) {
-		struct budget_group g;
-		if (group_init(&g, &s.e[first], n) == 0)
-			group_html(sb, ix, &g, order, &charts);
-		group_finish(&g);
-	}
-	sb_printf(sb, "</table>\n");
+	struct budget_walk w = {.sb = sb, .charts = &charts, .ix = ix, .scene = scene, .html = true};
+	each_group(&w, group_html);
+	if (w.opened)
+		sb_printf(sb, "</table>\n");
 	char *svg = sb_take(&charts);
 	if (svg && *svg)
 		sb_printf(sb, "<div class=\"charts\">\n%s</div>\n", svg);
 	free(svg);
-out:
-	free(order);
-	free(s.e);
 }

@@ -11,14 +11,7 @@ set -euo pipefail
 exe=$1
 width=1400
 
-browser=""
-for b in chromium chromium-browser google-chrome; do
-	if command -v "$b" >/dev/null 2>&1; then
-		browser=$b
-		break
-	fi
-done
-if [ -z "$browser" ]; then
+if ! browser=$("$(dirname "$0")/../../scripts/chromium.sh" 2>/dev/null); then
 	echo "report-layout: skipped: no chromium installed (apt-get install chromium)"
 	exit 77
 fi
