@@ -13,7 +13,7 @@
 #include "output/report.h"
 
 static const char css[] =
-	"body{font-family:sans-serif;margin:2em;color:#222}"
+	"body{font-family:sans-serif;margin:2em;color:#222}p{max-width:1400px}"
 	"table{border-collapse:collapse;margin:1em 0;font-size:13px}"
 	"th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}"
 	"th{background:#f0f0f0}td.l,th.l{text-align:left}"
