@@ -1,10 +1,9 @@
 /*
  * Pareto fronts: which builders are worth considering at all. Per scene,
- * machine and thread count, a run is on the front of build time against a tree
- * figure (SAH cost, ray cost: nodes and triangles per primary ray; lower
- * is better for both) when
- * no other run is at least as fast and at least as good with one of the
- * two strictly better (figures within 0.05 % count as equal). A run off
+ * machine and thread count, a run is on the front of build time against a
+ * tree figure (SAH cost, ray cost: nodes and triangles per primary ray;
+ * lower is better for both) when no other run is at least as fast and at
+ * least as good with one of the two strictly better (figures within 0.05 % count as equal). A run off
  * the front names the run that dominates it: of those, the fastest on the
  * front (there is one without the tolerance; with it, the fastest of all
  * when none is), so the reader is sent to a builder worth looking at.

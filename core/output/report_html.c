@@ -270,19 +270,16 @@ struct point_text {
 };
 
 /* A chart point of a run: its builder's colour, its library's shape,
- * "builder x2" as its label, and the run's marks when the chart shows a
- * time (timed). */
+ * "builder x2" as its label, and the run's marks (every chart of a scene
+ * shows a time). */
 static struct svg_point run_point(const struct report_index *ix, const cJSON *run,
-                                  struct point_text *t, double x, double y, bool timed)
+                                  struct point_text *t, double x, double y)
 {
 	char on[32];
 	const char *builder = report_str(run, "builder");
 	snprintf(t->label, sizeof(t->label), "%s x%.0f%s", builder, report_num(run, "threads"),
 	         machine_text(on, sizeof(on), ix, report_machine_number(ix, run)));
-	if (timed)
-		report_run_marks(t->mark, sizeof(t->mark), ix, run);
-	else
-		t->mark[0] = '\0';
+	report_run_marks(t->mark, sizeof(t->mark), ix, run);
 	struct svg_point p = {.label = t->label, .group = builder, .x = x, .y = y,
 	                      .shape = svg_plugin_shape(report_str(run, "plugin")),
 	                      .mark = t->mark};
@@ -308,7 +305,7 @@ static void front_charts(struct strbuf *sb, const struct report_index *ix,
 		for (size_t k = 0; k < n; k++) {
 			if (by[k] == FRONT_NONE || e[k].threads != threads[t] || e[k].machine != machine)
 				continue;
-			p[m] = run_point(ix, e[k].run, &texts[m], fp[k].time, fp[k].figure, true);
+			p[m] = run_point(ix, e[k].run, &texts[m], fp[k].time, fp[k].figure);
 			p[m++].front = by[k] == FRONT_ON;
 		}
 		char title[128], on[32];
@@ -329,8 +326,7 @@ static void bars_and_speedups(struct strbuf *sb, const struct report_index *ix,
 	size_t n = 0, m = 0;
 	for (size_t k = 0; k < count; k++)
 		if (isfinite(report_num(runs[k], "build_ms.median"))) {
-			q[n] = run_point(ix, runs[k], &texts[n], 0, report_num(runs[k], "build_ms.median"),
-			                 true);
+			q[n] = run_point(ix, runs[k], &texts[n], 0, report_num(runs[k], "build_ms.median"));
 			n++;
 		}
 	if (n > 0)
@@ -340,8 +336,7 @@ static void bars_and_speedups(struct strbuf *sb, const struct report_index *ix,
 		for (size_t k = 0; k < count; k++) {
 			double s = report_speedup(ix, runs[k]);
 			if (isfinite(s) && report_machine_number(ix, runs[k]) == machine) {
-				q[m] = run_point(ix, runs[k], &texts[m], report_num(runs[k], "threads"), s,
-				                 true);
+				q[m] = run_point(ix, runs[k], &texts[m], report_num(runs[k], "threads"), s);
 				m++;
 			}
 		}
