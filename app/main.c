@@ -22,7 +22,7 @@ static const char usage[] =
 	"                        one build, validated and measured\n"
 	"  render PLUGIN SCENE -o FILE [--heat] [--width W --height H] [-O KEY=VALUE]...\n"
 	"                        one image: the shaded scene or a heat map of nodes visited\n"
-	"  report RESULTS.json [--out DIR]\n"
+	"  report DIR|RESULTS.json [--out DIR] [--reference NAME] [--scene S] [--threads N]\n"
 	"                        regenerate report.md, report.html and results.csv\n"
 	"  plan CONFIG.json --out DIR [--format lines|slurm|json]\n"
 	"                        split a sweep into commands for GNU parallel or Slurm\n"

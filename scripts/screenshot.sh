@@ -20,14 +20,7 @@ report=${1:-$root/results/default/report.html}
 out=${2:-${report%.html}.png}
 [ -f "$report" ] || { echo "screenshot.sh: no report at $report (run scripts/run.sh first)" >&2; exit 2; }
 
-browser=""
-for b in chromium chromium-browser google-chrome; do
-	if command -v "$b" >/dev/null 2>&1; then
-		browser=$b
-		break
-	fi
-done
-if [ -z "$browser" ]; then
+if ! browser=$("$root/scripts/chromium.sh" 2>/dev/null); then
 	echo "screenshot.sh: no chromium installed; skipped (apt-get install chromium)" >&2
 	exit 0
 fi

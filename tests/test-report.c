@@ -75,7 +75,8 @@ static void add_run(cJSON *runs, const char *builder, const char *plugin, int th
 	         "{\"scene\": \"s\", \"builder\": \"%s\", \"plugin\": \"%s\", \"threads\": %d, "
 	         "\"status\": \"ok\", \"build_ms\": {\"median\": %g, \"min\": %g, \"max\": %g}, "
 	         "\"tree\": {\"sah_cost\": %g, \"nodes\": %d}, \"rays\": {\"primary\": "
-	         "{\"rays\": 10000, \"mrays_per_s\": %g, \"nodes_per_ray\": %g}, "
+	         "{\"rays\": 10000, \"mrays_per_s\": %g, \"nodes_per_ray\": %g, "
+	         "\"tris_per_ray\": 2}, "
 	         "\"diffuse\": {\"mrays_per_s\": %g, \"nodes_per_ray\": 20}}}",
 	         builder, plugin, threads, ms[0], ms[1], ms[2], sah, (int)sah * 10, mrays,
 	         nodes_per_ray, diffuse);
@@ -131,20 +132,21 @@ static void test_markdown_fallback(void)
 	                   "first builder that did: fast.");
 	CHECK_CONTAINS(md, "reference builder **fast**");
 	/* Summary and scene front: slow behind mid, 10 / 20 and (40 - 45) / 45. */
-	CHECK_CONTAINS(md, "| slow | 1 | 1 | 10.00× | 0.90× | n/a | 0.83× | 1.00× | dominated by mid "
-	                   "(0.50× time, −11.1 % SAH) |");
+	CHECK_CONTAINS(md, "| slow | 1 | 1 | 10.00× | 0.90× | n/a | 0.83× | 1.00× | dominated on 1 "
+	                   "of 1 scene by mid |");
+	/* Ray cost: 10 + 2 and 9 + 2 nodes and triangles per ray, -8.3 %. */
 	CHECK_CONTAINS(md, "| slow | 1 | 20.0 | 45.000 | dominated by mid (0.50× time, −11.1 % SAH) "
-	                   "| 10.0 | dominated by mid (0.50× time, −10.0 % nodes/ray) |");
+	                   "| 12.0 | dominated by mid (0.50× time, −8.3 % ray cost) |");
 	CHECK_CONTAINS(md, "| twin | 1 | 2.20 | 50.000 | dominated by fast (0.91× time, same SAH) |");
-	CHECK_CONTAINS(md, "| fast | 2 | 1.50 | 50.000 | front | 12.0 | front |");
+	CHECK_CONTAINS(md, "| fast | 2 | 1.50 | 50.000 | front | 14.0 | front |");
 	/* The 1-thread-only builders compete on the 2-thread front too:
 	 * twin's 2.2 ms against fast's 1.5 on 2 threads is 0.68x. */
 	CHECK_CONTAINS(md, "| mid | 2 (ran on 1) | 10.0 | 40.000 | front |");
 	/* 10 / 15 ms; (40 - 45) / 45. In the summary the same from the ratios
 	 * to fast's: 5.0 / 7.5 and (0.80 - 0.90) / 0.90. */
 	CHECK_CONTAINS(md, "| par | 2 | 15.0 | 45.000 | dominated by mid (0.67× time, −11.1 % SAH) |");
-	CHECK_CONTAINS(md, "| par | 2 | 1 | 7.50× | 0.90× | n/a | 0.92× | 1.00× | dominated by mid "
-	                   "(0.67× time, −11.1 % SAH) |");
+	CHECK_CONTAINS(md, "| par | 2 | 1 | 7.50× | 0.90× | n/a | 0.92× | 1.00× | dominated on 1 of "
+	                   "1 scene by mid |");
 	CHECK_CONTAINS(md, "| twin | 2 (ran on 1) | 2.20 | 50.000 | dominated by fast (0.68× time, "
 	                   "same SAH) |");
 	/* Break-even against fast: mid builds 8 ms longer and saves
@@ -196,7 +198,7 @@ static void test_html(void)
 	CHECK_CONTAINS(html, "dominated by mid (0.50× time, −11.1 % SAH)");
 	CHECK_CONTAINS(html, "stroke-dasharray=\"5,3\""); /* the front's line */
 	CHECK_CONTAINS(html, "SAH cost vs. build time, 1 thread");
-	CHECK_CONTAINS(html, "primary nodes/ray vs. build time, 2 threads");
+	CHECK_CONTAINS(html, "ray cost (nodes + tris per ray) vs. build time, 2 threads");
 	CHECK_CONTAINS(html, "<h3>Break-even against fast</h3>");
 	CHECK_CONTAINS(html, "⚠ Busy machine");
 	CHECK_CONTAINS(html, "title=\"build repeats spread 20.0 %\">≈ noisy</td>");
@@ -206,13 +208,15 @@ static void test_html(void)
 	CHECK_CONTAINS(html, "<td class=\"l\" title=\"the phases add up to 20 % of the median "
 	                     "build\">upload 0.500, device 1.50</td>");
 	CHECK_CONTAINS(html, "per pass min–max");
-	/* One colour per builder in every chart: mid is the second builder. Its
-	 * bar: labels of 7 characters leave 12 + 7 * 6.2 = 55.4 px, so 10 of
-	 * 30 ms is (640 - 55.4 - 90) / 3 = 164.9 px, its figure 4 px after. */
-	CHECK_CONTAINS(html, "fill=\"#ff7f0e\" stroke=\"#222\" stroke-width=\"1.5\"><title>mid x1"
-	                     "</title>");
-	CHECK_CONTAINS(html, "fill=\"#ff7f0e\"/><text x=\"224.3\" y=\"79.0\" text-anchor=\"start\">"
-	                     "10.0 ms</text>");
+	/* One colour per builder in every chart: mid is the second builder,
+	 * its tooltip with its mark. Its bar: labels of 7 characters leave
+	 * 12 + 7 * 6.2 = 55.4 px, and marked bars 170 px for the figure and
+	 * its marks, so 10 of 30 ms is (640 - 55.4 - 170) / 3 = 138.2 px, its
+	 * figure 6 px after. */
+	CHECK_CONTAINS(html, "fill=\"#ff7f0e\" stroke=\"#222\" stroke-width=\"1.5\"><title>mid x1 "
+	                     "(noisy: build repeats spread 20.0 %)</title>");
+	CHECK_CONTAINS(html, "<text x=\"199.6\" y=\"79.0\" text-anchor=\"start\">10.0 ms ≈ noisy"
+	                     "</text>");
 	CHECK_CONTAINS(html, "fill=\"#ff7f0e\"/><text x=\"128.8\" y=\"352.0\" text-anchor=\"start\">"
 	                     "mid</text>"); /* the legend */
 	CHECK(!strstr(html, "e+0")); /* plain numbers */
@@ -275,7 +279,9 @@ static void test_merged_machines(void)
 	/* Summary: a row per machine, fast (b) has no reference on b. */
 	CHECK_CONTAINS(md, "| builder | threads | machine | scenes |");
 	CHECK_CONTAINS(md, "| par | 1 | M1 | 1 | 2.00× | 0.90× |");
-	CHECK_CONTAINS(md, "| fast | 1 | M2 | 0 | n/a | n/a | n/a | n/a | n/a | — |");
+	/* Its Pareto verdict is its scene's, among M2's runs. */
+	CHECK_CONTAINS(md, "| fast | 1 | M2 | 0 | n/a | n/a | n/a | n/a | n/a | front on 1 of 1 "
+	                   "scene |");
 	CHECK(!strstr(md, "0.20×") && !strstr(md, "0.40×"));
 	/* Pareto: fast on b does not dominate ref on a. */
 	CHECK_CONTAINS(md, "| ref | 1 on M1 | 10.0 | 50.000 | front |");
@@ -381,9 +387,11 @@ static void check_cluster(int view)
 	static const bool front[][12] = {{0, 1, 0, 0, 1, 0, 1, 1, 0, 0, 0, 0},
 	                                 {0, 1, 0, 0, 1, 0, 1, 0, 0, 0, 0, 0}};
 	struct svg_point p[12];
-	for (int i = 0; i < 12; i++)
-		p[i] = (struct svg_point){"", names[i], fig[i][0], fig[i][1 + view],
-		                          svg_colour(i), front[view][i]};
+	for (int i = 0; i < 12; i++) {
+		p[i] = (struct svg_point){.label = "", .group = names[i], .x = fig[i][0],
+		                          .y = fig[i][1 + view], .front = front[view][i]};
+		svg_colour(i, p[i].colour, sizeof(p[i].colour));
+	}
 	struct strbuf sb = {0};
 	svg_scatter(&sb, "a view, 2 threads", "build time (ms)", "figure", p, 12);
 	char *svg = sb_take(&sb);
@@ -408,10 +416,10 @@ static void test_leader_lines(void)
  * the speedups on the y axis keep their fractional ticks. */
 static void test_whole_ticks(void)
 {
-	const struct svg_point p[] = {{"", "a", 1, 1, "#1f77b4", false},
-	                              {"", "a", 2, 1.33, "#1f77b4", false},
-	                              {"", "b", 1, 1, "#ff7f0e", false},
-	                              {"", "b", 2, 2, "#ff7f0e", false}};
+	const struct svg_point p[] = {{"", "a", 1, 1, "#1f77b4", false, SVG_CIRCLE, NULL},
+	                              {"", "a", 2, 1.33, "#1f77b4", false, SVG_CIRCLE, NULL},
+	                              {"", "b", 1, 1, "#ff7f0e", false, SVG_CIRCLE, NULL},
+	                              {"", "b", 2, 2, "#ff7f0e", false, SVG_CIRCLE, NULL}};
 	struct strbuf sb = {0};
 	svg_lines(&sb, "Speedup over 1 thread", "threads", "speedup", p, 4);
 	char *svg = sb_take(&sb);
@@ -430,10 +438,10 @@ static void test_whole_ticks(void)
  * 259,446. The same points without the outlier draw no triangle. */
 static void test_off_chart(void)
 {
-	struct svg_point p[] = {{"a x1", "a", 10, 31.2, "#1f77b4", true},
-	                        {"b x1", "b", 20, 30.1, "#ff7f0e", true},
-	                        {"c x1", "c", 30, 36.6, "#2ca02c", false},
-	                        {"q x1", "q", 7, 259446.2, "#d62728", true}};
+	struct svg_point p[] = {{"a x1", "a", 10, 31.2, "#1f77b4", true, SVG_CIRCLE, NULL},
+	                        {"b x1", "b", 20, 30.1, "#ff7f0e", true, SVG_CIRCLE, NULL},
+	                        {"c x1", "c", 30, 36.6, "#2ca02c", false, SVG_CIRCLE, NULL},
+	                        {"q x1", "q", 7, 259446.2, "#d62728", true, SVG_CIRCLE, NULL}};
 	struct strbuf sb = {0};
 	svg_scatter(&sb, "SAH cost vs. build time, 1 thread", "build time (ms)", "SAH cost", p, 4);
 	char *svg = sb_take(&sb);
@@ -453,6 +461,74 @@ static void test_off_chart(void)
 	free(svg);
 }
 
+/* Three builders whose cost lines cross at known ray counts, by hand:
+ * a (1 ms, 10 Mrays/s: 1e-7 s a ray), b (5 ms, 5e-8 s), c (25 ms,
+ * 2.5e-8 s). a and b cost the same at 0.004 / 5e-8 = 80,000 rays, b and
+ * c at 0.020 / 2.5e-8 = 800,000 (a and c only at 320,000, past b's
+ * lead). e (20 ms, 4e-8 s) is on the front (faster to build than c,
+ * faster rays than b) but never lowest: c undercuts it from 333,333 rays,
+ * before e would undercut b at 1.5 M. d (30 ms, 5e-8 s) is behind b;
+ * f traced nothing and g failed: neither is a candidate. */
+static cJSON *budget_document(void)
+{
+	cJSON *doc = cJSON_Parse("{\"machine\": {\"cpu\": \"test\", \"cores\": 2}, \"config\": {}, "
+	                         "\"scenes\": [{\"name\": \"s\", \"triangles\": 100}], "
+	                         "\"runs\": []}");
+	cJSON *runs = cJSON_GetObjectItem(doc, "runs");
+	add_run(runs, "a", "lbvh", 1, (double[]){1, 1, 1}, 50, 12, 10, 5);
+	add_run(runs, "b", "sah_tasks", 1, (double[]){5, 5, 5}, 45, 10, 20, 5);
+	add_run(runs, "c", "sbvh", 1, (double[]){25, 25, 25}, 40, 9, 40, 5);
+	add_run(runs, "d", "ploc", 1, (double[]){30, 30, 30}, 45, 10, 20, 5);
+	add_run(runs, "e", "embree", 1, (double[]){20, 20, 20}, 44, 10, 25, 5);
+	cJSON_AddItemToArray(runs, cJSON_Parse("{\"scene\": \"s\", \"builder\": \"f\", "
+	                                       "\"plugin\": \"lbvh\", \"threads\": 1, \"status\": "
+	                                       "\"ok\", \"build_ms\": {\"median\": 0.5}}"));
+	cJSON_AddItemToArray(runs, cJSON_Parse("{\"scene\": \"s\", \"builder\": \"g\", "
+	                                       "\"threads\": 1, \"status\": \"failed\"}"));
+	return doc;
+}
+
+static void test_budget(void)
+{
+	const double build[] = {1e-3, 5e-3, 25e-3, NAN, 20e-3}, ray[] = {1e-7, 5e-8, 2.5e-8, 1e-9, 4e-8};
+	struct budget_interval iv[5];
+	CHECK_INT(report_budget_intervals(build, ray, 5, iv), 3);
+	CHECK_INT(iv[0].index, 0);
+	CHECK_INT(iv[1].index, 1);
+	CHECK_INT(iv[2].index, 2);
+	CHECK(iv[0].from == 0 && fabs(iv[0].to - 8e4) < 1e-6);
+	CHECK(fabs(iv[1].from - 8e4) < 1e-6 && fabs(iv[1].to - 8e5) < 1e-6);
+	CHECK(fabs(iv[2].from - 8e5) < 1e-6 && isinf(iv[2].to));
+	CHECK_INT(report_budget_intervals(build, ray, 0, iv), 0);
+	cJSON *doc = budget_document();
+	char *md = report_markdown(doc), *html = report_html(doc);
+	CHECK_CONTAINS(md, "## Summary\n\n**Cheapest for a ray budget**");
+	CHECK_CONTAINS(md, "- s, 1 thread: up to 80.0 k rays: a; up to 800.0 k: b; beyond: c\n");
+	CHECK_CONTAINS(md, "| 1 thread | a | 1.00 | 10.0 | 0 | 80.0 k |\n"
+	                   "| 1 thread | b | 5.00 | 20.0 | 80.0 k | 800.0 k |\n"
+	                   "| 1 thread | e | 20.0 | 25.0 | never cheapest | — |\n"
+	                   "| 1 thread | c | 25.0 | 40.0 | 800.0 k | beyond |\n");
+	CHECK(!strstr(md, "| 1 thread | d |") && !strstr(md, "| 1 thread | f |"));
+	CHECK_CONTAINS(html, "<li>s, 1 thread: up to 80.0 k rays: a; up to 800.0 k: b; beyond: c"
+	                     "</li>");
+	CHECK_CONTAINS(html, "Cost of a ray budget, 1 thread");
+	CHECK_CONTAINS(html, "primary rays (log scale)");
+	free(md);
+	free(html);
+	/* No run traced rays: said, not guessed; nothing crashes. */
+	cJSON *run;
+	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
+		cJSON_DeleteItemFromObject(run, "rays");
+	md = report_markdown(doc);
+	html = report_html(doc);
+	CHECK_CONTAINS(md, "- s, 1 thread: not measured (no run traced rays)");
+	CHECK_CONTAINS(md, "| 1 thread | not measured |");
+	CHECK(!strstr(html, "Cost of a ray budget"));
+	free(md);
+	free(html);
+	cJSON_Delete(doc);
+}
+
 int main(void)
 {
 	test_front_points();
@@ -466,5 +542,6 @@ int main(void)
 	test_leader_lines();
 	test_whole_ticks();
 	test_off_chart();
+	test_budget();
 	return test_finish();
 }

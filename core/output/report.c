@@ -158,18 +158,6 @@ static void md_numbers(struct strbuf *sb, const cJSON *run, const char *const (*
 		report_md_cell(sb, num(buf, sizeof(buf), run, cols[k][0], cols[k][1]));
 }
 
-/* "noisy: why; busy: load" or "". */
-static const char *md_marks(char *buf, size_t size, const struct report_index *ix,
-                            const cJSON *run)
-{
-	char noise[160], load[160];
-	bool noisy = report_noise(ix, run, noise, sizeof(noise));
-	bool busy = report_busy(ix->doc, run, load, sizeof(load));
-	snprintf(buf, size, "%s%s%s%s%s", noisy ? "noisy: " : "", noise,
-	         noisy && busy ? "; " : "", busy ? "busy: " : "", load);
-	return buf;
-}
-
 static void md_run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
                        bool phases)
 {
@@ -183,7 +171,7 @@ static void md_run_row(struct strbuf *sb, const struct report_index *ix, const c
 	snprintf(buf, sizeof(buf), "%.2f", speedup);
 	report_md_cell(sb, isnan(speedup) ? "" : buf);
 	md_numbers(sb, run, md_figures, sizeof(md_figures) / sizeof(md_figures[0]));
-	report_md_cell(sb, md_marks(buf, sizeof(buf), ix, run));
+	report_md_cell(sb, report_run_marks(buf, sizeof(buf), ix, run));
 	if (phases)
 		report_md_cell(sb, report_phases(buf, sizeof(buf), run));
 	report_md_cell(sb, report_str(run, "error"));
@@ -251,6 +239,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	for (size_t k = 0; k < n; k++)
 		md_run_row(sb, ix, runs[k], phases);
 	report_front_md(sb, ix, runs, n);
+	report_budget_md(sb, ix, name);
 	report_breakeven_md(sb, ix, ref, runs, n);
 	md_images(sb, scene, runs, n);
 	report_frames_md(sb, ix, scene); /* an animated scene's frames */
@@ -289,6 +278,8 @@ char *report_markdown(const cJSON *doc)
 		sb.failed = true;
 	const char *asked, *ref = report_reference(doc, &asked, &(bool){false});
 	report_load_warning(&sb, doc, false);
+	if (*report_str(doc, "report_note")) /* bvhlab report --scene/--threads */
+		sb_printf(&sb, "\n**%s**\n", report_str(doc, "report_note"));
 	report_summary_md(&sb, &ix);
 	report_machines_md(&sb, doc);
 	report_thesis(&sb, doc, &ix);

@@ -98,29 +98,67 @@ struct front_entry *report_front_entries(const struct report_index *ix,
                                          const cJSON *const *runs, size_t n, size_t *count);
 /* The front_point group of a machine's thread count. */
 long report_front_group(long machine, double threads);
-/* The entries as points of the figure at a dotted path (runs not ok are
- * not compared), grouped by machine and thread count, and their verdicts. */
-void report_entries_front(const struct front_entry *e, size_t m, const char *figure,
+/* The SAH's weights, the report's SAH cost's and its ray cost's. */
+#define REPORT_C_TRAV 1.0
+#define REPORT_C_ISECT 1.0
+/* The second front's figure: c_trav x nodes + c_isect x triangles visited
+ * per primary ray (counting nodes alone rewards tiny leaves); NaN when
+ * either was not measured. */
+double report_ray_cost(const cJSON *run);
+/* A front view's figure of a run (0: SAH cost, 1: ray cost) and its name
+ * on the charts. */
+double report_front_figure(int view, const cJSON *run);
+const char *report_front_view_name(int view);
+/* The entries as points of view's figure (runs not ok are not compared),
+ * grouped by machine and thread count, and their verdicts. */
+void report_entries_front(const struct front_entry *e, size_t m, int view,
                           struct front_point *p, long *by);
 /* The distinct thread counts of the runs, ascending, at most max. */
 size_t report_thread_counts(const cJSON *const *runs, size_t n, double *out, size_t max);
-/* The scene's front table (both views: SAH cost, primary nodes per ray). */
+/* The scene's front table (both views: SAH cost, ray cost). */
 void report_front_md(struct strbuf *sb, const struct report_index *ix,
                      const cJSON *const *runs, size_t n);
 void report_front_html(struct strbuf *sb, const struct report_index *ix,
                        const cJSON *const *runs, size_t n);
+
+/* A point's shape: bvhlab's own builders are circles, each peer library's
+ * (report_style.c) has its own. */
+enum svg_shape { SVG_CIRCLE, SVG_SQUARE, SVG_DIAMOND, SVG_TRIANGLE_DOWN };
 
 /* One point or bar: a label and its values. */
 struct svg_point {
 	const char *label;  /* bars: beside the bar; scatter: the point's tooltip */
 	const char *group;  /* the builder: the legend's entry, a line's series */
 	double x, y;
-	const char *colour; /* the group's (svg_colour) */
+	char colour[16];    /* the group's (svg_colour) */
 	bool front;         /* scatter: on the Pareto front (a line joins them) */
+	enum svg_shape shape; /* the group's (svg_plugin_shape) */
+	const char *mark;   /* why its time is not to be trusted ("busy: ..."), or
+	                     * NULL/"": drawn with a dashed ring, said in the tooltip */
 };
 
-/* The colour of builder number k (report_builder_number) in every chart. */
-const char *svg_colour(long k);
+/* ---- how points look (report_style.c) ----------------------------------- */
+
+/* The colour of builder number k (report_builder_number) in every chart,
+ * "#rrggbb" into buf (16 bytes): no two numbers share one. */
+const char *svg_colour(long k, char *buf, size_t size);
+/* The shape of a plugin's points: a peer library's own, else a circle. */
+enum svg_shape svg_plugin_shape(const char *plugin);
+/* "embree", "tinybvh", "bvh2" or "bvhlab": whose points have the shape. */
+const char *svg_shape_name(enum svg_shape shape);
+/* Opens a shape's element at (x, y), radius about r, filled, with extra
+ * attributes; the caller closes it ("/>" or "><title>...</...>": the
+ * element is svg_shape_tag's). */
+void svg_shape(struct strbuf *sb, enum svg_shape shape, double x, double y, double r,
+               const char *fill, const char *extra);
+/* The element name svg_shape opened ("circle", "rect", "polygon"). */
+const char *svg_shape_tag(enum svg_shape shape);
+/* The dashed ring around a point whose time is marked busy or noisy. */
+void svg_warn_ring(struct strbuf *sb, double x, double y, double r);
+/* "noisy: why; busy: load", or "" for a run with no mark (report_marks.c's
+ * verdicts, in the words of report.md's marks column). */
+const char *report_run_marks(char *buf, size_t size, const struct report_index *ix,
+                             const cJSON *run);
 
 /* Horizontal bars of y, one per point, labelled. */
 void svg_bars(struct strbuf *sb, const char *title, const char *unit,
@@ -129,9 +167,14 @@ void svg_bars(struct strbuf *sb, const char *title, const char *unit,
  * points joined by a line and named. */
 void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                  const struct svg_point *p, size_t n);
-/* One polyline per group, points in the given order, and a legend. */
+/* One polyline per group, points in the given order, each drawn as a
+ * marker too, and a legend. */
 void svg_lines(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                const struct svg_point *p, size_t n);
+/* svg_lines with a marker at each line's end only: points that sample a
+ * curve. */
+void svg_curves(struct strbuf *sb, const char *title, const char *xname, const char *yname,
+                const struct svg_point *p, size_t n);
 
 /* ---- break-even against the reference (report_breakeven.c) -------------- */
 
@@ -161,6 +204,30 @@ void report_breakeven_md(struct strbuf *sb, const struct report_index *ix, const
                          const cJSON *const *runs, size_t n);
 void report_breakeven_html(struct strbuf *sb, const struct report_index *ix, const char *ref,
                            const cJSON *const *runs, size_t n);
+
+/* "950", "12.3 k", "1.2 M", "3.4 G": a count of rays. */
+void report_ray_count(char *buf, size_t size, double n);
+
+/* ---- the cheapest builder for a ray budget (report_budget.c) ------------ */
+
+/* Where one candidate is the cheapest: from `from` rays up to `to`
+ * (INFINITY: beyond). */
+struct budget_interval {
+	size_t index;
+	double from, to;
+};
+/* The lower envelope of the lines build[k] + n * ray[k] (seconds) over
+ * n >= 0: the cheapest candidate by ray count, in order, into out (room
+ * for n); candidates with a NaN or a ray time <= 0 are left out. Returns
+ * the intervals' count (0: no candidate). */
+size_t report_budget_intervals(const double *build, const double *ray, size_t n,
+                               struct budget_interval *out);
+/* The summary's first lines: per scene and thread count, "up to N rays:
+ * X; up to M: Y; beyond: Z", or "not measured". */
+void report_budget_summary(struct strbuf *sb, const struct report_index *ix, bool html);
+/* The scene's ray-budget table (and in HTML its charts). */
+void report_budget_md(struct strbuf *sb, const struct report_index *ix, const char *scene);
+void report_budget_html(struct strbuf *sb, const struct report_index *ix, const char *scene);
 
 /* ---- marks on figures not to trust (report_marks.c) --------------------- */
 
@@ -213,10 +280,4 @@ const char *report_summary_metric(int m);
 /* The summary section of report.md / report.html. */
 void report_summary_md(struct strbuf *sb, const struct report_index *ix);
 void report_summary_html(struct strbuf *sb, const struct report_index *ix);
-/* The summary rows as points of build time against SAH cost (ratios),
- * compared among the rows of one thread count over as many scenes, and
- * their verdicts (report_front_points). */
-void report_summary_fronts(const struct summary_row *rows, int n, struct front_point *p,
-                           long *by);
-
 #endif

@@ -35,8 +35,7 @@ struct breakeven report_breakeven(double build_ms, double mrays, double ref_buil
 	return b;
 }
 
-/* "950", "12.3 k", "1.2 M", "3.4 G" rays. */
-static void count_text(char *buf, size_t size, double n)
+void report_ray_count(char *buf, size_t size, double n)
 {
 	static const char *const units[] = {"k", "M", "G", "T"};
 	int u = -1;
@@ -60,7 +59,7 @@ void report_breakeven_text(char *buf, size_t size, struct breakeven b, double fr
 	case BREAKEVEN_NONE: snprintf(buf, size, "—"); return;
 	case BREAKEVEN_AFTER: case BREAKEVEN_UNTIL: break;
 	}
-	count_text(n, sizeof(n), b.rays);
+	report_ray_count(n, sizeof(n), b.rays);
 	if (frame_rays > 0)
 		snprintf(frames, sizeof(frames), " (%s frames)",
 		         report_plain((char[32]){0}, 32, b.rays / frame_rays));

@@ -180,20 +180,23 @@ static void charts(struct strbuf *sb, const struct report_index *ix, const struc
 		total += (size_t)s[k].count;
 	struct svg_point *sah = calloc(total ? total : 1, sizeof(*sah));
 	struct svg_point *cost = calloc(total ? total : 1, sizeof(*cost));
-	char title[2][96];
-	for (size_t k = 0; sah && cost && k < n; k++) {
+	char title[2][96], (*marks)[256] = calloc(n + 1, sizeof(*marks));
+	for (size_t k = 0; sah && cost && marks && k < n; k++) {
 		const cJSON *f;
+		report_run_marks(marks[k], sizeof(marks[k]), ix, s[k].run); /* the cost is a time */
 		double sum = 0;
 		if (report_num(s[k].run, "threads") != threads)
 			continue;
 		cJSON_ArrayForEach(f, s[k].frames) {
 			const char *g = report_str(s[k].run, "builder");
-			const char *colour = svg_colour(report_builder_number(ix, g));
 			sum += report_num(f, "cost_ms");
-			sah[m++] = (struct svg_point){.label = "", .group = g, .x = report_num(f, "frame"),
-			                              .y = report_num(f, "sah"), .colour = colour};
-			cost[c++] = (struct svg_point){.label = "", .group = g, .x = report_num(f, "frame"),
-			                               .y = sum, .colour = colour};
+			sah[m] = (struct svg_point){.label = "", .group = g, .x = report_num(f, "frame"),
+			                            .y = report_num(f, "sah"),
+			                            .shape = svg_plugin_shape(report_str(s[k].run, "plugin"))};
+			svg_colour(report_builder_number(ix, g), sah[m].colour, sizeof(sah[m].colour));
+			cost[c] = sah[m++];
+			cost[c].mark = marks[k];
+			cost[c++].y = sum;
 		}
 	}
 	snprintf(title[0], sizeof(title[0]), "SAH over the frames, %.0f thread%s", threads,
@@ -204,8 +207,9 @@ static void charts(struct strbuf *sb, const struct report_index *ix, const struc
 		svg_lines(sb, title[0], "frame", "SAH cost", sah, m);
 	if (c)
 		svg_lines(sb, title[1], "frame", "ms", cost, c);
-	if (!sah || !cost)
+	if (!sah || !cost || !marks)
 		sb->failed = true;
+	free(marks);
 	free(sah);
 	free(cost);
 }

@@ -1,9 +1,9 @@
 /*
  * Pareto fronts: which builders are worth considering at all. Per scene,
- * machine and thread count, a run is on the front of build time against a tree
- * figure (SAH cost, primary nodes per ray; lower is better for both) when
- * no other run is at least as fast and at least as good with one of the
- * two strictly better (figures within 0.05 % count as equal). A run off
+ * machine and thread count, a run is on the front of build time against a
+ * tree figure (SAH cost, ray cost: nodes and triangles per primary ray;
+ * lower is better for both) when no other run is at least as fast and at
+ * least as good with one of the two strictly better (figures within 0.05 % count as equal). A run off
  * the front names the run that dominates it: of those, the fastest on the
  * front (there is one without the tolerance; with it, the fastest of all
  * when none is), so the reader is sent to a builder worth looking at.
@@ -150,21 +150,37 @@ size_t report_thread_counts(const cJSON *const *runs, size_t n, double *out, siz
 	return m;
 }
 
-void report_entries_front(const struct front_entry *e, size_t m, const char *figure,
+double report_ray_cost(const cJSON *run)
+{
+	return REPORT_C_TRAV * report_num(run, "rays.primary.nodes_per_ray") +
+	       REPORT_C_ISECT * report_num(run, "rays.primary.tris_per_ray");
+}
+
+/* The two views the tables show: build time against each figure. */
+static const char *const figure_names[2] = {"SAH", "ray cost"};
+static const char *const view_names[2] = {"SAH cost", "ray cost (nodes + tris per ray)"};
+
+double report_front_figure(int view, const cJSON *run)
+{
+	return view == 0 ? report_num(run, "tree.sah_cost") : report_ray_cost(run);
+}
+
+const char *report_front_view_name(int view)
+{
+	return view_names[view];
+}
+
+void report_entries_front(const struct front_entry *e, size_t m, int view,
                           struct front_point *p, long *by)
 {
 	for (size_t k = 0; k < m; k++) {
 		bool ok = strcmp(report_str(e[k].run, "status"), "ok") == 0;
 		p[k] = (struct front_point){ok ? report_num(e[k].run, "build_ms.median") : NAN,
-		                            report_num(e[k].run, figure),
+		                            report_front_figure(view, e[k].run),
 		                            report_front_group(e[k].machine, e[k].threads)};
 	}
 	report_front_points(p, m, by);
 }
-
-/* The two views the tables show: build time against each figure. */
-static const char *const figures[2] = {"tree.sah_cost", "rays.primary.nodes_per_ray"};
-static const char *const figure_names[2] = {"SAH", "nodes/ray"};
 
 struct front_table {
 	struct front_entry *e;
@@ -183,7 +199,7 @@ static int table_init(struct front_table *t, const struct report_index *ix,
 		t->by[v] = calloc(t->n + 1, sizeof(*t->by[v]));
 		if (!t->p[v] || !t->by[v])
 			return -1;
-		report_entries_front(t->e, t->n, figures[v], t->p[v], t->by[v]);
+		report_entries_front(t->e, t->n, v, t->p[v], t->by[v]);
 	}
 	return t->e ? 0 : -1;
 }
@@ -237,7 +253,8 @@ long report_front_group(long machine, double threads)
 
 static const char intro[] =
 	"Per thread count: a builder is on the front when no other is at least as fast "
-	"and builds a tree at least as good (lower SAH cost; fewer primary nodes per ray), "
+	"and builds a tree at least as good (lower SAH cost; a lower ray cost: primary nodes "
+	"plus triangles visited per ray, the SAH's own weights c_trav = c_isect = 1), "
 	"one of the two strictly, figures within 0.05 % counting as equal; off it, the "
 	"fastest builder on the front that dominates it, its build time as a multiple of "
 	"this one's and the change in the figure. A builder that ran on 1 thread only "
@@ -250,7 +267,7 @@ void report_front_md(struct strbuf *sb, const struct report_index *ix,
 	char buf[256];
 	if (table_init(&t, ix, runs, n) == 0 && any_compared(&t)) {
 		sb_printf(sb, "\n### Pareto fronts\n\n%s\n\n| builder | threads | median ms | SAH cost "
-		              "| time × SAH | primary nodes/ray | time × nodes/ray |\n"
+		              "| time × SAH | ray cost | time × ray cost |\n"
 		              "|---|---:|---:|---:|---|---:|---|\n", intro);
 		for (size_t k = 0; k < t.n; k++) {
 			if (t.by[0][k] == FRONT_NONE)
@@ -262,7 +279,7 @@ void report_front_md(struct strbuf *sb, const struct report_index *ix,
 			          t.p[0][k].figure);
 			verdict(&t, 0, k, buf, sizeof(buf));
 			report_md_cell(sb, buf);
-			sb_printf(sb, " %.1f |", t.p[1][k].figure);
+			sb_printf(sb, " %s |", report_plain(buf, sizeof(buf), t.p[1][k].figure));
 			verdict(&t, 1, k, buf, sizeof(buf));
 			report_md_cell(sb, buf);
 			sb_printf(sb, "\n");
@@ -290,7 +307,7 @@ static void html_row(struct strbuf *sb, const struct report_index *ix,
 	          threads_text(buf, sizeof(buf), ix, &t->e[k]),
 	          report_plain(ms, sizeof(ms), t->p[0][k].time), t->p[0][k].figure);
 	html_verdict(sb, t, 0, k);
-	sb_printf(sb, "<td>%.1f</td>", t->p[1][k].figure);
+	sb_printf(sb, "<td>%s</td>", report_plain(ms, sizeof(ms), t->p[1][k].figure));
 	html_verdict(sb, t, 1, k);
 	sb_printf(sb, "</tr>\n");
 }
@@ -302,8 +319,8 @@ void report_front_html(struct strbuf *sb, const struct report_index *ix,
 	if (table_init(&t, ix, runs, n) == 0 && any_compared(&t)) {
 		sb_printf(sb, "<h3>Pareto fronts</h3>\n<p>%s</p>\n<table><tr><th class=\"l\">builder"
 		              "</th><th>threads</th><th>median ms</th><th>SAH cost</th>"
-		              "<th class=\"l\">time × SAH</th><th>primary nodes/ray</th>"
-		              "<th class=\"l\">time × nodes/ray</th></tr>\n", intro);
+		              "<th class=\"l\">time × SAH</th><th>ray cost</th>"
+		              "<th class=\"l\">time × ray cost</th></tr>\n", intro);
 		for (size_t k = 0; k < t.n; k++)
 			if (t.by[0][k] != FRONT_NONE)
 				html_row(sb, ix, &t, k);

@@ -13,7 +13,7 @@
 #include "output/report.h"
 
 static const char css[] =
-	"body{font-family:sans-serif;margin:2em;max-width:1400px;color:#222}"
+	"body{font-family:sans-serif;margin:2em;color:#222}p{max-width:1400px}"
 	"table{border-collapse:collapse;margin:1em 0;font-size:13px}"
 	"th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}"
 	"th{background:#f0f0f0}td.l,th.l{text-align:left}"
@@ -22,8 +22,7 @@ static const char css[] =
 	"img{image-rendering:pixelated;border:1px solid #ccc}"
 	"table.summary td.good{background:#e3f4e3}table.summary td.worse{background:#fbe7e7}"
 	"td.front{background:#e3f4e3;font-weight:bold}.warn{color:#8a4b00}"
-	"td.warn{background:#fff4dc}.wide{overflow-x:auto;max-width:100%}"
-	".wide td,.wide th{white-space:nowrap}"
+	"td.warn{background:#fff4dc}td.err{max-width:40em}"
 	"h3{margin-bottom:0.2em}";
 
 static void esc(struct strbuf *sb, const char *s)
@@ -95,14 +94,32 @@ static void phases_cell(struct strbuf *sb, const cJSON *run)
 	sb_printf(sb, "</td>");
 }
 
-static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
-                    const bool *others, bool any_other)
+/* The cells that start every row of a scene's tables. */
+static void name_cells(struct strbuf *sb, const cJSON *run)
 {
-	bool ok = strcmp(report_str(run, "status"), "ok") == 0;
 	sb_printf(sb, "<tr><td class=\"l\">");
 	esc(sb, report_str(run, "builder"));
 	sb_printf(sb, "</td>");
 	num_cell(sb, report_num(run, "threads"), "%.0f");
+}
+
+static void error_cell(struct strbuf *sb, const cJSON *run)
+{
+	sb_printf(sb, "<td class=\"l err\">");
+	esc(sb, report_str(run, "error"));
+	if (*report_str(run, "rays.error")) { /* a traversal's device missing, say */
+		sb_printf(sb, "%srays: ", *report_str(run, "error") ? "; " : "");
+		esc(sb, report_str(run, "rays.error"));
+	}
+	sb_printf(sb, "</td>");
+}
+
+/* The run's build: status, marks, times, memory, error. */
+static void build_row(struct strbuf *sb, const struct report_index *ix, const cJSON *run,
+                      bool phases)
+{
+	bool ok = strcmp(report_str(run, "status"), "ok") == 0;
+	name_cells(sb, run);
 	sb_printf(sb, "<td class=\"l%s\">", ok ? "" : " bad");
 	esc(sb, report_str(run, "status"));
 	sb_printf(sb, "</td>");
@@ -111,21 +128,37 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 	num_cell(sb, report_num(run, "build_ms.min"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.max"), "%.2f");
 	num_cell(sb, report_num(run, "build_ms.cold"), "%.2f");
-	if (others[OTHERS]) /* the scene has build phases */
+	if (phases)
 		phases_cell(sb, run);
 	num_cell(sb, report_num(run, "mtris_per_s"), "%.2f");
 	num_cell(sb, report_speedup(ix, run), "%.2f");
+	num_cell(sb, report_num(run, "memory.peak_bytes") / 1048576.0, "%.1f");
+	error_cell(sb, run);
+	sb_printf(sb, "</tr>\n");
+}
+
+/* The run's tree and its rays by the main traversal. */
+static void tree_row(struct strbuf *sb, const cJSON *run)
+{
+	name_cells(sb, run);
 	num_cell(sb, report_num(run, "tree.sah_cost"), "%.3f");
 	num_cell(sb, report_num(run, "tree.epo"), "%.3f");
-	num_cell(sb, report_num(run, "memory.peak_bytes") / 1048576.0, "%.1f");
 	num_cell(sb, report_num(run, "rays.primary.mrays_per_s"), "%.2f");
 	range_cell(sb, run, "rays.primary");
 	num_cell(sb, report_num(run, "rays.primary.nodes_per_ray"), "%.1f");
 	num_cell(sb, report_num(run, "rays.primary.tris_per_ray"), "%.1f");
 	num_cell(sb, report_num(run, "rays.diffuse.mrays_per_s"), "%.2f");
 	num_cell(sb, report_num(run, "rays.diffuse.nodes_per_ray"), "%.1f");
+	num_cell(sb, report_num(run, "tree.nodes"), "%.0f");
 	num_cell(sb, report_num(run, "tree.refs"), "%.0f");
 	num_cell(sb, report_num(run, "tree.dup_ratio"), "%.3f");
+	sb_printf(sb, "</tr>\n");
+}
+
+/* The run's rays by the other traversals it was traced with. */
+static void others_row(struct strbuf *sb, const cJSON *run, const bool *others)
+{
+	name_cells(sb, run);
 	for (size_t t = 0; t < OTHERS; t++) {
 		if (!others[t])
 			continue;
@@ -135,15 +168,8 @@ static void run_row(struct strbuf *sb, const struct report_index *ix, const cJSO
 			num_cell(sb, other_num(run, other_traversals[t], "primary.nodes_per_ray"),
 			         "%.1f");
 	}
-	if (any_other)
-		num_cell(sb, report_num(run, "rays.traversal_disagreements"), "%.0f");
-	sb_printf(sb, "<td class=\"l\">");
-	esc(sb, report_str(run, "error"));
-	if (*report_str(run, "rays.error")) { /* a traversal's device missing, say */
-		sb_printf(sb, "%srays: ", *report_str(run, "error") ? "; " : "");
-		esc(sb, report_str(run, "rays.error"));
-	}
-	sb_printf(sb, "</td></tr>\n");
+	num_cell(sb, report_num(run, "rays.traversal_disagreements"), "%.0f");
+	sb_printf(sb, "</tr>\n");
 }
 
 /* Which other traversals some run of the scene was also traced with;
@@ -162,30 +188,45 @@ static bool find_others(const cJSON *const *runs, size_t n, bool *others)
 	return any;
 }
 
-static void table(struct strbuf *sb, const struct report_index *ix, const char *scene)
+static const char name_heads[] = "<tr><th class=\"l\">builder</th><th>threads</th>";
+
+static void build_table(struct strbuf *sb, const struct report_index *ix,
+                        const cJSON *const *runs, size_t n)
 {
-	size_t n;
-	bool others[OTHERS + 1];
-	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
-	bool any_other = find_others(runs, n, others);
-	others[OTHERS] = report_any_phases(runs, n);
-	sb_printf(sb, "<div class=\"wide\"><table><tr><th class=\"l\">builder</th><th>threads</th>"
-	              "<th class=\"l\">status</th><th class=\"l\" title=\"≈ noisy: build repeats spread "
-	              "over 5 %%, or the same tree traced over 5 %% faster or slower elsewhere; ⚠ busy: "
-	              "the load exceeded the cores the run left free (hover a mark for its figures)"
-	              "\">marks</th><th>median ms</th><th>min ms</th><th>max ms</th>"
-	              "<th>cold ms</th>%s"
-	              "<th>Mtris/s</th><th>speedup</th><th>SAH cost</th><th>EPO</th>"
-	              "<th>peak MiB</th><th title=\"each tile of rays at its best pass: the "
-	              "figure runs compare by\">primary Mrays/s (best tile)</th><th title=\"whole "
-	              "passes, slowest to fastest: the best-tile figure can lie above them, as "
-	              "no single pass had every tile at its best\">per pass min–max</th>"
-	              "<th>primary nodes/ray</th><th>primary tris/ray</th><th>diffuse Mrays/s "
-	              "(best tile)</th><th>diffuse nodes/ray</th><th>refs</th><th>refs/tri</th>",
-	          others[OTHERS] ? "<th class=\"l\" title=\"the builder's own timing of the "
-	                           "phases of a build (median over the timed repeats), inside "
-	                           "the whole call that median ms times\">build phases ms</th>"
-	                         : "");
+	bool phases = report_any_phases(runs, n);
+	sb_printf(sb, "<table class=\"runs build\">%s<th class=\"l\">status</th><th class=\"l\" "
+	              "title=\"≈ noisy: build repeats spread over 5 %%, or the same tree traced over "
+	              "5 %% faster or slower elsewhere; ⚠ busy: the load exceeded the cores the run "
+	              "left free (hover a mark for its figures)\">marks</th><th>median ms</th>"
+	              "<th>min ms</th><th>max ms</th><th>cold ms</th>%s<th>Mtris/s</th>"
+	              "<th>speedup</th><th>peak MiB</th><th class=\"l\">error</th></tr>\n",
+	          name_heads,
+	          phases ? "<th class=\"l\" title=\"the builder's own timing of the phases of a "
+	                   "build (median over the timed repeats), inside the whole call that "
+	                   "median ms times\">build phases ms</th>" : "");
+	for (size_t k = 0; k < n; k++)
+		build_row(sb, ix, runs[k], phases);
+	sb_printf(sb, "</table>\n");
+}
+
+static void tree_table(struct strbuf *sb, const cJSON *const *runs, size_t n)
+{
+	sb_printf(sb, "<table class=\"runs tree\">%s<th>SAH cost</th><th>EPO</th><th title=\"each "
+	              "tile of rays at its best pass: the figure runs compare by\">primary Mrays/s "
+	              "(best tile)</th><th title=\"whole passes, slowest to fastest: the best-tile "
+	              "figure can lie above them, as no single pass had every tile at its best\">"
+	              "per pass min–max</th><th>primary nodes/ray</th><th>primary tris/ray</th>"
+	              "<th>diffuse Mrays/s (best tile)</th><th>diffuse nodes/ray</th><th>nodes</th>"
+	              "<th>refs</th><th>refs/tri</th></tr>\n", name_heads);
+	for (size_t k = 0; k < n; k++)
+		tree_row(sb, runs[k]);
+	sb_printf(sb, "</table>\n");
+}
+
+static void others_table(struct strbuf *sb, const cJSON *const *runs, size_t n,
+                         const bool *others)
+{
+	sb_printf(sb, "<table class=\"runs others\">%s", name_heads);
 	for (size_t t = 0; t < OTHERS; t++) {
 		const char *name = other_traversals[t];
 		if (!others[t])
@@ -194,12 +235,23 @@ static void table(struct strbuf *sb, const struct report_index *ix, const char *
 		if (strstr(name, "stackless"))
 			sb_printf(sb, "<th>%s primary nodes/ray</th>", name);
 	}
-	if (any_other)
-		sb_printf(sb, "<th>hits differing</th>");
-	sb_printf(sb, "<th class=\"l\">error</th></tr>\n");
+	sb_printf(sb, "<th>hits differing</th></tr>\n");
 	for (size_t k = 0; k < n; k++)
-		run_row(sb, ix, runs[k], others, any_other);
-	sb_printf(sb, "</table></div>\n");
+		others_row(sb, runs[k], others);
+	sb_printf(sb, "</table>\n");
+}
+
+/* The scene's runs in tables narrow enough for a 1400 px window: the
+ * builds, then the trees and their rays, then any other traversals. */
+static void table(struct strbuf *sb, const struct report_index *ix, const char *scene)
+{
+	size_t n;
+	bool others[OTHERS];
+	const cJSON *const *runs = report_scene_runs(ix, scene, &n);
+	build_table(sb, ix, runs, n);
+	tree_table(sb, runs, n);
+	if (find_others(runs, n, others))
+		others_table(sb, runs, n, others);
 }
 
 /* " on M2" when the runs come from several machines, else "". */
@@ -212,16 +264,27 @@ static const char *machine_text(char *buf, size_t size, const struct report_inde
 	return buf;
 }
 
-/* A chart point of a run: its builder's colour, "builder x2" as its label. */
-static struct svg_point run_point(const struct report_index *ix, const cJSON *run, char *label,
-                                  size_t size, double x, double y)
+/* A point's texts: its label and its run's marks. */
+struct point_text {
+	char label[96], mark[256];
+};
+
+/* A chart point of a run: its builder's colour, its library's shape,
+ * "builder x2" as its label, and the run's marks (every chart of a scene
+ * shows a time). */
+static struct svg_point run_point(const struct report_index *ix, const cJSON *run,
+                                  struct point_text *t, double x, double y)
 {
 	char on[32];
-	snprintf(label, size, "%s x%.0f%s", report_str(run, "builder"), report_num(run, "threads"),
+	const char *builder = report_str(run, "builder");
+	snprintf(t->label, sizeof(t->label), "%s x%.0f%s", builder, report_num(run, "threads"),
 	         machine_text(on, sizeof(on), ix, report_machine_number(ix, run)));
-	return (struct svg_point){label, report_str(run, "builder"), x, y,
-	                          svg_colour(report_builder_number(ix, report_str(run, "builder"))),
-	                          false};
+	report_run_marks(t->mark, sizeof(t->mark), ix, run);
+	struct svg_point p = {.label = t->label, .group = builder, .x = x, .y = y,
+	                      .shape = svg_plugin_shape(report_str(run, "plugin")),
+	                      .mark = t->mark};
+	svg_colour(report_builder_number(ix, builder), p.colour, sizeof(p.colour));
+	return p;
 }
 
 /* One view's Pareto charts, one per machine and thread count: build time
@@ -230,30 +293,27 @@ static struct svg_point run_point(const struct report_index *ix, const cJSON *ru
  * each). */
 static void front_charts(struct strbuf *sb, const struct report_index *ix,
                          const struct front_entry *e, size_t n, const double *threads,
-                         size_t nt, int view, struct svg_point *p, char (*labels)[96])
+                         size_t nt, int view, struct svg_point *p, struct point_text *texts)
 {
-	static const char *const figures[2] = {"tree.sah_cost", "rays.primary.nodes_per_ray"};
-	static const char *const names[2] = {"SAH cost", "primary nodes/ray"};
 	struct front_point *fp = calloc(n + 1, sizeof(*fp));
 	long *by = calloc(n + 1, sizeof(*by));
 	if (fp && by)
-		report_entries_front(e, n, figures[view], fp, by);
+		report_entries_front(e, n, view, fp, by);
 	for (size_t g = 0; fp && by && g < nt * ix->machine_count; g++) {
 		size_t m = 0, t = g % nt;
 		long machine = (long)(g / nt);
 		for (size_t k = 0; k < n; k++) {
 			if (by[k] == FRONT_NONE || e[k].threads != threads[t] || e[k].machine != machine)
 				continue;
-			p[m] = run_point(ix, e[k].run, labels[m], sizeof(labels[m]), fp[k].time,
-			                 fp[k].figure);
+			p[m] = run_point(ix, e[k].run, &texts[m], fp[k].time, fp[k].figure);
 			p[m++].front = by[k] == FRONT_ON;
 		}
 		char title[128], on[32];
-		snprintf(title, sizeof(title), "%s vs. build time, %.0f thread%s%s", names[view],
-		         threads[t], threads[t] == 1 ? "" : "s",
+		snprintf(title, sizeof(title), "%s vs. build time, %.0f thread%s%s",
+		         report_front_view_name(view), threads[t], threads[t] == 1 ? "" : "s",
 		         machine_text(on, sizeof(on), ix, machine));
 		if (m > 0)
-			svg_scatter(sb, title, "build time (ms)", names[view], p, m);
+			svg_scatter(sb, title, "build time (ms)", report_front_view_name(view), p, m);
 	}
 	free(fp);
 	free(by);
@@ -261,13 +321,12 @@ static void front_charts(struct strbuf *sb, const struct report_index *ix,
 
 static void bars_and_speedups(struct strbuf *sb, const struct report_index *ix,
                               const cJSON *const *runs, size_t count, struct svg_point *q,
-                              char (*labels)[96])
+                              struct point_text *texts)
 {
 	size_t n = 0, m = 0;
 	for (size_t k = 0; k < count; k++)
 		if (isfinite(report_num(runs[k], "build_ms.median"))) {
-			q[n] = run_point(ix, runs[k], labels[n], sizeof(labels[n]), 0,
-			                 report_num(runs[k], "build_ms.median"));
+			q[n] = run_point(ix, runs[k], &texts[n], 0, report_num(runs[k], "build_ms.median"));
 			n++;
 		}
 	if (n > 0)
@@ -277,8 +336,7 @@ static void bars_and_speedups(struct strbuf *sb, const struct report_index *ix,
 		for (size_t k = 0; k < count; k++) {
 			double s = report_speedup(ix, runs[k]);
 			if (isfinite(s) && report_machine_number(ix, runs[k]) == machine) {
-				q[m] = run_point(ix, runs[k], labels[m], sizeof(labels[m]),
-				                 report_num(runs[k], "threads"), s);
+				q[m] = run_point(ix, runs[k], &texts[m], report_num(runs[k], "threads"), s);
 				m++;
 			}
 		}
@@ -296,19 +354,19 @@ static void charts(struct strbuf *sb, const struct report_index *ix, const char 
 	const cJSON *const *runs = report_scene_runs(ix, scene, &count);
 	struct front_entry *e = report_front_entries(ix, runs, count, &ne);
 	struct svg_point *p = calloc(ne + count + 1, sizeof(*p));
-	char (*labels)[96] = calloc(ne + count + 1, sizeof(*labels));
-	if (!e || !p || !labels || count == 0)
+	struct point_text *texts = calloc(ne + count + 1, sizeof(*texts));
+	if (!e || !p || !texts || count == 0)
 		goto out;
 	sb_printf(sb, "<div class=\"charts\">\n");
-	bars_and_speedups(sb, ix, runs, count, p, labels);
+	bars_and_speedups(sb, ix, runs, count, p, texts);
 	nt = report_thread_counts(runs, count, threads, 16);
 	for (int view = 0; view < 2; view++)
-		front_charts(sb, ix, e, ne, threads, nt, view, p, labels);
+		front_charts(sb, ix, e, ne, threads, nt, view, p, texts);
 	sb_printf(sb, "</div>\n");
 out:
 	free(e);
 	free(p);
-	free(labels);
+	free(texts);
 }
 
 static void figure(struct strbuf *sb, const char *src, const char *caption)
@@ -398,6 +456,7 @@ static void scene_section(struct strbuf *sb, const struct report_index *ix, cons
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
 	report_front_html(sb, ix, runs, n);
+	report_budget_html(sb, ix, name);
 	report_breakeven_html(sb, ix, ref, runs, n);
 	images(sb, ix, scene);
 	report_frames_html(sb, ix, scene); /* an animated scene's frames */
@@ -437,6 +496,11 @@ char *report_html(const cJSON *doc)
 	          report_num(doc, "machine.cores"));
 	const char *asked, *ref = report_reference(doc, &asked, &(bool){false});
 	report_load_warning(&sb, doc, true);
+	if (*report_str(doc, "report_note")) { /* bvhlab report --scene/--threads */
+		sb_printf(&sb, "<p class=\"warn\">");
+		esc(&sb, report_str(doc, "report_note"));
+		sb_printf(&sb, "</p>\n");
+	}
 	report_summary_html(&sb, &ix);
 	report_machines_html(&sb, doc);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))

@@ -161,70 +161,109 @@ static const char *ratio_text(char *buf, size_t size, double r)
 	return buf;
 }
 
-/* Whether the row's builder has a row with more than 1 thread on its machine. */
-static bool has_parallel_row(const struct summary_row *rows, int n, const struct summary_row *r)
+/* Where a row's runs stand on their scenes' fronts (time × SAH). */
+struct row_verdict {
+	int on, dominated, compared;
+	const char *by[3]; /* the builders that dominate it, the first few */
+	int nby;
+};
+
+/* The row of the entry's run (its own thread count, not a stand-in's),
+ * or -1. */
+static int row_of(const struct summary_row *rows, int n, const struct front_entry *e)
 {
+	if (report_num(e->run, "threads") != e->threads)
+		return -1; /* a 1-thread-only builder standing in: its row is at 1 thread */
 	for (int i = 0; i < n; i++)
-		if (rows[i].threads > 1 && rows[i].machine == r->machine &&
-		    strcmp(rows[i].builder, r->builder) == 0)
-			return true;
-	return false;
+		if (rows[i].threads == e->threads && rows[i].machine == e->machine &&
+		    strcmp(rows[i].builder, report_str(e->run, "builder")) == 0)
+			return i;
+	return -1;
 }
 
-/* Rows compete within one machine, thread count and scene count. */
-static struct front_point row_point(const struct summary_row *r, double threads)
+static void add_dominator(struct row_verdict *v, const char *name)
 {
-	long group = report_front_group(r->machine, threads) * 100000 + r->scenes;
-	return (struct front_point){r->ratio[0], r->ratio[1], group};
+	for (int k = 0; k < v->nby; k++)
+		if (strcmp(v->by[k], name) == 0)
+			return;
+	if (v->nby < 3)
+		v->by[v->nby++] = name;
 }
 
-/* The rows' points, then a stand-in at every other thread count for each
- * row of a builder that ran on 1 thread only (it is a choice there too);
- * map[k]: the row point k stands for. Returns the count. */
-static size_t with_stand_ins(const struct summary_row *rows, int n, struct front_point *q,
-                             int *map)
+/* One scene's front verdicts added to its rows'. */
+static void scene_verdicts(const struct report_index *ix, const struct summary_row *rows, int n,
+                           const char *scene, struct row_verdict *v)
 {
-	size_t m = 0;
-	for (int i = 0; i < n; i++, m++)
-		q[m] = row_point(&rows[i], rows[i].threads), map[m] = i;
-	for (int t = 0; t < n; t++) {
-		bool first = rows[t].threads > 1;
-		for (int j = 0; j < t && first; j++) /* each thread count and machine once */
-			first = rows[j].threads != rows[t].threads || rows[j].machine != rows[t].machine;
-		for (int i = 0; first && i < n; i++)
-			if (rows[i].threads == 1 && rows[i].machine == rows[t].machine &&
-			    !has_parallel_row(rows, n, &rows[i]))
-				q[m] = row_point(&rows[i], rows[t].threads), map[m++] = i;
+	size_t count, m;
+	const cJSON *const *runs = report_scene_runs(ix, scene, &count);
+	struct front_entry *e = report_front_entries(ix, runs, count, &m);
+	struct front_point *p = calloc(m + 1, sizeof(*p));
+	long *by = calloc(m + 1, sizeof(*by));
+	if (e && p && by)
+		report_entries_front(e, m, 0, p, by);
+	for (size_t k = 0; e && p && by && k < m; k++) {
+		int i = row_of(rows, n, &e[k]);
+		if (i < 0 || by[k] == FRONT_NONE)
+			continue;
+		v[i].compared++;
+		if (by[k] == FRONT_ON)
+			v[i].on++;
+		else {
+			v[i].dominated++;
+			add_dominator(&v[i], report_str(e[by[k]].run, "builder"));
+		}
 	}
-	return m;
+	free(e);
+	free(p);
+	free(by);
 }
 
-void report_summary_fronts(const struct summary_row *rows, int n, struct front_point *p,
-                           long *by)
+/* Every row's verdict over the scenes (calloc'd; NULL on no memory). */
+static struct row_verdict *row_verdicts(const struct report_index *ix,
+                                        const struct summary_row *rows, int n)
 {
-	size_t cap = (size_t)n * ((size_t)n + 1) + 1;
-	struct front_point *q = calloc(cap, sizeof(*q));
-	long *qb = calloc(cap, sizeof(*qb));
-	int *map = calloc(cap, sizeof(*map));
-	size_t m = q && qb && map ? with_stand_ins(rows, n, q, map) : 0;
-	report_front_points(q, m, qb);
-	for (int i = 0; i < n; i++) {
-		p[i] = row_point(&rows[i], rows[i].threads);
-		by[i] = (size_t)i >= m ? FRONT_NONE : qb[i] >= 0 ? map[qb[i]] : qb[i];
+	struct row_verdict *v = calloc((size_t)n + 1, sizeof(*v));
+	const cJSON *scene;
+	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(ix->doc, "scenes"))
+		if (v)
+			scene_verdicts(ix, rows, n, report_str(scene, "name"), v);
+	return v;
+}
+
+/* "front on 2 of 3 scenes, dominated on 1 by X", "dominated on 2 of 2
+ * scenes by X, Y", "—" where no scene compared it. */
+static const char *verdict_text(char *buf, size_t size, const struct row_verdict *v)
+{
+	if (v->compared == 0) {
+		snprintf(buf, size, "—");
+		return buf;
 	}
-	free(q);
-	free(qb);
-	free(map);
+	int len = 0;
+	if (v->on > 0)
+		len = snprintf(buf, size, "front on %d of %d scene%s", v->on, v->compared,
+		               v->compared == 1 ? "" : "s");
+	if (v->dominated > 0 && len >= 0 && (size_t)len < size) {
+		if (v->on)
+			len += snprintf(buf + len, size - (size_t)len, ", dominated on %d by ",
+			                v->dominated);
+		else
+			len = snprintf(buf, size, "dominated on %d of %d scene%s by ", v->dominated,
+			               v->compared, v->compared == 1 ? "" : "s");
+		for (int k = 0; k < v->nby && len >= 0 && (size_t)len < size; k++)
+			len += snprintf(buf + len, size - (size_t)len, "%s%s", k ? ", " : "", v->by[k]);
+	}
+	return buf;
 }
 
 static const char intro[] =
 	"Geometric mean over scenes of each figure relative to the reference builder "
 	"**%s** on the same scene (its run with the fewest threads); below 1 is less "
 	"build time, a cheaper tree (SAH, end-point overlap) or fewer nodes visited per "
-	"ray. Scenes: how many had ok runs of both. Pareto: among the rows of the same "
-	"thread count over as many scenes (a builder that ran on 1 thread only counts at "
-	"every thread count), on the front of build time against SAH cost, or the fastest "
-	"row on it that is at least as fast and as good.\n\n";
+	"ray. Scenes: how many had ok runs of both. Pareto: on how many of the scenes "
+	"that compared it the run is on the scene's front of build time against SAH cost "
+	"(the scene's Pareto fronts table, same thread count), and on how many it is "
+	"dominated, by whom: a verdict per scene, never one over geometric means of "
+	"builders valid on different scenes.\n\n";
 
 static const char machines_note[] =
 	"The runs come from %zu machines (see Machines): a row holds one machine's runs, "
@@ -247,21 +286,11 @@ static void fallback_note(struct strbuf *sb, const cJSON *doc, const char *ref, 
 	sb_printf(sb, html ? ".</p>\n" : ".\n\n");
 }
 
-/* The row's Pareto verdict, in words. */
-static const char *front_text(char *buf, size_t size, const struct summary_row *rows,
-                              const struct front_point *p, const long *by, int i)
-{
-	report_front_text(buf, size, p, by[i], (size_t)i, by[i] >= 0 ? rows[by[i]].builder : "",
-	                  "SAH");
-	return buf;
-}
-
 struct summary {
 	struct summary_row *rows;
 	const char *ref;
 	int n;
-	struct front_point *p;
-	long *by;
+	struct row_verdict *v; /* where each row's runs stand on their scenes' fronts */
 	bool machines; /* runs from several machines: a machine column */
 };
 
@@ -269,18 +298,14 @@ static bool summary_init(struct summary *s, const struct report_index *ix)
 {
 	s->machines = ix->machine_count > 1;
 	s->n = report_summary(ix, &s->rows, &s->ref);
-	s->p = calloc((size_t)s->n + 1, sizeof(*s->p));
-	s->by = calloc((size_t)s->n + 1, sizeof(*s->by));
-	if (s->n > 0 && s->p && s->by)
-		report_summary_fronts(s->rows, s->n, s->p, s->by);
-	return s->n > 0 && s->p && s->by;
+	s->v = row_verdicts(ix, s->rows, s->n);
+	return s->n > 0 && s->v;
 }
 
 static void summary_finish(struct summary *s)
 {
 	free(s->rows);
-	free(s->p);
-	free(s->by);
+	free(s->v);
 }
 
 void report_summary_md(struct strbuf *sb, const struct report_index *ix)
@@ -293,6 +318,7 @@ void report_summary_md(struct strbuf *sb, const struct report_index *ix)
 		summary_finish(&s);
 		return;
 	}
+	report_budget_summary(sb, ix, false);
 	fallback_note(sb, ix->doc, s.ref, false);
 	sb_printf(sb, intro, s.ref);
 	if (s.machines) {
@@ -313,7 +339,7 @@ void report_summary_md(struct strbuf *sb, const struct report_index *ix)
 		sb_printf(sb, " %d |", s.rows[i].scenes);
 		for (int m = 0; m < SUMMARY_METRICS; m++)
 			sb_printf(sb, " %s |", ratio_text(buf, sizeof(buf), s.rows[i].ratio[m]));
-		report_md_cell(sb, front_text(buf, sizeof(buf), s.rows, s.p, s.by, i));
+		report_md_cell(sb, verdict_text(buf, sizeof(buf), &s.v[i]));
 		sb_printf(sb, "\n");
 	}
 	summary_finish(&s);
@@ -335,8 +361,9 @@ static void html_row(struct strbuf *sb, const struct summary *s, int i)
 		          : isfinite(r) && r > 1.005 ? " class=\"worse\"" : "",
 		          ratio_text(buf, sizeof(buf), r));
 	}
-	sb_printf(sb, "<td class=\"l%s\">", s->by[i] == FRONT_ON ? " front" : "");
-	report_escape(sb, front_text(buf, sizeof(buf), s->rows, s->p, s->by, i));
+	const struct row_verdict *v = &s->v[i];
+	sb_printf(sb, "<td class=\"l%s\">", v->compared && v->on == v->compared ? " front" : "");
+	report_escape(sb, verdict_text(buf, sizeof(buf), v));
 	sb_printf(sb, "</td></tr>\n");
 }
 
@@ -349,16 +376,16 @@ void report_summary_html(struct strbuf *sb, const struct report_index *ix)
 		summary_finish(&s);
 		return;
 	}
+	report_budget_summary(sb, ix, true);
 	fallback_note(sb, ix->doc, s.ref, true);
 	sb_printf(sb, "<p>Geometric mean over scenes of each figure relative to the reference "
 	              "builder <b>");
 	report_escape(sb, s.ref);
 	sb_printf(sb, "</b> on the same scene (its run with the fewest threads); below 1 is less "
 	              "build time, a cheaper tree (SAH, end-point overlap) or fewer nodes "
-	              "visited per ray. Pareto: among the rows of the same thread count over "
-	              "as many scenes (a builder that ran on 1 thread only counts at every "
-	              "thread count), on the front of build time against SAH cost, or the "
-	              "fastest row on it at least as fast and as good.</p>\n");
+	              "visited per ray. Pareto: on how many of the scenes that compared it the "
+	              "run is on the scene's front of build time against SAH cost (same "
+	              "thread count), and on how many it is dominated, by whom.</p>\n");
 	if (s.machines) {
 		sb_printf(sb, "<p class=\"warn\">");
 		sb_printf(sb, machines_note, ix->machine_count);

@@ -22,20 +22,6 @@
 #define LINE_H 12.0
 #define MARKER_R 4.5 /* a scatter point's radius */
 
-/* One colour per builder in every chart of the report: ten strong hues
- * first (Tableau 10, told apart by most colour-blind readers too), then
- * black and light variants for larger comparisons. */
-static const char *const palette[] = {
-	"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
-	"#7f7f7f", "#bcbd22", "#17becf", "#000000", "#aec7e8", "#ffbb78", "#98df8a",
-	"#ff9896", "#c5b0d5"};
-#define PALETTE (sizeof(palette) / sizeof(palette[0]))
-
-const char *svg_colour(long k)
-{
-	return k < 0 ? "#888888" : palette[(size_t)k % PALETTE];
-}
-
 static void open_svg(struct strbuf *sb, const char *title, int height)
 {
 	sb_printf(sb, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
@@ -73,6 +59,15 @@ static void bar_label(struct strbuf *sb, double x, double y, const char *label, 
 	sb_printf(sb, "</text>");
 }
 
+/* Whether some point is marked busy or noisy. */
+static bool any_mark(const struct svg_point *p, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		if (p[i].mark && *p[i].mark)
+			return true;
+	return false;
+}
+
 void svg_bars(struct strbuf *sb, const char *title, const char *unit,
               const struct svg_point *p, size_t n)
 {
@@ -85,15 +80,29 @@ void svg_bars(struct strbuf *sb, const char *title, const char *unit,
 	}
 	longest = longest < fit ? longest : fit;
 	double left = 12 + CHAR_W * (double)longest; /* as much room as the labels need */
+	double room = any_mark(p, n) ? 170 : 90;      /* for the value and its marks */
 	open_svg(sb, title, PAD_T + (int)n * (BAR_H + 4) + 8);
 	for (size_t i = 0; i < n; i++) {
 		double y = PAD_T + (double)i * (BAR_H + 4);
-		double w = max > 0 && isfinite(p[i].y) ? p[i].y / max * (W - left - 90) : 0;
+		double w = max > 0 && isfinite(p[i].y) ? p[i].y / max * (W - left - room) : 0;
+		bool marked = p[i].mark && *p[i].mark;
 		bar_label(sb, left - 6, y + BAR_H - 5, p[i].label, longest);
-		sb_printf(sb, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" fill=\"%s\"/>",
-		          left, y, w, BAR_H, p[i].colour ? p[i].colour : palette[0]);
-		snprintf(buf, sizeof(buf), "%s %s", report_plain(v, sizeof(v), p[i].y), unit);
-		text_at(sb, left + w + 4, y + BAR_H - 5, "start", buf);
+		sb_printf(sb, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%d\" fill=\"%s\"%s>"
+		              "<title>", left, y, w, BAR_H, p[i].colour,
+		          marked ? " stroke=\"#e08000\" stroke-width=\"2\" stroke-dasharray=\"3,2\"" : "");
+		report_escape(sb, p[i].label);
+		if (marked)
+			sb_printf(sb, " (");
+		report_escape(sb, marked ? p[i].mark : "");
+		sb_printf(sb, "%s</title></rect>", marked ? ")" : "");
+		if (p[i].shape != SVG_CIRCLE) { /* a peer library's bar: its shape at the bar's end */
+			svg_shape(sb, p[i].shape, left + w, y + BAR_H / 2.0, 4, "#fff", " stroke=\"#222\"");
+			sb_printf(sb, "/>");
+		}
+		snprintf(buf, sizeof(buf), "%s %s%s%s", report_plain(v, sizeof(v), p[i].y), unit,
+		         marked && strstr(p[i].mark, "noisy") ? " ≈ noisy" : "",
+		         marked && strstr(p[i].mark, "busy") ? " ⚠ busy" : "");
+		text_at(sb, left + w + 6, y + BAR_H - 5, "start", buf);
 	}
 	sb_printf(sb, "</svg>\n");
 }
@@ -279,26 +288,42 @@ static bool opens_group(const struct svg_point *p, size_t n, size_t i)
 	return drawable(p, n, p[i].group);
 }
 
-/* The legend under the plot: a swatch and the group's name per group
- * drawn, in rows that wrap at the chart's width. Draws when sb is not
- * NULL; returns the rows it takes. */
+/* One legend entry of width w at the running position; a new row when it
+ * does not fit. Returns the entry's baseline. */
+static double legend_slot(double *x, int *rows, double w, double top)
+{
+	if (*rows == 0 || (*x + w > W - 4 && *x > PLOT_X))
+		*x = PLOT_X, (*rows)++;
+	*x += w;
+	return top + (*rows - 1) * LEGEND_H;
+}
+
+/* The legend under the plot: a swatch in the group's shape and colour and
+ * the group's name per group drawn, then, when some point is marked, the
+ * mark's ring; in rows that wrap at the chart's width. Draws when sb is
+ * not NULL; returns the rows it takes. */
 static int legend(struct strbuf *sb, const struct svg_point *p, size_t n, double top)
 {
+	static const char ring_text[] = "busy or noisy (hover a point: why)";
 	double x = PLOT_X;
 	int rows = 0;
 	for (size_t i = 0; i < n; i++) {
 		if (!opens_group(p, n, i))
 			continue;
 		double w = 16 + CHAR_W * (double)strlen(p[i].group) + 14;
-		if (rows == 0 || (x + w > W - 4 && x > PLOT_X))
-			x = PLOT_X, rows++;
+		double y = legend_slot(&x, &rows, w, top), x0 = x - w; /* after any wrap */
 		if (sb) {
-			double y = top + (rows - 1) * LEGEND_H;
-			sb_printf(sb, "<rect x=\"%.1f\" y=\"%.1f\" width=\"10\" height=\"10\" fill=\"%s\"/>",
-			          x, y - 9, p[i].colour);
-			text_at(sb, x + 14, y, "start", p[i].group);
+			svg_shape(sb, p[i].shape, x0 + 5, y - 4, 5, p[i].colour, "/>");
+			text_at(sb, x0 + 14, y, "start", p[i].group);
 		}
-		x += w;
+	}
+	if (any_mark(p, n)) {
+		double w = 16 + CHAR_W * (double)strlen(ring_text) + 14;
+		double y = legend_slot(&x, &rows, w, top), x0 = x - w;
+		if (sb) {
+			svg_warn_ring(sb, x0 + 5, y - 4, 1);
+			text_at(sb, x0 + 14, y, "start", ring_text);
+		}
 	}
 	return rows;
 }
@@ -454,60 +479,69 @@ static int by_x(const void *a, const void *b)
 static void front_line(struct strbuf *sb, const struct frame *f, const struct svg_point *p,
                        size_t n)
 {
-	const struct svg_point *on[64];
+	const struct svg_point **on = malloc((n + 1) * sizeof(*on));
 	size_t m = 0;
-	for (size_t i = 0; i < n && m < 64; i++)
+	for (size_t i = 0; on && i < n; i++)
 		if (p[i].front && isfinite(p[i].x) && isfinite(p[i].y))
 			on[m++] = &p[i];
-	if (m == 0)
-		return;
-	qsort(on, m, sizeof(on[0]), by_x);
-	sb_printf(sb, "<polyline fill=\"none\" stroke=\"#444\" stroke-width=\"1.5\" "
-	              "stroke-dasharray=\"5,3\" points=\"");
-	for (size_t i = 0; i < m; i++)
-		sb_printf(sb, "%.1f,%.1f ", px(f, on[i]->x), py(f, on[i]->y));
-	sb_printf(sb, "\"/>");
+	if (!on)
+		sb->failed = true;
+	if (m > 0) {
+		qsort(on, m, sizeof(on[0]), by_x);
+		sb_printf(sb, "<polyline fill=\"none\" stroke=\"#444\" stroke-width=\"1.5\" "
+		              "stroke-dasharray=\"5,3\" points=\"");
+		for (size_t i = 0; i < m; i++)
+			sb_printf(sb, "%.1f,%.1f ", px(f, on[i]->x), py(f, on[i]->y));
+		sb_printf(sb, "\"/>");
+	}
+	free(on);
 }
 
-/* A point with its label as a tooltip; front points are ringed. One off
- * the chart is a triangle at the top edge, its value in the tooltip. */
-static void marker(struct strbuf *sb, const struct frame *f, const struct svg_point *p)
+/* A point in its shape, with its label (and its mark, ringed) as a
+ * tooltip; front points are outlined. One off the chart is a triangle at
+ * the top edge, its value in the tooltip. */
+static void marker(struct strbuf *sb, const struct frame *f, const struct svg_point *p,
+                   double r)
 {
-	const char *ring = p->front ? " stroke=\"#222\" stroke-width=\"1.5\"" : "";
+	const char *ring = p->front ? " stroke=\"#222\" stroke-width=\"1.5\">" : ">";
 	double x = px(f, p->x), y = py(f, p->y);
-	bool off = p->y > f->y_cap;
+	bool off = p->y > f->y_cap, marked = p->mark && *p->mark;
+	if (marked)
+		svg_warn_ring(sb, x, y, r);
 	if (off)
-		sb_printf(sb, "<polygon points=\"%.1f,%.1f %.1f,%.1f %.1f,%.1f\" fill=\"%s\"%s><title>",
-		          x, y - MARKER_R, x - MARKER_R, y + MARKER_R, x + MARKER_R, y + MARKER_R,
-		          p->colour, ring);
-	else
-		sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"%.1f\" fill=\"%s\"%s><title>", x, y,
-		          MARKER_R, p->colour, ring);
+		sb_printf(sb, "<polygon points=\"%.1f,%.1f %.1f,%.1f %.1f,%.1f\" fill=\"%s\"%s<title>",
+		          x, y - r, x - r, y + r, x + r, y + r, p->colour, ring);
+	else {
+		svg_shape(sb, p->shape, x, y, r, p->colour, ring);
+		sb_printf(sb, "<title>");
+	}
 	report_escape(sb, p->label);
 	if (off)
 		sb_printf(sb, ": %.6g, off the chart", p->y);
-	sb_printf(sb, off ? "</title></polygon>" : "</title></circle>");
+	if (marked)
+		sb_printf(sb, " (");
+	report_escape(sb, marked ? p->mark : "");
+	sb_printf(sb, "%s</title></%s>", marked ? ")" : "", off ? "polygon" : svg_shape_tag(p->shape));
 }
 
 void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                  const struct svg_point *p, size_t n)
 {
 	struct frame f;
-	struct placed taken[128];
+	struct placed *taken = malloc((2 * n + 1) * sizeof(*taken)); /* every marker and label */
 	size_t nt = 0;
 	double legend_top = plot_frame(sb, title, xname, yname, p, n, off_chart(p, n), &f);
 	front_line(sb, &f, p, n);
-	for (size_t i = 0; i < n; i++) {
+	for (size_t i = 0; taken && i < n; i++) {
 		if (!isfinite(p[i].x) || !isfinite(p[i].y))
 			continue;
-		marker(sb, &f, &p[i]);
+		marker(sb, &f, &p[i], MARKER_R);
 		double x = px(&f, p[i].x), y = py(&f, p[i].y);
-		if (nt < sizeof(taken) / sizeof(taken[0]))
-			taken[nt++] = (struct placed){x - 5, y - 5, x + 5, y + 5, true};
+		taken[nt++] = (struct placed){x - 5, y - 5, x + 5, y + 5, true};
 	}
 	/* Only the front is named on the plot: the legend names every colour,
 	 * and a name beside every point of a cluster would only collide. */
-	for (size_t i = 0; i < n && nt < sizeof(taken) / sizeof(taken[0]); i++) {
+	for (size_t i = 0; taken && i < n; i++) {
 		if (!p[i].front || !isfinite(p[i].x) || !isfinite(p[i].y))
 			continue;
 		double x = px(&f, p[i].x), y = py(&f, p[i].y);
@@ -520,6 +554,39 @@ void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const 
 			          x, y, b.x0 < x ? b.x1 : b.x0, (b.y0 + b.y1) / 2);
 		text_at(sb, b.x0, b.y1 - 2.5, "start", p[i].group);
 	}
+	if (!taken)
+		sb->failed = true;
+	free(taken);
+	legend(sb, p, n, legend_top);
+	sb_printf(sb, "</svg>\n");
+}
+
+static void lines(struct strbuf *sb, const char *title, const char *xname, const char *yname,
+                  const struct svg_point *p, size_t n, bool markers)
+{
+	struct frame f;
+	double legend_top = plot_frame(sb, title, xname, yname, p, n, INFINITY, &f);
+	for (size_t i = 0; i < n; i++) {
+		if (!opens_group(p, n, i))
+			continue; /* the legend names only what is drawn */
+		sb_printf(sb, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\" points=\"",
+		          p[i].colour);
+		for (size_t j = i; j < n; j++)
+			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y))
+				sb_printf(sb, "%.1f,%.1f ", px(&f, p[j].x), py(&f, p[j].y));
+		sb_printf(sb, "\"/>");
+		/* Markers too: a series of one point draws no line. A curve's
+		 * only at its end: its shape and its marks must show there too. */
+		size_t last = n;
+		for (size_t j = i; j < n; j++)
+			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y)) {
+				if (markers)
+					marker(sb, &f, &p[j], 3.5);
+				last = j;
+			}
+		if (!markers && last < n)
+			marker(sb, &f, &p[last], 3.5);
+	}
 	legend(sb, p, n, legend_top);
 	sb_printf(sb, "</svg>\n");
 }
@@ -527,23 +594,11 @@ void svg_scatter(struct strbuf *sb, const char *title, const char *xname, const 
 void svg_lines(struct strbuf *sb, const char *title, const char *xname, const char *yname,
                const struct svg_point *p, size_t n)
 {
-	struct frame f;
-	double legend_top = plot_frame(sb, title, xname, yname, p, n, INFINITY, &f);
-	for (size_t i = 0; i < n; i++) {
-		if (!opens_group(p, n, i))
-			continue; /* the legend names only what is drawn */
-		const char *c = p[i].colour;
-		sb_printf(sb, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\" points=\"", c);
-		for (size_t j = i; j < n; j++)
-			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y))
-				sb_printf(sb, "%.1f,%.1f ", px(&f, p[j].x), py(&f, p[j].y));
-		sb_printf(sb, "\"/>");
-		/* Markers too: a series of one point draws no line. */
-		for (size_t j = i; j < n; j++)
-			if (strcmp(p[j].group, p[i].group) == 0 && isfinite(p[j].y))
-				sb_printf(sb, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>",
-				          px(&f, p[j].x), py(&f, p[j].y), c);
-	}
-	legend(sb, p, n, legend_top);
-	sb_printf(sb, "</svg>\n");
+	lines(sb, title, xname, yname, p, n, true);
+}
+
+void svg_curves(struct strbuf *sb, const char *title, const char *xname, const char *yname,
+                const struct svg_point *p, size_t n)
+{
+	lines(sb, title, xname, yname, p, n, false);
 }

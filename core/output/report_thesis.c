@@ -10,7 +10,8 @@
  * that would hold only dashes is left out: no sequential time, or no
  * builder at that count. Runs from several machines (a merged sweep) give
  * one row per scene and machine: a time is only set against the same
- * machine's sequential time.
+ * machine's sequential time. A reference that ran on more than 1 thread
+ * (a parallel builder) gets no table.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -192,6 +193,18 @@ static void rows(struct strbuf *sb, const cJSON *doc, const struct report_index 
 				row(sb, ix, ref, text(scene, "name"), m, threads, cols, n);
 }
 
+/* Whether the builder ran on more than 1 thread: a parallel reference's
+ * 1-thread time is no sequential baseline, and gains over it would only
+ * measure it against its own threads. */
+static bool ran_parallel(const cJSON *runs, const char *builder)
+{
+	const cJSON *run;
+	cJSON_ArrayForEach(run, runs)
+		if (strcmp(text(run, "builder"), builder) == 0 && number(run, "threads", 1) > 1)
+			return true;
+	return false;
+}
+
 void report_thesis(struct strbuf *sb, const cJSON *doc, const struct report_index *ix)
 {
 	const cJSON *runs = cJSON_GetObjectItemCaseSensitive(doc, "runs");
@@ -200,6 +213,8 @@ void report_thesis(struct strbuf *sb, const cJSON *doc, const struct report_inde
 	bool titled = false, fallback;
 	const char *ref = report_reference(doc, &asked, &fallback);
 	if (!ref || fallback) /* the builder asked for did not run: no sequential time */
+		return;
+	if (ran_parallel(runs, ref)) /* its 1-thread run is no sequential baseline */
 		return;
 	int ncols = columns(runs, ref, cols), ncounts = thread_counts(runs, counts);
 

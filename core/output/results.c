@@ -561,7 +561,8 @@ static int own_reports(const char *json_path, const char *dir, bvhlab_error *err
 	return -EEXIST;
 }
 
-int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err)
+int results_render_saved(const char *json_path, const char *dir,
+                         const struct results_view *view, bvhlab_error *err)
 {
 	char *text = NULL;
 	int r = read_text(json_path, &text, err);
@@ -576,6 +577,8 @@ int results_render_saved(const char *json_path, const char *dir, bvhlab_error *e
 		error_set(err, "%s is not a bvhlab results document", json_path);
 		r = -EINVAL;
 	}
+	if (r == 0 && view)
+		r = results_view_apply(res.doc, view, json_path, err);
 	if (r == 0)
 		r = results_make_dirs(dir, err);
 	if (r == 0)

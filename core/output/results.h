@@ -252,8 +252,26 @@ void results_normalise_dir(char *dir);
 /* Writes `text` to dir/name through dir/.name.tmp and rename. */
 int results_write_file(const char *dir, const char *name, const char *text, bvhlab_error *err);
 
+/* How `bvhlab report` sees a saved sweep (results_view.c): its reference
+ * and the scenes and thread counts kept (none listed: all). */
+struct results_view {
+	const char *reference;   /* a builder label or plugin, or NULL: the config's */
+	const char *const *scenes;
+	size_t scene_count;
+	const double *threads;
+	size_t threads_count;
+};
+/* Applies the view to a results document in memory: runs and scenes not
+ * kept removed (a "report_note" says so), config.report.reference set.
+ * 0, or -EINVAL with err naming the file and the scene, thread count or
+ * reference it lacks (the reference must have an ok run among those kept). */
+int results_view_apply(struct cJSON *doc, const struct results_view *view, const char *path,
+                       bvhlab_error *err);
+
 /* Regenerates results.csv, report.md and report.html in dir from a saved
- * results.json (bvhlab report). */
-int results_render_saved(const char *json_path, const char *dir, bvhlab_error *err);
+ * results.json (bvhlab report), seen through view (NULL: as saved); the
+ * file itself is only read. */
+int results_render_saved(const char *json_path, const char *dir,
+                         const struct results_view *view, bvhlab_error *err);
 
 #endif
