@@ -21,10 +21,7 @@
 #include "morton_front.h"
 #include "plugin_options.h"
 
-#define CL_HPLOC_MAX_RADIUS 32    /* hploc's HPLOC_MAX_RADIUS */
-#define CL_HPLOC_MAX_THRESHOLD 32 /* hploc's HPLOC_MAX_THRESHOLD */
-#define CLUSTER_BYTES 40          /* cl_hploc.cl's struct cluster */
-#define NONE_WORD 0xffffffffu     /* meet[]'s "no arrival yet" */
+#define NONE_WORD 0xffffffffu /* meet[]'s "no arrival yet" */
 
 /* The device buffers besides the sort's. */
 enum { HB_BOUNDS, HB_CL, HB_REC, HB_IDX, HB_COUNT, HB_MEET, HB_ROOT, HB_BUFS };
@@ -48,14 +45,7 @@ typedef struct cl_hploc {
 } cl_hploc;
 
 static const plugin_option options[] = {
-	PLUGIN_OPTION(cl_hploc, radius, U32, .name = "radius",
-	              .help = "search radius: clusters on either side, in a node's list, that "
-	                      "each cluster compares with",
-	              .def_int = 8, .min = 1, .max = CL_HPLOC_MAX_RADIUS),
-	PLUGIN_OPTION(cl_hploc, threshold, U32, .name = "threshold",
-	              .help = "most clusters a node carries upwards (half a 32-wide warp in "
-	                      "the paper); a node merges its children's down to it",
-	              .def_int = 16, .min = 1, .max = CL_HPLOC_MAX_THRESHOLD),
+	HPLOC_OPTIONS(cl_hploc),
 	MORTON_OPTIONS(cl_hploc, bits),
 	CL_DEVICE_OPTION(cl_hploc),
 };
@@ -85,14 +75,35 @@ __attribute__((destructor)) static void release_device(void)
 
 /* ---- the device run ------------------------------------------------------ */
 
-/* Both sets of buffers' sizes against the device's memory, then made. */
+/* The host's copy of the merge tree, kept between builds. */
+static int host_tree(cl_hploc *b, char *err, size_t err_size)
+{
+	if (S.cap < b->n) {
+		free(S.rec);
+		S.rec = malloc(sizeof(*S.rec) * (size_t)b->n);
+		S.cap = S.rec ? b->n : 0;
+		if (!S.cap)
+			return bvhlab_cl_fail(-ENOMEM, err, err_size,
+			                      "out of memory for the merge tree of %u primitives",
+			                      b->n);
+	}
+	b->rec = S.rec;
+	return 0;
+}
+
+/* Both sets of buffers' sizes against the device's memory, then made;
+ * the host's copy of the tree first. */
 static int size_buffers(cl_hploc *b, char *err, size_t err_size)
 {
 	size_t n = b->n, want[HB_BUFS + SB_COUNT];
-	int rc;
+	int rc = host_tree(b, err, err_size);
+
+	if (rc < 0)
+		return rc;
 
 	want[HB_BOUNDS] = 24 * n;
-	want[HB_CL] = want[HB_REC] = CLUSTER_BYTES * n;
+	want[HB_CL] = sizeof(hploc_cluster) * n;
+	want[HB_REC] = sizeof(hploc_rec) * n;
 	want[HB_IDX] = want[HB_COUNT] = want[HB_MEET] = 4 * n;
 	want[HB_ROOT] = 4;
 	cl_sort_sizes(b->n, want + HB_BUFS);
@@ -161,7 +172,8 @@ static int device_run(cl_hploc *b, char *err, size_t err_size)
 	double up = 0;
 	int rc;
 
-	if ((rc = size_buffers(b, err, err_size)) == 0 && (rc = upload(b, &ev, err, err_size)) == 0 &&
+	if ((rc = size_buffers(b, err, err_size)) == 0 &&
+	    (rc = upload(b, &ev, err, err_size)) == 0 &&
 	    (rc = cl_sort_run(b->dev, b->sort, b->in, b->bits, &ev, &up, err, err_size)) == 0 &&
 	    (rc = climb(b, &ev, err, err_size)) == 0)
 		rc = download(b, err, err_size);
@@ -173,43 +185,15 @@ static int device_run(cl_hploc *b, char *err, size_t err_size)
 
 /* ---- build --------------------------------------------------------------- */
 
-/* The host's copy of the merge tree, kept between builds. */
-static int host_tree(cl_hploc *b)
+/* The merge tree into the output, timed as the phase convert. */
+static void convert(cl_hploc *b, bvhlab_build_output *out)
 {
-	if (S.cap < b->n) {
-		free(S.rec);
-		S.rec = malloc(sizeof(*S.rec) * (size_t)b->n);
-		S.cap = S.rec ? b->n : 0;
-		if (!S.cap)
-			return -ENOMEM;
-	}
-	b->rec = S.rec;
-	return 0;
-}
-
-static int run(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_hploc *b,
-               bvhlab_build_output *out)
-{
-	char err[BVHLAB_CL_ERROR_SIZE];
-	double t0;
-	int rc;
-
-	if (host_tree(b) < 0) {
-		host->set_error(ctx, "out of memory for the merge tree of %u primitives", b->n);
-		return -ENOMEM;
-	}
-	if ((rc = device_run(b, err, sizeof(err))) < 0) {
-		host->set_error(ctx, "%s", err);
-		return rc;
-	}
-	t0 = cl_now_ms();
+	double t0 = cl_now_ms();
 	hploc_tree tree = { b->n, b->rec, b->root, b->in->prim_bounds };
+
 	out->node_count = hploc_emit(&tree, out);
 	out->index_count = b->n;
 	b->ms[CL_PHASE_CONVERT] = cl_now_ms() - t0;
-	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims on %s", b->n, S.dev.cl.name);
-	cl_report_phases(host, ctx, b->ms);
-	return 0;
 }
 
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
@@ -217,13 +201,21 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 {
 	cl_hploc b = { .in = input, .n = input->prim_count, .dev = &S.dev, .sort = &S.sort,
 	               .b = S.b };
+	char err[BVHLAB_CL_ERROR_SIZE];
 	int rc;
 
 	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
 	                              &b)) < 0 ||
 	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
 		return rc < 0 ? rc : 0;
-	return run(host, ctx, &b, output);
+	if ((rc = device_run(&b, err, sizeof(err))) < 0) {
+		host->set_error(ctx, "%s", err);
+		return rc;
+	}
+	convert(&b, output);
+	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims on %s", b.n, S.dev.cl.name);
+	cl_report_phases(host, ctx, b.ms);
+	return 0;
 }
 
 PLUGIN_WITH_OPTIONS(options, .name = "cl_hploc", .flags = BVHLAB_BUILDER_DETERMINISTIC,

@@ -12,14 +12,7 @@
 #include "plugin_options.h"
 
 static const plugin_option options[] = {
-	PLUGIN_OPTION(hploc, radius, U32, .name = "radius",
-	              .help = "search radius: clusters on either side, in a node's list, that "
-	                      "each cluster compares with",
-	              .def_int = 8, .min = 1, .max = HPLOC_MAX_RADIUS),
-	PLUGIN_OPTION(hploc, threshold, U32, .name = "threshold",
-	              .help = "most clusters a node carries upwards (half a 32-wide warp in "
-	                      "the paper); a node merges its children's down to it",
-	              .def_int = 16, .min = 1, .max = HPLOC_MAX_THRESHOLD),
+	HPLOC_OPTIONS(hploc),
 	MORTON_OPTIONS(hploc, sort.bits),
 };
 
@@ -80,8 +73,7 @@ static void first_clusters(hploc *h, unsigned t)
 		memcpy(c->hi, b->hi, sizeof(c->hi));
 		c->node = HPLOC_LEAF | id;
 		c->info = 1;
-		c->cost = h->c_isect * hploc_half_area3(b->hi[0] - b->lo[0], b->hi[1] - b->lo[1],
-		                                        b->hi[2] - b->lo[2]);
+		c->cost = h->c_isect * hploc_half_area(c->lo, c->hi);
 		c->desc = 0;
 		h->idx[k] = k;
 		h->count[k] = 1;
@@ -155,6 +147,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	                              &h)) < 0 ||
 	    (rc = big_ensure_output(host, ctx, h.n, spare_nodes(h.n), output)) < 0)
 		return rc;
+	h.merge = (hploc_params){ h.radius, h.collapse, h.max_leaf, h.c_trav, h.c_isect };
 	if (input->prim_count == 1) {
 		morton_single_leaf(input, output);
 		return 0;

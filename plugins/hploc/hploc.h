@@ -28,7 +28,8 @@
  *
  * Ties: as ploc's (ploc.h): among candidates at the same distance the
  * nearest in the list, then the pair whose earlier cluster is at an even
- * position, then the one before; the least pair is always mutual.
+ * position, then the one before; the least pair is always mutual. The
+ * merging itself is hploc_merge.h, shared with the device kernel.
  */
 #ifndef BVHLAB_HPLOC_H
 #define BVHLAB_HPLOC_H
@@ -43,22 +44,7 @@
 #include "morton.h"
 #include "team.h"
 
-#define HPLOC_MAX_RADIUS 32
-#define HPLOC_MAX_THRESHOLD 32
-/* The most clusters a node merges: two children's, at most threshold each. */
-#define HPLOC_MAX_LIST (2 * HPLOC_MAX_THRESHOLD)
 #define HPLOC_NONE UINT32_MAX
-
-/* A cluster, by its representative (40 bytes; cl_hploc.cl's struct
- * cluster). */
-typedef struct hploc_cluster {
-	float lo[3];
-	uint32_t node;  /* its node word (hploc_tree.h) */
-	float hi[3];
-	uint32_t info;  /* HPLOC_COLLAPSED | primitives */
-	float cost;     /* the subtree's SAH cost, area-weighted */
-	uint32_t desc;  /* output nodes below the cluster's own */
-} hploc_cluster;
 
 typedef struct hploc {
 	/* parameters */
@@ -69,6 +55,7 @@ typedef struct hploc {
 	bool collapse;
 	uint32_t max_leaf;
 	float c_trav, c_isect;
+	hploc_params merge;   /* the above, for hploc_merge.h */
 
 	morton_sort sort;
 	hploc_cluster *cl;    /* [n] clusters by representative */
@@ -83,11 +70,6 @@ typedef struct hploc {
 	team team;
 	double phase_ms[4];   /* thread 0's phase end times, [3] the start */
 } hploc;
-
-static inline float hploc_half_area3(float dx, float dy, float dz)
-{
-	return dx * dy + dy * dz + dz * dx;
-}
 
 void hploc_climb(hploc *h, unsigned t); /* hploc_climb.c */
 

@@ -1,7 +1,8 @@
 /*
- * H-PLOC's merge tree, as the CPU builder (hploc) and the device builder
- * (cl_hploc, which downloads it) both leave it, and its emission into the
- * output (hploc_emit.c, compiled into both plugins).
+ * What the CPU builder (hploc) and the device builder (cl_hploc) share on
+ * the host: H-PLOC's own options, and the merge tree as both leave it
+ * (cl_hploc downloads it) with its emission into the output (hploc_emit.c,
+ * compiled into both plugins).
  *
  * A node of the merge tree is named by one word: HPLOC_LEAF | the
  * primitive's id for a primitive, else the slot of an inner record. Every
@@ -15,23 +16,23 @@
 #ifndef BVHLAB_HPLOC_TREE_H
 #define BVHLAB_HPLOC_TREE_H
 
-#include <stdint.h>
-
 #include <bvhlab/builder.h>
 
-#define HPLOC_LEAF 0x80000000u      /* a node word naming a primitive */
-#define HPLOC_COLLAPSED 0x40000000u /* in info: the SAH made the subtree one leaf */
-#define HPLOC_PRIMS 0x3fffffffu     /* in info: primitives below */
+#include "hploc_merge.h" /* hploc_rec, HPLOC_LEAF */
+#include "plugin_options.h"
 
-/* An inner record (40 bytes; cl_hploc.cl's struct record). */
-typedef struct hploc_rec {
-	float lo[3];
-	uint32_t left;  /* node word of the left (earlier) child */
-	float hi[3];
-	uint32_t right; /* node word of the right child */
-	uint32_t info;  /* HPLOC_COLLAPSED | primitives */
-	uint32_t desc;  /* output nodes below this one's own (0 when collapsed) */
-} hploc_rec;
+/* The options of H-PLOC's merging, in a plugin's table (plugin_options.h),
+ * into the members radius and threshold (uint32_t) of its struct `owner`;
+ * the Morton and collapse ones are MORTON_OPTIONS. */
+#define HPLOC_OPTIONS(owner)                                                                  \
+	PLUGIN_OPTION(owner, radius, U32, .name = "radius",                                   \
+	              .help = "search radius: clusters on either side, in a node's list, that " \
+	                      "each cluster compares with",                                   \
+	              .def_int = 8, .min = 1, .max = HPLOC_MAX_RADIUS),                       \
+	PLUGIN_OPTION(owner, threshold, U32, .name = "threshold",                             \
+	              .help = "most clusters a node carries upwards (half a 32-wide warp in " \
+	                      "the paper); a node merges its children's down to it",          \
+	              .def_int = 16, .min = 1, .max = HPLOC_MAX_THRESHOLD)
 
 /* The merge tree of n >= 2 primitives, rooted at node word `root`. */
 typedef struct hploc_tree {
