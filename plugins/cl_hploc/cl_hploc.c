@@ -191,7 +191,7 @@ static void convert(cl_hploc *b, bvhlab_build_output *out)
 	double t0 = cl_now_ms();
 	hploc_tree tree = { b->n, b->rec, b->root, b->in->prim_bounds };
 
-	out->node_count = hploc_emit(&tree, out);
+	hploc_emit_top(&tree, out, 0, NULL, &out->node_count); /* all on this thread */
 	out->index_count = b->n;
 	b->ms[CL_PHASE_CONVERT] = cl_now_ms() - t0;
 }

@@ -18,11 +18,13 @@ static const plugin_option options[] = {
 
 /* ---- scratch ------------------------------------------------------------ */
 
-/* Clusters, records, idx, count and meet: past the tree in the output
- * when the host gives the room (kept between builds), else mapped. */
+/* Clusters, records, idx, count, meet and the emit tasks: past the tree
+ * in the output when the host gives the room (kept between builds), else
+ * mapped. */
 static size_t work_size(size_t n)
 {
-	return 2 * morton_align64(sizeof(hploc_cluster) * n) + 3 * morton_align64(4 * n);
+	return 2 * morton_align64(sizeof(hploc_cluster) * n) + 3 * morton_align64(4 * n) +
+	       morton_align64(sizeof(hploc_place) * n);
 }
 
 static uint32_t spare_nodes(uint32_t n)
@@ -52,6 +54,7 @@ static int scratch_alloc(hploc *h, const bvhlab_build_output *out, morton_scratc
 	h->idx = (uint32_t *)(void *)take(&at, 4 * n);
 	h->count = (uint32_t *)(void *)take(&at, 4 * n);
 	h->meet = (atomic_uint *)(void *)take(&at, 4 * n);
+	h->tasks = (hploc_place *)(void *)take(&at, sizeof(hploc_place) * n);
 	return 0;
 }
 
@@ -81,6 +84,24 @@ static void first_clusters(hploc *h, unsigned t)
 	}
 }
 
+/* The merge tree into the output: thread 0 the nodes above the subtrees
+ * of at most emit_cut primitives, then the team those subtrees. */
+static void emit(hploc *h, unsigned t)
+{
+	hploc_tree tree = { h->n, h->rec, h->root, h->in->prim_bounds };
+	uint32_t cut = h->n / (HPLOC_EMIT_TASKS * h->team.threads), lo, hi;
+
+	if (t == 0) {
+		h->task_count = hploc_emit_top(&tree, h->out, cut ? cut : 1, h->tasks,
+		                               &h->node_count);
+		atomic_store_explicit(&h->blocks, 0, memory_order_relaxed);
+	}
+	team_sync(&h->team);
+	while (team_next_block(&h->blocks, h->task_count, 1, &lo, &hi))
+		hploc_emit_task(&tree, h->out, h->tasks[lo]);
+	team_sync(&h->team);
+}
+
 static void run_phases(void *arg, unsigned t)
 {
 	hploc *h = arg;
@@ -95,6 +116,9 @@ static void run_phases(void *arg, unsigned t)
 	hploc_climb(h, t);
 	if (t == 0)
 		h->phase_ms[1] = morton_now_ms();
+	emit(h, t);
+	if (t == 0)
+		h->phase_ms[2] = morton_now_ms();
 }
 
 /* ---- build --------------------------------------------------------------- */
@@ -115,15 +139,14 @@ static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, hploc *h,
 		host->set_error(ctx, "out of memory for the scratch of %u primitives", h->n);
 		goto out;
 	}
+	h->out = out;
 	team_host_init(&th, host, ctx);
 	if ((rc = team_run_on(&h->team, &th, h->threads, run_phases, h)) < 0) {
 		host->set_error(ctx, "cannot set up the thread team");
 		goto out;
 	}
-	hploc_tree tree = { h->n, h->rec, h->root, h->in->prim_bounds };
-	out->node_count = hploc_emit(&tree, out);
+	out->node_count = h->node_count;
 	out->index_count = h->n;
-	h->phase_ms[2] = morton_now_ms();
 	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims, %u threads: setup %.2f, sort %.2f, "
 	          "climb %.2f, emit %.2f ms", h->n, h->team.threads, h->phase_ms[3] - start,
 	          h->phase_ms[0] - h->phase_ms[3], h->phase_ms[1] - h->phase_ms[0],

@@ -24,7 +24,8 @@
  *   1. sort    Morton codes and their sort; one cluster per primitive
  *              (hploc.c)
  *   2. climb   by blocks of leaves, a climb from each (hploc_climb.c)
- *   3. emit    the merge tree into the output by thread 0 (hploc_emit.c)
+ *   3. emit    the merge tree into the output: thread 0 the top, the team
+ *              the subtrees below it (hploc_emit.c)
  *
  * Ties: as ploc's (ploc.h): among candidates at the same distance the
  * nearest in the list, then the pair whose earlier cluster is at an even
@@ -56,6 +57,7 @@ typedef struct hploc {
 	uint32_t max_leaf;
 	float c_trav, c_isect;
 	hploc_params merge;   /* the above, for hploc_merge.h */
+	bvhlab_build_output *out;
 
 	morton_sort sort;
 	hploc_cluster *cl;    /* [n] clusters by representative */
@@ -66,10 +68,17 @@ typedef struct hploc {
 	atomic_uint *meet;    /* [n - 1] the far end of the first arrival at the
 	                       * node split after position k; HPLOC_NONE before */
 	uint32_t root;        /* node word of the root */
-	atomic_uint blocks;   /* blocks of leaves handed out */
+	hploc_place *tasks;   /* [n] the emit phase's subtrees, for the team */
+	uint32_t task_count;
+	uint32_t node_count;
+	atomic_uint blocks;   /* blocks of leaves, then of tasks, handed out */
 	team team;
 	double phase_ms[4];   /* thread 0's phase end times, [3] the start */
 } hploc;
+
+/* Emit tasks per thread: subtrees of at most n / (this x T) primitives,
+ * so that a slow thread holds the others up by a small share (ploc's). */
+#define HPLOC_EMIT_TASKS 32
 
 void hploc_climb(hploc *h, unsigned t); /* hploc_climb.c */
 

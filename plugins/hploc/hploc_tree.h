@@ -42,11 +42,25 @@ typedef struct hploc_tree {
 	const bvhlab_aabb *prim_bounds;   /* the primitives' boxes, for the leaves */
 } hploc_tree;
 
+/* A node of the merge tree and where it goes in the output. */
+typedef struct hploc_place {
+	uint32_t node;  /* its node word */
+	uint32_t slot;  /* its output node */
+	uint32_t kids;  /* the output slot of its children's pair */
+	uint32_t first; /* its first prim_index slot */
+} hploc_place;
+
 /*
  * The tree into out (room for 2n - 1 nodes, n indices), collapse
  * applied: a node's children as a pair, the left child's subtree first.
- * Returns the node count.
+ * By one thread: hploc_emit_top with cut 0. By a team: thread 0 runs
+ * hploc_emit_top, which writes the nodes above the subtrees of at most
+ * `cut` primitives and puts those subtrees' roots into tasks[] (room for
+ * n), returning how many; after a barrier any thread writes any task with
+ * hploc_emit_task. *count gets the output's node count.
  */
-uint32_t hploc_emit(const hploc_tree *t, bvhlab_build_output *out);
+uint32_t hploc_emit_top(const hploc_tree *t, bvhlab_build_output *out, uint32_t cut,
+                        hploc_place *tasks, uint32_t *count);
+void hploc_emit_task(const hploc_tree *t, bvhlab_build_output *out, hploc_place task);
 
 #endif /* BVHLAB_HPLOC_TREE_H */
