@@ -85,7 +85,8 @@ static void first_clusters(hploc *h, unsigned t)
 }
 
 /* The merge tree into the output: thread 0 the nodes above the subtrees
- * of at most emit_cut primitives, then the team those subtrees. */
+ * of at most n / (HPLOC_EMIT_TASKS x T) primitives, then the team those
+ * subtrees. */
 static void emit(hploc *h, unsigned t)
 {
 	hploc_tree tree = { h->n, h->rec, h->root, h->in->prim_bounds };
