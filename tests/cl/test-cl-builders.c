@@ -3,7 +3,8 @@
  * mesh and on generated scenes (degenerate ones included: every centroid
  * equal, one, two and three triangles, needles, zero-area triangles),
  * cl_lbvh's tree equals lbvh's, cl_ploc's ploc's and cl_hploc's hploc's
- * under the canonical compare, for a few option setups, and every tree is valid.
+ * under the canonical compare, for a few option setups, and every tree is
+ * valid.
  * The device builds report the phases upload, device and download, the
  * device time within the whole call. A bad `device` option fails the build
  * with a message naming it.
