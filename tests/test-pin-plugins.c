@@ -171,11 +171,13 @@ out:
 int main(void)
 {
 	static const char *const builders[] = {
-		"sah_even", "sah_uneven", "sah_queue", "sah_tasks", "lbvh", "ploc", "hlbvh", "sbvh",
+		"sah_even", "sah_uneven", "sah_queue", "sah_tasks", "lbvh", "ploc", "hploc",
+		"hlbvh", "sbvh",
 	};
 	static const char *const stages[] = { "reinsert", "treelet" };
 	/* Large enough that every plugin starts its second thread (sah_queue
-	 * and sah_tasks want 4096 primitives a thread, lbvh, ploc and hlbvh 512). */
+	 * and sah_tasks want 4096 primitives a thread, lbvh, ploc, hploc and hlbvh
+	 * 512). */
 	bvhlab_scene *scene = generate("soup", 10000, 0, 0);
 	bvhlab_prims prims;
 	bvhlab_error err = { { 0 } };

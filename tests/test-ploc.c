@@ -1,6 +1,7 @@
 /*
- * ploc: on generated scenes (coincident centroids, needles, duplicates,
- * 1 to 3 triangles) and on the shared meshes, with radius 1, 4 and 16 and
+ * ploc, and hploc with argument "hploc": on generated scenes (coincident
+ * centroids, needles, duplicates, 1 to 3 triangles) and on the shared
+ * meshes, with radius 1, 4 and 16 (hploc: its threshold the same) and
  * with and without collapse, every build is valid, traces like brute
  * force, keeps leaves within max_leaf, and is the same tree, node for
  * node, for 1, 2 and 8 threads and when repeated. Collapse never raises
@@ -26,6 +27,7 @@ static const uint32_t thread_counts[] = { 1, 2, 8, 2 };
 #define THREAD_COUNTS (sizeof(thread_counts) / sizeof(thread_counts[0]))
 
 static bvhlab_plugin *plugin;
+static const char *builder = "ploc"; /* or "hploc", from the command line */
 
 struct setup {
 	uint32_t radius;
@@ -43,6 +45,8 @@ static int build_valid(const char *name, const bvhlab_build_input *in, const voi
 
 	if (rc == 0)
 		rc = bvhlab_options_set_int(&opts, "radius", s->radius, &err);
+	if (rc == 0 && strcmp(builder, "hploc") == 0)
+		rc = bvhlab_options_set_int(&opts, "threshold", s->radius, &err);
 	if (rc == 0)
 		rc = bvhlab_options_set_bool(&opts, "collapse", s->collapse, &err);
 	if (rc == 0)
@@ -86,14 +90,21 @@ static void test_descriptor(void)
 	bvhlab_options opts;
 	bvhlab_error err = { { 0 } };
 
-	CHECK(strcmp(b->name, "ploc") == 0);
+	bool h = strcmp(builder, "hploc") == 0;
+
+	CHECK(strcmp(b->name, builder) == 0);
 	CHECK(b->flags & BVHLAB_BUILDER_DETERMINISTIC);
 	CHECK(b->build != NULL);
 	CHECK(bvhlab_builder_refine(b) == NULL);
 	CHECK_INT(bvhlab_options_init(&opts, b), 0);
-	CHECK_INT(opts.values[bvhlab_options_find(&opts, "radius")].i, 16);
+	CHECK_INT(opts.values[bvhlab_options_find(&opts, "radius")].i, h ? 8 : 16);
 	CHECK(bvhlab_options_set_int(&opts, "radius", 0, &err) < 0);
-	CHECK(bvhlab_options_set_int(&opts, "radius", 65, &err) < 0);
+	CHECK(bvhlab_options_set_int(&opts, "radius", h ? 33 : 65, &err) < 0);
+	if (h) {
+		CHECK_INT(opts.values[bvhlab_options_find(&opts, "threshold")].i, 16);
+		CHECK(bvhlab_options_set_int(&opts, "threshold", 0, &err) < 0);
+		CHECK(bvhlab_options_set_int(&opts, "threshold", 33, &err) < 0);
+	}
 	bvhlab_options_finish(&opts);
 }
 
@@ -102,12 +113,14 @@ static void test_shared(const char *file, bvhlab_scene *scene)
 	test_scene(file, scene, 64);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
 	static const char *const shared[] = { "stanford-bunny.obj", "horse.ply", "ogre.obj",
 	                                      "igea.ply" };
 
-	if (!plugin_loads("ploc", &plugin))
+	if (argc > 1)
+		builder = argv[1];
+	if (!plugin_loads(builder, &plugin))
 		return test_finish();
 	test_descriptor();
 	test_scene("soup", generate("soup", SCALE(20000, 3000), 0, 0), RAYS);

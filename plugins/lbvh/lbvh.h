@@ -109,27 +109,6 @@ static inline void lbvh_sync(lbvh *b)
 	team_sync(&b->team);
 }
 
-/*
- * 1 + the common prefix length of the sorted keys at positions i < j,
- * extended by the positions where the codes are equal (Karras's k_i ++ i),
- * so that no two keys are equal. The words hold the codes' upper bits;
- * only where those agree are the full codes looked up.
- */
-static inline uint8_t common_prefix(const lbvh *b, uint32_t i, uint32_t j)
-{
-	uint64_t wi = b->sort.keys[0][i], wj = b->sort.keys[0][j];
-	uint64_t x = (wi ^ wj) >> b->sort.id_bits;
-	uint64_t id_mask = (1ull << b->sort.id_bits) - 1;
-
-	if (x)
-		return (uint8_t)(1 + __builtin_clzll(x) - b->sort.base);
-	if (b->sort.base)
-		x = b->sort.codes[wi & id_mask] ^ b->sort.codes[wj & id_mask];
-	if (x)
-		return (uint8_t)(1 + __builtin_clzll(x));
-	return (uint8_t)(1 + 64 + __builtin_clz(i ^ j));
-}
-
 /* The sorted range of internal node i: [range_first, + range_size). */
 static inline uint32_t range_first(const lbvh *b, uint32_t i)
 {

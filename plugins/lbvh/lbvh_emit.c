@@ -114,7 +114,8 @@ static void karras_node(lbvh *b, uint32_t i)
 	uint8_t left = lcp[(int64_t)i - 1], right = lcp[i];
 	uint32_t end = (uint32_t)other_end(lcp, i, right > left, left < right ? left : right);
 	uint32_t first = i < end ? i : end, last = i ^ end ^ first, leaves = b->n - 1;
-	uint32_t split = (uint32_t)first_equal(lcp, first, common_prefix(b, first, last));
+	uint32_t split =
+	        (uint32_t)first_equal(lcp, first, morton_common_prefix(&b->sort, first, last));
 
 	b->end[i] = end;
 	/* Each node is the child of exactly one parent: no two writes meet. */

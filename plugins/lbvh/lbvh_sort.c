@@ -4,7 +4,7 @@
  * the hierarchy needs from that order: the ids into output->prim_index,
  * and the common prefix lengths of neighbours, taken per bucket while the
  * sort still has it in cache. Karras compares the sorted words
- * (common_prefix()).
+ * (morton_common_prefix()).
  */
 #include <string.h>
 
@@ -34,7 +34,7 @@ static void bucket_done(void *arg, uint32_t s, uint32_t e)
 
 	for (uint32_t k = s; k + 1 < e; k++) {
 		b->prim_index[k] = morton_id(&b->sort, k);
-		b->lcp[k] = common_prefix(b, k, k + 1);
+		b->lcp[k] = morton_common_prefix(&b->sort, k, k + 1);
 	}
 	b->prim_index[e - 1] = morton_id(&b->sort, e - 1);
 }
@@ -50,7 +50,7 @@ static void border_prefixes(lbvh *b, unsigned t)
 		uint32_t s = b->sort.bucket[d];
 
 		if (s > 0 && b->sort.bucket[d + 1] > s)
-			b->lcp[s - 1] = common_prefix(b, s - 1, s);
+			b->lcp[s - 1] = morton_common_prefix(&b->sort, s - 1, s);
 	}
 	if (t == 0) {
 		memset(b->lcp - LCP_PAD, 0, LCP_PAD);

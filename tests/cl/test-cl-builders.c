@@ -2,8 +2,9 @@
  * The OpenCL device builders against their CPU references: on every shared
  * mesh and on generated scenes (degenerate ones included: every centroid
  * equal, one, two and three triangles, needles, zero-area triangles),
- * cl_lbvh's tree equals lbvh's and cl_ploc's equals ploc's under the
- * canonical compare, for a few option setups, and every tree is valid.
+ * cl_lbvh's tree equals lbvh's, cl_ploc's ploc's and cl_hploc's hploc's
+ * under the canonical compare, for a few option setups, and every tree is
+ * valid.
  * The device builds report the phases upload, device and download, the
  * device time within the whole call. A bad `device` option fails the build
  * with a message naming it.
@@ -57,6 +58,11 @@ static struct pair pairs[] = {
 	              /* a work-item per cluster in nearest: what a GPU runs */
 	              { { "radius=4", "bits=30" }, { "nn_block=1" } } },
 	  .differ = { { { "radius=1" } }, { { "radius=16" } } } },
+	{ .ref_name = "hploc", .dev_name = "cl_hploc",
+	  .setups = { { { "radius=8", "threshold=16", "collapse=true" } },
+	              { { "radius=1", "threshold=1", "collapse=false", "bits=30" } },
+	              { { "radius=4", "threshold=32", "max_leaf=3", "c_trav=2.5" } } },
+	  .differ = { { { "threshold=2" } }, { { "threshold=16" } } } },
 };
 #define PAIRS (sizeof(pairs) / sizeof(pairs[0]))
 

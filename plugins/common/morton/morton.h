@@ -91,4 +91,28 @@ static inline uint32_t morton_id(const morton_sort *s, uint32_t k)
 	return (uint32_t)(s->keys[0][k] & ((1ull << s->id_bits) - 1));
 }
 
+/*
+ * 1 + the common prefix length of the sorted keys at positions i < j,
+ * extended by the positions where the codes are equal (Karras's k_i ++ i),
+ * so that no two keys are equal: 1 + the leading zeros of the codes' XOR
+ * (64 bits), else 65 + those of i ^ j (32 bits). The words hold the codes'
+ * upper bits; only where those agree are the full codes looked up. (lbvh's
+ * hierarchy, hploc's climb; the device kernels compute the same from the
+ * full codes.)
+ */
+static inline uint8_t morton_common_prefix(const morton_sort *s, uint32_t i, uint32_t j)
+{
+	uint64_t wi = s->keys[0][i], wj = s->keys[0][j];
+	uint64_t x = (wi ^ wj) >> s->id_bits;
+	uint64_t id_mask = (1ull << s->id_bits) - 1;
+
+	if (x)
+		return (uint8_t)(1 + __builtin_clzll(x) - s->base);
+	if (s->base)
+		x = s->codes[wi & id_mask] ^ s->codes[wj & id_mask];
+	if (x)
+		return (uint8_t)(1 + __builtin_clzll(x));
+	return (uint8_t)(1 + 64 + __builtin_clz(i ^ j));
+}
+
 #endif /* BVHLAB_MORTON_H */
