@@ -29,16 +29,6 @@
 
 static bvhlab_plugin *lbvh, *collapser;
 
-static void tree_dup(bvhlab_tree *dst, const bvhlab_tree *src)
-{
-	CHECK_INT(bvhlab_tree_init(dst, src->node_count, src->index_count), 0);
-	memcpy(dst->nodes, src->nodes, src->node_count * sizeof(bvhlab_node));
-	memcpy(dst->prim_index, src->prim_index, src->index_count * sizeof(uint32_t));
-	dst->node_count = src->node_count;
-	dst->index_count = src->index_count;
-	dst->width = src->width;
-}
-
 /* Refines with plugin `p` and one option item (or NULL): 0 or the failure. */
 static int stage(bvhlab_plugin *p, const char *item, const bvhlab_build_input *in,
                  bvhlab_tree *tree, bvhlab_error *err)
