@@ -55,7 +55,8 @@ static uint32_t max_depth(const bvhlab_tree *tree)
 		const bvhlab_node *n = &tree->nodes[e.node];
 
 		deepest = e.depth > deepest ? e.depth : deepest;
-		if (tree_is_leaf(n) || tree_children_end(n) > tree->node_count)
+		if (tree_is_leaf(n) || tree_children_end(n) > tree->node_count ||
+		    tree_child_count(n) > BVHLAB_MAX_WIDTH)
 			continue;
 		if (sp + BVHLAB_MAX_WIDTH > cap && !grow(&stack, &cap, local)) {
 			deepest = UINT32_MAX;
