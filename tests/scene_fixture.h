@@ -28,6 +28,18 @@ static inline bool trees_identical(const bvhlab_tree *a, const bvhlab_tree *b)
 	       memcmp(a->prim_index, b->prim_index, a->index_count * sizeof(uint32_t)) == 0;
 }
 
+/* A copy of a tree (counts, width, nodes, leaf slots) with capacity for
+ * just what it holds. */
+static inline void tree_dup(bvhlab_tree *dst, const bvhlab_tree *src)
+{
+	CHECK_INT(bvhlab_tree_init(dst, src->node_count, src->index_count), 0);
+	memcpy(dst->nodes, src->nodes, src->node_count * sizeof(bvhlab_node));
+	memcpy(dst->prim_index, src->prim_index, src->index_count * sizeof(uint32_t));
+	dst->node_count = src->node_count;
+	dst->index_count = src->index_count;
+	dst->width = src->width;
+}
+
 /* A generated scene; 0 keeps a parameter's default. */
 static inline bvhlab_scene *generate(const char *generator, uint32_t count, uint32_t frequency,
                                      uint32_t size)

@@ -38,15 +38,6 @@
 static bvhlab_plugin *refiner;
 static const char *refiner_options;
 
-static void tree_dup(bvhlab_tree *dst, const bvhlab_tree *src)
-{
-	CHECK_INT(bvhlab_tree_init(dst, src->node_count, src->index_count), 0);
-	memcpy(dst->nodes, src->nodes, src->node_count * sizeof(bvhlab_node));
-	memcpy(dst->prim_index, src->prim_index, src->index_count * sizeof(uint32_t));
-	dst->node_count = src->node_count;
-	dst->index_count = src->index_count;
-}
-
 static double sah(const bvhlab_tree *t)
 {
 	bvhlab_tree_stats st;

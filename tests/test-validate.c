@@ -241,7 +241,7 @@ static void test_ranges(void)
 	x = find_inner(&t, 3);
 	t.nodes[x].first = t.node_count - 1; /* second child just past the end */
 	expectf(&t, "node %u: child index %u out of range", x, t.node_count);
-	expect(&t, false, "is the second one counted in node_count?");
+	expect(&t, false, "is the last one counted in node_count?");
 	t.nodes[x].first = UINT32_MAX;
 	expectf(&t, "node %u: child index %u out of range", x, UINT32_MAX);
 	bvhlab_tree_finish(&t);

@@ -26,6 +26,7 @@ static const char TREE_MAGIC[8] = "bvhltree";
 struct tree_header {
 	char magic[8];
 	uint32_t node_count, index_count;
+	uint32_t width, reserved; /* bvhlab_tree.width (0 reads as 2) */
 };
 
 /*
@@ -93,7 +94,8 @@ void harness_rounds_sweep(const char *dir)
 
 int harness_rounds_write_tree(const char *path, const bvhlab_tree *tree)
 {
-	struct tree_header h = {.node_count = tree->node_count, .index_count = tree->index_count};
+	struct tree_header h = {.node_count = tree->node_count, .index_count = tree->index_count,
+	                        .width = tree->width};
 	memcpy(h.magic, TREE_MAGIC, sizeof(h.magic));
 	const struct safe_part parts[] = {
 		{&h, sizeof(h)},
@@ -200,6 +202,7 @@ static int load_tree(const char *path, bvhlab_tree *t)
 	if (r == 0) {
 		t->node_count = t->node_capacity = h.node_count;
 		t->index_count = t->index_capacity = h.index_count;
+		t->width = h.width;
 	}
 	fclose(f);
 	return r;

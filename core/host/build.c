@@ -13,6 +13,7 @@
 #include <bvhlab/machine.h>
 
 #include "machine/machine.h"
+#include "tree/tree_view.h"
 #include "util/util.h"
 
 struct bvhlab_build_ctx {
@@ -281,6 +282,7 @@ static int call_plugin(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		.index_capacity = tree->index_capacity,
 		.node_count = in_place ? tree->node_count : 0,
 		.index_count = in_place ? tree->index_count : 0,
+		.width = in_place ? tree_width(tree) : 2,
 	};
 	struct bvhlab_build_ctx ctx = {.builder = b, .opts = opts, .tree = tree, .err = err};
 	tree->phase_count = 0;
@@ -292,7 +294,31 @@ static int call_plugin(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 	pinning_end(&ctx);
 	tree->node_count = out.node_count;
 	tree->index_count = out.index_count;
+	tree->width = out.width;
 	return explain(&ctx, r);
+}
+
+/* The primitive kind of the input, refused by name to a builder that
+ * does not take it (ABI 1.5), before the call. */
+static int check_kind(const bvhlab_builder *b, const bvhlab_build_input *input,
+                      bvhlab_error *err)
+{
+	uint32_t kind = input->struct_size >= offsetof(bvhlab_build_input, prim_kind) +
+	                                          sizeof(input->prim_kind)
+	                        ? input->prim_kind
+	                        : BVHLAB_PRIM_TRIANGLES;
+	if (kind == BVHLAB_PRIM_TRIANGLES)
+		return 0;
+	if (kind != BVHLAB_PRIM_BOXES) {
+		error_set(err, "builder '%s': unknown primitive kind %u (triangles 0, boxes 1)",
+		          b->name, kind);
+		return -EINVAL;
+	}
+	if (bvhlab_builder_takes_boxes(b))
+		return 0;
+	error_set(err, "builder '%s' builds over triangles only (its descriptor lacks "
+	          "BVHLAB_BUILDER_BOXES, ABI 1.5); this build is over boxes", b->name);
+	return -ENOTSUP;
 }
 
 int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
@@ -305,6 +331,9 @@ int bvhlab_build(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		          "a builder's \"refine\" list or \"animation\"", b->name);
 		return -ENOTSUP;
 	}
+	int r = check_kind(b, input, err);
+	if (r < 0)
+		return r;
 	if (prepare_tree(tree, input->prim_count) < 0) {
 		error_set(err, "builder '%s': cannot allocate the output for %u primitives", b->name,
 		          input->prim_count);
@@ -322,6 +351,11 @@ int bvhlab_refine(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		error_set(err, "plugin '%s' has no refinement stage (ABI 1.2 refine)", b->name);
 		return -ENOTSUP;
 	}
+	char stage[96];
+	snprintf(stage, sizeof(stage), "refinement '%s'", b->name);
+	int r = tree_require_binary(tree, stage, err);
+	if (r < 0)
+		return r;
 	return call_plugin(plugin, opts, input, threads, tree, bvhlab_builder_refine(b), err);
 }
 
@@ -352,7 +386,11 @@ int bvhlab_update(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		error_set(err, "plugin '%s' has no update function (ABI 1.4 update)", b->name);
 		return -ENOTSUP;
 	}
-	int r = check_update_counts(b, input, tree, err);
+	char stage[96];
+	snprintf(stage, sizeof(stage), "update '%s'", b->name);
+	int r = tree_require_binary(tree, stage, err);
+	if (r == 0)
+		r = check_update_counts(b, input, tree, err);
 	if (r == 0)
 		r = call_plugin(plugin, opts, input, threads, tree, bvhlab_builder_update(b), err);
 	return r;

@@ -78,6 +78,12 @@ bvhlab_refine_fn bvhlab_builder_refine(const bvhlab_builder *b)
 	return BVHLAB_BUILDER_HAS(b, refine) ? b->refine : NULL;
 }
 
+bool bvhlab_builder_takes_boxes(const bvhlab_builder *b)
+{
+	/* The flag bit was unused before 1.5: an older plugin's is not it. */
+	return BVHLAB_ABI_VERSION_MINOR(b->abi_version) >= 5 && (b->flags & BVHLAB_BUILDER_BOXES);
+}
+
 bvhlab_refine_fn bvhlab_builder_update(const bvhlab_builder *b)
 {
 	return BVHLAB_BUILDER_HAS(b, update) ? b->update : NULL;

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "trace/trace_kernel.h"
+#include "tree/tree_view.h"
 
 
 #define LOCAL_STACK 64
@@ -101,13 +102,13 @@ static void brute_all(const bvhlab_scene *scene, const ray_prep *p, bvhlab_hit *
 static void leaf(trace_state *s, const bvhlab_node *n)
 {
 	const bvhlab_tree *tree = s->tree;
-	uint32_t i;
+	uint32_t first = tree_leaf_first(n), count = tree_leaf_count(n), i;
 
 	/* An invalid tree must not make the traverser read out of bounds; what
 	 * it skips shows up as a mismatch in bvhlab_validate_rays. */
-	if (n->first > tree->index_count || n->count > tree->index_count - n->first)
+	if (first > tree->index_count || count > tree->index_count - first)
 		return;
-	for (i = n->first; i < n->first + n->count; i++) {
+	for (i = first; i < first + count; i++) {
 		if (tree->prim_index[i] >= s->scene->triangle_count)
 			continue;
 		s->tris++;
@@ -141,13 +142,26 @@ static int grow_stack(stack_entry **stack, uint32_t *cap, uint32_t node_count)
 	return TRACE_OK;
 }
 
+/* Pushes one stack entry, growing the stack when full. */
+static bool push(trace_state *s, stack_entry e, stack_entry **stack, uint32_t *sp, uint32_t *cap,
+                 int *fail)
+{
+	if (*sp == *cap) {
+		*fail = grow_stack(stack, cap, s->tree->node_count);
+		if (*fail != TRACE_OK)
+			return false;
+	}
+	(*stack)[(*sp)++] = e;
+	return true;
+}
+
 /* What entering node n reads next: its children's boxes or its triangles. */
 static inline void prefetch_next(const trace_state *s, const bvhlab_node *n)
 {
-	if (n->count == 0)
-		__builtin_prefetch(&s->node_array[n->first]);
+	if (!tree_is_leaf(n))
+		__builtin_prefetch(&s->node_array[tree_child(n, 0)]);
 	else if (s->verts)
-		__builtin_prefetch(s->verts + 9 * (size_t)n->first);
+		__builtin_prefetch(s->verts + 9 * (size_t)tree_leaf_first(n));
 }
 
 /*
@@ -159,10 +173,10 @@ static bool descend(trace_state *s, const bvhlab_node *n, uint32_t *node, stack_
                     uint32_t *sp, uint32_t *cap, int *fail)
 {
 	const bvhlab_node *nodes = s->node_array;
-	uint32_t near = n->first, far = n->first + 1;
+	uint32_t near = tree_child(n, 0), far = tree_child(n, 1);
 	float tn, tf;
 
-	if (n->first >= s->tree->node_count - 1)
+	if (tree_children_end(n) > s->tree->node_count)
 		return false;
 	tn = box_enter(s->p, &nodes[near], s->hit->t);
 	tf = box_enter(s->p, &nodes[far], s->hit->t);
@@ -172,7 +186,7 @@ static bool descend(trace_state *s, const bvhlab_node *n, uint32_t *node, stack_
 		tn = tf;
 		tf = t;
 		near = far;
-		far = n->first;
+		far = tree_child(n, 0);
 	}
 	if (tn == INFINITY)
 		return false;
@@ -181,15 +195,45 @@ static bool descend(trace_state *s, const bvhlab_node *n, uint32_t *node, stack_
 	if (tf != INFINITY)
 		prefetch_next(s, &nodes[far]);
 	prefetch_next(s, &nodes[near]);
-	if (tf != INFINITY) {
-		if (*sp == *cap) {
-			*fail = grow_stack(stack, cap, s->tree->node_count);
-			if (*fail != TRACE_OK)
-				return false;
-		}
-		(*stack)[(*sp)++] = (stack_entry){ far, tf };
-	}
+	if (tf != INFINITY && !push(s, (stack_entry){ far, tf }, stack, sp, cap, fail))
+		return false;
 	*node = near;
+	return true;
+}
+
+/*
+ * descend for a wider node: every child's box is tested, the hit ones are
+ * sorted near to far, the nearest is taken and the rest pushed, farthest
+ * first. The same closest hit as any order; near-first saves work.
+ */
+static bool descend_wide(trace_state *s, const bvhlab_node *n, uint32_t *node,
+                         stack_entry **stack, uint32_t *sp, uint32_t *cap, int *fail)
+{
+	stack_entry hit[BVHLAB_MAX_WIDTH];
+	uint32_t k = tree_child_count(n), m = 0;
+
+	if (k > BVHLAB_MAX_WIDTH || tree_children_end(n) > s->tree->node_count)
+		return false;
+	for (uint32_t i = 0; i < k; i++) {
+		stack_entry e = { tree_child(n, i), box_enter(s->p, &s->node_array[tree_child(n, i)],
+		                                               s->hit->t) };
+		uint32_t j = m++;
+
+		if (e.t == INFINITY) {
+			m--;
+			continue;
+		}
+		for (; j > 0 && hit[j - 1].t < e.t; j--) /* far to near */
+			hit[j] = hit[j - 1];
+		hit[j] = e;
+	}
+	if (m == 0)
+		return false;
+	for (uint32_t i = 0; i + 1 < m; i++)
+		if (!push(s, hit[i], stack, sp, cap, fail))
+			return false;
+	prefetch_next(s, &s->node_array[hit[m - 1].node]);
+	*node = hit[m - 1].node;
 	return true;
 }
 
@@ -222,13 +266,18 @@ static void traverse(trace_state *s)
 		 * cycle, and stopping keeps an invalid tree from hanging us. */
 		if (++s->nodes > tree->node_count)
 			break;
-		if (n->count) {
+		if (tree_is_binary_inner(n)) {
+			if (descend(s, n, &node, &stack, &sp, &cap, &fail))
+				continue;
+		} else if (!tree_is_leaf(n)) {
+			if (descend_wide(s, n, &node, &stack, &sp, &cap, &fail))
+				continue;
+		} else {
 			leaf(s, n);
 			if (s->done)
 				break;
-		} else if (descend(s, n, &node, &stack, &sp, &cap, &fail)) {
-			continue;
-		} else if (fail == TRACE_NOMEM) {
+		}
+		if (fail == TRACE_NOMEM) {
 			brute_all(s->scene, s->p, s->hit); /* slow, but still exact */
 			break;
 		} else if (fail == TRACE_INVALID) {
@@ -259,7 +308,7 @@ static void hit_init(const bvhlab_ray *ray, bvhlab_hit *hit)
 }
 
 /* Stats: nodes_visited counts the nodes entered (root included, each inner
- * node's two child boxes are tested from it), tris_tested the triangle tests. */
+ * node's child boxes are tested from it), tris_tested the triangle tests. */
 void trace_ray_stack(const bvhlab_tree *tree, const bvhlab_scene *scene,
                      const struct trace_view *view, const bvhlab_ray *ray, bool any,
                      bvhlab_hit *hit, bvhlab_trace_stats *stats)

@@ -12,6 +12,7 @@
 
 #include "trace/trace_cl.h"
 #include "trace/trace_cl_source.h"
+#include "tree/tree_view.h"
 #include "util/util.h"
 
 /* The private stack of the stack kernel: this many entries, or the next
@@ -124,8 +125,9 @@ static int get_program(struct device *d, unsigned stack, cl_program *out, bvhlab
 	return 0;
 }
 
-/* Inner nodes on the longest root-to-leaf path: the most far children the
- * stack kernel holds at once. -EINVAL for links that leave the array. */
+/* Inner nodes on the longest root-to-leaf path of a binary tree: the most
+ * far children the stack kernel holds at once. -EINVAL for links that
+ * leave the array. */
 static int tree_depth(const bvhlab_tree *tree, unsigned *depth)
 {
 	uint32_t n = tree->node_count, sp = 0;
@@ -138,15 +140,15 @@ static int tree_depth(const bvhlab_tree *tree, unsigned *depth)
 	while (sp) {
 		uint32_t node = stack[--sp][0], d = stack[sp][1];
 		const bvhlab_node *nd = &tree->nodes[node];
-		if (nd->count)
+		if (tree_is_leaf(nd))
 			continue;
-		if (nd->first == 0 || nd->first >= n - 1 || sp + 2 > n) {
+		if (tree_child(nd, 0) == 0 || tree_children_end(nd) > n || sp + 2 > n) {
 			free(stack);
 			return -EINVAL;
 		}
 		*depth = d + 1 > *depth ? d + 1 : *depth;
-		stack[sp][0] = nd->first, stack[sp++][1] = d + 1;
-		stack[sp][0] = nd->first + 1, stack[sp++][1] = d + 1;
+		stack[sp][0] = tree_child(nd, 0), stack[sp++][1] = d + 1;
+		stack[sp][0] = tree_child(nd, 1), stack[sp++][1] = d + 1;
 	}
 	free(stack);
 	return 0;
@@ -251,16 +253,42 @@ static int make_kernel(struct trace_cl_tree *t, int traversal, unsigned depth,
 	return r;
 }
 
+static int create_binary(const char *device, int traversal, const bvhlab_tree *tree,
+                         const bvhlab_scene *scene, struct trace_cl_tree **out,
+                         bvhlab_error *err);
+
+/* The kernels walk binary nodes: a wider tree goes up as its binary
+ * expansion (the same leaves and hits; its node counts are the
+ * expansion's). */
 int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *tree,
                          const bvhlab_scene *scene, struct trace_cl_tree **out,
                          bvhlab_error *err)
 {
-	unsigned depth;
 	*out = NULL;
 	if (traversal != BVHLAB_TRAVERSAL_CL_STACK && traversal != BVHLAB_TRAVERSAL_CL_STACKLESS) {
 		error_set(err, "cl: not a device traversal (%d)", traversal);
 		return -EINVAL;
 	}
+	if (tree_width(tree) == 2)
+		return create_binary(device, traversal, tree, scene, out, err);
+	bvhlab_tree bin = *tree;
+	int r = tree_binary_nodes(tree, &bin.nodes, &bin.node_count);
+	if (r < 0) {
+		error_set(err, r == -ENOMEM ? "cl: out of memory" : "cl: the tree's links leave it");
+		return r;
+	}
+	bin.node_capacity = bin.node_count;
+	bin.width = 2;
+	r = create_binary(device, traversal, &bin, scene, out, err);
+	free(bin.nodes);
+	return r;
+}
+
+static int create_binary(const char *device, int traversal, const bvhlab_tree *tree,
+                         const bvhlab_scene *scene, struct trace_cl_tree **out,
+                         bvhlab_error *err)
+{
+	unsigned depth;
 	int r = tree_depth(tree, &depth);
 	if (r < 0) {
 		error_set(err, r == -ENOMEM ? "cl: out of memory" : "cl: the tree's links leave it");

@@ -10,7 +10,10 @@
  * has to try the far one, from the far child it goes on up. That needs the
  * near/far decision to come out the same both times, so it depends only on
  * the ray and the two child boxes (their centres along the ray direction),
- * not on distances that shrink as hits are found.
+ * not on distances that shrink as hits are found. A wider node's children
+ * are tried in the order of their box centres along the ray (the first one
+ * on a tie), coming up from one the walk goes on with the next in that
+ * order: the same rule, k children instead of two.
  */
 #include <errno.h>
 #include <stdlib.h>
@@ -18,6 +21,7 @@
 #include <bvhlab/trace.h>
 
 #include "trace/trace_kernel.h"
+#include "tree/tree_view.h"
 
 #define NONE UINT32_MAX
 
@@ -32,17 +36,19 @@ int bvhlab_tree_parents(const bvhlab_tree *tree, uint32_t **parents)
 		par[i] = NONE;
 	for (uint32_t i = 0; i < n; i++) {
 		const bvhlab_node *nd = &tree->nodes[i];
-		if (nd->count)
+		if (tree_is_leaf(nd))
 			continue;
 		/* The root (0) is nobody's child; a child with a parent already is
 		 * shared or part of a cycle: either way not a tree. */
-		if (nd->first == 0 || nd->first >= n - 1 || par[nd->first] != NONE ||
-		    par[nd->first + 1] != NONE) {
+		bool bad = tree_child(nd, 0) == 0 || tree_children_end(nd) > n;
+		for (uint32_t k = 0; !bad && k < tree_child_count(nd); k++)
+			bad = par[tree_child(nd, k)] != NONE;
+		if (bad) {
 			free(par);
 			return -EINVAL;
 		}
-		par[nd->first] = i;
-		par[nd->first + 1] = i;
+		for (uint32_t k = 0; k < tree_child_count(nd); k++)
+			par[tree_child(nd, k)] = i;
 	}
 	*parents = par;
 	return 0;
@@ -50,13 +56,42 @@ int bvhlab_tree_parents(const bvhlab_tree *tree, uint32_t **parents)
 
 /* The near child of an inner node: the one whose box centre comes first
  * along the ray (the first child on a tie). */
-static inline uint32_t near_child(const ray_prep *p, const bvhlab_node *nodes, uint32_t first)
+static inline uint32_t near_child(const ray_prep *p, const bvhlab_node *nodes,
+                                  const bvhlab_node *n)
 {
-	const bvhlab_node *a = &nodes[first], *b = &nodes[first + 1];
+	uint32_t first = tree_child(n, 0), second = tree_child(n, 1);
+	const bvhlab_node *a = &nodes[first], *b = &nodes[second];
 	float d = 0.0f;
 	for (int k = 0; k < 3; k++)
 		d += ((b->lo[k] + b->hi[k]) - (a->lo[k] + a->hi[k])) * p->dir[k];
-	return d < 0.0f ? first + 1 : first;
+	return d < 0.0f ? second : first;
+}
+
+/* A wide node's child's place in the ray order (twice its centre's). */
+static inline float centre_key(const ray_prep *p, const bvhlab_node *b)
+{
+	float d = 0.0f;
+	for (int k = 0; k < 3; k++)
+		d += (b->lo[k] + b->hi[k]) * p->dir[k];
+	return d;
+}
+
+/* The child of wide node n after `after` in the ray order (by key, then by
+ * index), the first one for NONE; NONE past the last. */
+static uint32_t next_wide(const ray_prep *p, const bvhlab_node *nodes, const bvhlab_node *n,
+                          uint32_t after)
+{
+	float ka = after == NONE ? 0.0f : centre_key(p, &nodes[after]), kb = 0.0f;
+	uint32_t best = NONE;
+	for (uint32_t i = 0; i < tree_child_count(n); i++) {
+		uint32_t c = tree_child(n, i);
+		float k = centre_key(p, &nodes[c]);
+		if (after != NONE && !(k > ka || (k == ka && c > after)))
+			continue;
+		if (best == NONE || k < kb || (k == kb && c < best))
+			best = c, kb = k;
+	}
+	return best;
 }
 
 struct walk {
@@ -75,9 +110,10 @@ struct walk {
 static bool leaf(struct walk *w, const bvhlab_node *n)
 {
 	const bvhlab_tree *tree = w->tree;
-	if (n->first > tree->index_count || n->count > tree->index_count - n->first)
+	uint32_t first = tree_leaf_first(n), count = tree_leaf_count(n);
+	if (first > tree->index_count || count > tree->index_count - first)
 		return false;
-	for (uint32_t i = n->first; i < n->first + n->count; i++) {
+	for (uint32_t i = first; i < first + count; i++) {
 		if (tree->prim_index[i] >= w->scene->triangle_count)
 			continue;
 		w->tests++;
@@ -92,19 +128,41 @@ static inline bool enters(const struct walk *w, uint32_t node)
 	return box_enter(w->p, &w->node_array[node], w->hit->t) != INFINITY;
 }
 
-/* From a node whose subtree is done, up to the next far child to enter;
+/* The first child of inner node n after `after` (NONE: from the start) in
+ * the ray order that the ray enters, into *node; false when none is left. */
+static bool enter_next(struct walk *w, const bvhlab_node *n, uint32_t after, uint32_t *node)
+{
+	if (tree_is_binary_inner(n)) {
+		uint32_t near = near_child(w->p, w->node_array, n);
+		uint32_t far = near == tree_child(n, 0) ? tree_child(n, 1) : tree_child(n, 0);
+		if (after == NONE && enters(w, near)) {
+			*node = near;
+			return true;
+		}
+		if ((after == NONE || after == near) && enters(w, far)) {
+			*node = far;
+			return true;
+		}
+		return false;
+	}
+	for (uint32_t c = next_wide(w->p, w->node_array, n, after); c != NONE;
+	     c = next_wide(w->p, w->node_array, n, c))
+		if (enters(w, c)) {
+			*node = c;
+			return true;
+		}
+	return false;
+}
+
+/* From a node whose subtree is done, up to the next sibling to enter;
  * false when the walk is back at the root. */
 static bool climb(struct walk *w, uint32_t *node)
 {
 	uint32_t at = *node;
 	while (at != 0) {
-		uint32_t parent = w->parents[at], first = w->node_array[parent].first;
-		uint32_t near = near_child(w->p, w->node_array, first);
-		uint32_t far = near == first ? first + 1 : first;
-		if (at == near && enters(w, far)) {
-			*node = far;
+		uint32_t parent = w->parents[at];
+		if (enter_next(w, &w->node_array[parent], at, node))
 			return true;
-		}
 		at = parent;
 	}
 	return false;
@@ -122,17 +180,9 @@ static void walk(struct walk *w)
 		 * links are not one, and stopping keeps a bad tree from hanging. */
 		if (++w->nodes > w->tree->node_count)
 			return;
-		if (n->count == 0) {
-			uint32_t near = near_child(w->p, nodes, n->first);
-			uint32_t far = near == n->first ? n->first + 1 : n->first;
-			if (enters(w, near)) {
-				node = near;
+		if (!tree_is_leaf(n)) {
+			if (enter_next(w, n, NONE, &node))
 				continue;
-			}
-			if (enters(w, far)) {
-				node = far;
-				continue;
-			}
 		} else if (leaf(w, n)) {
 			return;
 		}

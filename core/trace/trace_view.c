@@ -12,12 +12,13 @@
 
 #include "trace/trace_kernel.h"
 #include "trace/trace_wide.h"
+#include "tree/tree_view.h"
 
 #define LINE 64
 
 /*
- * Builders write the children of a node side by side, nodes[first] and
- * nodes[first + 1], and the root alone at 0, so first is usually odd: in
+ * Builders write the children of a node side by side, a binary node's two
+ * from nodes[first], and the root alone at 0, so first is usually odd: in
  * the tree's own array (32-byte nodes, line-aligned) such a pair straddles
  * two cache lines, and each inner node costs two misses instead of one.
  * The copy starts half a line in when most pairs begin at odd indices.
@@ -26,10 +27,10 @@ static size_t pair_offset(const bvhlab_tree *tree)
 {
 	uint64_t odd = 0, inner = 0;
 	for (uint32_t i = 0; i < tree->node_count; i++) {
-		if (tree->nodes[i].count)
+		if (tree_is_leaf(&tree->nodes[i]))
 			continue;
 		inner++;
-		odd += tree->nodes[i].first & 1u;
+		odd += tree_child(&tree->nodes[i], 0) & 1u;
 	}
 	return 2 * odd > inner ? sizeof(bvhlab_node) : 0;
 }

@@ -1,8 +1,10 @@
 /*
- * Collapsing a binary tree into the wide traversal's 4-child nodes, once
- * per batch. Opening the child of largest surface area first keeps the
- * nodes a ray is most likely to enter near the top, as Embree and
- * tinybvh's wide layouts do when they collapse a binary build.
+ * Collapsing a tree into the wide traversal's 4-child nodes, once per
+ * batch. Opening the child of largest surface area first keeps the nodes a
+ * ray is most likely to enter near the top, as Embree and tinybvh's wide
+ * layouts do when they collapse a binary build. A node of a wider tree
+ * whose children do not fit in the lanes left is opened in halves first
+ * (a piece: children lo .. hi - 1 of one node, its box their union).
  */
 #include <errno.h>
 #include <math.h>
@@ -14,6 +16,7 @@
 #include <bvhlab/aabb.h>
 
 #include "trace/trace_wide.h"
+#include "tree/tree_view.h"
 
 #define LINE 64
 /* Subtrees of at most this many triangles become one leaf lane (two
@@ -22,9 +25,15 @@
  * builder's tree that its lower levels would no longer count. */
 #define SMALL (2 * TRI_LANES)
 
-/* A binary node waiting to become the wide node `wide`, at wide level `level`. */
+/* A node, or a piece of one (hi > 0: its children lo .. hi - 1). */
+struct piece {
+	uint32_t node, lo, hi;
+};
+
+/* A node or piece waiting to become the wide node `wide`, at wide level `level`. */
 struct pending {
-	uint32_t node, wide, level;
+	struct piece at;
+	uint32_t wide, level;
 };
 
 struct collapse {
@@ -37,19 +46,38 @@ struct collapse {
 	uint32_t todo_count, cap;
 };
 
-/* A lane being gathered: a binary node, and when it is an inner node with
- * at most SMALL triangles below it, their slots (it becomes a leaf lane). */
+/* A lane being gathered: a node or piece, and when it is an inner node
+ * with at most SMALL triangles below it, their slots (a leaf lane then). */
 struct lane {
-	uint32_t node;
+	struct piece at;
 	uint32_t small; /* how many slots; 0: a leaf, or an inner node to open */
 	uint32_t slots[SMALL];
 };
 
-static void set_lane(struct wide_node *w, uint32_t i, const bvhlab_node *n)
+/* The box of a lane: its node's, or the union of its piece's children. */
+static void lane_box(const struct collapse *c, const struct lane *l, float lo[3], float hi[3])
 {
+	const bvhlab_node *n = &c->tree->nodes[l->at.node];
+	for (int k = 0; k < 3; k++)
+		lo[k] = n->lo[k], hi[k] = n->hi[k];
+	for (uint32_t i = l->at.lo; i < l->at.hi; i++) {
+		const bvhlab_node *b = &c->tree->nodes[tree_child(n, i)];
+		for (int k = 0; k < 3; k++) {
+			lo[k] = i == l->at.lo || b->lo[k] < lo[k] ? b->lo[k] : lo[k];
+			hi[k] = i == l->at.lo || b->hi[k] > hi[k] ? b->hi[k] : hi[k];
+		}
+	}
+}
+
+static void set_lane(const struct collapse *c, struct wide_node *w, uint32_t i,
+                     const struct lane *l)
+{
+	float lo[3], hi[3];
+	if (l)
+		lane_box(c, l, lo, hi);
 	for (int k = 0; k < 3; k++) {
-		w->box[k][i] = n ? n->lo[k] : INFINITY;
-		w->box[3 + k][i] = n ? n->hi[k] : -INFINITY;
+		w->box[k][i] = l ? lo[k] : INFINITY;
+		w->box[3 + k][i] = l ? hi[k] : -INFINITY;
 	}
 }
 
@@ -72,7 +100,7 @@ static void group_lane(struct collapse *c, struct wide_tris *g, uint32_t lane, u
 /*
  * Wide lane i as a leaf of n triangles copied into groups: those of slots
  * (a small subtree's), or with slots NULL those of slots first..first+n-1
- * (a binary leaf, of any size).
+ * (a leaf of the tree, of any size).
  */
 static int leaf_lane(struct collapse *c, struct wide_node *w, uint32_t i,
                      const uint32_t *slots, uint32_t first, uint32_t n)
@@ -105,93 +133,124 @@ static uint32_t small_subtree(const struct collapse *c, uint32_t node, uint32_t 
 	stack[sp++] = node;
 	while (sp > 0) {
 		const bvhlab_node *b = &t->nodes[stack[--sp]];
+		uint32_t first = tree_leaf_first(b), count = tree_leaf_count(b);
 		if (++visits > 2 * SMALL)
 			return 0;
-		if (b->count) {
-			if (b->count > SMALL - n || b->first > t->index_count - b->count)
+		if (tree_is_leaf(b)) {
+			if (count > SMALL - n || first > t->index_count - count)
 				return 0;
-			for (uint32_t i = 0; i < b->count; i++)
-				slots[n++] = b->first + i;
+			for (uint32_t i = 0; i < count; i++)
+				slots[n++] = first + i;
 		} else {
-			if (b->first == 0 || b->first >= t->node_count - 1 || sp + 2 > 2 * SMALL)
+			if (tree_child(b, 0) == 0 || tree_children_end(b) > t->node_count ||
+			    sp + tree_child_count(b) > 2 * SMALL)
 				return 0;
-			stack[sp++] = b->first;
-			stack[sp++] = b->first + 1;
+			for (uint32_t i = 0; i < tree_child_count(b); i++)
+				stack[sp++] = tree_child(b, i);
 		}
 	}
 	return n;
 }
 
-/* Lane l for binary node `node`, its small subtree found once here. */
+/* Lane l for node `node`, its small subtree found once here. */
 static void take_lane(const struct collapse *c, struct lane *l, uint32_t node)
 {
-	l->node = node;
-	l->small = c->tree->nodes[node].count ? 0 : small_subtree(c, node, l->slots);
+	l->at = (struct piece){node, 0, 0};
+	l->small = tree_is_leaf(&c->tree->nodes[node]) ? 0 : small_subtree(c, node, l->slots);
 }
 
-/* Takes both children of inner node `node` as lanes at lane[at] and lane[n]. */
-static int open_node(struct collapse *c, uint32_t node, struct lane *lane, uint32_t at,
-                     uint32_t n)
+/* Lane l for children lo .. hi - 1 of `node`: the child itself when one. */
+static int take_piece(struct collapse *c, struct lane *l, uint32_t node, uint32_t lo,
+                      uint32_t hi)
 {
-	const bvhlab_tree *t = c->tree;
-	uint32_t first = t->nodes[node].first;
-	if (first == 0 || first >= t->node_count - 1 || c->seen[first] || c->seen[first + 1])
+	if (hi - lo > 1) {
+		*l = (struct lane){.at = {node, lo, hi}};
+		return 0;
+	}
+	uint32_t child = tree_child(&c->tree->nodes[node], lo);
+	if (c->seen[child])
 		return -EINVAL;
-	c->seen[first] = c->seen[first + 1] = 1;
-	take_lane(c, &lane[at], first);
-	take_lane(c, &lane[n], first + 1);
+	c->seen[child] = 1;
+	take_lane(c, l, child);
 	return 0;
 }
 
-/* The binary nodes under `node` that become one wide node's lanes: the
- * inner lane of largest area that is not a small subtree is opened until
- * there are WIDE. */
-static int gather(struct collapse *c, uint32_t node, struct lane lane[WIDE], uint32_t *lanes)
+/* Replaces lane[at] by its children, the first at lane[at] and the rest
+ * from lane[*n] on, or by two halves when they would not fit in WIDE. */
+static int open_lane(struct collapse *c, struct lane *lane, uint32_t at, uint32_t *n)
 {
-	const bvhlab_node *nodes = c->tree->nodes;
-	uint32_t n = 2;
-	int r = open_node(c, node, lane, 0, 1);
+	struct piece p = lane[at].at;
+	const bvhlab_node *b = &c->tree->nodes[p.node];
+	uint32_t lo = p.hi ? p.lo : 0, hi = p.hi ? p.hi : tree_child_count(b);
+	if (tree_child(b, 0) == 0 || tree_children_end(b) > c->tree->node_count)
+		return -EINVAL;
+	if (hi - lo > WIDE - *n + 1) {
+		uint32_t mid = lo + (hi - lo) / 2;
+		int r = take_piece(c, &lane[at], p.node, lo, mid);
+		return r < 0 ? r : take_piece(c, &lane[(*n)++], p.node, mid, hi);
+	}
+	for (uint32_t k = lo; k < hi; k++) {
+		int r = take_piece(c, &lane[k == lo ? at : (*n)++], p.node, k, k + 1);
+		if (r < 0)
+			return r;
+	}
+	return 0;
+}
+
+static bool lane_opens(const struct collapse *c, const struct lane *l)
+{
+	return l->at.hi > 0 || (!tree_is_leaf(&c->tree->nodes[l->at.node]) && l->small == 0);
+}
+
+/* The nodes under piece `p` that become one wide node's lanes: the inner
+ * lane of largest area that is not a small subtree is opened until there
+ * are WIDE. */
+static int gather(struct collapse *c, struct piece p, struct lane lane[WIDE], uint32_t *lanes)
+{
+	uint32_t n = 1;
+	lane[0] = (struct lane){.at = p};
+	int r = open_lane(c, lane, 0, &n);
 	while (r == 0 && n < WIDE) {
 		int best = -1;
 		float best_area = -1.0f;
 		for (uint32_t i = 0; i < n; i++) {
-			const bvhlab_node *b = &nodes[lane[i].node];
-			float a = bvhlab_half_area(b->lo, b->hi);
-			if (!(a <= best_area) && b->count == 0 && lane[i].small == 0) {
+			float lo[3], hi[3];
+			lane_box(c, &lane[i], lo, hi);
+			float a = bvhlab_half_area(lo, hi);
+			if (!(a <= best_area) && lane_opens(c, &lane[i])) {
 				best = (int)i;
 				best_area = a;
 			}
 		}
 		if (best < 0)
 			break;
-		r = open_node(c, lane[best].node, lane, (uint32_t)best, n++);
+		r = open_lane(c, lane, (uint32_t)best, &n);
 	}
 	*lanes = n;
 	return r;
 }
 
 /* An inner lane: its node becomes a new wide node, filled later. */
-static int inner_lane(struct collapse *c, struct wide_node *w, uint32_t i, uint32_t node,
+static int inner_lane(struct collapse *c, struct wide_node *w, uint32_t i, struct piece at,
                       uint32_t level)
 {
 	if (c->w->node_count == c->cap)
-		return -EINVAL; /* more wide nodes than inner nodes: links are shared */
+		return -EINVAL; /* more wide nodes than pieces: links are shared */
 	uint32_t id = c->w->node_count++;
 	w->child[i] = id;
 	w->count[i] = 0;
-	c->todo[c->todo_count++] = (struct pending){node, id, level};
+	c->todo[c->todo_count++] = (struct pending){at, id, level};
 	return 0;
 }
 
-/* A binary leaf as a leaf lane, checked against the index array so the
- * traversal need not. */
-static int binary_leaf(struct collapse *c, struct wide_node *w, uint32_t i,
-                       const bvhlab_node *b)
+/* A leaf of the tree as a leaf lane, checked against the index array so
+ * the traversal need not. */
+static int tree_leaf(struct collapse *c, struct wide_node *w, uint32_t i, const bvhlab_node *b)
 {
-	if (b->first > c->tree->index_count || b->count > c->tree->index_count - b->first ||
-	    b->count == WIDE_EMPTY)
+	uint32_t first = tree_leaf_first(b), count = tree_leaf_count(b);
+	if (first > c->tree->index_count || count > c->tree->index_count - first)
 		return -EINVAL;
-	return leaf_lane(c, w, i, NULL, b->first, b->count);
+	return leaf_lane(c, w, i, NULL, first, count);
 }
 
 static int fill(struct collapse *c, const struct pending *p)
@@ -201,22 +260,23 @@ static int fill(struct collapse *c, const struct pending *p)
 	struct lane lane[WIDE];
 	uint32_t n = 1;
 	int r = 0;
-	if (nodes[p->node].count == 0)
-		r = gather(c, p->node, lane, &n);
+	if (p->at.hi > 0 || !tree_is_leaf(&nodes[p->at.node]))
+		r = gather(c, p->at, lane, &n);
 	else
-		lane[0] = (struct lane){.node = p->node}; /* a leaf root */
+		lane[0] = (struct lane){.at = p->at}; /* a leaf root */
 	for (uint32_t i = 0; r == 0 && i < WIDE; i++) {
-		const bvhlab_node *b = i < n ? &nodes[lane[i].node] : NULL;
-		set_lane(w, i, b);
+		const struct lane *l = i < n ? &lane[i] : NULL;
+		const bvhlab_node *b = l ? &nodes[l->at.node] : NULL;
+		set_lane(c, w, i, l);
 		if (!b) {
 			w->child[i] = 0;
 			w->count[i] = WIDE_EMPTY;
-		} else if (b->count) {
-			r = binary_leaf(c, w, i, b);
-		} else if (lane[i].small) {
-			r = leaf_lane(c, w, i, lane[i].slots, 0, lane[i].small);
+		} else if (l->at.hi == 0 && tree_is_leaf(b)) {
+			r = tree_leaf(c, w, i, b);
+		} else if (l->small) {
+			r = leaf_lane(c, w, i, l->slots, 0, l->small);
 		} else {
-			r = inner_lane(c, w, i, lane[i].node, p->level + 1);
+			r = inner_lane(c, w, i, l->at, p->level + 1);
 		}
 	}
 	if (c->w->depth < p->level)
@@ -224,17 +284,20 @@ static int fill(struct collapse *c, const struct pending *p)
 	return r;
 }
 
-/* Inner nodes, and triangle groups the leaves need (saturating: a sum
- * that overflows is a tree no wide copy can hold). */
-static void count_nodes(const bvhlab_tree *tree, uint32_t *inner, uint32_t *groups)
+/* The pieces that can become wide nodes: the inner nodes, and the k - 2
+ * halves at most a node of k children is opened in; and the triangle
+ * groups the leaves need (saturating: a sum that overflows is a tree no
+ * wide copy can hold). */
+static void count_nodes(const bvhlab_tree *tree, uint32_t *pieces, uint32_t *groups)
 {
-	uint64_t g = 0;
-	*inner = 0;
+	uint64_t g = 0, p = 0;
 	for (uint32_t i = 0; i < tree->node_count; i++) {
-		uint32_t n = tree->nodes[i].count;
-		*inner += n == 0;
-		g += (n + (uint64_t)TRI_LANES - 1) / TRI_LANES;
+		const bvhlab_node *n = &tree->nodes[i];
+		uint32_t k = tree_child_count(n);
+		p += k ? k - 1 : 0;
+		g += (tree_leaf_count(n) + (uint64_t)TRI_LANES - 1) / TRI_LANES;
 	}
+	*pieces = p < UINT32_MAX - 1 ? (uint32_t)p : UINT32_MAX - 1;
 	*groups = g < UINT32_MAX ? (uint32_t)g : UINT32_MAX;
 }
 
@@ -261,7 +324,7 @@ int wide_bvh_init(struct wide_bvh *w, const bvhlab_tree *tree, const bvhlab_scen
 	int r = c.seen && c.todo && w->nodes && w->tris ? 0 : -ENOMEM;
 	if (r == 0) {
 		w->node_count = 1;
-		c.todo[c.todo_count++] = (struct pending){0, 0, 1};
+		c.todo[c.todo_count++] = (struct pending){{0, 0, 0}, 0, 1};
 	}
 	while (r == 0 && c.todo_count > 0) {
 		struct pending p = c.todo[--c.todo_count];

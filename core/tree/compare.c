@@ -4,14 +4,15 @@
  * primitive multiset in each leaf. The SAH plugins differ only in scheduling,
  * so with the same options their trees must compare equal here.
  *
- * Every subtree gets a 64-bit hash, bottom-up, symmetric in its two children
- * and in the order of a leaf's primitives. The two roots are then walked in
+ * Every subtree gets a 64-bit hash, bottom-up, symmetric in the order of
+ * its children and in the order of a leaf's primitives. The two roots are then walked in
  * parallel: at each inner node the children are paired by hash (a child
  * whose hash has an equal on the other side is the same subtree, so its
  * sibling holds the difference), else by a total order on (box bits,
  * subtree size, smallest primitive). Hashes only steer the walk; equality is
  * decided by comparing everything, so a collision cannot hide a difference.
- * Paths in messages name tree a's children: L is `first`, R is `first + 1`.
+ * Paths in messages name tree a's children: in a binary node L is the first
+ * child, R the second; in a wider one, 0 to 7 by position.
  *
  * A malformed tree (child or leaf range out of bounds, a node reached twice)
  * is -EINVAL with the reason: the walk must not loop or read out of bounds.
@@ -23,6 +24,8 @@
 #include <string.h>
 
 #include <bvhlab/tree.h>
+
+#include "tree/tree_view.h"
 
 #define PATH_SHOWN 150 /* levels spelled out in a message */
 
@@ -78,14 +81,17 @@ static int fail(bvhlab_error *err, int rc, const char *what, char name, uint32_t
 	return rc;
 }
 
-/* Queues both children of an inner node, refusing a node seen before. */
+/* Queues the children of an inner node, refusing a node seen before. */
 static int enqueue_children(canon *c, uint32_t node, bvhlab_error *err)
 {
-	uint32_t first = c->tree->nodes[node].first, k;
+	const bvhlab_node *n = &c->tree->nodes[node];
+	uint32_t count = tree_child_count(n);
 
-	if (first >= c->tree->node_count - 1)
+	if (tree_children_end(n) > c->tree->node_count || count > BVHLAB_MAX_WIDTH)
 		return fail(err, -EINVAL, "child index out of range", c->name, node);
-	for (k = first; k < first + 2; k++) {
+	for (uint32_t i = 0; i < count; i++) {
+		uint32_t k = tree_child(n, i);
+
 		if (c->size[k]) {
 			snprintf(err->message, sizeof(err->message), "tree %c: node %" PRIu32
 			         ": child %" PRIu32 " reached twice (cycle or shared child)",
@@ -113,12 +119,12 @@ static int canon_order(canon *c, bvhlab_error *err)
 		uint32_t node = c->order[head];
 		const bvhlab_node *n = &t->nodes[node];
 
-		if (n->count == 0) {
+		if (!tree_is_leaf(n)) {
 			rc = enqueue_children(c, node, err);
-		} else if ((uint64_t)n->first + n->count > t->index_count) {
+		} else if ((uint64_t)tree_leaf_first(n) + tree_leaf_count(n) > t->index_count) {
 			rc = fail(err, -EINVAL, "leaf range past index_count", c->name, node);
-		} else if (n->count > c->max_leaf) {
-			c->max_leaf = n->count;
+		} else if (tree_leaf_count(n) > c->max_leaf) {
+			c->max_leaf = tree_leaf_count(n);
 		}
 	}
 	return rc;
@@ -130,32 +136,42 @@ static void hash_leaf(canon *c, uint32_t node)
 	uint64_t sum = 0;
 	uint32_t i, least = UINT32_MAX;
 
-	for (i = n->first; i < n->first + n->count; i++) {
+	uint32_t first = tree_leaf_first(n), count = tree_leaf_count(n);
+
+	for (i = first; i < first + count; i++) {
 		uint32_t p = c->tree->prim_index[i];
 
 		sum += mix64(p + 0x632be59bd9b4e019u); /* a sum ignores the order */
 		least = p < least ? p : least;
 	}
-	c->hash[node] = mix64(box_hash(n, 1) ^ mix64(sum + n->count));
+	c->hash[node] = mix64(box_hash(n, 1) ^ mix64(sum + count));
 	c->size[node] = 1;
 	c->minprim[node] = least;
 }
 
+/* Symmetric in the order of the children: their hashes are sorted first
+ * (for two, the smaller one is folded in first, as it always was). */
 static void hash_inner(canon *c, uint32_t node)
 {
 	const bvhlab_node *n = &c->tree->nodes[node];
-	uint64_t h0 = c->hash[n->first], h1 = c->hash[n->first + 1];
-	uint32_t m0 = c->minprim[n->first], m1 = c->minprim[n->first + 1];
+	uint32_t count = tree_child_count(n), size = 1, least = UINT32_MAX;
+	uint64_t hs[BVHLAB_MAX_WIDTH];
 
-	if (h1 < h0) { /* symmetric in the two children */
-		uint64_t h = h0;
+	for (uint32_t i = 0; i < count; i++) {
+		uint32_t k = tree_child(n, i), j = i;
 
-		h0 = h1;
-		h1 = h;
+		for (; j > 0 && hs[j - 1] > c->hash[k]; j--)
+			hs[j] = hs[j - 1];
+		hs[j] = c->hash[k];
+		size += c->size[k];
+		least = c->minprim[k] < least ? c->minprim[k] : least;
 	}
-	c->hash[node] = mix64(mix64(box_hash(n, 2) ^ h0) + h1);
-	c->size[node] = 1 + c->size[n->first] + c->size[n->first + 1];
-	c->minprim[node] = m0 < m1 ? m0 : m1;
+	uint64_t h = mix64(box_hash(n, 2) ^ hs[0]);
+	for (uint32_t i = 1; i < count; i++)
+		h = mix64(h + hs[i]);
+	c->hash[node] = h;
+	c->size[node] = size;
+	c->minprim[node] = least;
 }
 
 static int canon_build(canon *c, const bvhlab_tree *tree, char name, bvhlab_error *err)
@@ -178,7 +194,7 @@ static int canon_build(canon *c, const bvhlab_tree *tree, char name, bvhlab_erro
 	if (rc < 0)
 		return rc;
 	for (i = c->reached; i-- > 0;) { /* children before parents */
-		if (tree->nodes[c->order[i]].count)
+		if (tree_is_leaf(&tree->nodes[c->order[i]]))
 			hash_leaf(c, c->order[i]);
 		else
 			hash_inner(c, c->order[i]);
@@ -249,24 +265,24 @@ static int compare_leaves(walk *w, const pair *p)
 {
 	const bvhlab_tree *ta = w->ca->tree, *tb = w->cb->tree;
 	const bvhlab_node *na = &ta->nodes[p->a], *nb = &tb->nodes[p->b];
+	uint32_t count = tree_leaf_count(na), i;
 	char detail[128];
-	uint32_t i;
 
-	if (na->count != nb->count) {
+	if (count != tree_leaf_count(nb)) {
 		snprintf(detail, sizeof(detail), "%" PRIu32 " vs %" PRIu32 " primitives",
-		         na->count, nb->count);
+		         count, tree_leaf_count(nb));
 		return differ(w, "leaf primitive sets differ", p->depth, detail);
 	}
-	memcpy(w->sort_a, ta->prim_index + na->first, na->count * sizeof(uint32_t));
-	memcpy(w->sort_b, tb->prim_index + nb->first, nb->count * sizeof(uint32_t));
-	if (na->count <= 32) {
-		sort_prims(w->sort_a, na->count);
-		sort_prims(w->sort_b, nb->count);
+	memcpy(w->sort_a, ta->prim_index + tree_leaf_first(na), count * sizeof(uint32_t));
+	memcpy(w->sort_b, tb->prim_index + tree_leaf_first(nb), count * sizeof(uint32_t));
+	if (count <= 32) {
+		sort_prims(w->sort_a, count);
+		sort_prims(w->sort_b, count);
 	} else {
-		qsort(w->sort_a, na->count, sizeof(uint32_t), cmp_u32);
-		qsort(w->sort_b, nb->count, sizeof(uint32_t), cmp_u32);
+		qsort(w->sort_a, count, sizeof(uint32_t), cmp_u32);
+		qsort(w->sort_b, count, sizeof(uint32_t), cmp_u32);
 	}
-	for (i = 0; i < na->count; i++) {
+	for (i = 0; i < count; i++) {
 		if (w->sort_a[i] != w->sort_b[i]) {
 			snprintf(detail, sizeof(detail), "primitive %" PRIu32 " vs %" PRIu32,
 			         w->sort_a[i], w->sort_b[i]);
@@ -281,8 +297,9 @@ static int compare_leaves(walk *w, const pair *p)
 static void push_children(walk *w, const pair *p)
 {
 	const canon *ca = w->ca, *cb = w->cb;
-	uint32_t a0 = ca->tree->nodes[p->a].first, a1 = a0 + 1;
-	uint32_t b0 = cb->tree->nodes[p->b].first, b1 = b0 + 1;
+	const bvhlab_node *na = &ca->tree->nodes[p->a], *nb = &cb->tree->nodes[p->b];
+	uint32_t a0 = tree_child(na, 0), a1 = tree_child(na, 1);
+	uint32_t b0 = tree_child(nb, 0), b1 = tree_child(nb, 1);
 	int same = (ca->hash[a0] == cb->hash[b0]) + (ca->hash[a1] == cb->hash[b1]);
 	int crossed = (ca->hash[a0] == cb->hash[b1]) + (ca->hash[a1] == cb->hash[b0]);
 	bool straight, first_equal;
@@ -301,26 +318,77 @@ static void push_children(walk *w, const pair *p)
 	w->stack[w->sp++] = first_equal ? y : x;
 }
 
+/* Children in the order key_cmp gives them. */
+static uint32_t sorted_children(const canon *c, const bvhlab_node *n, uint32_t *out)
+{
+	uint32_t count = tree_child_count(n);
+
+	for (uint32_t i = 0; i < count; i++) {
+		uint32_t k = tree_child(n, i), j = i;
+
+		for (; j > 0 && key_cmp(c, out[j - 1], k) > 0; j--)
+			out[j] = out[j - 1];
+		out[j] = k;
+	}
+	return count;
+}
+
+/* A wider node's children: paired by equal hash first, the rest in key
+ * order; the pairs with equal hashes are pushed first, examined last. */
+static void push_wide(walk *w, const pair *p)
+{
+	uint32_t a[BVHLAB_MAX_WIDTH], b[BVHLAB_MAX_WIDTH], to[BVHLAB_MAX_WIDTH];
+	bool used[BVHLAB_MAX_WIDTH] = { false };
+	uint32_t count = sorted_children(w->ca, &w->ca->tree->nodes[p->a], a), i, j;
+	uint32_t first = tree_child(&w->ca->tree->nodes[p->a], 0);
+
+	sorted_children(w->cb, &w->cb->tree->nodes[p->b], b);
+	for (i = 0; i < count; i++) {
+		to[i] = BVHLAB_MAX_WIDTH;
+		for (j = 0; j < count && to[i] == BVHLAB_MAX_WIDTH; j++)
+			if (!used[j] && w->ca->hash[a[i]] == w->cb->hash[b[j]])
+				used[j] = true, to[i] = j;
+	}
+	for (i = 0, j = 0; i < count; i++) {
+		for (; to[i] == BVHLAB_MAX_WIDTH && used[j]; j++)
+			;
+		if (to[i] == BVHLAB_MAX_WIDTH)
+			used[j] = true, to[i] = j;
+	}
+	for (int equal = 1; equal >= 0; equal--)
+		for (i = 0; i < count; i++)
+			if ((w->ca->hash[a[i]] == w->cb->hash[b[to[i]]]) == equal)
+				w->stack[w->sp++] = (pair){ a[i], b[to[i]], p->depth + 1,
+				                            (char)('0' + (a[i] - first)) };
+}
+
 static int compare_pair(walk *w, const pair *p)
 {
 	const bvhlab_node *na = &w->ca->tree->nodes[p->a], *nb = &w->cb->tree->nodes[p->b];
+	char detail[256];
 
 	w->path[p->depth] = p->side;
-	if ((na->count == 0) != (nb->count == 0))
-		return differ(w, na->count == 0 ? "inner node vs leaf" : "leaf vs inner node",
+	if (tree_is_leaf(na) != tree_is_leaf(nb))
+		return differ(w, !tree_is_leaf(na) ? "inner node vs leaf" : "leaf vs inner node",
 		              p->depth, "");
+	if (tree_child_count(na) != tree_child_count(nb)) {
+		snprintf(detail, sizeof(detail), "%" PRIu32 " vs %" PRIu32 " children",
+		         tree_child_count(na), tree_child_count(nb));
+		return differ(w, "inner nodes differ", p->depth, detail);
+	}
 	if (memcmp(na->lo, nb->lo, sizeof(na->lo)) || memcmp(na->hi, nb->hi, sizeof(na->hi))) {
-		char detail[256];
-
 		snprintf(detail, sizeof(detail), "[%.9g %.9g %.9g]-[%.9g %.9g %.9g] vs "
 		         "[%.9g %.9g %.9g]-[%.9g %.9g %.9g]", na->lo[0], na->lo[1], na->lo[2],
 		         na->hi[0], na->hi[1], na->hi[2], nb->lo[0], nb->lo[1], nb->lo[2],
 		         nb->hi[0], nb->hi[1], nb->hi[2]);
 		return differ(w, "boxes differ", p->depth, detail);
 	}
-	if (na->count)
+	if (tree_is_leaf(na))
 		return compare_leaves(w, p);
-	push_children(w, p);
+	if (tree_child_count(na) == 2)
+		push_children(w, p);
+	else
+		push_wide(w, p);
 	return 0;
 }
 
@@ -330,8 +398,9 @@ static int walk_trees(const canon *ca, const canon *cb, bvhlab_error *err)
 	walk w = { ca, cb, NULL, 0, NULL, NULL, NULL, err };
 	int rc = -ENOMEM;
 
-	/* Each pair holds a distinct node of a, and a pop pushes at most two. */
-	w.stack = malloc(((size_t)ca->reached + 2) * sizeof(pair));
+	/* Each pair holds a distinct node of a, and a pop pushes at most a
+	 * node's children. */
+	w.stack = malloc(((size_t)ca->reached + BVHLAB_MAX_WIDTH) * sizeof(pair));
 	w.path = malloc((size_t)ca->reached + 1);
 	w.sort_a = malloc(((size_t)leaf + 1) * sizeof(uint32_t));
 	w.sort_b = malloc(((size_t)leaf + 1) * sizeof(uint32_t));

@@ -13,6 +13,8 @@
 #include <bvhlab/aabb.h>
 #include <bvhlab/tree.h>
 
+#include "tree/tree_view.h"
+
 #define LOCAL_STACK 128
 
 typedef struct depth_entry {
@@ -53,14 +55,15 @@ static uint32_t max_depth(const bvhlab_tree *tree)
 		const bvhlab_node *n = &tree->nodes[e.node];
 
 		deepest = e.depth > deepest ? e.depth : deepest;
-		if (n->count != 0 || n->first >= tree->node_count - 1)
+		if (tree_is_leaf(n) || tree_children_end(n) > tree->node_count ||
+		    tree_child_count(n) > BVHLAB_MAX_WIDTH)
 			continue;
-		if (sp + 2 > cap && !grow(&stack, &cap, local)) {
+		if (sp + BVHLAB_MAX_WIDTH > cap && !grow(&stack, &cap, local)) {
 			deepest = UINT32_MAX;
 			break;
 		}
-		stack[sp++] = (depth_entry){ n->first, e.depth + 1 };
-		stack[sp++] = (depth_entry){ n->first + 1, e.depth + 1 };
+		for (uint32_t k = 0; k < tree_child_count(n); k++)
+			stack[sp++] = (depth_entry){ tree_child(n, k), e.depth + 1 };
 	}
 	if (stack != local)
 		free(stack);
@@ -76,18 +79,20 @@ static void count_leaf(bvhlab_tree_stats *stats, uint32_t count)
 
 /*
  * SAH cost as documented in tree.h:
- *   (sum over inner n of SA(n) + sum over leaves l of SA(l) * count(l)) / SA(root).
+ *   (sum over inner n of SA(n) * k(n) / 2 + sum over leaves l of SA(l) * count(l))
+ *   / SA(root), k(n) the children of n (tree_trav_cost: 1 for a binary node).
  * SA(n) / SA(root) is the chance that a ray hitting the root hits n. When
  * the root has no area (all primitives on a line or a point) that ratio is
  * 0 / 0; every ray that meets such a scene meets all of it, so each node
- * counts with ratio 1: cost = inner nodes + primitive references. That is
+ * counts with ratio 1: cost = the inner nodes' k(n) / 2 + primitive
+ * references (binary: inner nodes + references). That is
  * also the limit of the formula for a box squashed flat uniformly, and it
  * keeps a single-leaf tree at cost = count, as for any other root.
  */
 void bvhlab_tree_stats_compute(const bvhlab_tree *tree, bvhlab_tree_stats *stats)
 {
-	double root_area, inner_area = 0.0, leaf_area = 0.0;
-	uint64_t refs = 0, inner = 0;
+	double root_area, inner_area = 0.0, leaf_area = 0.0, inner = 0.0;
+	uint64_t refs = 0;
 	uint32_t i;
 
 	memset(stats, 0, sizeof(*stats));
@@ -99,20 +104,20 @@ void bvhlab_tree_stats_compute(const bvhlab_tree *tree, bvhlab_tree_stats *stats
 	for (i = 0; i < tree->node_count; i++) {
 		const bvhlab_node *n = &tree->nodes[i];
 
-		if (n->count == 0) {
-			inner++;
-			inner_area += bvhlab_box_area(n->lo, n->hi);
+		if (!tree_is_leaf(n)) {
+			inner += tree_trav_cost(n);
+			inner_area += bvhlab_box_area(n->lo, n->hi) * tree_trav_cost(n);
 			continue;
 		}
-		count_leaf(stats, n->count);
-		refs += n->count;
-		leaf_area += bvhlab_box_area(n->lo, n->hi) * n->count;
+		count_leaf(stats, tree_leaf_count(n));
+		refs += tree_leaf_count(n);
+		leaf_area += bvhlab_box_area(n->lo, n->hi) * tree_leaf_count(n);
 	}
 	root_area = bvhlab_box_area(tree->nodes[0].lo, tree->nodes[0].hi);
 	if (root_area > 0.0)
 		stats->sah_cost = (inner_area + leaf_area) / root_area;
 	else
-		stats->sah_cost = (double)inner + (double)refs;
+		stats->sah_cost = inner + (double)refs;
 	stats->avg_leaf_size = stats->leaves ? (double)refs / stats->leaves : 0.0;
 	stats->refs = refs;
 	stats->max_depth = max_depth(tree);

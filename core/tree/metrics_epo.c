@@ -12,6 +12,7 @@
 #include <bvhlab/epo.h>
 #include <bvhlab/trace.h>
 
+#include "tree/tree_view.h"
 #include "util/util.h"
 
 #define NONE UINT32_MAX
@@ -24,9 +25,11 @@ struct epo_walk {
 	double *cdf;     /* [triangle_count]: running sum of triangle areas */
 };
 
+/* The SAH's weights (tree.h): a leaf's references, an inner node's
+ * traversal cost (1 for a binary node). */
 static double cost(const bvhlab_node *n)
 {
-	return n->count ? (double)n->count : 1.0;
+	return tree_is_leaf(n) ? (double)tree_leaf_count(n) : tree_trav_cost(n);
 }
 
 static bool holds(const bvhlab_node *n, const float p[3])
@@ -39,7 +42,9 @@ static bool holds(const bvhlab_node *n, const float p[3])
 
 static bool leaf_has(const bvhlab_tree *tree, const bvhlab_node *n, uint32_t prim)
 {
-	for (uint32_t i = n->first; i < n->first + n->count && i < tree->index_count; i++)
+	uint32_t end = tree_leaf_first(n) + tree_leaf_count(n);
+
+	for (uint32_t i = tree_leaf_first(n); i < end && i < tree->index_count; i++)
 		if (tree->prim_index[i] == prim)
 			return true;
 	return false;
@@ -58,13 +63,13 @@ static double point_cost(const struct epo_walk *w, const float p[3], uint32_t pr
 		if (!holds(n, p))
 			continue;
 		sum += cost(n);
-		if (n->count) {
+		if (tree_is_leaf(n)) {
 			if (own == NONE && leaf_has(w->tree, n, prim))
 				own = i;
 			continue;
 		}
-		w->stack[sp++] = n->first;
-		w->stack[sp++] = n->first + 1;
+		for (uint32_t k = 0; k < tree_child_count(n); k++)
+			w->stack[sp++] = tree_child(n, k);
 	}
 	for (uint32_t i = own; i != NONE; i = w->parents[i])
 		sum -= cost(&nodes[i]);

@@ -20,6 +20,7 @@
 #include <bvhlab/trace.h>
 #include <bvhlab/tree.h>
 
+#include "tree/tree_view.h"
 #include "tree/validate_clip.h"
 #include "util/util.h"
 
@@ -58,6 +59,9 @@ static int check_counts(vstate *st)
 	if (t->index_count > t->index_capacity)
 		return FAIL(st, "index_count %" PRIu32 " exceeds index_capacity %" PRIu32,
 		            t->index_count, t->index_capacity);
+	if (t->width == 1 || t->width > BVHLAB_MAX_WIDTH)
+		return FAIL(st, "width %" PRIu32 " outside 2 .. %d (output->width)", t->width,
+		            BVHLAB_MAX_WIDTH);
 	return 0;
 }
 
@@ -114,17 +118,17 @@ static int reach(vstate *st, uint32_t node, uint32_t parent)
 
 /*
  * The likely cause of a child index past the end, for the message: counts
- * a build() forgot, or a pair that is one short (children are nodes[first]
- * and nodes[first + 1], both below node_count).
+ * a build() forgot, or a child list one short (a binary node's children
+ * are the pair from nodes[first], both below node_count).
  */
-static const char *child_hint(const bvhlab_tree *t, uint32_t node, uint32_t c)
+static const char *child_hint(const bvhlab_tree *t, uint32_t node, uint64_t end)
 {
 	if (t->node_count == 1)
 		return ": did build() set output->node_count to the nodes it wrote?";
-	if (c == t->node_count - 1)
-		return ": children are the pair nodes[first] and nodes[first + 1]; is the "
-		       "second one counted in node_count?";
-	if (node > 0 && c < node)
+	if (end == (uint64_t)t->node_count + 1)
+		return ": children are consecutive from nodes[first]; is the last one counted "
+		       "in node_count?";
+	if (node > 0 && t->nodes[node].first < node)
 		return ": an inner node's children come from 'first'; is this a leaf whose "
 		       "count was left 0?";
 	return ": a child index past the end (did build() count every node it wrote in "
@@ -133,17 +137,23 @@ static const char *child_hint(const bvhlab_tree *t, uint32_t node, uint32_t c)
 
 static int check_inner(vstate *st, uint32_t node)
 {
-	uint32_t c = st->tree->nodes[node].first;
-	int rc;
+	const bvhlab_node *n = &st->tree->nodes[node];
+	uint32_t k = tree_child_count(n), width = tree_width(st->tree);
+	uint64_t end = tree_children_end(n);
+	int rc = 0;
 
-	if (c >= st->tree->node_count - 1)
-		return FAIL(st, "node %" PRIu32 ": child index %" PRIu32 " out of range "
-		            "(children %" PRIu32 " and %" PRIu64 ", node_count %" PRIu32 ")%s",
-		            node, c >= st->tree->node_count ? c : c + 1, c, (uint64_t)c + 1,
-		            st->tree->node_count, child_hint(st->tree, node, c));
-	rc = reach(st, c, node);
-	if (rc == 0)
-		rc = reach(st, c + 1, node);
+	if (k < 2 || k > width)
+		return FAIL(st, "node %" PRIu32 ": %" PRIu32 " children in a %" PRIu32 "-wide tree "
+		            "(count 0x%08" PRIx32 "; a wide inner node's count is BVHLAB_NODE_INNER "
+		            "| children, 2 .. width)", node, k, width, n->count);
+	if (end > st->tree->node_count)
+		return FAIL(st, "node %" PRIu32 ": child index %" PRIu64 " out of range "
+		            "(children %" PRIu32 " to %" PRIu64 ", node_count %" PRIu32 ")%s",
+		            node, n->first >= st->tree->node_count ? n->first : end - 1, n->first,
+		            end - 1, st->tree->node_count,
+		            child_hint(st->tree, node, end));
+	for (uint32_t i = 0; rc == 0 && i < k; i++)
+		rc = reach(st, tree_child(n, i), node);
 	return rc;
 }
 
@@ -188,7 +198,7 @@ static const char *leaf_hint(const bvhlab_tree *t, uint64_t end)
 static int check_leaf(vstate *st, uint32_t node)
 {
 	const bvhlab_node *n = &st->tree->nodes[node];
-	uint64_t end = (uint64_t)n->first + n->count;
+	uint64_t end = (uint64_t)tree_leaf_first(n) + tree_leaf_count(n);
 	uint32_t slot;
 	int rc;
 
@@ -196,9 +206,9 @@ static int check_leaf(vstate *st, uint32_t node)
 	 * range lies (partly) outside the referenced slots. */
 	if (end > st->tree->index_count)
 		return FAIL(st, "node %" PRIu32 ": leaf range [%" PRIu32 ", %" PRIu64
-		            ") exceeds index_count %" PRIu32 "%s", node, n->first, end,
+		            ") exceeds index_count %" PRIu32 "%s", node, tree_leaf_first(n), end,
 		            st->tree->index_count, leaf_hint(st->tree, end));
-	for (slot = n->first; slot < end; slot++) {
+	for (slot = tree_leaf_first(n); slot < end; slot++) {
 		rc = check_slot(st, node, slot);
 		if (rc < 0)
 			return rc;
@@ -260,7 +270,7 @@ static int walk(vstate *st)
 	while (rc == 0 && st->sp > 0) {
 		uint32_t node = st->stack[--st->sp];
 
-		if (st->tree->nodes[node].count == 0)
+		if (!tree_is_leaf(&st->tree->nodes[node]))
 			rc = check_inner(st, node);
 		else
 			rc = check_leaf(st, node);

@@ -17,6 +17,12 @@
  *        place for primitives that moved (same count and order), e.g. a
  *        refit; an update-only plugin leaves build and refine NULL.
  *        Older plugins load as before and have none.
+ *   1.5  open trees and primitive kinds: bvhlab_build_output.width (a
+ *        builder may emit a 2- to 8-wide tree, whose inner nodes mark their
+ *        count with BVHLAB_NODE_INNER, see bvhlab_node), and
+ *        bvhlab_build_input.prim_kind (triangles, or boxes for a builder
+ *        with BVHLAB_BUILDER_BOXES). Older plugins load as before: they
+ *        leave width at 2 and are only given triangles.
  *
  * A plugin is a shared object that exports exactly one symbol,
  *
@@ -47,7 +53,7 @@
 BVHLAB_BEGIN_DECLS
 
 #define BVHLAB_ABI_MAJOR 1
-#define BVHLAB_ABI_MINOR 4
+#define BVHLAB_ABI_MINOR 5
 #define BVHLAB_ABI_VERSION(major, minor) (((uint32_t)(major) << 16) | (uint32_t)(minor))
 #define BVHLAB_ABI_VERSION_MAJOR(v) ((uint32_t)(v) >> 16)
 #define BVHLAB_ABI_VERSION_MINOR(v) ((uint32_t)(v) & 0xffffu)
@@ -219,9 +225,19 @@ typedef struct bvhlab_host {
 
 /* ---- build input and output ------------------------------------------- */
 
+/* What the primitives of a build are (bvhlab_build_input.prim_kind, 1.5). */
+enum bvhlab_prim_kind {
+	/* primitive i is triangle i: indices[3i .. 3i + 3) into vertices */
+	BVHLAB_PRIM_TRIANGLES = 0,
+	/* primitive i is the box prim_bounds[i], its id i (an instance, a user's
+	 * primitive); vertices and indices are NULL, vertex_count 0. Only given
+	 * to a builder whose flags have BVHLAB_BUILDER_BOXES. */
+	BVHLAB_PRIM_BOXES = 1,
+};
+
 /*
  * What a builder builds over: read-only, owned by the host, valid during
- * build(). Primitive i is triangle i of the scene.
+ * build(). Primitive i is triangle i of the scene, or box i (prim_kind).
  */
 typedef struct bvhlab_build_input {
 	uint32_t struct_size;       /* sizeof(bvhlab_build_input) in the host */
@@ -235,6 +251,10 @@ typedef struct bvhlab_build_input {
 	const uint32_t *indices;    /* [3 * prim_count] vertex indices per triangle */
 	uint32_t threads;           /* threads the builder may use, >= 1 (0 resolved) */
 	uint32_t reserved;          /* zero; keeps the struct 8-byte aligned */
+	/* since 1.5: enum bvhlab_prim_kind. A plugin built against an older
+	 * minor never sees it, and is only given triangles. */
+	uint32_t prim_kind;
+	uint32_t reserved2;         /* zero */
 } bvhlab_build_input;
 
 /*
@@ -256,6 +276,12 @@ typedef struct bvhlab_build_output {
 	uint32_t node_count;      /* set by the builder: nodes used */
 	uint32_t index_count;     /* set by the builder: prim_index slots used */
 	uint32_t reserved;        /* zero */
+	/* since 1.5: the tree's branching factor, 2 to BVHLAB_MAX_WIDTH. The
+	 * host sets it to 2 on entry (to the input tree's width for refine and
+	 * update, which are only given binary trees); a builder of wider trees
+	 * sets it with the counts. Older plugins never touch it: binary. */
+	uint32_t width;
+	uint32_t reserved2;       /* zero */
 } bvhlab_build_output;
 
 /* ---- the descriptor ------------------------------------------------------ */
@@ -271,6 +297,9 @@ enum bvhlab_builder_flags {
 	 * holds only the part of a triangle inside it (judged by coverage) */
 	BVHLAB_BUILDER_SPATIAL_SPLITS = 1u << 2,
 	BVHLAB_BUILDER_UNFINISHED = 1u << 3,    /* work in progress: reported as such */
+	/* since 1.5: build() accepts prim_kind BVHLAB_PRIM_BOXES (the host
+	 * refuses a box build to a builder without it, by name) */
+	BVHLAB_BUILDER_BOXES = 1u << 4,
 };
 
 /*

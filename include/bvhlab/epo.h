@@ -5,8 +5,8 @@
  * SAH assumes a ray that enters a box was aimed at it; EPO counts the
  * boxes a ray's end point lies in although the surface it ends on belongs
  * to another subtree: work that box overlap adds however well the areas
- * were split. With the node costs of the SAH in tree.h (1 per inner node,
- * count(l) per leaf):
+ * were split. With the node costs of the SAH in tree.h (k(n) / 2 per inner
+ * node of k(n) children, 1 in a binary tree; count(l) per leaf):
  *
  *   EPO = sum over nodes n of c(n) * A(surface outside subtree(n) inside box(n))
  *         / A(all surface)

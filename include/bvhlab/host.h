@@ -38,6 +38,10 @@ bvhlab_refine_fn bvhlab_builder_refine(const bvhlab_builder *b);
 /* A descriptor's update function (ABI 1.4), or NULL: NULL too for a
  * plugin built against an older minor. Same signature as refine. */
 bvhlab_refine_fn bvhlab_builder_update(const bvhlab_builder *b);
+/* Whether the descriptor's build takes boxes (BVHLAB_BUILDER_BOXES, ABI
+ * 1.5; false for a plugin built against an older minor). bvhlab_build
+ * refuses a box input to any other by name. */
+bool bvhlab_builder_takes_boxes(const bvhlab_builder *b);
 /* The file the plugin was loaded from. */
 const char *bvhlab_plugin_path(const bvhlab_plugin *plugin);
 

@@ -108,6 +108,12 @@ typedef struct bvhlab_prims {
 } bvhlab_prims;
 
 int bvhlab_prims_init(bvhlab_prims *prims, const bvhlab_scene *scene, bvhlab_error *err);
+/* The input of a build over boxes (prim_kind BVHLAB_PRIM_BOXES, ABI 1.5):
+ * primitive i is boxes[i], its id i, e.g. an instance's world box for a
+ * top-level tree. The boxes are copied. 0, -EINVAL (no box, or an empty
+ * or non-finite one, named), -ENOMEM. */
+int bvhlab_prims_init_boxes(bvhlab_prims *prims, const bvhlab_aabb *boxes, uint32_t count,
+                            bvhlab_error *err);
 void bvhlab_prims_finish(bvhlab_prims *prims);
 
 BVHLAB_END_DECLS

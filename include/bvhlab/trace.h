@@ -213,7 +213,7 @@ typedef struct bvhlab_trace_timing {
  * from a shared counter; per ray nothing is allocated or locked. hits and
  * nodes (may be NULL) get each ray's hit and count of nodes entered, from
  * the first pass. For BVHLAB_TRAVERSAL_WIDE the counters and nodes still
- * count the binary tree's nodes, from an extra untimed pass of the stack
+ * count the tree's own nodes, from an extra untimed pass of the stack
  * traversal, so they mean the same whatever traversal is timed; hits come
  * from the first wide pass. 0, -EINVAL (bad traversal, tree links for
  * stackless or wide), -ENOMEM, -ENOTSUP (a cl_ traversal in a build

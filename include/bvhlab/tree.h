@@ -35,6 +35,9 @@ typedef struct bvhlab_tree {
 	uint32_t *prim_index;
 	uint32_t index_count;
 	uint32_t index_capacity;
+	/* Branching factor (ABI 1.5 bvhlab_build_output.width): 2 to
+	 * BVHLAB_MAX_WIDTH; 0, as in a zeroed struct, reads as 2. */
+	uint32_t width;
 	/* The phases the last bvhlab_build or bvhlab_refine into this tree
 	 * reported (ABI 1.3), in the order first reported; 0 when none. */
 	uint32_t phase_count;
@@ -81,9 +84,12 @@ int bvhlab_validate_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
 #define BVHLAB_LEAF_HISTOGRAM 17 /* leaf sizes 1..16, then "more than 16" */
 
 /*
- * SAH cost with c_trav = c_isect = 1, normalised by the root's surface area:
- *   cost = (sum over inner nodes n of SA(n) + sum over leaves l of SA(l) * count(l))
- *          / SA(root)
+ * SAH cost with c_isect = 1 and c_trav(n) = k(n) / 2 for an inner node of
+ * k(n) children (one half per child box tested: 1 for every binary node, as
+ * in the binary SAH; 2 for a full 4-wide node, 4 for a full 8-wide one),
+ * normalised by the root's surface area:
+ *   cost = (sum over inner nodes n of SA(n) * k(n) / 2
+ *           + sum over leaves l of SA(l) * count(l)) / SA(root)
  * Memory counts node_count * 32 + index_count * 4 bytes.
  */
 typedef struct bvhlab_tree_stats {

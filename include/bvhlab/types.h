@@ -34,8 +34,13 @@ typedef struct bvhlab_aabb {
 /*
  * The one node layout every builder emits (32 bytes, two per cache line).
  *
- * count == 0: inner node; its children are nodes[first] and nodes[first + 1].
- * count  > 0: leaf of `count` primitives, prim_index[first .. first + count).
+ * count == 0: binary inner node; its children are nodes[first] and the node
+ *             after it.
+ * count has BVHLAB_NODE_INNER set (since ABI 1.5, trees wider than 2):
+ *             inner node of k = count & ~BVHLAB_NODE_INNER children, the k
+ *             consecutive nodes from nodes[first], 2 <= k <= the tree's
+ *             width (bvhlab_build_output.width).
+ * otherwise:  leaf of `count` primitives, prim_index[first .. first + count).
  * The root is nodes[0]. Boxes are conservative: a node's box contains the
  * boxes of its children, or of its primitives.
  */
@@ -45,6 +50,10 @@ typedef struct bvhlab_node {
 	float hi[3];    /* box maximum */
 	uint32_t count; /* 0 for an inner node, else the leaf's primitive count */
 } bvhlab_node;
+
+/* The inner-node mark of a wide node's count (ABI 1.5), and the widest tree. */
+#define BVHLAB_NODE_INNER 0x80000000u
+#define BVHLAB_MAX_WIDTH 8
 
 BVHLAB_STATIC_ASSERT(sizeof(bvhlab_node) == 32, "bvhlab_node must be 32 bytes");
 BVHLAB_STATIC_ASSERT(offsetof(bvhlab_node, first) == 12, "bvhlab_node.first at 12");

@@ -164,6 +164,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 }
 
 PLUGIN_WITH_OPTIONS(options, .name = "lbvh",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
+	         BVHLAB_BUILDER_BOXES,
 	.summary = "parallel LBVH: Morton codes, radix sort, Karras 2012 emission, SAH collapse",
 	.build = build)

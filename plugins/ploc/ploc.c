@@ -190,7 +190,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 }
 
 PLUGIN_WITH_OPTIONS(options, .name = "ploc",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
+	         BVHLAB_BUILDER_BOXES,
 	.summary = "parallel locally-ordered clustering (Meister & Bittner 2018) from Morton "
 	           "order, SAH collapse",
 	.build = build)

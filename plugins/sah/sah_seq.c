@@ -21,5 +21,5 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 	return 0;
 }
 
-SAH_PLAIN_PLUGIN("sah_seq", BVHLAB_BUILDER_DETERMINISTIC,
+SAH_PLAIN_PLUGIN("sah_seq", BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_BOXES,
 	"sequential top-down SAH (exact sweep or binned), the reference")

@@ -1,0 +1,338 @@
+/*
+ * bvhlab — the builder plugin ABI.
+ *
+ * Version history (major.minor; a minor only appends fields, marked "since"):
+ *   1.0  first version: bvhlab_builder, bvhlab_host, bvhlab_build_input,
+ *        bvhlab_build_output, bvhlab_option_decl.
+ *   1.1  bvhlab_host.pin_thread (check BVHLAB_HOST_HAS(host, pin_thread));
+ *        hardware_threads counts physical cores, not logical CPUs.
+ *   1.2  bvhlab_builder.refine: a plugin may improve a finished tree in
+ *        place (a refinement stage); a refinement-only plugin leaves
+ *        build NULL. Plugins of 1.0 and 1.1 load as before.
+ *   1.3  bvhlab_host.phase: a builder may report named phases of a build
+ *        (upload, device, download, convert, ...) in milliseconds; the
+ *        harness records them per run as build_phases. Older plugins load
+ *        as before and report none.
+ *   1.4  bvhlab_builder.update: a plugin may update a finished tree in
+ *        place for primitives that moved (same count and order), e.g. a
+ *        refit; an update-only plugin leaves build and refine NULL.
+ *        Older plugins load as before and have none.
+ *
+ * A plugin is a shared object that exports exactly one symbol,
+ *
+ *     const bvhlab_builder *bvhlab_plugin_entry(uint32_t host_abi_major);
+ *
+ * (BVHLAB_PLUGIN(...) writes the descriptor and the entry point; or write
+ * BVHLAB_PLUGIN_EXPORT(descriptor) after a descriptor of your own, or declare
+ * the function with BVHLAB_PLUGIN_ENTRY). It returns a static descriptor owned by the
+ * plugin, or NULL when it cannot serve that ABI major. C++ plugins include
+ * this header as it is: its declarations are extern "C". The host refuses
+ * a descriptor of another major and never reads past its struct_size; a
+ * plugin built against an older minor therefore keeps working.
+ *
+ * Rules for plugins: do not link against libbvhlab, never print, exit or
+ * abort; return 0 or a negative errno and explain failures with
+ * host->set_error. Everything crossing this boundary is plain C data:
+ * no JSON, no core structures.
+ */
+#ifndef BVHLAB_BUILDER_H
+#define BVHLAB_BUILDER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "types.h"
+
+BVHLAB_BEGIN_DECLS
+
+#define BVHLAB_ABI_MAJOR 1
+#define BVHLAB_ABI_MINOR 4
+#define BVHLAB_ABI_VERSION(major, minor) (((uint32_t)(major) << 16) | (uint32_t)(minor))
+#define BVHLAB_ABI_VERSION_MAJOR(v) ((uint32_t)(v) >> 16)
+#define BVHLAB_ABI_VERSION_MINOR(v) ((uint32_t)(v) & 0xffffu)
+#define BVHLAB_ABI_CURRENT BVHLAB_ABI_VERSION(BVHLAB_ABI_MAJOR, BVHLAB_ABI_MINOR)
+
+/* The entry point's name, for dlsym, and its signature. */
+#define BVHLAB_PLUGIN_ENTRY_NAME "bvhlab_plugin_entry"
+typedef const struct bvhlab_builder *(*bvhlab_plugin_entry_fn)(uint32_t host_abi_major);
+
+#if defined(__GNUC__)
+#define BVHLAB_EXPORT __attribute__((visibility("default")))
+#define BVHLAB_PRINTF(fmt, args) __attribute__((format(printf, fmt, args)))
+#else
+#define BVHLAB_EXPORT
+#define BVHLAB_PRINTF(fmt, args)
+#endif
+
+/* The entry point's linkage: C names in a C++ plugin too, so dlsym finds it. */
+#ifdef __cplusplus
+#define BVHLAB_ENTRY_LINKAGE extern "C"
+#else
+#define BVHLAB_ENTRY_LINKAGE
+#endif
+
+/* Use as: BVHLAB_PLUGIN_ENTRY { return host_abi_major == 1 ? &desc : NULL; } */
+#define BVHLAB_PLUGIN_ENTRY                              \
+	BVHLAB_ENTRY_LINKAGE BVHLAB_EXPORT const struct bvhlab_builder * \
+	bvhlab_plugin_entry(uint32_t host_abi_major)
+
+/*
+ * The whole entry point of a plugin with one descriptor, at file scope after
+ * it: BVHLAB_PLUGIN_EXPORT(descriptor). Serves this header's ABI major only
+ * and returns NULL for any other, which the host reports by name.
+ */
+#define BVHLAB_PLUGIN_EXPORT(descriptor)                                      \
+	BVHLAB_PLUGIN_ENTRY                                                   \
+	{                                                                     \
+		return host_abi_major == BVHLAB_ABI_MAJOR ? &(descriptor) : NULL; \
+	}
+
+/*
+ * A C plugin's descriptor and entry point in one, at file scope, from the
+ * descriptor's designated fields; abi_version and struct_size are filled in
+ * (the ones a hand-written descriptor most easily gets wrong):
+ *
+ *     BVHLAB_PLUGIN(.name = "mine", .summary = "...", .flags = 0,
+ *                   .option_count = 1, .options = options, .build = build)
+ *
+ * C++17 has no designated initializers: C++ plugins write the descriptor
+ * and BVHLAB_PLUGIN_EXPORT(descriptor) (examples/plugin-template-cpp/).
+ */
+#define BVHLAB_PLUGIN(...)                                                       \
+	static const bvhlab_builder bvhlab_plugin_descriptor = {                 \
+		.abi_version = BVHLAB_ABI_CURRENT, .struct_size = sizeof(bvhlab_builder), \
+		__VA_ARGS__};                                                    \
+	BVHLAB_PLUGIN_EXPORT(bvhlab_plugin_descriptor)
+
+/* ---- options -------------------------------------------------------- */
+
+enum bvhlab_option_type {
+	BVHLAB_OPTION_BOOL = 1,
+	BVHLAB_OPTION_INT = 2,    /* int64_t; JSON numbers without a fraction */
+	BVHLAB_OPTION_FLOAT = 3,  /* double; any JSON number */
+	BVHLAB_OPTION_STRING = 4, /* one of `choices` when choices is set */
+};
+
+/*
+ * One option a builder accepts. The host checks a config's options against
+ * this list (unknown key, wrong type, out of range, not a choice: an error
+ * naming the key) and fills in the defaults, so the getters in bvhlab_host
+ * always succeed for declared names.
+ */
+typedef struct bvhlab_option_decl {
+	const char *name;     /* key in the config's "options" object */
+	uint32_t type;        /* enum bvhlab_option_type */
+	const char *help;     /* one line for `bvhlab list` */
+	bool def_bool;        /* default, BOOL */
+	int64_t def_int;      /* default, INT */
+	double def_float;     /* default, FLOAT */
+	const char *def_string; /* default, STRING */
+	double min, max;      /* inclusive range, INT and FLOAT; ignored if min > max */
+	const char *choices;  /* STRING: allowed values separated by '|', or NULL */
+} bvhlab_option_decl;
+
+/* ---- the host's function table ---------------------------------------- */
+
+/* Opaque per-build context; the host passes it back through every call. */
+typedef struct bvhlab_build_ctx bvhlab_build_ctx;
+
+enum bvhlab_log_level {
+	BVHLAB_LOG_ERROR = 0,
+	BVHLAB_LOG_WARN = 1,
+	BVHLAB_LOG_INFO = 2,
+	BVHLAB_LOG_DEBUG = 3,
+};
+
+struct bvhlab_build_output;
+
+/*
+ * Services the host offers a plugin during build(). The table is owned by the
+ * host and valid during the call only. A plugin compiled against a newer
+ * minor must check struct_size before using a field that came later.
+ * All functions are thread-safe unless said otherwise.
+ */
+typedef struct bvhlab_host {
+	uint32_t abi_version; /* BVHLAB_ABI_CURRENT of the host */
+	uint32_t struct_size; /* sizeof(bvhlab_host) in the host */
+
+	/* printf-style log line, attributed to the plugin by the host. */
+	void (*log)(bvhlab_build_ctx *ctx, int level, const char *fmt, ...)
+		BVHLAB_PRINTF(3, 4);
+	/* Explains the failure that build() is about to return; last call wins. */
+	void (*set_error)(bvhlab_build_ctx *ctx, const char *fmt, ...)
+		BVHLAB_PRINTF(2, 3);
+
+	/* Typed option getters: 0, or -ENOENT for an undeclared name, -EINVAL
+	 * for a name declared with another type. Strings stay valid during build. */
+	int (*option_bool)(bvhlab_build_ctx *ctx, const char *name, bool *out);
+	int (*option_int)(bvhlab_build_ctx *ctx, const char *name, int64_t *out);
+	int (*option_float)(bvhlab_build_ctx *ctx, const char *name, double *out);
+	int (*option_string)(bvhlab_build_ctx *ctx, const char *name, const char **out);
+
+	/* Grows the output buffers to hold at least `nodes` nodes and `indices`
+	 * primitive references, keeping their contents; updates out's pointers
+	 * and capacities. Not thread-safe: call it from one thread while no
+	 * other thread touches the buffers. 0 or -ENOMEM. */
+	int (*grow_output)(bvhlab_build_ctx *ctx, struct bvhlab_build_output *out,
+	                   uint32_t nodes, uint32_t indices);
+
+	/* Optional progress report, fraction in [0, 1]; may be a no-op. */
+	void (*progress)(bvhlab_build_ctx *ctx, double fraction);
+
+	/* What threads = 0 resolves to: the physical cores the calling thread
+	 * may run on (its affinity mask and cgroup cpuset; SMT siblings count
+	 * once). Logical CPUs before 1.1. */
+	uint32_t (*hardware_threads)(bvhlab_build_ctx *ctx);
+
+	/* since 1.1. Binds the calling thread to the worker-th distinct
+	 * physical core of the set the build started with (wrapping around
+	 * past the last core), when the user enabled pinning; otherwise does
+	 * nothing. Call it first thing in each worker, with distinct workers
+	 * 0 .. input->threads - 1; the host restores the affinity of the
+	 * thread that called build() afterwards. 0, or a negative errno (the
+	 * thread then keeps running unpinned). */
+	int (*pin_thread)(bvhlab_build_ctx *ctx, uint32_t worker);
+
+	/* since 1.3. Adds `ms` milliseconds to the named phase of this build
+	 * or refinement (a call with a name already reported adds to it), so
+	 * a builder can say where its time went: e.g. "upload", "device" (a
+	 * device's own kernel time, from its events), "download", "convert"
+	 * (a peer library's tree turned into the standard layout). Names are
+	 * [a-z0-9_], 1 to BVHLAB_PHASE_NAME_MAX - 1 characters, at most
+	 * BVHLAB_MAX_PHASES distinct ones per call of build(); anything else,
+	 * or a negative or non-finite ms, fails the build with a message
+	 * naming the phase. The phases need not add up to the whole call,
+	 * which the host times itself (build_ms). Call it from the thread
+	 * that called build(). Check BVHLAB_HOST_HAS(host, phase) first. */
+	void (*phase)(bvhlab_build_ctx *ctx, const char *name, double ms);
+} bvhlab_host;
+
+/* Limits of host->phase (ABI 1.3). */
+#define BVHLAB_MAX_PHASES 8
+#define BVHLAB_PHASE_NAME_MAX 32
+
+/* True when `host` has `field`: a host older than the plugin lacks fields
+ * that came in later minors, e.g. BVHLAB_HOST_HAS(host, pin_thread). */
+#define BVHLAB_HOST_HAS(host, field) \
+	((host)->struct_size >= offsetof(bvhlab_host, field) + sizeof((host)->field))
+
+/* ---- build input and output ------------------------------------------- */
+
+/*
+ * What a builder builds over: read-only, owned by the host, valid during
+ * build(). Primitive i is triangle i of the scene.
+ */
+typedef struct bvhlab_build_input {
+	uint32_t struct_size;       /* sizeof(bvhlab_build_input) in the host */
+	uint32_t prim_count;        /* number of primitives, >= 1 */
+	const bvhlab_aabb *prim_bounds; /* [prim_count] box of each primitive */
+	const float *centroids;     /* [3 * prim_count] box centre of each primitive */
+	bvhlab_aabb bounds;         /* union of all prim_bounds */
+	bvhlab_aabb centroid_bounds; /* bounds of all centroids */
+	const float *vertices;      /* [3 * vertex_count] triangle vertices */
+	uint32_t vertex_count;
+	const uint32_t *indices;    /* [3 * prim_count] vertex indices per triangle */
+	uint32_t threads;           /* threads the builder may use, >= 1 (0 resolved) */
+	uint32_t reserved;          /* zero; keeps the struct 8-byte aligned */
+} bvhlab_build_input;
+
+/*
+ * Where a builder writes its tree. On entry the host has allocated
+ * nodes[2 * prim_count - 1] and prim_index[prim_count]; grow them with
+ * host->grow_output (e.g. for spatial splits). On success the builder sets
+ * node_count and index_count; nodes[0] is the root. Until then the whole
+ * capacity is the builder's, and the host ignores what lies past the
+ * counts, so a builder may keep scratch there (lbvh does). The harness
+ * builds its timed repeats into the same output, so room grown once stays
+ * allocated and paged in; its contents on entry are unspecified.
+ */
+typedef struct bvhlab_build_output {
+	uint32_t struct_size;     /* sizeof(bvhlab_build_output) in the host */
+	uint32_t node_capacity;   /* nodes allocated */
+	bvhlab_node *nodes;       /* [node_capacity] */
+	uint32_t *prim_index;     /* [index_capacity] primitive ids referenced by leaves */
+	uint32_t index_capacity;  /* prim_index slots allocated */
+	uint32_t node_count;      /* set by the builder: nodes used */
+	uint32_t index_count;     /* set by the builder: prim_index slots used */
+	uint32_t reserved;        /* zero */
+} bvhlab_build_output;
+
+/* ---- the descriptor ------------------------------------------------------ */
+
+enum bvhlab_builder_flags {
+	BVHLAB_BUILDER_PARALLEL = 1u << 0,      /* uses input->threads > 1 */
+	/* Same tree for any thread count and run, as bvhlab_tree_compare judges
+	 * it: the same shape, bit-identical boxes and leaf contents; the order
+	 * of nodes in the array may differ (parallel builders place subtrees as
+	 * their tasks finish). */
+	BVHLAB_BUILDER_DETERMINISTIC = 1u << 1,
+	/* may reference a primitive more than once, and give a leaf a box that
+	 * holds only the part of a triangle inside it (judged by coverage) */
+	BVHLAB_BUILDER_SPATIAL_SPLITS = 1u << 2,
+	BVHLAB_BUILDER_UNFINISHED = 1u << 3,    /* work in progress: reported as such */
+};
+
+/*
+ * The plugin's descriptor: static, owned by the plugin, never freed.
+ * Fields are only ever appended; each later one names the minor it came in.
+ */
+typedef struct bvhlab_builder {
+	uint32_t abi_version;  /* BVHLAB_ABI_CURRENT the plugin was built against */
+	uint32_t struct_size;  /* sizeof(bvhlab_builder) the plugin was built with */
+	const char *name;      /* short name, [a-z0-9_]+, e.g. "sah_seq" */
+	const char *summary;   /* one line for `bvhlab list` */
+	uint32_t flags;        /* enum bvhlab_builder_flags */
+	uint32_t option_count; /* entries in options */
+	const bvhlab_option_decl *options; /* [option_count] */
+
+	/* Builds one tree. Returns 0, or a negative errno after host->set_error.
+	 * May be called many times, from one thread at a time. NULL (since
+	 * 1.2) in a plugin that only refines. */
+	int (*build)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+	             const bvhlab_build_input *input, bvhlab_build_output *output);
+
+	/*
+	 * since 1.2, may be NULL. Improves a finished tree in place: on entry
+	 * `tree` holds a valid tree in the standard layout (node_count,
+	 * index_count set, nodes[0] the root) over the primitives of `input`,
+	 * built by any builder; input->threads is the thread count to use.
+	 * On return it must hold a valid tree over the same primitives, with
+	 * the counts updated; the capacity past the counts is scratch, and
+	 * host->grow_output works as in build(). The harness times it as a
+	 * stage of its own and reports the SAH cost before and after.
+	 * Returns 0, or a negative errno after host->set_error (the tree is
+	 * then discarded). Same calling rules as build.
+	 */
+	int (*refine)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+	              const bvhlab_build_input *input, bvhlab_build_output *tree);
+
+	/*
+	 * since 1.4, may be NULL. Updates a finished tree in place after its
+	 * primitives moved: on entry `tree` holds a valid tree in the standard
+	 * layout (any builder's, counts set) over primitives of the same count
+	 * and order as `input`'s, which gives their new boxes and vertices
+	 * (the topology is kept; only positions changed). On return it must
+	 * hold a valid tree over `input`, with the counts updated; it may
+	 * reorder the nodes and prim_index (refit does, into an order it
+	 * streams), so a caller keeps no node or slot index across it. The
+	 * capacity past the counts is scratch, and host->grow_output works as
+	 * in build(). A tree whose references do not fit input (another
+	 * triangle count) must be refused with host->set_error, not walked
+	 * out of bounds; the host refuses the plainest mismatches before the
+	 * call. The harness times it per frame of an animated scene in place
+	 * of a rebuild. Returns 0, or a negative errno after host->set_error.
+	 * Same calling rules as build.
+	 */
+	int (*update)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+	              const bvhlab_build_input *input, bvhlab_build_output *tree);
+} bvhlab_builder;
+
+/* True when descriptor `b` has `field`: one built against an older minor
+ * lacks the fields that came later, e.g. BVHLAB_BUILDER_HAS(b, refine). */
+#define BVHLAB_BUILDER_HAS(b, field) \
+	((b)->struct_size >= offsetof(bvhlab_builder, field) + sizeof((b)->field))
+
+BVHLAB_END_DECLS
+
+#endif /* BVHLAB_BUILDER_H */
