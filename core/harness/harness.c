@@ -535,8 +535,14 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 	struct harness h = {.cfg = cfg, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
 	bvhlab_set_pinning(cfg->pin);
-	/* Every builder's plugin and options first, before the folder is touched. */
+	/* Every builder's plugin and options and every scene file first, before
+	 * the folder is touched; the files' errors printed even after the
+	 * builders' (err keeps the first). */
 	int r = harness_open_sweep_builders(cfg, &h.builders, err);
+	bvhlab_error files_err = {{0}};
+	int f = r == -ENOMEM ? 0 : harness_check_scene_files(cfg, &files_err);
+	if (r == 0 && f < 0)
+		r = f, *err = files_err;
 	if (r == 0)
 		r = make_list(&h, opts, err);
 	if (r == 0)
