@@ -59,6 +59,8 @@ struct series_report {
 	bool validated;
 	struct tree_measure tree;
 	struct build_memory memory;
+	bool has_device;       /* a device builder's run: its device opened */
+	struct run_device device;
 	struct ray_metrics rays;
 	bool heat_written, shade_written;
 	bool tree_written; /* the tree is in the job's tree_path */
@@ -241,6 +243,7 @@ static void series_work(void *arg, void *report, size_t size)
 	bvhlab_error err = {{0}};
 	(void)size;
 	rep->status = SERIES_OK;
+	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);
 	harness_memory_begin(&rep->memory);
 	int r = harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err);
 	harness_memory_end(&rep->memory, &s.tree);
@@ -286,6 +289,7 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, uint32_t f
 	run->stats = rep->tree.has_stats ? &rep->tree.stats : NULL;
 	run->epo = rep->tree.has_epo ? &rep->tree.epo : NULL;
 	run->memory = rep->memory.measured ? &rep->memory : NULL;
+	run->device = rep->has_device ? harness_memory_device_checked(&rep->device) : NULL;
 	run->validated = rep->validated;
 	run->valid = rep->tree.valid;
 	run->rays_checked = rep->tree.rays_checked;

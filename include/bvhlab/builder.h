@@ -271,6 +271,13 @@ enum bvhlab_builder_flags {
 	 * holds only the part of a triangle inside it (judged by coverage) */
 	BVHLAB_BUILDER_SPATIAL_SPLITS = 1u << 2,
 	BVHLAB_BUILDER_UNFINISHED = 1u << 3,    /* work in progress: reported as such */
+	/* Builds on an OpenCL device that its string option "device" names
+	 * (auto, gpu, cpu or P:D, as bvhlab_cl_init in <bvhlab/opencl.h>
+	 * takes): the harness records that device with each run (name, kind,
+	 * compute units), measures the OpenCL runtime's memory apart from the
+	 * build's, and reports the runs in a group of the device, not at a CPU
+	 * thread count. A host that predates the flag ignores it. */
+	BVHLAB_BUILDER_DEVICE = 1u << 4,
 };
 
 /*
