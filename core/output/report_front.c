@@ -296,11 +296,12 @@ static void html_verdict(struct strbuf *sb, const struct front_table *t, int v, 
 static void html_row(struct strbuf *sb, const struct report_index *ix,
                      const struct front_table *t, size_t k)
 {
-	char buf[64], ms[32];
+	char buf[192], ms[32];
 	sb_printf(sb, "<tr><td class=\"l\">");
 	report_escape(sb, report_str(t->e[k].run, "builder"));
-	sb_printf(sb, "</td><td>%s</td><td>%s</td><td>%.3f</td>",
-	          threads_text(buf, sizeof(buf), ix, &t->e[k]),
+	sb_printf(sb, "</td><td>");
+	report_escape(sb, threads_text(buf, sizeof(buf), ix, &t->e[k])); /* a device's name */
+	sb_printf(sb, "</td><td>%s</td><td>%.3f</td>",
 	          report_plain(ms, sizeof(ms), t->p[0][k].time), t->p[0][k].figure);
 	html_verdict(sb, t, 0, k);
 	sb_printf(sb, "<td>%.1f</td>", t->p[1][k].figure);
