@@ -21,10 +21,10 @@ static const char usage[] =
 static void print_flags(uint32_t flags)
 {
 	static const char *names[] = {"parallel", "deterministic", "spatial-splits", "UNFINISHED",
-	                              "boxes"};
+	                              "boxes", "device"};
 	const char *sep = "";
 	printf("  flags:");
-	for (int k = 0; k < 5; k++)
+	for (size_t k = 0; k < sizeof(names) / sizeof(names[0]); k++)
 		if (flags & (1u << k)) {
 			printf("%s %s", sep, names[k]);
 			sep = ",";

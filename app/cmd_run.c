@@ -55,9 +55,10 @@ static const char usage[] =
 	"results record the plan's hash so `bvhlab merge` can join the parts. It is\n"
 	"refused when the config it was planned from has changed since.\n"
 	"\n"
-	"Every builder's plugin and options are checked before anything runs: a\n"
-	"config with errors is refused whole (all of them printed), exit 2, and no\n"
-	"output folder is made.\n"
+	"Every builder's plugin and options, and every scene file (meshes, composite\n"
+	"parts, frame files: there, readable, a PLY's header parsed), are checked\n"
+	"before anything runs: a config with errors is refused whole (all of them\n"
+	"printed), exit 2, and no output folder is made.\n"
 	"\n"
 	"exit status: 0 every run ok and valid, 1 some run failed or was invalid,\n"
 	"2 bad arguments or config.\n";

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets everything up (Debian packages, meson build) and runs an experiment.
 # Usage: scripts/run.sh [CONFIG.json] [bvhlab run options...]
-# Default config: configs/default.json (generated scenes only, < 1 minute).
+# Default config: configs/default.json (generated scenes only, every plugin built, < 1 minute of CPU).
 # Running again starts afresh: unless --resume or --force is given, --force
 # is passed, so the earlier results are moved aside (results.json.1, ...).
 set -euo pipefail

@@ -9,10 +9,12 @@
 # examples/plugin-template-cpp (C++17), checks each exports only its entry
 # point and loads both through `bvhlab run` (every run ok, every tree
 # valid); the installed C template is also installed and loaded by name.
-# When bvhlab was built with OpenCL (bvhlab/opencl.h installed), the
-# installed way also builds examples/plugin-template-cl and, when the
-# machine has an OpenCL device, builds a tree with it that must be valid
-# and report its phases; with no device, the build must fail saying why.
+# When bvhlab was built with OpenCL, the checkout's way also builds
+# examples/plugin-template-cl with docs/gpu.md's commands and runs its
+# compare.json (where there is a device), and the installed way builds
+# it and, when the machine has an OpenCL device, builds a tree with it
+# that must be valid and report its phases; with no device, the build
+# must fail saying why.
 # Usage: test-sdk.sh SOURCE_ROOT BUILD_ROOT
 set -eu
 src=$1
@@ -69,6 +71,38 @@ grep -q -- "-I$src/include" "$tmp/tree-plugin-template-build/build.ninja" ||
 	fail "the uninstalled build did not use the source tree's include/"
 run_both "$build/app/bvhlab" "$tmp/tree-plugin-template-build/template.so" \
 	"$tmp/tree-plugin-template-cpp-build/template_cpp.so"
+
+# The OpenCL template as docs/gpu.md says, from a copy of the checkout's
+# root: a setup without PKG_CONFIG_PATH stops naming the one to give; with
+# it, the template builds and its compare.json runs (every run ok).
+cl_template_checkout() {
+	step "against the checkout: the OpenCL template, docs/gpu.md's commands"
+	mkdir "$tmp/root" && cp -R "$src/examples/plugin-template-cl" "$tmp/root/mygpu"
+	out=$(cd "$tmp/root" && env -u PKG_CONFIG_PATH meson setup mygpu/build mygpu 2>&1) &&
+		fail "the OpenCL template configured without bvhlab.pc?"
+	echo "$out" | grep -q 'PKG_CONFIG_PATH=$PWD/build/meson-uninstalled' ||
+		{ echo "$out"; fail "no PKG_CONFIG_PATH hint when bvhlab is not found"; }
+	rm -rf "$tmp/root/mygpu/build"
+	(cd "$tmp/root" && PKG_CONFIG_PATH=$build/meson-uninstalled \
+		meson setup mygpu/build mygpu -Dwerror=true >"$tmp/setup.log" 2>&1 &&
+		ninja -C mygpu/build >"$tmp/build.log" 2>&1) ||
+		{ cat "$tmp/setup.log" "$tmp/build.log"; fail "the OpenCL template against the checkout"; }
+	if ! "$build/app/bvhlab" info --machine --json | grep -q '"compute_units"'; then
+		echo "== its compare.json skipped: no OpenCL device on this machine"
+		return
+	fi
+	"$build/app/bvhlab" run "$tmp/root/mygpu/compare.json" --repeat 1 --quiet ||
+		{ cat "$tmp/root/mygpu/results/results.json"; fail "compare.json of the OpenCL template"; }
+	csv=$tmp/root/mygpu/results/results.csv
+	mine=$(grep -c '^[a-z]*,mine,template_cl,ok,1,' "$csv" || true)
+	echo "compare.json: every run ok, $(($(wc -l <"$csv") - 1)) runs, $mine of the template"
+	[ "$mine" = 2 ] || { cat "$csv"; fail "compare.json: $mine ok runs of the template, not 2"; }
+}
+if [ -f "$build/plugins/cl_lbvh/cl_lbvh.so" ] && pkg-config --exists OpenCL; then
+	cl_template_checkout
+else
+	echo "== OpenCL template against the checkout skipped: bvhlab was built without OpenCL"
+fi
 
 step "install with --destdir into $tmp/stage"
 meson install -C "$build" --no-rebuild --destdir "$tmp/stage" >"$tmp/install.log" 2>&1 ||

@@ -61,6 +61,8 @@ struct series_report {
 	bool validated;
 	struct tree_measure tree;
 	struct build_memory memory;
+	bool has_device;       /* a device builder's run: its device opened */
+	struct run_device device;
 	struct ray_metrics rays;
 	bool heat_written, shade_written;
 	bool tree_written; /* the tree is in the job's tree_path */
@@ -243,6 +245,7 @@ static void series_work(void *arg, void *report, size_t size)
 	bvhlab_error err = {{0}};
 	(void)size;
 	rep->status = SERIES_OK;
+	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);
 	harness_memory_begin(&rep->memory);
 	int r = harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err);
 	harness_memory_end(&rep->memory, &s.tree);
@@ -288,6 +291,7 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, uint32_t f
 	run->stats = rep->tree.has_stats ? &rep->tree.stats : NULL;
 	run->epo = rep->tree.has_epo ? &rep->tree.epo : NULL;
 	run->memory = rep->memory.measured ? &rep->memory : NULL;
+	run->device = rep->has_device ? harness_memory_device_checked(&rep->device) : NULL;
 	run->validated = rep->validated;
 	run->valid = rep->tree.valid;
 	run->rays_checked = rep->tree.rays_checked;
@@ -551,8 +555,14 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 	progress_init(&h.progress, opts->quiet);
 	bvhlab_set_pinning(cfg->pin);
 	h.images = want_images(cfg);
-	/* Every builder's plugin and options first, before the folder is touched. */
+	/* Every builder's plugin and options and every scene file first, before
+	 * the folder is touched; the files' errors printed even after the
+	 * builders' (err keeps the first). */
 	int r = harness_open_sweep_builders(cfg, &h.builders, err);
+	bvhlab_error files_err = {{0}};
+	int f = r == -ENOMEM ? 0 : harness_check_scene_files(cfg, &files_err);
+	if (r == 0 && f < 0)
+		r = f, *err = files_err;
 	if (r == 0)
 		r = make_list(&h, opts, err);
 	if (r == 0)

@@ -6,12 +6,16 @@
  * so the peak afterwards minus the resident set before is what the builds
  * added at their worst moment: the builder's scratch and the output, as far
  * as they were touched. Pages the child shares with its parent (the scene,
- * the primitives) are resident before and count for neither side.
+ * the primitives) are resident before and count for neither side. A
+ * device builder's device is opened before that reset, so the OpenCL
+ * runtime's memory is measured apart (harness_memory_device).
  */
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "harness/harness_memory.h"
+#include "machine/machine.h"
 #include "output/results.h"
 
 /* A "Name:   123 kB" line of /proc/self/status, in bytes; 0 if absent. */
@@ -55,4 +59,45 @@ void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree)
 	if (m->reset && m->peak_rss_bytes > m->start_rss_bytes)
 		m->peak_bytes = m->peak_rss_bytes - m->start_rss_bytes;
 	m->measured = m->peak_rss_bytes > 0;
+}
+
+/* The runtime's baseline: the resident memory machine_cl_open added the
+ * first time in this process. */
+static int open_device(const char *spec, struct run_device *dev)
+{
+	static bool measured;
+	static uint64_t baseline;
+	char why[256];
+	uint64_t before = status_bytes("VmRSS");
+	int r = machine_cl_open(spec, &dev->cl, why, sizeof(why));
+	if (r < 0)
+		return r;
+	uint64_t after = status_bytes("VmRSS");
+	if (!measured && before && after) {
+		baseline = after > before ? after - before : 0;
+		measured = true;
+	}
+	dev->runtime_measured = measured;
+	dev->runtime_bytes = baseline;
+	return 0;
+}
+
+bool harness_memory_device(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                           struct run_device *dev)
+{
+	memset(dev, 0, sizeof(*dev));
+	if (!(bvhlab_plugin_builder(plugin)->flags & BVHLAB_BUILDER_DEVICE))
+		return false;
+	int k = bvhlab_options_find(opts, "device");
+	bool named = k >= 0 && opts->values[k].type == BVHLAB_OPTION_STRING;
+	return open_device(named ? opts->values[k].s : NULL, dev) == 0;
+}
+
+const struct run_device *harness_memory_device_checked(struct run_device *dev)
+{
+	dev->cl.name[sizeof(dev->cl.name) - 1] = '\0';
+	dev->cl.kind[sizeof(dev->cl.kind) - 1] = '\0';
+	dev->cl.platform[sizeof(dev->cl.platform) - 1] = '\0';
+	dev->cl.version[sizeof(dev->cl.version) - 1] = '\0';
+	return dev;
 }

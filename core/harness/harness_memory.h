@@ -10,4 +10,20 @@ struct build_memory; /* output/results.h */
 void harness_memory_begin(struct build_memory *m);
 void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree);
 
+struct run_device; /* output/results.h */
+
+/*
+ * For a device builder (BVHLAB_BUILDER_DEVICE): the device its "device"
+ * option names (auto without one) opened before harness_memory_begin, with
+ * the OpenCL runtime loaded and a context made on it (machine_cl_open), so
+ * the builds' peak is their own; the resident memory that took, the
+ * runtime's baseline, is measured once per process (a later run in it
+ * reuses the figure). True when *dev was filled; false for a CPU builder
+ * or when there is no such device (its build says so itself).
+ */
+bool harness_memory_device(const bvhlab_plugin *plugin, const bvhlab_options *opts,
+                           struct run_device *dev);
+/* dev, as sent back by a run's child, with its strings ended in their arrays. */
+const struct run_device *harness_memory_device_checked(struct run_device *dev);
+
 #endif

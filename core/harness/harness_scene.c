@@ -1,6 +1,7 @@
 /*
  * A config scene made real: loaded from its file or generated (a composite:
  * each part loaded, placed and merged), subdivided and named; `bvhlab build`/`render` and the sweep share it.
+ * Before a sweep, every file its scenes name is tried (harness_check_scene_files).
  */
 #include <errno.h>
 #include <stdio.h>
@@ -9,6 +10,7 @@
 
 #include "harness/harness_scene.h"
 #include "harness/isolate.h"
+#include "scene/scene_check.h"
 #include "util/util.h"
 
 /* Prefixes err's message with the part it came from. */
@@ -120,4 +122,59 @@ int harness_probe_scene(const struct config *cfg, const struct config_scene *cs,
 	else
 		error_set(err, "scene '%s': loading %s%s", cs->name, why, limit);
 	return outcome == ISOLATE_TIMEOUT ? -ETIMEDOUT : -EINVAL;
+}
+
+/* ---- the files, before the sweep --------------------------------------- */
+
+/* One file of scene cs, tried; a failure printed as a config error, `what`
+ * naming the part or frame it is ("" for the scene's own). 1 when bad. */
+static int check_one(const struct config *cfg, const struct config_scene *cs,
+                     const char *what, const char *path)
+{
+	bvhlab_error err = {{0}};
+	if (scene_check_file(path, &err) == 0)
+		return 0;
+	fprintf(stderr, "bvhlab: %s:%d:%d: scene '%s': %s%s\n", cfg->path, cs->line, cs->column,
+	        cs->name, what, err.message);
+	return 1;
+}
+
+/* The bad files of one scene: its own, its parts', its frame files. */
+static size_t check_scene(const struct config *cfg, const struct config_scene *cs)
+{
+	char what[64], path[4096];
+	size_t bad = 0;
+	if (cs->frame_pattern) {
+		for (uint32_t f = 0; f < cs->frames; f++) {
+			snprintf(path, sizeof(path), cs->frame_pattern, (int)(cs->frame_first + f));
+			snprintf(what, sizeof(what), "frame %u: ", f);
+			bad += check_one(cfg, cs, what, path);
+		}
+		/* Its path is frame 0's file unless it names one of its own. */
+		snprintf(path, sizeof(path), cs->frame_pattern, (int)cs->frame_first);
+		if (cs->path && strcmp(cs->path, path) != 0)
+			bad += check_one(cfg, cs, "", cs->path);
+		return bad;
+	}
+	if (cs->path)
+		bad += check_one(cfg, cs, "", cs->path);
+	for (size_t i = 0; i < cs->part_count; i++) {
+		if (!cs->parts[i].src.path)
+			continue;
+		snprintf(what, sizeof(what), "part %zu: ", i);
+		bad += check_one(cfg, cs, what, cs->parts[i].src.path);
+	}
+	return bad;
+}
+
+int harness_check_scene_files(const struct config *cfg, bvhlab_error *err)
+{
+	size_t bad = 0;
+	for (size_t s = 0; s < cfg->scene_count; s++)
+		bad += check_scene(cfg, &cfg->scenes[s]);
+	if (!bad)
+		return 0;
+	error_set(err, "%s: %zu scene file%s cannot be read (above); nothing was run", cfg->path,
+	          bad, bad == 1 ? "" : "s");
+	return -EINVAL;
 }

@@ -22,4 +22,14 @@ int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab
 int harness_probe_scene(const struct config *cfg, const struct config_scene *cs,
                         bvhlab_error *err);
 
+/*
+ * Tries every file the config's scenes name (meshes, composite parts, each
+ * frame file of a pattern) with scene_check_file: one that is missing,
+ * unreadable, not a regular file or of an unknown type, or a PLY whose
+ * header does not parse, is printed as FILE:LINE:COLUMN: scene 'NAME': ...
+ * Called before the output folder is touched: 0, or -EINVAL with err
+ * counting the bad files.
+ */
+int harness_check_scene_files(const struct config *cfg, bvhlab_error *err);
+
 #endif

@@ -66,6 +66,15 @@ void machine_icd_setup(void);
 /* Which ICD the loader gets and how it was found, for info --machine. */
 const char *machine_icd_how(void);
 
+/*
+ * The device a spec names (auto, gpu, cpu or P:D: a device builder's
+ * "device" option, chosen as bvhlab_cl_init chooses) described into *out,
+ * with the OpenCL runtime loaded and a context made on it that stay for
+ * the life of the process (a spec opened before is not opened again).
+ * 0, or a negative errno with why saying why (-ENOTSUP OpenCL not built).
+ */
+int machine_cl_open(const char *spec, struct machine_cl_device *out, char *why, size_t why_size);
+
 /* The 1-minute load average from /proc/loadavg, or -1 when unreadable. */
 double machine_load_average(void);
 

@@ -1,7 +1,8 @@
 /*
  * The OpenCL platforms and devices of this machine, for `bvhlab info
  * --machine` (machine.h): what the cl_ builders' and traversals' device
- * specs can name, "P:D" being the indices listed here.
+ * specs can name, "P:D" being the indices listed here; and the device a
+ * device builder's run builds on, opened before its builds.
  */
 #include <errno.h>
 #include <stdio.h>
@@ -79,7 +80,47 @@ int machine_cl_devices(struct machine_cl_device **out, size_t *count, char *why,
 	return r;
 }
 
+/* The devices opened by spec, each with its context, for the process's life. */
+static struct opened {
+	char spec[64];
+	bvhlab_cl cl;
+	struct machine_cl_device dev;
+} opened[4];
+static unsigned opened_count;
+
+int machine_cl_open(const char *spec, struct machine_cl_device *out, char *why, size_t why_size)
+{
+	spec = spec ? spec : "auto";
+	for (unsigned k = 0; k < opened_count; k++)
+		if (strcmp(opened[k].spec, spec) == 0)
+			return *out = opened[k].dev, 0;
+	if (opened_count == sizeof(opened) / sizeof(opened[0]) ||
+	    strlen(spec) >= sizeof(opened[0].spec))
+		return snprintf(why, why_size, "cl: too many device specs in one process (or '%.40s' "
+		                "too long)", spec), -ENOMEM;
+	struct opened *o = &opened[opened_count];
+	int r = bvhlab_cl_init(&o->cl, spec, why, why_size);
+	if (r < 0)
+		return r;
+	memset(&o->dev, 0, sizeof(o->dev));
+	o->dev.platform_index = o->cl.platform_index;
+	o->dev.device_index = o->cl.device_index;
+	describe(o->cl.platform, o->cl.device, &o->dev);
+	snprintf(o->spec, sizeof(o->spec), "%s", spec);
+	opened_count++;
+	*out = o->dev;
+	return 0;
+}
+
 #else
+
+int machine_cl_open(const char *spec, struct machine_cl_device *out, char *why, size_t why_size)
+{
+	(void)spec;
+	memset(out, 0, sizeof(*out));
+	snprintf(why, why_size, "not built (this bvhlab was built without OpenCL)");
+	return -ENOTSUP;
+}
 
 int machine_cl_devices(struct machine_cl_device **out, size_t *count, char *why, size_t why_size)
 {

@@ -90,6 +90,8 @@ static const char *const csv_numbers[][2] = {
 	{"rays.cl_stackless.diffuse.wall_mrays_per_s", "%.4f"},
 	{"load_before", "%.2f"},
 	{"load_after", "%.2f"},
+	{"device.compute_units", "%.0f"},
+	{"memory.runtime_bytes", "%.0f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary
@@ -119,6 +121,8 @@ static void csv_row(struct strbuf *sb, const cJSON *run)
 	csv_field(sb, cJSON_IsString(trav) ? trav->valuestring : "", false);
 	const cJSON *valid = report_at(run, "validation.valid");
 	csv_field(sb, cJSON_IsBool(valid) ? (cJSON_IsTrue(valid) ? "true" : "false") : "", false);
+	csv_field(sb, report_str(run, "device.name"), false);
+	csv_field(sb, report_str(run, "device.kind"), false);
 	csv_phases(sb, cJSON_GetObjectItemCaseSensitive(run, "build_phases"));
 	csv_field(sb, report_str(run, "error"), true);
 }
@@ -129,7 +133,8 @@ char *report_csv(const cJSON *doc)
 	sb_printf(&sb, "scene,builder,plugin,status");
 	for (size_t k = 0; k < sizeof(csv_numbers) / sizeof(csv_numbers[0]); k++)
 		sb_printf(&sb, ",%s", csv_numbers[k][0]);
-	sb_printf(&sb, ",rays.traversal,validation.valid,build_phases,error\n");
+	sb_printf(&sb, ",rays.traversal,validation.valid,device.name,device.kind,build_phases,"
+	          "error\n");
 	const cJSON *run;
 	cJSON_ArrayForEach(run, cJSON_GetObjectItem(doc, "runs"))
 		csv_row(&sb, run);

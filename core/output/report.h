@@ -96,6 +96,11 @@ struct front_entry {
  * NULL on no memory). */
 struct front_entry *report_front_entries(const struct report_index *ix,
                                          const cJSON *const *runs, size_t n, size_t *count);
+/* The front_entry threads of a device builder's runs (a "device" in
+ * results.json): a group of their own, after every CPU thread count. */
+#define REPORT_DEVICE_GROUP 99999.0
+/* Whether run ran on an OpenCL device (BVHLAB_BUILDER_DEVICE). */
+bool report_on_device(const cJSON *run);
 /* The front_point group of a machine's thread count. */
 long report_front_group(long machine, double threads);
 /* The SAH's weights, the report's SAH cost's and its ray cost's. */

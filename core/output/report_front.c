@@ -105,12 +105,21 @@ static int by_threads(const void *a, const void *b)
 	return (x->order > y->order) - (x->order < y->order);
 }
 
+bool report_on_device(const cJSON *run)
+{
+	return cJSON_IsObject(cJSON_GetObjectItemCaseSensitive(run, "device"));
+}
+
 /* Whether run k competes at thread count t: its own, or any for the
- * 1-thread run of a builder that ran on 1 thread only (on its machine). */
+ * 1-thread run of a builder that ran on 1 thread only (on its machine). A
+ * device builder's run competes in the device group only: its one host
+ * thread says nothing of what the device ran on. */
 static bool competes(const struct report_index *ix, const cJSON *const *runs, size_t n,
                      size_t k, double t)
 {
 	double own = report_num(runs[k], "threads");
+	if (report_on_device(runs[k]))
+		return t == REPORT_DEVICE_GROUP;
 	return own == t || (own == 1 && t > 1 &&
 	                    !ran_parallel(ix, runs, n, report_str(runs[k], "builder"),
 	                                  report_machine_number(ix, runs[k])));
@@ -119,8 +128,9 @@ static bool competes(const struct report_index *ix, const cJSON *const *runs, si
 struct front_entry *report_front_entries(const struct report_index *ix,
                                          const cJSON *const *runs, size_t n, size_t *count)
 {
-	double t[64];
+	double t[65];
 	size_t nt = report_thread_counts(runs, n, t, 64), m = 0;
+	t[nt++] = REPORT_DEVICE_GROUP; /* after every thread count */
 	struct front_entry *e = calloc(n * nt + 1, sizeof(*e));
 	for (size_t i = 0; e && i < nt; i++)
 		for (size_t k = 0; k < n; k++)
@@ -239,7 +249,9 @@ static const char *threads_text(char *buf, size_t size, const struct report_inde
 	char on[32] = "";
 	if (ix->machine_count > 1)
 		snprintf(on, sizeof(on), " on M%ld", e->machine + 1);
-	if (own == e->threads)
+	if (e->threads == REPORT_DEVICE_GROUP)
+		snprintf(buf, size, "device: %s%s", report_str(e->run, "device.name"), on);
+	else if (own == e->threads)
 		snprintf(buf, size, "%.0f%s", own, on);
 	else
 		snprintf(buf, size, "%.0f (ran on %.0f)%s", e->threads, own, on);
@@ -258,7 +270,8 @@ static const char intro[] =
 	"one of the two strictly, figures within 0.05 % counting as equal; off it, the "
 	"fastest builder on the front that dominates it, its build time as a multiple of "
 	"this one's and the change in the figure. A builder that ran on 1 thread only "
-	"competes with its 1-thread run at every thread count.";
+	"competes with its 1-thread run at every thread count; a device builder's runs "
+	"(OpenCL) compete among themselves, as \"device: NAME\".";
 
 void report_front_md(struct strbuf *sb, const struct report_index *ix,
                      const cJSON *const *runs, size_t n)
@@ -300,11 +313,12 @@ static void html_verdict(struct strbuf *sb, const struct front_table *t, int v, 
 static void html_row(struct strbuf *sb, const struct report_index *ix,
                      const struct front_table *t, size_t k)
 {
-	char buf[64], ms[32];
+	char buf[192], ms[32];
 	sb_printf(sb, "<tr><td class=\"l\">");
 	report_escape(sb, report_str(t->e[k].run, "builder"));
-	sb_printf(sb, "</td><td>%s</td><td>%s</td><td>%.3f</td>",
-	          threads_text(buf, sizeof(buf), ix, &t->e[k]),
+	sb_printf(sb, "</td><td>");
+	report_escape(sb, threads_text(buf, sizeof(buf), ix, &t->e[k])); /* a device's name */
+	sb_printf(sb, "</td><td>%s</td><td>%.3f</td>",
 	          report_plain(ms, sizeof(ms), t->p[0][k].time), t->p[0][k].figure);
 	html_verdict(sb, t, 0, k);
 	sb_printf(sb, "<td>%s</td>", report_plain(ms, sizeof(ms), t->p[1][k].figure));

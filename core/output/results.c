@@ -240,6 +240,8 @@ int results_add_run(struct results *res, const struct run_record *run)
 		cJSON_AddNumberToObject(cJSON_GetObjectItem(o, "tree"), "epo", *run->epo);
 	if (run->memory)
 		cJSON_AddItemToObject(o, "memory", memory_json(run->memory));
+	if (run->device) /* after "memory", which it adds to */
+		results_device_add(o, run->device);
 	if (run->validated)
 		cJSON_AddItemToObject(o, "validation", validation_json(run));
 	if (run->rays)

@@ -69,6 +69,17 @@ struct build_memory {
 	uint64_t output_bytes;    /* the output buffers the host allocated, capacity */
 };
 
+/* The device a device builder's run built on (BVHLAB_BUILDER_DEVICE) and
+ * what the OpenCL runtime took (harness/harness_memory.c measures it). */
+struct run_device {
+	struct machine_cl_device cl; /* as its "device" option chose it */
+	bool runtime_measured;
+	uint64_t runtime_bytes; /* resident memory the runtime and a context on the
+	                         * device added before the first build, measured once
+	                         * per process: part of memory.start_rss_bytes, not of
+	                         * memory.peak_bytes (the build's own) */
+};
+
 /* What a build series measured of one refinement stage. */
 struct stage_metrics {
 	char plugin[64];       /* the descriptor's name */
@@ -109,6 +120,7 @@ struct run_record {
 	const bvhlab_tree_stats *stats; /* or NULL */
 	const double *epo;     /* end-point overlap (bvhlab_tree_epo), or NULL */
 	const struct build_memory *memory; /* peak memory of the builds, or NULL */
+	const struct run_device *device; /* a device builder's device, or NULL */
 	bool validated;
 	bool valid;
 	uint64_t rays_checked, mismatches;
@@ -148,6 +160,11 @@ int results_add_run(struct results *res, const struct run_record *run);
  */
 int results_set_not_applicable(struct results *res, const char *builder,
                                const uint32_t *threads, size_t count, const char *reason);
+
+/* A device builder's run: "device": {"name", "kind", "compute_units",
+ * "platform", "index": "P:D", "global_mem_bytes"} into run object o, and
+ * "runtime_bytes" into its "memory" (results_device.c). */
+void results_device_add(struct cJSON *o, const struct run_device *d);
 
 /* "rays": {"primary": {...}, "diffuse": {...}, "threads": n} of docs/design.md. */
 struct cJSON *results_rays_json(const struct ray_metrics *m);

@@ -118,7 +118,8 @@ static int read_exact(int fd, char *buf, size_t size)
 	return 0;
 }
 
-int scene_read_file(const char *path, char **data, size_t *size, bvhlab_error *err)
+int scene_read_head(const char *path, size_t max, char **data, size_t *size,
+                    bvhlab_error *err)
 {
 	/* O_NONBLOCK: opening a FIFO for reading would wait for a writer forever;
 	 * this way it opens at once and fstat refuses it. */
@@ -134,6 +135,7 @@ int scene_read_file(const char *path, char **data, size_t *size, bvhlab_error *e
 	ret = regular_file_size(fd, path, size, err);
 	if (ret)
 		goto out;
+	*size = *size < max ? *size : max;
 	buf = malloc(*size + 1);
 	if (!buf) {
 		ret = -ENOMEM;
@@ -150,6 +152,11 @@ out:
 	free(buf);
 	close(fd);
 	return ret;
+}
+
+int scene_read_file(const char *path, char **data, size_t *size, bvhlab_error *err)
+{
+	return scene_read_head(path, SIZE_MAX, data, size, err);
 }
 
 static int grow(void **array, size_t *cap, size_t need, size_t elem_size)

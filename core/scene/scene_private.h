@@ -35,6 +35,9 @@ int scene_set_path_names(bvhlab_scene *scene, const char *path);
  * in *size). On failure: -errno and "PATH: ..." in err.
  */
 int scene_read_file(const char *path, char **data, size_t *size, bvhlab_error *err);
+/* Same, for at most the first `max` bytes of the file (a header). */
+int scene_read_head(const char *path, size_t max, char **data, size_t *size,
+                    bvhlab_error *err);
 
 /* Geometry collected by a loader; zero-initialise before use. */
 struct scene_mesh {

@@ -265,6 +265,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return rc;
 }
 
-BVHLAB_PLUGIN(.name = "template_cl", .flags = BVHLAB_BUILDER_DETERMINISTIC,
+BVHLAB_PLUGIN(.name = "template_cl",
+	.flags = BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_DEVICE,
 	.summary = "template OpenCL plugin: Morton codes on the device, LBVH split on the host",
 	.option_count = sizeof(options) / sizeof(options[0]), .options = options, .build = build)

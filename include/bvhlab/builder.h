@@ -300,6 +300,14 @@ enum bvhlab_builder_flags {
 	/* since 1.5: build() accepts prim_kind BVHLAB_PRIM_BOXES (the host
 	 * refuses a box build to a builder without it, by name) */
 	BVHLAB_BUILDER_BOXES = 1u << 4,
+	/* Builds on an OpenCL device that its string option "device" names
+	 * (auto, gpu, cpu or P:D, as bvhlab_cl_init in <bvhlab/opencl.h>
+	 * takes): the harness records that device with each run (name, kind,
+	 * compute units), measures the OpenCL runtime's memory apart from the
+	 * build's, and reports the runs in a group of the device, not at a CPU
+	 * thread count. Since 1.5; a host that predates the flag
+	 * ignores it. */
+	BVHLAB_BUILDER_DEVICE = 1u << 5,
 };
 
 /*

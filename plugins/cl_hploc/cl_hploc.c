@@ -218,7 +218,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return 0;
 }
 
-PLUGIN_WITH_OPTIONS(options, .name = "cl_hploc", .flags = BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_WITH_OPTIONS(options, .name = "cl_hploc",
+	.flags = BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_DEVICE,
 	.summary = "H-PLOC on an OpenCL device (Benthin et al. 2024): the hploc plugin's tree, "
 	           "the hierarchy in one kernel launch",
 	.build = build)

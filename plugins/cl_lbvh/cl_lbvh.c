@@ -76,6 +76,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return 0;
 }
 
-PLUGIN_WITH_OPTIONS(options, .name = "cl_lbvh", .flags = BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_WITH_OPTIONS(options, .name = "cl_lbvh",
+	.flags = BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_DEVICE,
 	.summary = "LBVH on an OpenCL device (Karras 2012): the lbvh plugin's tree, built by kernels",
 	.build = build)

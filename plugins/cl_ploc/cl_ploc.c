@@ -118,7 +118,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return run(host, ctx, &b, output);
 }
 
-PLUGIN_WITH_OPTIONS(options, .name = "cl_ploc", .flags = BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_WITH_OPTIONS(options, .name = "cl_ploc",
+	.flags = BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_DEVICE,
 	.summary = "PLOC on an OpenCL device (Meister & Bittner 2018): the ploc plugin's tree, "
 	           "built by kernels",
 	.build = build)

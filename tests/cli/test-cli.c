@@ -281,14 +281,63 @@ static void test_bad_builders(void)
 	CHECK(!exists(path_in("out-badgrid")));
 }
 
+/*
+ * A scene file that is not there (a mesh, a composite's part, a frame file
+ * of an animation) refuses the config before anything runs: exit 2, the
+ * scene and the path named at the scene's position, no output folder. So
+ * does a PLY whose header does not parse; every bad file is said at once.
+ */
+static void test_missing_scene_files(void)
+{
+	static const char *const scenes[] = {
+		"{ \"path\": \"gone.obj\" }",
+		"{ \"name\": \"comp\", \"parts\": [ { \"generator\": \"soup\", \"count\": 10 },\n"
+		"                                  { \"path\": \"sub/gone.ply\" } ] }",
+		"{ \"name\": \"anim\", \"frames\": { \"pattern\": \"gone%02d.obj\", \"count\": 2 } }"};
+	static const char *const said[] = {
+		"m0.json:2:15: scene 'gone': ", "m1.json:2:15: scene 'comp': part 1: ",
+		"m2.json:2:15: scene 'anim': frame 0: "};
+	static const char *const paths[] = {"gone.obj", "sub/gone.ply", "gone00.obj"};
+	char text[1024], name[32], expected[256];
+	for (int k = 0; k < 3; k++) {
+		snprintf(text, sizeof(text), "{ \"output\": \"out-gone\", \"repeat\": 1,\n"
+		         "  \"scenes\": [ %s ],\n  \"builders\": [ { \"plugin\": \"sah_seq\" } ] }\n",
+		         scenes[k]);
+		snprintf(name, sizeof(name), "m%d.json", k);
+		CHECK_INT(run(ARGS("run", "--quiet", write_config(name, text))), 2);
+		snprintf(expected, sizeof(expected), "%s%s/%s: cannot open: No such file or directory",
+		         said[k], tmpdir, paths[k]);
+		CHECK_CONTAINS(err_text, expected);
+		CHECK_CONTAINS(err_text, k < 2 ? "1 scene file cannot be read (above); nothing was run"
+		                               : "2 scene files cannot be read");
+		CHECK(!exists(path_in("out-gone")));
+	}
+	/* Present but with a broken PLY header, beside a missing frame 1. */
+	write_config("head.ply", "ply\nformat ascii 1.0\nelement vertex 3\nwhat\nend_header\n");
+	write_config("here00.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+	const char *cfg = write_config("m3.json",
+		"{ \"output\": \"out-gone\", \"scenes\": [ { \"path\": \"head.ply\" },\n"
+		"  { \"name\": \"a\", \"frames\": { \"pattern\": \"here%02d.obj\", \"count\": 2 } } ],\n"
+		"  \"builders\": [ { \"plugin\": \"sah_seq\" } ] }\n");
+	CHECK_INT(run(ARGS("run", "--quiet", cfg)), 2);
+	CHECK_CONTAINS(err_text, "scene 'head': ");
+	CHECK_CONTAINS(err_text, "head.ply:4: bad PLY header");
+	CHECK_CONTAINS(err_text, "scene 'a': frame 1: ");
+	CHECK(!strstr(err_text, "frame 0"));
+	CHECK_CONTAINS(err_text, "2 scene files cannot be read");
+	CHECK(!exists(path_in("out-gone")));
+}
+
 /* Failures at run time (a build that fails, a scene that does not load)
  * are recorded as failed runs; the rest still run. */
 static void test_failed_runs(void)
 {
+	/* It opens, so the config is fine; its face's vertex is missing. */
+	write_config("broken.obj", "v 0 0 0\nf 1 2 3\n");
 	const char *cfg = write_config("fails.json",
 		"{ \"output\": \"out-fails\", \"repeat\": 1, \"rays\": { \"min_ms\": 1 },\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 500 },\n"
-		"              { \"name\": \"broken\", \"path\": \"missing.obj\" } ],\n"
+		"              { \"path\": \"broken.obj\" } ],\n"
 		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"fails\",\n"
 		"                  \"options\": { \"fail\": \"error\" } },\n"
 		"                { \"plugin\": \"sah_seq\" } ] }\n");
@@ -300,11 +349,11 @@ static void test_failed_runs(void)
 		return;
 	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 4);
 	CHECK_INT(count_runs(doc, "sah_seq", "ok"), 1);
-	CHECK_INT(count_runs(doc, "sah_seq", "failed"), 1); /* the missing scene */
+	CHECK_INT(count_runs(doc, "sah_seq", "failed"), 1); /* the broken scene */
 	CHECK_INT(count_runs(doc, "fails", "failed"), 2);
 	char *json = cJSON_PrintUnformatted(doc);
 	CHECK_CONTAINS(json, "builder 'fake_good': asked to fail");
-	CHECK_CONTAINS(json, "missing.obj");
+	CHECK_CONTAINS(json, "broken.obj:2: vertex index 3 out of range");
 	free(json);
 	cJSON_Delete(doc);
 }
@@ -399,6 +448,7 @@ int main(int argc, char **argv)
 	} else if (!strcmp(argv[2], "errors")) {
 		test_config_errors();
 		test_bad_builders();
+		test_missing_scene_files();
 		test_failed_runs();
 		test_cxx_exception();
 	} else if (!strcmp(argv[2], "shared")) {
