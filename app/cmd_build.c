@@ -114,12 +114,12 @@ static int check(const bvhlab_scene *scene, const bvhlab_prims *prims, const bvh
 	bool dup = b->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
 	enum tree_verdict v = harness_measure_tree(tree, scene, &prims->input, dup, (uint32_t)rays,
 	                                           &m, &err);
-	if (!m.valid && !m.mismatches) {
-		printf("valid:      NO: %s\n", err.message);
-		return EXIT_RUNS_FAILED;
-	}
 	if (v == TREE_FAILED) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
+		return EXIT_RUNS_FAILED;
+	}
+	if (!m.valid && !m.mismatches) {
+		printf("valid:      NO: %s\n", err.message);
 		return EXIT_RUNS_FAILED;
 	}
 	printf("valid:      %s (structure; %llu of %lu rays disagree with brute force)\n",

@@ -110,6 +110,15 @@ const char *report_plain(char *buf, size_t size, double v)
 	return buf;
 }
 
+const char *report_figure(char *buf, size_t size, double v, int decimals)
+{
+	if (isfinite(v))
+		snprintf(buf, size, "%.*f", decimals, v);
+	else
+		snprintf(buf, size, "not measured");
+	return buf;
+}
+
 const char *report_phases(char *buf, size_t size, const cJSON *run)
 {
 	const cJSON *p;
@@ -134,11 +143,24 @@ bool report_any_phases(const cJSON *const *runs, size_t n)
 	return false;
 }
 
-/* Markdown cell text: pipes and newlines would break the table. */
+/* Markdown text: raw HTML (a <script>, a <!-- that hides the rest) as
+ * entities, pipes that would split a table cell escaped, line breaks that
+ * would end the table's row or the paragraph flattened. */
+void report_md_text(struct strbuf *sb, const char *text)
+{
+	for (const unsigned char *p = (const unsigned char *)text; *p; p++) {
+		if (*p == '&' || *p == '<' || *p == '>')
+			sb_printf(sb, *p == '&' ? "&amp;" : *p == '<' ? "&lt;" : "&gt;");
+		else if (*p == '|')
+			sb_printf(sb, "\\|");
+		else
+			sb_printf(sb, "%c", *p < 0x20 || *p == 0x7f ? ' ' : *p);
+	}
+}
+
 void report_md_cell(struct strbuf *sb, const char *s)
 {
 	sb_printf(sb, " ");
-	for (const char *p = s; *p; p++)
-		sb_printf(sb, *p == '|' ? "\\|" : *p == '\n' ? " " : "%c", *p);
+	report_md_text(sb, s);
 	sb_printf(sb, " |");
 }

@@ -258,11 +258,11 @@ void report_front_md(struct strbuf *sb, const struct report_index *ix,
 			sb_printf(sb, "|");
 			report_md_cell(sb, report_str(t.e[k].run, "builder"));
 			report_md_cell(sb, threads_text(buf, sizeof(buf), ix, &t.e[k]));
-			sb_printf(sb, " %s | %.3f |", report_plain(buf, sizeof(buf), t.p[0][k].time),
-			          t.p[0][k].figure);
+			sb_printf(sb, " %s |", report_plain(buf, sizeof(buf), t.p[0][k].time));
+			sb_printf(sb, " %s |", report_figure(buf, sizeof(buf), t.p[0][k].figure, 3));
 			verdict(&t, 0, k, buf, sizeof(buf));
 			report_md_cell(sb, buf);
-			sb_printf(sb, " %.1f |", t.p[1][k].figure);
+			sb_printf(sb, " %s |", report_figure(buf, sizeof(buf), t.p[1][k].figure, 1));
 			verdict(&t, 1, k, buf, sizeof(buf));
 			report_md_cell(sb, buf);
 			sb_printf(sb, "\n");
@@ -283,14 +283,15 @@ static void html_verdict(struct strbuf *sb, const struct front_table *t, int v, 
 static void html_row(struct strbuf *sb, const struct report_index *ix,
                      const struct front_table *t, size_t k)
 {
-	char buf[64], ms[32];
+	char buf[64], ms[32], fig[32];
 	sb_printf(sb, "<tr><td class=\"l\">");
 	report_escape(sb, report_str(t->e[k].run, "builder"));
-	sb_printf(sb, "</td><td>%s</td><td>%s</td><td>%.3f</td>",
+	sb_printf(sb, "</td><td>%s</td><td>%s</td><td>%s</td>",
 	          threads_text(buf, sizeof(buf), ix, &t->e[k]),
-	          report_plain(ms, sizeof(ms), t->p[0][k].time), t->p[0][k].figure);
+	          report_plain(ms, sizeof(ms), t->p[0][k].time),
+	          report_figure(fig, sizeof(fig), t->p[0][k].figure, 3));
 	html_verdict(sb, t, 0, k);
-	sb_printf(sb, "<td>%.1f</td>", t->p[1][k].figure);
+	sb_printf(sb, "<td>%s</td>", report_figure(fig, sizeof(fig), t->p[1][k].figure, 1));
 	html_verdict(sb, t, 1, k);
 	sb_printf(sb, "</tr>\n");
 }

@@ -26,7 +26,7 @@ static const bvhlab_option_decl options[] = {
 	 .def_float = 0.5, .min = 0.0, .max = 100.0},
 	{.name = "fail", .type = BVHLAB_OPTION_STRING, .help = "how build() fails or misbehaves",
 	 .def_string = "no",
-	 .choices = "no|error|silent|positive|segfault|abort|loop|exit|invalid|alloc|shared"},
+	 .choices = "no|error|silent|positive|segfault|abort|loop|exit|invalid|alloc|shared|hog"},
 #ifdef FAKE_BAD_OPTION
 	{.name = "broken", .type = 0, .help = "an option of no type"},
 #endif
@@ -76,6 +76,18 @@ static int allocate(const bvhlab_host *host, bvhlab_build_ctx *ctx)
 	host->set_error(ctx, "%s after %zu MB", total < ALLOC_CAP ? "out of memory" :
 	                "no memory limit", total / MB);
 	return -ENOMEM;
+}
+
+/* "hog": a good tree, then all the address space the memory limit leaves
+ * is taken and kept (chunks from 16 MB down to 64 bytes, untouched: the
+ * limit is on address space), so what comes after the build (validation)
+ * runs out of memory. Only ever run under a memory limit. */
+static void hog(void)
+{
+	for (size_t chunk = ALLOC_CHUNK; chunk >= 64; chunk /= 4)
+		for (size_t total = 0; total < ALLOC_CAP; total += chunk)
+			if (!malloc(chunk))
+				break;
 }
 
 /* Blocks until the file named by "wait_for" exists: tests stop a sweep there. */
@@ -194,8 +206,24 @@ __attribute__((unused)) static int build(const bvhlab_host *host, bvhlab_build_c
 		out->prim_index[k] = k;
 	out->node_count = 1;
 	out->index_count = count;
+	if (fail_is(host, ctx, "hog"))
+		hog();
 	return 0;
 }
+
+#ifdef FAKE_UPDATE_CRASH
+/* An update (ABI 1.4) that crashes: frame 1 of an animation dies in it. */
+static int update(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                  const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	(void)host;
+	(void)ctx;
+	(void)in;
+	(void)out;
+	segfault();
+	return 0;
+}
+#endif
 
 #ifdef FAKE_ABI_MAJOR
 #define ABI BVHLAB_ABI_VERSION(FAKE_ABI_MAJOR, 0)
@@ -219,6 +247,9 @@ static const bvhlab_builder desc = {
 	.options = options,
 #ifndef FAKE_NULL_BUILD
 	.build = build,
+#endif
+#ifdef FAKE_UPDATE_CRASH
+	.update = update,
 #endif
 };
 

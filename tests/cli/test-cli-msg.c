@@ -1,0 +1,162 @@
+/*
+ * Issue 43's statuses, figures, versions, messages and escaping, one mode
+ * per group, each a meson test of its own (cli-rel-MODE):
+ *   status    out of memory while validating is "failed", not "invalid";
+ *             an update plugin that crashes names the frame and the plugin
+ *             and keeps frame 0; untraced rays leave figures null, name no
+ *             cheapest strategy, and every failed traversal is kept
+ *   version   bvhlab_version names the commit; merge refuses parts of other
+ *             versions (--allow-mixed-versions records each); --repeat on a
+ *             plan part refused
+ *   config    bad options, names and coordinates refused before any output
+ *   escape    names and errors escaped in report.md, CSV cells guarded
+ * Usage: test-cli-msg BVHLAB_EXE MODE
+ */
+#include <sys/stat.h>
+
+#include "cliutil.h"
+
+static const char *path_in(const char *name)
+{
+	static char buf[4][600];
+	static int next;
+	char *p = buf[next++ % 4];
+	snprintf(p, 600, "%s/%s", tmpdir, name);
+	return p;
+}
+
+static inline bool exists(const char *path)
+{
+	struct stat st;
+	return lstat(path, &st) == 0;
+}
+
+/* Runs config `text` as `name` (from tmpdir): its exit status; the results
+ * of folder `out` into *doc (checked to be there), NULL after exit 2. */
+static int sweep(const char *name, const char *text, const char *out, cJSON **doc)
+{
+	int status = run_in(tmpdir, ARGS("run", "--quiet", write_config(name, text)));
+	*doc = status == 2 ? NULL : load_results(path_in(out));
+	return status;
+}
+
+static const cJSON *first_run(const cJSON *doc)
+{
+	return cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
+}
+
+static const cJSON *frame_at(const cJSON *run, int f)
+{
+	return cJSON_GetArrayItem(cJSON_GetObjectItem(run, "frames"), f);
+}
+
+/* 4. No memory left to validate: the tree is not called invalid. */
+static void status_validate_oom(void)
+{
+#if UNDER_ASAN || UNDER_TSAN
+	/* Sanitizers reserve terabytes of address space: no limit can apply. */
+#else
+	cJSON *doc;
+	CHECK_INT(sweep("hog.json",
+		"{ \"output\": \"out-hog\", \"repeat\": 1, \"warmup\": 0, \"memory_limit_mb\": 1024,\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 1000 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"options\": { \"fail\": \"hog\" } } ] }\n",
+		"out-hog", &doc), 1);
+	const cJSON *run = first_run(doc);
+	CHECK_CONTAINS(run_str(run, "status"), "failed");
+	CHECK_CONTAINS(run_str(run, "error"), "out of memory validating");
+	CHECK_CONTAINS(run_str(run, "error"), "not found invalid");
+	CHECK_CONTAINS(run_str(run, "error"), "(under memory_limit_mb = 1024)");
+	cJSON_Delete(doc);
+#endif
+}
+
+/* 9. An update plugin that crashes in frame 1: named with its frame, frame 0 kept. */
+static void status_update_crash(void)
+{
+	cJSON *doc;
+	plain_crashes();
+	CHECK_INT(sweep("up.json",
+		"{ \"output\": \"out-up\", \"repeat\": 1, \"warmup\": 0,\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200,\n"
+		"                \"frames\": 3, \"deform\": \"wave\" } ],\n"
+		"  \"builders\": [ { \"name\": \"h12\", \"plugin\": \"fake_good\",\n"
+		"                  \"animation\": { \"update\": \"fake_upcrash\" } } ] }\n",
+		"out-up", &doc), 1);
+	const cJSON *run = first_run(doc);
+	CHECK_INT(count_runs(doc, "h12", "crashed"), 1);
+	CHECK_CONTAINS(run_str(run, "error"), "frame 1, updated by 'fake_upcrash': killed by SIGSEGV");
+	CHECK(!strstr(run_str(run, "error"), "builder 'h12'"));
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(run, "frames")), 1);
+	CHECK(cJSON_IsNumber(cJSON_GetObjectItem(frame_at(run, 0), "sah")));
+	CHECK(cJSON_IsNumber(cJSON_GetObjectItem(cJSON_GetObjectItem(run, "build_ms"), "median")));
+	cJSON_Delete(doc);
+}
+
+/* 5, 9. Device traversals that cannot run (no OpenCL platform): the frames'
+ * ray figures and costs null, no cheapest strategy, both errors kept. */
+static void status_untraced(void)
+{
+	cJSON *doc;
+	CHECK(mkdir(path_in("no-icd"), 0755) == 0);
+	setenv("OCL_ICD_VENDORS", path_in("no-icd"), 1);
+	int status = sweep("nr.json",
+		"{ \"output\": \"out-nr\", \"repeat\": 1, \"warmup\": 0,\n"
+		"  \"rays\": { \"width\": 16, \"height\": 16,\n"
+		"            \"traversal\": [ \"cl_stack\", \"cl_stackless\" ] },\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200,\n"
+		"                \"frames\": 3, \"deform\": \"wave\" } ],\n"
+		"  \"builders\": [ { \"name\": \"a\", \"plugin\": \"lbvh\",\n"
+		"                  \"animation\": { \"update\": \"refit\" } } ] }\n", "out-nr", &doc);
+	unsetenv("OCL_ICD_VENDORS");
+	if (status == 2 && strstr(err_text, "OpenCL")) {
+		fprintf(stderr, "built without OpenCL: the untraced frames are not checked\n");
+		return;
+	}
+	CHECK_INT(status, 0);
+	const cJSON *run = first_run(doc);
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(run, "frames")), 3);
+	for (int f = 0; f < 3; f++) {
+		const cJSON *fr = frame_at(run, f);
+		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(fr, "sah")));
+		CHECK(cJSON_IsNull(cJSON_GetObjectItem(fr, "nodes_per_ray")));
+		CHECK(cJSON_IsNull(cJSON_GetObjectItem(fr, "mrays_per_s")));
+		CHECK(cJSON_IsNull(cJSON_GetObjectItem(fr, "cost_ms")));
+	}
+	char *md = read_file(path_in("out-nr"), "report.md");
+	CHECK(md && !strstr(md, "Cheapest over the animation") && !strstr(md, "nan"));
+	CHECK_CONTAINS(md ? md : "", "not measured");
+	CHECK_CONTAINS(md ? md : "", "No strategy's cost was measured");
+	free(md);
+	cJSON_Delete(doc);
+	/* The main traversal's failure fails the batch; a static scene's rays
+	 * with a CPU main and two device ones keep both devices' errors. */
+	setenv("OCL_ICD_VENDORS", path_in("no-icd"), 1);
+	CHECK_INT(sweep("nr2.json",
+		"{ \"output\": \"out-nr2\", \"repeat\": 1, \"warmup\": 0,\n"
+		"  \"rays\": { \"width\": 16, \"height\": 16,\n"
+		"            \"traversal\": [ \"stack\", \"cl_stack\", \"cl_stackless\" ] },\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"lbvh\" } ] }\n", "out-nr2", &doc), 0);
+	unsetenv("OCL_ICD_VENDORS");
+	const char *e = run_str(cJSON_GetObjectItem(first_run(doc), "rays"), "error");
+	CHECK_CONTAINS(e, "cl_stack: ");
+	CHECK_CONTAINS(e, "; cl_stackless: ");
+	CHECK(!strchr(e, '\n'));
+	cJSON_Delete(doc);
+}
+
+static void test_status(void)
+{
+	status_validate_oom();
+	status_update_crash();
+	status_untraced();
+}
+
+int main(int argc, char **argv)
+{
+	static const struct cli_mode modes[] = {
+		{"status", test_status},
+	};
+	return cli_main_modes(argc, argv, "test-cli-msg", modes, sizeof(modes) / sizeof(modes[0]));
+}
