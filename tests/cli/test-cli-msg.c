@@ -25,7 +25,7 @@ static const char *path_in(const char *name)
 	return p;
 }
 
-static inline bool exists(const char *path)
+static bool exists(const char *path)
 {
 	struct stat st;
 	return lstat(path, &st) == 0;
@@ -153,10 +153,67 @@ static void test_status(void)
 	status_untraced();
 }
 
+/* Replaces the bvhlab_version in dir/results.json with `version`. */
+static void set_version(const char *dir, const char *version)
+{
+	cJSON *doc = load_results(dir);
+	cJSON_ReplaceItemInObject(doc, "bvhlab_version", cJSON_CreateString(version));
+	char *text = cJSON_Print(doc), path[700];
+	snprintf(path, sizeof(path), "%s/results.json", dir);
+	FILE *f = fopen(path, "w");
+	CHECK(f && text && fputs(text, f) >= 0);
+	if (f)
+		fclose(f);
+	free(text);
+	cJSON_Delete(doc);
+}
+
+/* 7. The version names the commit; merge checks and keeps each part's;
+ * --repeat on a plan part is refused like --threads. */
+static void test_version(void)
+{
+	CHECK_INT(run_in(tmpdir, ARGS("--version")), 0);
+	/* "bvhlab 0.1.0+COMMIT (plugin ABI ...)": a commit, or "unknown" outside git. */
+	CHECK(strstr(out_text, "0.1.0+") != NULL);
+	const char *cfg = write_config("v.json",
+		"{ \"repeat\": 1,\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
+		"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n");
+	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "pv")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pv/plan.json"), "--only", "0", "--repeat",
+	                              "7", "--out", path_in("pv/parts/0"), "--quiet")), 2);
+	CHECK_CONTAINS(err_text, "--repeat cannot be combined with a plan");
+	CHECK(!exists(path_in("pv/parts/0")));
+	for (int k = 0; k < 2; k++) {
+		char id[4], out[64];
+		snprintf(id, sizeof(id), "%d", k);
+		snprintf(out, sizeof(out), "pv/parts/%d", k);
+		CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pv/plan.json"), "--only", id, "--out",
+		                              path_in(out), "--quiet")), 0);
+	}
+	set_version(path_in("pv/parts/1"), "0.0.9+000000000000");
+	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pv/parts/0"), path_in("pv/parts/1"),
+	                              "--out", path_in("pv"))), 2);
+	CHECK_CONTAINS(err_text, "by bvhlab 0.0.9+000000000000");
+	CHECK_CONTAINS(err_text, "--allow-mixed-versions");
+	CHECK(!exists(path_in("pv/results.json")));
+	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pv/parts/0"), path_in("pv/parts/1"),
+	                              "--out", path_in("pv"), "--allow-mixed-versions")), 0);
+	cJSON *doc = load_results(path_in("pv"));
+	CHECK_CONTAINS(run_str(doc, "bvhlab_version"), "mixed");
+	CHECK_CONTAINS(run_str(find_run(doc, "s", "b", 1), "bvhlab_version"), "0.0.9+000000000000");
+	CHECK_CONTAINS(run_str(find_run(doc, "s", "a", 1), "bvhlab_version"), "0.1.0+");
+	const cJSON *versions = cJSON_GetObjectItem(cJSON_GetObjectItem(doc, "merged"), "versions");
+	CHECK_INT(cJSON_GetArraySize(versions), 2);
+	cJSON_Delete(doc);
+}
+
 int main(int argc, char **argv)
 {
 	static const struct cli_mode modes[] = {
 		{"status", test_status},
+		{"version", test_version},
 	};
 	return cli_main_modes(argc, argv, "test-cli-msg", modes, sizeof(modes) / sizeof(modes[0]));
 }
