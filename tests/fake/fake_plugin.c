@@ -32,7 +32,7 @@ static const bvhlab_option_decl options[] = {
 #endif
 	{.name = "phases", .type = BVHLAB_OPTION_STRING,
 	 .help = "phases build() reports (ABI 1.3): none, two (upload twice, device), or broken",
-	 .def_string = "none", .choices = "none|two|bad_name|negative|too_many"},
+	 .def_string = "none", .choices = "none|two|bad_name|negative|too_many|huge|long"},
 	{.name = "wait_for", .type = BVHLAB_OPTION_STRING,
 	 .help = "a file build() waits for first (up to a minute)", .def_string = ""},
 };
@@ -164,6 +164,16 @@ static int build_shared(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return 0;
 }
 
+/* Busy for ms milliseconds of the monotonic clock. */
+static void spend_ms(double ms)
+{
+	struct timespec t0, t;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	do
+		clock_gettime(CLOCK_MONOTONIC, &t);
+	while ((double)(t.tv_sec - t0.tv_sec) * 1e3 + (double)(t.tv_nsec - t0.tv_nsec) / 1e6 < ms);
+}
+
 /* The "phases" option: upload is reported twice to show that calls add up. */
 static void report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx)
 {
@@ -172,6 +182,7 @@ static void report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx)
 	if (!BVHLAB_HOST_HAS(host, phase) || host->option_string(ctx, "phases", &how) < 0)
 		return;
 	if (strcmp(how, "two") == 0) {
+		spend_ms(4.0); /* the phases' 4 ms, for real: a phase is part of the build */
 		host->phase(ctx, "upload", 1.0);
 		host->phase(ctx, "device", 2.5);
 		host->phase(ctx, "upload", 0.5);
@@ -179,6 +190,10 @@ static void report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx)
 		host->phase(ctx, "Device Time", 1.0);
 	} else if (strcmp(how, "negative") == 0) {
 		host->phase(ctx, "device", -1.0);
+	} else if (strcmp(how, "huge") == 0) {
+		host->phase(ctx, "device", 2e12);
+	} else if (strcmp(how, "long") == 0) {
+		host->phase(ctx, "device", 5000.0);
 	} else if (strcmp(how, "too_many") == 0) {
 		for (size_t k = 0; k < sizeof(many) / sizeof(many[0]); k++)
 			host->phase(ctx, many[k], 1.0);
