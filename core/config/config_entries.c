@@ -402,5 +402,9 @@ int config_apply_options(const struct config *cfg, const struct config_builder *
 			return grid_note(rc, m, at, err);
 		}
 	}
+	bvhlab_error inner = { "" };
+	if (bvhlab_options_check(opts, &inner) < 0)
+		return config_error(cfg, b->options, true, err, "builder '%s': %s", b->name,
+		                    inner.message);
 	return 0;
 }

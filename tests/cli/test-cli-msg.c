@@ -209,11 +209,122 @@ static void test_version(void)
 	cJSON_Delete(doc);
 }
 
+#define LOADCRASH_DIR BVHLAB_TEST_BUILDDIR "/fake/loadcrash"
+
+/* Runs config `text` as `name` expecting exit 2 before any output folder
+ * (`out`) exists, with `message` on stderr. */
+static void refused(const char *name, const char *text, const char *out, const char *message)
+{
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", write_config(name, text))), 2);
+	CHECK_CONTAINS(err_text, message);
+	CHECK(!exists(path_in(out)));
+}
+
+/* 9. Options no declaration states, names and coordinates: config errors. */
+static void config_errors(void)
+{
+	refused("leaf.json",
+		"{ \"output\": \"out-leaf\",\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"bvh2\", \"options\": { \"min_leaf\": 9 } },\n"
+		"                  { \"plugin\": \"embree\", \"name\": \"e\",\n"
+		"                    \"options\": { \"min_leaf\": 6, \"max_leaf\": 4 } } ] }\n",
+		"out-leaf", "builder 'bvh2': option 'min_leaf' of builder 'bvh2' is 9, more than "
+		"'max_leaf' (8)");
+	if (strstr(err_text, "'embree'")) /* built with Embree */
+		CHECK_CONTAINS(err_text, "builder 'e': option 'min_leaf' of builder 'embree' is 6");
+	refused("dev.json",
+		"{ \"output\": \"out-dev\",\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"cl_lbvh\", \"options\": { \"device\": \"\" } } ] }\n",
+		"out-dev", "");
+	if (!strstr(err_text, "plugin 'cl_lbvh' not found")) /* built with OpenCL */
+		CHECK_CONTAINS(err_text, "builder 'cl_lbvh': option 'device' of builder 'cl_lbvh' "
+		               "must not be empty (default 'auto')");
+	FILE *f = fopen(path_in("big.obj"), "w");
+	CHECK(f && fputs("v 0 0 0\nv 1 0 0\nv 0 -1e38 0\nf 1 2 3\n", f) >= 0);
+	if (f)
+		fclose(f);
+	CHECK_INT(run_in(tmpdir, ARGS("build", "lbvh", path_in("big.obj"))), 2);
+	CHECK_CONTAINS(err_text, "big.obj:3: coordinate beyond +-1e18");
+}
+
+/* 9. Phase times: over 1e12 ms and longer than the build, each with its rule. */
+static void config_phases(void)
+{
+	cJSON *doc;
+	CHECK_INT(sweep("ph.json",
+		"{ \"output\": \"out-ph\", \"repeat\": 1,\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"huge\",\n"
+		"                    \"options\": { \"phases\": \"huge\" } },\n"
+		"                  { \"plugin\": \"fake_good\", \"name\": \"long\",\n"
+		"                    \"options\": { \"phases\": \"long\" } } ] }\n", "out-ph", &doc),
+		1);
+	CHECK_CONTAINS(run_str(find_run(doc, "soup", "huge", 1), "error"),
+	               "'device' (2e+12 ms): times are finite, >= 0 and at most 1e12 ms");
+	CHECK_CONTAINS(run_str(find_run(doc, "soup", "long", 1), "error"),
+	               "'device' (5000 ms) in a build that took");
+	cJSON_Delete(doc);
+}
+
+/* 9. bvhlab build isolates the plugin: a C++ static constructor that
+ * throws, or a crash while loading, is exit status 1 naming the plugin. */
+static void config_build_isolated(void)
+{
+	plain_crashes();
+	CHECK_INT(run_in(tmpdir, ARGS("build", LOADCRASH_DIR "/throw_ctor.so", "soup:count=50")), 1);
+	CHECK_CONTAINS(err_text, "throw_ctor.so' on soup:count=50: killed by SIGABRT");
+	CHECK_CONTAINS(err_text, "fake_throw: escaped build() unguarded");
+	CHECK_INT(run_in(tmpdir, ARGS("build", LOADCRASH_DIR "/crash_ctor.so", "soup:count=50")), 1);
+	CHECK_CONTAINS(err_text, "killed by SIGSEGV");
+	CHECK_INT(run_in(tmpdir, ARGS("build", "fake_good", "soup:count=50")), 0);
+	CHECK_CONTAINS(out_text, "valid:      yes");
+	CHECK_INT(run_in(tmpdir, ARGS("build", "fake_good", "soup:count=50", "-o", "alpha=99")), 2);
+	CHECK_CONTAINS(err_text, "option 'alpha' of builder 'fake_good' is out of range");
+}
+
+/* 9. Device layers under a memory limit say so, not "install a driver". */
+static void config_memory_messages(void)
+{
+#if UNDER_ASAN || UNDER_TSAN
+	/* Sanitizers reserve terabytes of address space: no limit can apply. */
+#else
+	cJSON *doc;
+	int status = sweep("lim.json",
+		"{ \"output\": \"out-lim\", \"repeat\": 1, \"warmup\": 0, \"memory_limit_mb\": 512,\n"
+		"  \"threads\": [2],\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 1000 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"cl_lbvh\", \"optional\": true },\n"
+		"                  { \"plugin\": \"embree\", \"optional\": true } ] }\n", "out-lim", &doc);
+	CHECK(status == 1 || status == 0);
+	const cJSON *cl = find_run(doc, "soup", "cl_lbvh", 2), *em = find_run(doc, "soup", "embree", 2);
+	if (cl) {
+		CHECK_CONTAINS(run_str(cl, "error"), "no OpenCL platform could be opened: this "
+		               "process's address space is limited to 512 MB (memory_limit_mb)");
+		CHECK(!strstr(run_str(cl, "error"), "install an OpenCL driver"));
+	}
+	if (em)
+		CHECK_CONTAINS(run_str(em, "error"), "rtcNewDevice(threads=2) failed: out of memory; "
+		               "the address space is limited to 512 MB");
+	cJSON_Delete(doc);
+#endif
+}
+
+static void test_config(void)
+{
+	config_errors();
+	config_phases();
+	config_build_isolated();
+	config_memory_messages();
+}
+
 int main(int argc, char **argv)
 {
 	static const struct cli_mode modes[] = {
 		{"status", test_status},
 		{"version", test_version},
+		{"config", test_config},
 	};
 	return cli_main_modes(argc, argv, "test-cli-msg", modes, sizeof(modes) / sizeof(modes[0]));
 }
