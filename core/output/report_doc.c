@@ -5,6 +5,7 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cJSON.h>
@@ -163,4 +164,30 @@ void report_md_cell(struct strbuf *sb, const char *s)
 	sb_printf(sb, " ");
 	report_md_text(sb, s);
 	sb_printf(sb, " |");
+}
+
+/* Whether s reads as a number (-1.5, +3, 2e-7): left as it is in CSV. */
+static bool numeric_text(const char *s)
+{
+	char *end;
+	if (!*s)
+		return false;
+	strtod(s, &end);
+	return *end == '\0';
+}
+
+void report_csv_field(struct strbuf *sb, const char *s, bool last)
+{
+	/* A spreadsheet runs a cell that starts with = + - @ (or a tab or CR
+	 * before one) as a formula: such text gets a leading ' to stay text. */
+	bool formula = strchr("=+-@\t\r", s[0]) && s[0] && !numeric_text(s);
+	if (formula || strpbrk(s, ",\"\n\r")) {
+		sb_printf(sb, "\"%s", formula ? "'" : "");
+		for (const char *p = s; *p; p++)
+			sb_printf(sb, *p == '"' ? "\"\"" : "%c", *p);
+		sb_printf(sb, "\"");
+	} else {
+		sb_printf(sb, "%s", s);
+	}
+	sb_printf(sb, last ? "\n" : ",");
 }

@@ -50,6 +50,11 @@ bool report_any_phases(const cJSON *const *runs, size_t n);
 void report_md_text(struct strbuf *sb, const char *text);
 /* " text |": a Markdown table cell of report_md_text. */
 void report_md_cell(struct strbuf *sb, const char *text);
+/* A CSV field and its separator (',', or a newline when last): quoted
+ * when it holds a separator, quote or newline; text a spreadsheet would
+ * run as a formula (starting = + - @, not a number) quoted with a leading
+ * '. Every CSV writer's cells go through here. */
+void report_csv_field(struct strbuf *sb, const char *s, bool last);
 /* A plain number with the decimals its size needs ("2140", "21.4", "2.14"),
  * never an exponent; "" for NaN. Returns buf. */
 const char *report_plain(char *buf, size_t size, double v);

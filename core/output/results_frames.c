@@ -45,25 +45,18 @@ cJSON *results_frames_json(const struct frame_metrics *frames, uint32_t count)
 	return a;
 }
 
-/* A CSV field: quoted when it holds a separator, quote or newline. */
-static void field(struct strbuf *sb, const char *s)
-{
-	if (!strpbrk(s, ",\"\n\r")) {
-		sb_printf(sb, "%s,", s);
-		return;
-	}
-	sb_printf(sb, "\"");
-	for (; *s; s++)
-		sb_printf(sb, *s == '"' ? "\"\"" : "%c", *s);
-	sb_printf(sb, "\",");
-}
-
 static void number(struct strbuf *sb, const cJSON *o, const char *key, bool last)
 {
 	double v = report_num(o, key);
+	char buf[32] = "";
 	if (isfinite(v))
-		sb_printf(sb, "%.9g", v);
-	sb_printf(sb, last ? "\n" : ",");
+		snprintf(buf, sizeof(buf), "%.9g", v);
+	report_csv_field(sb, buf, last);
+}
+
+static void field(struct strbuf *sb, const char *s)
+{
+	report_csv_field(sb, s, false);
 }
 
 static const char *flag(const cJSON *o, const char *key)

@@ -319,12 +319,67 @@ static void test_config(void)
 	config_memory_messages();
 }
 
+/* 10. Names and errors escaped in report.md (tables and text), CSV cells
+ * that a spreadsheet would run guarded, names refused that are blank or
+ * hold control or bidirectional characters. */
+static void test_escape(void)
+{
+	cJSON *doc;
+	CHECK_INT(sweep("esc.json",
+		"{ \"output\": \"out-esc\", \"repeat\": 1, \"warmup\": 0,\n"
+		"  \"rays\": { \"width\": 8, \"height\": 8 },\n"
+		"  \"scenes\": [ { \"name\": \"=1+2 <script>s</script>\", \"generator\": \"soup\",\n"
+		"                \"count\": 100, \"frames\": 2, \"deform\": \"wave\" },\n"
+		"                { \"name\": \"-x\", \"path\": \"missing <!-- m.obj\" } ],\n"
+		"  \"builders\": [ { \"plugin\": \"lbvh\", \"name\": \"a|b <!-- c\",\n"
+		"                    \"animation\": { \"update\": \"refit\" } },\n"
+		"                  { \"plugin\": \"lbvh\", \"name\": \"@sum\" } ] }\n", "out-esc", &doc),
+		1);
+	cJSON_Delete(doc);
+	char *md = read_file(path_in("out-esc"), "report.md");
+	CHECK(md != NULL);
+	if (md) {
+		CHECK(!strstr(md, "<script") && !strstr(md, "<!--"));
+		const char *anim = strstr(md, "### Animation");
+		CHECK_CONTAINS(anim ? anim : "", "| a\\|b &lt;!-- c | 1 | 2 | yes |");
+		CHECK_CONTAINS(md, "## =1+2 &lt;script&gt;s&lt;/script&gt;");
+		CHECK_CONTAINS(md, "missing &lt;!-- m.obj");
+	}
+	free(md);
+	char *csv = read_file(path_in("out-esc"), "results.csv");
+	CHECK(csv != NULL);
+	if (csv) {
+		CHECK_CONTAINS(csv, "\n\"'=1+2 <script>s</script>\",a|b <!-- c,lbvh,");
+		CHECK_CONTAINS(csv, "\n\"'-x\",\"'@sum\",");
+		CHECK(!strstr(csv, "\n=") && !strstr(csv, ",=") && !strstr(csv, ",@"));
+	}
+	free(csv);
+	char *frames = read_file(path_in("out-esc"), "frames.csv");
+	CHECK_CONTAINS(frames ? frames : "", "\n\"'=1+2 <script>s</script>\",a|b <!-- c,lbvh,");
+	free(frames);
+	static const char *const bad[][2] = {
+		{"\"  \"", "its scene name is only blanks"},
+		{"\"a\\u202eb\"", "its scene name holds the bidirectional control U+202E"},
+		{"\"a\\u0007b\"", "its scene name holds the control character U+0007"},
+		{"\"a\\u0085b\"", "its scene name holds the control character U+0085"},
+	};
+	for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
+		char text[512];
+		snprintf(text, sizeof(text),
+		         "{ \"output\": \"out-bad\", \"scenes\": [ { \"name\": %s, \"generator\": "
+		         "\"soup\", \"count\": 100 } ], \"builders\": [ { \"plugin\": \"lbvh\" } ] }\n",
+		         bad[k][0]);
+		refused("bad.json", text, "out-bad", bad[k][1]);
+	}
+}
+
 int main(int argc, char **argv)
 {
 	static const struct cli_mode modes[] = {
 		{"status", test_status},
 		{"version", test_version},
 		{"config", test_config},
+		{"escape", test_escape},
 	};
 	return cli_main_modes(argc, argv, "test-cli-msg", modes, sizeof(modes) / sizeof(modes[0]));
 }
