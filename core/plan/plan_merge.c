@@ -127,7 +127,7 @@ static int check_part_version(const struct merge *m, size_t p, bvhlab_error *err
 {
 	const char *v = string_at(m->parts[p].doc, "bvhlab_version");
 	const char *first = string_at(m->parts[0].doc, "bvhlab_version");
-	if (p == 0 || (v && first && strcmp(v, first) == 0))
+	if (p == 0 || m->mixed_versions || (v && first && strcmp(v, first) == 0))
 		return 0;
 	error_set(err, "part %s was run by bvhlab %s, part %s by %s: nothing merged (run every "
 	          "part with one build, or merge with --allow-mixed-versions)", m->parts[p].dir,
@@ -147,8 +147,7 @@ static int collect(struct merge *m, const char *const *dirs, bvhlab_error *err)
 			          "never started)", part->dir);
 		if (r == 0)
 			r = check_part_plan(m->plan, part->dir, part->doc, err);
-		if (r == 0 && !m->mixed_versions)
-			r = check_part_version(m, p, err);
+		r = r ? r : check_part_version(m, p, err);
 		const cJSON *run;
 		cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(part->doc, "runs")) {
 			uint32_t id;
@@ -327,13 +326,10 @@ static cJSON *merged_header(const struct merge *m)
 	struct tm tm;
 	cJSON *doc = cJSON_CreateObject();
 	strftime(stamp, sizeof(stamp), "%Y-%m-%dT%H:%M:%SZ", gmtime_r(&now, &tm));
-	/* The parts' version (checked to be one), "mixed" when allowed not to be. */
-	const char *version = string_at(m->parts[0].doc, "bvhlab_version");
+	const char *version = string_at(m->parts[0].doc, "bvhlab_version"); /* the parts' */
 	for (size_t p = 1; version && p < m->part_count; p++)
-		if (!same_string(m->parts[0].doc, m->parts[p].doc, "bvhlab_version"))
-			version = "mixed";
+		version = same_string(m->parts[0].doc, m->parts[p].doc, "bvhlab_version") ? version : "mixed";
 	cJSON_AddStringToObject(doc, "bvhlab_version", version ? version : "unknown");
-	cJSON_AddStringToObject(doc, "merged_by", bvhlab_version());
 	cJSON_AddStringToObject(doc, "created", stamp);
 	/* The reports' header names one machine: the first part's (runs carry their own). */
 	cJSON_AddItemToObject(doc, "machine", cJSON_Duplicate(cJSON_GetObjectItemCaseSensitive(
@@ -519,10 +515,9 @@ static int write_merged(const struct merge *m, const char *dir, struct merge_sum
 }
 
 int plan_merge(const struct plan_file *plan, const char *const *parts, size_t part_count,
-               const char *dir, bool mixed_versions, struct merge_summary *sum,
-               bvhlab_error *err)
+               const char *dir, bool mixed, struct merge_summary *sum, bvhlab_error *err)
 {
-	struct merge m = {.plan = plan, .part_count = part_count, .mixed_versions = mixed_versions};
+	struct merge m = {.plan = plan, .part_count = part_count, .mixed_versions = mixed};
 	memset(sum, 0, sizeof(*sum));
 	m.parts = calloc(part_count ? part_count : 1, sizeof(*m.parts));
 	m.owner_run = calloc(plan->run_count ? plan->run_count : 1, sizeof(*m.owner_run));
