@@ -170,6 +170,8 @@ int cli_target_open(struct cli_target *t, const char *plugin, const char *scene,
 	for (int k = 0; k < option_count; k++)
 		if (bvhlab_options_parse(&t->opts, options[k], &err) < 0)
 			goto fail;
+	if (bvhlab_options_check(&t->opts, &err) < 0)
+		goto fail;
 	if (cli_load_scene(scene, subdivide, &t->scene, &err) < 0)
 		goto fail;
 	return 0;

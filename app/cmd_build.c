@@ -5,6 +5,7 @@
 
 #include "cli.h"
 #include "harness/harness_measure.h"
+#include "harness/isolate.h"
 #include "harness/harness_series.h"
 #include "util/util.h"
 
@@ -28,7 +29,11 @@ static const char usage[] =
 	"                   in order; timed apart, SAH before and after printed)\n"
 	"  -R KEY=VALUE     an option of the last --refine stage (repeatable)\n"
 	"\n"
-	"exit status: 0 valid tree, 1 build failed or tree invalid, 2 bad arguments.\n";
+	"The plugin is loaded and run in a child process, as `bvhlab run` does: one\n"
+	"that crashes, exits or throws (a C++ static constructor) is exit status 1.\n"
+	"\n"
+	"exit status: 0 valid tree, 1 build failed, crashed or tree invalid, 2 bad\n"
+	"arguments.\n";
 
 struct build_args {
 	unsigned long threads, repeat, subdivide, rays;
@@ -114,12 +119,12 @@ static int check(const bvhlab_scene *scene, const bvhlab_prims *prims, const bvh
 	bool dup = b->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
 	enum tree_verdict v = harness_measure_tree(tree, scene, &prims->input, dup, (uint32_t)rays,
 	                                           &m, &err);
-	if (!m.valid && !m.mismatches) {
-		printf("valid:      NO: %s\n", err.message);
-		return EXIT_RUNS_FAILED;
-	}
 	if (v == TREE_FAILED) {
 		fprintf(stderr, "bvhlab: %s\n", err.message);
+		return EXIT_RUNS_FAILED;
+	}
+	if (!m.valid && !m.mismatches) {
+		printf("valid:      NO: %s\n", err.message);
 		return EXIT_RUNS_FAILED;
 	}
 	printf("valid:      %s (structure; %llu of %lu rays disagree with brute force)\n",
@@ -212,18 +217,45 @@ out:
 	return status;
 }
 
+struct build_job {
+	const struct build_args *a;
+	const char *plugin, *scene;
+};
+
+/* Everything that touches the plugin, from loading it: in a child. */
+static void build_work(void *arg, void *report, size_t size)
+{
+	const struct build_job *job = arg;
+	struct cli_target t;
+	int status = EXIT_USAGE;
+	(void)size;
+	if (cli_target_open(&t, job->plugin, job->scene, (unsigned)job->a->subdivide,
+	                    job->a->options, job->a->option_count) == 0) {
+		status = build_and_check(t.plugin, &t.opts, t.scene, job->a);
+		cli_target_close(&t);
+	}
+	fflush(stdout); /* the child leaves without flushing */
+	*(int *)report = status;
+}
+
 int cmd_build(int argc, char **argv)
 {
 	struct build_args a = {.threads = 1, .repeat = 1, .rays = 256};
-	struct cli_target t;
 	int r = parse(argc, argv, &a);
+	if (r < 0 || a.repeat == 0)
+		return EXIT_USAGE;
 	/* Resolved once: the build and what is printed use this count. */
 	a.threads = a.threads ? a.threads : bvhlab_hardware_threads();
-	if (r < 0 || a.repeat == 0 ||
-	    cli_target_open(&t, argv[optind], argv[optind + 1], (unsigned)a.subdivide, a.options,
-	                    a.option_count) < 0)
-		return EXIT_USAGE;
-	int status = build_and_check(t.plugin, &t.opts, t.scene, &a);
-	cli_target_close(&t);
-	return status;
+	/* As a sweep's runs: a plugin that crashes (loading, say: a C++ static
+	 * constructor that throws) or exits is an exit status of 1, not its own. */
+	struct build_job job = {.a = &a, .plugin = argv[optind], .scene = argv[optind + 1]};
+	struct isolate_limits none = {.timeout_s = 1e9};
+	char why[512] = "";
+	int status = EXIT_RUNS_FAILED;
+	r = isolate_call(build_work, &job, &status, sizeof(status), &none, why, sizeof(why));
+	if (r == ISOLATE_REPORTED && status >= 0 && status <= EXIT_USAGE)
+		return status;
+	fprintf(stderr, "bvhlab: plugin '%s' on %s: %s\n", job.plugin, job.scene,
+	        r == ISOLATE_REPORTED ? "sent back a malformed status" : why);
+	return EXIT_RUNS_FAILED;
 }

@@ -11,7 +11,7 @@
 #include "plan/plan.h"
 
 static const char usage[] =
-	"usage: bvhlab merge PART... --out DIR [--plan PLAN.json]\n"
+	"usage: bvhlab merge PART... --out DIR [--plan PLAN.json] [--allow-mixed-versions]\n"
 	"\n"
 	"Joins results folders written by the commands of `bvhlab plan` (usually\n"
 	"DIR/parts/*) into DIR: results.json with every run in the plan's order,\n"
@@ -20,8 +20,9 @@ static const char usage[] =
 	"reports list the machines when there are several, since times from\n"
 	"different machines do not compare.\n"
 	"\n"
-	"Checks that every part comes from the plan (its hash), that no run is\n"
-	"claimed by two parts and that the plan's config has not changed. A partial\n"
+	"Checks that every part comes from the plan (its hash) and the same bvhlab\n"
+	"build (its bvhlab_version), that no run is claimed by two parts and that\n"
+	"the plan's config has not changed. A partial\n"
 	"set merges fine and names the runs still missing (`bvhlab plan --missing\n"
 	"DIR` prints their commands); merging again later replaces an earlier merge\n"
 	"of the same plan, and nothing else.\n"
@@ -29,6 +30,10 @@ static const char usage[] =
 	"options:\n"
 	"  --out DIR        where the merged results go (default plan: DIR/plan.json)\n"
 	"  --plan FILE      the plan the parts come from\n"
+	"  --allow-mixed-versions\n"
+	"                   merge parts run by different bvhlab builds (refused\n"
+	"                   otherwise: figures of other builds may not compare); each\n"
+	"                   run keeps its part's bvhlab_version\n"
 	"\n"
 	"exit status: 0 every run present and ok, 1 runs missing, failed or invalid,\n"
 	"2 bad arguments or parts (another plan, no results.json, a run twice).\n";
@@ -73,13 +78,19 @@ int cmd_merge(int argc, char **argv)
 {
 	static const struct option longopts[] = {
 		{"out", required_argument, NULL, 'o'}, {"plan", required_argument, NULL, 'p'},
-		{"help", no_argument, NULL, 'h'},      {NULL, 0, NULL, 0}};
+		{"help", no_argument, NULL, 'h'},
+		{"allow-mixed-versions", no_argument, NULL, 'm'}, {NULL, 0, NULL, 0}};
 	const char *out = NULL, *plan_path = NULL;
+	bool mixed = false;
 	char buf[PATH_MAX + 16];
 	int c;
 	while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
 		if (c == 'h')
 			return fputs(usage, stdout), 0;
+		if (c == 'm') {
+			mixed = true;
+			continue;
+		}
 		if (c != 'o' && c != 'p')
 			return EXIT_USAGE;
 		*(c == 'o' ? &out : &plan_path) = optarg;
@@ -95,7 +106,7 @@ int cmd_merge(int argc, char **argv)
 	bvhlab_error err = {{0}};
 	int status = EXIT_USAGE;
 	if (plan_file_load(&plan, plan_path, NULL, &err) == 0 &&
-	    plan_merge(&plan, (const char *const *)argv + optind, (size_t)(argc - optind), out, &sum,
+	    plan_merge(&plan, (const char *const *)argv + optind, (size_t)(argc - optind), out, mixed, &sum,
 	               &err) == 0)
 		status = report(&plan, &sum, out);
 	else

@@ -44,7 +44,7 @@ static const char usage[] =
 	"                   --force such a folder is refused)\n"
 	"  --threads LIST   build thread counts, e.g. 1,2,0 (0 = one per physical core;\n"
 	"                   overrides \"threads\")\n"
-	"  --repeat N       timed builds per run (overrides \"repeat\")\n"
+	"  --repeat N       timed builds per run (overrides \"repeat\"; not with a plan)\n"
 	"  --only IDS       run just these runs (ids as `bvhlab plan` lists them: the\n"
 	"                   order scenes x builders x thread counts, one for a serial\n"
 	"                   builder, from 0), e.g. 3,7,10-12\n"
@@ -161,6 +161,12 @@ static int select_runs(struct run_args *a, bvhlab_error *err)
 		/* Thread counts are part of a run's identity: other ones renumber the runs. */
 		error_set(err, "--threads cannot be combined with --only or a plan: it changes the "
 		          "runs and their ids (edit the config and plan again)");
+		return -1;
+	}
+	if (a->repeat && a->opts.plan) {
+		/* Every part of a plan measures alike, or the merge mixes sample counts. */
+		error_set(err, "--repeat cannot be combined with a plan: its parts would measure "
+		          "with other repeat counts than the plan's (edit the config and plan again)");
 		return -1;
 	}
 	a->opts.only = a->only;

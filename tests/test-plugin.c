@@ -137,6 +137,11 @@ static void test_phases(void)
 	CHECK_CONTAINS(err.message, "reported phase 'device' (-1 ms)");
 	CHECK_INT(build_with(p, "phases=too_many", &tree, &err), -EPROTO);
 	CHECK_CONTAINS(err.message, "'p8' (more than 8 phases)");
+	CHECK_INT(build_with(p, "phases=huge", &tree, &err), -EPROTO);
+	CHECK_CONTAINS(err.message, "'device' (2e+12 ms): times are finite, >= 0 and at most 1e12");
+	CHECK_INT(build_with(p, "phases=long", &tree, &err), -EPROTO);
+	CHECK_CONTAINS(err.message, "'device' (5000 ms) in a build that took");
+	CHECK_CONTAINS(err.message, "a phase is part of its build, never longer");
 	bvhlab_tree_finish(&tree);
 	bvhlab_plugin_close(p);
 }

@@ -40,28 +40,57 @@ static int entry_array(struct config *cfg, const char *key, size_t size, const c
 	return 0;
 }
 
-/* Whether s is UTF-8 (no overlong forms, surrogates or code points past
- * U+10FFFF): names go into results.json, which JSON readers must read. */
-static bool utf8_valid(const char *s)
+/* The code point at *p (UTF-8, advancing p), or -1 for no valid UTF-8
+ * (overlong forms, surrogates, past U+10FFFF). */
+static int32_t next_code_point(const unsigned char **p)
+{
+	const unsigned char *q = *p;
+	int n = *q < 0x80 ? 0 : (*q & 0xe0) == 0xc0 ? 1 : (*q & 0xf0) == 0xe0 ? 2
+	        : (*q & 0xf8) == 0xf0 ? 3 : -1;
+	if (n < 0 || (n == 1 && *q < 0xc2) || (n == 3 && *q > 0xf4))
+		return -1;
+	uint32_t cp = *q & (0x7f >> n);
+	for (int k = 1; k <= n; k++) {
+		if ((q[k] & 0xc0) != 0x80)
+			return -1;
+		cp = cp << 6 | (q[k] & 0x3f);
+	}
+	if ((n == 2 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
+	    (n == 3 && (cp < 0x10000 || cp > 0x10ffff)))
+		return -1;
+	*p = q + n + 1;
+	return (int32_t)cp;
+}
+
+/* Characters that reorder or hide what follows them in a report or a
+ * terminal: U+061C, U+200E/F, U+202A-E, U+2066-9. */
+static bool bidi_control(uint32_t cp)
+{
+	return cp == 0x61c || cp == 0x200e || cp == 0x200f || (cp >= 0x202a && cp <= 0x202e) ||
+	       (cp >= 0x2066 && cp <= 0x2069);
+}
+
+/* What is wrong with a name, written into why; false when nothing.
+ * Names go into results.json (JSON readers must read them), reports and
+ * progress lines: printable text, something besides blanks. */
+static bool bad_name(const char *s, char *why, size_t size)
 {
 	const unsigned char *p = (const unsigned char *)s;
+	bool visible = false;
 	while (*p) {
-		int n = *p < 0x80 ? 0 : (*p & 0xe0) == 0xc0 ? 1 : (*p & 0xf0) == 0xe0 ? 2
-		        : (*p & 0xf8) == 0xf0 ? 3 : -1;
-		if (n < 0 || (n == 1 && *p < 0xc2) || (n == 3 && *p > 0xf4))
-			return false;
-		uint32_t cp = *p & (0x7f >> n);
-		for (int k = 1; k <= n; k++) {
-			if ((p[k] & 0xc0) != 0x80)
-				return false;
-			cp = cp << 6 | (p[k] & 0x3f);
-		}
-		if ((n == 2 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
-		    (n == 3 && (cp < 0x10000 || cp > 0x10ffff)))
-			return false;
-		p += n + 1;
+		int32_t cp = next_code_point(&p);
+		if (cp < 0)
+			return snprintf(why, size, "is not valid UTF-8 (results.json could not be read)"),
+			       true;
+		if (cp < 0x20 || (cp >= 0x7f && cp < 0xa0) || bidi_control((uint32_t)cp))
+			return snprintf(why, size, "holds %s U+%04X", bidi_control((uint32_t)cp)
+			                ? "the bidirectional control" : "the control character",
+			                (unsigned)cp), true;
+		visible = visible || cp != ' ';
 	}
-	return true;
+	if (!visible)
+		snprintf(why, size, "is %s", *s ? "only blanks" : "empty");
+	return !visible;
 }
 
 /* Scene and builder names label runs and reports: two alike would mix them up. */
@@ -70,11 +99,12 @@ static int unique_names(const struct config *cfg, const cJSON *array, const char
 {
 	size_t i = 0;
 	for (const cJSON *e = array->child; e; e = e->next, i++) {
-		if (!utf8_valid(names[i])) {
+		char why[96];
+		if (bad_name(names[i], why, sizeof(why))) {
 			const cJSON *name = config_member(e, "name");
 			return config_error(cfg, name ? name : e, false, err,
-			                    "%s[%zu]: its %s name is not valid UTF-8 (results.json "
-			                    "could not be read): give it a \"name\"", key, i, what);
+			                    "%s[%zu]: its %s name %s: give it a \"name\" of printable "
+			                    "text", key, i, what, why);
 		}
 		for (size_t j = 0; j < i; j++) {
 			if (strcmp(names[i], names[j]) != 0)
@@ -402,5 +432,9 @@ int config_apply_options(const struct config *cfg, const struct config_builder *
 			return grid_note(rc, m, at, err);
 		}
 	}
+	bvhlab_error inner = { "" };
+	if (bvhlab_options_check(opts, &inner) < 0)
+		return config_error(cfg, b->options, true, err, "builder '%s': %s", b->name,
+		                    inner.message);
 	return 0;
 }

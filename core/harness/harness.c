@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include "harness/harness.h"
@@ -71,6 +72,7 @@ struct series_report {
 	uint32_t phase_count;
 	bvhlab_phase phases[BVHLAB_MAX_PHASES];
 	uint32_t frame_count;  /* frames done, after samples[] (an animated scene) */
+	bool in_frames;        /* the frames began: a death after keeps the frames done */
 	char error[sizeof(((bvhlab_error *)0)->message)];
 	double samples[];      /* [repeat], then struct frame_metrics [frames] */
 };
@@ -192,6 +194,18 @@ static int image_buffers(const struct series_job *job, size_t n, uint32_t **node
 	return (job->heat_path && !*nodes) || (job->shade_path && !*shade) ? -ENOMEM : 0;
 }
 
+/* Why no ray was traced; out of memory with its limit, as a build's says. */
+static void rays_error(const struct series_job *job, struct series_report *rep, int r)
+{
+	uint64_t limit = harness_run_limits(job->h->cfg, job->hb->cb).memory_bytes;
+	char note[64] = "";
+	if (r == -ENOMEM && limit && job->h->cfg->isolate)
+		snprintf(note, sizeof(note), " (under memory_limit_mb = %llu)",
+		         (unsigned long long)(limit >> 20));
+	snprintf(rep->rays.error, sizeof(rep->rays.error), "%s%s",
+	         r == -ENOMEM ? "out of memory tracing the rays" : strerror(-r), note);
+}
+
 /* Traversal statistics on the valid tree, and the raw image data. A
  * failure here costs the numbers, not the run: the tree itself is fine. */
 static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
@@ -226,7 +240,7 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
 	/* The run stays ok (its tree is); its "rays" says why there are no figures. */
 	if (r < 0 && !rep->rays.error[0])
-		snprintf(rep->rays.error, sizeof(rep->rays.error), "%s", strerror(-r));
+		rays_error(job, rep, r);
 	free(nodes);
 	free(shade);
 }
@@ -260,6 +274,7 @@ static void series_work(void *arg, void *report, size_t size)
 		measure(job, &s.tree, rep, &err);
 		if (rep->status == SERIES_OK)
 			trace_rays(job, &s.tree, rep);
+		rep->in_frames = rep->status == SERIES_OK;
 		int f = rep->status != SERIES_OK ? 0 : harness_frames_after_series(cfg, job->hb,
 			&job->h->anim, job->scene, job->run->key.threads, rep->samples, s.repeat, &s.tree,
 			&rep->frame_count, &err); /* an animated scene's frames: harness_frames.c */
@@ -333,6 +348,11 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	if (outcome == ISOLATE_REPORTED) {
 		report_to_run(rep, h->cfg->repeat, h->anim.frames, run);
 	} else {
+		/* Dead among the frames: those done stay, the one that killed it is named. */
+		if (outcome > 0 && rep->in_frames) {
+			report_to_run(rep, h->cfg->repeat, h->anim.frames, run);
+			harness_frames_death(job->hb->cb, rep->frame_count, why, sizeof(why));
+		}
 		run->status = outcome < 0 ? "failed" : outcomes[outcome];
 		run->error = why;
 	}
@@ -390,8 +410,10 @@ static void run_one(struct harness *h, struct series_job *job)
 		return;
 	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double) +
 	              harness_frames_size(&h->anim);
-	struct series_report *rep = calloc(1, size);
-	if (!rep) {
+	/* Shared with the run's child: what it finished survives its death. */
+	struct series_report *rep = mmap(NULL, size, PROT_READ | PROT_WRITE,
+	                                 MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+	if (rep == MAP_FAILED) {
 		run.error = "out of memory for the run's samples";
 		record(h, &run);
 		return;
@@ -404,7 +426,7 @@ static void run_one(struct harness *h, struct series_job *job)
 	run_series(h, job, &run, rep, size);
 	queue_tree(h, job, &run, rep);
 	h->shade_done = h->shade_done || (job->shade_path && rep->shade_written);
-	free(rep);
+	munmap(rep, size);
 }
 
 /* The scene's runs of the list, on the loaded scene. */

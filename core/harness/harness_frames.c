@@ -140,9 +140,12 @@ static void measure(const struct frames_job *job, const bvhlab_scene *scene,
 		const bvhlab_trace_timing *t = &m.primary[rs.main];
 		fm->nodes_per_ray = t->stats.rays ? (double)t->stats.nodes_visited / t->stats.rays : 0;
 		fm->mrays_per_s = t->mrays_best;
+		fm->traced = t->stats.rays > 0 && t->mrays_best > 0;
 	}
+	/* Untraced rays are not free: such a frame's cost stays unknown. */
+	fm->costed = fm->traced || job->cfg->rays_per_frame == 0;
 	fm->cost_ms = fm->update_ms;
-	if (fm->mrays_per_s > 0)
+	if (fm->traced)
 		fm->cost_ms += (double)job->cfg->rays_per_frame / (fm->mrays_per_s * 1e3);
 }
 
@@ -217,4 +220,16 @@ int harness_frames_after_series(const struct config *cfg, const struct harness_b
 	                         .spatial_splits = desc->flags & BVHLAB_BUILDER_SPATIAL_SPLITS,
 	                         .first_ms = median};
 	return harness_frames_run(&job, tree, (struct frame_metrics *)(samples + repeat), count, err);
+}
+
+void harness_frames_death(const struct config_builder *cb, uint32_t f, char *why, size_t size)
+{
+	char was[512];
+	const struct config_animation *a = cb->animation;
+	snprintf(was, sizeof(was), "%s", why);
+	if (a && !(a->rebuild_every && f % a->rebuild_every == 0))
+		snprintf(why, size, "frame %u, updated by '%s'%s: %s", f, a->update,
+		         a->refine_count ? " and its refine stages" : "", was);
+	else
+		snprintf(why, size, "frame %u, rebuilt by '%s': %s", f, cb->plugin, was);
 }

@@ -60,4 +60,11 @@ int harness_frames_after_series(const struct config *cfg, const struct harness_b
                                 uint32_t threads, double *samples, uint32_t repeat,
                                 bvhlab_tree *tree, uint32_t *count, bvhlab_error *err);
 
+/*
+ * A run's child died (why: how) during frame f, the first of the frames
+ * not done: why rewritten to name the frame and what it ran then ("frame
+ * 3, updated by 'refit': killed by SIGSEGV ...").
+ */
+void harness_frames_death(const struct config_builder *cb, uint32_t f, char *why, size_t size);
+
 #endif

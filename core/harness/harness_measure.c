@@ -2,6 +2,7 @@
  * Measuring one built tree: what a sweep's run child and `bvhlab build`
  * both do after the builds, so the two never drift apart.
  */
+#include <errno.h>
 #include <string.h>
 
 #include <bvhlab/epo.h>
@@ -18,7 +19,11 @@ static enum tree_verdict validate(const bvhlab_tree *tree, const bvhlab_scene *s
                                   const bvhlab_build_input *input, bool spatial_splits,
                                   uint32_t rays, struct tree_measure *m, bvhlab_error *err)
 {
-	m->valid = bvhlab_validate_tree(tree, input, spatial_splits, err) == 0;
+	int r = bvhlab_validate_tree(tree, input, spatial_splits, err);
+	m->valid = r == 0;
+	/* No memory to check the tree says nothing about the tree. */
+	if (r == -ENOMEM)
+		return TREE_FAILED;
 	if (!m->valid)
 		return TREE_INVALID;
 	if (rays == 0)

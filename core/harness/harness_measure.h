@@ -17,7 +17,7 @@
 enum tree_verdict {
 	TREE_OK,      /* valid: statistics and EPO measured */
 	TREE_INVALID, /* broken structure, or rays that disagree with brute force */
-	TREE_FAILED,  /* the ray check itself could not run */
+	TREE_FAILED,  /* a check could not run (out of memory, say): no verdict */
 };
 
 struct tree_measure {

@@ -53,6 +53,24 @@ static bool same_hit(const bvhlab_hit *a, const bvhlab_hit *b)
 	       memcmp(&a->u, &b->u, sizeof(a->u)) == 0 && memcmp(&a->v, &b->v, sizeof(a->v)) == 0;
 }
 
+/* A traversal's failure joins the others' in m->error ("; " between), on
+ * one line: a device's build log ends in a newline and may hold more. */
+static void add_error(struct ray_metrics *m, const char *text)
+{
+	size_t used = strlen(m->error), n = strlen(text);
+	while (n > 0 && (text[n - 1] == '\n' || text[n - 1] == '\r' || text[n - 1] == ' '))
+		n--;
+	if (used && strstr(m->error, text))
+		return; /* the diffuse batch's repeat of a primary one's */
+	if (used && used + 2 < sizeof(m->error)) {
+		memcpy(m->error + used, "; ", 2);
+		used += 2;
+	}
+	for (size_t k = 0; k < n && used + 1 < sizeof(m->error); k++)
+		m->error[used++] = text[k] == '\n' || text[k] == '\r' || text[k] == '\t' ? ' ' : text[k];
+	m->error[used < sizeof(m->error) ? used : sizeof(m->error) - 1] = '\0';
+}
+
 /* One traversal of a batch; a failure's reason, named after the
  * traversal, goes to m->error. */
 static int measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhlab_ray *rays,
@@ -69,8 +87,7 @@ static int measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvh
 		if (!err.message[0])
 			error_set(&err, "%s", strerror(-r));
 		error_prefix(&err, "%s", bvhlab_traversal_name(o->traversal));
-		_Static_assert(sizeof(m->error) == sizeof(err.message), "error sizes");
-		memcpy(m->error, err.message, sizeof(m->error));
+		add_error(m, err.message);
 	}
 	return r;
 }

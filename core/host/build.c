@@ -22,7 +22,7 @@ struct bvhlab_build_ctx {
 	bvhlab_tree *tree;
 	bvhlab_error *err;
 	bool error_set;
-	char bad_phase[96];    /* the first phase report host_phase refused, or "" */
+	char bad_phase[192];   /* the first phase report refused and why, or "" */
 	bool pinning;          /* plan is set: pin_thread binds */
 	struct pin_plan plan;
 	cpu_set_t caller_mask; /* restored after build(): the caller may be a worker */
@@ -168,9 +168,15 @@ static void host_phase(bvhlab_build_ctx *ctx, const char *name, double ms)
 	uint32_t k = 0;
 	if (ctx->bad_phase[0])
 		return;
-	if (!phase_name_ok(name) || !(ms >= 0 && ms <= 1e12)) {
-		snprintf(ctx->bad_phase, sizeof(ctx->bad_phase), "'%.40s' (%g ms)",
-		         name ? name : "(null)", ms);
+	if (!phase_name_ok(name)) {
+		snprintf(ctx->bad_phase, sizeof(ctx->bad_phase), "'%.40s' (%g ms): names are "
+		         "[a-z0-9_], 1 to %d characters", name ? name : "(null)", ms,
+		         BVHLAB_PHASE_NAME_MAX - 1);
+		return;
+	}
+	if (!(ms >= 0 && ms <= 1e12)) {
+		snprintf(ctx->bad_phase, sizeof(ctx->bad_phase), "'%s' (%g ms): times are finite, "
+		         ">= 0 and at most 1e12 ms", name, ms);
 		return;
 	}
 	while (k < t->phase_count && strcmp(t->phases[k].name, name) != 0)
@@ -240,15 +246,25 @@ static void pinning_end(struct bvhlab_build_ctx *ctx)
 	ctx->pinning = false;
 }
 
+/* A phase is part of its build: one longer than the whole call is a
+ * plugin's mistake (a unit, a clock), refused like a negative one. The
+ * margin is for the clocks' resolution. */
+static void phases_within(struct bvhlab_build_ctx *ctx, double call_ms)
+{
+	const bvhlab_tree *t = ctx->tree;
+	for (uint32_t k = 0; !ctx->bad_phase[0] && k < t->phase_count; k++)
+		if (t->phases[k].ms > call_ms * 1.01 + 0.05)
+			snprintf(ctx->bad_phase, sizeof(ctx->bad_phase), "'%s' (%g ms) in a build that "
+			         "took %.3g ms: a phase is part of its build, never longer",
+			         t->phases[k].name, t->phases[k].ms, call_ms);
+}
+
 /* The plugin's status, with a message that names it whatever it said. */
 static int explain(const struct bvhlab_build_ctx *ctx, int r)
 {
 	const char *name = ctx->builder->name;
 	if (r == 0 && ctx->bad_phase[0]) {
-		error_set(ctx->err,
-		          "builder '%s' reported phase %s: names are [a-z0-9_], 1 to %d "
-		          "characters, at most %d per build, times finite and >= 0",
-		          name, ctx->bad_phase, BVHLAB_PHASE_NAME_MAX - 1, BVHLAB_MAX_PHASES);
+		error_set(ctx->err, "builder '%s' reported phase %s", name, ctx->bad_phase);
 		return -EPROTO;
 	}
 	if (r < 0 && !ctx->error_set)
@@ -289,8 +305,10 @@ static int call_plugin(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 	int r = pinning_begin(&ctx);
 	if (r < 0)
 		return r;
+	double t0 = util_now();
 	r = in_place ? in_place(&host_table, &ctx, &in, &out)
 	             : b->build(&host_table, &ctx, &in, &out);
+	phases_within(&ctx, (util_now() - t0) * 1e3);
 	pinning_end(&ctx);
 	tree->node_count = out.node_count;
 	tree->index_count = out.index_count;

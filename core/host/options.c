@@ -178,6 +178,12 @@ int bvhlab_options_set_string(bvhlab_options *opts, const char *key, const char 
 		                 opts->builder->name, d->choices, v);
 		return -EINVAL;
 	}
+	/* An option with a default means something by it: empty is no value. */
+	if (!*v && d->def_string && *d->def_string) {
+		error_set(err, "option '%s' of builder '%s' must not be empty (default '%s')", key,
+		          opts->builder->name, d->def_string);
+		return -EINVAL;
+	}
 	char *copy = strdup(v);
 	if (!copy)
 		return -ENOMEM;
@@ -283,4 +289,32 @@ void bvhlab_option_format(const bvhlab_option_value *v, char *buf, size_t size)
 	default:
 		snprintf(buf, size, "null");
 	}
+}
+
+/* An INT or FLOAT option's value as a double; false for other types. */
+static bool numeric(const bvhlab_options *opts, int k, double *v)
+{
+	uint32_t type = opts->builder->options[k].type;
+	*v = type == BVHLAB_OPTION_INT ? (double)opts->values[k].i : opts->values[k].f;
+	return type == BVHLAB_OPTION_INT || type == BVHLAB_OPTION_FLOAT;
+}
+
+int bvhlab_options_check(const bvhlab_options *opts, bvhlab_error *err)
+{
+	const bvhlab_builder *b = opts->builder;
+	for (uint32_t k = 0; k < b->option_count; k++) {
+		const char *name = b->options[k].name;
+		char max[128];
+		double lo, hi;
+		if (strncmp(name, "min_", 4) != 0 ||
+		    (size_t)snprintf(max, sizeof(max), "max_%s", name + 4) >= sizeof(max))
+			continue;
+		int j = bvhlab_options_find(opts, max);
+		if (j >= 0 && numeric(opts, (int)k, &lo) && numeric(opts, j, &hi) && lo > hi) {
+			error_set(err, "option '%s' of builder '%s' is %.15g, more than '%s' (%.15g)",
+			          name, b->name, lo, max, hi);
+			return -EINVAL;
+		}
+	}
+	return 0;
 }

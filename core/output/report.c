@@ -23,20 +23,6 @@ static const char *num(char *buf, size_t size, const cJSON *o, const char *path,
 	return buf;
 }
 
-/* CSV field: quoted when it holds a separator, quote or newline. */
-static void csv_field(struct strbuf *sb, const char *s, bool last)
-{
-	if (strpbrk(s, ",\"\n\r")) {
-		sb_printf(sb, "\"");
-		for (const char *p = s; *p; p++)
-			sb_printf(sb, *p == '"' ? "\"\"" : "%c", *p);
-		sb_printf(sb, "\"");
-	} else {
-		sb_printf(sb, "%s", s);
-	}
-	sb_printf(sb, last ? "\n" : ",");
-}
-
 static const char *const csv_numbers[][2] = {
 	{"threads", "%.0f"},
 	{"build_ms.median", "%.4f"},
@@ -104,27 +90,27 @@ static void csv_phases(struct strbuf *sb, const cJSON *phases)
 		if (cJSON_IsNumber(p) && p->string)
 			sb_printf(&f, "%s%s=%.4f", f.len ? ";" : "", p->string, p->valuedouble);
 	char *text = sb_take(&f);
-	csv_field(sb, text ? text : "", false);
+	report_csv_field(sb, text ? text : "", false);
 	free(text);
 }
 
 static void csv_row(struct strbuf *sb, const cJSON *run)
 {
 	char buf[64];
-	csv_field(sb, report_str(run, "scene"), false);
-	csv_field(sb, report_str(run, "builder"), false);
-	csv_field(sb, report_str(run, "plugin"), false);
-	csv_field(sb, report_str(run, "status"), false);
+	report_csv_field(sb, report_str(run, "scene"), false);
+	report_csv_field(sb, report_str(run, "builder"), false);
+	report_csv_field(sb, report_str(run, "plugin"), false);
+	report_csv_field(sb, report_str(run, "status"), false);
 	for (size_t k = 0; k < sizeof(csv_numbers) / sizeof(csv_numbers[0]); k++)
-		csv_field(sb, num(buf, sizeof(buf), run, csv_numbers[k][0], csv_numbers[k][1]), false);
+		report_csv_field(sb, num(buf, sizeof(buf), run, csv_numbers[k][0], csv_numbers[k][1]), false);
 	const cJSON *trav = report_at(run, "rays.traversal");
-	csv_field(sb, cJSON_IsString(trav) ? trav->valuestring : "", false);
+	report_csv_field(sb, cJSON_IsString(trav) ? trav->valuestring : "", false);
 	const cJSON *valid = report_at(run, "validation.valid");
-	csv_field(sb, cJSON_IsBool(valid) ? (cJSON_IsTrue(valid) ? "true" : "false") : "", false);
-	csv_field(sb, report_str(run, "device.name"), false);
-	csv_field(sb, report_str(run, "device.kind"), false);
+	report_csv_field(sb, cJSON_IsBool(valid) ? (cJSON_IsTrue(valid) ? "true" : "false") : "", false);
+	report_csv_field(sb, report_str(run, "device.name"), false);
+	report_csv_field(sb, report_str(run, "device.kind"), false);
 	csv_phases(sb, cJSON_GetObjectItemCaseSensitive(run, "build_phases"));
-	csv_field(sb, report_str(run, "error"), true);
+	report_csv_field(sb, report_str(run, "error"), true);
 }
 
 char *report_csv(const cJSON *doc)
@@ -192,8 +178,9 @@ static void md_own_scales(struct strbuf *sb, const cJSON *scene, const cJSON *co
 		double lo, hi;
 		if (!*report_str(runs[k], "heat_image") || !report_heat_scale(scene, runs[k], &lo, &hi))
 			continue;
-		sb_printf(sb, "%s%s x%.0f %.0f to %.0f", sep, report_str(runs[k], "builder"),
-		          report_num(runs[k], "threads"), lo, hi);
+		sb_printf(sb, "%s", sep);
+		report_md_text(sb, report_str(runs[k], "builder"));
+		sb_printf(sb, " x%.0f %.0f to %.0f", report_num(runs[k], "threads"), lo, hi);
 		sep = ", ";
 	}
 }
@@ -207,8 +194,11 @@ static void md_images(struct strbuf *sb, const cJSON *scene, const cJSON *const 
 	const char *legend = report_str(scene, "images.legend");
 	const char *kind = strcmp(report_str(scene, "images.heat_scale"), "log") == 0 ? "log"
 	                                                                              : "linear";
-	if (*shaded)
-		sb_printf(sb, "\n![%s](%s)\n", report_str(scene, "name"), shaded);
+	if (*shaded) {
+		sb_printf(sb, "\n![");
+		report_md_text(sb, report_str(scene, "name"));
+		sb_printf(sb, "](%s)\n", shaded);
+	}
 	if (report_heat_scales_differ(scene, runs, n)) {
 		sb_printf(sb, "\nHeat maps (nodes visited per primary ray, %s scale) per builder in "
 		              "report.html, drawn on different scales, each its own: ", kind);
@@ -227,10 +217,15 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 {
 	const char *name = report_str(scene, "name");
 	char buf[64];
-	sb_printf(sb, "\n## %s\n\n%s, %s triangles", name, report_str(scene, "source"),
-	          num(buf, sizeof(buf), scene, "triangles", "%.0f"));
-	if (*report_str(scene, "error"))
-		sb_printf(sb, ". **Could not be loaded:** %s", report_str(scene, "error"));
+	sb_printf(sb, "\n## ");
+	report_md_text(sb, name);
+	sb_printf(sb, "\n\n");
+	report_md_text(sb, report_str(scene, "source"));
+	sb_printf(sb, ", %s triangles", num(buf, sizeof(buf), scene, "triangles", "%.0f"));
+	if (*report_str(scene, "error")) {
+		sb_printf(sb, ". **Could not be loaded:** ");
+		report_md_text(sb, report_str(scene, "error"));
+	}
 	sb_printf(sb, "\n\n| builder | threads | status | median ms | min ms | max ms | cold ms "
 	              "| Mtris/s | speedup | SAH cost | EPO | peak bytes | primary Mrays/s (best tile) "
 	              "| primary nodes/ray | diffuse Mrays/s (best tile) | diffuse nodes/ray | nodes "
@@ -258,7 +253,13 @@ char *report_markdown(const cJSON *doc)
 	const cJSON *run, *scene;
 	cJSON_ArrayForEach(run, runs)
 		ok += strcmp(report_str(run, "status"), "ok") == 0;
-	sb_printf(&sb, "# bvhlab report\n\nbvhlab %s, %s. Machine: %s, %s cores, %s available "
+	sb_printf(&sb, "# bvhlab report\n\nbvhlab ");
+	report_md_text(&sb, report_str(doc, "bvhlab_version"));
+	sb_printf(&sb, ", ");
+	report_md_text(&sb, report_str(doc, "created"));
+	sb_printf(&sb, ". Machine: ");
+	report_md_text(&sb, report_str(doc, "machine.cpu"));
+	sb_printf(&sb, ", %s cores, %s available "
 	               "to this process.\n\n%d runs, %d ok. Times are build times in ms over "
 	               "the timed repeats; SAH cost with c_trav = c_isect = 1, normalised by "
 	               "the root's surface area; EPO: end-point overlap, sampled. Peak bytes: "
@@ -275,7 +276,6 @@ char *report_markdown(const cJSON *doc)
 	               "Marks: noisy where the build repeats spread more than 5 %% or a run "
 	               "of the same tree traced more than 5 %% faster or slower; busy where "
 	               "other processes kept more CPUs busy than the run left free.\n",
-	          report_str(doc, "bvhlab_version"), report_str(doc, "created"), report_str(doc, "machine.cpu"),
 	          num((char[32]){0}, 32, doc, "machine.cores", "%.0f"),
 	          num((char[32]){0}, 32, doc, "machine.threads_available", "%.0f"), total, ok);
 	struct report_index ix;

@@ -135,10 +135,13 @@ void report_breakeven_md(struct strbuf *sb, const struct report_index *ix, const
 		const cJSON *base = base_of(ix, ref, runs[k], &elsewhere);
 		if ((!base && !elsewhere) || base == runs[k])
 			continue;
-		if (!header)
-			sb_printf(sb, "\n### Break-even against %s\n\n%s\n\n| builder | threads "
-			              "| median ms | reference ms | primary rays | diffuse rays |\n"
-			              "|---|---:|---:|---:|---|---|\n", ref, intro);
+		if (!header) {
+			sb_printf(sb, "\n### Break-even against ");
+			report_md_text(sb, ref);
+			sb_printf(sb, "\n\n%s\n\n| builder | threads | median ms | reference ms "
+			              "| primary rays | diffuse rays |\n|---|---:|---:|---:|---|---|\n",
+			          intro);
+		}
 		header = true;
 		sb_printf(sb, "|");
 		report_md_cell(sb, report_str(runs[k], "builder"));

@@ -5,6 +5,7 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cJSON.h>
@@ -110,6 +111,15 @@ const char *report_plain(char *buf, size_t size, double v)
 	return buf;
 }
 
+const char *report_figure(char *buf, size_t size, double v, int decimals)
+{
+	if (isfinite(v))
+		snprintf(buf, size, "%.*f", decimals, v);
+	else
+		snprintf(buf, size, "not measured");
+	return buf;
+}
+
 const char *report_phases(char *buf, size_t size, const cJSON *run)
 {
 	const cJSON *p;
@@ -134,11 +144,50 @@ bool report_any_phases(const cJSON *const *runs, size_t n)
 	return false;
 }
 
-/* Markdown cell text: pipes and newlines would break the table. */
+/* Markdown text: raw HTML (a <script>, a <!-- that hides the rest) as
+ * entities, pipes that would split a table cell escaped, line breaks that
+ * would end the table's row or the paragraph flattened. */
+void report_md_text(struct strbuf *sb, const char *text)
+{
+	for (const unsigned char *p = (const unsigned char *)text; *p; p++) {
+		if (*p == '&' || *p == '<' || *p == '>')
+			sb_printf(sb, *p == '&' ? "&amp;" : *p == '<' ? "&lt;" : "&gt;");
+		else if (*p == '|')
+			sb_printf(sb, "\\|");
+		else
+			sb_printf(sb, "%c", *p < 0x20 || *p == 0x7f ? ' ' : *p);
+	}
+}
+
 void report_md_cell(struct strbuf *sb, const char *s)
 {
 	sb_printf(sb, " ");
-	for (const char *p = s; *p; p++)
-		sb_printf(sb, *p == '|' ? "\\|" : *p == '\n' ? " " : "%c", *p);
+	report_md_text(sb, s);
 	sb_printf(sb, " |");
+}
+
+/* Whether s reads as a number (-1.5, +3, 2e-7): left as it is in CSV. */
+static bool numeric_text(const char *s)
+{
+	char *end;
+	if (!*s)
+		return false;
+	strtod(s, &end);
+	return *end == '\0';
+}
+
+void report_csv_field(struct strbuf *sb, const char *s, bool last)
+{
+	/* A spreadsheet runs a cell that starts with = + - @ (or a tab or CR
+	 * before one) as a formula: such text gets a leading ' to stay text. */
+	bool formula = strchr("=+-@\t\r", s[0]) && s[0] && !numeric_text(s);
+	if (formula || strpbrk(s, ",\"\n\r")) {
+		sb_printf(sb, "\"%s", formula ? "'" : "");
+		for (const char *p = s; *p; p++)
+			sb_printf(sb, *p == '"' ? "\"\"" : "%c", *p);
+		sb_printf(sb, "\"");
+	} else {
+		sb_printf(sb, "%s", s);
+	}
+	sb_printf(sb, last ? "\n" : ",");
 }

@@ -38,12 +38,23 @@ bool report_heat_scales_differ(const cJSON *scene, const cJSON *const *runs, siz
 
 /* Text with & < > " ' escaped for HTML and SVG. */
 void report_escape(struct strbuf *sb, const char *text);
+/* v with `decimals`, or "not measured" for NaN (a figure absent or null).
+ * Returns buf. */
+const char *report_figure(char *buf, size_t size, double v, int decimals);
 /* A run's build_phases as "upload 1.50, device 2.50" ("" when none). */
 const char *report_phases(char *buf, size_t size, const cJSON *run);
 /* Whether some run has build_phases (the tables then add their column). */
 bool report_any_phases(const cJSON *const *runs, size_t n);
-/* " text |": a Markdown table cell, pipes escaped and newlines flattened. */
+/* Text for Markdown: & < > as entities (no raw HTML passes), pipes
+ * escaped, newlines and other control characters as spaces. */
+void report_md_text(struct strbuf *sb, const char *text);
+/* " text |": a Markdown table cell of report_md_text. */
 void report_md_cell(struct strbuf *sb, const char *text);
+/* A CSV field and its separator (',', or a newline when last): quoted
+ * when it holds a separator, quote or newline; text a spreadsheet would
+ * run as a formula (starting = + - @, not a number) quoted with a leading
+ * '. Every CSV writer's cells go through here. */
+void report_csv_field(struct strbuf *sb, const char *s, bool last);
 /* A plain number with the decimals its size needs ("2140", "21.4", "2.14"),
  * never an exponent; "" for NaN. Returns buf. */
 const char *report_plain(char *buf, size_t size, double v);

@@ -48,7 +48,7 @@ static void sum_up(const cJSON *run, struct strategy *s)
 		s->all_valid = s->all_valid && valid;
 		s->updates = s->updates || !is_true(f, "rebuilt");
 		s->update_ms += report_num(f, "update_ms");
-		s->cost_ms += report_num(f, "cost_ms");
+		s->cost_ms += report_num(f, "cost_ms"); /* NaN from one frame not measured on */
 		if (!valid || !isfinite(sah))
 			continue; /* an invalid frame's tree has no SAH worth the name */
 		s->sah_mean += sah;
@@ -114,7 +114,7 @@ static const struct strategy *cheapest(const struct strategy *s, size_t n, doubl
 	for (size_t k = 0; k < n; k++)
 		most = s[k].count > most ? s[k].count : most;
 	for (size_t k = 0; k < n; k++)
-		if (s[k].all_valid && s[k].count == most &&
+		if (s[k].all_valid && s[k].count == most && isfinite(s[k].cost_ms) &&
 		    (threads < 0 || report_num(s[k].run, "threads") == threads) &&
 		    (!best || s[k].cost_ms < best->cost_ms))
 			best = &s[k];
@@ -124,50 +124,67 @@ static const struct strategy *cheapest(const struct strategy *s, size_t n, doubl
 static void cheapest_line(struct strbuf *sb, const struct strategy *s, size_t n, bool html)
 {
 	const struct strategy *best = cheapest(s, n, -1);
+	bool any_valid = false;
+	char sah[32], update[32];
+	for (size_t k = 0; k < n; k++)
+		any_valid = any_valid || s[k].all_valid;
 	if (!best) {
-		sb_printf(sb, "%sNo strategy has every frame valid.%s\n", html ? "<p>" : "",
-		          html ? "</p>" : "\n");
+		sb_printf(sb, "%s%s%s\n", html ? "<p>" : "", any_valid ?
+		          "No strategy's cost was measured (its rays were not traced): none is named "
+		          "cheapest." : "No strategy has every frame valid.", html ? "</p>" : "\n");
 		return;
 	}
 	sb_printf(sb, html ? "<p><b>Cheapest over the animation: " : "**Cheapest over the "
 	                                                             "animation: ");
-	if (html)
-		report_escape(sb, report_str(best->run, "builder"));
-	else
-		sb_printf(sb, "%s", report_str(best->run, "builder"));
-	sb_printf(sb, " at %.0f thread%s%s, %.1f ms modelled over %d frames (%.1f ms of "
-	              "updates, mean SAH %.3f).", report_num(best->run, "threads"),
+	(html ? report_escape : report_md_text)(sb, report_str(best->run, "builder"));
+	sb_printf(sb, " at %.0f thread%s%s, %.1f ms modelled over %d frames (%s ms of "
+	              "updates, mean SAH %s).", report_num(best->run, "threads"),
 	          report_num(best->run, "threads") == 1 ? "" : "s", html ? "</b>" : "**",
-	          best->cost_ms, best->count, best->update_ms, best->sah_mean);
+	          best->cost_ms, best->count, report_figure(update, sizeof(update), best->update_ms, 1),
+	          report_figure(sah, sizeof(sah), best->sah_mean, 3));
 	sb_printf(sb, html ? "</p>\n" : "\n\n");
 }
 
 static const char *const head[] = {"strategy", "threads", "frames", "valid", "update ms",
                                    "mean SAH", "last SAH", "cost ms", "rebuild pays off"};
 
+/* The row's cells after the strategy's name, as text. */
+static void row_cells(const struct strategy *s, bool html, char (*cell)[32])
+{
+	snprintf(cell[0], 32, "%.0f", report_num(s->run, "threads"));
+	snprintf(cell[1], 32, "%d", s->count);
+	snprintf(cell[2], 32, "%s", s->all_valid ? "yes" : html ? "no" : "**no**");
+	report_figure(cell[3], 32, s->update_ms, 2);
+	report_figure(cell[4], 32, s->sah_mean, 3);
+	report_figure(cell[5], 32, s->sah_last, 3);
+	report_figure(cell[6], 32, s->cost_ms, 2);
+	cell[7][0] = '\0';
+	if (s->pays_off >= 0)
+		snprintf(cell[7], 32, "frame %d", s->pays_off);
+}
+
 static void md_row(struct strbuf *sb, const struct strategy *s)
 {
-	char off[32] = "";
-	if (s->pays_off >= 0)
-		snprintf(off, sizeof(off), "frame %d", s->pays_off);
-	sb_printf(sb, "| %s | %.0f | %d | %s | %.2f | %.3f | %.3f | %.2f | %s |\n",
-	          report_str(s->run, "builder"), report_num(s->run, "threads"), s->count,
-	          s->all_valid ? "yes" : "**no**", s->update_ms, s->sah_mean, s->sah_last,
-	          s->cost_ms, off);
+	char cell[8][32];
+	row_cells(s, false, cell);
+	sb_printf(sb, "|");
+	report_md_cell(sb, report_str(s->run, "builder"));
+	for (size_t k = 0; k < 8; k++)
+		report_md_cell(sb, cell[k]);
+	sb_printf(sb, "\n");
 }
 
 /* ---- HTML ----------------------------------------------------------------- */
 
 static void html_row(struct strbuf *sb, const struct strategy *s)
 {
+	char cell[8][32];
+	row_cells(s, true, cell);
 	sb_printf(sb, "<tr><td>");
 	report_escape(sb, report_str(s->run, "builder"));
-	sb_printf(sb, "</td><td>%.0f</td><td>%d</td><td>%s</td><td>%.2f</td><td>%.3f</td>"
-	              "<td>%.3f</td><td>%.2f</td><td>", report_num(s->run, "threads"), s->count,
-	          s->all_valid ? "yes" : "<b class=\"bad\">no</b>", s->update_ms, s->sah_mean,
-	          s->sah_last, s->cost_ms);
-	if (s->pays_off >= 0)
-		sb_printf(sb, "frame %d", s->pays_off);
+	for (size_t k = 0; k < 8; k++)
+		sb_printf(sb, k == 2 && !s->all_valid ? "</td><td><b class=\"bad\">%s</b>"
+		                                      : "</td><td>%s", cell[k]);
 	sb_printf(sb, "</td></tr>\n");
 }
 
@@ -189,14 +206,19 @@ static void charts(struct strbuf *sb, const struct report_index *ix, const struc
 			continue;
 		cJSON_ArrayForEach(f, s[k].frames) {
 			const char *g = report_str(s[k].run, "builder");
-			sum += report_num(f, "cost_ms");
-			sah[m] = (struct svg_point){.label = "", .group = g, .x = report_num(f, "frame"),
-			                            .y = report_num(f, "sah"),
-			                            .shape = svg_plugin_shape(report_str(s[k].run, "plugin"))};
-			svg_colour(report_builder_number(ix, g), sah[m].colour, sizeof(sah[m].colour));
-			cost[c] = sah[m++];
-			cost[c].mark = marks[k];
-			cost[c++].y = sum;
+			struct svg_point p = {.label = "", .group = g, .x = report_num(f, "frame"),
+			                      .shape = svg_plugin_shape(report_str(s[k].run, "plugin"))};
+			svg_colour(report_builder_number(ix, g), p.colour, sizeof(p.colour));
+			sum += report_num(f, "cost_ms"); /* NaN from the first frame not measured on */
+			if (isfinite(report_num(f, "sah"))) {
+				sah[m] = p;
+				sah[m++].y = report_num(f, "sah");
+			}
+			if (isfinite(sum)) {
+				cost[c] = p;
+				cost[c].mark = marks[k];
+				cost[c++].y = sum;
+			}
 		}
 	}
 	snprintf(title[0], sizeof(title[0]), "SAH over the frames, %.0f thread%s", threads,

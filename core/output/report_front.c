@@ -242,6 +242,12 @@ static void verdict(const struct front_table *t, int v, size_t k, char *buf, siz
 
 /* "2", or "2 (ran on 1)" for a 1-thread run standing in at 2 threads;
  * " on M2" after it when the runs come from several machines. */
+/* A figure as the tables print it, or "not measured" where it is not finite. */
+static const char *measured(char *buf, size_t size, double v)
+{
+	return isfinite(v) ? report_plain(buf, size, v) : report_figure(buf, size, v, 0);
+}
+
 static const char *threads_text(char *buf, size_t size, const struct report_index *ix,
                                 const struct front_entry *e)
 {
@@ -288,11 +294,11 @@ void report_front_md(struct strbuf *sb, const struct report_index *ix,
 			sb_printf(sb, "|");
 			report_md_cell(sb, report_str(t.e[k].run, "builder"));
 			report_md_cell(sb, threads_text(buf, sizeof(buf), ix, &t.e[k]));
-			sb_printf(sb, " %s | %.3f |", report_plain(buf, sizeof(buf), t.p[0][k].time),
-			          t.p[0][k].figure);
+			sb_printf(sb, " %s |", report_plain(buf, sizeof(buf), t.p[0][k].time));
+			sb_printf(sb, " %s |", report_figure(buf, sizeof(buf), t.p[0][k].figure, 3));
 			verdict(&t, 0, k, buf, sizeof(buf));
 			report_md_cell(sb, buf);
-			sb_printf(sb, " %s |", report_plain(buf, sizeof(buf), t.p[1][k].figure));
+			sb_printf(sb, " %s |", measured(buf, sizeof(buf), t.p[1][k].figure));
 			verdict(&t, 1, k, buf, sizeof(buf));
 			report_md_cell(sb, buf);
 			sb_printf(sb, "\n");
@@ -313,15 +319,15 @@ static void html_verdict(struct strbuf *sb, const struct front_table *t, int v, 
 static void html_row(struct strbuf *sb, const struct report_index *ix,
                      const struct front_table *t, size_t k)
 {
-	char buf[192], ms[32];
+	char buf[192], ms[32], fig[32];
 	sb_printf(sb, "<tr><td class=\"l\">");
 	report_escape(sb, report_str(t->e[k].run, "builder"));
 	sb_printf(sb, "</td><td>");
 	report_escape(sb, threads_text(buf, sizeof(buf), ix, &t->e[k])); /* a device's name */
-	sb_printf(sb, "</td><td>%s</td><td>%.3f</td>",
-	          report_plain(ms, sizeof(ms), t->p[0][k].time), t->p[0][k].figure);
+	sb_printf(sb, "</td><td>%s</td><td>%s</td>", report_plain(ms, sizeof(ms), t->p[0][k].time),
+	          report_figure(fig, sizeof(fig), t->p[0][k].figure, 3));
 	html_verdict(sb, t, 0, k);
-	sb_printf(sb, "<td>%s</td>", report_plain(ms, sizeof(ms), t->p[1][k].figure));
+	sb_printf(sb, "<td>%s</td>", measured(fig, sizeof(fig), t->p[1][k].figure));
 	html_verdict(sb, t, 1, k);
 	sb_printf(sb, "</tr>\n");
 }

@@ -38,13 +38,9 @@ static void runs_on(struct strbuf *sb, const cJSON *doc, const cJSON *m, bool ht
 		if (!report_same_machine(report_machine(doc, run), m))
 			continue;
 		sb_printf(sb, "%s", sep);
-		if (html) {
-			report_escape(sb, report_str(run, "scene"));
-			sb_printf(sb, " ");
-			report_escape(sb, report_str(run, "builder"));
-		} else {
-			sb_printf(sb, "%s %s", report_str(run, "scene"), report_str(run, "builder"));
-		}
+		(html ? report_escape : report_md_text)(sb, report_str(run, "scene"));
+		sb_printf(sb, " ");
+		(html ? report_escape : report_md_text)(sb, report_str(run, "builder"));
 		sb_printf(sb, "/%.0f", report_num(run, "threads"));
 		sep = ", ";
 	}

@@ -320,7 +320,11 @@ void report_summary_md(struct strbuf *sb, const struct report_index *ix)
 	}
 	report_budget_summary(sb, ix, false);
 	fallback_note(sb, ix->doc, s.ref, false);
-	sb_printf(sb, intro, s.ref);
+	struct strbuf ref = {0};
+	report_md_text(&ref, s.ref);
+	char *ref_text = sb_take(&ref);
+	sb_printf(sb, intro, ref_text ? ref_text : "");
+	free(ref_text);
 	if (s.machines) {
 		sb_printf(sb, machines_note, ix->machine_count);
 		sb_printf(sb, "\n\n");

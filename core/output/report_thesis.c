@@ -104,9 +104,14 @@ static int thread_counts(const cJSON *runs, double *out)
 static void header(struct strbuf *sb, const char *ref, double threads, const char **cols,
                    int n)
 {
-	sb_printf(sb, "\n### %.0f threads\n\n| scene | %s 1 thread ms |", threads, ref);
-	for (int i = 0; i < n; i++)
-		sb_printf(sb, " %s ms | gain | speedup |", cols[i]);
+	sb_printf(sb, "\n### %.0f threads\n\n| scene | ", threads);
+	report_md_text(sb, ref);
+	sb_printf(sb, " 1 thread ms |");
+	for (int i = 0; i < n; i++) {
+		sb_printf(sb, " ");
+		report_md_text(sb, cols[i]);
+		sb_printf(sb, " ms | gain | speedup |");
+	}
 	sb_printf(sb, "\n|---|---:|");
 	for (int i = 0; i < n; i++)
 		sb_printf(sb, "---:|---:|---:|");
@@ -130,10 +135,11 @@ static void row(struct strbuf *sb, const struct report_index *ix, const char *re
 {
 	double seq = median_ms(ix, scene, machine, ref, 1);
 
+	sb_printf(sb, "| ");
+	report_md_text(sb, scene);
 	if (ix->machine_count > 1)
-		sb_printf(sb, "| %s (M%ld) |", scene, machine + 1);
-	else
-		sb_printf(sb, "| %s |", scene);
+		sb_printf(sb, " (M%ld)", machine + 1);
+	sb_printf(sb, " |");
 	if (seq > 0)
 		sb_printf(sb, " %.2f |", seq);
 	else
@@ -176,10 +182,13 @@ static int columns_at(const cJSON *doc, const struct report_index *ix, double th
 /* The title and what the table holds. */
 static void intro(struct strbuf *sb, const char *ref)
 {
-	sb_printf(sb, "\n## Parallel builders against %s\n\nThe thesis's table: median build "
-	              "times in ms; the sequential time is %s on 1 thread; gain = (t_seq − t) / "
-	              "t_seq, speedup = t_seq / t. Only ok runs count; " MISSING " marks a missing "
-	              "one.\n", ref, ref);
+	sb_printf(sb, "\n## Parallel builders against ");
+	report_md_text(sb, ref);
+	sb_printf(sb, "\n\nThe thesis's table: median build times in ms; the sequential time "
+	              "is ");
+	report_md_text(sb, ref);
+	sb_printf(sb, " on 1 thread; gain = (t_seq − t) / t_seq, speedup = t_seq / t. Only ok "
+	              "runs count; " MISSING " marks a missing one.\n");
 }
 
 /* The rows of one thread count: per scene, one per machine that measured it. */

@@ -99,6 +99,8 @@ struct frame_metrics {
 	double nodes_per_ray;  /* primary rays of the frame's camera */
 	double mrays_per_s;
 	double cost_ms;        /* update_ms + rays_per_frame / rays per second */
+	bool traced;           /* the rays were traced: nodes_per_ray, mrays_per_s measured */
+	bool costed;           /* cost_ms known: traced, or no rays per frame to pay for */
 };
 
 /* Everything known about one run; fields beyond status are optional. */

@@ -16,6 +16,14 @@
 #include "output/safe_file.h"
 #include "util/util.h"
 
+static void number_or_null(cJSON *o, const char *key, double v, bool measured)
+{
+	if (measured && isfinite(v))
+		cJSON_AddNumberToObject(o, key, v);
+	else
+		cJSON_AddNullToObject(o, key);
+}
+
 cJSON *results_frames_json(const struct frame_metrics *frames, uint32_t count)
 {
 	cJSON *a = cJSON_CreateArray();
@@ -24,11 +32,12 @@ cJSON *results_frames_json(const struct frame_metrics *frames, uint32_t count)
 		cJSON *o = cJSON_CreateObject();
 		cJSON_AddNumberToObject(o, "frame", f->frame);
 		cJSON_AddNumberToObject(o, "update_ms", f->update_ms);
-		cJSON_AddNumberToObject(o, "sah", f->sah);
+		/* What was not measured is null, never a 0 to be read as a figure. */
+		number_or_null(o, "sah", f->sah, f->valid);
 		cJSON_AddBoolToObject(o, "valid", f->valid);
-		cJSON_AddNumberToObject(o, "nodes_per_ray", f->nodes_per_ray);
-		cJSON_AddNumberToObject(o, "mrays_per_s", f->mrays_per_s);
-		cJSON_AddNumberToObject(o, "cost_ms", f->cost_ms);
+		number_or_null(o, "nodes_per_ray", f->nodes_per_ray, f->valid && f->traced);
+		number_or_null(o, "mrays_per_s", f->mrays_per_s, f->valid && f->traced);
+		number_or_null(o, "cost_ms", f->cost_ms, f->valid && f->costed);
 		cJSON_AddBoolToObject(o, "rebuilt", f->rebuilt);
 		cJSON_AddBoolToObject(o, "rays_checked", f->rays_checked);
 		cJSON_AddItemToArray(a, o);
@@ -36,25 +45,18 @@ cJSON *results_frames_json(const struct frame_metrics *frames, uint32_t count)
 	return a;
 }
 
-/* A CSV field: quoted when it holds a separator, quote or newline. */
-static void field(struct strbuf *sb, const char *s)
-{
-	if (!strpbrk(s, ",\"\n\r")) {
-		sb_printf(sb, "%s,", s);
-		return;
-	}
-	sb_printf(sb, "\"");
-	for (; *s; s++)
-		sb_printf(sb, *s == '"' ? "\"\"" : "%c", *s);
-	sb_printf(sb, "\",");
-}
-
 static void number(struct strbuf *sb, const cJSON *o, const char *key, bool last)
 {
 	double v = report_num(o, key);
+	char buf[32] = "";
 	if (isfinite(v))
-		sb_printf(sb, "%.9g", v);
-	sb_printf(sb, last ? "\n" : ",");
+		snprintf(buf, sizeof(buf), "%.9g", v);
+	report_csv_field(sb, buf, last);
+}
+
+static void field(struct strbuf *sb, const char *s)
+{
+	report_csv_field(sb, s, false);
 }
 
 static const char *flag(const cJSON *o, const char *key)

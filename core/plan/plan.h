@@ -167,11 +167,14 @@ struct merge_summary {
  * (every part's runs as they are, in id order, each with its part's machine
  * record), results.csv, report.md, report.html and the images. Refuses
  * (-EINVAL, err naming the part) a part without results.json, of another
- * plan, or claiming a run another part has; refuses a results.json in dir
- * that is not an earlier merge of the same plan.
+ * plan, or claiming a run another part has, or (unless mixed_versions) run
+ * by another bvhlab_version than the first part; refuses a results.json in
+ * dir that is not an earlier merge of the same plan. Each run keeps its
+ * part's version, "merged.versions" lists the parts'.
  */
 int plan_merge(const struct plan_file *plan, const char *const *parts, size_t part_count,
-               const char *dir, struct merge_summary *sum, bvhlab_error *err);
+               const char *dir, bool mixed_versions, struct merge_summary *sum,
+               bvhlab_error *err);
 void merge_summary_finish(struct merge_summary *sum);
 
 /*

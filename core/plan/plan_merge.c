@@ -28,6 +28,7 @@ struct part {
 
 struct merge {
 	const struct plan_file *plan;
+	bool mixed_versions; /* parts of other bvhlab versions allowed */
 	struct part *parts;
 	size_t part_count;
 	const cJSON **owner_run; /* [run id] the run found for it, or NULL */
@@ -121,6 +122,19 @@ static int run_id(const struct merge *m, const char *dir, const cJSON *run, uint
 	return 0;
 }
 
+/* Figures from other builds may differ for other reasons than the runs'. */
+static int check_part_version(const struct merge *m, size_t p, bvhlab_error *err)
+{
+	const char *v = string_at(m->parts[p].doc, "bvhlab_version");
+	const char *first = string_at(m->parts[0].doc, "bvhlab_version");
+	if (p == 0 || m->mixed_versions || (v && first && strcmp(v, first) == 0))
+		return 0;
+	error_set(err, "part %s was run by bvhlab %s, part %s by %s: nothing merged (run every "
+	          "part with one build, or merge with --allow-mixed-versions)", m->parts[p].dir,
+	          v ? v : "(no version)", m->parts[0].dir, first ? first : "(no version)");
+	return -EINVAL;
+}
+
 /* Reads every part and assigns each run to its id; a second claim is an error. */
 static int collect(struct merge *m, const char *const *dirs, bvhlab_error *err)
 {
@@ -133,6 +147,7 @@ static int collect(struct merge *m, const char *const *dirs, bvhlab_error *err)
 			          "never started)", part->dir);
 		if (r == 0)
 			r = check_part_plan(m->plan, part->dir, part->doc, err);
+		r = r ? r : check_part_version(m, p, err);
 		const cJSON *run;
 		cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(part->doc, "runs")) {
 			uint32_t id;
@@ -218,8 +233,11 @@ static cJSON *run_copy(const cJSON *run, const cJSON *part_doc)
 {
 	cJSON *copy = cJSON_Duplicate(run, 1);
 	const cJSON *machine = cJSON_GetObjectItemCaseSensitive(part_doc, "machine");
+	const char *version = string_at(part_doc, "bvhlab_version");
 	if (copy && machine && !cJSON_GetObjectItemCaseSensitive(copy, "machine"))
 		cJSON_AddItemToObject(copy, "machine", cJSON_Duplicate(machine, 1));
+	if (copy && version && !cJSON_GetObjectItemCaseSensitive(copy, "bvhlab_version"))
+		cJSON_AddStringToObject(copy, "bvhlab_version", version);
 	const char *scene = string_at(run, "scene");
 	const cJSON *images = cJSON_GetObjectItemCaseSensitive(
 		scene ? find_named(cJSON_GetObjectItemCaseSensitive(part_doc, "scenes"), scene) : NULL,
@@ -308,7 +326,10 @@ static cJSON *merged_header(const struct merge *m)
 	struct tm tm;
 	cJSON *doc = cJSON_CreateObject();
 	strftime(stamp, sizeof(stamp), "%Y-%m-%dT%H:%M:%SZ", gmtime_r(&now, &tm));
-	cJSON_AddStringToObject(doc, "bvhlab_version", bvhlab_version());
+	const char *version = string_at(m->parts[0].doc, "bvhlab_version"); /* the parts' */
+	for (size_t p = 1; version && p < m->part_count; p++)
+		version = same_string(m->parts[0].doc, m->parts[p].doc, "bvhlab_version") ? version : "mixed";
+	cJSON_AddStringToObject(doc, "bvhlab_version", version ? version : "unknown");
 	cJSON_AddStringToObject(doc, "created", stamp);
 	/* The reports' header names one machine: the first part's (runs carry their own). */
 	cJSON_AddItemToObject(doc, "machine", cJSON_Duplicate(cJSON_GetObjectItemCaseSensitive(
@@ -321,8 +342,12 @@ static cJSON *merged_header(const struct merge *m)
 	cJSON_AddStringToObject(plan, "path", m->plan->path);
 	cJSON *merged = cJSON_AddObjectToObject(doc, "merged");
 	cJSON *parts = cJSON_AddArrayToObject(merged, "parts");
-	for (size_t p = 0; p < m->part_count; p++)
+	cJSON *versions = cJSON_AddArrayToObject(merged, "versions");
+	for (size_t p = 0; p < m->part_count; p++) {
+		const char *v = string_at(m->parts[p].doc, "bvhlab_version");
 		cJSON_AddItemToArray(parts, cJSON_CreateString(m->parts[p].dir));
+		cJSON_AddItemToArray(versions, v ? cJSON_CreateString(v) : cJSON_CreateNull());
+	}
 	return doc;
 }
 
@@ -490,9 +515,9 @@ static int write_merged(const struct merge *m, const char *dir, struct merge_sum
 }
 
 int plan_merge(const struct plan_file *plan, const char *const *parts, size_t part_count,
-               const char *dir, struct merge_summary *sum, bvhlab_error *err)
+               const char *dir, bool mixed, struct merge_summary *sum, bvhlab_error *err)
 {
-	struct merge m = {.plan = plan, .part_count = part_count};
+	struct merge m = {.plan = plan, .part_count = part_count, .mixed_versions = mixed};
 	memset(sum, 0, sizeof(*sum));
 	m.parts = calloc(part_count ? part_count : 1, sizeof(*m.parts));
 	m.owner_run = calloc(plan->run_count ? plan->run_count : 1, sizeof(*m.owner_run));

@@ -79,6 +79,9 @@ static int parse_coord(struct obj_parser *p, const char **s, const char *end, fl
 		return parse_error(p, "malformed number", start, end);
 	if (!isfinite(*out))
 		return parse_error(p, "coordinate is NaN or infinite:", start, end);
+	if (fabsf(*out) > SCENE_MAX_COORD)
+		return parse_error(p, "coordinate beyond +-1e18 (a box's squared extent would "
+		                   "overflow float):", start, end);
 	*s = stop;
 	return 0;
 }

@@ -203,6 +203,10 @@ static int read_vertex(struct ply_reader *r)
 		if (!isfinite(xyz[k]))
 			return body_error(r, "vertex %llu: coordinate %c is NaN or infinite",
 			                  (unsigned long long)r->item, "xyz"[k]);
+		if (fabsf(xyz[k]) > SCENE_MAX_COORD)
+			return body_error(r, "vertex %llu: coordinate %c is %g, beyond +-1e18 (a box's "
+			                  "squared extent would overflow float)",
+			                  (unsigned long long)r->item, "xyz"[k], (double)xyz[k]);
 	}
 	scene_mesh_put_vertex(&r->mesh, xyz[0], xyz[1], xyz[2]);
 	return 0;

@@ -17,6 +17,11 @@
 /* printf into err->message; err may be NULL. */
 void scene_error(bvhlab_error *err, const char *fmt, ...) BVHLAB_PRINTF(2, 3);
 
+/* The largest coordinate magnitude a loader accepts: a box's surface area
+ * (its extent squared, times 6) must stay finite in float for the SAH, and
+ * (2 * 1e18)^2 * 6 is ~2.4e37, under FLT_MAX's 3.4e38. */
+#define SCENE_MAX_COORD 1e18f
+
 /*
  * A scene with uninitialised vertex and index arrays of the given sizes,
  * name and source NULL, bounds empty. 0, -ENOMEM or -EOVERFLOW.

@@ -230,7 +230,8 @@ int validate_coverage(const bvhlab_tree *tree, const bvhlab_build_input *input,
 
 	if (!r.offset || !r.leaf || !c) {
 		snprintf(err->message, sizeof(err->message),
-		         "out of memory checking the coverage of %" PRIu32 " references",
+		         "out of memory checking the coverage of %" PRIu32 " references "
+		         "(not checked, so not found invalid)",
 		         tree->index_count);
 		rc = -ENOMEM;
 		goto out;

@@ -124,7 +124,10 @@ enum bvhlab_option_type {
  * One option a builder accepts. The host checks a config's options against
  * this list (unknown key, wrong type, out of range, not a choice: an error
  * naming the key) and fills in the defaults, so the getters in bvhlab_host
- * always succeed for declared names.
+ * always succeed for declared names. Two rules hold beyond single
+ * declarations: an INT or FLOAT pair min_NAME / max_NAME is refused with
+ * min_NAME > max_NAME, and a STRING option whose default is not empty may
+ * not be set to "" (bvhlab_options_check, host.h).
  */
 typedef struct bvhlab_option_decl {
 	const char *name;     /* key in the config's "options" object */
@@ -207,8 +210,9 @@ typedef struct bvhlab_host {
 	 * (a peer library's tree turned into the standard layout). Names are
 	 * [a-z0-9_], 1 to BVHLAB_PHASE_NAME_MAX - 1 characters, at most
 	 * BVHLAB_MAX_PHASES distinct ones per call of build(); anything else,
-	 * or a negative or non-finite ms, fails the build with a message
-	 * naming the phase. The phases need not add up to the whole call,
+	 * an ms that is negative, non-finite or over 1e12, or a phase longer
+	 * than the whole call, fails the build with a message naming the
+	 * phase and the rule. The phases need not add up to the whole call,
 	 * which the host times itself (build_ms). Call it from the thread
 	 * that called build(). Check BVHLAB_HOST_HAS(host, phase) first. */
 	void (*phase)(bvhlab_build_ctx *ctx, const char *name, double ms);

@@ -32,7 +32,9 @@
 
 BVHLAB_BEGIN_DECLS
 
-/* The library's version, e.g. "0.1.0". */
+/* The library's version and the commit it was built from, e.g.
+ * "0.1.0+2f1cbf6a0b1c" ("-dirty" after it: with uncommitted changes;
+ * "+unknown": built outside git). */
 const char *bvhlab_version(void);
 
 BVHLAB_END_DECLS

@@ -89,6 +89,14 @@ int bvhlab_options_set_float(bvhlab_options *opts, const char *key, double v, bv
 int bvhlab_options_set_string(bvhlab_options *opts, const char *key, const char *v,
                               bvhlab_error *err);
 
+/*
+ * What no single declaration states, checked once all are set: an INT or
+ * FLOAT pair min_NAME / max_NAME needs min_NAME <= max_NAME. -EINVAL with
+ * a message naming both and the builder. (The setters refuse an empty
+ * string for a STRING option whose default is not empty.)
+ */
+int bvhlab_options_check(const bvhlab_options *opts, bvhlab_error *err);
+
 /* Parses "key=value" text (command line), by the declared type. */
 int bvhlab_options_parse(bvhlab_options *opts, const char *assignment, bvhlab_error *err);
 

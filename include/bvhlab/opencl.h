@@ -38,6 +38,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -150,8 +152,28 @@ static inline int bvhlab_cl_check(cl_int code, const char *what, char *err, size
 		what, bvhlab_cl_error_name(code), (int)code);
 }
 
+/* Why an installed driver may show no platform or device: an unusable
+ * POCL_CACHE_DIR (PoCL then offers no device) or a limited address space
+ * (RLIMIT_AS, the harness's memory_limit_mb: the driver cannot load).
+ * The cause into buf, "" when neither; returns buf. */
+static inline const char *bvhlab_cl_suspect(char *buf, size_t size)
+{
+	const char *cache = getenv("POCL_CACHE_DIR");
+	struct stat st;
+	struct rlimit rl;
+	buf[0] = '\0';
+	if (cache && *cache && (stat(cache, &st) != 0 || !S_ISDIR(st.st_mode)))
+		snprintf(buf, size, "POCL_CACHE_DIR=%s is not a folder PoCL can use (fix or unset "
+			"it)", cache);
+	else if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY)
+		snprintf(buf, size, "this process's address space is limited to %llu MB "
+			"(memory_limit_mb), too little for an OpenCL driver to load: raise "
+			"memory_limit_mb or drop it", (unsigned long long)(rl.rlim_cur >> 20));
+	return buf;
+}
+
 /* The platforms: 0 and *out (malloc'd, count in *n; free it), or an error
- * saying there are none and what to install. */
+ * saying there are none and why, or what to install. */
 static inline int bvhlab_cl_platforms(cl_platform_id **out, cl_uint *n, char *err, size_t err_size)
 {
 	cl_uint count = 0;
@@ -161,6 +183,10 @@ static inline int bvhlab_cl_platforms(cl_platform_id **out, cl_uint *n, char *er
 	/* The ICD loader says -1001 (CL_PLATFORM_NOT_FOUND_KHR) for no driver. */
 	if (rc != CL_SUCCESS && rc != -1001)
 		return bvhlab_cl_check(rc, "clGetPlatformIDs", err, err_size);
+	char why[512];
+	if ((rc != CL_SUCCESS || count == 0) && bvhlab_cl_suspect(why, sizeof why)[0])
+		return bvhlab_cl_fail(-ENODEV, err, err_size,
+			"cl: no OpenCL platform could be opened: %s", why);
 	if (rc != CL_SUCCESS || count == 0)
 		return bvhlab_cl_fail(-ENODEV, err, err_size,
 			"cl: no OpenCL platform found: " BVHLAB_CL_INSTALL_HINT);
@@ -291,6 +317,11 @@ static inline int bvhlab_cl_choose(bvhlab_cl *cl, const char *spec, char *err, s
 	free(plats);
 	if (rc < 0)
 		return rc;
+	char why[512];
+	if (rc == 0 && bvhlab_cl_suspect(why, sizeof why)[0])
+		return bvhlab_cl_fail(-ENODEV, err, err_size,
+			"cl: device '%s': no such OpenCL device among %u platform(s), most "
+			"likely because %s", spec ? spec : "auto", (unsigned)np, why);
 	if (rc == 0)
 		return bvhlab_cl_fail(-ENODEV, err, err_size,
 			"cl: device '%s': no such OpenCL device among %u platform(s) "
@@ -377,6 +408,7 @@ static inline int bvhlab_cl_build_log(bvhlab_cl *cl, cl_program prog, cl_int cod
 	char *err, size_t err_size)
 {
 	size_t head;
+	char why[512];
 	char *log = bvhlab_cl_read_log(cl, prog);
 	const char *cut = "\n[compiler log truncated]";
 	if (!err || !err_size)
@@ -394,6 +426,11 @@ static inline int bvhlab_cl_build_log(bvhlab_cl *cl, cl_program prog, cl_int cod
 		memcpy(err + head, log, keep);
 		memcpy(err + head + keep, cut, strlen(cut) + 1);
 	}
+	/* The log's last newline would end a progress line mid-message. */
+	for (head = strlen(err); head > 0 && (err[head - 1] == '\n' || err[head - 1] == ' ');)
+		err[--head] = '\0';
+	if (bvhlab_cl_suspect(why, sizeof why)[0] && head + 16 < err_size)
+		snprintf(err + head, err_size - head, " (most likely because %s)", why);
 out:
 	free(log);
 	return bvhlab_cl_errno(code) == -EIO ? -EINVAL : bvhlab_cl_errno(code);

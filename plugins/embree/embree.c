@@ -26,6 +26,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <time.h>
 
 #include "embree_internal.h"
@@ -62,6 +63,28 @@ static RTCDevice device_for(uint32_t threads)
 	if (cache.device)
 		rtcSetDeviceErrorFunction(cache.device, on_error, NULL);
 	return cache.device;
+}
+
+/* Why rtcNewDevice failed: Embree's error code for it (rtcGetDeviceError
+ * on no device), and an address-space limit, which its allocators and
+ * threads run into first. */
+static int device_failed(const bvhlab_host *host, bvhlab_build_ctx *ctx, uint32_t threads)
+{
+	static const char *const names[] = {"no error code", "unknown error", "invalid argument",
+	                                    "invalid operation", "out of memory",
+	                                    "unsupported CPU", "cancelled"};
+	enum RTCError code = rtcGetDeviceError(NULL);
+	struct rlimit rl;
+	char limit[160] = "";
+	if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY)
+		snprintf(limit, sizeof(limit), "; the address space is limited to %llu MB "
+		         "(memory_limit_mb): raise it or drop it for Embree",
+		         (unsigned long long)(rl.rlim_cur >> 20));
+	host->set_error(ctx, "rtcNewDevice(threads=%u) failed: %s%s", threads,
+	                (unsigned)code < sizeof(names) / sizeof(names[0]) ? names[code]
+	                                                                  : "unknown error",
+	                limit);
+	return code == RTC_ERROR_OUT_OF_MEMORY || limit[0] ? -ENOMEM : -ENODEV;
 }
 
 typedef struct settings {
@@ -166,10 +189,8 @@ static int build_locked(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		capacity = (size_t)ceil(s->split_factor * (double)n);
 	double t0 = now_ms();
 	RTCDevice dev = device_for(input->threads);
-	if (!dev) {
-		host->set_error(ctx, "rtcNewDevice(threads=%u) failed", input->threads);
-		return -ENODEV;
-	}
+	if (!dev)
+		return device_failed(host, ctx, input->threads);
 	double t1 = now_ms();
 	struct RTCBuildPrimitive *prims = make_prims(input, capacity);
 	RTCBVH bvh = prims ? rtcNewBVH(dev) : NULL;

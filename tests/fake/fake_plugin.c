@@ -26,13 +26,13 @@ static const bvhlab_option_decl options[] = {
 	 .def_float = 0.5, .min = 0.0, .max = 100.0},
 	{.name = "fail", .type = BVHLAB_OPTION_STRING, .help = "how build() fails or misbehaves",
 	 .def_string = "no",
-	 .choices = "no|error|silent|positive|segfault|abort|loop|exit|invalid|alloc|shared"},
+	 .choices = "no|error|silent|positive|segfault|abort|loop|exit|invalid|alloc|shared|hog"},
 #ifdef FAKE_BAD_OPTION
 	{.name = "broken", .type = 0, .help = "an option of no type"},
 #endif
 	{.name = "phases", .type = BVHLAB_OPTION_STRING,
 	 .help = "phases build() reports (ABI 1.3): none, two (upload twice, device), or broken",
-	 .def_string = "none", .choices = "none|two|bad_name|negative|too_many"},
+	 .def_string = "none", .choices = "none|two|bad_name|negative|too_many|huge|long"},
 	{.name = "wait_for", .type = BVHLAB_OPTION_STRING,
 	 .help = "a file build() waits for first (up to a minute)", .def_string = ""},
 };
@@ -76,6 +76,18 @@ static int allocate(const bvhlab_host *host, bvhlab_build_ctx *ctx)
 	host->set_error(ctx, "%s after %zu MB", total < ALLOC_CAP ? "out of memory" :
 	                "no memory limit", total / MB);
 	return -ENOMEM;
+}
+
+/* "hog": a good tree, then all the address space the memory limit leaves
+ * is taken and kept (chunks from 16 MB down to 64 bytes, untouched: the
+ * limit is on address space), so what comes after the build (validation)
+ * runs out of memory. Only ever run under a memory limit. */
+static void hog(void)
+{
+	for (size_t chunk = ALLOC_CHUNK; chunk >= 64; chunk /= 4)
+		for (size_t total = 0; total < ALLOC_CAP; total += chunk)
+			if (!malloc(chunk))
+				break;
 }
 
 /* Blocks until the file named by "wait_for" exists: tests stop a sweep there. */
@@ -152,6 +164,16 @@ static int build_shared(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return 0;
 }
 
+/* Busy for ms milliseconds of the monotonic clock. */
+static void spend_ms(double ms)
+{
+	struct timespec t0, t;
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	do
+		clock_gettime(CLOCK_MONOTONIC, &t);
+	while ((double)(t.tv_sec - t0.tv_sec) * 1e3 + (double)(t.tv_nsec - t0.tv_nsec) / 1e6 < ms);
+}
+
 /* The "phases" option: upload is reported twice to show that calls add up. */
 static void report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx)
 {
@@ -160,6 +182,7 @@ static void report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx)
 	if (!BVHLAB_HOST_HAS(host, phase) || host->option_string(ctx, "phases", &how) < 0)
 		return;
 	if (strcmp(how, "two") == 0) {
+		spend_ms(4.0); /* the phases' 4 ms, for real: a phase is part of the build */
 		host->phase(ctx, "upload", 1.0);
 		host->phase(ctx, "device", 2.5);
 		host->phase(ctx, "upload", 0.5);
@@ -167,6 +190,10 @@ static void report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx)
 		host->phase(ctx, "Device Time", 1.0);
 	} else if (strcmp(how, "negative") == 0) {
 		host->phase(ctx, "device", -1.0);
+	} else if (strcmp(how, "huge") == 0) {
+		host->phase(ctx, "device", 2e12);
+	} else if (strcmp(how, "long") == 0) {
+		host->phase(ctx, "device", 5000.0);
 	} else if (strcmp(how, "too_many") == 0) {
 		for (size_t k = 0; k < sizeof(many) / sizeof(many[0]); k++)
 			host->phase(ctx, many[k], 1.0);
@@ -194,8 +221,24 @@ __attribute__((unused)) static int build(const bvhlab_host *host, bvhlab_build_c
 		out->prim_index[k] = k;
 	out->node_count = 1;
 	out->index_count = count;
+	if (fail_is(host, ctx, "hog"))
+		hog();
 	return 0;
 }
+
+#ifdef FAKE_UPDATE_CRASH
+/* An update (ABI 1.4) that crashes: frame 1 of an animation dies in it. */
+static int update(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                  const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	(void)host;
+	(void)ctx;
+	(void)in;
+	(void)out;
+	segfault();
+	return 0;
+}
+#endif
 
 #ifdef FAKE_ABI_MAJOR
 #define ABI BVHLAB_ABI_VERSION(FAKE_ABI_MAJOR, 0)
@@ -219,6 +262,9 @@ static const bvhlab_builder desc = {
 	.options = options,
 #ifndef FAKE_NULL_BUILD
 	.build = build,
+#endif
+#ifdef FAKE_UPDATE_CRASH
+	.update = update,
 #endif
 };
 

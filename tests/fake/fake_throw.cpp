@@ -69,6 +69,14 @@ const bvhlab_builder descriptor = bvhlab::make_builder(
 	"fake_throw", "C++ builder that throws from build() (bvhlab::guarded_build)", 0, options,
 	bvhlab::guarded_build<build>);
 
+#ifdef FAKE_THROW_IN_CONSTRUCTOR
+// A static object whose constructor throws (tests/fake/loadcrash): loading
+// the plugin ends in std::terminate, before any entry point is asked.
+struct ThrowsOnLoad {
+	ThrowsOnLoad() { throw_fn(); }
+} throws_on_load;
+#endif
+
 } // namespace
 
 BVHLAB_PLUGIN_EXPORT(descriptor)

@@ -1,0 +1,385 @@
+/*
+ * Issue 43's statuses, figures, versions, messages and escaping, one mode
+ * per group, each a meson test of its own (cli-rel-MODE):
+ *   status    out of memory while validating is "failed", not "invalid";
+ *             an update plugin that crashes names the frame and the plugin
+ *             and keeps frame 0; untraced rays leave figures null, name no
+ *             cheapest strategy, and every failed traversal is kept
+ *   version   bvhlab_version names the commit; merge refuses parts of other
+ *             versions (--allow-mixed-versions records each); --repeat on a
+ *             plan part refused
+ *   config    bad options, names and coordinates refused before any output
+ *   escape    names and errors escaped in report.md, CSV cells guarded
+ * Usage: test-cli-msg BVHLAB_EXE MODE
+ */
+#include <sys/stat.h>
+
+#include "cliutil.h"
+
+static const char *path_in(const char *name)
+{
+	static char buf[4][600];
+	static int next;
+	char *p = buf[next++ % 4];
+	snprintf(p, 600, "%s/%s", tmpdir, name);
+	return p;
+}
+
+static bool exists(const char *path)
+{
+	struct stat st;
+	return lstat(path, &st) == 0;
+}
+
+/* Runs config `text` as `name` (from tmpdir): its exit status; the results
+ * of folder `out` into *doc (checked to be there), NULL after exit 2. */
+static int sweep(const char *name, const char *text, const char *out, cJSON **doc)
+{
+	int status = run_in(tmpdir, ARGS("run", "--quiet", write_config(name, text)));
+	*doc = status == 2 ? NULL : load_results(path_in(out));
+	return status;
+}
+
+static const cJSON *first_run(const cJSON *doc)
+{
+	return cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
+}
+
+static const cJSON *frame_at(const cJSON *run, int f)
+{
+	return cJSON_GetArrayItem(cJSON_GetObjectItem(run, "frames"), f);
+}
+
+/* 4. No memory left to validate: the tree is not called invalid. */
+static void status_validate_oom(void)
+{
+#if UNDER_ASAN || UNDER_TSAN
+	/* Sanitizers reserve terabytes of address space: no limit can apply. */
+#else
+	cJSON *doc;
+	CHECK_INT(sweep("hog.json",
+		"{ \"output\": \"out-hog\", \"repeat\": 1, \"warmup\": 0, \"memory_limit_mb\": 1024,\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 1000 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"options\": { \"fail\": \"hog\" } } ] }\n",
+		"out-hog", &doc), 1);
+	const cJSON *run = first_run(doc);
+	CHECK_CONTAINS(run_str(run, "status"), "failed");
+	CHECK_CONTAINS(run_str(run, "error"), "out of memory validating");
+	CHECK_CONTAINS(run_str(run, "error"), "not found invalid");
+	CHECK_CONTAINS(run_str(run, "error"), "(under memory_limit_mb = 1024)");
+	cJSON_Delete(doc);
+#endif
+}
+
+/* 9. An update plugin that crashes in frame 1: named with its frame, frame 0 kept. */
+static void status_update_crash(void)
+{
+	cJSON *doc;
+	plain_crashes();
+	CHECK_INT(sweep("up.json",
+		"{ \"output\": \"out-up\", \"repeat\": 1, \"warmup\": 0,\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200,\n"
+		"                \"frames\": 3, \"deform\": \"wave\" } ],\n"
+		"  \"builders\": [ { \"name\": \"h12\", \"plugin\": \"fake_good\",\n"
+		"                  \"animation\": { \"update\": \"fake_upcrash\" } } ] }\n",
+		"out-up", &doc), 1);
+	const cJSON *run = first_run(doc);
+	CHECK_INT(count_runs(doc, "h12", "crashed"), 1);
+	CHECK_CONTAINS(run_str(run, "error"), "frame 1, updated by 'fake_upcrash': killed by SIGSEGV");
+	CHECK(!strstr(run_str(run, "error"), "builder 'h12'"));
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(run, "frames")), 1);
+	CHECK(cJSON_IsNumber(cJSON_GetObjectItem(frame_at(run, 0), "sah")));
+	CHECK(cJSON_IsNumber(cJSON_GetObjectItem(cJSON_GetObjectItem(run, "build_ms"), "median")));
+	cJSON_Delete(doc);
+}
+
+/* 5, 9. Device traversals that cannot run (no OpenCL platform): the frames'
+ * ray figures and costs null, no cheapest strategy, both errors kept. */
+static void status_untraced(void)
+{
+	cJSON *doc;
+	CHECK(mkdir(path_in("no-icd"), 0755) == 0);
+	setenv("OCL_ICD_VENDORS", path_in("no-icd"), 1);
+	int status = sweep("nr.json",
+		"{ \"output\": \"out-nr\", \"repeat\": 1, \"warmup\": 0,\n"
+		"  \"rays\": { \"width\": 16, \"height\": 16,\n"
+		"            \"traversal\": [ \"cl_stack\", \"cl_stackless\" ] },\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200,\n"
+		"                \"frames\": 3, \"deform\": \"wave\" } ],\n"
+		"  \"builders\": [ { \"name\": \"a\", \"plugin\": \"lbvh\",\n"
+		"                  \"animation\": { \"update\": \"refit\" } } ] }\n", "out-nr", &doc);
+	unsetenv("OCL_ICD_VENDORS");
+	if (status == 2 && strstr(err_text, "OpenCL")) {
+		fprintf(stderr, "built without OpenCL: the untraced frames are not checked\n");
+		return;
+	}
+	CHECK_INT(status, 0);
+	const cJSON *run = first_run(doc);
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(run, "frames")), 3);
+	for (int f = 0; f < 3; f++) {
+		const cJSON *fr = frame_at(run, f);
+		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(fr, "sah")));
+		CHECK(cJSON_IsNull(cJSON_GetObjectItem(fr, "nodes_per_ray")));
+		CHECK(cJSON_IsNull(cJSON_GetObjectItem(fr, "mrays_per_s")));
+		CHECK(cJSON_IsNull(cJSON_GetObjectItem(fr, "cost_ms")));
+	}
+	char *md = read_file(path_in("out-nr"), "report.md");
+	CHECK(md && !strstr(md, "Cheapest over the animation") && !strstr(md, "nan"));
+	CHECK_CONTAINS(md ? md : "", "not measured");
+	CHECK_CONTAINS(md ? md : "", "No strategy's cost was measured");
+	free(md);
+	cJSON_Delete(doc);
+	/* The main traversal's failure fails the batch; a static scene's rays
+	 * with a CPU main and two device ones keep both devices' errors. */
+	setenv("OCL_ICD_VENDORS", path_in("no-icd"), 1);
+	CHECK_INT(sweep("nr2.json",
+		"{ \"output\": \"out-nr2\", \"repeat\": 1, \"warmup\": 0,\n"
+		"  \"rays\": { \"width\": 16, \"height\": 16,\n"
+		"            \"traversal\": [ \"stack\", \"cl_stack\", \"cl_stackless\" ] },\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"lbvh\" } ] }\n", "out-nr2", &doc), 0);
+	unsetenv("OCL_ICD_VENDORS");
+	const char *e = run_str(cJSON_GetObjectItem(first_run(doc), "rays"), "error");
+	CHECK_CONTAINS(e, "cl_stack: ");
+	CHECK_CONTAINS(e, "; cl_stackless: ");
+	CHECK(!strchr(e, '\n'));
+	cJSON_Delete(doc);
+}
+
+static void test_status(void)
+{
+	status_validate_oom();
+	status_update_crash();
+	status_untraced();
+}
+
+/* Replaces the bvhlab_version in dir/results.json with `version`. */
+static void set_version(const char *dir, const char *version)
+{
+	cJSON *doc = load_results(dir);
+	cJSON_ReplaceItemInObject(doc, "bvhlab_version", cJSON_CreateString(version));
+	char *text = cJSON_Print(doc), path[700];
+	snprintf(path, sizeof(path), "%s/results.json", dir);
+	FILE *f = fopen(path, "w");
+	CHECK(f && text && fputs(text, f) >= 0);
+	if (f)
+		fclose(f);
+	free(text);
+	cJSON_Delete(doc);
+}
+
+/* 7. The version names the commit; merge checks and keeps each part's;
+ * --repeat on a plan part is refused like --threads. */
+static void test_version(void)
+{
+	CHECK_INT(run_in(tmpdir, ARGS("--version")), 0);
+	/* "bvhlab 0.1.0+COMMIT (plugin ABI ...)": a commit, or "unknown" outside git. */
+	CHECK(strstr(out_text, "0.1.0+") != NULL);
+	const char *cfg = write_config("v.json",
+		"{ \"repeat\": 1,\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
+		"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n");
+	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "pv")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pv/plan.json"), "--only", "0", "--repeat",
+	                              "7", "--out", path_in("pv/parts/0"), "--quiet")), 2);
+	CHECK_CONTAINS(err_text, "--repeat cannot be combined with a plan");
+	CHECK(!exists(path_in("pv/parts/0")));
+	for (int k = 0; k < 2; k++) {
+		char id[4], out[64];
+		snprintf(id, sizeof(id), "%d", k);
+		snprintf(out, sizeof(out), "pv/parts/%d", k);
+		CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pv/plan.json"), "--only", id, "--out",
+		                              path_in(out), "--quiet")), 0);
+	}
+	set_version(path_in("pv/parts/1"), "0.0.9+000000000000");
+	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pv/parts/0"), path_in("pv/parts/1"),
+	                              "--out", path_in("pv"))), 2);
+	CHECK_CONTAINS(err_text, "by bvhlab 0.0.9+000000000000");
+	CHECK_CONTAINS(err_text, "--allow-mixed-versions");
+	CHECK(!exists(path_in("pv/results.json")));
+	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pv/parts/0"), path_in("pv/parts/1"),
+	                              "--out", path_in("pv"), "--allow-mixed-versions")), 0);
+	cJSON *doc = load_results(path_in("pv"));
+	CHECK_CONTAINS(run_str(doc, "bvhlab_version"), "mixed");
+	CHECK_CONTAINS(run_str(find_run(doc, "s", "b", 1), "bvhlab_version"), "0.0.9+000000000000");
+	CHECK_CONTAINS(run_str(find_run(doc, "s", "a", 1), "bvhlab_version"), "0.1.0+");
+	const cJSON *versions = cJSON_GetObjectItem(cJSON_GetObjectItem(doc, "merged"), "versions");
+	CHECK_INT(cJSON_GetArraySize(versions), 2);
+	cJSON_Delete(doc);
+}
+
+#define LOADCRASH_DIR BVHLAB_TEST_BUILDDIR "/fake/loadcrash"
+
+/* Runs config `text` as `name` expecting exit 2 before any output folder
+ * (`out`) exists, with `message` on stderr. */
+static void refused(const char *name, const char *text, const char *out, const char *message)
+{
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", write_config(name, text))), 2);
+	CHECK_CONTAINS(err_text, message);
+	CHECK(!exists(path_in(out)));
+}
+
+/* 9. Options no declaration states, names and coordinates: config errors. */
+static void config_errors(void)
+{
+	refused("leaf.json",
+		"{ \"output\": \"out-leaf\",\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"bvh2\", \"options\": { \"min_leaf\": 9 } },\n"
+		"                  { \"plugin\": \"embree\", \"name\": \"e\",\n"
+		"                    \"options\": { \"min_leaf\": 6, \"max_leaf\": 4 } } ] }\n",
+		"out-leaf", "builder 'bvh2': option 'min_leaf' of builder 'bvh2' is 9, more than "
+		"'max_leaf' (8)");
+	if (strstr(err_text, "'embree'")) /* built with Embree */
+		CHECK_CONTAINS(err_text, "builder 'e': option 'min_leaf' of builder 'embree' is 6");
+	refused("dev.json",
+		"{ \"output\": \"out-dev\",\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"cl_lbvh\", \"options\": { \"device\": \"\" } } ] }\n",
+		"out-dev", "");
+	if (!strstr(err_text, "plugin 'cl_lbvh' not found")) /* built with OpenCL */
+		CHECK_CONTAINS(err_text, "builder 'cl_lbvh': option 'device' of builder 'cl_lbvh' "
+		               "must not be empty (default 'auto')");
+	FILE *f = fopen(path_in("big.obj"), "w");
+	CHECK(f && fputs("v 0 0 0\nv 1 0 0\nv 0 -1e38 0\nf 1 2 3\n", f) >= 0);
+	if (f)
+		fclose(f);
+	CHECK_INT(run_in(tmpdir, ARGS("build", "lbvh", path_in("big.obj"))), 2);
+	CHECK_CONTAINS(err_text, "big.obj:3: coordinate beyond +-1e18");
+}
+
+/* 9. Phase times: over 1e12 ms and longer than the build, each with its rule. */
+static void config_phases(void)
+{
+	cJSON *doc;
+	CHECK_INT(sweep("ph.json",
+		"{ \"output\": \"out-ph\", \"repeat\": 1,\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"huge\",\n"
+		"                    \"options\": { \"phases\": \"huge\" } },\n"
+		"                  { \"plugin\": \"fake_good\", \"name\": \"long\",\n"
+		"                    \"options\": { \"phases\": \"long\" } } ] }\n", "out-ph", &doc),
+		1);
+	CHECK_CONTAINS(run_str(find_run(doc, "soup", "huge", 1), "error"),
+	               "'device' (2e+12 ms): times are finite, >= 0 and at most 1e12 ms");
+	CHECK_CONTAINS(run_str(find_run(doc, "soup", "long", 1), "error"),
+	               "'device' (5000 ms) in a build that took");
+	cJSON_Delete(doc);
+}
+
+/* 9. bvhlab build isolates the plugin: a C++ static constructor that
+ * throws, or a crash while loading, is exit status 1 naming the plugin. */
+static void config_build_isolated(void)
+{
+	plain_crashes();
+	CHECK_INT(run_in(tmpdir, ARGS("build", LOADCRASH_DIR "/throw_ctor.so", "soup:count=50")), 1);
+	CHECK_CONTAINS(err_text, "throw_ctor.so' on soup:count=50: killed by SIGABRT");
+	CHECK_CONTAINS(err_text, "fake_throw: escaped build() unguarded");
+	CHECK_INT(run_in(tmpdir, ARGS("build", LOADCRASH_DIR "/crash_ctor.so", "soup:count=50")), 1);
+	CHECK_CONTAINS(err_text, "killed by SIGSEGV");
+	CHECK_INT(run_in(tmpdir, ARGS("build", "fake_good", "soup:count=50")), 0);
+	CHECK_CONTAINS(out_text, "valid:      yes");
+	CHECK_INT(run_in(tmpdir, ARGS("build", "fake_good", "soup:count=50", "-o", "alpha=99")), 2);
+	CHECK_CONTAINS(err_text, "option 'alpha' of builder 'fake_good' is out of range");
+}
+
+/* 9. Device layers under a memory limit say so, not "install a driver". */
+static void config_memory_messages(void)
+{
+#if UNDER_ASAN || UNDER_TSAN
+	/* Sanitizers reserve terabytes of address space: no limit can apply. */
+#else
+	cJSON *doc;
+	int status = sweep("lim.json",
+		"{ \"output\": \"out-lim\", \"repeat\": 1, \"warmup\": 0, \"memory_limit_mb\": 512,\n"
+		"  \"threads\": [2],\n"
+		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 1000 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"cl_lbvh\", \"optional\": true },\n"
+		"                  { \"plugin\": \"embree\", \"optional\": true } ] }\n", "out-lim", &doc);
+	CHECK(status == 1 || status == 0);
+	const cJSON *cl = find_run(doc, "soup", "cl_lbvh", 2), *em = find_run(doc, "soup", "embree", 2);
+	if (cl) {
+		CHECK_CONTAINS(run_str(cl, "error"), "no OpenCL platform could be opened: this "
+		               "process's address space is limited to 512 MB (memory_limit_mb)");
+		CHECK(!strstr(run_str(cl, "error"), "install an OpenCL driver"));
+	}
+	if (em)
+		CHECK_CONTAINS(run_str(em, "error"), "rtcNewDevice(threads=2) failed: out of memory; "
+		               "the address space is limited to 512 MB");
+	cJSON_Delete(doc);
+#endif
+}
+
+static void test_config(void)
+{
+	config_errors();
+	config_phases();
+	config_build_isolated();
+	config_memory_messages();
+}
+
+/* 10. Names and errors escaped in report.md (tables and text), CSV cells
+ * that a spreadsheet would run guarded, names refused that are blank or
+ * hold control or bidirectional characters. */
+static void test_escape(void)
+{
+	cJSON *doc;
+	CHECK_INT(sweep("esc.json",
+		"{ \"output\": \"out-esc\", \"repeat\": 1, \"warmup\": 0,\n"
+		"  \"rays\": { \"width\": 8, \"height\": 8 },\n"
+		"  \"scenes\": [ { \"name\": \"=1+2 <script>s</script>\", \"generator\": \"soup\",\n"
+		"                \"count\": 100, \"frames\": 2, \"deform\": \"wave\" },\n"
+		"                { \"name\": \"-x\", \"path\": \"missing <!-- m.obj\" } ],\n"
+		"  \"builders\": [ { \"plugin\": \"lbvh\", \"name\": \"a|b <!-- c\",\n"
+		"                    \"animation\": { \"update\": \"refit\" } },\n"
+		"                  { \"plugin\": \"lbvh\", \"name\": \"@sum\" } ] }\n", "out-esc", &doc),
+		1);
+	cJSON_Delete(doc);
+	char *md = read_file(path_in("out-esc"), "report.md");
+	CHECK(md != NULL);
+	if (md) {
+		CHECK(!strstr(md, "<script") && !strstr(md, "<!--"));
+		const char *anim = strstr(md, "### Animation");
+		CHECK_CONTAINS(anim ? anim : "", "| a\\|b &lt;!-- c | 1 | 2 | yes |");
+		CHECK_CONTAINS(md, "## =1+2 &lt;script&gt;s&lt;/script&gt;");
+		CHECK_CONTAINS(md, "missing &lt;!-- m.obj");
+	}
+	free(md);
+	char *csv = read_file(path_in("out-esc"), "results.csv");
+	CHECK(csv != NULL);
+	if (csv) {
+		CHECK_CONTAINS(csv, "\n\"'=1+2 <script>s</script>\",a|b <!-- c,lbvh,");
+		CHECK_CONTAINS(csv, "\n\"'-x\",\"'@sum\",");
+		CHECK(!strstr(csv, "\n=") && !strstr(csv, ",=") && !strstr(csv, ",@"));
+	}
+	free(csv);
+	char *frames = read_file(path_in("out-esc"), "frames.csv");
+	CHECK_CONTAINS(frames ? frames : "", "\n\"'=1+2 <script>s</script>\",a|b <!-- c,lbvh,");
+	free(frames);
+	static const char *const bad[][2] = {
+		{"\"  \"", "its scene name is only blanks"},
+		{"\"a\\u202eb\"", "its scene name holds the bidirectional control U+202E"},
+		{"\"a\\u0007b\"", "its scene name holds the control character U+0007"},
+		{"\"a\\u0085b\"", "its scene name holds the control character U+0085"},
+	};
+	for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
+		char text[512];
+		snprintf(text, sizeof(text),
+		         "{ \"output\": \"out-bad\", \"scenes\": [ { \"name\": %s, \"generator\": "
+		         "\"soup\", \"count\": 100 } ], \"builders\": [ { \"plugin\": \"lbvh\" } ] }\n",
+		         bad[k][0]);
+		refused("bad.json", text, "out-bad", bad[k][1]);
+	}
+}
+
+int main(int argc, char **argv)
+{
+	static const struct cli_mode modes[] = {
+		{"status", test_status},
+		{"version", test_version},
+		{"config", test_config},
+		{"escape", test_escape},
+	};
+	return cli_main_modes(argc, argv, "test-cli-msg", modes, sizeof(modes) / sizeof(modes[0]));
+}
