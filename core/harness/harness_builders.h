@@ -33,6 +33,9 @@ struct harness_builder {
 		bvhlab_plugin *plugin;
 		bvhlab_options opts;
 	} stages[HARNESS_MAX_STAGES];
+	/* "animation": its update plugin (its default options) and stages,
+	 * opened to check them before the sweep (open when opts_ok) */
+	struct harness_stage update, anim_stages[HARNESS_MAX_STAGES];
 	struct refine_stage refine[HARNESS_MAX_STAGES]; /* views of stages[] */
 };
 

@@ -138,6 +138,19 @@ int plan_check_list(const struct plan_file *plan, const struct run_list *list,
 
 /* ---- scene files (plan_scenes.c) ------------------------------------------- */
 
+/* A file's size and 64-bit FNV-1a of its bytes. */
+struct plan_fingerprint {
+	double size;
+	char hash[17];
+};
+/* 0, or a negative errno when the file cannot be read (-EINVAL: not a
+ * regular file). */
+int plan_fingerprint(const char *path, struct plan_fingerprint *fp);
+/* Calls fn for every file scene cs reads (its path, its parts' paths, every
+ * frame file of its pattern), *k counting up; stops at fn's first non-zero. */
+int plan_scene_each_file(const struct config_scene *cs,
+                         int (*fn)(const char *path, size_t k, void *ctx), size_t *k, void *ctx);
+
 /* "scene_files": [{"path", "size", "hash"}] of every file cfg's scenes
  * read (in config order; size and hash missing for one not readable here). */
 struct cJSON *plan_scene_files(const struct config *cfg);

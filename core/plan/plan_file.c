@@ -1,7 +1,8 @@
 /*
  * plan.json: a config frozen for a sweep split across machines. It holds a
  * copy of the config with every path absolute (so any machine that sees
- * the same files can run it from anywhere), the copy's hash (the plan's
+ * the same files can run it from anywhere: scene and part paths, frame
+ * patterns, plugin paths), the copy's hash (the plan's
  * identity, recorded in every part's results), the hash of the config file
  * it came from (so a changed config is noticed before runs get mixed up)
  * and the run list with ids.
@@ -54,19 +55,37 @@ static char *absolute(const char *path)
 }
 
 /* Replaces the string member key of obj by its path made absolute (relative
- * paths in a config are relative to its folder). */
-static int absolute_member(const struct config *cfg, cJSON *obj, const char *key)
+ * paths in a config are relative to its folder); a frame pattern's folder
+ * is escaped. */
+static int absolute_member(const struct config *cfg, cJSON *obj, const char *key,
+                           bool pattern)
 {
 	const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
 	char *abs = NULL;
 	if (!cJSON_IsString(v))
 		return 0;
-	abs = absolute_in(cfg->dir, v->valuestring);
+	const char *path = v->valuestring;
+	abs = absolute_in(cfg->dir, path);
+	if (abs && pattern && path[0] != '/')
+		abs = util_pattern_folder(abs, strlen(abs) - strlen(strncmp(path, "./", 2) == 0
+		                                                     ? path + 2 : path));
 	if (!abs)
 		return -ENOMEM;
 	cJSON_ReplaceItemInObjectCaseSensitive(obj, key, cJSON_CreateString(abs));
 	free(abs);
 	return 0;
+}
+
+/* Every path a scene of the copy reads: its own, its parts', its frame
+ * pattern (the plan runs from its own folder, not the config's). */
+static int absolute_scene(const struct config *cfg, cJSON *scene)
+{
+	cJSON *part;
+	int r = absolute_member(cfg, scene, "path", false);
+	cJSON_ArrayForEach(part, cJSON_GetObjectItemCaseSensitive(scene, "parts"))
+		r = r ? r : absolute_member(cfg, part, "path", false);
+	cJSON *frames = cJSON_GetObjectItemCaseSensitive(scene, "frames");
+	return r ? r : absolute_member(cfg, frames, "pattern", true);
 }
 
 static bool is_plugin_path(const char *plugin)
@@ -86,11 +105,11 @@ static cJSON *config_copy(const struct config *cfg)
 	if (r == 0 && !cJSON_AddStringToObject(copy, "output", output))
 		r = -ENOMEM;
 	cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(copy, "scenes"))
-		r = r ? r : absolute_member(cfg, e, "path");
+		r = r ? r : absolute_scene(cfg, e);
 	cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(copy, "builders")) {
 		const cJSON *p = cJSON_GetObjectItemCaseSensitive(e, "plugin");
 		if (cJSON_IsString(p) && is_plugin_path(p->valuestring))
-			r = r ? r : absolute_member(cfg, e, "plugin");
+			r = r ? r : absolute_member(cfg, e, "plugin", false);
 	}
 	free(output);
 	if (r == 0)

@@ -529,7 +529,8 @@ void merge_summary_finish(struct merge_summary *sum)
 
 /* ---- what is done already ----------------------------------------------------------- */
 
-/* Marks the finished runs of one part folder; none when it has no results.json. */
+/* Marks the runs of one part folder that ended ok (a failed one is to be
+ * run again); none when it has no results.json. */
 static int mark_done(const struct plan_file *plan, const char *dir, bool *done,
                      bvhlab_error *err)
 {
@@ -542,8 +543,9 @@ static int mark_done(const struct plan_file *plan, const char *dir, bool *done,
 	const cJSON *run, *runs = r == 0 ? cJSON_GetObjectItemCaseSensitive(doc, "runs") : NULL;
 	cJSON_ArrayForEach(run, runs) {
 		const cJSON *id = cJSON_GetObjectItemCaseSensitive(run, "id");
+		const char *status = string_at(run, "status");
 		if (cJSON_IsNumber(id) && id->valuedouble >= 0 &&
-		    id->valuedouble < (double)plan->run_count && string_at(run, "status"))
+		    id->valuedouble < (double)plan->run_count && status && !strcmp(status, "ok"))
 			done[(size_t)id->valuedouble] = true;
 	}
 	cJSON_Delete(doc);
