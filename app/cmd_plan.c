@@ -259,7 +259,7 @@ static unsigned max_threads(const struct plan_file *plan)
 	unsigned most = 1;
 	const cJSON *run;
 	cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(plan->doc, "runs")) {
-		const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
+		const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads_configured");
 		if (cJSON_IsNumber(t) && t->valuedouble > most)
 			most = (unsigned)t->valuedouble;
 	}

@@ -201,6 +201,49 @@ static int hash_options(struct harness_builder *hb)
 	return 0;
 }
 
+/* {"plugin": descriptor name, "options": {...}} of an opened plugin. */
+static cJSON *plugin_json(const bvhlab_plugin *plugin, const bvhlab_options *opts)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "plugin", bvhlab_plugin_builder(plugin)->name);
+	cJSON_AddItemToObject(o, "options", results_options_json(opts));
+	return o;
+}
+
+static cJSON *stages_json(const struct harness_stage *stages, size_t count)
+{
+	cJSON *a = cJSON_CreateArray();
+	for (size_t k = 0; a && k < count; k++)
+		cJSON_AddItemToArray(a, plugin_json(stages[k].plugin, &stages[k].opts));
+	return a;
+}
+
+/*
+ * The builder as its runs are made, for their identity (plan_identity.c)
+ * and their record's "config": plugins by their descriptors' names (a
+ * plan's absolute path is the same plugin), options resolved (defaults
+ * filled in, a grid's value picked), refine stages and the animation.
+ */
+static int builder_identity(struct harness_builder *hb)
+{
+	const struct config_animation *a = hb->cb->animation;
+	cJSON *o = plugin_json(hb->plugin, &hb->opts);
+	cJSON_AddItemToObject(o, "refine", stages_json(hb->stages, hb->cb->refine_count));
+	if (a) {
+		cJSON *anim = plugin_json(hb->update.plugin, &hb->update.opts);
+		cJSON_AddNumberToObject(anim, "rebuild_every", a->rebuild_every);
+		cJSON_AddItemToObject(anim, "refine", stages_json(hb->anim_stages, a->refine_count));
+		cJSON_AddItemToObject(o, "animation", anim);
+	}
+	char *text = o ? cJSON_PrintUnformatted(o) : NULL;
+	if (!text)
+		return cJSON_Delete(o), -ENOMEM;
+	plan_hash_text(text, hb->builder_hash);
+	free(text);
+	hb->identity = o;
+	return 0;
+}
+
 /* 0, -EINVAL with hb's error set, or -ENOMEM. */
 static int open_one(const struct config *cfg, bool probed, struct harness_builder *hb)
 {
@@ -219,7 +262,7 @@ static int open_one(const struct config *cfg, bool probed, struct harness_builde
 		return -ENOMEM;
 	if (hb->opts_ok && open_animation(cfg, probed, hb, &hb->opts_ok) < 0)
 		return -ENOMEM;
-	if (hb->opts_ok && hash_options(hb) < 0)
+	if (hb->opts_ok && (hash_options(hb) < 0 || builder_identity(hb) < 0))
 		return -ENOMEM;
 	hb->bad_config = !hb->opts_ok;
 	return hb->opts_ok ? 0 : -EINVAL;
@@ -294,6 +337,7 @@ void harness_close_builders(const struct config *cfg, struct harness_builder *bu
 			close_stage(&builders[b].anim_stages[k]);
 		}
 		close_stage(&builders[b].update);
+		cJSON_Delete(builders[b].identity);
 	}
 	free(builders);
 }

@@ -137,21 +137,23 @@ static int doc_hash(const cJSON *config, const cJSON *files, char out[17])
 	return 0;
 }
 
-/* The run list as planned: threads as configured (0 resolves where it runs). */
+/* The run list as planned: threads as configured (0 resolves where it
+ * runs), each run's identity (its config fragments are the plan's config). */
 static cJSON *runs_json(const struct run_list *list)
 {
 	cJSON *array = cJSON_CreateArray();
 	for (size_t k = 0; array && k < list->count; k++) {
 		const struct plan_run *run = &list->runs[k];
+		struct run_identity key = run->key;
 		cJSON *o = cJSON_CreateObject();
 		cJSON_AddItemToArray(array, o);
 		cJSON_AddNumberToObject(o, "id", run->key.id);
 		cJSON_AddStringToObject(o, "scene", run->key.scene);
 		cJSON_AddStringToObject(o, "builder", run->key.builder);
 		cJSON_AddStringToObject(o, "plugin", list->cfg->builders[run->builder].plugin);
-		cJSON_AddNumberToObject(o, "threads", run->threads);
-		if (run->key.options_hash)
-			cJSON_AddStringToObject(o, "options_hash", run->key.options_hash);
+		key.scene_config = key.builder_config = key.measure_config = NULL;
+		if (run_identity_add(o, &key) < 0)
+			return cJSON_Delete(array), NULL;
 	}
 	return array;
 }
@@ -366,29 +368,42 @@ int plan_file_load(struct plan_file *plan, const char *path, struct config *cfg,
 	return r;
 }
 
-/* One run of the plan against the list's run of its id. */
-static bool same_run(const cJSON *want, const struct plan_run *run)
+/* One run of the plan against the list's run of its id: RUN_SAME, or
+ * *changed says what differs (a plugin or its defaults differ here). */
+static enum run_match same_run(const cJSON *want, const struct plan_run *run,
+                               const char **changed)
 {
+	struct run_identity planned;
 	const cJSON *id = cJSON_GetObjectItemCaseSensitive(want, "id");
-	const cJSON *threads = cJSON_GetObjectItemCaseSensitive(want, "threads");
-	const char *scene = string_at(want, "scene"), *builder = string_at(want, "builder");
-	return cJSON_IsNumber(id) && id->valuedouble == run->key.id && cJSON_IsNumber(threads) &&
-	       threads->valuedouble == run->threads && scene && !strcmp(scene, run->key.scene) &&
-	       builder && !strcmp(builder, run->key.builder);
+	run_identity_read(want, &planned);
+	if (!cJSON_IsNumber(id) || id->valuedouble != run->key.id)
+		return RUN_OTHER;
+	/* A plan records only what it can know: the thread count as configured. */
+	enum run_match m = run_identity_compare(&run->key, &planned, changed);
+	return m == RUN_CHANGED && !planned.hash ? RUN_SAME : m;
 }
 
 int plan_check_list(const struct plan_file *plan, const struct run_list *list,
                     bvhlab_error *err)
 {
 	const cJSON *runs = cJSON_GetObjectItemCaseSensitive(plan->doc, "runs"), *want;
+	const char *changed = NULL;
+	enum run_match m = RUN_SAME;
 	size_t k = 0;
 	cJSON_ArrayForEach(want, runs) {
-		if (k >= list->count || !same_run(want, &list->runs[k]))
+		if (k >= list->count || (m = same_run(want, &list->runs[k], &changed)) != RUN_SAME)
 			break;
 		k++;
 	}
 	if (k == list->count && k == plan->run_count)
 		return 0;
+	if (m == RUN_CHANGED) {
+		error_set(err, "%s: run %zu (%s, %s) would be made another way here than planned "
+		          "(its %s differs: a plugin or its defaults here differ from the planning "
+		          "machine's?); plan again here", plan->path, k, list->runs[k].key.scene,
+		          list->runs[k].key.builder, changed);
+		return -EINVAL;
+	}
 	error_set(err, "%s: this machine makes %zu runs of its config and the plan lists %zu, "
 	          "%s at run %zu (a builder's plugin here differs: its PARALLEL flag?); plan again "
 	          "here", plan->path, list->count, plan->run_count,

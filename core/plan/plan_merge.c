@@ -110,12 +110,22 @@ static int run_id(const struct merge *m, const char *dir, const cJSON *run, uint
 		return -EINVAL;
 	}
 	*id = (uint32_t)v->valuedouble;
-	const cJSON *want = cJSON_GetArrayItem(runs, (int)*id);
-	const char *s = string_at(run, "scene"), *b = string_at(run, "builder");
-	if (!s || !b || strcmp(s, string_at(want, "scene") ? string_at(want, "scene") : "") ||
-	    strcmp(b, string_at(want, "builder") ? string_at(want, "builder") : "")) {
+	struct run_identity planned, have;
+	const char *changed = NULL;
+	run_identity_read(cJSON_GetArrayItem(runs, (int)*id), &planned);
+	run_identity_read(run, &have);
+	have.threads = 0; /* the plan knows the configured count only */
+	enum run_match match = run_identity_compare(&planned, &have, &changed);
+	if (match == RUN_OTHER) {
 		error_set(err, "part %s: run %u is %s/%s there but %s/%s in the plan", dir, *id,
-		          s ? s : "?", b ? b : "?", string_at(want, "scene"), string_at(want, "builder"));
+		          have.scene ? have.scene : "?", have.builder ? have.builder : "?",
+		          planned.scene, planned.builder);
+		return -EINVAL;
+	}
+	if (match == RUN_CHANGED && have.hash) { /* a part of an older bvhlab has none */
+		error_set(err, "part %s: run %u (%s, %s) was made another way than the plan's (its "
+		          "%s differs): nothing merged; run it again from the plan", dir, *id,
+		          planned.scene, planned.builder, changed);
 		return -EINVAL;
 	}
 	return 0;
