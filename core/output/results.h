@@ -46,9 +46,10 @@ struct run_identity {
 	uint32_t threads;         /* resolved thread count, >= 1 (0: not known, a plan's) */
 	uint32_t threads_configured; /* as configured, 0 = all cores (RUN_THREADS_UNKNOWN) */
 	const char *options_hash; /* of its options and refine stages, or NULL */
-	/* 16 hex digits each, or NULL (a builder that could not be opened): */
+	/* 16 hex digits each, or NULL (not known: a record of an older bvhlab) */
 	const char *scene_hash;   /* the scene's description and its files' contents */
-	const char *builder_hash; /* plugin, options, refine stages, animation */
+	const char *builder_hash; /* plugin, options, refine stages, animation ("": the
+	                           * builder's plugin could not be opened) */
 	const char *measure_hash; /* repeat, warmup, validation, rays, pin, rays_per_frame */
 	const char *hash;         /* of the three: the run's identity */
 	/* The config fragments that produced it, recorded with the run as

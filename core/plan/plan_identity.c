@@ -153,8 +153,8 @@ void plan_identity_key(struct run_list *list, struct plan_run *run)
 		cJSON_GetObjectItemCaseSensitive(list->cfg->root, "scenes"), (int)run->scene);
 	key->measure_config = id->measure_config[run->scene];
 	key->builder_config = id->builder_config[run->builder];
-	if (!builder[0])
-		return; /* its plugin or options could not be used: no identity */
+	/* "" for a builder whose plugin could not be opened: its failed runs
+	 * still follow their scene and measurement. */
 	key->builder_hash = builder;
 	char text[3 * 17 + 3];
 	snprintf(text, sizeof(text), "%s %s %s", key->scene_hash, builder, key->measure_hash);
