@@ -398,10 +398,13 @@ int plan_check_list(const struct plan_file *plan, const struct run_list *list,
 	if (k == list->count && k == plan->run_count)
 		return 0;
 	if (m == RUN_CHANGED) {
-		error_set(err, "%s: run %zu (%s, %s) would be made another way here than planned "
-		          "(its %s differs: a plugin or its defaults here differ from the planning "
-		          "machine's?); plan again here", plan->path, k, list->runs[k].key.scene,
-		          list->runs[k].key.builder, changed);
+		bool builder = !strcmp(changed, "builder");
+		error_set(err, "%s: run %zu (%s, %s) would be made another way here than planned: "
+		          "its %s differs (%s); plan again here", plan->path, k,
+		          list->runs[k].key.scene, list->runs[k].key.builder,
+		          builder ? "builder" : !strcmp(changed, "scene") ? "scene" : "measurement",
+		          builder ? "a plugin or its defaults here are not the planning machine's"
+		                  : "scene files missing when planning, or settings given here");
 		return -EINVAL;
 	}
 	error_set(err, "%s: this machine makes %zu runs of its config and the plan lists %zu, "
