@@ -186,8 +186,11 @@ size_t results_forget_changed(struct results *res, const struct run_identity *ke
 		long k = results_is_stale(res, run) ? -1 : find_key(keys, count, run);
 		if (k < 0)
 			continue;
-		cJSON_DeleteItemFromObjectCaseSensitive(run, "id");
-		cJSON_AddNumberToObject(run, "id", keys[k].id);
+		cJSON *id = cJSON_GetObjectItemCaseSensitive(run, "id");
+		if (cJSON_IsNumber(id))
+			cJSON_SetNumberValue(id, keys[k].id);
+		else
+			cJSON_AddNumberToObject(run, "id", keys[k].id);
 		run_identity_read(run, &have);
 		if (run_identity_compare(&keys[k], &have, &what) != RUN_CHANGED ||
 		    !results_mark_stale(res, run))

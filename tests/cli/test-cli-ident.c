@@ -17,25 +17,10 @@
 
 #include "cliutil.h"
 
-static const char *path_in(const char *name)
-{
-	static char buf[4][600];
-	static int next;
-	char *p = buf[next++ % 4];
-	snprintf(p, 600, "%s/%s", tmpdir, name);
-	return p;
-}
-
-static bool exists(const char *path)
-{
-	struct stat st;
-	return lstat(path, &st) == 0;
-}
-
 /* A quad of two triangles at height z (the same topology in every frame). */
 static void write_frame(const char *name, double z)
 {
-	FILE *f = fopen(path_in(name), "w");
+	FILE *f = fopen(cli_path_in(name), "w");
 	CHECK(f != NULL);
 	if (!f)
 		return;
@@ -48,7 +33,7 @@ static void write_frame(const char *name, double z)
 static const char *member_text(const char *builder, const char *key, const char *sub)
 {
 	static char text[512];
-	cJSON *doc = load_results(path_in("out-r"));
+	cJSON *doc = load_results(cli_path_in("out-r"));
 	const cJSON *run = doc ? find_run(doc, "s", builder, 1) : NULL;
 	const cJSON *v = cJSON_GetObjectItem(cJSON_GetObjectItem(run, key), sub);
 	char *t = v ? cJSON_PrintUnformatted(v) : NULL;
@@ -133,7 +118,7 @@ static void test_planpaths(void)
 		"  \"builders\": [ { \"plugin\": \"lbvh\", \"animation\": { \"update\": \"refit\", "
 		"\"allow_static\": true } },\n"
 		"    { \"plugin\": \"fake_good\", \"options\": { \"fail\": \"error\" } } ] }\n";
-	mkdir(path_in("m"), 0755);
+	mkdir(cli_path_in("m"), 0755);
 	write_frame("m/a.obj", 0);
 	write_frame("m/b.obj", 1);
 	for (int k = 0; k < 3; k++) {
@@ -144,22 +129,22 @@ static void test_planpaths(void)
 	const char *cfg = write_config("paths.json", text);
 	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "d1/d2/d3/sweep")), 0);
 	char plan[600];
-	snprintf(plan, sizeof(plan), "%s", path_in("d1/d2/d3/sweep/plan.json"));
+	snprintf(plan, sizeof(plan), "%s", cli_path_in("d1/d2/d3/sweep/plan.json"));
 	for (int id = 0; id < 4; id++) {
 		char ids[8], out[64];
 		snprintf(ids, sizeof(ids), "%d", id);
 		snprintf(out, sizeof(out), "d1/d2/d3/sweep/parts/%d", id);
-		CHECK_INT(run_in(path_in("d1"), ARGS("run", plan, "--only", ids, "--out",
-		                                     path_in(out), "--quiet")), id % 2);
+		CHECK_INT(run_in(cli_path_in("d1"), ARGS("run", plan, "--only", ids, "--out",
+		                                     cli_path_in(out), "--quiet")), id % 2);
 	}
-	CHECK_INT(run_in(path_in("d1/d2/d3/sweep"), ARGS("merge", "parts/0", "parts/1", "parts/2",
+	CHECK_INT(run_in(cli_path_in("d1/d2/d3/sweep"), ARGS("merge", "parts/0", "parts/1", "parts/2",
 	                                                 "parts/3", "--out", ".")), 1);
-	cJSON *doc = load_results(path_in("d1/d2/d3/sweep"));
+	cJSON *doc = load_results(cli_path_in("d1/d2/d3/sweep"));
 	CHECK_INT(count_runs(doc, "lbvh+refit", "ok"), 2);
 	CHECK_INT(count_runs(doc, "fake_good", "failed"), 2);
 	cJSON_Delete(doc);
 	/* plan --missing: the failed runs (1, 3) are not done. */
-	CHECK_INT(run_in(tmpdir, ARGS("plan", "--missing", path_in("d1/d2/d3/sweep"))), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("plan", "--missing", cli_path_in("d1/d2/d3/sweep"))), 0);
 	CHECK_CONTAINS(out_text, "--only 1 ");
 	CHECK_CONTAINS(out_text, "--only 3 ");
 	CHECK(!strstr(out_text, "--only 0 ") && !strstr(out_text, "--only 2 "));
@@ -167,9 +152,9 @@ static void test_planpaths(void)
 	/* The last frame changed after planning: its runs are refused. */
 	write_frame("m/f002.obj", 7);
 	CHECK_INT(run_in(tmpdir, ARGS("run", plan, "--only", "2", "--out",
-	                              path_in("d1/d2/d3/sweep/parts/9"), "--quiet")), 2);
+	                              cli_path_in("d1/d2/d3/sweep/parts/9"), "--quiet")), 2);
 	CHECK_CONTAINS(err_text, "f002.obj has changed since planning");
-	CHECK(!exists(path_in("d1/d2/d3/sweep/parts/9")));
+	CHECK(!cli_exists(cli_path_in("d1/d2/d3/sweep/parts/9")));
 }
 
 static void test_subcfg(void)
@@ -179,21 +164,21 @@ static void test_subcfg(void)
 		"  \"rays\": { \"width\": 8, \"height\": 8, \"min_ms\": 1, \"rounds\": 1 },\n"
 		"  \"scenes\": [ { \"frames\": { \"pattern\": \"fr/ok%03d.obj\", \"count\": 4 } } ],\n"
 		"  \"builders\": [ { \"plugin\": \"lbvh\", \"animation\": { \"update\": \"refit\" } } ] }\n";
-	mkdir(path_in("sub"), 0755);
-	mkdir(path_in("sub/fr"), 0755);
+	mkdir(cli_path_in("sub"), 0755);
+	mkdir(cli_path_in("sub/fr"), 0755);
 	for (int k = 0; k < 4; k++) {
 		char name[32];
 		snprintf(name, sizeof(name), "sub/fr/ok%03d.obj", k);
 		write_frame(name, 0.25 * k);
 	}
-	FILE *f = fopen(path_in("sub/cfg.json"), "w");
+	FILE *f = fopen(cli_path_in("sub/cfg.json"), "w");
 	CHECK(f != NULL);
 	if (f) {
 		fputs(text, f);
 		fclose(f);
 	}
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "sub/cfg.json")), 0);
-	cJSON *doc = load_results(path_in("sub/out"));
+	cJSON *doc = load_results(cli_path_in("sub/out"));
 	CHECK_INT(count_runs(doc, "lbvh+refit", "ok"), 1);
 	const cJSON *run = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
 	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(run, "frames")), 4);
@@ -213,10 +198,10 @@ static void refused(const char *more, const char *b, const char *message)
 	const char *cfg = write_config("anim.json", text);
 	CHECK_INT(run_in(tmpdir, ARGS("run", cfg)), 2);
 	CHECK_CONTAINS(err_text, message);
-	CHECK(!exists(path_in("out-a")));
+	CHECK(!cli_exists(cli_path_in("out-a")));
 	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "plan-a")), 2);
 	CHECK_CONTAINS(err_text, message);
-	CHECK(!exists(path_in("plan-a")));
+	CHECK(!cli_exists(cli_path_in("plan-a")));
 }
 
 static void test_animcheck(void)
