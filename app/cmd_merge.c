@@ -43,7 +43,7 @@ static void describe(const struct plan_file *plan, uint32_t id, char *buf, size_
 {
 	const cJSON *run = cJSON_GetArrayItem(cJSON_GetObjectItem(plan->doc, "runs"), (int)id);
 	const cJSON *s = cJSON_GetObjectItem(run, "scene"), *b = cJSON_GetObjectItem(run, "builder");
-	const cJSON *t = cJSON_GetObjectItem(run, "threads");
+	const cJSON *t = cJSON_GetObjectItem(run, "threads_configured");
 	snprintf(buf, size, "%u (%s, %s, %g threads)", id, cJSON_IsString(s) ? s->valuestring : "?",
 	         cJSON_IsString(b) ? b->valuestring : "?", cJSON_IsNumber(t) ? t->valuedouble : 0);
 }

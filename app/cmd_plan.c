@@ -39,10 +39,10 @@ static const char usage[] =
 	"  json    the runs with their commands, as a JSON array on stdout\n"
 	"\n"
 	"Then `bvhlab merge DIR/parts/* --out DIR` joins the parts. With --missing,\n"
-	"only the runs that no folder of DIR/parts holds yet (--format slurm:\n"
-	"DIR/sweep-missing.sbatch); a run that finished failed counts as done, so\n"
-	"remove its part folder to run it again. Planning again into DIR is fine\n"
-	"for the same config; another plan there is refused.\n"
+	"only the runs that no folder of DIR/parts holds ended ok (--format slurm:\n"
+	"DIR/sweep-missing.sbatch): a run that failed, crashed or timed out is run\n"
+	"again (each command resumes its part with --retry-failed). Planning again\n"
+	"into DIR is fine for the same config; another plan there is refused.\n"
 	"\n"
 	"options:\n"
 	"  --out DIR        the plan's folder (plan.json, parts/, slurm/)\n"
@@ -176,7 +176,8 @@ static void run_command(struct strbuf *sb, const char *command, const char *dir,
 	shell_word(sb, plan);
 	sb_printf(sb, " --only %s --out ", id ? id : "\"$SLURM_ARRAY_TASK_ID\"");
 	shell_word(sb, part);
-	sb_printf(sb, "%s --resume --quiet", id ? "" : "\"$SLURM_ARRAY_TASK_ID\"");
+	/* --retry-failed: a part that did not end ok is not done (--missing). */
+	sb_printf(sb, "%s --resume --retry-failed --quiet", id ? "" : "\"$SLURM_ARRAY_TASK_ID\"");
 }
 
 /* What to emit: the plan's runs, those with want[id]. */
@@ -258,7 +259,7 @@ static unsigned max_threads(const struct plan_file *plan)
 	unsigned most = 1;
 	const cJSON *run;
 	cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(plan->doc, "runs")) {
-		const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
+		const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads_configured");
 		if (cJSON_IsNumber(t) && t->valuedouble > most)
 			most = (unsigned)t->valuedouble;
 	}

@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Soak test of `bvhlab run`: N random configs, each sweep killed at a
-random moment and resumed (sometimes killed again while resuming).
+random moment and resumed (sometimes killed again while resuming), its
+config often changed in between (a scene, the rays, repeat, an animation,
+rays_per_frame).
 
 Each config mixes generated scenes, adversarial scene files (empty, NaN,
 garbage, all-degenerate triangles), real builders
@@ -11,7 +13,12 @@ creation, a run, the interleaved ray rounds) and the Nth file --force moves
 aside. Some resumes run as two concurrent writers. After every sweep:
   - results.json parses and holds each scene x builder x thread count once;
   - every run finished before the kill is still there, unchanged (but for
-    provisional ray figures, which a resume measures again);
+    provisional ray figures, which a resume measures again), when the config
+    did not change;
+  - every run's identity matches the config it was resumed under: its
+    recorded config fragment is the scene, builder and measurement settings
+    of that config, and runs of one scene, builder or measurement share one
+    hash (no stale run is kept);
   - --force's move keeps the old results.json whole, in place or as .1;
   - of two concurrent writers one is refused, naming the other;
   - no temporary folder, tree, heat or shade file is left behind;
@@ -69,12 +76,18 @@ def random_scene(rng, folder, k):
         scene["size"] = rng.randrange(1, 24)
     if rng.random() < 0.2:
         scene["subdivide"] = 1
+    if rng.random() < 0.25:
+        scene["frames"] = rng.randrange(2, 4)
+        scene["deform"] = "wave"
     return scene
 
 
 def random_builder(rng, k, loadcrash, memory_limits):
     name = f"b{k}"
     roll = rng.random()
+    if roll < 0.1:
+        return {"plugin": "lbvh", "name": name,
+                "animation": {"update": "refit", "allow_static": True}}
     if roll < 0.45:
         plugin, options = rng.choice(REAL)
         return {"plugin": plugin, "name": name, "options": dict(options)}
@@ -110,6 +123,60 @@ def random_config(rng, folder, out, loadcrash, memory_limits):
 # Plugins without the PARALLEL flag: one run per scene, at the first of
 # their thread counts that is 1, else at their first (README, threads).
 SERIAL = {"sah_seq", "fake_good"}
+
+
+def mutate(rng, cfg):
+    """Changes the config the way a user between two attempts might: a
+    scene, the rays, repeat, an animation or rays_per_frame. What changed."""
+    kind = rng.choice(["scene", "rays", "repeat", "animation", "rays_per_frame"])
+    generated = [s for s in cfg["scenes"] if "generator" in s]
+    animated = [b for b in cfg["builders"] if "animation" in b]
+    if kind == "scene" and generated:
+        s = rng.choice(generated)
+        key = {"icosphere": "frequency", "terrain": "size"}.get(s["generator"], "count")
+        s[key] = s.get(key, 4) + rng.randrange(1, 4)
+    elif kind == "animation" and animated:
+        a = rng.choice(animated)["animation"]
+        if "rebuild_every" in a:
+            del a["rebuild_every"]
+        else:
+            a["rebuild_every"] = 2
+    elif kind == "repeat":
+        cfg["repeat"] = 3 - cfg["repeat"]
+    elif kind == "rays_per_frame":
+        cfg["rays_per_frame"] = rng.randrange(1, 1000)
+    else:
+        kind = "rays"
+        cfg["rays"]["width"] = 24 - cfg["rays"]["width"]  # 16 <-> 8
+    return kind
+
+
+def check_identity(cfg, runs, where):
+    """Every run was made under cfg: its fragment is cfg's, and one scene,
+    builder or measurement has one hash over all runs."""
+    scenes = {s["name"]: s for s in cfg["scenes"]}
+    builders = {b["name"]: b for b in cfg["builders"]}
+    hashes = {}
+    for key, r in runs.items():
+        c, ident = r.get("config", {}), r.get("identity")
+        if ident is None:
+            raise AssertionError(f"{where}: run {key} has no identity")
+        scene, b = scenes[key[0]], builders[key[1]]
+        m = c.get("measure", {})
+        want = (cfg["repeat"], cfg["warmup"], cfg["rays"]["width"],
+                cfg.get("rays_per_frame", 1000000) if "frames" in scene else None)
+        got = (m.get("repeat"), m.get("warmup"), m.get("rays", {}).get("width"),
+               m.get("rays_per_frame"))
+        if c.get("scene") != scene or got != want:
+            raise AssertionError(f"{where}: run {key} kept from another config: "
+                                 f"{c.get('scene')} {got}, config now {scene} {want}")
+        anim = c.get("builder", {}).get("animation")
+        if anim and anim.get("rebuild_every") != b["animation"].get("rebuild_every", 0):
+            raise AssertionError(f"{where}: run {key} kept from another animation: {anim}")
+        for part, name in (("scene", key[0]), ("builder", key[1]),
+                           ("measure", "frames" in scene)):
+            if hashes.setdefault((part, name), ident[part]) != ident[part]:
+                raise AssertionError(f"{where}: runs of {part} {name} with two hashes")
 
 
 def expected_runs(cfg):
@@ -246,6 +313,11 @@ def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
         before = again
     if rng.random() < 0.2 and os.path.exists(os.path.join(out, "results.json")):
         before = killed_force(rng, bvhlab, config, out, before, shim)
+    changed = None
+    if rng.random() < 0.5:
+        changed = mutate(rng, cfg)
+        with open(config, "w") as f:
+            json.dump(cfg, f, indent=1)
     if rng.random() < 0.2:
         concurrent_resume(bvhlab, config, f"config {i}")
     p = launch(bvhlab, config, True)
@@ -255,7 +327,13 @@ def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
         p.kill()
         raise AssertionError(f"config {i}: resumed sweep still running after {LIMIT_S} s")
     after = load_runs(out) or {}
-    check_kept(before, after, f"config {i}")
+    if changed is None:
+        check_kept(before, after, f"config {i}")
+    else:
+        MUTATED[changed] = MUTATED.get(changed, 0) + 1
+        RERUN[0] += sum(1 for k, r in before.items() if not same_run(after.get(k), r))
+        RERUN[1] += len(before)
+    check_identity(cfg, after, f"config {i}")
     want = expected_runs(cfg)
     if set(after) != want:
         raise AssertionError(f"config {i}: runs {sorted(set(after) ^ want)} missing or extra")
@@ -265,6 +343,10 @@ def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
         raise AssertionError(f"config {i}: exit status {p.returncode} but "
                              f"{'all' if all_ok else 'not all'} runs ok\n{err.decode()}")
     shutil.rmtree(work)
+
+
+MUTATED = {}  # kind of change: configs resumed after it
+RERUN = [0, 0]  # runs made again after a change, runs there were before it
 
 
 def main():
@@ -291,6 +373,8 @@ def main():
             sys.exit(1)
         if (i + 1) % 10 == 0 or i + 1 == n:
             print(f"soak: {i + 1}/{n} configs ok", flush=True)
+    print(f"soak: configs changed before resuming: {MUTATED or 'none'}; "
+          f"{RERUN[0]} of the {RERUN[1]} runs made before a change made again")
     shutil.rmtree(folder)
 
 

@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # Soak test of `bvhlab run`: N random configs (generated and adversarial
 # scenes, real builders, plugins that crash, hang, leak or return broken
-# trees), each sweep killed at a random moment and resumed; checks that
-# results.json always parses, no finished run is lost or duplicated and the
-# exit status matches the runs. Builds the release tree first if needed.
+# trees), each sweep killed at a random moment and resumed, half of them
+# after the config changed; checks that results.json always parses, no
+# finished run is lost or duplicated, every kept run was made under the
+# config it is resumed under, and the exit status matches the runs. Builds
+# the release tree first if needed.
 # Usage: scripts/soak.sh N [BUILD_DIR] [SEED]
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 case "${1:-}" in
-''|-h|--help) sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
+''|-h|--help) sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
 esac
 n=$1
 build=${2:-$here/../build}

@@ -84,6 +84,9 @@ struct config_animation {
 	uint32_t rebuild_every; /* "rebuild_every": K > 0 rebuilds frames K, 2K, ...; 0: never */
 	struct config_refine *refine; /* "refine": stages after each update, or NULL */
 	size_t refine_count;
+	bool allow_static; /* "allow_static", default false: the builder may run on the
+	                    * config's static scenes (as a plain build); without it a
+	                    * static scene beside an animation is a config error */
 	struct config_animation *next_owned; /* the config's list, for freeing */
 };
 

@@ -4,7 +4,7 @@
  * scene or of a composite's part ("animate": {"rotate", "translate",
  * "scale"}, "deform": "wave" | "explode", "amplitude"), the top level's
  * "rays_per_frame" (a table key) and a builder's strategy over the frames,
- * "animation": {"update", "rebuild_every", "refine"}.
+ * "animation": {"update", "rebuild_every", "refine", "allow_static"}.
  */
 #include <errno.h>
 #include <math.h>
@@ -74,7 +74,9 @@ static int frames_object(struct config *cfg, const cJSON *item, const char *pref
 }
 
 /* The pattern resolved against the config; frame 0's file becomes the
- * scene's path when it has no source of its own. */
+ * scene's path when it has no source of its own. That path is taken from
+ * the pattern as written: the scene's path is resolved once, with the
+ * scene (a resolved one would be resolved again, sub/sub/...). */
 static int pattern_paths(struct config *cfg, const cJSON *obj, const char *prefix,
                          struct config_scene *sc, bvhlab_error *err)
 {
@@ -83,14 +85,17 @@ static int pattern_paths(struct config *cfg, const cJSON *obj, const char *prefi
 		return config_error(cfg, config_member(obj, "frames"), true, err,
 		                    "'%sframes' with a 'pattern' takes its frames from files: not "
 		                    "with a 'generator' or 'parts'", prefix);
+	if (!sc->path) {
+		snprintf(first, sizeof(first), sc->frame_pattern, (int)sc->frame_first);
+		if (!(sc->path = strdup(first)))
+			return out_of_memory(cfg, err);
+	}
 	if (config_resolve(cfg, sc->frame_pattern, &resolved))
 		return out_of_memory(cfg, err);
+	size_t head = strlen(resolved) - strlen(sc->frame_pattern);
 	free(sc->frame_pattern);
-	sc->frame_pattern = resolved;
-	if (sc->path)
-		return 0;
-	snprintf(first, sizeof(first), sc->frame_pattern, (int)sc->frame_first);
-	return (sc->path = strdup(first)) ? 0 : out_of_memory(cfg, err);
+	sc->frame_pattern = util_pattern_folder(resolved, head);
+	return sc->frame_pattern ? 0 : out_of_memory(cfg, err);
 }
 
 int config_parse_frames(struct config *cfg, const cJSON *obj, const char *prefix,
@@ -226,7 +231,8 @@ static int anim_body(struct config *cfg, const cJSON *item, size_t index,
 {
 	static const struct config_key keys[] = {
 		{"update", CONFIG_CUSTOM, 0, 0, 0, 0, 0}, {"rebuild_every", CONFIG_CUSTOM, 0, 0, 0, 0, 0},
-		{"refine", CONFIG_CUSTOM, 0, 0, 0, 0, 0}, {NULL, CONFIG_CUSTOM, 0, 0, 0, 0, 0}};
+		{"refine", CONFIG_CUSTOM, 0, 0, 0, 0, 0}, {"allow_static", CONFIG_CUSTOM, 0, 0, 0, 0, 0},
+		{NULL, CONFIG_CUSTOM, 0, 0, 0, 0, 0}};
 	char sub[CONFIG_NAME_SIZE + 16], where[CONFIG_NAME_SIZE + 24];
 	struct config_builder stages = {.name = strdup("")};
 	snprintf(sub, sizeof(sub), "builders[%zu].animation.", index);
@@ -237,6 +243,8 @@ static int anim_body(struct config *cfg, const cJSON *item, size_t index,
 	if (!rc)
 		rc = config_get_u32(cfg, item, "rebuild_every", sub, 1, MAX_FRAMES, &a->rebuild_every,
 		                    err);
+	if (!rc)
+		rc = config_get_bool(cfg, item, "allow_static", sub, &a->allow_static, err);
 	if (!rc && !a->update)
 		rc = config_error(cfg, item, false, err, "'builders[%zu].animation' needs an 'update' "
 		                  "(a plugin with an update function, such as \"refit\")", index);
@@ -247,6 +255,21 @@ static int anim_body(struct config *cfg, const cJSON *item, size_t index,
 	a->refine_count = stages.refine_count;
 	*stage_names = stages.name;
 	return rc == -ENOMEM ? out_of_memory(cfg, err) : rc;
+}
+
+/* An animation meets every scene of the config: on a static one it would
+ * be ignored, silently, unless the config says that is meant. */
+static int static_scenes(struct config *cfg, const cJSON *item, size_t index,
+                         const struct config_animation *a, bvhlab_error *err)
+{
+	for (size_t s = 0; !a->allow_static && s < cfg->scene_count; s++)
+		if (!cfg->scenes[s].frames)
+			return config_error(cfg, item, false, err, "'builders[%zu].animation': scene "
+			                    "'%s' (scenes[%zu]) is static (no 'frames'), where the "
+			                    "animation would be ignored: give the scene 'frames', or set "
+			                    "\"allow_static\": true to run this builder on static scenes "
+			                    "as a plain build", index, cfg->scenes[s].name, s);
+	return 0;
 }
 
 int config_parse_animation(struct config *cfg, const cJSON *obj, size_t index,
@@ -267,6 +290,8 @@ int config_parse_animation(struct config *cfg, const cJSON *obj, size_t index,
 	cfg->animations = a;
 	b->animation = a;
 	int rc = anim_body(cfg, item, index, a, &stage_names, err);
+	if (!rc)
+		rc = static_scenes(cfg, item, index, a, err);
 	if (!rc && !config_member(obj, "name") && anim_name(b, a, stage_names) < 0)
 		rc = out_of_memory(cfg, err);
 	free(stage_names);
@@ -288,8 +313,6 @@ void config_anim_finish(struct config *cfg)
 int config_apply_anim_refine_options(const struct config *cfg, const struct config_builder *b,
                                      size_t k, bvhlab_options *opts, bvhlab_error *err)
 {
-	struct config_builder view = *b;
-	view.refine = b->animation->refine;
-	view.refine_count = b->animation->refine_count;
-	return config_apply_refine_options(cfg, &view, k, opts, err);
+	return config_apply_stage_options(cfg, b, b->animation->refine, "animation refine stage",
+	                                  k, opts, err);
 }

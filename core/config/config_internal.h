@@ -161,6 +161,11 @@ int config_parse_motion(struct config *cfg, const cJSON *obj, const char *prefix
                         struct config_motion *m, bvhlab_error *err);
 int config_check_scene_anim(struct config *cfg, const cJSON *obj, const char *prefix,
                             const struct config_scene *sc, bvhlab_error *err);
+/* Stage k of `stages` (a builder's "refine" or its animation's, `kind`
+ * naming which) through config_apply_options (config_refine.c). */
+int config_apply_stage_options(const struct config *cfg, const struct config_builder *b,
+                               const struct config_refine *stages, const char *kind, size_t k,
+                               bvhlab_options *opts, bvhlab_error *err);
 int config_parse_animation(struct config *cfg, const cJSON *obj, size_t index,
                            struct config_builder *b, bvhlab_error *err);
 void config_anim_finish(struct config *cfg);

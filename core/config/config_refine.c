@@ -120,16 +120,23 @@ void config_refine_finish(struct config_builder *b)
 	b->refine_count = 0;
 }
 
-/* The stage's options through the builder's checks, under a label that
- * names the stage ("lbvh+reinsert, stage 1 (reinsert)"). */
-int config_apply_refine_options(const struct config *cfg, const struct config_builder *b,
-                                size_t k, bvhlab_options *opts, bvhlab_error *err)
+/* Stage k of `stages` (a builder's "refine" or its animation's) through the
+ * builder's option checks, under a label that names the stage
+ * ("lbvh+reinsert, refine stage 1 (reinsert)"). */
+int config_apply_stage_options(const struct config *cfg, const struct config_builder *b,
+                               const struct config_refine *stages, const char *kind, size_t k,
+                               bvhlab_options *opts, bvhlab_error *err)
 {
 	char label[256];
 	struct config_builder stage = *b;
-	snprintf(label, sizeof(label), "%s, refine stage %zu (%s)", b->name, k + 1,
-	         b->refine[k].plugin);
+	snprintf(label, sizeof(label), "%s, %s %zu (%s)", b->name, kind, k + 1, stages[k].plugin);
 	stage.name = label;
-	stage.options = b->refine[k].options;
+	stage.options = stages[k].options;
 	return config_apply_options(cfg, &stage, opts, err);
+}
+
+int config_apply_refine_options(const struct config *cfg, const struct config_builder *b,
+                                size_t k, bvhlab_options *opts, bvhlab_error *err)
+{
+	return config_apply_stage_options(cfg, b, b->refine, "refine stage", k, opts, err);
 }

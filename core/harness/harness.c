@@ -134,7 +134,8 @@ static struct run_record run_record_of(const struct plan_run *run,
 	                           .builder = run->key.builder, .plugin = hb->cb->plugin,
 	                           .threads = run->key.threads,
 	                           .opts = hb->opts_ok ? &hb->opts : NULL,
-	                           .options_hash = hb->opts_ok ? hb->options_hash : NULL};
+	                           .options_hash = hb->opts_ok ? hb->options_hash : NULL,
+	                           .key = &run->key};
 }
 
 /* A run that fails before it starts (its plugin or scene unusable). */

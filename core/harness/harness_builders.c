@@ -114,6 +114,64 @@ static int open_stages(const struct config *cfg, struct harness_builder *hb, boo
 	return 0;
 }
 
+/* One plugin of the builder's animation, probed (when `probed`) and opened
+ * into st with its defaults; *ok false (hb->error naming it) when it is not
+ * there or not a plugin. -ENOMEM only for options that cannot be set up. */
+static int open_anim_plugin(const struct config *cfg, bool probed, struct harness_builder *hb,
+                            const char *plugin, const char *what, struct harness_stage *st,
+                            bool *ok)
+{
+	const char *status;
+	bvhlab_error err = {{0}};
+	double timeout_s = harness_run_limits(cfg, hb->cb).timeout_s;
+	*ok = !probed || harness_probe_plugin(plugin, timeout_s, &status, &err) == 0;
+	if (*ok)
+		*ok = bvhlab_plugin_open(plugin, &st->plugin, &err) == 0;
+	if (!*ok) {
+		error_set(&hb->error, "%s: %s", what, err.message);
+		return 0;
+	}
+	return bvhlab_options_init(&st->opts, bvhlab_plugin_builder(st->plugin)) < 0 ? -ENOMEM : 0;
+}
+
+/*
+ * The builder's "animation" checked as its own stages are, before any run:
+ * the update plugin there and with an update function, each stage there,
+ * refining, and its options known and valid. Without this each run would
+ * fail after frame 0 was built and timed. The runs' children open them
+ * again (harness_frames.c); these stay open for the options' hash.
+ */
+static int open_animation(const struct config *cfg, bool probed, struct harness_builder *hb,
+                          bool *ok)
+{
+	const struct config_animation *a = hb->cb->animation;
+	char what[48];
+	*ok = true;
+	if (!a)
+		return 0;
+	int r = open_anim_plugin(cfg, probed, hb, a->update, "animation update", &hb->update, ok);
+	if (r == 0 && *ok && !bvhlab_builder_update(bvhlab_plugin_builder(hb->update.plugin))) {
+		error_set(&hb->error, "animation update: plugin '%s' has no update function (ABI "
+		          "1.4)", a->update);
+		*ok = false;
+	}
+	for (size_t k = 0; r == 0 && *ok && k < a->refine_count; k++) {
+		struct harness_stage *st = &hb->anim_stages[k];
+		snprintf(what, sizeof(what), "animation refine stage %zu", k + 1);
+		r = open_anim_plugin(cfg, probed, hb, a->refine[k].plugin, what, st, ok);
+		if (r == 0 && *ok && !bvhlab_builder_refine(bvhlab_plugin_builder(st->plugin))) {
+			error_set(&hb->error, "%s: plugin '%s' has no refinement stage", what,
+			          a->refine[k].plugin);
+			*ok = false;
+		}
+		if (r == 0 && *ok)
+			*ok = config_apply_anim_refine_options(cfg, hb->cb, k, &st->opts, &hb->error) == 0;
+	}
+	if (r == 0 && !*ok)
+		config_locate_builder_error(cfg, hb->cb, SIZE_MAX, &hb->error);
+	return r;
+}
+
 /*
  * The hash of what a builder's runs are made with beyond its name: its
  * plugin and resolved options, each stage's plugin and options. Part of a
@@ -143,6 +201,49 @@ static int hash_options(struct harness_builder *hb)
 	return 0;
 }
 
+/* {"plugin": descriptor name, "options": {...}} of an opened plugin. */
+static cJSON *plugin_json(const bvhlab_plugin *plugin, const bvhlab_options *opts)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "plugin", bvhlab_plugin_builder(plugin)->name);
+	cJSON_AddItemToObject(o, "options", results_options_json(opts));
+	return o;
+}
+
+static cJSON *stages_json(const struct harness_stage *stages, size_t count)
+{
+	cJSON *a = cJSON_CreateArray();
+	for (size_t k = 0; a && k < count; k++)
+		cJSON_AddItemToArray(a, plugin_json(stages[k].plugin, &stages[k].opts));
+	return a;
+}
+
+/*
+ * The builder as its runs are made, for their identity (plan_identity.c)
+ * and their record's "config": plugins by their descriptors' names (a
+ * plan's absolute path is the same plugin), options resolved (defaults
+ * filled in, a grid's value picked), refine stages and the animation.
+ */
+static int builder_identity(struct harness_builder *hb)
+{
+	const struct config_animation *a = hb->cb->animation;
+	cJSON *o = plugin_json(hb->plugin, &hb->opts);
+	cJSON_AddItemToObject(o, "refine", stages_json(hb->stages, hb->cb->refine_count));
+	if (a) {
+		cJSON *anim = plugin_json(hb->update.plugin, &hb->update.opts);
+		cJSON_AddNumberToObject(anim, "rebuild_every", a->rebuild_every);
+		cJSON_AddItemToObject(anim, "refine", stages_json(hb->anim_stages, a->refine_count));
+		cJSON_AddItemToObject(o, "animation", anim);
+	}
+	char *text = o ? cJSON_PrintUnformatted(o) : NULL;
+	if (!text)
+		return cJSON_Delete(o), -ENOMEM;
+	plan_hash_text(text, hb->builder_hash);
+	free(text);
+	hb->identity = o;
+	return 0;
+}
+
 /* 0, -EINVAL with hb's error set, or -ENOMEM. */
 static int open_one(const struct config *cfg, bool probed, struct harness_builder *hb)
 {
@@ -159,7 +260,9 @@ static int open_one(const struct config *cfg, bool probed, struct harness_builde
 	hb->opts_ok = config_apply_options(cfg, hb->cb, &hb->opts, &hb->error) == 0;
 	if (hb->opts_ok && open_stages(cfg, hb, &hb->opts_ok) < 0)
 		return -ENOMEM;
-	if (hb->opts_ok && hash_options(hb) < 0)
+	if (hb->opts_ok && open_animation(cfg, probed, hb, &hb->opts_ok) < 0)
+		return -ENOMEM;
+	if (hb->opts_ok && (hash_options(hb) < 0 || builder_identity(hb) < 0))
 		return -ENOMEM;
 	hb->bad_config = !hb->opts_ok;
 	return hb->opts_ok ? 0 : -EINVAL;
@@ -216,6 +319,13 @@ int harness_open_builders(const struct config *cfg, bool probed,
 	return 0;
 }
 
+static void close_stage(struct harness_stage *st)
+{
+	if (st->opts.values)
+		bvhlab_options_finish(&st->opts);
+	bvhlab_plugin_close(st->plugin);
+}
+
 void harness_close_builders(const struct config *cfg, struct harness_builder *builders)
 {
 	for (size_t b = 0; builders && b < cfg->builder_count; b++) {
@@ -223,10 +333,11 @@ void harness_close_builders(const struct config *cfg, struct harness_builder *bu
 			bvhlab_options_finish(&builders[b].opts);
 		bvhlab_plugin_close(builders[b].plugin);
 		for (size_t k = 0; k < HARNESS_MAX_STAGES; k++) {
-			if (builders[b].stages[k].opts.values)
-				bvhlab_options_finish(&builders[b].stages[k].opts);
-			bvhlab_plugin_close(builders[b].stages[k].plugin);
+			close_stage(&builders[b].stages[k]);
+			close_stage(&builders[b].anim_stages[k]);
 		}
+		close_stage(&builders[b].update);
+		cJSON_Delete(builders[b].identity);
 	}
 	free(builders);
 }

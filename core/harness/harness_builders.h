@@ -24,6 +24,9 @@ struct harness_builder {
 	bool skipped;          /* optional ("optional": true) and its plugin could not be
 	                        * loaded: it has no runs at all */
 	char options_hash[17]; /* of the resolved options and stages, when opts_ok */
+	char builder_hash[17]; /* of identity, when opts_ok */
+	struct cJSON *identity; /* plugin, options, stages and animation as its runs are
+	                         * made (docs/design.md, "Run identity"), when opts_ok */
 	bool stage_failed;     /* the builder loaded but a refine stage's plugin did not */
 	bool bad_config;       /* its plugin (or a stage's) is not there or not a
 	                        * bvhlab plugin, or an option is wrong: the config
@@ -33,6 +36,9 @@ struct harness_builder {
 		bvhlab_plugin *plugin;
 		bvhlab_options opts;
 	} stages[HARNESS_MAX_STAGES];
+	/* "animation": its update plugin (its default options) and stages,
+	 * opened to check them before the sweep (open when opts_ok) */
+	struct harness_stage update, anim_stages[HARNESS_MAX_STAGES];
 	struct refine_stage refine[HARNESS_MAX_STAGES]; /* views of stages[] */
 };
 

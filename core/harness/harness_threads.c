@@ -16,7 +16,9 @@ struct plan_builder harness_plan_builder(const struct harness_builder *hb)
 	bool serial = hb->plugin &&
 	              !(bvhlab_plugin_builder(hb->plugin)->flags & BVHLAB_BUILDER_PARALLEL);
 	return (struct plan_builder){.serial = serial,
-	                             .options_hash = hb->opts_ok ? hb->options_hash : NULL};
+	                             .options_hash = hb->opts_ok ? hb->options_hash : NULL,
+	                             .builder_hash = hb->opts_ok ? hb->builder_hash : NULL,
+	                             .builder_config = hb->opts_ok ? hb->identity : NULL};
 }
 
 /* One serial builder's counts left out of the list, said and recorded. */

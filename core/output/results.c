@@ -188,14 +188,16 @@ static cJSON *validation_json(const struct run_record *run)
 	return o;
 }
 
-static cJSON *find_any(const struct results *res, const char *scene, const char *builder,
-                       uint32_t threads, bool stale);
+static cJSON *find_any(const struct results *res, const struct run_identity *key, bool stale);
 
 /* A run made again takes its stale record's place (which stayed on disk
  * until now); any other is appended. */
 static void replace_or_add(struct results *res, const struct run_record *run, cJSON *o)
 {
-	cJSON *old = find_any(res, run->scene ? run->scene : "", run->builder, run->threads, true);
+	struct run_identity slot = {.scene = run->scene ? run->scene : "", .builder = run->builder,
+	                            .threads = run->threads,
+	                            .threads_configured = RUN_THREADS_UNKNOWN};
+	cJSON *old = find_any(res, run->key ? run->key : &slot, true);
 	if (!old) {
 		cJSON_AddItemToArray(res->runs, o);
 		return;
@@ -219,6 +221,8 @@ int results_add_run(struct results *res, const struct run_record *run)
 	cJSON_AddItemToObject(o, "options", results_options_json(run->opts));
 	if (run->options_hash)
 		cJSON_AddStringToObject(o, "options_hash", run->options_hash);
+	if (run->key && run_identity_add(o, run->key) < 0)
+		return cJSON_Delete(o), -ENOMEM;
 	cJSON_AddStringToObject(o, "status", run->status);
 	if (run->error)
 		cJSON_AddStringToObject(o, "error", run->error);
@@ -310,17 +314,7 @@ static const char *string_of(const cJSON *obj, const char *key)
 	return cJSON_IsString(v) ? v->valuestring : NULL;
 }
 
-static bool run_matches(const cJSON *run, const char *scene, const char *builder,
-                        uint32_t threads)
-{
-	const char *s = string_of(run, "scene"), *b = string_of(run, "builder");
-	const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "threads");
-	return s && b && cJSON_IsNumber(t) && t->valuedouble == threads && strcmp(s, scene) == 0 &&
-	       strcmp(b, builder) == 0;
-}
-
-/* The document's run of scene x builder x threads, or NULL. */
-static bool is_stale(const struct results *res, const cJSON *run)
+bool results_is_stale(const struct results *res, const cJSON *run)
 {
 	for (size_t k = 0; k < res->stale_count; k++)
 		if (res->stale[k] == run)
@@ -328,34 +322,34 @@ static bool is_stale(const struct results *res, const cJSON *run)
 	return false;
 }
 
-/* The document's run of scene x builder x threads, or NULL; one to be
- * made again (stale) only when `stale`. */
-static cJSON *find_any(const struct results *res, const char *scene, const char *builder,
-                       uint32_t threads, bool stale)
+/* The document's run of key's slot, or NULL; one to be made again
+ * (stale) only when `stale`. */
+static cJSON *find_any(const struct results *res, const struct run_identity *key, bool stale)
 {
 	cJSON *run;
-	cJSON_ArrayForEach(run, res->runs)
-		if (run_matches(run, scene, builder, threads) && stale == is_stale(res, run))
+	cJSON_ArrayForEach(run, res->runs) {
+		struct run_identity have;
+		run_identity_read(run, &have);
+		if (run_identity_compare(key, &have, NULL) != RUN_OTHER &&
+		    stale == results_is_stale(res, run))
 			return run;
+	}
 	return NULL;
 }
 
-static cJSON *find_run(const struct results *res, const char *scene, const char *builder,
-                       uint32_t threads)
+static cJSON *find_run(const struct results *res, const struct run_identity *key)
 {
-	return find_any(res, scene, builder, threads, false);
+	return find_any(res, key, false);
 }
 
 bool results_has_run(const struct results *res, const struct run_identity *key)
 {
-	return find_run(res, key->scene, key->builder, key->threads) != NULL;
+	return find_run(res, key) != NULL;
 }
 
-/* Marks a run to be made again; it stays in the document (and the file)
- * until its new record replaces it. 0, or 1 when it was not marked yet. */
-static size_t mark_stale(struct results *res, cJSON *run)
+size_t results_mark_stale(struct results *res, cJSON *run)
 {
-	if (is_stale(res, run))
+	if (results_is_stale(res, run))
 		return 0;
 	cJSON **grown = realloc(res->stale, (res->stale_count + 1) * sizeof(*grown));
 	if (!grown)
@@ -376,7 +370,7 @@ size_t results_forget_runs(struct results *res, const char *builder, const char 
 		bool other_options = options_hash && h && strcmp(h, options_hash) != 0;
 		bool failed = not_ok && (!status || strcmp(status, "ok") != 0);
 		if (b && strcmp(b, builder) == 0 && (other_options || failed))
-			n += mark_stale(res, run);
+			n += results_mark_stale(res, run);
 	}
 	return n;
 }
@@ -388,7 +382,7 @@ size_t results_forget_provisional(struct results *res)
 	cJSON_ArrayForEach(run, res->runs) {
 		const cJSON *rays = cJSON_GetObjectItemCaseSensitive(run, "rays");
 		if (cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(rays, "provisional")))
-			n += mark_stale(res, run);
+			n += results_mark_stale(res, run);
 	}
 	return n;
 }
@@ -398,7 +392,7 @@ bool results_all_ok(const struct results *res)
 	const cJSON *run;
 	cJSON_ArrayForEach(run, res->runs) {
 		const char *status = string_of(run, "status");
-		if (!is_stale(res, run) && (!status || strcmp(status, "ok") != 0))
+		if (!results_is_stale(res, run) && (!status || strcmp(status, "ok") != 0))
 			return false;
 	}
 	return true;
@@ -522,7 +516,7 @@ int results_set_scene_image(struct results *res, const char *scene, const char *
 int results_set_run_image(struct results *res, const struct run_identity *key,
                           const char *name)
 {
-	cJSON *run = find_run(res, key->scene, key->builder, key->threads);
+	cJSON *run = find_run(res, key);
 	if (!run)
 		return -ENOENT;
 	cJSON_DeleteItemFromObjectCaseSensitive(run, "heat_image");
@@ -532,7 +526,7 @@ int results_set_run_image(struct results *res, const struct run_identity *key,
 int results_set_run_rays(struct results *res, const struct run_identity *key,
                          const struct ray_metrics *m)
 {
-	cJSON *run = find_run(res, key->scene, key->builder, key->threads);
+	cJSON *run = find_run(res, key);
 	cJSON *rays = run ? results_rays_json(m) : NULL;
 	if (!run)
 		return -ENOENT;

@@ -29,15 +29,53 @@ struct results {
 	int lock_fd;
 };
 
-/* Who a run is: made once, in the run list (plan/plan.h), and the key a
- * sweep, --resume and merge find its results by. */
+/* A configured thread count not known (a record written before it was kept). */
+#define RUN_THREADS_UNKNOWN UINT32_MAX
+
+/*
+ * Who a run is: made once, in the run list (plan/plan.h), and the one key
+ * results, --resume, ray and image updates, plan.json and merge find a run
+ * by (run_identity.c). Its slot is scene x builder x thread count; its
+ * identity hash covers everything that shapes its figures (docs/design.md,
+ * "Run identity"), so a kept run whose hash differs is made again.
+ */
 struct run_identity {
 	uint32_t id;              /* position in the run list */
 	const char *scene;
 	const char *builder;      /* the config's label for the builder */
-	uint32_t threads;         /* resolved thread count, >= 1 */
+	uint32_t threads;         /* resolved thread count, >= 1 (0: not known, a plan's) */
+	uint32_t threads_configured; /* as configured, 0 = all cores (RUN_THREADS_UNKNOWN) */
 	const char *options_hash; /* of its options and refine stages, or NULL */
+	/* 16 hex digits each, or NULL (not known: a record of an older bvhlab) */
+	const char *scene_hash;   /* the scene's description and its files' contents */
+	const char *builder_hash; /* plugin, options, refine stages, animation ("": the
+	                           * builder's plugin could not be opened) */
+	const char *measure_hash; /* repeat, warmup, validation, rays, pin, rays_per_frame */
+	const char *hash;         /* of the three: the run's identity */
+	/* The config fragments that produced it, recorded with the run as
+	 * "config": {"scene", "builder", "measure"} (NULL: not recorded). */
+	const struct cJSON *scene_config, *builder_config, *measure_config;
 };
+
+/* How a recorded run stands to a key (run_identity_compare). */
+enum run_match {
+	RUN_OTHER,   /* another slot: scene, builder or thread count differ */
+	RUN_SAME,    /* the same run, made the same way */
+	RUN_CHANGED  /* the same slot made another way: to be made again */
+};
+
+/* Adds "threads_configured", "identity": {"hash", "scene", "builder",
+ * "measure"} and "config" of key to the record o (nothing for what key
+ * does not know). 0, or -1 when out of memory. */
+int run_identity_add(struct cJSON *o, const struct run_identity *key);
+/* A record's identity (a results.json or plan.json run); its strings point
+ * into run. Members missing are NULL, 0 or RUN_THREADS_UNKNOWN. */
+void run_identity_read(const struct cJSON *run, struct run_identity *out);
+/* The one comparison: RUN_OTHER, RUN_SAME (also when want has no hash), or
+ * RUN_CHANGED with *changed (if not NULL) naming the first part that
+ * differs: "scene", "builder", "measure", or "record" (have has no hash). */
+enum run_match run_identity_compare(const struct run_identity *want,
+                                    const struct run_identity *have, const char **changed);
 
 /* Traversal counters and timings of one run's primary and diffuse rays,
  * by traversal (harness/harness_rays.c measures them). */
@@ -113,6 +151,8 @@ struct run_record {
 	const bvhlab_options *opts; /* resolved options, or NULL */
 	const char *options_hash; /* of opts and the refine stages' (part of the
 	                           * run's identity), or NULL */
+	const struct run_identity *key; /* the run's identity (its hashes and config
+	                                 * fragment are recorded), or NULL */
 	const char *status;    /* "ok", "invalid", "failed", ... */
 	const char *error;     /* message when status is not "ok", or NULL */
 	const double *samples_ms;
@@ -226,6 +266,23 @@ int results_check_runs(const struct cJSON *runs, const struct run_identity *keys
  */
 size_t results_forget_runs(struct results *res, const char *builder, const char *options_hash,
                            bool not_ok);
+/* Marks a run of the document to be made again: it stays (and in the file)
+ * until its new record replaces it. 1 when it was not marked yet, else 0. */
+size_t results_mark_stale(struct results *res, struct cJSON *run);
+/* Whether run is marked to be made again. */
+bool results_is_stale(const struct results *res, const struct cJSON *run);
+/*
+ * Marks every kept run whose identity differs from the run of keys[] in
+ * its slot to be made again (run_identity_compare: RUN_CHANGED), calling
+ * changed(ctx, key, what) for each; every kept run takes its slot's id in
+ * keys[] (the list's ids move when builders or scenes are added). How many
+ * were marked (results_check.c).
+ */
+size_t results_forget_changed(struct results *res, const struct run_identity *keys,
+                              size_t count,
+                              void (*changed)(void *ctx, const struct run_identity *key,
+                                              const char *what),
+                              void *ctx);
 /* Marks the runs whose rays are provisional (their sweep was killed before
  * the rounds replaced them) to be made again, as results_forget_runs does. */
 size_t results_forget_provisional(struct results *res);

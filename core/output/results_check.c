@@ -4,7 +4,9 @@
  * a run that is duplicated, belongs to no run of the list, or has
  * fields of the wrong type or range would be kept forever and shown in
  * every report. Such a file is refused with the run named; the harness
- * has written nothing yet, so the file stays as it was.
+ * has written nothing yet, so the file stays as it was. A run made another
+ * way than its run of the list now (its identity changed) is kept until
+ * its new record replaces it (results_forget_changed).
  */
 #include <errno.h>
 #include <math.h>
@@ -25,13 +27,13 @@ struct claims {
 	unsigned char *seen; /* [count] */
 };
 
-/* The run of the list with this identity, or -1. */
-static long find_key(const struct claims *c, const char *scene, const char *builder,
-                     double threads)
+/* The run of the list in the slot of this record, or -1. */
+static long find_key(const struct run_identity *keys, size_t count, const cJSON *run)
 {
-	for (size_t k = 0; k < c->count; k++)
-		if (c->keys[k].threads == threads && strcmp(c->keys[k].scene, scene) == 0 &&
-		    strcmp(c->keys[k].builder, builder) == 0)
+	struct run_identity have;
+	run_identity_read(run, &have);
+	for (size_t k = 0; k < count; k++)
+		if (run_identity_compare(&keys[k], &have, NULL) != RUN_OTHER)
 			return (long)k;
 	return -1;
 }
@@ -125,7 +127,7 @@ static const char *check_run(struct claims *c, const cJSON *run, char *why, size
 		return "\"threads\" is not a whole number from 1 to the limit of 1024";
 	if (!known_status(string_of(run, "status")))
 		return "\"status\" is none of ok, invalid, failed, crashed, timeout";
-	long k = find_key(c, scene, builder, t->valuedouble);
+	long k = find_key(c->keys, c->count, run);
 	if (k < 0)
 		return "is not a run of this config (scene, builder or thread count unknown)";
 	const char *field = optional_fields(run);
@@ -168,4 +170,34 @@ int results_check_runs(const cJSON *runs, const struct run_identity *keys, size_
 	}
 	free(c.seen);
 	return r;
+}
+
+size_t results_forget_changed(struct results *res, const struct run_identity *keys,
+                              size_t count,
+                              void (*changed)(void *ctx, const struct run_identity *key,
+                                              const char *what),
+                              void *ctx)
+{
+	size_t n = 0;
+	cJSON *run;
+	cJSON_ArrayForEach(run, res->runs) {
+		struct run_identity have;
+		const char *what = NULL;
+		long k = results_is_stale(res, run) ? -1 : find_key(keys, count, run);
+		if (k < 0)
+			continue;
+		cJSON *id = cJSON_GetObjectItemCaseSensitive(run, "id");
+		if (cJSON_IsNumber(id))
+			cJSON_SetNumberValue(id, keys[k].id);
+		else
+			cJSON_AddNumberToObject(run, "id", keys[k].id);
+		run_identity_read(run, &have);
+		if (run_identity_compare(&keys[k], &have, &what) != RUN_CHANGED ||
+		    !results_mark_stale(res, run))
+			continue;
+		n++;
+		if (changed)
+			changed(ctx, &keys[k], what);
+	}
+	return n;
 }

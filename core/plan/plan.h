@@ -29,13 +29,25 @@ struct cJSON;
 struct plan_builder {
 	bool serial;              /* its plugin loaded without the PARALLEL flag */
 	const char *options_hash; /* of its resolved options and stages, or NULL */
+	const char *builder_hash; /* of builder_config, or NULL: not usable */
+	const struct cJSON *builder_config; /* plugin, options, stages, animation as
+	                                     * resolved (copied into the list) */
 };
 
 /* One run: its identity (results.h) and where it comes from in the config. */
 struct plan_run {
-	struct run_identity key;  /* id, scene, builder, resolved threads, options_hash */
+	struct run_identity key;  /* id, scene, builder, threads, hashes, fragments */
 	size_t scene, builder;    /* indexes into the config's arrays */
 	uint32_t threads;         /* as configured: 0 = all cores of the machine */
+	char hash[17];            /* key.hash's text */
+};
+
+/* The identity parts of a list's runs (plan_identity.c), by scene and builder. */
+struct plan_identity {
+	char (*scene_hash)[17], (*measure_hash)[17]; /* [scene_count] */
+	struct cJSON **measure_config;               /* [scene_count] */
+	char (*builder_hash)[17];                    /* [builder_count], "" when unusable */
+	struct cJSON **builder_config;               /* [builder_count] */
 };
 
 /* A builder's thread counts in the list: configured, resolved, and which one
@@ -54,6 +66,7 @@ struct run_list {
 	size_t count;
 	size_t *scene_first;      /* [scene_count + 1]: scene s has runs [first[s], first[s + 1]) */
 	struct plan_threads *threads; /* [builder_count] */
+	struct plan_identity identity;
 };
 
 /* The builder's thread counts: its own list or the config's. */
@@ -78,6 +91,11 @@ int plan_check_threads(const struct config *cfg, bvhlab_error *err);
 int plan_list_make(struct run_list *list, const struct config *cfg,
                    const struct plan_builder *builders, bvhlab_error *err);
 void plan_list_finish(struct run_list *list);
+/* The scenes' and builders' hashes and fragments of list (its cfg set). */
+int plan_identity_make(struct run_list *list, const struct plan_builder *builders);
+/* A run's hashes and fragments into its key (after plan_identity_make). */
+void plan_identity_key(struct run_list *list, struct plan_run *run);
+void plan_identity_finish(struct run_list *list);
 /* The run of scene x builder at its configured thread index, or NULL. */
 const struct plan_run *plan_list_find(const struct run_list *list, size_t scene,
                                       size_t builder, size_t thread_index);
@@ -137,6 +155,19 @@ int plan_check_list(const struct plan_file *plan, const struct run_list *list,
                     bvhlab_error *err);
 
 /* ---- scene files (plan_scenes.c) ------------------------------------------- */
+
+/* A file's size and 64-bit FNV-1a of its bytes. */
+struct plan_fingerprint {
+	double size;
+	char hash[17];
+};
+/* 0, or a negative errno when the file cannot be read (-EINVAL: not a
+ * regular file). */
+int plan_fingerprint(const char *path, struct plan_fingerprint *fp);
+/* Calls fn for every file scene cs reads (its path, its parts' paths, every
+ * frame file of its pattern), *k counting up; stops at fn's first non-zero. */
+int plan_scene_each_file(const struct config_scene *cs,
+                         int (*fn)(const char *path, size_t k, void *ctx), size_t *k, void *ctx);
 
 /* "scene_files": [{"path", "size", "hash"}] of every file cfg's scenes
  * read (in config order; size and hash missing for one not readable here). */

@@ -1,7 +1,8 @@
 /*
  * plan.json: a config frozen for a sweep split across machines. It holds a
  * copy of the config with every path absolute (so any machine that sees
- * the same files can run it from anywhere), the copy's hash (the plan's
+ * the same files can run it from anywhere: scene and part paths, frame
+ * patterns, plugin paths), the copy's hash (the plan's
  * identity, recorded in every part's results), the hash of the config file
  * it came from (so a changed config is noticed before runs get mixed up)
  * and the run list with ids.
@@ -54,19 +55,37 @@ static char *absolute(const char *path)
 }
 
 /* Replaces the string member key of obj by its path made absolute (relative
- * paths in a config are relative to its folder). */
-static int absolute_member(const struct config *cfg, cJSON *obj, const char *key)
+ * paths in a config are relative to its folder); a frame pattern's folder
+ * is escaped. */
+static int absolute_member(const struct config *cfg, cJSON *obj, const char *key,
+                           bool pattern)
 {
 	const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
 	char *abs = NULL;
 	if (!cJSON_IsString(v))
 		return 0;
-	abs = absolute_in(cfg->dir, v->valuestring);
+	const char *path = v->valuestring;
+	abs = absolute_in(cfg->dir, path);
+	if (abs && pattern && path[0] != '/')
+		abs = util_pattern_folder(abs, strlen(abs) - strlen(strncmp(path, "./", 2) == 0
+		                                                     ? path + 2 : path));
 	if (!abs)
 		return -ENOMEM;
 	cJSON_ReplaceItemInObjectCaseSensitive(obj, key, cJSON_CreateString(abs));
 	free(abs);
 	return 0;
+}
+
+/* Every path a scene of the copy reads: its own, its parts', its frame
+ * pattern (the plan runs from its own folder, not the config's). */
+static int absolute_scene(const struct config *cfg, cJSON *scene)
+{
+	cJSON *part;
+	int r = absolute_member(cfg, scene, "path", false);
+	cJSON_ArrayForEach(part, cJSON_GetObjectItemCaseSensitive(scene, "parts"))
+		r = r ? r : absolute_member(cfg, part, "path", false);
+	cJSON *frames = cJSON_GetObjectItemCaseSensitive(scene, "frames");
+	return r ? r : absolute_member(cfg, frames, "pattern", true);
 }
 
 static bool is_plugin_path(const char *plugin)
@@ -86,11 +105,11 @@ static cJSON *config_copy(const struct config *cfg)
 	if (r == 0 && !cJSON_AddStringToObject(copy, "output", output))
 		r = -ENOMEM;
 	cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(copy, "scenes"))
-		r = r ? r : absolute_member(cfg, e, "path");
+		r = r ? r : absolute_scene(cfg, e);
 	cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(copy, "builders")) {
 		const cJSON *p = cJSON_GetObjectItemCaseSensitive(e, "plugin");
 		if (cJSON_IsString(p) && is_plugin_path(p->valuestring))
-			r = r ? r : absolute_member(cfg, e, "plugin");
+			r = r ? r : absolute_member(cfg, e, "plugin", false);
 	}
 	free(output);
 	if (r == 0)
@@ -118,21 +137,23 @@ static int doc_hash(const cJSON *config, const cJSON *files, char out[17])
 	return 0;
 }
 
-/* The run list as planned: threads as configured (0 resolves where it runs). */
+/* The run list as planned: threads as configured (0 resolves where it
+ * runs), each run's identity (its config fragments are the plan's config). */
 static cJSON *runs_json(const struct run_list *list)
 {
 	cJSON *array = cJSON_CreateArray();
 	for (size_t k = 0; array && k < list->count; k++) {
 		const struct plan_run *run = &list->runs[k];
+		struct run_identity key = run->key;
 		cJSON *o = cJSON_CreateObject();
 		cJSON_AddItemToArray(array, o);
 		cJSON_AddNumberToObject(o, "id", run->key.id);
 		cJSON_AddStringToObject(o, "scene", run->key.scene);
 		cJSON_AddStringToObject(o, "builder", run->key.builder);
 		cJSON_AddStringToObject(o, "plugin", list->cfg->builders[run->builder].plugin);
-		cJSON_AddNumberToObject(o, "threads", run->threads);
-		if (run->key.options_hash)
-			cJSON_AddStringToObject(o, "options_hash", run->key.options_hash);
+		key.scene_config = key.builder_config = key.measure_config = NULL;
+		if (run_identity_add(o, &key) < 0)
+			return cJSON_Delete(array), NULL;
 	}
 	return array;
 }
@@ -347,29 +368,45 @@ int plan_file_load(struct plan_file *plan, const char *path, struct config *cfg,
 	return r;
 }
 
-/* One run of the plan against the list's run of its id. */
-static bool same_run(const cJSON *want, const struct plan_run *run)
+/* One run of the plan against the list's run of its id: RUN_SAME, or
+ * *changed says what differs (a plugin or its defaults differ here). */
+static enum run_match same_run(const cJSON *want, const struct plan_run *run,
+                               const char **changed)
 {
+	struct run_identity planned;
 	const cJSON *id = cJSON_GetObjectItemCaseSensitive(want, "id");
-	const cJSON *threads = cJSON_GetObjectItemCaseSensitive(want, "threads");
-	const char *scene = string_at(want, "scene"), *builder = string_at(want, "builder");
-	return cJSON_IsNumber(id) && id->valuedouble == run->key.id && cJSON_IsNumber(threads) &&
-	       threads->valuedouble == run->threads && scene && !strcmp(scene, run->key.scene) &&
-	       builder && !strcmp(builder, run->key.builder);
+	run_identity_read(want, &planned);
+	if (!cJSON_IsNumber(id) || id->valuedouble != run->key.id)
+		return RUN_OTHER;
+	/* A plan records only what it can know: the thread count as configured. */
+	enum run_match m = run_identity_compare(&run->key, &planned, changed);
+	return m == RUN_CHANGED && !planned.hash ? RUN_SAME : m;
 }
 
 int plan_check_list(const struct plan_file *plan, const struct run_list *list,
                     bvhlab_error *err)
 {
 	const cJSON *runs = cJSON_GetObjectItemCaseSensitive(plan->doc, "runs"), *want;
+	const char *changed = NULL;
+	enum run_match m = RUN_SAME;
 	size_t k = 0;
 	cJSON_ArrayForEach(want, runs) {
-		if (k >= list->count || !same_run(want, &list->runs[k]))
+		if (k >= list->count || (m = same_run(want, &list->runs[k], &changed)) != RUN_SAME)
 			break;
 		k++;
 	}
 	if (k == list->count && k == plan->run_count)
 		return 0;
+	if (m == RUN_CHANGED) {
+		bool builder = !strcmp(changed, "builder");
+		error_set(err, "%s: run %zu (%s, %s) would be made another way here than planned: "
+		          "its %s differs (%s); plan again here", plan->path, k,
+		          list->runs[k].key.scene, list->runs[k].key.builder,
+		          builder ? "builder" : !strcmp(changed, "scene") ? "scene" : "measurement",
+		          builder ? "a plugin or its defaults here are not the planning machine's"
+		                  : "scene files missing when planning, or settings given here");
+		return -EINVAL;
+	}
 	error_set(err, "%s: this machine makes %zu runs of its config and the plan lists %zu, "
 	          "%s at run %zu (a builder's plugin here differs: its PARALLEL flag?); plan again "
 	          "here", plan->path, list->count, plan->run_count,

@@ -111,12 +111,22 @@ static int run_id(const struct merge *m, const char *dir, const cJSON *run, uint
 		return -EINVAL;
 	}
 	*id = (uint32_t)v->valuedouble;
-	const cJSON *want = cJSON_GetArrayItem(runs, (int)*id);
-	const char *s = string_at(run, "scene"), *b = string_at(run, "builder");
-	if (!s || !b || strcmp(s, string_at(want, "scene") ? string_at(want, "scene") : "") ||
-	    strcmp(b, string_at(want, "builder") ? string_at(want, "builder") : "")) {
+	struct run_identity planned, have;
+	const char *changed = NULL;
+	run_identity_read(cJSON_GetArrayItem(runs, (int)*id), &planned);
+	run_identity_read(run, &have);
+	have.threads = 0; /* the plan knows the configured count only */
+	enum run_match match = run_identity_compare(&planned, &have, &changed);
+	if (match == RUN_OTHER) {
 		error_set(err, "part %s: run %u is %s/%s there but %s/%s in the plan", dir, *id,
-		          s ? s : "?", b ? b : "?", string_at(want, "scene"), string_at(want, "builder"));
+		          have.scene ? have.scene : "?", have.builder ? have.builder : "?",
+		          planned.scene, planned.builder);
+		return -EINVAL;
+	}
+	if (match == RUN_CHANGED && have.hash) { /* a part of an older bvhlab has none */
+		error_set(err, "part %s: run %u (%s, %s) was made another way than the plan's (its "
+		          "%s differs): nothing merged; run it again from the plan", dir, *id,
+		          planned.scene, planned.builder, changed);
 		return -EINVAL;
 	}
 	return 0;
@@ -554,7 +564,8 @@ void merge_summary_finish(struct merge_summary *sum)
 
 /* ---- what is done already ----------------------------------------------------------- */
 
-/* Marks the finished runs of one part folder; none when it has no results.json. */
+/* Marks the runs of one part folder that ended ok (a failed one is to be
+ * run again); none when it has no results.json. */
 static int mark_done(const struct plan_file *plan, const char *dir, bool *done,
                      bvhlab_error *err)
 {
@@ -567,8 +578,9 @@ static int mark_done(const struct plan_file *plan, const char *dir, bool *done,
 	const cJSON *run, *runs = r == 0 ? cJSON_GetObjectItemCaseSensitive(doc, "runs") : NULL;
 	cJSON_ArrayForEach(run, runs) {
 		const cJSON *id = cJSON_GetObjectItemCaseSensitive(run, "id");
+		const char *status = string_at(run, "status");
 		if (cJSON_IsNumber(id) && id->valuedouble >= 0 &&
-		    id->valuedouble < (double)plan->run_count && string_at(run, "status"))
+		    id->valuedouble < (double)plan->run_count && status && !strcmp(status, "ok"))
 			done[(size_t)id->valuedouble] = true;
 	}
 	cJSON_Delete(doc);

@@ -88,7 +88,9 @@ static void add_scene(struct run_list *list, size_t s, const struct plan_builder
 			run->key = (struct run_identity){
 				.id = (uint32_t)list->count, .scene = cfg->scenes[s].name,
 				.builder = cfg->builders[b].name, .threads = t->resolved[k],
+				.threads_configured = t->configured[k],
 				.options_hash = builders ? builders[b].options_hash : NULL};
+			plan_identity_key(list, run);
 			list->count++;
 		}
 	}
@@ -113,6 +115,8 @@ int plan_list_make(struct run_list *list, const struct config *cfg,
 	}
 	if (r == 0 && !(list->runs = calloc(per_scene * cfg->scene_count + 1, sizeof(*list->runs))))
 		r = -ENOMEM;
+	if (r == 0)
+		r = plan_identity_make(list, builders);
 	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
 		add_scene(list, s, builders);
 	if (r < 0) {
@@ -126,6 +130,7 @@ void plan_list_finish(struct run_list *list)
 {
 	for (size_t b = 0; list->threads && b < list->cfg->builder_count; b++)
 		free(list->threads[b].resolved);
+	plan_identity_finish(list);
 	free(list->threads);
 	free(list->scene_first);
 	free(list->runs);

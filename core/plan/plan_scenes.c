@@ -17,13 +17,8 @@
 #include "plan/plan.h"
 #include "util/util.h"
 
-struct fingerprint {
-	double size;
-	char hash[17];
-};
-
 /* Size and 64-bit FNV-1a of the file's bytes; a negative errno if unreadable. */
-static int fingerprint(const char *path, struct fingerprint *fp)
+int plan_fingerprint(const char *path, struct plan_fingerprint *fp)
 {
 	static unsigned char buf[1 << 16];
 	uint64_t h = 0xcbf29ce484222325ULL, size = 0;
@@ -48,31 +43,41 @@ static int fingerprint(const char *path, struct fingerprint *fp)
 	return -e;
 }
 
+int plan_scene_each_file(const struct config_scene *cs,
+                         int (*fn)(const char *path, size_t k, void *ctx), size_t *k, void *ctx)
+{
+	char frame[4096];
+	int r = cs->path ? fn(cs->path, (*k)++, ctx) : 0;
+	for (size_t p = 0; r == 0 && p < cs->part_count; p++)
+		if (cs->parts[p].src.path)
+			r = fn(cs->parts[p].src.path, (*k)++, ctx);
+	for (uint32_t f = 0; r == 0 && cs->frame_pattern && f < cs->frames; f++) {
+		snprintf(frame, sizeof(frame), cs->frame_pattern, (int)(cs->frame_first + f));
+		if (!cs->path || strcmp(frame, cs->path) != 0) /* frame 0's is the path */
+			r = fn(frame, (*k)++, ctx);
+	}
+	return r;
+}
+
 /* Calls fn for every file the config's scenes read, in config order. */
 static int each_file(const struct config *cfg, int (*fn)(const char *path, size_t k, void *ctx),
                      void *ctx)
 {
 	size_t k = 0;
 	int r = 0;
-	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++) {
-		const struct config_scene *cs = &cfg->scenes[s];
-		if (cs->path)
-			r = fn(cs->path, k++, ctx);
-		for (size_t p = 0; r == 0 && p < cs->part_count; p++)
-			if (cs->parts[p].src.path)
-				r = fn(cs->parts[p].src.path, k++, ctx);
-	}
+	for (size_t s = 0; r == 0 && s < cfg->scene_count; s++)
+		r = plan_scene_each_file(&cfg->scenes[s], fn, &k, ctx);
 	return r;
 }
 
 static int add_file(const char *path, size_t k, void *ctx)
 {
-	struct fingerprint fp;
+	struct plan_fingerprint fp;
 	cJSON *o = cJSON_CreateObject();
 	(void)k;
 	cJSON_AddItemToArray(ctx, o);
 	cJSON_AddStringToObject(o, "path", path);
-	if (fingerprint(path, &fp) < 0)
+	if (plan_fingerprint(path, &fp) < 0)
 		return 0; /* missing here: the run that loads it says so */
 	cJSON_AddNumberToObject(o, "size", fp.size);
 	cJSON_AddStringToObject(o, "hash", fp.hash);
@@ -99,8 +104,8 @@ static int check_file(const char *path, size_t k, void *ctx)
 	const cJSON *then = cJSON_GetArrayItem(c->files, (int)k);
 	const cJSON *size = cJSON_GetObjectItemCaseSensitive(then, "size");
 	const cJSON *hash = cJSON_GetObjectItemCaseSensitive(then, "hash");
-	struct fingerprint now;
-	if (!cJSON_IsNumber(size) || !cJSON_IsString(hash) || fingerprint(path, &now) < 0)
+	struct plan_fingerprint now;
+	if (!cJSON_IsNumber(size) || !cJSON_IsString(hash) || plan_fingerprint(path, &now) < 0)
 		return 0; /* not known then, or not here now: loading will tell */
 	if (now.size == size->valuedouble && strcmp(now.hash, hash->valuestring) == 0)
 		return 0;

@@ -169,6 +169,22 @@ char *util_path_normalise(const char *path)
 	return out;
 }
 
+char *util_pattern_folder(char *s, size_t head)
+{
+	size_t n = strlen(s), extra = 0;
+	for (size_t k = 0; k < head; k++)
+		extra += s[k] == '%';
+	char *out = extra ? malloc(n + extra + 1) : s;
+	for (size_t k = 0, j = 0; extra && out && k <= n; k++) {
+		if (k < head && s[k] == '%')
+			out[j++] = '%';
+		out[j++] = s[k];
+	}
+	if (out != s)
+		free(s);
+	return out;
+}
+
 char *util_path_shown(const char *dir, const char *path)
 {
 	size_t n = strlen(dir);

@@ -54,6 +54,10 @@ char *util_path_normalise(const char *path);
 /* A path the config resolved against its folder dir, as the reports show
  * it: relative to that folder again, normalised. malloc'd, or NULL. */
 char *util_path_shown(const char *dir, const char *path);
+/* A file pattern (one %d) joined to a folder: every '%' of its first
+ * `head` bytes (the folder, no part of the pattern) doubled. Takes s;
+ * NULL when out of memory. */
+char *util_pattern_folder(char *s, size_t head);
 
 /* Monotonic clock in seconds. */
 double util_now(void);

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -95,6 +96,24 @@ static int finish(pid_t pid)
 	slurp(out_path, out_text, sizeof(out_text));
 	slurp(err_path, err_text, sizeof(err_text));
 	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+/* tmpdir/name, in one of four rotating buffers (so up to four may be used
+ * at once, in one call's arguments). */
+static inline const char *cli_path_in(const char *name)
+{
+	static char buf[4][600];
+	static int next;
+	char *p = buf[next++ % 4];
+	snprintf(p, 600, "%s/%s", tmpdir, name);
+	return p;
+}
+
+/* Whether something (a link too) is at path. */
+static inline bool cli_exists(const char *path)
+{
+	struct stat st;
+	return lstat(path, &st) == 0;
 }
 
 /* Runs bvhlab with args (NULL-terminated); stdout/stderr into the buffers. */

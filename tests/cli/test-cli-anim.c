@@ -216,15 +216,17 @@ static void test_errors(void)
 	             "unknown key 'spin' in scenes[0].parts[0].animate");
 	config_error(ico, "{ \"plugin\": \"lbvh\", \"animation\": { \"rebuild_every\": 2 } }",
 	             "'builders[0].animation' needs an 'update'");
-	/* A plugin without an update function fails its runs, saying so. */
+	/* A plugin without an update function is a config error, before any run. */
 	char text[1024];
 	snprintf(text, sizeof(text), "{ \"output\": \"out-noupd\", \"repeat\": 1, \"warmup\": 0,\n"
 	         "  \"rays\": { \"width\": 8, \"height\": 8, \"min_ms\": 1, \"rounds\": 1 },\n"
 	         "  \"scenes\": [ %s ],\n"
 	         "  \"builders\": [ { \"plugin\": \"sah_seq\", \"animation\": { \"update\": "
 	         "\"lbvh\" } } ] }\n", ico);
-	CHECK_INT(run(ARGS("run", write_config("noupd.json", text))), 1);
+	CHECK_INT(run(ARGS("run", write_config("noupd.json", text))), 2);
 	CHECK_CONTAINS(err_text, "animation update: plugin 'lbvh' has no update function (ABI 1.4)");
+	snprintf(text, sizeof(text), "%s/out-noupd", tmpdir);
+	CHECK(access(text, F_OK) != 0);
 }
 
 /* Two animated scenes, the "gated" builder on both (struct kill_sweep). */

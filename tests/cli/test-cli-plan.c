@@ -365,7 +365,7 @@ static void test_slurm_file(void)
 	cJSON *runs = cJSON_Parse(out_text);
 	CHECK_INT(cJSON_GetArraySize(runs), 2);
 	const cJSON *second = cJSON_GetArrayItem(runs, 1);
-	CHECK(num(second, "id", NULL) == 1 && num(second, "threads", NULL) == 2);
+	CHECK(num(second, "id", NULL) == 1 && num(second, "threads_configured", NULL) == 2);
 	CHECK(!strcmp(run_str(second, "builder"), "sah_tasks"));
 	CHECK_CONTAINS(run_str(second, "command"), "/m/plan.json --only 1 --out ");
 	cJSON_Delete(runs);

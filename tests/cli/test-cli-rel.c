@@ -254,20 +254,24 @@ static int alpha_of(const cJSON *run)
 	return cJSON_GetObjectItem(cJSON_GetObjectItem(run, "options"), "alpha")->valueint;
 }
 
-/* Resumed runs made with other options run again; --retry-failed reruns failures. */
+/* Resumed runs made with other options, or on a scene file that appeared
+ * since, run again; --retry-failed reruns failures. */
 static void identity_resume(void)
 {
 	char dir[600];
 	snprintf(dir, sizeof(dir), "%s", path_in("out-id"));
 	write_mesh("v 0 0 0\n"); /* no face yet: its run fails */
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", alpha(2))), 1);
-	write_mesh("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", alpha(2))), 1);
 	CHECK_CONTAINS(err_text, "2 finished runs kept");
-	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", "--retry-failed", alpha(2))), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", "--retry-failed", alpha(2))), 1);
 	CHECK_CONTAINS(err_text, "--retry-failed: 1 run that did not end ok will run again");
+	write_mesh("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", alpha(2))), 0);
+	CHECK_CONTAINS(err_text, "1 finished run kept");
+	CHECK_CONTAINS(err_text, "1 run rerun: scene 'tri' changed");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", alpha(3))), 0);
-	CHECK_CONTAINS(err_text, "2 resumed runs made with other options will run again");
+	CHECK_CONTAINS(err_text, "2 runs rerun: builder 'fake_good' changed");
 	cJSON *doc = load_results(dir);
 	CHECK_INT(count_runs(doc, "fake_good", "ok"), 2);
 	const cJSON *r;
