@@ -136,7 +136,9 @@ static const char *count(char *buf, size_t size, double n)
 static const char *group_title(char *buf, size_t size, const struct report_index *ix,
                                const struct front_entry *e)
 {
-	int len = snprintf(buf, size, "%.0f thread%s", e->threads, e->threads == 1 ? "" : "s");
+	int len = e->threads == REPORT_DEVICE_GROUP
+	                  ? snprintf(buf, size, "device: %s", report_str(e->run, "device.name"))
+	                  : snprintf(buf, size, "%.0f thread%s", e->threads, e->threads == 1 ? "" : "s");
 	if (ix->machine_count > 1 && len >= 0 && (size_t)len < size)
 		snprintf(buf + len, size - (size_t)len, " on M%ld", e->machine + 1);
 	return buf;
@@ -162,18 +164,18 @@ static void verdict_line(struct strbuf *sb, const struct budget_group *g)
 	}
 }
 
-/* The text in Markdown or, escaped, in HTML. */
+/* The text escaped for HTML or for Markdown. */
 static void put(struct strbuf *sb, bool html, const char *text)
 {
 	if (html)
 		report_escape(sb, text);
 	else
-		sb_printf(sb, "%s", text);
+		report_md_text(sb, text);
 }
 
 static void summary_line(struct budget_walk *w, const struct budget_group *g)
 {
-	char title[64];
+	char title[160];
 	if (!w->opened)
 		sb_printf(w->sb, w->html ? "<p><b>Cheapest for a ray budget</b> (build plus primary "
 		                           "rays at the measured Mrays/s; see each scene's table):"
@@ -264,7 +266,7 @@ static void row_cells(const struct budget_group *g, size_t k, char (*cell)[48])
 
 static void group_md(struct budget_walk *w, const struct budget_group *g)
 {
-	char title[64], cell[5][48] = {{0}};
+	char title[160], cell[5][48] = {{0}};
 	if (!w->opened)
 		sb_printf(w->sb, "\n### Cheapest for a ray budget\n\n%s\n\n| threads | builder "
 		                 "| median ms | primary Mrays/s | cheapest from (rays) | up to (rays) |\n"
@@ -330,7 +332,7 @@ static void group_chart(struct strbuf *sb, const struct report_index *ix,
 
 static void group_html(struct budget_walk *w, const struct budget_group *g)
 {
-	char title[64], cell[5][48] = {{0}};
+	char title[160], cell[5][48] = {{0}};
 	if (!w->opened)
 		sb_printf(w->sb, "<h3>Cheapest for a ray budget</h3>\n<p>%s</p>\n<table class=\"budget\">"
 		                 "<tr><th class=\"l\">threads</th><th class=\"l\">builder</th><th>median "

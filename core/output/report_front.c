@@ -120,6 +120,8 @@ static bool competes(const struct report_index *ix, const cJSON *const *runs, si
 	double own = report_num(runs[k], "threads");
 	if (report_on_device(runs[k]))
 		return t == REPORT_DEVICE_GROUP;
+	if (t == REPORT_DEVICE_GROUP)
+		return false; /* not even a 1-thread run standing in */
 	return own == t || (own == 1 && t > 1 &&
 	                    !ran_parallel(ix, runs, n, report_str(runs[k], "builder"),
 	                                  report_machine_number(ix, runs[k])));
@@ -240,13 +242,14 @@ static void verdict(const struct front_table *t, int v, size_t k, char *buf, siz
 	report_front_text(buf, size, t->p[v], by, k, name, figure_names[v]);
 }
 
-/* "2", or "2 (ran on 1)" for a 1-thread run standing in at 2 threads;
- * " on M2" after it when the runs come from several machines. */
 /* A figure as the tables print it, or "not measured" where it is not finite. */
 static const char *measured(char *buf, size_t size, double v)
 {
 	return isfinite(v) ? report_plain(buf, size, v) : report_figure(buf, size, v, 0);
 }
+
+/* "2", or "2 (ran on 1)" for a 1-thread run standing in at 2 threads;
+ * " on M2" after it when the runs come from several machines. */
 
 static const char *threads_text(char *buf, size_t size, const struct report_index *ix,
                                 const struct front_entry *e)

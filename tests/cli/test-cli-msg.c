@@ -292,7 +292,7 @@ static void config_memory_messages(void)
 #else
 	cJSON *doc;
 	int status = sweep("lim.json",
-		"{ \"output\": \"out-lim\", \"repeat\": 1, \"warmup\": 0, \"memory_limit_mb\": 512,\n"
+		"{ \"output\": \"out-lim\", \"repeat\": 1, \"warmup\": 0, \"memory_limit_mb\": 100,\n"
 		"  \"threads\": [2],\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 1000 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"cl_lbvh\", \"optional\": true },\n"
@@ -301,12 +301,12 @@ static void config_memory_messages(void)
 	const cJSON *cl = find_run(doc, "soup", "cl_lbvh", 2), *em = find_run(doc, "soup", "embree", 2);
 	if (cl) {
 		CHECK_CONTAINS(run_str(cl, "error"), "no OpenCL platform could be opened: this "
-		               "process's address space is limited to 512 MB (memory_limit_mb)");
+		               "process's address space is limited to 100 MB (memory_limit_mb)");
 		CHECK(!strstr(run_str(cl, "error"), "install an OpenCL driver"));
 	}
 	if (em)
 		CHECK_CONTAINS(run_str(em, "error"), "rtcNewDevice(threads=2) failed: out of memory; "
-		               "the address space is limited to 512 MB");
+		               "the address space is limited to 100 MB");
 	cJSON_Delete(doc);
 #endif
 }
@@ -325,14 +325,16 @@ static void test_config(void)
 static void test_escape(void)
 {
 	cJSON *doc;
+	write_config("bad <!-- m.obj", "v 0 0 0\n"); /* opens, but has no triangle */
 	CHECK_INT(sweep("esc.json",
 		"{ \"output\": \"out-esc\", \"repeat\": 1, \"warmup\": 0,\n"
 		"  \"rays\": { \"width\": 8, \"height\": 8 },\n"
 		"  \"scenes\": [ { \"name\": \"=1+2 <script>s</script>\", \"generator\": \"soup\",\n"
 		"                \"count\": 100, \"frames\": 2, \"deform\": \"wave\" },\n"
-		"                { \"name\": \"-x\", \"path\": \"missing <!-- m.obj\" } ],\n"
+		"                { \"name\": \"-x\", \"path\": \"bad <!-- m.obj\" } ],\n"
 		"  \"builders\": [ { \"plugin\": \"lbvh\", \"name\": \"a|b <!-- c\",\n"
-		"                    \"animation\": { \"update\": \"refit\" } },\n"
+		"                    \"animation\": { \"update\": \"refit\",\n"
+		"                                    \"allow_static\": true } },\n"
 		"                  { \"plugin\": \"lbvh\", \"name\": \"@sum\" } ] }\n", "out-esc", &doc),
 		1);
 	cJSON_Delete(doc);
@@ -343,7 +345,7 @@ static void test_escape(void)
 		const char *anim = strstr(md, "### Animation");
 		CHECK_CONTAINS(anim ? anim : "", "| a\\|b &lt;!-- c | 1 | 2 | yes |");
 		CHECK_CONTAINS(md, "## =1+2 &lt;script&gt;s&lt;/script&gt;");
-		CHECK_CONTAINS(md, "missing &lt;!-- m.obj");
+		CHECK_CONTAINS(md, "bad &lt;!-- m.obj");
 	}
 	free(md);
 	char *csv = read_file(path_in("out-esc"), "results.csv");
