@@ -84,7 +84,9 @@ static void test_rerun(void)
 	CHECK_INT(resume(rerun_config(scene, "", "\"repeat\": 2, \"rays\": { \"width\": 4, "
 	                              "\"height\": 4, \"min_ms\": 1, \"rounds\": 1 },")), 0);
 	CHECK_CONTAINS(err_text, "1 run rerun: measurement settings changed");
-	CHECK_INT(cJSON_GetArraySize(cJSON_Parse(member_text("A", "build_ms", "samples"))), 2);
+	cJSON *samples = cJSON_Parse(member_text("A", "build_ms", "samples"));
+	CHECK_INT(cJSON_GetArraySize(samples), 2);
+	cJSON_Delete(samples);
 	CHECK_CONTAINS(member_text("A", "config", "measure"), "\"repeat\":2");
 
 	/* An animated scene: the animation block, then rays_per_frame. */
