@@ -261,6 +261,7 @@ void report_load_warning(struct strbuf *sb, const cJSON *doc, bool html);
 struct summary_row {
 	const char *builder; /* points into the document */
 	double threads;
+	bool device;         /* the runs ran on an OpenCL device: threads is the host's */
 	long machine;        /* report_machine_number's: rows never mix machines */
 	int scenes;          /* scenes with ok runs of both */
 	double ratio[SUMMARY_METRICS];

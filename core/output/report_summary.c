@@ -107,6 +107,7 @@ static void summarise(const struct report_index *ix, const char *ref, const cJSO
 	memset(row, 0, sizeof(*row));
 	row->builder = report_str(first, "builder");
 	row->threads = report_num(first, "threads");
+	row->device = report_on_device(first);
 	row->machine = report_machine_number(ix, first);
 	cJSON_ArrayForEach(run, cJSON_GetObjectItem(ix->doc, "runs")) {
 		if (!is_ok(run) || strcmp(report_str(run, "builder"), row->builder) != 0 ||
@@ -161,6 +162,18 @@ static const char *ratio_text(char *buf, size_t size, double r)
 	return buf;
 }
 
+/* "2", or "device" for a device builder's row (its one host thread says
+ * nothing of what the device ran on; the fronts put it in a group of its
+ * own). */
+static const char *threads_cell(char *buf, size_t size, const struct summary_row *row)
+{
+	if (row->device)
+		snprintf(buf, size, "device");
+	else
+		snprintf(buf, size, "%.0f", row->threads);
+	return buf;
+}
+
 /* Where a row's runs stand on their scenes' fronts (time × SAH). */
 struct row_verdict {
 	int on, dominated, compared;
@@ -172,10 +185,11 @@ struct row_verdict {
  * or -1. */
 static int row_of(const struct summary_row *rows, int n, const struct front_entry *e)
 {
-	if (report_num(e->run, "threads") != e->threads)
+	double own = report_num(e->run, "threads");
+	if (own != e->threads && e->threads != REPORT_DEVICE_GROUP)
 		return -1; /* a 1-thread-only builder standing in: its row is at 1 thread */
 	for (int i = 0; i < n; i++)
-		if (rows[i].threads == e->threads && rows[i].machine == e->machine &&
+		if (rows[i].threads == own && rows[i].machine == e->machine &&
 		    strcmp(rows[i].builder, report_str(e->run, "builder")) == 0)
 			return i;
 	return -1;
@@ -337,7 +351,7 @@ void report_summary_md(struct strbuf *sb, const struct report_index *ix)
 	for (int i = 0; i < s.n; i++) {
 		sb_printf(sb, "|");
 		report_md_cell(sb, s.rows[i].builder);
-		sb_printf(sb, " %.0f |", s.rows[i].threads);
+		sb_printf(sb, " %s |", threads_cell(buf, sizeof(buf), &s.rows[i]));
 		if (s.machines)
 			sb_printf(sb, " M%ld |", s.rows[i].machine + 1);
 		sb_printf(sb, " %d |", s.rows[i].scenes);
@@ -354,7 +368,7 @@ static void html_row(struct strbuf *sb, const struct summary *s, int i)
 	char buf[256];
 	sb_printf(sb, "<tr><td class=\"l\">");
 	report_escape(sb, s->rows[i].builder);
-	sb_printf(sb, "</td><td>%.0f</td>", s->rows[i].threads);
+	sb_printf(sb, "</td><td>%s</td>", threads_cell(buf, sizeof(buf), &s->rows[i]));
 	if (s->machines)
 		sb_printf(sb, "<td>M%ld</td>", s->rows[i].machine + 1);
 	sb_printf(sb, "<td>%d</td>", s->rows[i].scenes);

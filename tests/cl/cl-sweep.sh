@@ -90,6 +90,14 @@ for b in ("cl_lbvh", "cl_ploc"):
     lines = [l for l in fronts.splitlines() if l.startswith("| %s |" % b)]
     assert lines == [l for l in lines if l.startswith("| %s | device: %s |" % (b, by[b]["device"]["name"]))], lines
     assert len(lines) == 1, lines
+# The summary rows: a device builder says "device", never a thread
+# count, and its Pareto verdict comes from the device group.
+summary = report[report.index("## Summary"):]
+summary = summary[:summary.index("\n## ")]
+for b in ("cl_lbvh", "cl_ploc"):
+    lines = [l for l in summary.splitlines() if l.startswith("| %s |" % b)]
+    assert len(lines) == 1 and lines[0].startswith("| %s | device |" % b), lines
+    assert "on 1 of 1 scene" in lines[0], lines
 print("with drivers: every run ok, device phases within build_ms, on",
       by["cl_lbvh"]["device"]["name"], "(runtime %.1f MiB, the cl_lbvh build %.1f MiB)" %
       (by["cl_lbvh"]["memory"]["runtime_bytes"] / 2**20, by["cl_lbvh"]["memory"]["peak_bytes"] / 2**20))
