@@ -155,7 +155,8 @@ static void md_run_row(struct strbuf *sb, const struct report_index *ix, const c
 	char buf[400];
 	sb_printf(sb, "|");
 	report_md_cell(sb, report_str(run, "builder"));
-	report_md_cell(sb, num(buf, sizeof(buf), run, "threads", "%.0f"));
+	report_md_cell(sb, report_on_device(run) ? "device" /* its host thread says nothing */
+	                                         : num(buf, sizeof(buf), run, "threads", "%.0f"));
 	report_md_cell(sb, report_str(run, "status"));
 	md_numbers(sb, run, md_times, sizeof(md_times) / sizeof(md_times[0]));
 	double speedup = report_speedup(ix, run);

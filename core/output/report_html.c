@@ -100,7 +100,10 @@ static void name_cells(struct strbuf *sb, const cJSON *run)
 	sb_printf(sb, "<tr><td class=\"l\">");
 	esc(sb, report_str(run, "builder"));
 	sb_printf(sb, "</td>");
-	num_cell(sb, report_num(run, "threads"), "%.0f");
+	if (report_on_device(run))
+		sb_printf(sb, "<td>device</td>"); /* its one host thread says nothing */
+	else
+		num_cell(sb, report_num(run, "threads"), "%.0f");
 }
 
 static void error_cell(struct strbuf *sb, const cJSON *run)

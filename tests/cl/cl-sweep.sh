@@ -98,6 +98,8 @@ for b in ("cl_lbvh", "cl_ploc"):
     lines = [l for l in summary.splitlines() if l.startswith("| %s |" % b)]
     assert len(lines) == 1 and lines[0].startswith("| %s | device |" % b), lines
     assert "on 1 of 1 scene" in lines[0], lines
+    runs_table = [l for l in report.splitlines() if l.startswith("| %s | " % b) and "| ok |" in l]
+    assert runs_table and all(l.startswith("| %s | device | ok |" % b) for l in runs_table), runs_table
 print("with drivers: every run ok, device phases within build_ms, on",
       by["cl_lbvh"]["device"]["name"], "(runtime %.1f MiB, the cl_lbvh build %.1f MiB)" %
       (by["cl_lbvh"]["memory"]["runtime_bytes"] / 2**20, by["cl_lbvh"]["memory"]["peak_bytes"] / 2**20))
