@@ -195,18 +195,6 @@ static int image_buffers(const struct series_job *job, size_t n, uint32_t **node
 	return (job->heat_path && !*nodes) || (job->shade_path && !*shade) ? -ENOMEM : 0;
 }
 
-/* Why no ray was traced; out of memory with its limit, as a build's says. */
-static void rays_error(const struct series_job *job, struct series_report *rep, int r)
-{
-	uint64_t limit = harness_run_limits(job->h->cfg, job->hb->cb).memory_bytes;
-	char note[64] = "";
-	if (r == -ENOMEM && limit && job->h->cfg->isolate)
-		snprintf(note, sizeof(note), " (under memory_limit_mb = %llu)",
-		         (unsigned long long)(limit >> 20));
-	snprintf(rep->rays.error, sizeof(rep->rays.error), "%s%s",
-	         r == -ENOMEM ? "out of memory tracing the rays" : strerror(-r), note);
-}
-
 /* Traversal statistics on the valid tree, and the raw image data. A
  * failure here costs the numbers, not the run: the tree itself is fine. */
 static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
@@ -241,7 +229,8 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
 	/* The run stays ok (its tree is); its "rays" says why there are no figures. */
 	if (r < 0 && !rep->rays.error[0])
-		rays_error(job, rep, r);
+		harness_rays_error(r, harness_run_limits(job->h->cfg, job->hb->cb).memory_bytes,
+		                   job->h->cfg->isolate, rep->rays.error, sizeof(rep->rays.error));
 	free(nodes);
 	free(shade);
 }

@@ -178,3 +178,13 @@ out:
 	free(rays);
 	return r;
 }
+
+void harness_rays_error(int r, uint64_t memory_limit, bool isolated, char *buf, size_t size)
+{
+	char note[64] = "";
+	if (r == -ENOMEM && memory_limit && isolated)
+		snprintf(note, sizeof(note), " (under memory_limit_mb = %llu)",
+		         (unsigned long long)(memory_limit >> 20));
+	snprintf(buf, size, "%s%s", r == -ENOMEM ? "out of memory tracing the rays" : strerror(-r),
+	         note);
+}

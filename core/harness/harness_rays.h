@@ -49,4 +49,9 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
                        const bvhlab_camera *cam, const struct ray_settings *rs,
                        struct ray_metrics *m, uint32_t *nodes, uint8_t *shade);
 
+/* Why no ray was traced (r a negative errno) into buf; out of memory with
+ * the limit it ran under (memory_limit bytes, 0 none; only when isolated,
+ * where the limit applies), as a build's failure says. */
+void harness_rays_error(int r, uint64_t memory_limit, bool isolated, char *buf, size_t size);
+
 #endif

@@ -208,6 +208,16 @@ int plan_merge(const struct plan_file *plan, const char *const *parts, size_t pa
                bvhlab_error *err);
 void merge_summary_finish(struct merge_summary *sum);
 
+/* DIR/results.json parsed into *doc; -ENOENT when there is none, -EINVAL
+ * (with err) when it is not a results document (plan_parts.c). */
+int plan_part_read(const char *dir, struct cJSON **doc, bvhlab_error *err);
+/* 0 when doc, read from part folder dir, was run from this plan; else
+ * -EINVAL with err saying how to run it or which plan it came from. */
+int plan_part_check(const struct plan_file *plan, const char *dir,
+                    const struct cJSON *doc, bvhlab_error *err);
+/* The plan hash a results document records, or NULL. */
+const char *plan_part_hash(const struct cJSON *doc);
+
 /*
  * The ids each part folder under parts_dir holds a finished run of
  * ((*done)[id] true), for `plan --missing`. Folders without results.json

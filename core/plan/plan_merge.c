@@ -54,50 +54,6 @@ static const char *string_at(const cJSON *o, const char *key)
 	return cJSON_IsString(v) ? v->valuestring : NULL;
 }
 
-static const char *plan_hash_of(const cJSON *doc)
-{
-	return string_at(cJSON_GetObjectItemCaseSensitive(doc, "plan"), "hash");
-}
-
-/* dir/results.json parsed; -ENOENT when there is none. */
-static int read_results(const char *dir, cJSON **doc, bvhlab_error *err)
-{
-	char path[4096], *text = NULL;
-	*doc = NULL;
-	snprintf(path, sizeof(path), "%s/results.json", dir);
-	if (access(path, F_OK) != 0)
-		return -ENOENT;
-	int r = plan_read_file(path, &text, err);
-	if (r < 0)
-		return r;
-	*doc = cJSON_Parse(text);
-	free(text);
-	if (cJSON_IsObject(*doc) && cJSON_IsArray(cJSON_GetObjectItemCaseSensitive(*doc, "runs")))
-		return 0;
-	cJSON_Delete(*doc);
-	*doc = NULL;
-	error_set(err, "%s is not a bvhlab results document (damaged?)", path);
-	return -EINVAL;
-}
-
-/* A part must be a results folder of this very plan. */
-static int check_part_plan(const struct plan_file *plan, const char *dir, const cJSON *doc,
-                           bvhlab_error *err)
-{
-	const char *hash = plan_hash_of(doc);
-	if (!hash) {
-		error_set(err, "part %s was not run from a plan (its results.json has no \"plan\"): "
-		          "run it as `bvhlab run %s --only ID --out %s`", dir, plan->path, dir);
-		return -EINVAL;
-	}
-	if (strcmp(hash, plan->hash) != 0) {
-		error_set(err, "part %s comes from another plan (hash %s; %s is %s): nothing merged",
-		          dir, hash, plan->path, plan->hash);
-		return -EINVAL;
-	}
-	return 0;
-}
-
 /* The run's id, checked against the plan's run of that id. */
 static int run_id(const struct merge *m, const char *dir, const cJSON *run, uint32_t *id,
                   bvhlab_error *err)
@@ -151,12 +107,12 @@ static int collect(struct merge *m, const char *const *dirs, bvhlab_error *err)
 	for (size_t p = 0; p < m->part_count; p++) {
 		struct part *part = &m->parts[p];
 		part->dir = dirs[p];
-		int r = read_results(part->dir, &part->doc, err);
+		int r = plan_part_read(part->dir, &part->doc, err);
 		if (r == -ENOENT)
 			error_set(err, "part %s has no results.json (not a results folder, or its run "
 			          "never started)", part->dir);
 		if (r == 0)
-			r = check_part_plan(m->plan, part->dir, part->doc, err);
+			r = plan_part_check(m->plan, part->dir, part->doc, err);
 		r = r ? r : check_part_version(m, p, err);
 		const cJSON *run;
 		cJSON_ArrayForEach(run, cJSON_GetObjectItemCaseSensitive(part->doc, "runs")) {
@@ -420,11 +376,11 @@ static int build_runs(const struct merge *m, cJSON *runs, struct merge_summary *
 static int check_target(const struct plan_file *plan, const char *dir, bvhlab_error *err)
 {
 	cJSON *old = NULL;
-	int r = read_results(dir, &old, err);
+	int r = plan_part_read(dir, &old, err);
 	if (r == -ENOENT)
 		return 0;
-	if (r == 0 && (!cJSON_GetObjectItemCaseSensitive(old, "merged") || !plan_hash_of(old) ||
-	               strcmp(plan_hash_of(old), plan->hash) != 0)) {
+	if (r == 0 && (!cJSON_GetObjectItemCaseSensitive(old, "merged") || !plan_part_hash(old) ||
+	               strcmp(plan_part_hash(old), plan->hash) != 0)) {
 		error_set(err, "%s/results.json is not an earlier merge of this plan: nothing "
 		          "overwritten; merge into another folder", dir);
 		r = -EEXIST;
@@ -560,53 +516,4 @@ void merge_summary_finish(struct merge_summary *sum)
 	free(sum->missing);
 	free(sum->not_ok);
 	memset(sum, 0, sizeof(*sum));
-}
-
-/* ---- what is done already ----------------------------------------------------------- */
-
-/* Marks the runs of one part folder that ended ok (a failed one is to be
- * run again); none when it has no results.json. */
-static int mark_done(const struct plan_file *plan, const char *dir, bool *done,
-                     bvhlab_error *err)
-{
-	cJSON *doc = NULL;
-	int r = read_results(dir, &doc, err);
-	if (r == -ENOENT)
-		return 0;
-	if (r == 0)
-		r = check_part_plan(plan, dir, doc, err);
-	const cJSON *run, *runs = r == 0 ? cJSON_GetObjectItemCaseSensitive(doc, "runs") : NULL;
-	cJSON_ArrayForEach(run, runs) {
-		const cJSON *id = cJSON_GetObjectItemCaseSensitive(run, "id");
-		const char *status = string_at(run, "status");
-		if (cJSON_IsNumber(id) && id->valuedouble >= 0 &&
-		    id->valuedouble < (double)plan->run_count && status && !strcmp(status, "ok"))
-			done[(size_t)id->valuedouble] = true;
-	}
-	cJSON_Delete(doc);
-	return r;
-}
-
-int plan_done_runs(const struct plan_file *plan, const char *parts_dir, bool **done,
-                   bvhlab_error *err)
-{
-	char path[4096];
-	*done = calloc(plan->run_count ? plan->run_count : 1, sizeof(**done));
-	if (!*done) {
-		error_set(err, "out of memory");
-		return -ENOMEM;
-	}
-	DIR *d = opendir(parts_dir);
-	if (!d)
-		return 0; /* nothing run yet */
-	int r = 0;
-	for (struct dirent *e; r == 0 && (e = readdir(d));) {
-		struct stat st;
-		if ((size_t)snprintf(path, sizeof(path), "%s/%s", parts_dir, e->d_name) >= sizeof(path))
-			continue;
-		if (e->d_name[0] != '.' && stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-			r = mark_done(plan, path, *done, err);
-	}
-	closedir(d);
-	return r;
 }
