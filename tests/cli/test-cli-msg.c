@@ -16,27 +16,12 @@
 
 #include "cliutil.h"
 
-static const char *path_in(const char *name)
-{
-	static char buf[4][600];
-	static int next;
-	char *p = buf[next++ % 4];
-	snprintf(p, 600, "%s/%s", tmpdir, name);
-	return p;
-}
-
-static bool exists(const char *path)
-{
-	struct stat st;
-	return lstat(path, &st) == 0;
-}
-
 /* Runs config `text` as `name` (from tmpdir): its exit status; the results
  * of folder `out` into *doc (checked to be there), NULL after exit 2. */
 static int sweep(const char *name, const char *text, const char *out, cJSON **doc)
 {
 	int status = run_in(tmpdir, ARGS("run", "--quiet", write_config(name, text)));
-	*doc = status == 2 ? NULL : load_results(path_in(out));
+	*doc = status == 2 ? NULL : load_results(cli_path_in(out));
 	return status;
 }
 
@@ -98,8 +83,8 @@ static void status_update_crash(void)
 static void status_untraced(void)
 {
 	cJSON *doc;
-	CHECK(mkdir(path_in("no-icd"), 0755) == 0);
-	setenv("OCL_ICD_VENDORS", path_in("no-icd"), 1);
+	CHECK(mkdir(cli_path_in("no-icd"), 0755) == 0);
+	setenv("OCL_ICD_VENDORS", cli_path_in("no-icd"), 1);
 	int status = sweep("nr.json",
 		"{ \"output\": \"out-nr\", \"repeat\": 1, \"warmup\": 0,\n"
 		"  \"rays\": { \"width\": 16, \"height\": 16,\n"
@@ -123,7 +108,7 @@ static void status_untraced(void)
 		CHECK(cJSON_IsNull(cJSON_GetObjectItem(fr, "mrays_per_s")));
 		CHECK(cJSON_IsNull(cJSON_GetObjectItem(fr, "cost_ms")));
 	}
-	char *md = read_file(path_in("out-nr"), "report.md");
+	char *md = read_file(cli_path_in("out-nr"), "report.md");
 	CHECK(md && !strstr(md, "Cheapest over the animation") && !strstr(md, "nan"));
 	CHECK_CONTAINS(md ? md : "", "not measured");
 	CHECK_CONTAINS(md ? md : "", "No strategy's cost was measured");
@@ -131,7 +116,7 @@ static void status_untraced(void)
 	cJSON_Delete(doc);
 	/* The main traversal's failure fails the batch; a static scene's rays
 	 * with a CPU main and two device ones keep both devices' errors. */
-	setenv("OCL_ICD_VENDORS", path_in("no-icd"), 1);
+	setenv("OCL_ICD_VENDORS", cli_path_in("no-icd"), 1);
 	CHECK_INT(sweep("nr2.json",
 		"{ \"output\": \"out-nr2\", \"repeat\": 1, \"warmup\": 0,\n"
 		"  \"rays\": { \"width\": 16, \"height\": 16,\n"
@@ -181,26 +166,26 @@ static void test_version(void)
 		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
 		"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n");
 	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "pv")), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pv/plan.json"), "--only", "0", "--repeat",
-	                              "7", "--out", path_in("pv/parts/0"), "--quiet")), 2);
+	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("pv/plan.json"), "--only", "0", "--repeat",
+	                              "7", "--out", cli_path_in("pv/parts/0"), "--quiet")), 2);
 	CHECK_CONTAINS(err_text, "--repeat cannot be combined with a plan");
-	CHECK(!exists(path_in("pv/parts/0")));
+	CHECK(!cli_exists(cli_path_in("pv/parts/0")));
 	for (int k = 0; k < 2; k++) {
 		char id[4], out[64];
 		snprintf(id, sizeof(id), "%d", k);
 		snprintf(out, sizeof(out), "pv/parts/%d", k);
-		CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pv/plan.json"), "--only", id, "--out",
-		                              path_in(out), "--quiet")), 0);
+		CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("pv/plan.json"), "--only", id, "--out",
+		                              cli_path_in(out), "--quiet")), 0);
 	}
-	set_version(path_in("pv/parts/1"), "0.0.9+000000000000");
-	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pv/parts/0"), path_in("pv/parts/1"),
-	                              "--out", path_in("pv"))), 2);
+	set_version(cli_path_in("pv/parts/1"), "0.0.9+000000000000");
+	CHECK_INT(run_in(tmpdir, ARGS("merge", cli_path_in("pv/parts/0"), cli_path_in("pv/parts/1"),
+	                              "--out", cli_path_in("pv"))), 2);
 	CHECK_CONTAINS(err_text, "by bvhlab 0.0.9+000000000000");
 	CHECK_CONTAINS(err_text, "--allow-mixed-versions");
-	CHECK(!exists(path_in("pv/results.json")));
-	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pv/parts/0"), path_in("pv/parts/1"),
-	                              "--out", path_in("pv"), "--allow-mixed-versions")), 0);
-	cJSON *doc = load_results(path_in("pv"));
+	CHECK(!cli_exists(cli_path_in("pv/results.json")));
+	CHECK_INT(run_in(tmpdir, ARGS("merge", cli_path_in("pv/parts/0"), cli_path_in("pv/parts/1"),
+	                              "--out", cli_path_in("pv"), "--allow-mixed-versions")), 0);
+	cJSON *doc = load_results(cli_path_in("pv"));
 	CHECK_CONTAINS(run_str(doc, "bvhlab_version"), "mixed");
 	CHECK_CONTAINS(run_str(find_run(doc, "s", "b", 1), "bvhlab_version"), "0.0.9+000000000000");
 	CHECK_CONTAINS(run_str(find_run(doc, "s", "a", 1), "bvhlab_version"), "0.1.0+");
@@ -217,7 +202,7 @@ static void refused(const char *name, const char *text, const char *out, const c
 {
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", write_config(name, text))), 2);
 	CHECK_CONTAINS(err_text, message);
-	CHECK(!exists(path_in(out)));
+	CHECK(!cli_exists(cli_path_in(out)));
 }
 
 /* 9. Options no declaration states, names and coordinates: config errors. */
@@ -241,11 +226,11 @@ static void config_errors(void)
 	if (!strstr(err_text, "plugin 'cl_lbvh' not found")) /* built with OpenCL */
 		CHECK_CONTAINS(err_text, "builder 'cl_lbvh': option 'device' of builder 'cl_lbvh' "
 		               "must not be empty (default 'auto')");
-	FILE *f = fopen(path_in("big.obj"), "w");
+	FILE *f = fopen(cli_path_in("big.obj"), "w");
 	CHECK(f && fputs("v 0 0 0\nv 1 0 0\nv 0 -1e38 0\nf 1 2 3\n", f) >= 0);
 	if (f)
 		fclose(f);
-	CHECK_INT(run_in(tmpdir, ARGS("build", "lbvh", path_in("big.obj"))), 2);
+	CHECK_INT(run_in(tmpdir, ARGS("build", "lbvh", cli_path_in("big.obj"))), 2);
 	CHECK_CONTAINS(err_text, "big.obj:3: coordinate beyond +-1e18");
 }
 
@@ -338,7 +323,7 @@ static void test_escape(void)
 		"                  { \"plugin\": \"lbvh\", \"name\": \"@sum\" } ] }\n", "out-esc", &doc),
 		1);
 	cJSON_Delete(doc);
-	char *md = read_file(path_in("out-esc"), "report.md");
+	char *md = read_file(cli_path_in("out-esc"), "report.md");
 	CHECK(md != NULL);
 	if (md) {
 		CHECK(!strstr(md, "<script") && !strstr(md, "<!--"));
@@ -348,7 +333,7 @@ static void test_escape(void)
 		CHECK_CONTAINS(md, "bad &lt;!-- m.obj");
 	}
 	free(md);
-	char *csv = read_file(path_in("out-esc"), "results.csv");
+	char *csv = read_file(cli_path_in("out-esc"), "results.csv");
 	CHECK(csv != NULL);
 	if (csv) {
 		CHECK_CONTAINS(csv, "\n\"'=1+2 <script>s</script>\",a|b <!-- c,lbvh,");
@@ -356,7 +341,7 @@ static void test_escape(void)
 		CHECK(!strstr(csv, "\n=") && !strstr(csv, ",=") && !strstr(csv, ",@"));
 	}
 	free(csv);
-	char *frames = read_file(path_in("out-esc"), "frames.csv");
+	char *frames = read_file(cli_path_in("out-esc"), "frames.csv");
 	CHECK_CONTAINS(frames ? frames : "", "\n\"'=1+2 <script>s</script>\",a|b <!-- c,lbvh,");
 	free(frames);
 	static const char *const bad[][2] = {

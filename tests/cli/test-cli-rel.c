@@ -21,21 +21,6 @@
 #include "cliutil.h"
 
 #define LOADCRASH_DIR BVHLAB_TEST_BUILDDIR "/fake/loadcrash"
-static const char *path_in(const char *name)
-{
-	static char buf[4][600];
-	static int next;
-	char *p = buf[next++ % 4];
-	snprintf(p, 600, "%s/%s", tmpdir, name);
-	return p;
-}
-
-static bool exists(const char *path)
-{
-	struct stat st;
-	return lstat(path, &st) == 0;
-}
-
 static const cJSON *run_of(const cJSON *doc, const char *builder, int threads)
 {
 	const cJSON *r;
@@ -89,7 +74,7 @@ static void test_probe(void)
 	         LOADCRASH_DIR, LOADCRASH_DIR);
 	const char *cfg = write_config("probe.json", text);
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 1);
-	cJSON *doc = load_results(path_in("out-probe"));
+	cJSON *doc = load_results(cli_path_in("out-probe"));
 	check_run(doc, "c", 1, "crashed", "refine stage 1: plugin");
 	check_run(doc, "c", 1, "crashed", "died while loading");
 	check_run(doc, "h", 1, "timeout", "hung while loading");
@@ -99,7 +84,7 @@ static void test_probe(void)
 	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "plan-probe")), 2);
 	CHECK_CONTAINS(err_text, "builder 'c': refine stage 1: plugin");
 	CHECK_CONTAINS(err_text, "died while loading");
-	CHECK(!exists(path_in("plan-probe/plan.json")));
+	CHECK(!cli_exists(cli_path_in("plan-probe/plan.json")));
 
 	plan_builders("refopt.json",
 	              "{ \"plugin\": \"fake_good\",\n"
@@ -146,7 +131,7 @@ static const char *write_small(const char *name, const char *out, char dir[stati
 {
 	char text[1024];
 	snprintf(text, sizeof(text), small, out);
-	snprintf(dir, 600, "%s", path_in(out));
+	snprintf(dir, 600, "%s", cli_path_in(out));
 	return write_config(name, text);
 }
 
@@ -164,7 +149,7 @@ static void test_lock(void)
 	CHECK_CONTAINS(err_text, "pid 4242");
 	char *after = read_file(dir, "results.json");
 	CHECK(before && after && !strcmp(before, after));
-	CHECK(!exists(path_in("out-lock/results.json.1")));
+	CHECK(!cli_exists(cli_path_in("out-lock/results.json.1")));
 	close(fd);
 	CHECK_INT(run(ARGS("run", "--quiet", "--resume", cfg)), 0);
 	cJSON *doc = load_results(dir);
@@ -186,7 +171,7 @@ static void test_threads(void)
 	const char *cfg = write_config("thr.json", text);
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 2);
 	CHECK_CONTAINS(err_text, "duplicate thread count");
-	CHECK(!exists(path_in("out-thr")));
+	CHECK(!cli_exists(cli_path_in("out-thr")));
 	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "plan-thr")), 2);
 	CHECK_CONTAINS(err_text, "duplicate thread count");
 	snprintf(list, sizeof(list), "%ld,0", cores);
@@ -213,17 +198,17 @@ static void test_temps(void)
 	         "touch '%s/parts/.bvhlab-new-abc123/.bvhlab.lock'", tmpdir, tmpdir, tmpdir);
 	CHECK_INT(system(leftover), 0);
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 0);
-	CHECK(exists(path_in("parts/6/results.json")));
-	CHECK(!exists(path_in("parts/.bvhlab-new-abc123")));
+	CHECK(cli_exists(cli_path_in("parts/6/results.json")));
+	CHECK(!cli_exists(cli_path_in("parts/.bvhlab-new-abc123")));
 
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--out", "trail/", cfg)), 0);
-	CHECK(exists(path_in("trail/results.json")));
+	CHECK(cli_exists(cli_path_in("trail/results.json")));
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--out", "dot/.", cfg)), 0);
-	CHECK(exists(path_in("dot/results.json")));
+	CHECK(cli_exists(cli_path_in("dot/results.json")));
 	memset(name, 'x', 250);
 	name[250] = '\0';
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--out", name, cfg)), 0);
-	CHECK_INT(runs_written(path_in(name)), 2);
+	CHECK_INT(runs_written(cli_path_in(name)), 2);
 }
 
 /* Two runs, ids 0 (tri) and 1 (soup), of one builder. */
@@ -236,7 +221,7 @@ static const char alpha_config[] =
 
 static void write_mesh(const char *text)
 {
-	FILE *f = fopen(path_in("tri.obj"), "w");
+	FILE *f = fopen(cli_path_in("tri.obj"), "w");
 	fputs(text, f);
 	fclose(f);
 }
@@ -259,7 +244,7 @@ static int alpha_of(const cJSON *run)
 static void identity_resume(void)
 {
 	char dir[600];
-	snprintf(dir, sizeof(dir), "%s", path_in("out-id"));
+	snprintf(dir, sizeof(dir), "%s", cli_path_in("out-id"));
 	write_mesh("v 0 0 0\n"); /* no face yet: its run fails */
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", alpha(2))), 1);
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", alpha(2))), 1);
@@ -288,33 +273,33 @@ static void identity_parts(void)
 {
 	CHECK_INT(run_in(tmpdir, ARGS("plan", alpha(2), "--out", "pa")), 0);
 	CHECK_INT(run_in(tmpdir, ARGS("plan", alpha(5), "--out", "pb")), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pa/plan.json"), "--only", "0", "--out",
-	                              path_in("pa/parts/0"), "--quiet")), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pa/plan.json"), "--only", "1", "--out",
-	                              path_in("pa/parts/1"), "--quiet")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("pa/plan.json"), "--only", "0", "--out",
+	                              cli_path_in("pa/parts/0"), "--quiet")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("pa/plan.json"), "--only", "1", "--out",
+	                              cli_path_in("pa/parts/1"), "--quiet")), 0);
 	char cmd[1400];
 	snprintf(cmd, sizeof(cmd), "cp -r '%s/pa/parts' '%s/pb/'", tmpdir, tmpdir);
 	CHECK_INT(system(cmd), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pb/plan.json"), "--only", "0", "--out",
-	                              path_in("pb/parts/0"), "--resume", "--quiet")), 2);
+	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("pb/plan.json"), "--only", "0", "--out",
+	                              cli_path_in("pb/parts/0"), "--resume", "--quiet")), 2);
 	CHECK_CONTAINS(err_text, "its runs were made from plan");
-	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pb/parts/0"), "--out", path_in("pb"))), 2);
+	CHECK_INT(run_in(tmpdir, ARGS("merge", cli_path_in("pb/parts/0"), "--out", cli_path_in("pb"))), 2);
 	CHECK_CONTAINS(err_text, "comes from another plan");
 
 	/* A part whose options_hash differs from another part's run of its builder. */
 	snprintf(cmd, sizeof(cmd), "sed -i 's/\"options_hash\":[[:space:]]*\"[0-9a-f]*\"/\"options_hash\": "
 	         "\"00000000deadbeef\"/' '%s/pa/parts/1/results.json'", tmpdir);
 	CHECK_INT(system(cmd), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("pa/parts/0"), path_in("pa/parts/1"),
-	                              "--out", path_in("pa"))), 2);
+	CHECK_INT(run_in(tmpdir, ARGS("merge", cli_path_in("pa/parts/0"), cli_path_in("pa/parts/1"),
+	                              "--out", cli_path_in("pa"))), 2);
 	CHECK_CONTAINS(err_text, "were made with other options");
 
 	/* The mesh regenerated after planning: its runs are refused. */
 	write_mesh("v 0 0 0\nv 2 0 0\nv 0 2 0\nf 1 2 3\n");
-	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("pb/plan.json"), "--only", "1", "--out",
-	                              path_in("pb/parts/9"), "--quiet")), 2);
+	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("pb/plan.json"), "--only", "1", "--out",
+	                              cli_path_in("pb/parts/9"), "--quiet")), 2);
 	CHECK_CONTAINS(err_text, "tri.obj has changed since planning");
-	CHECK(!exists(path_in("pb/parts/9")));
+	CHECK(!cli_exists(cli_path_in("pb/parts/9")));
 }
 
 static void test_identity(void)
@@ -366,7 +351,7 @@ static void measure_rays_error(void)
 		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
 	CHECK_INT(run_in(tmpdir, ARGS("run", cfg)), 0);
 	CHECK_CONTAINS(err_text, "1 run traced no rays (see their rays.error)");
-	cJSON *doc = load_results(path_in("out-cam"));
+	cJSON *doc = load_results(cli_path_in("out-cam"));
 	check_run(doc, "fake_good", 1, "ok", NULL);
 	CHECK(run_str(rays_of(run_of(doc, "fake_good", 1)), "error")[0] != '\0');
 	cJSON_Delete(doc);
@@ -377,7 +362,7 @@ static void measure_rays_error(void)
 static void measure_rounds(void)
 {
 	char dir[600];
-	snprintf(dir, sizeof(dir), "%s", path_in("out-rounds"));
+	snprintf(dir, sizeof(dir), "%s", cli_path_in("out-rounds"));
 	const char *cfg = write_config("rounds.json",
 		"{ \"output\": \"out-rounds\", \"repeat\": 1, \"images\": true,\n"
 		"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 2, \"rounds\": 2 },\n"
@@ -390,7 +375,7 @@ static void measure_rounds(void)
 	const cJSON *r = run_of(doc, "b", 1);
 	CHECK(r && cJSON_IsTrue(cJSON_GetObjectItem(rays_of(r), "provisional")));
 	cJSON_Delete(doc);
-	CHECK(exists(path_in("out-rounds/.heat-0-0.raw")));
+	CHECK(cli_exists(cli_path_in("out-rounds/.heat-0-0.raw")));
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--resume", cfg)), 0);
 	CHECK_CONTAINS(err_text, "2 resumed runs with provisional ray timings");
 	doc = load_results(dir);
@@ -400,8 +385,8 @@ static void measure_rounds(void)
 	}
 	CHECK(run_str(run_of(doc, "a", 1), "heat_image")[0] != '\0');
 	cJSON_Delete(doc);
-	CHECK(!exists(path_in("out-rounds/.heat-0-0.raw")));
-	CHECK(!exists(path_in("out-rounds/.shade-0-0.raw")));
+	CHECK(!cli_exists(cli_path_in("out-rounds/.heat-0-0.raw")));
+	CHECK(!cli_exists(cli_path_in("out-rounds/.shade-0-0.raw")));
 }
 
 /* 9. Heat data an earlier sweep left is not drawn for a run that timed out. */
@@ -410,8 +395,8 @@ static void measure_stale_heat(void)
 	uint32_t stale[64];
 	for (int k = 0; k < 64; k++)
 		stale[k] = 999;
-	CHECK_INT(mkdir(path_in("out-stale"), 0755), 0);
-	FILE *f = fopen(path_in("out-stale/.heat-0-0.raw"), "wb");
+	CHECK_INT(mkdir(cli_path_in("out-stale"), 0755), 0);
+	FILE *f = fopen(cli_path_in("out-stale/.heat-0-0.raw"), "wb");
 	CHECK(f && fwrite(stale, sizeof(stale), 1, f) == 1);
 	fclose(f);
 	const char *cfg = write_config("stale.json",
@@ -422,7 +407,7 @@ static void measure_stale_heat(void)
 		"                    \"options\": { \"fail\": \"loop\" } },\n"
 		"                  { \"plugin\": \"fake_good\" } ] }\n");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 1);
-	cJSON *doc = load_results(path_in("out-stale"));
+	cJSON *doc = load_results(cli_path_in("out-stale"));
 	check_run(doc, "slow", 1, "timeout", NULL);
 	CHECK(!cJSON_GetObjectItem(run_of(doc, "slow", 1), "heat_image"));
 	const cJSON *images = cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(doc,
@@ -450,16 +435,16 @@ static void test_force(void)
 	char *json = read_file(dir, "results.json"), *csv = read_file(dir, "results.csv");
 	CHECK_INT(killed_at("/report.md.1", "1", ARGS("run", "--quiet", "--force", cfg)),
 	          128 + SIGKILL);
-	CHECK(exists(path_in("out-force/results.csv.1")));
-	CHECK(!exists(path_in("out-force/results.json.1")));
+	CHECK(cli_exists(cli_path_in("out-force/results.csv.1")));
+	CHECK(!cli_exists(cli_path_in("out-force/results.json.1")));
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 2);
 	CHECK_CONTAINS(err_text, "already holds a results.json");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--force", cfg)), 0);
 	char *json1 = read_file(dir, "results.json.1"), *csv1 = read_file(dir, "results.csv.1");
 	CHECK(json && json1 && !strcmp(json, json1));
 	CHECK(csv && csv1 && !strcmp(csv, csv1));
-	CHECK(exists(path_in("out-force/report.md.1")));
-	CHECK(!exists(path_in("out-force/results.csv.2")));
+	CHECK(cli_exists(cli_path_in("out-force/report.md.1")));
+	CHECK(!cli_exists(cli_path_in("out-force/results.csv.2")));
 	CHECK_INT(runs_written(dir), 2);
 	free(json);
 	free(csv);
@@ -486,18 +471,18 @@ static void misc_merge(void)
 		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
 		"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n");
 	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "ph")), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("ph/plan.json"), "--only", "0", "--out",
-	                              path_in("ph/parts/0"), "--quiet")), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("run", path_in("ph/plan.json"), "--only", "1", "--out",
-	                              path_in("ph/parts/1"), "--quiet")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("ph/plan.json"), "--only", "0", "--out",
+	                              cli_path_in("ph/parts/0"), "--quiet")), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("ph/plan.json"), "--only", "1", "--out",
+	                              cli_path_in("ph/parts/1"), "--quiet")), 0);
 	CHECK_INT(shell("sed -i 's/\"heat_max\":[[:space:]]*[0-9.]*/\"heat_max\": 77/' "
 	                "ph/parts/1/results.json%s", ""), 0);
 	CHECK_INT(shell("echo secret > secret.txt && ln -s '%s/secret.txt' ph/parts/1/images/"
 	                "s--stolen.png", tmpdir), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("merge", path_in("ph/parts/0"), path_in("ph/parts/1"),
-	                              "--out", path_in("ph"))), 0);
-	CHECK(!exists(path_in("ph/images/s--stolen.png")));
-	cJSON *doc = load_results(path_in("ph"));
+	CHECK_INT(run_in(tmpdir, ARGS("merge", cli_path_in("ph/parts/0"), cli_path_in("ph/parts/1"),
+	                              "--out", cli_path_in("ph"))), 0);
+	CHECK(!cli_exists(cli_path_in("ph/images/s--stolen.png")));
+	cJSON *doc = load_results(cli_path_in("ph"));
 	const cJSON *images = cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(doc,
 	                                          "scenes"), 0), "images");
 	CHECK(!cJSON_GetObjectItem(images, "heat_max"));
@@ -506,7 +491,7 @@ static void misc_merge(void)
 	CHECK(cJSON_IsNumber(cJSON_GetObjectItem(scale, "max")) &&
 	      cJSON_GetObjectItem(scale, "max")->valuedouble == 77);
 	cJSON_Delete(doc);
-	char *md = read_file(path_in("ph"), "report.md");
+	char *md = read_file(cli_path_in("ph"), "report.md");
 	CHECK(md && !strstr(md, "nan"));
 	free(md);
 }
@@ -527,7 +512,7 @@ static void misc_full(void)
 	unsetenv("BVHLAB_FAULT_FULL");
 	CHECK_CONTAINS(err_text, "2 finished runs could not be saved");
 	CHECK(!strstr(err_text, "some runs failed or were invalid"));
-	CHECK_INT(runs_written(path_in("out-full")), 1);
+	CHECK_INT(runs_written(cli_path_in("out-full")), 1);
 }
 
 /* 17. JSON nested past the reader's limit, names that are not UTF-8. */
@@ -544,7 +529,7 @@ static void misc_input(void)
 		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", cfg)), 2);
 	CHECK_CONTAINS(err_text, "its scene name is not valid UTF-8");
-	CHECK(!exists(path_in("out-latin1")));
+	CHECK(!cli_exists(cli_path_in("out-latin1")));
 }
 
 /* 14, 16. A plan folder with a newline; report over another sweep's folder. */
@@ -558,17 +543,17 @@ static void test_misc(void)
 	const char *a = write_config("m1.json", text);
 	CHECK_INT(run_in(tmpdir, ARGS("plan", a, "--out", "bad\nname")), 2);
 	CHECK_CONTAINS(err_text, "control character");
-	CHECK(!exists(path_in("bad\nname")));
+	CHECK(!cli_exists(cli_path_in("bad\nname")));
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", a)), 0);
 	snprintf(text, sizeof(text), small, "out-m2");
 	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", write_config("m2.json", text))), 0);
-	char *before = read_file(path_in("out-m2"), "report.md");
-	CHECK_INT(run_in(tmpdir, ARGS("report", path_in("out-m1/results.json"), "--out",
-	                              path_in("out-m2"))), 2);
+	char *before = read_file(cli_path_in("out-m2"), "report.md");
+	CHECK_INT(run_in(tmpdir, ARGS("report", cli_path_in("out-m1/results.json"), "--out",
+	                              cli_path_in("out-m2"))), 2);
 	CHECK_CONTAINS(err_text, "holds the results.json of another sweep");
-	char *after = read_file(path_in("out-m2"), "report.md");
+	char *after = read_file(cli_path_in("out-m2"), "report.md");
 	CHECK(before && after && !strcmp(before, after));
-	CHECK_INT(run_in(tmpdir, ARGS("report", path_in("out-m1/results.json"))), 0);
+	CHECK_INT(run_in(tmpdir, ARGS("report", cli_path_in("out-m1/results.json"))), 0);
 	free(before);
 	free(after);
 }
