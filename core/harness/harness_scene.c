@@ -10,6 +10,7 @@
 
 #include "harness/harness_scene.h"
 #include "harness/isolate.h"
+#include "plan/plan.h"
 #include "scene/scene_check.h"
 #include "util/util.h"
 
@@ -126,55 +127,39 @@ int harness_probe_scene(const struct config *cfg, const struct config_scene *cs,
 
 /* ---- the files, before the sweep --------------------------------------- */
 
-/* One file of scene cs, tried; a failure printed as a config error, `what`
- * naming the part or frame it is ("" for the scene's own). 1 when bad. */
-static int check_one(const struct config *cfg, const struct config_scene *cs,
-                     const char *what, const char *path)
+struct file_check {
+	const struct config *cfg;
+	const struct config_scene *cs;
+	size_t bad;
+};
+
+/* One file of the scene, tried; a failure printed as a config error, `what`
+ * naming the part or frame it is ("" for the scene's own). Counts bad ones
+ * and goes on, so that every bad file is named. */
+static int check_one(const char *path, const char *what, size_t k, void *ctx)
 {
+	struct file_check *c = ctx;
 	bvhlab_error err = {{0}};
+	(void)k;
 	if (scene_check_file(path, &err) == 0)
 		return 0;
-	fprintf(stderr, "bvhlab: %s:%d:%d: scene '%s': %s%s\n", cfg->path, cs->line, cs->column,
-	        cs->name, what, err.message);
-	return 1;
-}
-
-/* The bad files of one scene: its own, its parts', its frame files. */
-static size_t check_scene(const struct config *cfg, const struct config_scene *cs)
-{
-	char what[64], path[4096];
-	size_t bad = 0;
-	if (cs->frame_pattern) {
-		for (uint32_t f = 0; f < cs->frames; f++) {
-			snprintf(path, sizeof(path), cs->frame_pattern, (int)(cs->frame_first + f));
-			snprintf(what, sizeof(what), "frame %u: ", f);
-			bad += check_one(cfg, cs, what, path);
-		}
-		/* Its path is frame 0's file unless it names one of its own. */
-		snprintf(path, sizeof(path), cs->frame_pattern, (int)cs->frame_first);
-		if (cs->path && strcmp(cs->path, path) != 0)
-			bad += check_one(cfg, cs, "", cs->path);
-		return bad;
-	}
-	if (cs->path)
-		bad += check_one(cfg, cs, "", cs->path);
-	for (size_t i = 0; i < cs->part_count; i++) {
-		if (!cs->parts[i].src.path)
-			continue;
-		snprintf(what, sizeof(what), "part %zu: ", i);
-		bad += check_one(cfg, cs, what, cs->parts[i].src.path);
-	}
-	return bad;
+	fprintf(stderr, "bvhlab: %s:%d:%d: scene '%s': %s%s\n", c->cfg->path, c->cs->line,
+	        c->cs->column, c->cs->name, what, err.message);
+	c->bad++;
+	return 0;
 }
 
 int harness_check_scene_files(const struct config *cfg, bvhlab_error *err)
 {
-	size_t bad = 0;
-	for (size_t s = 0; s < cfg->scene_count; s++)
-		bad += check_scene(cfg, &cfg->scenes[s]);
-	if (!bad)
+	struct file_check c = {.cfg = cfg};
+	size_t k = 0;
+	for (size_t s = 0; s < cfg->scene_count; s++) {
+		c.cs = &cfg->scenes[s];
+		plan_scene_each_file(c.cs, check_one, &k, &c);
+	}
+	if (!c.bad)
 		return 0;
 	error_set(err, "%s: %zu scene file%s cannot be read (above); nothing was run", cfg->path,
-	          bad, bad == 1 ? "" : "s");
+	          c.bad, c.bad == 1 ? "" : "s");
 	return -EINVAL;
 }

@@ -164,10 +164,12 @@ struct plan_fingerprint {
 /* 0, or a negative errno when the file cannot be read (-EINVAL: not a
  * regular file). */
 int plan_fingerprint(const char *path, struct plan_fingerprint *fp);
+/* What a scene file is to its scene, for messages: "" (its own path),
+ * "part 2: " or "frame 3: ". */
+typedef int (*plan_file_fn)(const char *path, const char *what, size_t k, void *ctx);
 /* Calls fn for every file scene cs reads (its path, its parts' paths, every
  * frame file of its pattern), *k counting up; stops at fn's first non-zero. */
-int plan_scene_each_file(const struct config_scene *cs,
-                         int (*fn)(const char *path, size_t k, void *ctx), size_t *k, void *ctx);
+int plan_scene_each_file(const struct config_scene *cs, plan_file_fn fn, size_t *k, void *ctx);
 
 /* "scene_files": [{"path", "size", "hash"}] of every file cfg's scenes
  * read (in config order; size and hash missing for one not readable here). */

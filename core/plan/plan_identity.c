@@ -27,9 +27,10 @@ static void strip_paths(cJSON *scene)
 	                                        "pattern");
 }
 
-static int add_fingerprint(const char *path, size_t k, void *ctx)
+static int add_fingerprint(const char *path, const char *what, size_t k, void *ctx)
 {
 	struct plan_fingerprint fp;
+	(void)what;
 	(void)k;
 	if (plan_fingerprint(path, &fp) == 0)
 		sb_printf(ctx, " %.0f:%s", fp.size, fp.hash);

@@ -43,25 +43,30 @@ int plan_fingerprint(const char *path, struct plan_fingerprint *fp)
 	return -e;
 }
 
-int plan_scene_each_file(const struct config_scene *cs,
-                         int (*fn)(const char *path, size_t k, void *ctx), size_t *k, void *ctx)
+int plan_scene_each_file(const struct config_scene *cs, plan_file_fn fn, size_t *k, void *ctx)
 {
-	char frame[4096];
-	int r = cs->path ? fn(cs->path, (*k)++, ctx) : 0;
-	for (size_t p = 0; r == 0 && p < cs->part_count; p++)
+	char frame[4096], what[64];
+	/* A frame pattern's path is frame 0's file unless it names one of its own. */
+	frame[0] = '\0';
+	if (cs->frame_pattern)
+		snprintf(frame, sizeof(frame), cs->frame_pattern, (int)cs->frame_first);
+	int r = cs->path ? fn(cs->path, strcmp(frame, cs->path) ? "" : "frame 0: ", (*k)++, ctx) : 0;
+	for (size_t p = 0; r == 0 && p < cs->part_count; p++) {
+		snprintf(what, sizeof(what), "part %zu: ", p);
 		if (cs->parts[p].src.path)
-			r = fn(cs->parts[p].src.path, (*k)++, ctx);
+			r = fn(cs->parts[p].src.path, what, (*k)++, ctx);
+	}
 	for (uint32_t f = 0; r == 0 && cs->frame_pattern && f < cs->frames; f++) {
 		snprintf(frame, sizeof(frame), cs->frame_pattern, (int)(cs->frame_first + f));
+		snprintf(what, sizeof(what), "frame %u: ", f);
 		if (!cs->path || strcmp(frame, cs->path) != 0) /* frame 0's is the path */
-			r = fn(frame, (*k)++, ctx);
+			r = fn(frame, what, (*k)++, ctx);
 	}
 	return r;
 }
 
 /* Calls fn for every file the config's scenes read, in config order. */
-static int each_file(const struct config *cfg, int (*fn)(const char *path, size_t k, void *ctx),
-                     void *ctx)
+static int each_file(const struct config *cfg, plan_file_fn fn, void *ctx)
 {
 	size_t k = 0;
 	int r = 0;
@@ -70,10 +75,11 @@ static int each_file(const struct config *cfg, int (*fn)(const char *path, size_
 	return r;
 }
 
-static int add_file(const char *path, size_t k, void *ctx)
+static int add_file(const char *path, const char *what, size_t k, void *ctx)
 {
 	struct plan_fingerprint fp;
 	cJSON *o = cJSON_CreateObject();
+	(void)what;
 	(void)k;
 	cJSON_AddItemToArray(ctx, o);
 	cJSON_AddStringToObject(o, "path", path);
@@ -98,9 +104,10 @@ struct check {
 	bvhlab_error *err;
 };
 
-static int check_file(const char *path, size_t k, void *ctx)
+static int check_file(const char *path, const char *what, size_t k, void *ctx)
 {
 	struct check *c = ctx;
+	(void)what;
 	const cJSON *then = cJSON_GetArrayItem(c->files, (int)k);
 	const cJSON *size = cJSON_GetObjectItemCaseSensitive(then, "size");
 	const cJSON *hash = cJSON_GetObjectItemCaseSensitive(then, "hash");
