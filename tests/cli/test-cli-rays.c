@@ -87,6 +87,15 @@ static void check_html(const char *dir)
 
 /* Every run: the three traversals with the same hits, the same node counts
  * for wide (main) and stack, repeated passes, EPO and peak memory. */
+/* A batch's 10 passes, or fewer that took 10 x min_ms (1 ms here) between
+ * them: min_repeats gives way to slow passes (trace_measure.c), as they
+ * are under ASan on a busy machine. */
+static bool ten_passes(const cJSON *batch)
+{
+	return cJSON_GetObjectItem(batch, "repeats")->valueint >= 10 ||
+	       cJSON_GetObjectItem(batch, "seconds")->valuedouble >= 10 * 1e-3;
+}
+
 static void check_measures(const cJSON *doc)
 {
 	const cJSON *run;
@@ -105,8 +114,8 @@ static void check_measures(const cJSON *doc)
 		 * its 10: more than the run's own provisional timing (one pass
 		 * of min_ms / 8) makes. */
 		CHECK_INT(cJSON_GetObjectItem(rays, "rounds")->valueint, 8);
-		CHECK(cJSON_GetObjectItem(st, "repeats")->valueint >= 10);
-		CHECK(cJSON_GetObjectItem(sl, "repeats")->valueint >= 10);
+		CHECK(ten_passes(st));
+		CHECK(ten_passes(sl));
 		CHECK(cJSON_GetObjectItem(st, "mrays_min")->valuedouble <=
 		      cJSON_GetObjectItem(st, "mrays_max")->valuedouble);
 		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(cJSON_GetObjectItem(run, "tree"), "epo")));
