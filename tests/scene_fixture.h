@@ -121,19 +121,35 @@ struct scene_sizes {
 	uint32_t identical; /* triangles */
 };
 
-/* test(name, scene) on the generated scenes every builder test runs: a
- * soup, an icosphere, a stadium and a terrain of the given sizes,
- * `identical` copies of one triangle, and soups of 1 and 2 triangles. */
+/* The generated scenes every builder test runs, in order: a soup, an
+ * icosphere, a stadium and a terrain of the given sizes, `identical`
+ * copies of one triangle, and soups of 1 and 2 triangles. */
+#define GENERATED_SCENES 7
+static inline bvhlab_scene *generated_scene(const struct scene_sizes *s, int k,
+                                            const char **name)
+{
+	static const char *const names[GENERATED_SCENES] = {
+		"soup", "icosphere", "stadium", "terrain", "identical", "one", "two" };
+	*name = names[k];
+	switch (k) {
+	case 0: return generate("soup", s->soup, 0, 0);
+	case 1: return generate("icosphere", 0, s->icosphere, 0);
+	case 2: return generate("stadium", s->stadium, 0, 0);
+	case 3: return generate("terrain", 0, 0, s->terrain);
+	case 4: return identical_scene(s->identical);
+	default: return generate("soup", (uint32_t)k - 4, 0, 0);
+	}
+}
+
+/* test(name, scene) on the generated scenes (generated_scene). */
 static inline void for_generated(const struct scene_sizes *sizes,
                                  void (*test)(const char *name, bvhlab_scene *scene))
 {
-	test("soup", generate("soup", sizes->soup, 0, 0));
-	test("icosphere", generate("icosphere", 0, sizes->icosphere, 0));
-	test("stadium", generate("stadium", sizes->stadium, 0, 0));
-	test("terrain", generate("terrain", 0, 0, sizes->terrain));
-	test("identical", identical_scene(sizes->identical));
-	test("one", generate("soup", 1, 0, 0));
-	test("two", generate("soup", 2, 0, 0));
+	const char *name;
+	for (int k = 0; k < GENERATED_SCENES; k++) {
+		bvhlab_scene *scene = generated_scene(sizes, k, &name);
+		test(name, scene);
+	}
 }
 
 /* A mesh of ../shared/scenes by file name; NULL (a failed check) if it
@@ -297,14 +313,9 @@ static inline void compare_collapse(const char *name, bvhlab_scene *scene, uint3
 	bvhlab_scene_destroy(scene);
 }
 
-/*
- * test(file, scene) on the first `count` shared meshes of files (the first
- * `small_count` under a sanitizer, where the rest are too slow), scene NULL for one
- * that does not load. False, and a line saying so, when the shared meshes
- * are not there, so the test can report itself skipped.
- */
-static inline bool for_shared(const char *const *files, size_t count, size_t small_count,
-                              void (*test)(const char *file, bvhlab_scene *scene))
+/* Whether ../shared/scenes is there; a line saying so when not, so the
+ * test can report itself skipped. */
+static inline bool shared_present(void)
 {
 	struct stat st;
 
@@ -312,8 +323,47 @@ static inline bool for_shared(const char *const *files, size_t count, size_t sma
 		printf("no shared scenes at %s: shared meshes skipped\n", BVHLAB_SHARED_SCENES);
 		return false;
 	}
-	for (size_t i = 0; i < (UNDER_SANITIZER ? small_count : count); i++)
+	return true;
+}
+
+/* The shared meshes a test runs: the first `count` of files, the first
+ * `small_count` under a sanitizer (where the rest are too slow). */
+static inline size_t shared_count(size_t count, size_t small_count)
+{
+	return UNDER_SANITIZER ? small_count : count;
+}
+
+/*
+ * test(file, scene) on the shared meshes of files (shared_count), scene
+ * NULL for one that does not load. False when they are not there
+ * (shared_present).
+ */
+static inline bool for_shared(const char *const *files, size_t count, size_t small_count,
+                              void (*test)(const char *file, bvhlab_scene *scene))
+{
+	if (!shared_present())
+		return false;
+	for (size_t i = 0; i < shared_count(count, small_count); i++)
 		test(files[i], load_shared(files[i]));
+	return true;
+}
+
+/* for_generated and for_shared with one test, told which it has:
+ * test(name, scene, generated). for_shared's result. */
+static inline bool for_scenes(const struct scene_sizes *sizes, const char *const *files,
+                              size_t count, size_t small_count,
+                              void (*test)(const char *name, bvhlab_scene *scene,
+                                           bool generated))
+{
+	const char *name;
+	for (int k = 0; k < GENERATED_SCENES; k++) {
+		bvhlab_scene *scene = generated_scene(sizes, k, &name);
+		test(name, scene, true);
+	}
+	if (!shared_present())
+		return false;
+	for (size_t i = 0; i < shared_count(count, small_count); i++)
+		test(files[i], load_shared(files[i]), false);
 	return true;
 }
 

@@ -68,27 +68,41 @@ static void test_many_labels(void)
 	free(svg);
 }
 
-/* A run of scene s: builder, plugin, threads, median ms, SAH, status. */
-static void add(cJSON *runs, const char *scene, const char *builder, const char *plugin,
-                int threads, double ms, double sah, const char *status)
+/* A run of a scene, as the reports read it. */
+struct run_row {
+	const char *scene, *builder, *plugin;
+	int threads;
+	double ms, sah; /* median build time, SAH cost */
+	const char *status;
+};
+
+static void add(cJSON *runs, const struct run_row *r)
 {
 	char text[512];
 	snprintf(text, sizeof(text),
 	         "{\"scene\": \"%s\", \"builder\": \"%s\", \"plugin\": \"%s\", \"threads\": %d, "
 	         "\"status\": \"%s\", \"build_ms\": {\"median\": %g, \"min\": %g, \"max\": %g}, "
 	         "\"tree\": {\"sah_cost\": %g}}",
-	         scene, builder, plugin, threads, status, ms, ms, ms, sah);
+	         r->scene, r->builder, r->plugin, r->threads, r->status, r->ms, r->ms, r->ms, r->sah);
 	cJSON_AddItemToArray(runs, cJSON_Parse(text));
 }
 
-static cJSON *doc_of(const char *reference, const char *scenes)
+/* A results document over `scenes` (the members of its array) with the n
+ * runs of rows, `reference` the report's reference builder. */
+static cJSON *doc_of(const char *reference, const char *scenes, const struct run_row *rows,
+                     size_t n)
 {
 	char text[512];
 	snprintf(text, sizeof(text), "{\"machine\": {\"cpu\": \"t\", \"cores\": 2}, \"config\": "
 	                             "{\"report\": {\"reference\": \"%s\"}}, \"scenes\": [%s], "
 	                             "\"runs\": []}", reference, scenes);
-	return cJSON_Parse(text);
+	cJSON *doc = cJSON_Parse(text);
+	for (size_t k = 0; doc && k < n; k++)
+		add(cJSON_GetObjectItem(doc, "runs"), &rows[k]);
+	return doc;
 }
+
+#define ROWS(rows) rows, sizeof(rows) / sizeof(rows[0])
 
 /* x is invalid on s3: of the two scenes that compared it, it is on the
  * front of one (s1, faster than y) and behind y on the other (s2). The
@@ -96,14 +110,13 @@ static cJSON *doc_of(const char *reference, const char *scenes)
  * in its group and called it "front". The peer's points are squares. */
 static void test_summary_verdict(void)
 {
-	cJSON *doc = doc_of("y", "{\"name\": \"s1\"}, {\"name\": \"s2\"}, {\"name\": \"s3\"}");
-	cJSON *runs = cJSON_GetObjectItem(doc, "runs");
-	add(runs, "s1", "y", "sah_seq", 1, 10, 40, "ok");
-	add(runs, "s1", "x", "embree", 1, 5, 42, "ok");
-	add(runs, "s2", "y", "sah_seq", 1, 10, 40, "ok");
-	add(runs, "s2", "x", "embree", 1, 12, 42, "ok");
-	add(runs, "s3", "y", "sah_seq", 1, 10, 40, "ok");
-	add(runs, "s3", "x", "embree", 1, 1, 99, "invalid");
+	static const struct run_row rows[] = {
+		{"s1", "y", "sah_seq", 1, 10, 40, "ok"},  {"s1", "x", "embree", 1, 5, 42, "ok"},
+		{"s2", "y", "sah_seq", 1, 10, 40, "ok"},  {"s2", "x", "embree", 1, 12, 42, "ok"},
+		{"s3", "y", "sah_seq", 1, 10, 40, "ok"},  {"s3", "x", "embree", 1, 1, 99, "invalid"},
+	};
+	cJSON *doc = doc_of("y", "{\"name\": \"s1\"}, {\"name\": \"s2\"}, {\"name\": \"s3\"}",
+	                    ROWS(rows));
 	char *md = report_markdown(doc), *html = report_html(doc);
 	CHECK_CONTAINS(md, "| front on 1 of 2 scenes, dominated on 1 by y |");
 	CHECK_CONTAINS(md, "| y | 1 | 3 |");
@@ -118,12 +131,13 @@ static void test_summary_verdict(void)
 /* The speedup chart shows a time: its busy run is ringed and says why. */
 static void test_speedup_marks(void)
 {
-	cJSON *doc = doc_of("p", "{\"name\": \"s\"}");
-	cJSON *runs = cJSON_GetObjectItem(doc, "runs");
-	add(runs, "s", "p", "sah_tasks", 1, 10, 40, "ok");
-	add(runs, "s", "p", "sah_tasks", 2, 6, 40, "ok");
-	add(runs, "s", "q", "sah_seq", 1, 12, 40, "ok");
-	cJSON *busy = cJSON_GetArrayItem(runs, 1);
+	static const struct run_row rows[] = {
+		{"s", "p", "sah_tasks", 1, 10, 40, "ok"},
+		{"s", "p", "sah_tasks", 2, 6, 40, "ok"},
+		{"s", "q", "sah_seq", 1, 12, 40, "ok"},
+	};
+	cJSON *doc = doc_of("p", "{\"name\": \"s\"}", ROWS(rows));
+	cJSON *busy = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 1);
 	cJSON_AddNumberToObject(busy, "load_other", 1.5); /* 2 threads on 2 CPUs: none free */
 	char *html = report_html(doc), *md = report_markdown(doc);
 	const char *speedup = strstr(html, "Speedup over 1 thread");
@@ -138,10 +152,11 @@ static void test_speedup_marks(void)
 	free(md);
 	cJSON_Delete(doc);
 	/* A sequential reference keeps the table. */
-	doc = doc_of("q", "{\"name\": \"s\"}");
-	runs = cJSON_GetObjectItem(doc, "runs");
-	add(runs, "s", "q", "sah_seq", 1, 12, 40, "ok");
-	add(runs, "s", "p", "sah_tasks", 2, 6, 40, "ok");
+	static const struct run_row seq_first[] = {
+		{"s", "q", "sah_seq", 1, 12, 40, "ok"},
+		{"s", "p", "sah_tasks", 2, 6, 40, "ok"},
+	};
+	doc = doc_of("q", "{\"name\": \"s\"}", ROWS(seq_first));
 	md = report_markdown(doc);
 	CHECK_CONTAINS(md, "## Parallel builders against q");
 	CHECK_CONTAINS(md, "| s | 12.00 | 6.00 | 50.0 % | 2.00 |");

@@ -182,16 +182,6 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool generated)
 	bvhlab_scene_destroy(scene);
 }
 
-static void test_generated(const char *name, bvhlab_scene *scene)
-{
-	test_scene(name, scene, true);
-}
-
-static void test_shared(const char *file, bvhlab_scene *scene)
-{
-	test_scene(file, scene, false);
-}
-
 static void test_descriptors(void)
 {
 	static const char *const sah[] = { "method", "bins", "max_leaf", "c_trav", "c_isect",
@@ -345,8 +335,7 @@ int main(void)
 	test_descriptors();
 	test_options();
 	test_all_cores();
-	for_generated(&generated_sizes, test_generated);
-	shared_missing = !for_shared(shared, 2, 2, test_shared);
+	shared_missing = !for_scenes(&generated_sizes, shared, 2, 2, test_scene);
 	close_plugins();
 	return shared_missing && !test_failures ? TEST_SKIP : test_finish();
 }

@@ -143,7 +143,7 @@ static void check_sampled(const char *name, const bvhlab_scene *scene,
 	bvhlab_tree_finish(&tree);
 }
 
-static void test_scene(const char *name, bvhlab_scene *scene, bool mesh)
+static void test_scene(const char *name, bvhlab_scene *scene, bool generated)
 {
 	bvhlab_prims prims;
 	bvhlab_tree ref = { 0 };
@@ -161,7 +161,7 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool mesh)
 			continue;
 		if (build_valid(seq, NULL, scene, &prims.input, 1, &ref) == 0) {
 			check_scene(name, scene, &prims.input, &ref, "parallel_min=128");
-			if (mesh && !q)
+			if (!generated && !q)
 				check_scene(name, scene, &prims.input, &ref, NULL);
 			if (q)
 				check_sampled(name, scene, &prims.input, &ref);
@@ -178,16 +178,6 @@ static const struct scene_sizes generated_sizes = {
 	.soup = SCALE(20000, 3000), .icosphere = SCALE(24, 10), .stadium = SCALE(10000, 3000),
 	.terrain = SCALE(48, 24), .identical = SCALE(1000, 300),
 };
-
-static void test_generated(const char *name, bvhlab_scene *scene)
-{
-	test_scene(name, scene, false);
-}
-
-static void test_shared(const char *file, bvhlab_scene *scene)
-{
-	test_scene(file, scene, true);
-}
 
 static void test_descriptor(void)
 {
@@ -214,10 +204,9 @@ int main(void)
 	if (!plugin_loads("sah_seq", &seq) || !plugin_loads("sah_tasks", &tasks))
 		goto out;
 	test_descriptor();
-	for_generated(&generated_sizes, test_generated);
-	/* Under ASan the first two, under TSan none: the rest are too slow
-	 * there, and the generated scenes reach the same parallel paths. */
-	shared_missing = !for_shared(shared, 5, UNDER_TSAN ? 0 : 2, test_shared);
+	/* Under ASan the first two shared meshes, under TSan none: the rest are
+	 * too slow there, and the generated scenes reach the same parallel paths. */
+	shared_missing = !for_scenes(&generated_sizes, shared, 5, UNDER_TSAN ? 0 : 2, test_scene);
 out:
 	if (tasks)
 		bvhlab_plugin_close(tasks);

@@ -217,16 +217,6 @@ static void test_scene(const char *name, bvhlab_scene *scene, bool generated)
 	bvhlab_scene_destroy(scene);
 }
 
-static void test_generated(const char *name, bvhlab_scene *scene)
-{
-	test_scene(name, scene, true);
-}
-
-static void test_shared(const char *file, bvhlab_scene *scene)
-{
-	test_scene(file, scene, false);
-}
-
 /* reinsert (refine) and refit (update) keep the binary fast path: a wide
  * tree is refused by name, before the plugin sees it. */
 static void test_binary_only(void)
@@ -380,11 +370,10 @@ int main(void)
 		                              "conference.obj" };
 	if (!plugin_loads("lbvh", &lbvh) || !plugin_loads("wide_collapse", &collapser))
 		return test_finish();
-	for_generated(&sizes, test_generated);
+	for_scenes(&sizes, shared, 7, 1, test_scene);
 	test_binary_only();
 	test_boxes();
 	test_box_refusals();
-	for_shared(shared, 7, 1, test_shared);
 	bvhlab_plugin_close(lbvh);
 	bvhlab_plugin_close(collapser);
 	return test_finish();

@@ -254,12 +254,8 @@ char *report_markdown(const cJSON *doc)
 	const cJSON *run, *scene;
 	cJSON_ArrayForEach(run, runs)
 		ok += strcmp(report_str(run, "status"), "ok") == 0;
-	sb_printf(&sb, "# bvhlab report\n\nbvhlab ");
-	report_md_text(&sb, report_str(doc, "bvhlab_version"));
-	sb_printf(&sb, ", ");
-	report_md_text(&sb, report_str(doc, "created"));
-	sb_printf(&sb, ". Machine: ");
-	report_md_text(&sb, report_str(doc, "machine.cpu"));
+	sb_printf(&sb, "# bvhlab report\n\n");
+	report_byline(&sb, doc, report_md_text);
 	sb_printf(&sb, ", %s cores, %s available "
 	               "to this process.\n\n%d runs, %d ok. Times are build times in ms over "
 	               "the timed repeats; SAH cost with c_trav = c_isect = 1, normalised by "

@@ -126,68 +126,103 @@ static const cJSON *base_of(const struct report_index *ix, const char *ref, cons
 
 static const char other_machine[] = "not compared: the reference ran on another machine";
 
+/* One row of the table, as text both renderings write. */
+struct row {
+	char ms[32], ref_ms[32], texts[2][96];
+};
+
+/* Whether the run has a row (a traced ok run with a reference of its own,
+ * or one whose reference ran only elsewhere), and its texts. */
+static bool row_of(const struct report_index *ix, const char *ref, const cJSON *run,
+                   struct row *r)
+{
+	bool elsewhere;
+	const cJSON *base = base_of(ix, ref, run, &elsewhere);
+	if ((!base && !elsewhere) || base == run)
+		return false;
+	report_plain(r->ms, sizeof(r->ms), report_num(run, "build_ms.median"));
+	if (base) {
+		report_plain(r->ref_ms, sizeof(r->ref_ms), report_num(base, "build_ms.median"));
+		run_texts(run, base, r->texts);
+	} else {
+		snprintf(r->ref_ms, sizeof(r->ref_ms), "—");
+		snprintf(r->texts[0], sizeof(r->texts[0]), "%s", other_machine);
+		snprintf(r->texts[1], sizeof(r->texts[1]), "%s", other_machine);
+	}
+	return true;
+}
+
+/* How a rendering writes the table: its header (before the first row),
+ * a row, and what closes it. */
+struct form {
+	void (*header)(struct strbuf *sb, const char *ref);
+	void (*row)(struct strbuf *sb, const cJSON *run, const struct row *r);
+	const char *end;
+};
+
+static void table(struct strbuf *sb, const struct report_index *ix, const char *ref,
+                  const cJSON *const *runs, size_t n, const struct form *f)
+{
+	struct row r;
+	bool header = false;
+	for (size_t k = 0; ref && k < n; k++) {
+		if (!row_of(ix, ref, runs[k], &r))
+			continue;
+		if (!header)
+			f->header(sb, ref);
+		header = true;
+		f->row(sb, runs[k], &r);
+	}
+	if (header)
+		sb_printf(sb, "%s", f->end);
+}
+
+static void md_header(struct strbuf *sb, const char *ref)
+{
+	sb_printf(sb, "\n### Break-even against ");
+	report_md_text(sb, ref);
+	sb_printf(sb, "\n\n%s\n\n| builder | threads | median ms | reference ms "
+	              "| primary rays | diffuse rays |\n|---|---:|---:|---:|---|---|\n",
+	          intro);
+}
+
+static void md_row(struct strbuf *sb, const cJSON *run, const struct row *r)
+{
+	sb_printf(sb, "|");
+	report_md_cell(sb, report_str(run, "builder"));
+	sb_printf(sb, " %.0f | %s | %s | %s | %s |\n", report_num(run, "threads"), r->ms,
+	          r->ref_ms, r->texts[0], r->texts[1]);
+}
+
 void report_breakeven_md(struct strbuf *sb, const struct report_index *ix, const char *ref,
                          const cJSON *const *runs, size_t n)
 {
-	char texts[2][96], buf[32];
-	bool header = false, elsewhere;
-	for (size_t k = 0; ref && k < n; k++) {
-		const cJSON *base = base_of(ix, ref, runs[k], &elsewhere);
-		if ((!base && !elsewhere) || base == runs[k])
-			continue;
-		if (!header) {
-			sb_printf(sb, "\n### Break-even against ");
-			report_md_text(sb, ref);
-			sb_printf(sb, "\n\n%s\n\n| builder | threads | median ms | reference ms "
-			              "| primary rays | diffuse rays |\n|---|---:|---:|---:|---|---|\n",
-			          intro);
-		}
-		header = true;
-		sb_printf(sb, "|");
-		report_md_cell(sb, report_str(runs[k], "builder"));
-		sb_printf(sb, " %.0f | %s |", report_num(runs[k], "threads"),
-		          report_plain(buf, sizeof(buf), report_num(runs[k], "build_ms.median")));
-		if (!base) {
-			sb_printf(sb, " — | %s | %s |\n", other_machine, other_machine);
-			continue;
-		}
-		run_texts(runs[k], base, texts);
-		sb_printf(sb, " %s | %s | %s |\n",
-		          report_plain(buf, sizeof(buf), report_num(base, "build_ms.median")),
-		          texts[0], texts[1]);
-	}
+	static const struct form md = {md_header, md_row, ""};
+	table(sb, ix, ref, runs, n, &md);
+}
+
+static void html_header(struct strbuf *sb, const char *ref)
+{
+	sb_printf(sb, "<h3>Break-even against ");
+	report_escape(sb, ref);
+	sb_printf(sb, "</h3>\n<p>%s</p>\n<table class=\"breakeven\"><tr><th class=\"l\">"
+	              "builder</th><th>threads</th><th>median ms</th><th>reference ms"
+	              "</th><th class=\"l\">primary rays</th><th class=\"l\">diffuse rays"
+	              "</th></tr>\n", intro);
+}
+
+static void html_row(struct strbuf *sb, const cJSON *run, const struct row *r)
+{
+	sb_printf(sb, "<tr><td class=\"l\">");
+	report_escape(sb, report_str(run, "builder"));
+	sb_printf(sb, "</td><td>%.0f</td><td>%s</td><td>%s</td><td class=\"l\">%s</td>"
+	              "<td class=\"l\">%s</td></tr>\n", report_num(run, "threads"),
+	          r->ms, r->ref_ms, r->texts[0], r->texts[1]);
 }
 
 void report_breakeven_html(struct strbuf *sb, const struct report_index *ix, const char *ref,
                            const cJSON *const *runs, size_t n)
 {
-	char texts[2][96], a[32], b[32];
-	bool header = false, elsewhere;
-	for (size_t k = 0; ref && k < n; k++) {
-		const cJSON *base = base_of(ix, ref, runs[k], &elsewhere);
-		if ((!base && !elsewhere) || base == runs[k])
-			continue;
-		if (!header) {
-			sb_printf(sb, "<h3>Break-even against ");
-			report_escape(sb, ref);
-			sb_printf(sb, "</h3>\n<p>%s</p>\n<table class=\"breakeven\"><tr><th class=\"l\">"
-			              "builder</th><th>threads</th><th>median ms</th><th>reference ms"
-			              "</th><th class=\"l\">primary rays</th><th class=\"l\">diffuse rays"
-			              "</th></tr>\n", intro);
-		}
-		header = true;
-		if (base)
-			run_texts(runs[k], base, texts);
-		else
-			snprintf(texts[0], sizeof(texts[0]), "%s", other_machine);
-		sb_printf(sb, "<tr><td class=\"l\">");
-		report_escape(sb, report_str(runs[k], "builder"));
-		sb_printf(sb, "</td><td>%.0f</td><td>%s</td><td>%s</td><td class=\"l\">%s</td>"
-		              "<td class=\"l\">%s</td></tr>\n", report_num(runs[k], "threads"),
-		          report_plain(a, sizeof(a), report_num(runs[k], "build_ms.median")),
-		          base ? report_plain(b, sizeof(b), report_num(base, "build_ms.median")) : "—",
-		          texts[0], base ? texts[1] : texts[0]);
-	}
-	if (header)
-		sb_printf(sb, "</table>\n");
+	static const struct form html = {html_header, html_row, "</table>\n"};
+	table(sb, ix, ref, runs, n, &html);
 }

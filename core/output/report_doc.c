@@ -147,6 +147,17 @@ bool report_any_phases(const cJSON *const *runs, size_t n)
 /* Markdown text: raw HTML (a <script>, a <!-- that hides the rest) as
  * entities, pipes that would split a table cell escaped, line breaks that
  * would end the table's row or the paragraph flattened. */
+void report_byline(struct strbuf *sb, const cJSON *doc,
+                   void (*text)(struct strbuf *sb, const char *text))
+{
+	sb_printf(sb, "bvhlab ");
+	text(sb, report_str(doc, "bvhlab_version"));
+	sb_printf(sb, ", ");
+	text(sb, report_str(doc, "created"));
+	sb_printf(sb, ". Machine: ");
+	text(sb, report_str(doc, "machine.cpu"));
+}
+
 void report_md_text(struct strbuf *sb, const char *text)
 {
 	for (const unsigned char *p = (const unsigned char *)text; *p; p++) {

@@ -48,6 +48,10 @@ bool report_any_phases(const cJSON *const *runs, size_t n);
 /* Text for Markdown: & < > as entities (no raw HTML passes), pipes
  * escaped, newlines and other control characters as spaces. */
 void report_md_text(struct strbuf *sb, const char *text);
+/* "bvhlab VERSION, CREATED. Machine: CPU": the reports' first line, its
+ * values through `text` (report_md_text or report_escape). */
+void report_byline(struct strbuf *sb, const cJSON *doc,
+                   void (*text)(struct strbuf *sb, const char *text));
 /* " text |": a Markdown table cell of report_md_text. */
 void report_md_cell(struct strbuf *sb, const char *text);
 /* A CSV field and its separator (',', or a newline when last): quoted

@@ -474,12 +474,8 @@ char *report_html(const cJSON *doc)
 		sb.failed = true;
 	sb_printf(&sb, "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
 	               "<title>bvhlab report</title><style>%s</style></head><body>\n"
-	               "<h1>bvhlab report</h1>\n<p>bvhlab ", css);
-	esc(&sb, report_str(doc, "bvhlab_version"));
-	sb_printf(&sb, ", ");
-	esc(&sb, report_str(doc, "created"));
-	sb_printf(&sb, ". Machine: ");
-	esc(&sb, report_str(doc, "machine.cpu"));
+	               "<h1>bvhlab report</h1>\n<p>", css);
+	report_byline(&sb, doc, report_escape);
 	sb_printf(&sb, ", %.0f cores. Build times in ms over the timed repeats; speedup over the "
 	               "same builder's 1-thread run; SAH cost with c_trav = c_isect = 1, "
 	               "normalised by the root's area; EPO: end-point overlap, sampled; peak "

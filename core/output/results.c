@@ -26,11 +26,14 @@ static cJSON *machine_json(void)
 	gethostname(host, sizeof(host) - 1);
 	cJSON_AddStringToObject(o, "hostname", host);
 	cJSON_AddStringToObject(o, "cpu", m.cpu);
-	cJSON_AddNumberToObject(o, "cores", m.cores);
-	cJSON_AddNumberToObject(o, "threads_available", m.threads_available);
-	cJSON_AddNumberToObject(o, "packages", m.topo.packages);
-	cJSON_AddNumberToObject(o, "physical_cores", m.topo.physical_cores);
-	cJSON_AddNumberToObject(o, "logical_cpus", m.topo.logical_cpus);
+	const struct results_number counts[] = {
+		{"cores", m.cores},
+		{"threads_available", m.threads_available},
+		{"packages", m.topo.packages},
+		{"physical_cores", m.topo.physical_cores},
+		{"logical_cpus", m.topo.logical_cpus},
+	};
+	results_add_numbers(o, counts, RESULTS_NUMBERS(counts));
 	/* "caches": { "L1d": { "bytes": 49152, "instances": 2 }, ... }, known levels. */
 	cJSON *caches = cJSON_AddObjectToObject(o, "caches");
 	for (int k = 0; caches && k < MACHINE_CACHE_LEVELS; k++) {
@@ -117,77 +120,6 @@ int results_add_scene(struct results *res, const char *name, const char *source,
 	return 0;
 }
 
-cJSON *results_options_json(const bvhlab_options *opts)
-{
-	cJSON *o = cJSON_CreateObject();
-	for (uint32_t k = 0; opts && k < opts->builder->option_count; k++) {
-		const char *name = opts->builder->options[k].name;
-		const bvhlab_option_value *v = &opts->values[k];
-		if (v->type == BVHLAB_OPTION_BOOL)
-			cJSON_AddBoolToObject(o, name, v->b);
-		else if (v->type == BVHLAB_OPTION_INT)
-			cJSON_AddNumberToObject(o, name, (double)v->i);
-		else if (v->type == BVHLAB_OPTION_FLOAT)
-			cJSON_AddNumberToObject(o, name, v->f);
-		else
-			cJSON_AddStringToObject(o, name, v->s ? v->s : "");
-	}
-	return o;
-}
-
-static cJSON *timing_json(const struct run_record *run)
-{
-	double med, mn, mx;
-	util_summarise(run->samples_ms, run->sample_count, &med, &mn, &mx);
-	cJSON *o = cJSON_CreateObject();
-	cJSON_AddNumberToObject(o, "median", med);
-	cJSON_AddNumberToObject(o, "min", mn);
-	cJSON_AddNumberToObject(o, "max", mx);
-	cJSON_AddNumberToObject(o, "cold", run->cold_ms);
-	cJSON *samples = cJSON_AddArrayToObject(o, "samples");
-	for (uint32_t k = 0; k < run->sample_count; k++)
-		cJSON_AddItemToArray(samples, cJSON_CreateNumber(run->samples_ms[k]));
-	return o;
-}
-
-static cJSON *memory_json(const struct build_memory *m)
-{
-	cJSON *o = cJSON_CreateObject();
-	cJSON_AddNumberToObject(o, "peak_bytes", (double)m->peak_bytes);
-	cJSON_AddNumberToObject(o, "peak_rss_bytes", (double)m->peak_rss_bytes);
-	cJSON_AddNumberToObject(o, "start_rss_bytes", (double)m->start_rss_bytes);
-	cJSON_AddNumberToObject(o, "output_bytes", (double)m->output_bytes);
-	return o;
-}
-
-/* dup_ratio: references per triangle, 1 unless spatial splits duplicated some. */
-static cJSON *tree_json(const bvhlab_tree_stats *st, uint32_t triangles)
-{
-	cJSON *o = cJSON_CreateObject();
-	cJSON_AddNumberToObject(o, "nodes", st->nodes);
-	cJSON_AddNumberToObject(o, "leaves", st->leaves);
-	cJSON_AddNumberToObject(o, "max_depth", st->max_depth);
-	cJSON_AddNumberToObject(o, "avg_leaf_size", st->avg_leaf_size);
-	cJSON_AddNumberToObject(o, "sah_cost", st->sah_cost);
-	cJSON_AddNumberToObject(o, "refs", (double)st->refs);
-	if (triangles)
-		cJSON_AddNumberToObject(o, "dup_ratio", (double)st->refs / triangles);
-	cJSON_AddNumberToObject(o, "memory_bytes", (double)st->memory_bytes);
-	cJSON *hist = cJSON_AddArrayToObject(o, "leaf_size_histogram");
-	for (int k = 0; k < BVHLAB_LEAF_HISTOGRAM; k++)
-		cJSON_AddItemToArray(hist, cJSON_CreateNumber(st->leaf_histogram[k]));
-	return o;
-}
-
-static cJSON *validation_json(const struct run_record *run)
-{
-	cJSON *o = cJSON_CreateObject();
-	cJSON_AddBoolToObject(o, "valid", run->valid);
-	cJSON_AddNumberToObject(o, "rays_checked", (double)run->rays_checked);
-	cJSON_AddNumberToObject(o, "mismatches", (double)run->mismatches);
-	return o;
-}
-
 static cJSON *find_any(const struct results *res, const struct run_identity *key, bool stale);
 
 /* A run made again takes its stale record's place (which stayed on disk
@@ -210,54 +142,9 @@ static void replace_or_add(struct results *res, const struct run_record *run, cJ
 
 int results_add_run(struct results *res, const struct run_record *run)
 {
-	cJSON *o = cJSON_CreateObject();
+	cJSON *o = results_run_json(run);
 	if (!o)
 		return -ENOMEM;
-	cJSON_AddNumberToObject(o, "id", run->id);
-	cJSON_AddStringToObject(o, "scene", run->scene ? run->scene : "");
-	cJSON_AddStringToObject(o, "builder", run->builder);
-	cJSON_AddStringToObject(o, "plugin", run->plugin ? run->plugin : "");
-	cJSON_AddNumberToObject(o, "threads", run->threads);
-	cJSON_AddItemToObject(o, "options", results_options_json(run->opts));
-	if (run->options_hash)
-		cJSON_AddStringToObject(o, "options_hash", run->options_hash);
-	if (run->key && run_identity_add(o, run->key) < 0)
-		return cJSON_Delete(o), -ENOMEM;
-	cJSON_AddStringToObject(o, "status", run->status);
-	if (run->error)
-		cJSON_AddStringToObject(o, "error", run->error);
-	if (run->sample_count) {
-		cJSON *t = timing_json(run);
-		double med = cJSON_GetObjectItem(t, "median")->valuedouble;
-		cJSON_AddItemToObject(o, "build_ms", t);
-		cJSON_AddNumberToObject(o, "mtris_per_s",
-		                        med > 0 ? run->triangles / (med * 1e3) : 0);
-	}
-	if (run->phase_count)
-		cJSON_AddItemToObject(o, "build_phases",
-		                      results_phases_json(run->phases, run->phase_count));
-	if (run->stage_count)
-		cJSON_AddItemToObject(o, "stages", results_stages_json(run->stages, run->stage_count));
-	if (run->stats)
-		cJSON_AddItemToObject(o, "tree", tree_json(run->stats, run->triangles));
-	if (run->stats && run->epo)
-		cJSON_AddNumberToObject(cJSON_GetObjectItem(o, "tree"), "epo", *run->epo);
-	if (run->memory)
-		cJSON_AddItemToObject(o, "memory", memory_json(run->memory));
-	if (run->device) /* after "memory", which it adds to */
-		results_device_add(o, run->device);
-	if (run->validated)
-		cJSON_AddItemToObject(o, "validation", validation_json(run));
-	if (run->rays)
-		cJSON_AddItemToObject(o, "rays", results_rays_json(run->rays));
-	if (run->frame_count) /* an animated scene: results_frames.c */
-		cJSON_AddItemToObject(o, "frames", results_frames_json(run->frames, run->frame_count));
-	if (run->load_read) {
-		cJSON_AddNumberToObject(o, "load_before", run->load_before);
-		cJSON_AddNumberToObject(o, "load_after", run->load_after);
-		if (run->load_other >= 0)
-			cJSON_AddNumberToObject(o, "load_other", run->load_other);
-	}
 	replace_or_add(res, run, o);
 	return 0;
 }

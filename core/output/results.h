@@ -195,6 +195,9 @@ void results_finish(struct results *res);
 int results_add_scene(struct results *res, const char *name, const char *source,
                       uint32_t triangles, const char *error);
 int results_add_run(struct results *res, const struct run_record *run);
+/* The run's record as results_add_run adds it (results_run.c); NULL when
+ * out of memory. */
+struct cJSON *results_run_json(const struct run_record *run);
 /*
  * "not_applicable": [{"builder", "threads": [...], "reason"}]: thread counts
  * of the config that a builder was not run at (one without the PARALLEL
@@ -290,6 +293,17 @@ size_t results_forget_provisional(struct results *res);
 bool results_all_ok(const struct results *res);
 /* "options": {name: value, ...} of resolved options (NULL: {}). */
 struct cJSON *results_options_json(const bvhlab_options *opts);
+
+/* A number member of an object the writers build: each writes its figures
+ * as one table through results_add_numbers, in the table's order (the
+ * order results.json shows them in). */
+struct results_number {
+	const char *name;
+	double value;
+};
+#define RESULTS_NUMBERS(table) (sizeof(table) / sizeof((table)[0]))
+/* Adds the n numbers of f to o, in order; o NULL adds nothing. */
+void results_add_numbers(struct cJSON *o, const struct results_number *f, size_t n);
 
 /* Whether the document holds the run (found by scene, builder and threads). */
 bool results_has_run(const struct results *res, const struct run_identity *key);

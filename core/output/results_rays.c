@@ -14,16 +14,19 @@ static cJSON *kind_json(const bvhlab_trace_timing *t)
 	cJSON *o = cJSON_CreateObject();
 	const bvhlab_trace_stats *st = &t->stats;
 	double rays = (double)st->rays;
-	cJSON_AddNumberToObject(o, "rays", rays);
-	cJSON_AddNumberToObject(o, "mrays_per_s", t->mrays_best);
-	cJSON_AddNumberToObject(o, "mrays_median", t->mrays_median);
-	cJSON_AddNumberToObject(o, "mrays_min", t->mrays_min);
-	cJSON_AddNumberToObject(o, "mrays_max", t->mrays_max);
-	cJSON_AddNumberToObject(o, "wall_mrays_per_s", t->wall_mrays_median);
-	cJSON_AddNumberToObject(o, "repeats", t->repeats);
-	cJSON_AddNumberToObject(o, "nodes_per_ray", rays > 0 ? (double)st->nodes_visited / rays : 0);
-	cJSON_AddNumberToObject(o, "tris_per_ray", rays > 0 ? (double)st->tris_tested / rays : 0);
-	cJSON_AddNumberToObject(o, "seconds", t->seconds_total);
+	const struct results_number figures[] = {
+		{"rays", rays},
+		{"mrays_per_s", t->mrays_best},
+		{"mrays_median", t->mrays_median},
+		{"mrays_min", t->mrays_min},
+		{"mrays_max", t->mrays_max},
+		{"wall_mrays_per_s", t->wall_mrays_median},
+		{"repeats", t->repeats},
+		{"nodes_per_ray", rays > 0 ? (double)st->nodes_visited / rays : 0},
+		{"tris_per_ray", rays > 0 ? (double)st->tris_tested / rays : 0},
+		{"seconds", t->seconds_total},
+	};
+	results_add_numbers(o, figures, RESULTS_NUMBERS(figures));
 	return o;
 }
 

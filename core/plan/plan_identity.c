@@ -66,12 +66,12 @@ static int scene_hash(const struct config *cfg, size_t s, char out[17])
 static cJSON *rays_json(const struct config *cfg)
 {
 	cJSON *r = cJSON_CreateObject(), *names = cJSON_AddArrayToObject(r, "traversals");
-	cJSON_AddNumberToObject(r, "width", cfg->ray_width);
-	cJSON_AddNumberToObject(r, "height", cfg->ray_height);
-	cJSON_AddNumberToObject(r, "diffuse", cfg->ray_diffuse);
-	cJSON_AddNumberToObject(r, "threads", cfg->ray_threads);
-	cJSON_AddNumberToObject(r, "min_ms", cfg->ray_min_ms);
-	cJSON_AddNumberToObject(r, "rounds", cfg->ray_rounds);
+	const struct results_number settings[] = {
+		{"width", cfg->ray_width},     {"height", cfg->ray_height},
+		{"diffuse", cfg->ray_diffuse}, {"threads", cfg->ray_threads},
+		{"min_ms", cfg->ray_min_ms},   {"rounds", cfg->ray_rounds},
+	};
+	results_add_numbers(r, settings, RESULTS_NUMBERS(settings));
 	cJSON_AddStringToObject(r, "traversal", bvhlab_traversal_name(cfg->ray_traversal));
 	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++)
 		if (cfg->ray_traversals & (1u << k))

@@ -99,9 +99,8 @@ static const plugin_option options[] = {
 	              .help = "low (Morton), medium (binned SAH) or high (SAH with spatial "
 	                      "splits)",
 	              .def_string = "medium", .choices = "low|medium|high"),
-	PLUGIN_OPTION(settings, max_leaf, I64, .name = "max_leaf",
-	              .help = "most primitives in a leaf (Embree allows up to 32)",
-	              .def_int = 8, .min = 1, .max = RTC_BUILD_MAX_PRIMITIVES_PER_LEAF),
+	PLUGIN_MAX_LEAF(settings, max_leaf, I64, RTC_BUILD_MAX_PRIMITIVES_PER_LEAF,
+	                "most primitives in a leaf (Embree allows up to 32)"),
 	PLUGIN_OPTION(settings, min_leaf, I64, .name = "min_leaf",
 	              .help = "always a leaf at this size or below; low (Morton) makes every "
 	                      "leaf this small",

@@ -60,32 +60,25 @@ static inline void bins_add(sah_bins *g, const int32_t k[4], v4 nlo, v4 hi)
 	}
 }
 
-/* Even and odd primitives go to two sets of bins, merged at the end:
- * neighbours in memory are neighbours in space, so consecutive primitives
- * mostly hit the same bins, and with one set each update would wait for
- * the store of the one before. */
+static inline void add_prim(sah_bins *bins, const sah_grid *g, const sah_prim *p)
+{
+	int32_t k[4];
+	v4 lo = v4_load3(p->lo), hi = v4_load3(p->hi);
+
+	bins_of(g, lo, hi, k);
+	bins_add(bins, k, v4_neg(lo), hi);
+}
+
 static void fill_sse(sah_bins *out, const sah_grid *g, const sah_prim *prims, uint32_t begin,
                      uint32_t end)
 {
 	sah_bins odd;
-	int32_t k[4], q[4];
-	uint32_t i = begin;
 
 	sah_bins_clear(out, g->nb);
 	sah_bins_clear(&odd, g->nb);
-	for (; i + 1 < end; i += 2) {
-		v4 lo = v4_load3(prims[i].lo), hi = v4_load3(prims[i].hi);
-		v4 lo2 = v4_load3(prims[i + 1].lo), hi2 = v4_load3(prims[i + 1].hi);
-		bins_of(g, lo, hi, k);
-		bins_of(g, lo2, hi2, q);
-		bins_add(out, k, v4_neg(lo), hi);
-		bins_add(&odd, q, v4_neg(lo2), hi2);
-	}
-	if (i < end) {
-		v4 lo = v4_load3(prims[i].lo), hi = v4_load3(prims[i].hi);
-		bins_of(g, lo, hi, k);
-		bins_add(out, k, v4_neg(lo), hi);
-	}
+#define ADD_SSE(bins, i) add_prim(bins, g, &prims[i])
+	SAH_BINS_EVEN_ODD(out, &odd, begin, end, ADD_SSE);
+#undef ADD_SSE
 	sah_bins_merge(out, &odd, g->nb);
 }
 

@@ -69,7 +69,17 @@ AVX2 static inline void add(sah_bins *g, const int32_t k[4], __m256 v)
 	}
 }
 
-/* Two sets of bins, even and odd primitives, as in the 4-lane path. */
+/* The three bins of primitive p, and p into them. */
+AVX2 static inline void add_prim(sah_bins *bins, const sah_prim *p, __m128 base, __m128 scale,
+                                 __m128 top)
+{
+	int32_t k[4];
+	__m256 v = _mm256_loadu_ps(p->lo);
+
+	bins_of(v, base, scale, top, k);
+	add(bins, k, as_bin(v));
+}
+
 AVX2 void sah_bins_fill_avx2(sah_bins *out, const sah_grid *g, const sah_prim *prims,
                              uint32_t begin, uint32_t end)
 {
@@ -77,24 +87,12 @@ AVX2 void sah_bins_fill_avx2(sah_bins *out, const sah_grid *g, const sah_prim *p
 	const __m128 scale = _mm_set_ps(0, g->scale[2], g->scale[1], g->scale[0]);
 	const __m128 top = _mm_set1_ps((float)(g->nb - 1));
 	sah_bins odd;
-	int32_t k[4], q[4];
-	uint32_t i = begin;
 
 	clear(out, g->nb);
 	clear(&odd, g->nb);
-	for (; i + 1 < end; i += 2) {
-		__m256 p = _mm256_loadu_ps(prims[i].lo);
-		__m256 p2 = _mm256_loadu_ps(prims[i + 1].lo);
-		bins_of(p, base, scale, top, k);
-		bins_of(p2, base, scale, top, q);
-		add(out, k, as_bin(p));
-		add(&odd, q, as_bin(p2));
-	}
-	if (i < end) {
-		__m256 p = _mm256_loadu_ps(prims[i].lo);
-		bins_of(p, base, scale, top, k);
-		add(out, k, as_bin(p));
-	}
+#define ADD_AVX2(bins, i) add_prim(bins, &prims[i], base, scale, top)
+	SAH_BINS_EVEN_ODD(out, &odd, begin, end, ADD_AVX2);
+#undef ADD_AVX2
 	merge(out, &odd, g->nb);
 }
 

@@ -18,6 +18,25 @@ void sah_bins_fill_avx2(sah_bins *out, const sah_grid *g, const sah_prim *prims,
                         uint32_t begin, uint32_t end);
 #endif
 
+/*
+ * Both paths' fill loop: ADD(bins, i) bins primitive i into *bins; even
+ * primitives go to out, odd ones to odd (both cleared before, merged
+ * after). Neighbours in memory are neighbours in space, so consecutive
+ * primitives mostly hit the same bins, and with one set each update would
+ * wait for the store of the one before. A macro, so that ADD is inlined
+ * in each path's own instruction set.
+ */
+#define SAH_BINS_EVEN_ODD(out, odd, begin, end, ADD) \
+	do {                                          \
+		uint32_t i_ = (begin);                \
+		for (; i_ + 1 < (end); i_ += 2) {     \
+			ADD(out, i_);                 \
+			ADD(odd, i_ + 1);             \
+		}                                     \
+		if (i_ < (end))                       \
+			ADD(out, i_);                 \
+	} while (0)
+
 /* True when this build has the AVX2 path and the CPU runs it. */
 bool sah_cpu_has_avx2(void);
 

@@ -86,9 +86,8 @@
 	PLUGIN_OPTION(owner, sah.bins, U32, .name = "bins",                                      \
 	              .help = "bins per axis for method binned",                                 \
 	              .def_int = 32, .min = 2, .max = SAH_MAX_BINS),                             \
-	PLUGIN_OPTION(owner, sah.max_leaf, U32, .name = "max_leaf",                              \
-	              .help = "most primitives in a leaf (unless all their centroids coincide)", \
-	              .def_int = 8, .min = 1, .max = 64),                                        \
+	PLUGIN_MAX_LEAF(owner, sah.max_leaf, U32, 64,                                            \
+	                "most primitives in a leaf (unless all their centroids coincide)"),      \
 	PLUGIN_OPTION(owner, sah.c_trav, FLOAT, .name = "c_trav",                                \
 	              .help = "SAH cost of traversing an inner node (> 0)",                      \
 	              .def_float = 1.0, .min = 1e-6, .max = 1e6),                                \

@@ -32,10 +32,7 @@ void tasks_split_free(tasks_split *s)
 	free(s->total);
 	free(s->left);
 	free(s->cbox);
-	s->bins = NULL;
-	s->total = NULL;
-	s->left = NULL;
-	s->cbox = NULL;
+	*s = (tasks_split){0};
 }
 
 /* Chunk `part` of [begin, end): P contiguous chunks, sizes differing by 1. */

@@ -42,9 +42,7 @@ static const plugin_option options[] = {
 	PLUGIN_OPTION(sbvh_options, bins, U32, .name = "bins",
 	              .help = "object and spatial bins per axis",
 	              .def_int = 32, .min = 2, .max = SBVH_MAX_BINS),
-	PLUGIN_OPTION(sbvh_options, max_leaf, U32, .name = "max_leaf",
-	              .help = "most references in a leaf",
-	              .def_int = 8, .min = 1, .max = SBVH_MAX_LEAF),
+	PLUGIN_MAX_LEAF(sbvh_options, max_leaf, U32, SBVH_MAX_LEAF, "most references in a leaf"),
 	PLUGIN_OPTION(sbvh_options, parallel_min, U32, .name = "parallel_min",
 	              .help = "nodes of at least this many references are split by all threads "
 	                      "together; smaller ones are built as one-thread tasks",

@@ -267,6 +267,50 @@ static inline int run_in(const char *cwd, const char *const *args)
 	return finish(start_in(cwd, CLI_LIMIT_S, args));
 }
 
+/* Runs config `text`, written as `name` in tmpdir (`run --quiet`): it
+ * must exit 2 with `message` on stderr (checked). */
+static inline void cli_refused(const char *name, const char *text, const char *message)
+{
+	CHECK_INT(run_in(NULL, ARGS("run", "--quiet", write_config(name, text))), 2);
+	CHECK_CONTAINS(err_text, message);
+}
+
+/* cli_refused of the config `format` gives with `value` in its one %s. */
+static inline void cli_refused_with(const char *name, const char *format, const char *value,
+                                    const char *message)
+{
+	char text[2048];
+	snprintf(text, sizeof(text), format, value);
+	cli_refused(name, text, message);
+}
+
+/* Plans config `name` (checked) into tmpdir/`plan`: builders "a" and "b"
+ * of fake_good over one 100-triangle soup "s", repeat 1, with `more`
+ * (members and their commas, "" for none) besides. */
+static inline void cli_plan_ab(const char *name, const char *more, const char *plan)
+{
+	char text[1024];
+	snprintf(text, sizeof(text),
+	         "{ \"repeat\": 1, %s\n"
+	         "  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 100 } ],\n"
+	         "  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
+	         "                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n",
+	         more);
+	CHECK_INT(run_in(tmpdir, ARGS("plan", write_config(name, text), "--out", plan)), 0);
+}
+
+/* Runs part k of the plan in tmpdir/`plan` into plan/parts/K (`run
+ * PLAN/plan.json --only K --out ... --quiet`, in tmpdir): its exit status. */
+static inline int cli_run_part(const char *plan, int k)
+{
+	char id[16], plan_json[512], out[512];
+	snprintf(id, sizeof(id), "%d", k);
+	snprintf(plan_json, sizeof(plan_json), "%s/plan.json", plan);
+	snprintf(out, sizeof(out), "%s/parts/%d", plan, k);
+	return run_in(tmpdir, ARGS("run", cli_path_in(plan_json), "--only", id, "--out",
+	                           cli_path_in(out), "--quiet"));
+}
+
 /* Makes tmpdir and takes the command's path; false on bad arguments. */
 static bool cli_begin(int argc, char **argv)
 {

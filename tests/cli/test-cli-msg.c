@@ -160,23 +160,13 @@ static void test_version(void)
 	CHECK_INT(run_in(tmpdir, ARGS("--version")), 0);
 	/* "bvhlab 0.1.0+COMMIT (plugin ABI ...)": a commit, or "unknown" outside git. */
 	CHECK(strstr(out_text, "0.1.0+") != NULL);
-	const char *cfg = write_config("v.json",
-		"{ \"repeat\": 1,\n"
-		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
-		"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n");
-	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "pv")), 0);
+	cli_plan_ab("v.json", "", "pv");
 	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("pv/plan.json"), "--only", "0", "--repeat",
 	                              "7", "--out", cli_path_in("pv/parts/0"), "--quiet")), 2);
 	CHECK_CONTAINS(err_text, "--repeat cannot be combined with a plan");
 	CHECK(!cli_exists(cli_path_in("pv/parts/0")));
-	for (int k = 0; k < 2; k++) {
-		char id[4], out[64];
-		snprintf(id, sizeof(id), "%d", k);
-		snprintf(out, sizeof(out), "pv/parts/%d", k);
-		CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("pv/plan.json"), "--only", id, "--out",
-		                              cli_path_in(out), "--quiet")), 0);
-	}
+	for (int k = 0; k < 2; k++)
+		CHECK_INT(cli_run_part("pv", k), 0);
 	set_version(cli_path_in("pv/parts/1"), "0.0.9+000000000000");
 	CHECK_INT(run_in(tmpdir, ARGS("merge", cli_path_in("pv/parts/0"), cli_path_in("pv/parts/1"),
 	                              "--out", cli_path_in("pv"))), 2);
@@ -200,8 +190,7 @@ static void test_version(void)
  * (`out`) exists, with `message` on stderr. */
 static void refused(const char *name, const char *text, const char *out, const char *message)
 {
-	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", write_config(name, text))), 2);
-	CHECK_CONTAINS(err_text, message);
+	cli_refused(name, text, message);
 	CHECK(!cli_exists(cli_path_in(out)));
 }
 
@@ -351,12 +340,11 @@ static void test_escape(void)
 		{"\"a\\u0085b\"", "its scene name holds the control character U+0085"},
 	};
 	for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
-		char text[512];
-		snprintf(text, sizeof(text),
-		         "{ \"output\": \"out-bad\", \"scenes\": [ { \"name\": %s, \"generator\": "
-		         "\"soup\", \"count\": 100 } ], \"builders\": [ { \"plugin\": \"lbvh\" } ] }\n",
-		         bad[k][0]);
-		refused("bad.json", text, "out-bad", bad[k][1]);
+		cli_refused_with("bad.json",
+		                 "{ \"output\": \"out-bad\", \"scenes\": [ { \"name\": %s, \"generator\": "
+		                 "\"soup\", \"count\": 100 } ], \"builders\": [ { \"plugin\": \"lbvh\" } ] }\n",
+		                 bad[k][0], bad[k][1]);
+		CHECK(!cli_exists(cli_path_in("out-bad")));
 	}
 }
 

@@ -464,17 +464,12 @@ static int shell(const char *fmt, const char *arg)
  * part's images/ are not followed. */
 static void misc_merge(void)
 {
-	const char *cfg = write_config("heat.json",
-		"{ \"repeat\": 1, \"images\": true,\n"
-		"  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1 },\n"
-		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 100 } ],\n"
-		"  \"builders\": [ { \"plugin\": \"fake_good\", \"name\": \"a\" },\n"
-		"                  { \"plugin\": \"fake_good\", \"name\": \"b\" } ] }\n");
-	CHECK_INT(run_in(tmpdir, ARGS("plan", cfg, "--out", "ph")), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("ph/plan.json"), "--only", "0", "--out",
-	                              cli_path_in("ph/parts/0"), "--quiet")), 0);
-	CHECK_INT(run_in(tmpdir, ARGS("run", cli_path_in("ph/plan.json"), "--only", "1", "--out",
-	                              cli_path_in("ph/parts/1"), "--quiet")), 0);
+	cli_plan_ab("heat.json",
+	            "\"images\": true,\n"
+	            "  \"rays\": { \"width\": 8, \"height\": 8, \"diffuse\": 0, \"min_ms\": 1 },",
+	            "ph");
+	CHECK_INT(cli_run_part("ph", 0), 0);
+	CHECK_INT(cli_run_part("ph", 1), 0);
 	CHECK_INT(shell("sed -i 's/\"heat_max\":[[:space:]]*[0-9.]*/\"heat_max\": 77/' "
 	                "ph/parts/1/results.json%s", ""), 0);
 	CHECK_INT(shell("echo secret > secret.txt && ln -s '%s/secret.txt' ph/parts/1/images/"

@@ -24,10 +24,8 @@
 	                      "primitives can be rearranged too, and cut the tree into "  \
 	                      "leaves by the SAH afterwards (kept only if the SAH fell)", \
 	              .def_bool = true),                                                  \
-	PLUGIN_OPTION(owner, max_leaf, I64, .name = "max_leaf",                           \
-	              .help = "most primitives in a leaf of that final cut (8, as the "   \
-	                      "builders)",                                                \
-	              .def_int = 8, .min = 1, .max = 64)
+	PLUGIN_MAX_LEAF(owner, max_leaf, I64, 64,                                         \
+	                "most primitives in a leaf of that final cut (8, as the builders)")
 
 /* A stage's own work between the split and the cut: 0, or a negative
  * errno after host->set_error. */

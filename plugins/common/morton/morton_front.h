@@ -30,9 +30,8 @@
 	              .help = "turn subtrees of at most max_leaf primitives into leaves where " \
 	                      "the SAH says a leaf is cheaper (off: one primitive per leaf)",   \
 	              .def_bool = true),                                                        \
-	PLUGIN_OPTION(owner, max_leaf, U32, .name = "max_leaf",                                 \
-	              .help = "most primitives in a collapsed leaf (8, as the SAH builders)",   \
-	              .def_int = 8, .min = 1, .max = 64),                                       \
+	PLUGIN_MAX_LEAF(owner, max_leaf, U32, 64,                                               \
+	                "most primitives in a collapsed leaf (8, as the SAH builders)"),        \
 	PLUGIN_OPTION(owner, c_trav, FLOAT, .name = "c_trav",                                   \
 	              .help = "SAH cost of traversing an inner node (> 0), for collapse",       \
 	              .def_float = 1.0, .min = 1e-6, .max = 1e6),                               \

@@ -104,6 +104,14 @@ typedef struct plugin_option {
 
 #define PLUGIN_OPTION_COUNT(table) (sizeof(table) / sizeof((table)[0]))
 
+/* C: the entry of "max_leaf", the most primitives (or references) in a
+ * leaf, which every builder and stage of this tree offers with one name,
+ * one default (8, so that they compare at one leaf size) and one floor (1);
+ * `most` is the builder's own limit, `text` its help. */
+#define PLUGIN_MAX_LEAF(struct_type, member, field_type, most, text)   \
+	PLUGIN_OPTION(struct_type, member, field_type, .name = "max_leaf", \
+	              .help = text, .def_int = 8, .min = 1, .max = most)
+
 /* Copies the declarations of table[0 .. count) into decls, in order. */
 void plugin_options_decls(const plugin_option *table, size_t count, bvhlab_option_decl *decls);
 
