@@ -32,6 +32,7 @@ static const plugin_option options[] = {
 	                      "on a CPU device, 1 on a GPU); the tree is the same for every value",
 	              .def_int = 0, .min = 0, .max = CL_PLOC_MAX_NN_BLOCK),
 };
+PLUGIN_DECLS(options, cl_ploc, NULL)
 
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "first_clusters", "nearest", "count_chunks", "prefix",
@@ -107,13 +108,18 @@ static int run(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_ploc *b,
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	cl_ploc b = { .in = input, .n = input->prim_count, .dev = &S.dev, .sort = &S.sort,
-	              .b = S.b };
+	cl_ploc b;
 	int rc;
 
-	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
-	                              &b)) < 0 ||
-	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
+	/* The options first: the copy sets the whole struct, the rest zero. */
+	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b)) < 0)
+		return rc;
+	b.in = input;
+	b.n = input->prim_count;
+	b.dev = &S.dev;
+	b.sort = &S.sort;
+	b.b = S.b;
+	if ((rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
 		return rc < 0 ? rc : 0;
 	return run(host, ctx, &b, output);
 }
