@@ -49,7 +49,8 @@ static const plugin_option options[] = {
 	MORTON_OPTIONS(cl_hploc, bits),
 	CL_DEVICE_OPTION(cl_hploc),
 };
-PLUGIN_DECLS(options, cl_hploc, NULL)
+CL_DEVICE_CHECK(cl_hploc)
+PLUGIN_DECLS(options, cl_hploc, cl_device_check)
 
 static const char *const kernel_names[] = { CL_SORT_KERNEL_NAMES, "hploc_climb" };
 enum { K_CLIMB = CL_SORT_KERNELS };

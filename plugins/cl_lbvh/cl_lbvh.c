@@ -33,7 +33,8 @@ static const plugin_option options[] = {
 	                      "device, search on a GPU); the tree is the same",
 	              .def_string = "auto", .choices = "auto|search|scan"),
 };
-PLUGIN_DECLS(options, cl_lbvh, NULL)
+CL_DEVICE_CHECK(cl_lbvh)
+PLUGIN_DECLS(options, cl_lbvh, cl_device_check)
 
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "gather_leaves", "prefixes",

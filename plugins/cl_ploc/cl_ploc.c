@@ -32,7 +32,8 @@ static const plugin_option options[] = {
 	                      "on a CPU device, 1 on a GPU); the tree is the same for every value",
 	              .def_int = 0, .min = 0, .max = CL_PLOC_MAX_NN_BLOCK),
 };
-PLUGIN_DECLS(options, cl_ploc, NULL)
+CL_DEVICE_CHECK(cl_ploc)
+PLUGIN_DECLS(options, cl_ploc, cl_device_check)
 
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "first_clusters", "nearest", "count_chunks", "prefix",
