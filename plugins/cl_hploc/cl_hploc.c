@@ -205,15 +205,11 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	char err[BVHLAB_CL_ERROR_SIZE];
 	int rc;
 
-	/* The options first: the copy sets the whole struct, the rest zero. */
-	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b)) < 0)
-		return rc;
-	b.in = input;
-	b.n = input->prim_count;
-	b.dev = &S.dev;
-	b.sort = &S.sort;
-	b.b = S.b;
-	if ((rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
+	/* The options first: their copy sets the whole struct. */
+	rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);
+	b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, b.b = S.b;
+	if (rc < 0 || (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input,
+	                                   output)) != 0)
 		return rc < 0 ? rc : 0;
 	if ((rc = device_run(&b, err, sizeof(err))) < 0) {
 		host->set_error(ctx, "%s", err);
