@@ -264,8 +264,10 @@ static void test_bad_builders(void)
 	                         "'no_such_plugin' not found");
 	CHECK_CONTAINS(err_text, "bad.json:4:17: builder 'fake_abi2': ");
 	CHECK_CONTAINS(err_text, "built for ABI 2.0");
-	CHECK_CONTAINS(err_text, "bad.json:6:32: builder 'typed': option 'alpha' of plugin 'fake_good' must be");
-	CHECK_CONTAINS(err_text, "bad.json:8:32: builder 'typo': unknown option 'alpah' for plugin 'fake_good'");
+	CHECK_CONTAINS(err_text, "bad.json:6:32: builder 'typed': option 'alpha' of plugin "
+	                         "'fake_good' must be");
+	CHECK_CONTAINS(err_text, "bad.json:8:32: builder 'typo': unknown option 'alpah' for plugin "
+	                         "'fake_good'");
 	CHECK_CONTAINS(err_text, "4 builders cannot run as configured");
 	CHECK_INT(occurrences(err_text, "builder 'typo'"), 1); /* said once, not twice */
 	CHECK_INT(occurrences(err_text, "builder 'no_such_plugin'"), 1);
