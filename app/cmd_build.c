@@ -164,6 +164,8 @@ static int stages_open(struct stages *st, const struct build_args *a, bvhlab_err
 			if (a->refine_option_stage[j] == k &&
 			    bvhlab_options_parse(&st->opts[k], a->refine_options[j], err) < 0)
 				return -1;
+		if (bvhlab_options_check(&st->opts[k], err) < 0)
+			return -1;
 		st->stage[k] = (struct refine_stage){.plugin = st->plugin[k], .opts = &st->opts[k]};
 	}
 	return 0;

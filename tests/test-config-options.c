@@ -90,18 +90,21 @@ static void test_options(void)
 	bvhlab_options_finish(&opts);
 
 	EXPECT_OPTION_ERROR("{ \"max_leaf\": 8, \"mthod\": \"x\" }", "\"mthod\"",
-	                    "unknown option 'mthod' (known: max_leaf, method, spatial, alpha, "
-	                    "salt); did you mean 'method'?");
+	                    "unknown option 'mthod' for plugin 'fake' (known: max_leaf, method, "
+	                    "spatial, alpha, salt); did you mean 'method'?");
 	EXPECT_OPTION_ERROR("{ \"max_leaf\": \"8\" }", "\"max_leaf\"",
-	                    "option 'max_leaf' must be an integer, not a string");
+	                    "option 'max_leaf' of plugin 'fake' must be an integer in [1, 64], not a "
+	                    "string");
 	EXPECT_OPTION_ERROR("{ \"max_leaf\": 2.5 }", "\"max_leaf\"",
-	                    "option 'max_leaf' must be an integer, not 2.5");
+	                    "option 'max_leaf' of plugin 'fake' must be an integer in [1, 64], not 2.5");
 	EXPECT_OPTION_ERROR("{ \"salt\": 1e30 }", "\"salt\"", "an integer that fits in 64 bits");
 	EXPECT_OPTION_ERROR("{ \"spatial\": 1 }", "\"spatial\"",
-	                    "option 'spatial' must be true or false, not 1");
-	EXPECT_OPTION_ERROR("{ \"alpha\": \"x\" }", "\"alpha\"", "option 'alpha' must be a");
+	                    "option 'spatial' of plugin 'fake' must be true or false, not 1");
+	EXPECT_OPTION_ERROR("{ \"alpha\": \"x\" }", "\"alpha\"",
+	                    "option 'alpha' of plugin 'fake' must be a");
 	EXPECT_OPTION_ERROR("{ \"method\": null }", "\"method\"",
-	                    "option 'method' must be a string, not null");
+	                    "option 'method' of plugin 'fake' must be a string (one of sweep|binned), "
+	                    "not null");
 	/* Range and choices: the options module's message, located and named. */
 	EXPECT_OPTION_ERROR("{ \"max_leaf\": 99 }", "\"max_leaf\"", "max_leaf");
 	EXPECT_OPTION_ERROR("{ \"method\": \"fast\" }", "\"method\"", "sweep|binned");

@@ -165,7 +165,7 @@ static void test_descriptor(void)
 	}
 }
 
-/* The host checks ranges; the plugin refuses a bit count it has no codes for. */
+/* The host checks ranges and the bit counts the plugin has codes for. */
 static void test_options(void)
 {
 	bvhlab_scene *scene = generate("soup", 100, 0, 0);
@@ -181,10 +181,23 @@ static void test_options(void)
 	CHECK_CONTAINS(err.message, "bits");
 	CHECK_INT(bvhlab_options_set_float(&opts, "c_trav", 0, &err), -EINVAL);
 	CHECK_CONTAINS(err.message, "c_trav");
-	CHECK_INT(bvhlab_options_set_int(&opts, "bits", 31, &err), 0);
+	/* bits in range but not a code length: refused when set (ABI 1.6
+	 * INT choices), no longer only when built */
+	CHECK_INT(bvhlab_options_set_int(&opts, "bits", 31, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "option 'bits' of plugin 'lbvh' must be one of 30|63, not 31");
+	CHECK_INT(bvhlab_options_set_int(&opts, "bits", 30, &err), 0);
+	CHECK_INT(bvhlab_options_check(&opts, &err), 0);
+	CHECK(opts.filled != NULL);
+	/* the struct filled once, or (no check since the last setter) read
+	 * by the plugin at the build: the same tree */
 	if (scene && bvhlab_prims_init(&prims, scene, &err) == 0) {
-		CHECK_INT(bvhlab_build(plugin, &opts, &prims.input, 2, &tree, &err), -EINVAL);
-		CHECK_CONTAINS(err.message, "bits");
+		bvhlab_tree once = { 0 };
+		CHECK_INT(bvhlab_build(plugin, &opts, &prims.input, 2, &once, &err), 0);
+		CHECK_INT(bvhlab_options_set_int(&opts, "bits", 30, &err), 0);
+		CHECK(opts.filled == NULL);
+		CHECK_INT(bvhlab_build(plugin, &opts, &prims.input, 2, &tree, &err), 0);
+		check_same_tree("bits 30", &once, &tree, 2);
+		bvhlab_tree_finish(&once);
 		bvhlab_prims_finish(&prims);
 	}
 	bvhlab_options_finish(&opts);

@@ -37,11 +37,11 @@ static void test_setters(bvhlab_options *o)
 	CHECK_INT(bvhlab_options_set_int(o, "bins", 16, &err), 0);
 	CHECK_INT(o->values[0].i, 16);
 	CHECK_INT(bvhlab_options_set_int(o, "bins", 1, &err), -EINVAL);
-	CHECK_CONTAINS(err.message, "option 'bins' of builder 'demo' is out of range: 1 not in [2, 256]");
+	CHECK_CONTAINS(err.message, "option 'bins' of plugin 'demo' is out of range: 1 not in [2, 256]");
 	CHECK_INT(bvhlab_options_set_int(o, "bims", 4, &err), -ENOENT);
-	CHECK_CONTAINS(err.message, "unknown option 'bims' for builder 'demo' (known: bins, method");
+	CHECK_CONTAINS(err.message, "unknown option 'bims' for plugin 'demo' (known: bins, method");
 	CHECK_INT(bvhlab_options_set_string(o, "bins", "x", &err), -EINVAL);
-	CHECK_CONTAINS(err.message, "option 'bins' of builder 'demo' must be an integer");
+	CHECK_CONTAINS(err.message, "option 'bins' of plugin 'demo' must be an integer");
 	CHECK_INT(bvhlab_options_set_string(o, "method", "median", &err), -EINVAL);
 	CHECK_CONTAINS(err.message, "must be one of sweep|binned, not 'median'");
 	CHECK_INT(bvhlab_options_set_string(o, "method", "binned", &err), 0);

@@ -110,7 +110,8 @@ static void test_bad_value(void)
 	CHECK_INT(bvhlab_options_init(&opts, &fake_builder), 0);
 	CHECK_INT(config_apply_options(&cfg, &cfg.builders[1], &opts, &err), -EINVAL);
 	CHECK_CONTAINS(err.message, "grid.json:3:35: builder 'fake[method=3]': option 'method' "
-	                            "must be a string, not 3 (options.method.grid[1])");
+	                            "of plugin 'fake' must be a string (one of sweep|binned), "
+	                            "not 3 (options.method.grid[1])");
 	bvhlab_options_finish(&opts);
 	config_finish(&cfg);
 }

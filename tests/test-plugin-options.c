@@ -3,9 +3,12 @@
  * test is a plugin of its own (PLUGIN_WITH_OPTIONS) with a fake host.
  * The entry point returns the descriptor with the table's declarations,
  * in order, field for field (the field's type where an entry leaves it
- * out), to any thread (several ask at once, the first time); build()
- * fills every field type at its offset with the value the host gives (a
- * choice as its index, a float rounded as a cast rounds); an entry whose
+ * out), to any thread (several ask at once, the first time), and its
+ * fill_options (ABI 1.6); that fills a zeroed struct, every field type at
+ * its offset with the value the host gives (a choice as its index, a
+ * float rounded as a cast rounds), then runs the plugin's check; build()
+ * copies the struct the host gives as input->options, or fills its own
+ * from a host that gives none (an older one); an entry whose
  * field does not fit its declaration (a type that does not fit, a U32 for
  * a range past 32 bits, a CHOICE without choices) fails with -EINVAL and
  * a message naming the option.
@@ -15,7 +18,9 @@
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stdint.h>
+#include <stddef.h>
 #include <stdio.h>
+#include <string.h>
 
 #include <bvhlab/builder.h>
 
@@ -67,6 +72,14 @@ static int get_string(bvhlab_build_ctx *ctx, const char *name, const char **out)
 	return 0;
 }
 
+static int get_seven(bvhlab_build_ctx *ctx, const char *name, int64_t *out)
+{
+	(void)ctx;
+	(void)name;
+	*out = 7;
+	return 0;
+}
+
 static const bvhlab_host host = {
 	.abi_version = BVHLAB_ABI_CURRENT, .struct_size = sizeof(bvhlab_host),
 	.set_error = set_error, .option_bool = get_bool, .option_int = get_int,
@@ -82,6 +95,7 @@ struct opts {
 	double cost_d;
 	int method;
 	const char *label;
+	int derived; /* set by the check */
 };
 
 static const plugin_option options[] = {
@@ -96,16 +110,28 @@ static const plugin_option options[] = {
 	PLUGIN_OPTION(struct opts, label, STRING, .name = "label", .help = "free text"),
 };
 
+/* The plugin's own rule: derives a field, refuses a count of 7. */
+static int check(const bvhlab_host *h, bvhlab_build_ctx *ctx, void *opt)
+{
+	struct opts *o = opt;
+
+	o->derived = o->method + 100;
+	if (o->count != 7)
+		return 0;
+	h->set_error(ctx, "option 'count' must not be 7");
+	return -EINVAL;
+}
+PLUGIN_DECLS(options, struct opts, check)
+
 /* What the last build read. */
 static struct opts filled;
 
 static int build(const bvhlab_host *h, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
                  bvhlab_build_output *out)
 {
-	(void)in;
 	(void)out;
 	filled = (struct opts){ .pad = 'x' };
-	return plugin_options_fill(h, ctx, options, PLUGIN_OPTION_COUNT(options), &filled);
+	return PLUGIN_OPTIONS_GET(h, ctx, in, &filled);
 }
 
 PLUGIN_WITH_OPTIONS(options, .name = "options_probe", .summary = "plugin_options.h's test",
@@ -159,21 +185,63 @@ static void test_entry(void)
 	}
 	CHECK(strcmp(d->options[5].choices, "sweep|binned|grid") == 0);
 	CHECK(bvhlab_plugin_entry(BVHLAB_ABI_MAJOR + 1) == NULL);
+	CHECK(d->fill_options != NULL);
+	CHECK_INT(d->options_size, sizeof(struct opts));
+}
+
+static void check_filled(const struct opts *o, char pad)
+{
+	CHECK(o->pad == pad && o->on);
+	CHECK_INT(o->count, 42);
+	CHECK_INT(o->big, 5000000000LL);
+	CHECK(o->cost_f == (float)0.1 && o->cost_d == 0.1);
+	CHECK_INT(o->method, 2);
+	CHECK(o->label && strcmp(o->label, "hello") == 0);
+	CHECK_INT(o->derived, 102);
 }
 
 static void test_fill(void)
 {
 	const bvhlab_builder *d = bvhlab_plugin_entry(BVHLAB_ABI_MAJOR);
+	struct opts once;
+	bvhlab_build_input in = { .struct_size = sizeof(in) };
+
+	/* fill_options: a zeroed struct, filled and checked */
+	memset(&once, 'z', sizeof(once));
+	errors = 0;
+	CHECK_INT(d->fill_options(&host, NULL, &once), 0);
+	CHECK_INT(errors, 0);
+	check_filled(&once, 0);
+	/* a build from a host that filled it: a copy, nothing asked */
+	once.pad = 'c';
+	in.options = &once;
+	CHECK_INT(d->build(&host, NULL, &in, NULL), 0);
+	check_filled(&filled, 'c');
+	/* from a host that did not (no options, or an older input) */
+	in.options = NULL;
+	CHECK_INT(d->build(&host, NULL, &in, NULL), 0);
+	check_filled(&filled, 0);
+	in.options = &once;
+	in.struct_size = offsetof(bvhlab_build_input, options);
+	CHECK_INT(d->build(&host, NULL, &in, NULL), 0);
+	check_filled(&filled, 0);
+	CHECK_INT(errors, 0);
+}
+
+/* The check's refusal is fill_options's, with its message. */
+static void test_check(void)
+{
+	static const bvhlab_host seven = {
+		.abi_version = BVHLAB_ABI_CURRENT, .struct_size = sizeof(bvhlab_host),
+		.set_error = set_error, .option_bool = get_bool, .option_int = get_seven,
+		.option_float = get_float, .option_string = get_string,
+	};
+	struct opts o;
 
 	errors = 0;
-	CHECK_INT(d->build(&host, NULL, NULL, NULL), 0);
-	CHECK_INT(errors, 0);
-	CHECK(filled.pad == 'x' && filled.on);
-	CHECK_INT(filled.count, 42);
-	CHECK_INT(filled.big, 5000000000LL);
-	CHECK(filled.cost_f == (float)0.1 && filled.cost_d == 0.1);
-	CHECK_INT(filled.method, 2);
-	CHECK(filled.label && strcmp(filled.label, "hello") == 0);
+	CHECK_INT(bvhlab_plugin_entry(BVHLAB_ABI_MAJOR)->fill_options(&seven, NULL, &o), -EINVAL);
+	CHECK_INT(errors, 1);
+	CHECK_CONTAINS(last_error, "option 'count' must not be 7");
 }
 
 /* Each bad entry alone: -EINVAL, one message naming it, nothing else read. */
@@ -207,6 +275,7 @@ int main(void)
 {
 	test_entry();
 	test_fill();
+	test_check();
 	test_bad_entries();
 	return test_finish();
 }

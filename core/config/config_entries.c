@@ -341,43 +341,63 @@ static int unknown_option(const struct config *cfg, const struct config_builder 
 		snprintf(hint, sizeof(hint), "; did you mean '%s'?", s.best);
 	if (used == 0)
 		return config_error(cfg, m, true, err,
-		                    "builder '%s': unknown option '%s' (it takes no options)", b->name,
-		                    m->string);
-	return config_error(cfg, m, true, err, "builder '%s': unknown option '%s' (known: %s)%s",
-	                    b->name, m->string, list, hint);
+		                    "builder '%s': unknown option '%s' for plugin '%s' (it takes no "
+		                    "options)", b->name, m->string, desc->name);
+	return config_error(cfg, m, true, err,
+	                    "builder '%s': unknown option '%s' for plugin '%s' (known: %s)%s",
+	                    b->name, m->string, desc->name, list, hint);
+}
+
+/* " in [lo, hi]", " (one of a|b)": what a declaration allows beyond its type. */
+static void allowed(const bvhlab_builder *desc, const bvhlab_option_decl *d, char *buf,
+                    size_t size)
+{
+	size_t n = 0;
+	buf[0] = '\0';
+	if (d->min <= d->max && (d->type == BVHLAB_OPTION_INT || d->type == BVHLAB_OPTION_FLOAT))
+		n = (size_t)snprintf(buf, size, " in [%.15g, %.15g]", d->min, d->max);
+	if (d->choices && n < size && (d->type == BVHLAB_OPTION_STRING ||
+	                               (d->type == BVHLAB_OPTION_INT &&
+	                                bvhlab_builder_int_choices(desc))))
+		snprintf(buf + n, size - n, " (one of %s)", d->choices);
 }
 
 static int wrong_type(const struct config *cfg, const struct config_builder *b,
-                      const cJSON *m, const cJSON *v, const char *expected, bvhlab_error *err)
+                      const bvhlab_options *opts, const cJSON *m, const cJSON *v,
+                      const char *expected, bvhlab_error *err)
 {
-	char got[48];
-	return config_error(cfg, v, true, err, "builder '%s': option '%s' must be %s, not %s",
-	                    b->name, m->string, expected, config_describe(cfg, v, got, sizeof(got)));
+	char got[48], also[160];
+	const bvhlab_builder *desc = opts->builder;
+	allowed(desc, &desc->options[bvhlab_options_find(opts, m->string)], also, sizeof(also));
+	return config_error(cfg, v, true, err,
+	                    "builder '%s': option '%s' of plugin '%s' must be %s%s, not %s",
+	                    b->name, m->string, desc->name, expected, also,
+	                    config_describe(cfg, v, got, sizeof(got)));
 }
 
 /* 0 when the JSON value v of member m fits the declared type; *i gets an INT's value. */
 static int check_type(const struct config *cfg, const struct config_builder *b,
-                      const cJSON *m, const cJSON *v, uint32_t type, int64_t *i,
-                      bvhlab_error *err)
+                      const bvhlab_options *opts, const cJSON *m, const cJSON *v,
+                      uint32_t type, int64_t *i, bvhlab_error *err)
 {
 	switch (type) {
 	case BVHLAB_OPTION_BOOL:
-		return cJSON_IsBool(v) ? 0 : wrong_type(cfg, b, m, v, "true or false", err);
+		return cJSON_IsBool(v) ? 0 : wrong_type(cfg, b, opts, m, v, "true or false", err);
 	case BVHLAB_OPTION_INT:
 		switch (cJSON_IsNumber(v) ? json_get_int64(cfg->locations, v, i) : -EINVAL) {
 		case 0:
 			return 0;
 		case -ERANGE:
-			return wrong_type(cfg, b, m, v, "an integer that fits in 64 bits", err);
+			return wrong_type(cfg, b, opts, m, v, "an integer that fits in 64 bits", err);
 		default:
-			return wrong_type(cfg, b, m, v, "an integer", err);
+			return wrong_type(cfg, b, opts, m, v, "an integer", err);
 		}
 	case BVHLAB_OPTION_FLOAT:
 		if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble))
-			return wrong_type(cfg, b, m, v, "a finite number", err);
+			return wrong_type(cfg, b, opts, m, v, "a finite number", err);
 		return 0;
 	case BVHLAB_OPTION_STRING:
-		return cJSON_IsString(v) ? 0 : wrong_type(cfg, b, m, v, "a string", err);
+		return cJSON_IsString(v) ? 0 : wrong_type(cfg, b, opts, m, v, "a string", err);
 	default:
 		return config_error(cfg, m, true, err, "builder '%s': option '%s' has no valid type (%u)",
 		                    b->name, m->string, type);
@@ -421,7 +441,7 @@ int config_apply_options(const struct config *cfg, const struct config_builder *
 		const cJSON *v = config_grid_value(b, m, &at);
 		uint32_t type = opts->builder->options[index].type;
 		int64_t i = 0;
-		int rc = check_type(cfg, b, m, v, type, &i, err);
+		int rc = check_type(cfg, b, opts, m, v, type, &i, err);
 		if (rc)
 			return grid_note(rc, m, at, err);
 		/* The setter's message (range, choices) gets the position and the name. */

@@ -155,6 +155,10 @@ static int open_animation(const struct config *cfg, bool probed, struct harness_
 		          "1.4)", a->update);
 		*ok = false;
 	}
+	if (r == 0 && *ok && bvhlab_options_check(&hb->update.opts, &hb->error) < 0) {
+		error_prefix(&hb->error, "animation update");
+		*ok = false;
+	}
 	for (size_t k = 0; r == 0 && *ok && k < a->refine_count; k++) {
 		struct harness_stage *st = &hb->anim_stages[k];
 		snprintf(what, sizeof(what), "animation refine stage %zu", k + 1);

@@ -67,9 +67,12 @@ static int updater_open(const struct frames_job *job, struct updater *u, bvhlab_
 		          a->update);
 		r = -EINVAL;
 	}
-	/* Updates take no options from the config: the plugin's defaults. */
+	/* Updates take no options from the config: the plugin's defaults,
+	 * read into its struct once for the run. */
 	if (r == 0 && bvhlab_options_init(&u->opts, bvhlab_plugin_builder(u->plugin)) < 0)
 		r = -ENOMEM;
+	if (r == 0)
+		r = bvhlab_options_check(&u->opts, err);
 	for (size_t k = 0; r == 0 && k < a->refine_count; k++)
 		r = open_stage(job, u, k, err);
 	return r;

@@ -12,6 +12,7 @@
 #include <bvhlab/host.h>
 #include <bvhlab/machine.h>
 
+#include "host/options_fill.h"
 #include "machine/machine.h"
 #include "tree/tree_view.h"
 #include "util/util.h"
@@ -120,6 +121,8 @@ static int host_grow_output(bvhlab_build_ctx *ctx, bvhlab_build_output *out, uin
                             uint32_t indices)
 {
 	bvhlab_tree *t = ctx->tree;
+	if (!t) /* fill_options has no output to grow */
+		return -EINVAL;
 	int rc = bvhlab_tree_reserve(t, nodes, indices);
 	/* Even a refused reserve may have moved the node array (it grows
 	 * first), so the builder gets the current pointers either way. */
@@ -166,7 +169,7 @@ static void host_phase(bvhlab_build_ctx *ctx, const char *name, double ms)
 {
 	bvhlab_tree *t = ctx->tree;
 	uint32_t k = 0;
-	if (ctx->bad_phase[0])
+	if (ctx->bad_phase[0] || !t) /* no phases in fill_options */
 		return;
 	if (!phase_name_ok(name)) {
 		snprintf(ctx->bad_phase, sizeof(ctx->bad_phase), "'%.40s' (%g ms): names are "
@@ -280,6 +283,32 @@ static int explain(const struct bvhlab_build_ctx *ctx, int r)
 	return r;
 }
 
+int options_fill(bvhlab_options *opts, bvhlab_error *err)
+{
+	const bvhlab_builder *b = opts->builder;
+	bvhlab_fill_options_fn fill = bvhlab_builder_fill_options(b);
+	free(opts->filled);
+	opts->filled = NULL;
+	if (!fill)
+		return 0;
+	void *out = calloc(1, b->options_size);
+	if (!out) {
+		error_set(err, "plugin '%s': out of memory for its options", b->name);
+		return -ENOMEM;
+	}
+	struct bvhlab_build_ctx ctx = {.builder = b, .opts = opts, .err = err};
+	int r = fill(&host_table, &ctx, out);
+	if (r == 0) {
+		opts->filled = out;
+		return 0;
+	}
+	free(out);
+	if (!ctx.error_set)
+		error_set(err, "its options are refused (%s) without saying why", strerror(-r));
+	error_prefix(err, "plugin '%s'", b->name);
+	return r < 0 ? r : -EPROTO;
+}
+
 /* The call into the plugin, with pinning around it and the counts back
  * into the tree; `in_place` is its refine or update function (the tree's
  * counts go in), NULL for build. */
@@ -290,6 +319,7 @@ static int call_plugin(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 	const bvhlab_builder *b = bvhlab_plugin_builder(plugin);
 	bvhlab_build_input in = *input;
 	in.threads = threads ? threads : bvhlab_hardware_threads();
+	in.options = opts ? opts->filled : NULL;
 	bvhlab_build_output out = {
 		.struct_size = sizeof(out),
 		.node_capacity = tree->node_capacity,

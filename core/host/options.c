@@ -12,6 +12,7 @@
 
 #include <bvhlab/host.h>
 
+#include "host/options_fill.h"
 #include "util/util.h"
 
 static const char *type_name(uint32_t type)
@@ -32,6 +33,7 @@ static const char *type_name(uint32_t type)
 int bvhlab_options_init(bvhlab_options *opts, const bvhlab_builder *builder)
 {
 	opts->builder = builder;
+	opts->filled = NULL;
 	opts->values = calloc(builder->option_count ? builder->option_count : 1,
 	                      sizeof(*opts->values));
 	if (!opts->values)
@@ -54,8 +56,16 @@ int bvhlab_options_init(bvhlab_options *opts, const bvhlab_builder *builder)
 	return 0;
 }
 
+/* A set value makes the plugin's struct stale: bvhlab_options_check fills it anew. */
+static void drop_filled(bvhlab_options *opts)
+{
+	free(opts->filled);
+	opts->filled = NULL;
+}
+
 void bvhlab_options_finish(bvhlab_options *opts)
 {
+	drop_filled(opts);
 	if (!opts->values)
 		return;
 	for (uint32_t k = 0; k < opts->builder->option_count; k++)
@@ -84,12 +94,12 @@ static int lookup(const bvhlab_options *opts, const char *key, uint32_t type,
 		for (uint32_t i = 0; i < b->option_count && used < sizeof(known); i++)
 			used += (size_t)snprintf(known + used, sizeof(known) - used, "%s%s",
 			                         i ? ", " : "", b->options[i].name);
-		error_set(err, "unknown option '%s' for builder '%s' (known: %s)", key,
+		error_set(err, "unknown option '%s' for plugin '%s' (known: %s)", key,
 		                 b->name, b->option_count ? known : "none");
 		return -ENOENT;
 	}
 	if (b->options[k].type != type) {
-		error_set(err, "option '%s' of builder '%s' must be %s", key, b->name,
+		error_set(err, "option '%s' of plugin '%s' must be %s", key, b->name,
 		                 type_name(b->options[k].type));
 		return -EINVAL;
 	}
@@ -106,48 +116,9 @@ static int check_range(const bvhlab_options *opts, int k, double v, bvhlab_error
 	const bvhlab_option_decl *d = &opts->builder->options[k];
 	if (!has_range(d) || (v >= d->min && v <= d->max))
 		return 0;
-	error_set(err, "option '%s' of builder '%s' is out of range: %.15g not in [%.15g, %.15g]",
+	error_set(err, "option '%s' of plugin '%s' is out of range: %.15g not in [%.15g, %.15g]",
 	                 d->name, opts->builder->name, v, d->min, d->max);
 	return -EINVAL;
-}
-
-int bvhlab_options_set_bool(bvhlab_options *opts, const char *key, bool v, bvhlab_error *err)
-{
-	int k = lookup(opts, key, BVHLAB_OPTION_BOOL, err);
-	if (k < 0)
-		return k;
-	opts->values[k].b = v;
-	return 0;
-}
-
-int bvhlab_options_set_int(bvhlab_options *opts, const char *key, int64_t v, bvhlab_error *err)
-{
-	int k = lookup(opts, key, BVHLAB_OPTION_INT, err);
-	if (k < 0)
-		return k;
-	int r = check_range(opts, k, (double)v, err);
-	if (r < 0)
-		return r;
-	opts->values[k].i = v;
-	opts->values[k].f = (double)v;
-	return 0;
-}
-
-int bvhlab_options_set_float(bvhlab_options *opts, const char *key, double v, bvhlab_error *err)
-{
-	int k = lookup(opts, key, BVHLAB_OPTION_FLOAT, err);
-	if (k < 0)
-		return k;
-	if (!isfinite(v)) {
-		error_set(err, "option '%s' of builder '%s' must be a finite number", key,
-		                 opts->builder->name);
-		return -EINVAL;
-	}
-	int r = check_range(opts, k, v, err);
-	if (r < 0)
-		return r;
-	opts->values[k].f = v;
-	return 0;
 }
 
 /* Whether `v` is one of the '|'-separated `choices`. */
@@ -166,21 +137,81 @@ static bool is_choice(const char *choices, const char *v)
 	return false;
 }
 
+/* An INT option's choices (ABI 1.6): the value must be one of them. */
+static int check_int_choice(const bvhlab_options *opts, int k, int64_t v, bvhlab_error *err)
+{
+	const bvhlab_option_decl *d = &opts->builder->options[k];
+	char text[24];
+	if (!d->choices || !bvhlab_builder_int_choices(opts->builder))
+		return 0;
+	snprintf(text, sizeof(text), "%" PRId64, v);
+	if (is_choice(d->choices, text))
+		return 0;
+	error_set(err, "option '%s' of plugin '%s' must be one of %s, not %s", d->name,
+	          opts->builder->name, d->choices, text);
+	return -EINVAL;
+}
+
+int bvhlab_options_set_bool(bvhlab_options *opts, const char *key, bool v, bvhlab_error *err)
+{
+	int k = lookup(opts, key, BVHLAB_OPTION_BOOL, err);
+	if (k < 0)
+		return k;
+	drop_filled(opts);
+	opts->values[k].b = v;
+	return 0;
+}
+
+int bvhlab_options_set_int(bvhlab_options *opts, const char *key, int64_t v, bvhlab_error *err)
+{
+	int k = lookup(opts, key, BVHLAB_OPTION_INT, err);
+	if (k < 0)
+		return k;
+	drop_filled(opts);
+	int r = check_range(opts, k, (double)v, err);
+	if (r == 0)
+		r = check_int_choice(opts, k, v, err);
+	if (r < 0)
+		return r;
+	opts->values[k].i = v;
+	opts->values[k].f = (double)v;
+	return 0;
+}
+
+int bvhlab_options_set_float(bvhlab_options *opts, const char *key, double v, bvhlab_error *err)
+{
+	int k = lookup(opts, key, BVHLAB_OPTION_FLOAT, err);
+	if (k < 0)
+		return k;
+	drop_filled(opts);
+	if (!isfinite(v)) {
+		error_set(err, "option '%s' of plugin '%s' must be a finite number", key,
+		                 opts->builder->name);
+		return -EINVAL;
+	}
+	int r = check_range(opts, k, v, err);
+	if (r < 0)
+		return r;
+	opts->values[k].f = v;
+	return 0;
+}
+
 int bvhlab_options_set_string(bvhlab_options *opts, const char *key, const char *v,
                               bvhlab_error *err)
 {
 	int k = lookup(opts, key, BVHLAB_OPTION_STRING, err);
 	if (k < 0)
 		return k;
+	drop_filled(opts);
 	const bvhlab_option_decl *d = &opts->builder->options[k];
 	if (d->choices && !is_choice(d->choices, v)) {
-		error_set(err, "option '%s' of builder '%s' must be one of %s, not '%s'", key,
+		error_set(err, "option '%s' of plugin '%s' must be one of %s, not '%s'", key,
 		                 opts->builder->name, d->choices, v);
 		return -EINVAL;
 	}
 	/* An option with a default means something by it: empty is no value. */
 	if (!*v && d->def_string && *d->def_string) {
-		error_set(err, "option '%s' of builder '%s' must not be empty (default '%s')", key,
+		error_set(err, "option '%s' of plugin '%s' must not be empty (default '%s')", key,
 		          opts->builder->name, d->def_string);
 		return -EINVAL;
 	}
@@ -234,7 +265,7 @@ static int set_from_text(bvhlab_options *opts, const char *key, int k, const cha
 	case BVHLAB_OPTION_STRING:
 		return bvhlab_options_set_string(opts, key, text, err);
 	}
-	error_set(err, "option '%s' of builder '%s' must be %s, not '%s'", key,
+	error_set(err, "option '%s' of plugin '%s' must be %s, not '%s'", key,
 	                 opts->builder->name, type_name(d->type), text);
 	return -EINVAL;
 }
@@ -299,7 +330,8 @@ static bool numeric(const bvhlab_options *opts, int k, double *v)
 	return type == BVHLAB_OPTION_INT || type == BVHLAB_OPTION_FLOAT;
 }
 
-int bvhlab_options_check(const bvhlab_options *opts, bvhlab_error *err)
+/* The min_NAME <= max_NAME pairs. */
+static int check_pairs(const bvhlab_options *opts, bvhlab_error *err)
 {
 	const bvhlab_builder *b = opts->builder;
 	for (uint32_t k = 0; k < b->option_count; k++) {
@@ -311,10 +343,16 @@ int bvhlab_options_check(const bvhlab_options *opts, bvhlab_error *err)
 			continue;
 		int j = bvhlab_options_find(opts, max);
 		if (j >= 0 && numeric(opts, (int)k, &lo) && numeric(opts, j, &hi) && lo > hi) {
-			error_set(err, "option '%s' of builder '%s' is %.15g, more than '%s' (%.15g)",
+			error_set(err, "option '%s' of plugin '%s' is %.15g, more than '%s' (%.15g)",
 			          name, b->name, lo, max, hi);
 			return -EINVAL;
 		}
 	}
 	return 0;
+}
+
+int bvhlab_options_check(bvhlab_options *opts, bvhlab_error *err)
+{
+	int r = check_pairs(opts, err);
+	return r < 0 ? r : options_fill(opts, err);
 }

@@ -25,6 +25,31 @@ struct bvhlab_plugin {
 	char *path;
 };
 
+/* An INT option's choices (1.6): integers within its range, the default
+ * one of them; a mistake here would refuse every config. */
+static int check_int_choices(const bvhlab_builder *b, const bvhlab_option_decl *d,
+                             const char *path, bvhlab_error *err)
+{
+	bool has_def = false;
+	for (const char *p = d->choices; *p;) {
+		char *end;
+		long long v = strtoll(p, &end, 10);
+		bool in_range = !(d->min <= d->max) || ((double)v >= d->min && (double)v <= d->max);
+		if (end == p || (*end && *end != '|') || !in_range) {
+			error_set(err, "plugin %s ('%s'): option '%s' declares choices '%s': integers "
+			          "within its range, separated by '|'", path, b->name, d->name, d->choices);
+			return -EINVAL;
+		}
+		has_def = has_def || v == d->def_int;
+		p = *end ? end + 1 : end;
+	}
+	if (has_def)
+		return 0;
+	error_set(err, "plugin %s ('%s'): option '%s' defaults to %lld, not one of its choices %s",
+	          path, b->name, d->name, (long long)d->def_int, d->choices);
+	return -EINVAL;
+}
+
 static int check_options(const bvhlab_builder *b, const char *path, bvhlab_error *err)
 {
 	if (b->option_count && !b->options) {
@@ -39,6 +64,13 @@ static int check_options(const bvhlab_builder *b, const char *path, bvhlab_error
 			error_set(err, "plugin %s: option %u has no name or an unknown type", path, k);
 			return -EINVAL;
 		}
+		if (d->type == BVHLAB_OPTION_INT && d->choices && bvhlab_builder_int_choices(b) &&
+		    check_int_choices(b, d, path, err) < 0)
+			return -EINVAL;
+	}
+	if (bvhlab_builder_fill_options(b) && b->options_size == 0) {
+		error_set(err, "plugin %s ('%s'): fill_options without options_size", path, b->name);
+		return -EINVAL;
 	}
 	return 0;
 }
@@ -87,6 +119,18 @@ bool bvhlab_builder_takes_boxes(const bvhlab_builder *b)
 bvhlab_refine_fn bvhlab_builder_update(const bvhlab_builder *b)
 {
 	return BVHLAB_BUILDER_HAS(b, update) ? b->update : NULL;
+}
+
+bvhlab_fill_options_fn bvhlab_builder_fill_options(const bvhlab_builder *b)
+{
+	return BVHLAB_BUILDER_HAS(b, options_size) ? b->fill_options : NULL;
+}
+
+bool bvhlab_builder_int_choices(const bvhlab_builder *b)
+{
+	/* Before 1.6 choices meant nothing on an INT option: whatever an older
+	 * plugin left there is not a rule it asked for. */
+	return BVHLAB_ABI_VERSION_MINOR(b->abi_version) >= 6;
 }
 
 static int load(bvhlab_plugin *p, bvhlab_error *err)

@@ -23,6 +23,12 @@
  *        bvhlab_build_input.prim_kind (triangles, or boxes for a builder
  *        with BVHLAB_BUILDER_BOXES). Older plugins load as before: they
  *        leave width at 2 and are only given triangles.
+ *   1.6  options read once, when the config is read: bvhlab_builder's
+ *        fill_options and options_size (the plugin fills its own options
+ *        struct and checks the rules no declaration states; the host keeps
+ *        the struct for the run and gives it to every call as
+ *        bvhlab_build_input.options), and `choices` on INT options ("30|63").
+ *        Older plugins load as before and read their options per build.
  *
  * A plugin is a shared object that exports exactly one symbol,
  *
@@ -53,7 +59,7 @@
 BVHLAB_BEGIN_DECLS
 
 #define BVHLAB_ABI_MAJOR 1
-#define BVHLAB_ABI_MINOR 5
+#define BVHLAB_ABI_MINOR 6
 #define BVHLAB_ABI_VERSION(major, minor) (((uint32_t)(major) << 16) | (uint32_t)(minor))
 #define BVHLAB_ABI_VERSION_MAJOR(v) ((uint32_t)(v) >> 16)
 #define BVHLAB_ABI_VERSION_MINOR(v) ((uint32_t)(v) & 0xffffu)
@@ -122,12 +128,14 @@ enum bvhlab_option_type {
 
 /*
  * One option a builder accepts. The host checks a config's options against
- * this list (unknown key, wrong type, out of range, not a choice: an error
- * naming the key) and fills in the defaults, so the getters in bvhlab_host
- * always succeed for declared names. Two rules hold beyond single
- * declarations: an INT or FLOAT pair min_NAME / max_NAME is refused with
- * min_NAME > max_NAME, and a STRING option whose default is not empty may
- * not be set to "" (bvhlab_options_check, host.h).
+ * this list when it reads the config (unknown key, wrong type, out of
+ * range, not a choice: a config error naming the builder, the plugin, the
+ * key and what it allows) and fills in the defaults, so the getters in
+ * bvhlab_host always succeed for declared names. Two rules hold beyond
+ * single declarations: an INT or FLOAT pair min_NAME / max_NAME is refused
+ * with min_NAME > max_NAME, and a STRING option whose default is not empty
+ * may not be set to "" (bvhlab_options_check, host.h). Any other rule is
+ * the descriptor's fill_options (1.6), also run when the config is read.
  */
 typedef struct bvhlab_option_decl {
 	const char *name;     /* key in the config's "options" object */
@@ -138,7 +146,11 @@ typedef struct bvhlab_option_decl {
 	double def_float;     /* default, FLOAT */
 	const char *def_string; /* default, STRING */
 	double min, max;      /* inclusive range, INT and FLOAT; ignored if min > max */
-	const char *choices;  /* STRING: allowed values separated by '|', or NULL */
+	/* STRING: allowed values separated by '|', or NULL. Since 1.6 also INT:
+	 * allowed integers, e.g. "30|63" (each within min..max, the default one
+	 * of them); a host before 1.6 ignores it on an INT option and checks
+	 * the range only. */
+	const char *choices;
 } bvhlab_option_decl;
 
 /* ---- the host's function table ---------------------------------------- */
@@ -259,6 +271,13 @@ typedef struct bvhlab_build_input {
 	 * minor never sees it, and is only given triangles. */
 	uint32_t prim_kind;
 	uint32_t reserved2;         /* zero */
+	/* since 1.6: the struct the descriptor's fill_options filled from this
+	 * call's options (the builder's own, or the refine or update stage's),
+	 * options_size bytes, read-only, valid during the call; the same one
+	 * for every call of a run. NULL when the host has none (a host before
+	 * 1.6 lacks the field: check struct_size; a caller that never read
+	 * the options in advance): the plugin then calls its fill_options. */
+	const void *options;
 } bvhlab_build_input;
 
 /*
@@ -367,6 +386,25 @@ typedef struct bvhlab_builder {
 	 */
 	int (*update)(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	              const bvhlab_build_input *input, bvhlab_build_output *tree);
+
+	/*
+	 * since 1.6, may be NULL (options_size then 0). Reads this plugin's
+	 * options with the host's getters into `out`, options_size bytes the
+	 * host zeroed (the plugin's own options struct, choices turned into
+	 * what the plugin uses), and checks what no declaration states: a
+	 * rule between options, or what this machine allows (e.g. AVX2). The
+	 * host calls it once per builder or stage when it reads the config,
+	 * where a refusal is a config error (exit 2 before any output, the
+	 * message naming the builder and the plugin), and hands the struct to
+	 * every build, refine and update of the run as input->options.
+	 * Returns 0, or -EINVAL after host->set_error naming the option and
+	 * what it allows. Only log, set_error, hardware_threads and the option
+	 * getters may be called; the ctx has no output. Must be thread-safe
+	 * and keep no state: the struct is all it leaves.
+	 */
+	int (*fill_options)(const bvhlab_host *host, bvhlab_build_ctx *ctx, void *out);
+	uint32_t options_size; /* since 1.6: bytes fill_options writes; 0 without it */
+	uint32_t reserved;     /* zero */
 } bvhlab_builder;
 
 /* True when descriptor `b` has `field`: one built against an older minor

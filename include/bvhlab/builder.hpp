@@ -115,7 +115,8 @@ constexpr bvhlab_builder make_builder(const char *name, const char *summary, uin
                                       build_fn refine = nullptr, build_fn update = nullptr)
 {
 	return bvhlab_builder{BVHLAB_ABI_CURRENT, sizeof(bvhlab_builder), name, summary, flags,
-	                      static_cast<uint32_t>(N), options, build, refine, update};
+	                      static_cast<uint32_t>(N), options, build, refine, update,
+	                      nullptr, 0, 0};
 }
 
 /* The descriptor of a plugin without options. */
@@ -124,7 +125,22 @@ constexpr bvhlab_builder make_builder(const char *name, const char *summary, uin
                                       build_fn update = nullptr)
 {
 	return bvhlab_builder{BVHLAB_ABI_CURRENT, sizeof(bvhlab_builder), name, summary, flags,
-	                      0, nullptr, build, refine, update};
+	                      0, nullptr, build, refine, update, nullptr, 0, 0};
+}
+
+/* The signature of fill_options (ABI 1.6). */
+using fill_options_fn = int (*)(const bvhlab_host *, bvhlab_build_ctx *, void *);
+
+/* `descriptor` with fill_options (ABI 1.6): the options read once, into a
+ * struct of `size` bytes, when the config is read:
+ *     const bvhlab_builder descriptor = bvhlab::with_fill_options(
+ *         bvhlab::make_builder(...), fill, sizeof(Settings)); */
+constexpr bvhlab_builder with_fill_options(bvhlab_builder descriptor, fill_options_fn fill,
+                                           std::size_t size)
+{
+	descriptor.fill_options = fill;
+	descriptor.options_size = static_cast<uint32_t>(size);
+	return descriptor;
 }
 
 } // namespace bvhlab

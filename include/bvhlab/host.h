@@ -42,6 +42,12 @@ bvhlab_refine_fn bvhlab_builder_update(const bvhlab_builder *b);
  * 1.5; false for a plugin built against an older minor). bvhlab_build
  * refuses a box input to any other by name. */
 bool bvhlab_builder_takes_boxes(const bvhlab_builder *b);
+/* A descriptor's fill_options (ABI 1.6), or NULL: NULL too for a plugin
+ * built against an older minor. */
+typedef int (*bvhlab_fill_options_fn)(const bvhlab_host *host, bvhlab_build_ctx *ctx, void *out);
+bvhlab_fill_options_fn bvhlab_builder_fill_options(const bvhlab_builder *b);
+/* Whether the descriptor's INT options' `choices` are meant (ABI 1.6). */
+bool bvhlab_builder_int_choices(const bvhlab_builder *b);
 /* The file the plugin was loaded from. */
 const char *bvhlab_plugin_path(const bvhlab_plugin *plugin);
 
@@ -70,6 +76,11 @@ typedef struct bvhlab_option_value {
 typedef struct bvhlab_options {
 	const bvhlab_builder *builder;
 	bvhlab_option_value *values; /* [builder->option_count] */
+	/* The plugin's own options struct (ABI 1.6 fill_options), filled by
+	 * bvhlab_options_check from these values and given to every build;
+	 * NULL before the check, after any setter, or for a plugin without
+	 * fill_options. */
+	void *filled;
 } bvhlab_options;
 
 int bvhlab_options_init(bvhlab_options *opts, const bvhlab_builder *builder);
@@ -90,12 +101,15 @@ int bvhlab_options_set_string(bvhlab_options *opts, const char *key, const char 
                               bvhlab_error *err);
 
 /*
- * What no single declaration states, checked once all are set: an INT or
- * FLOAT pair min_NAME / max_NAME needs min_NAME <= max_NAME. -EINVAL with
- * a message naming both and the builder. (The setters refuse an empty
- * string for a STRING option whose default is not empty.)
+ * What no single declaration states, checked once all are set (when a
+ * config or a command line is read): an INT or FLOAT pair min_NAME /
+ * max_NAME needs min_NAME <= max_NAME; then the plugin's fill_options (ABI
+ * 1.6) reads the values into its own struct, kept in opts->filled for
+ * every build, and checks its own rules. -EINVAL with a message naming the
+ * plugin and the option(s), -ENOMEM. (The setters refuse an empty string
+ * for a STRING option whose default is not empty.)
  */
-int bvhlab_options_check(const bvhlab_options *opts, bvhlab_error *err);
+int bvhlab_options_check(bvhlab_options *opts, bvhlab_error *err);
 
 /* Parses "key=value" text (command line), by the declared type. */
 int bvhlab_options_parse(bvhlab_options *opts, const char *assignment, bvhlab_error *err);

@@ -49,6 +49,8 @@ static const plugin_option options[] = {
 	MORTON_OPTIONS(cl_hploc, bits),
 	CL_DEVICE_OPTION(cl_hploc),
 };
+CL_DEVICE_CHECK(cl_hploc)
+PLUGIN_DECLS(options, cl_hploc, cl_device_check)
 
 static const char *const kernel_names[] = { CL_SORT_KERNEL_NAMES, "hploc_climb" };
 enum { K_CLIMB = CL_SORT_KERNELS };
@@ -199,14 +201,15 @@ static void convert(cl_hploc *b, bvhlab_build_output *out)
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	cl_hploc b = { .in = input, .n = input->prim_count, .dev = &S.dev, .sort = &S.sort,
-	               .b = S.b };
+	cl_hploc b;
 	char err[BVHLAB_CL_ERROR_SIZE];
 	int rc;
 
-	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
-	                              &b)) < 0 ||
-	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
+	/* The options first: their copy sets the whole struct. */
+	rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);
+	b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, b.b = S.b;
+	if (rc < 0 || (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input,
+	                                   output)) != 0)
 		return rc < 0 ? rc : 0;
 	if ((rc = device_run(&b, err, sizeof(err))) < 0) {
 		host->set_error(ctx, "%s", err);

@@ -33,6 +33,8 @@ static const plugin_option options[] = {
 	                      "device, search on a GPU); the tree is the same",
 	              .def_string = "auto", .choices = "auto|search|scan"),
 };
+CL_DEVICE_CHECK(cl_lbvh)
+PLUGIN_DECLS(options, cl_lbvh, cl_device_check)
 
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "gather_leaves", "prefixes",
@@ -59,14 +61,15 @@ __attribute__((destructor)) static void release_device(void)
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	cl_lbvh b = { .in = input, .n = input->prim_count, .dev = &S.dev, .sort = &S.sort,
-	              .b = S.b };
+	cl_lbvh b;
 	char err[BVHLAB_CL_ERROR_SIZE];
 	int rc;
 
-	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
-	                              &b)) < 0 ||
-	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
+	/* The options first: their copy sets the whole struct. */
+	rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);
+	b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, b.b = S.b;
+	if (rc < 0 || (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input,
+	                                   output)) != 0)
 		return rc < 0 ? rc : 0;
 	if ((rc = cl_lbvh_run(&b, output, err, sizeof(err))) < 0) {
 		host->set_error(ctx, "%s", err);

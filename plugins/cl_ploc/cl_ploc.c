@@ -32,6 +32,8 @@ static const plugin_option options[] = {
 	                      "on a CPU device, 1 on a GPU); the tree is the same for every value",
 	              .def_int = 0, .min = 0, .max = CL_PLOC_MAX_NN_BLOCK),
 };
+CL_DEVICE_CHECK(cl_ploc)
+PLUGIN_DECLS(options, cl_ploc, cl_device_check)
 
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "first_clusters", "nearest", "count_chunks", "prefix",
@@ -107,13 +109,14 @@ static int run(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_ploc *b,
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	cl_ploc b = { .in = input, .n = input->prim_count, .dev = &S.dev, .sort = &S.sort,
-	              .b = S.b };
+	cl_ploc b;
 	int rc;
 
-	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
-	                              &b)) < 0 ||
-	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
+	/* The options first: their copy sets the whole struct. */
+	rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);
+	b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, b.b = S.b;
+	if (rc < 0 || (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input,
+	                                   output)) != 0)
 		return rc < 0 ? rc : 0;
 	return run(host, ctx, &b, output);
 }

@@ -118,23 +118,20 @@ static const plugin_option options[] = {
 	              .def_float = 1.2, .min = 1.0, .max = 4.0),
 };
 
-static int read_settings(const bvhlab_host *host, bvhlab_build_ctx *ctx, settings *s)
+/* The quality choice into Embree's enum, once per run (min_leaf <=
+ * max_leaf is the host's rule for min_/max_ pairs). */
+static int derive_quality(const bvhlab_host *host, bvhlab_build_ctx *ctx, void *opt)
 {
 	static const enum RTCBuildQuality quality[] = {
 		RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH,
 	};
-	int rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), s);
-	if (rc < 0)
-		return rc;
-	/* What the declarations cannot say: one option bounded by another. */
-	if (s->min_leaf > s->max_leaf) {
-		host->set_error(ctx, "min_leaf %lld exceeds max_leaf %lld", (long long)s->min_leaf,
-		                (long long)s->max_leaf);
-		return -EINVAL;
-	}
+	settings *s = opt;
+	(void)host;
+	(void)ctx;
 	s->quality = quality[s->quality_choice];
 	return 0;
 }
+PLUGIN_DECLS(options, settings, derive_quality)
 
 /* Embree's input: one 32-byte record per triangle, room for splits after. */
 static struct RTCBuildPrimitive *make_prims(const bvhlab_build_input *in, size_t capacity)
@@ -234,7 +231,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = read_settings(host, ctx, &s)) < 0)
+	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &s)) < 0)
 		return rc;
 	pthread_mutex_lock(&cache.lock);
 	rc = build_locked(host, ctx, input, &s, output);

@@ -18,6 +18,12 @@ static const plugin_option options[] = {
 	              .def_int = 32, .min = 2, .max = SAH_SMALL_MAX),
 };
 
+static int check_options(const bvhlab_host *host, bvhlab_build_ctx *ctx, void *opt)
+{
+	return sah_options_resolve(host, ctx, &((hlbvh_options *)opt)->sah);
+}
+PLUGIN_DECLS(options, hlbvh_options, check_options)
+
 /* ---- scratch ------------------------------------------------------------ */
 
 /* The sorted records and the cluster bounds; past the tree in the output
@@ -150,9 +156,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
-	                              &h.opt)) < 0 ||
-	    (rc = sah_options_resolve(host, ctx, &h.opt.sah)) < 0 ||
+	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &h.opt)) < 0 ||
 	    (rc = big_ensure_output(host, ctx, h.n, spare_nodes(h.n), output)) < 0)
 		return rc;
 	if (input->prim_count == 1) {

@@ -15,6 +15,7 @@ static const plugin_option options[] = {
 	HPLOC_OPTIONS(hploc),
 	MORTON_OPTIONS(hploc, sort.bits),
 };
+PLUGIN_DECLS(options, hploc, NULL)
 
 /* ---- scratch ------------------------------------------------------------ */
 
@@ -160,16 +161,19 @@ out:
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	hploc h = { .in = input, .n = input->prim_count };
+	hploc h;
 	int rc;
 
 	if (input->prim_count == 0 || input->prim_count > HPLOC_PRIMS) {
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
-	                              &h)) < 0 ||
-	    (rc = big_ensure_output(host, ctx, h.n, spare_nodes(h.n), output)) < 0)
+	/* The options first: the copy sets the whole struct, the rest zero. */
+	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &h)) < 0)
+		return rc;
+	h.in = input;
+	h.n = input->prim_count;
+	if ((rc = big_ensure_output(host, ctx, h.n, spare_nodes(h.n), output)) < 0)
 		return rc;
 	h.merge = (hploc_params){ h.radius, h.collapse, h.max_leaf, h.c_trav, h.c_isect };
 	if (input->prim_count == 1) {

@@ -13,6 +13,7 @@
 #include "morton_front.h"
 
 static const plugin_option options[] = { MORTON_OPTIONS(lbvh, bits) };
+PLUGIN_DECLS(options, lbvh, NULL)
 
 /* Nodes past the tree's 2n - 1 that hold the hierarchy's scratch (see
  * scratch_alloc()); 0 when that would not fit a uint32_t count. */
@@ -143,16 +144,19 @@ out:
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	lbvh b = { .in = input, .n = input->prim_count };
+	lbvh b;
 	int rc;
 
 	if (input->prim_count == 0 || input->prim_count > UINT32_MAX / 2) {
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
-	                              &b)) < 0 ||
-	    (rc = ensure_capacity(host, ctx, &b, output)) < 0)
+	/* The options first: the copy sets the whole struct, the rest zero. */
+	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b)) < 0)
+		return rc;
+	b.in = input;
+	b.n = input->prim_count;
+	if ((rc = ensure_capacity(host, ctx, &b, output)) < 0)
 		return rc;
 	if (input->prim_count == 1) {
 		morton_single_leaf(input, output);

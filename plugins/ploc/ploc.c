@@ -20,6 +20,7 @@ static const plugin_option options[] = {
 	              .def_int = 16, .min = 1, .max = PLOC_MAX_RADIUS),
 	MORTON_OPTIONS(ploc, sort.bits),
 };
+PLUGIN_DECLS(options, ploc, NULL)
 
 /* ---- scratch ------------------------------------------------------------ */
 
@@ -171,16 +172,19 @@ out:
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	ploc p = { .in = input, .n = input->prim_count };
+	ploc p;
 	int rc;
 
 	if (input->prim_count == 0 || input->prim_count > REC_PRIMS) {
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
-	                              &p)) < 0 ||
-	    (rc = big_ensure_output(host, ctx, p.n, spare_nodes(p.n), output)) < 0)
+	/* The options first: the copy sets the whole struct, the rest zero. */
+	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &p)) < 0)
+		return rc;
+	p.in = input;
+	p.n = input->prim_count;
+	if ((rc = big_ensure_output(host, ctx, p.n, spare_nodes(p.n), output)) < 0)
 		return rc;
 	if (input->prim_count == 1) {
 		morton_single_leaf(input, output);

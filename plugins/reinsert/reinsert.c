@@ -45,6 +45,7 @@ static const plugin_option options[] = {
 	              .help = "most nodes one candidate's search may look at",
 	              .def_int = 4096, .min = 16, .max = 1 << 24),
 };
+PLUGIN_DECLS(options, struct params, NULL)
 
 /* ---- iterations ----------------------------------------------------------- */
 
@@ -181,7 +182,7 @@ static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	struct stage st = { .host = host, .ctx = ctx, .o = &o, .input = input };
 	int rc;
 
-	if ((rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), &o)) < 0)
+	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &o)) < 0)
 		return rc;
 	if (tree->node_count < 3 && !(o.leaves && tree->node_count == 1 && tree->nodes[0].count > 1))
 		return 0; /* nothing can move */

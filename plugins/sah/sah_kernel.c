@@ -14,15 +14,16 @@
 #include "sah_split.h"
 
 /* simd "auto" becomes avx2 where the CPU has it; "avx2" without it is refused
- * (the declaration cannot say what the CPU has). */
+ * (the declaration cannot say what the CPU has). Run once, as the plugin's
+ * fill_options check, when the config is read. */
 int sah_options_resolve(const bvhlab_host *host, bvhlab_build_ctx *ctx, sah_options *opt)
 {
 	bool avx2 = sah_cpu_has_avx2();
 
 	if (opt->simd_asked == SAH_ASK_AVX2 && !avx2) {
-		host->set_error(ctx, "option \"simd\" = \"avx2\", but this CPU (or build) has no "
-		                "AVX2; use auto or sse");
-		return -ENOTSUP;
+		host->set_error(ctx, "option 'simd' is 'avx2', but this CPU (or build) has no "
+		                "AVX2: allowed here are auto and sse");
+		return -EINVAL;
 	}
 	opt->simd = opt->simd_asked != SAH_ASK_SSE && avx2 ? SAH_SIMD_AVX2 : SAH_SIMD_SSE;
 	return 0;

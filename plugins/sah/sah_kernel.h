@@ -6,8 +6,8 @@
  *
  * Use:
  *     sah_options opt;  sah_builder b;  sah_job root;
- *     plugin_options_fill(..., &opt);  (a table holding SAH_OPTIONS), then
- *     sah_options_resolve(host, ctx, &opt.sah);
+ *     PLUGIN_OPTIONS_GET(..., &opt);  (a table holding SAH_OPTIONS, and
+ *     sah_options_resolve(host, ctx, &opt.sah) its PLUGIN_DECLS check)
  *     sah_builder_init(&b, &opt, input, output);    (allocates, presorts)
  *     sah_builder_root(&b, &root);
  *     ... sah_split_job() on jobs, from any threads, and/or

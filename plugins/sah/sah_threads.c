@@ -21,8 +21,7 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
 		return -EINVAL;
 	}
-	if ((rc = sah_options_resolve(host, ctx, opt)) < 0 ||
-	    (rc = big_ensure_output(host, ctx, input->prim_count,
+	if ((rc = big_ensure_output(host, ctx, input->prim_count,
 	                            sah_scratch_nodes(opt->method, input->prim_count), output)) < 0)
 		return rc;
 	team_host_init(&th, host, ctx);

@@ -31,8 +31,8 @@ typedef int (*sah_scheduler_fn)(team_host *th, sah_builder *b, const sah_job *ro
                                 uint32_t threads, void *arg);
 
 /* The whole build() of a SAH plugin around `schedule`, with the options
- * as filled from SAH_OPTIONS: 0, or a negative errno after
- * host->set_error. */
+ * as filled from SAH_OPTIONS and resolved (sah_options_resolve): 0, or a
+ * negative errno after host->set_error. */
 int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *output,
                   sah_options *opt, sah_scheduler_fn schedule, void *arg);
@@ -44,12 +44,16 @@ int sah_run_build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
  * is `sah_options sah`, and the schedule gets that struct as its argument.
  */
 #define SAH_PLUGIN(plugin_name, plugin_flags, plugin_summary, options_type)            \
+	static int sah_check(const bvhlab_host *host, bvhlab_build_ctx *ctx, void *o)  \
+	{                                                                              \
+		return sah_options_resolve(host, ctx, &((options_type *)o)->sah);      \
+	}                                                                              \
+	PLUGIN_DECLS(options, options_type, sah_check)                                 \
 	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,               \
 	                 const bvhlab_build_input *input, bvhlab_build_output *output) \
 	{                                                                              \
-		options_type o = { 0 };                                                \
-		int rc = plugin_options_fill(host, ctx, options,                       \
-		                             PLUGIN_OPTION_COUNT(options), &o);        \
+		options_type o;                                                        \
+		int rc = PLUGIN_OPTIONS_GET(host, ctx, input, &o);                     \
 		return rc < 0 ? rc : sah_run_build(host, ctx, input, output, &o.sah,   \
 		                                   schedule, &o);                      \
 	}                                                                              \

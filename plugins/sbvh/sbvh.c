@@ -59,6 +59,7 @@ static const plugin_option options[] = {
 	                      "object split's",
 	              .def_int = 65536, .min = 2, .max = UINT32_MAX),
 };
+PLUGIN_DECLS(options, sbvh_options, NULL)
 
 /* Room for the whole budget: at most 2 * refs - 1 nodes and refs slots. */
 static int reserve(const bvhlab_host *host, bvhlab_build_ctx *ctx, bvhlab_build_output *out,
@@ -108,7 +109,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	sbvh_build B = { .in = input, .threads = input->threads ? input->threads : 1 };
 	sbvh_job root;
 	double want;
-	int rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), &B.opt);
+	int rc = PLUGIN_OPTIONS_GET(host, ctx, input, &B.opt);
 
 	if (rc < 0)
 		return rc;

@@ -81,7 +81,7 @@ const plugin_option options[] = {
 	              bvhlab::int_option("hq_bins", "hq: bins per axis for object and spatial "
 	                                 "splits", HQBVHBINS, 2, MAXHQBINS)),
 };
-PLUGIN_DECLS(options)
+PLUGIN_DECLS(options, Settings, nullptr)
 
 // Three 16-byte vertices per triangle, in primitive order.
 std::unique_ptr<bvhvec4[]> soup(const bvhlab_build_input *in)
@@ -191,7 +191,7 @@ int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_inp
           bvhlab_build_output *out)
 {
 	Settings s;
-	int rc = plugin_options_fill(host, ctx, options, s);
+	int rc = PLUGIN_OPTIONS_GET(host, ctx, in, &s);
 	// tinybvh's counts are 32-bit and hq keeps 3 nodes per triangle.
 	if (rc == 0)
 		rc = peer::check_prims(host, ctx, in, UINT32_MAX / 8);
@@ -199,12 +199,15 @@ int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_inp
 }
 
 // Any exception out of build() becomes the run's error (bvhlab::guarded_build).
-const bvhlab_builder descriptor = bvhlab::make_builder(
-	"tinybvh",
-	"jbikker/tinybvh 1.6.7: quick, binned, avx, sweep, hq (spatial splits), optional "
-	"Optimize; thread count held by CPU affinity (see the builder option)",
-	BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_SPATIAL_SPLITS,
-	plugin_decls, bvhlab::guarded_build<build>);
+const bvhlab_builder descriptor = bvhlab::with_fill_options(
+	bvhlab::make_builder("tinybvh",
+	                     "jbikker/tinybvh 1.6.7: quick, binned, avx, sweep, hq (spatial "
+	                     "splits), optional Optimize; thread count held by CPU affinity (see "
+	                     "the builder option)",
+	                     BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
+	                             BVHLAB_BUILDER_SPATIAL_SPLITS,
+	                     plugin_decls, bvhlab::guarded_build<build>),
+	plugin_fill_options, sizeof(Settings));
 
 } // namespace
 

@@ -107,15 +107,20 @@ static const plugin_option options[] = {
 	              .def_int = 3, .min = 1, .max = 100),
 	LEAVES_OPTIONS(struct params),
 };
+PLUGIN_DECLS(options, struct params, NULL)
 
 static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                   const bvhlab_build_input *input, bvhlab_build_output *tree)
 {
-	struct params o = { .host = host, .ctx = ctx, .input = input };
+	struct params o;
 	int rc;
 
-	if ((rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), &o)) < 0)
+	/* The options first: the copy sets the whole struct, the rest zero. */
+	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &o)) < 0)
 		return rc;
+	o.host = host;
+	o.ctx = ctx;
+	o.input = input;
 	/* the costs assume the final cut, so it is made with or without splitting */
 	return leaves_run(host, ctx, input, tree, o.leaves, true, (uint32_t)o.max_leaf, optimise,
 	                  &o);

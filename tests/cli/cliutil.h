@@ -145,7 +145,7 @@ static inline int runs_written(const char *dir)
 	return n;
 }
 
-static cJSON *load_results(const char *dir)
+static inline cJSON *load_results(const char *dir)
 {
 	char *text = read_file(dir, "results.json");
 	CHECK(text != NULL);
@@ -161,7 +161,7 @@ static const char *run_str(const cJSON *run, const char *key)
 	return cJSON_IsString(v) ? v->valuestring : "";
 }
 
-static int count_runs(const cJSON *doc, const char *builder, const char *status)
+static inline int count_runs(const cJSON *doc, const char *builder, const char *status)
 {
 	int n = 0;
 	const cJSON *run;

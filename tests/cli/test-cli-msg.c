@@ -203,17 +203,17 @@ static void config_errors(void)
 		"  \"builders\": [ { \"plugin\": \"bvh2\", \"options\": { \"min_leaf\": 9 } },\n"
 		"                  { \"plugin\": \"embree\", \"name\": \"e\",\n"
 		"                    \"options\": { \"min_leaf\": 6, \"max_leaf\": 4 } } ] }\n",
-		"out-leaf", "builder 'bvh2': option 'min_leaf' of builder 'bvh2' is 9, more than "
+		"out-leaf", "builder 'bvh2': option 'min_leaf' of plugin 'bvh2' is 9, more than "
 		"'max_leaf' (8)");
 	if (strstr(err_text, "'embree'")) /* built with Embree */
-		CHECK_CONTAINS(err_text, "builder 'e': option 'min_leaf' of builder 'embree' is 6");
+		CHECK_CONTAINS(err_text, "builder 'e': option 'min_leaf' of plugin 'embree' is 6");
 	refused("dev.json",
 		"{ \"output\": \"out-dev\",\n"
 		"  \"scenes\": [ { \"generator\": \"soup\", \"count\": 100 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"cl_lbvh\", \"options\": { \"device\": \"\" } } ] }\n",
 		"out-dev", "");
 	if (!strstr(err_text, "plugin 'cl_lbvh' not found")) /* built with OpenCL */
-		CHECK_CONTAINS(err_text, "builder 'cl_lbvh': option 'device' of builder 'cl_lbvh' "
+		CHECK_CONTAINS(err_text, "builder 'cl_lbvh': option 'device' of plugin 'cl_lbvh' "
 		               "must not be empty (default 'auto')");
 	FILE *f = fopen(cli_path_in("big.obj"), "w");
 	CHECK(f && fputs("v 0 0 0\nv 1 0 0\nv 0 -1e38 0\nf 1 2 3\n", f) >= 0);
@@ -255,7 +255,7 @@ static void config_build_isolated(void)
 	CHECK_INT(run_in(tmpdir, ARGS("build", "fake_good", "soup:count=50")), 0);
 	CHECK_CONTAINS(out_text, "valid:      yes");
 	CHECK_INT(run_in(tmpdir, ARGS("build", "fake_good", "soup:count=50", "-o", "alpha=99")), 2);
-	CHECK_CONTAINS(err_text, "option 'alpha' of builder 'fake_good' is out of range");
+	CHECK_CONTAINS(err_text, "option 'alpha' of plugin 'fake_good' is out of range");
 }
 
 /* 9. Device layers under a memory limit say so, not "install a driver". */

@@ -191,7 +191,7 @@ static void test_info_build_list(void)
 	CHECK_INT(run(ARGS("build", "fake_good", "soup:count=50", "-o", "phases=two")), 0);
 	CHECK_CONTAINS(out_text, "phase:      upload 1.500 ms median\nphase:      device 2.500");
 	CHECK_INT(run(ARGS("build", "sah_seq", "soup:count=500", "-o", "bins=1")), 2);
-	CHECK_CONTAINS(err_text, "option 'bins' of builder 'sah_seq' is out of range");
+	CHECK_CONTAINS(err_text, "option 'bins' of plugin 'sah_seq' is out of range");
 	CHECK_INT(run(ARGS("build", "no_such_plugin", "soup")), 2);
 	CHECK_CONTAINS(err_text, "plugin 'no_such_plugin' not found");
 
@@ -264,8 +264,10 @@ static void test_bad_builders(void)
 	                         "'no_such_plugin' not found");
 	CHECK_CONTAINS(err_text, "bad.json:4:17: builder 'fake_abi2': ");
 	CHECK_CONTAINS(err_text, "built for ABI 2.0");
-	CHECK_CONTAINS(err_text, "bad.json:6:32: builder 'typed': option 'alpha' must be");
-	CHECK_CONTAINS(err_text, "bad.json:8:32: builder 'typo': unknown option 'alpah'");
+	CHECK_CONTAINS(err_text, "bad.json:6:32: builder 'typed': option 'alpha' of plugin "
+	                         "'fake_good' must be");
+	CHECK_CONTAINS(err_text, "bad.json:8:32: builder 'typo': unknown option 'alpah' for plugin "
+	                         "'fake_good'");
 	CHECK_CONTAINS(err_text, "4 builders cannot run as configured");
 	CHECK_INT(occurrences(err_text, "builder 'typo'"), 1); /* said once, not twice */
 	CHECK_INT(occurrences(err_text, "builder 'no_such_plugin'"), 1);

@@ -39,6 +39,25 @@
 	                      "lists them)",                                                 \
 	              .def_string = "auto")
 
+/* The device option's form (auto, gpu, cpu or P:D), for the plugin's
+ * fill_options check (plugin_options.h): a config error when the config
+ * is read, not a failed build. Whether such a device exists is the
+ * build's to find out (the runs record it). */
+#define CL_DEVICE_CHECK(owner)                                                            \
+	static int cl_device_check(const bvhlab_host *host, bvhlab_build_ctx *ctx, void *o) \
+	{                                                                                 \
+		cl_device_type want;                                                      \
+		long pi, di;                                                              \
+		char why[160];                                                            \
+		if (bvhlab_cl_parse_spec(((owner *)o)->device, &want, &pi, &di, why,     \
+		                         sizeof(why)) == 0)                               \
+			return 0;                                                         \
+		host->set_error(ctx, "option 'device' is '%s': allowed are auto, gpu, cpu " \
+		                "or P:D (platform and device indices, e.g. 0:0)",         \
+		                ((owner *)o)->device);                                    \
+		return -EINVAL;                                                           \
+	}
+
 typedef struct cl_dev {
 	bvhlab_cl cl;
 	char spec[64];

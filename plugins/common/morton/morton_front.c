@@ -12,25 +12,6 @@
  * save (thread start and barriers are tens of microseconds). */
 #define MIN_PRIMS_PER_THREAD 512
 
-int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                        const plugin_option *table, size_t count, void *out)
-{
-	int rc = plugin_options_fill(host, ctx, table, count, out);
-
-	for (size_t k = 0; rc == 0 && k < count; k++) {
-		unsigned bits;
-
-		if (strcmp(table[k].decl.name, "bits") != 0)
-			continue;
-		memcpy(&bits, (const char *)out + table[k].offset, sizeof(bits));
-		if (bits != 30 && bits != 63) {
-			host->set_error(ctx, "option bits: %u, expected 30 or 63", bits);
-			rc = -EINVAL;
-		}
-	}
-	return rc;
-}
-
 double morton_now_ms(void)
 {
 	struct timespec ts;

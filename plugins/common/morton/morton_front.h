@@ -25,7 +25,7 @@
 	PLUGIN_OPTION(owner, bits_member, U32, .name = "bits",                                  \
 	              .help = "Morton code length: 30 (10 bits per axis) or 63 (21 bits per "   \
 	                      "axis)",                                                          \
-	              .def_int = 63, .min = 30, .max = 63),                                     \
+	              .def_int = 63, .min = 30, .max = 63, .choices = "30|63"),                 \
 	PLUGIN_OPTION(owner, collapse, BOOL, .name = "collapse",                                \
 	              .help = "turn subtrees of at most max_leaf primitives into leaves where " \
 	                      "the SAH says a leaf is cheaper (off: one primitive per leaf)",   \
@@ -38,12 +38,6 @@
 	PLUGIN_OPTION(owner, c_isect, FLOAT, .name = "c_isect",                                 \
 	              .help = "SAH cost of intersecting one primitive (> 0), for collapse",     \
 	              .def_float = 1.0, .min = 1e-6, .max = 1e6)
-
-/* plugin_options_fill() by a table holding MORTON_OPTIONS, then what the
- * declarations cannot say: bits 30 or 63. 0, or a negative errno after
- * host->set_error. */
-int morton_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                        const plugin_option *table, size_t count, void *out);
 
 /* Monotonic clock in milliseconds, for the phase times in the debug log. */
 double morton_now_ms(void);

@@ -1,5 +1,6 @@
 /* Options into a plugin's struct, by table (see plugin_options.h). */
 #include <errno.h>
+#include <stddef.h>
 #include <stdbool.h>
 #include <string.h>
 
@@ -124,4 +125,29 @@ int plugin_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		}
 	}
 	return 0;
+}
+
+int plugin_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                        const plugin_option *table, size_t count, plugin_check_fn check,
+                        size_t size, void *out)
+{
+	int rc;
+
+	memset(out, 0, size);
+	rc = plugin_options_fill(host, ctx, table, count, out);
+	return rc == 0 && check ? check(host, ctx, out) : rc;
+}
+
+int plugin_options_get(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                       const bvhlab_build_input *input,
+                       int (*fill)(const bvhlab_host *, bvhlab_build_ctx *, void *),
+                       size_t size, void *out)
+{
+	size_t has = offsetof(bvhlab_build_input, options) + sizeof(input->options);
+
+	if (input->struct_size >= has && input->options) {
+		memcpy(out, input->options, size);
+		return 0;
+	}
+	return fill(host, ctx, out);
 }

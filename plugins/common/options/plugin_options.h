@@ -3,10 +3,17 @@
  * plugin's struct it fills: one table of plugin_option entries gives both
  * the descriptor's bvhlab_option_decl array (the ABI's, so `bvhlab list`
  * and the host's checks see nothing new) and the filling of the struct by
- * offset. The host has already checked every value against its
- * declaration (type, range, choices) and filled in the defaults, so
- * nothing here checks a value again; what a plugin still checks is only
- * what a declaration cannot say (lbvh's bits: 30 or 63, within 30..63).
+ * offset. The host checks every value against its declaration (type,
+ * range, choices) when it reads the config and fills in the defaults, so
+ * nothing here checks a value again; a plugin's `check` function only
+ * states what a declaration cannot (sah's simd avx2 on a CPU without it)
+ * and derives what its build uses (embree's quality enum).
+ *
+ * The struct is filled once per run (ABI 1.6): the descriptor's
+ * fill_options, which PLUGIN_DECLS writes, runs when the host reads the
+ * config, and each build gets a copy of the struct it filled
+ * (PLUGIN_OPTIONS_GET); only an older host makes the plugin read its
+ * options at each build.
  *
  * In C:
  *
@@ -18,8 +25,9 @@
  *                           .help = "split search", .def_string = "sweep",
  *                           .choices = "sweep|binned"),
  *     };
+ *     PLUGIN_DECLS(options, struct my_options, NULL)   // or a check function
  *     ... in build(): struct my_options opt;
- *         rc = plugin_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), &opt);
+ *         rc = PLUGIN_OPTIONS_GET(host, ctx, input, &opt);
  *     PLUGIN_WITH_OPTIONS(options, .name = "mine", .summary = "...", .build = build)
  *
  * The declared type follows from the field's (U32 and I64 from INT, ...):
@@ -32,11 +40,12 @@
  *             PLUGIN_OPTION(Settings, bins, I64,
  *                           bvhlab::int_option("bins", "bins per axis", 16, 2, 256)),
  *     };
- *     PLUGIN_DECLS(options)
- *     const bvhlab_builder descriptor = bvhlab::make_builder(
- *             "mine", "...", 0, plugin_decls, bvhlab::guarded_build<build>);
+ *     PLUGIN_DECLS(options, Settings, nullptr)
+ *     const bvhlab_builder descriptor = bvhlab::with_fill_options(bvhlab::make_builder(
+ *             "mine", "...", 0, plugin_decls, bvhlab::guarded_build<build>),
+ *             plugin_fill_options, sizeof(Settings));
  *     PLUGIN_EXPORT(descriptor)
- *     ... in build(): plugin_options_fill(host, ctx, options, settings);
+ *     ... in build(): PLUGIN_OPTIONS_GET(host, ctx, input, &settings);
  *
  * The descriptor's bvhlab_option_decl array must be contiguous, and an
  * entry here is longer than a declaration, so PLUGIN_DECLS keeps an array
@@ -125,19 +134,57 @@ void plugin_options_decls(const plugin_option *table, size_t count, bvhlab_optio
 int plugin_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                         const plugin_option *table, size_t count, void *out);
 
+/* What a plugin's options must meet beyond their declarations, checked on
+ * the struct just filled, which it may complete (a choice turned into what
+ * the build uses). 0, or -EINVAL after host->set_error naming the option
+ * and what it allows. */
+typedef int (*plugin_check_fn)(const bvhlab_host *host, bvhlab_build_ctx *ctx, void *options);
+
+/* fill_options's body: *out (size bytes) zeroed, filled by the table, then
+ * checked by `check` (NULL: nothing beyond the declarations). */
+int plugin_options_read(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                        const plugin_option *table, size_t count, plugin_check_fn check,
+                        size_t size, void *out);
+
+/* This call's options into *out (size bytes): a copy of input->options,
+ * the struct fill_options filled when the host read the config, or, from
+ * an older host that has none, `fill` run now. 0, or fill's error. */
+int plugin_options_get(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                       const bvhlab_build_input *input,
+                       int (*fill)(const bvhlab_host *, bvhlab_build_ctx *, void *),
+                       size_t size, void *out);
+
 BVHLAB_END_DECLS
 
 /*
- * At file scope after `table`: plugin_decls, the descriptor's declarations
+ * At file scope after `table`, whose entries fill a struct `options_type`:
+ * plugin_decls, the descriptor's declarations
  * (bvhlab_option_decl[PLUGIN_OPTION_COUNT(table)]), filled from the table
- * by PLUGIN_EXPORT's entry point the first time it is called.
+ * by PLUGIN_EXPORT's entry point the first time it is called, and
+ * plugin_fill_options, the descriptor's fill_options (the table, then
+ * `check`, a plugin_check_fn or NULL).
  */
-#define PLUGIN_DECLS(table)                                                            \
-	static bvhlab_option_decl plugin_decls[PLUGIN_OPTION_COUNT(table)];            \
-	static void plugin_decls_fill(void)                                            \
-	{                                                                              \
-		plugin_options_decls(table, PLUGIN_OPTION_COUNT(table), plugin_decls); \
+#define PLUGIN_DECLS(table, options_type, check)                                             \
+	static bvhlab_option_decl plugin_decls[PLUGIN_OPTION_COUNT(table)];                  \
+	static void plugin_decls_fill(void)                                                  \
+	{                                                                                    \
+		plugin_options_decls(table, PLUGIN_OPTION_COUNT(table), plugin_decls);       \
+	}                                                                                    \
+	typedef options_type plugin_options_type;                                            \
+	static int plugin_fill_options(const bvhlab_host *host, bvhlab_build_ctx *ctx,       \
+	                               void *out)                                            \
+	{                                                                                    \
+		return plugin_options_read(host, ctx, table, PLUGIN_OPTION_COUNT(table), check, \
+		                           sizeof(options_type), out);                       \
 	}
+
+/* In build(), refine() or update(), after PLUGIN_DECLS: this call's options
+ * into *out, a struct of PLUGIN_DECLS's options_type (plugin_options_get). */
+#define PLUGIN_OPTIONS_GET(host, ctx, input, out)                                        \
+	plugin_options_get(host, ctx, input, plugin_fill_options,                        \
+	                   sizeof(plugin_options_type) +                                 \
+	                           0 * sizeof((out) == (plugin_options_type *)0), \
+	                   out)
 
 /* The entry point (BVHLAB_PLUGIN_EXPORT's), after PLUGIN_DECLS and the
  * descriptor: plugin_decls filled, once, before the descriptor is returned
@@ -152,30 +199,15 @@ BVHLAB_END_DECLS
 		return &(descriptor);                                         \
 	}
 
-/* C: BVHLAB_PLUGIN with the options of `table` (PLUGIN_DECLS and
- * PLUGIN_EXPORT around the descriptor); `...` are its other fields. */
+/* C: BVHLAB_PLUGIN with the options of `table` (after its PLUGIN_DECLS;
+ * PLUGIN_EXPORT after the descriptor); `...` are its other fields. */
 #define PLUGIN_WITH_OPTIONS(table, ...)                                                   \
-	PLUGIN_DECLS(table)                                                               \
 	static const bvhlab_builder plugin_descriptor = {                                 \
 		.abi_version = BVHLAB_ABI_CURRENT, .struct_size = sizeof(bvhlab_builder), \
 		.option_count = PLUGIN_OPTION_COUNT(table), .options = plugin_decls,      \
-		__VA_ARGS__};                                                             \
+		.fill_options = plugin_fill_options,                                      \
+		.options_size = sizeof(plugin_options_type), __VA_ARGS__};                \
 	PLUGIN_EXPORT(plugin_descriptor)
 
-#ifdef __cplusplus
-#include <type_traits>
-
-/* The C++ form: the count from the array, and only a struct whose offsets
- * offsetof gives (standard layout; default member initialisers are fine,
- * every field of the table is filled anyway). */
-template <class Options, size_t Count>
-int plugin_options_fill(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                        const plugin_option (&table)[Count], Options &out)
-{
-	static_assert(std::is_standard_layout<Options>::value,
-	              "plugin_options_fill: offsetof needs a standard-layout struct");
-	return plugin_options_fill(host, ctx, table, Count, &out);
-}
-#endif
 
 #endif /* BVHLAB_PLUGIN_OPTIONS_H */
