@@ -35,8 +35,7 @@ static const plugin_option options[] = {
 };
 
 static const char *const kernel_names[] = {
-	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "gather_leaves", "prefixes",
-	"karras_scan",
+	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "prefixes", "karras_scan",
 };
 
 static const cl_builder program = CL_BUILDER(cl_lbvh_src, kernel_names, UINT32_MAX / 2);

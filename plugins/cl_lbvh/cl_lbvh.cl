@@ -195,31 +195,20 @@ static void store_node(volatile __global node *p, const node *x)
 	p->count = x->count;
 }
 
-/* The primitives' boxes in sorted order, and their ids into prim_index:
- * the one random read of the build, in a kernel of its own, one work-item
- * per leaf with nothing else to wait for, so that many of its misses are
- * in flight at once (lbvh_emit.c's leaf loop, for the same reason). */
-__kernel void gather_leaves(__global const float *prim_bounds, __global const uint *order,
-	uint n, __global float *leaf_bounds, __global uint *prim_index)
+/* Leaf k's slot: primitive order[k]'s box, and its id into prim_index.
+ * The boxes are the one random read of the build (input order to sorted
+ * order); the leaves of a block are put in a loop of their own, with
+ * nothing else to wait for, so that many of those misses are in flight at
+ * once (lbvh_emit.c's leaf loop, for the same reason). */
+static void put_leaf(__global const float *prim_bounds, __global const uint *order,
+	__global const uint *parent, uint n, uint k, volatile __global node *nodes,
+	__global uint *prim_index)
 {
-	uint k = get_global_id(0);
-	if (k >= n)
-		return;
 	uint id = order[k];
 	__global const float *b = prim_bounds + 6 * (size_t)id;
-	__global float *to = leaf_bounds + 6 * (size_t)k;
-	for (int a = 0; a < 6; a++)
-		to[a] = b[a];
-	prim_index[k] = id;
-}
-
-/* Leaf k's slot. */
-static void put_leaf(__global const float *leaf_bounds, __global const uint *parent, uint n,
-	uint k, volatile __global node *nodes)
-{
-	__global const float *b = leaf_bounds + 6 * (size_t)k;
 	node leaf = { { b[0], b[1], b[2] }, k, { b[3], b[4], b[5] }, 1 };
 	store_node(nodes + 1 + (size_t)parent[n - 1 + k], &leaf);
+	prim_index[k] = id;
 }
 
 /*
@@ -230,17 +219,18 @@ static void put_leaf(__global const float *leaf_bounds, __global const uint *par
  * it needs no counter; the others take the atomic one, whose fences hand
  * the first child's slot over. block is 1 on a GPU (a work-item per leaf),
  * larger on a CPU device, where it keeps the climbs in cache and off the
- * atomics (lbvh_emit.c's blocks). leaf_bounds from gather_leaves;
+ * atomics (lbvh_emit.c's blocks). order[] is the sorted primitive ids;
  * visits[] and flags[] zeroed.
  */
-__kernel void bounds(__global const float *leaf_bounds, uint n, uint block,
+__kernel void bounds(__global const float *prim_bounds, __global const uint *order,
+	__global uint *prim_index, uint n, uint block,
 	__global const uint *parent, __global const uint *end, volatile __global node *nodes,
 	volatile __global uint *visits, __global float *cost, __global uchar *flags,
 	uint collapse, uint max_leaf, float c_trav, float c_isect)
 {
 	size_t lo = get_global_id(0) * (size_t)block, hi = min((size_t)n, lo + block);
 	for (size_t k = lo; k < hi; k++)
-		put_leaf(leaf_bounds, parent, n, (uint)k, nodes);
+		put_leaf(prim_bounds, order, parent, n, (uint)k, nodes, prim_index);
 	for (size_t k = lo; k < hi; k++) {
 		uint word = parent[n - 1 + k];
 		while (word != NO_NODE) {

@@ -9,7 +9,7 @@
 
 /* The device buffers besides the sort's. */
 enum { LB_BOUNDS, LB_PARENT, LB_END, LB_NODES, LB_VISITS, LB_COST, LB_FLAGS, LB_INDEX,
-       LB_INNER, LB_LEAVES, LB_LCP, LB_COUNT };
+       LB_INNER, LB_LCP, LB_COUNT };
 
 typedef struct cl_lbvh {
 	const bvhlab_build_input *in;
@@ -25,6 +25,10 @@ typedef struct cl_lbvh {
 	cl_dev *dev;
 	cl_sort *sort;
 	cl_buf *b;           /* [LB_COUNT] */
+	/* On a CPU device, this build's buffers over the host's arrays
+	 * (CL_MEM_USE_HOST_PTR) in place of b[]'s: the input's boxes, the
+	 * output's nodes and indices, the input's centroids; else NULL. */
+	cl_mem host[LB_COUNT], centroids;
 	double ms[CL_PHASES]; /* upload, device, download, convert */
 } cl_lbvh;
 

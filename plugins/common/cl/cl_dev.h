@@ -117,12 +117,17 @@ enum { SB_CENTROIDS, SB_KEYS0, SB_KEYS1, SB_VALS0, SB_VALS1, SB_HIST, SB_PART, S
 typedef struct cl_sort {
 	cl_buf b[SB_COUNT];
 	unsigned sorted; /* after cl_sort_run: keys/vals[sorted] hold the order */
+	/* When set, the centroids' buffer for the next cl_sort_run instead of
+	 * b[SB_CENTROIDS] and its upload: on a CPU device, a buffer over the
+	 * input's own array (CL_MEM_USE_HOST_PTR), no copy. The caller owns it. */
+	cl_mem centroids;
 } cl_sort;
 
 /* Bytes of each of the sort's buffers for n primitives (into want[]). */
 void cl_sort_sizes(uint32_t n, size_t want[SB_COUNT]);
 /*
- * Uploads the centroids (blocking; its wall-clock time into *ms_upload),
+ * Uploads the centroids unless s->centroids holds them (blocking; its
+ * wall-clock time into *ms_upload),
  * computes the codes of `bits` (30 or 63) as plugins/common/morton does,
  * and sorts the (code, id) pairs, the kernels' events into ev. Reads back
  * once, the bits in which the codes vary (which digits need a pass).

@@ -41,8 +41,9 @@ static int codes(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned b
 	uint32_t n = in->prim_count;
 
 	morton_cells_init(&q, &in->centroid_bounds, bits);
+	cl_mem centroids = s->centroids ? s->centroids : s->b[SB_CENTROIDS].mem;
 	cl_arg args[] = {
-		CL_ARG(s->b[SB_CENTROIDS].mem), CL_ARG(n), CL_ARG(q.lo[0]), CL_ARG(q.lo[1]),
+		CL_ARG(centroids), CL_ARG(n), CL_ARG(q.lo[0]), CL_ARG(q.lo[1]),
 		CL_ARG(q.lo[2]), CL_ARG(q.scale[0]), CL_ARG(q.scale[1]), CL_ARG(q.scale[2]),
 		CL_ARG(q.top), CL_ARG(s->b[SB_KEYS0].mem), CL_ARG(s->b[SB_VALS0].mem),
 	};
@@ -99,7 +100,8 @@ int cl_sort_run(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned bi
 	uint32_t n = in->prim_count;
 	uint64_t vary = 0;
 	double t0 = cl_now_ms();
-	int rc = bvhlab_cl_check(clEnqueueWriteBuffer(d->cl.queue, s->b[SB_CENTROIDS].mem,
+	int rc = s->centroids ? 0 :
+	         bvhlab_cl_check(clEnqueueWriteBuffer(d->cl.queue, s->b[SB_CENTROIDS].mem,
 	                                              CL_TRUE, 0, 12 * (size_t)n, in->centroids,
 	                                              0, NULL, NULL),
 	                         "uploading the centroids", err, err_size);
