@@ -32,6 +32,17 @@ static const plugin_option options[] = {
 	                      "searches), scan (lbvh's prefix scans), auto (scan on a CPU "
 	                      "device, search on a GPU); the tree is the same",
 	              .def_string = "auto", .choices = "auto|search|scan"),
+	PLUGIN_OPTION(cl_lbvh, sort_shape, STRING, .name = "sort",
+	              .help = "the radix sort's shape: passes (every digit over all keys), "
+	                      "buckets (the two top digits over all keys, then a work-item "
+	                      "per bucket), auto (buckets on a CPU device, passes on a GPU); "
+	                      "the tree is the same",
+	              .def_string = "auto", .choices = "auto|passes|buckets"),
+	PLUGIN_OPTION(cl_lbvh, zero_copy, BOOL, .name = "zero_copy",
+	              .help = "on a CPU device, the input's and the output's arrays used where "
+	                      "they lie (CL_MEM_USE_HOST_PTR) instead of copied in and out; "
+	                      "no effect on a GPU",
+	              .def_bool = true),
 };
 
 static const char *const kernel_names[] = {
@@ -67,6 +78,9 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	                              &b)) < 0 ||
 	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
 		return rc < 0 ? rc : 0;
+	S.sort.shape = !strcmp(b.sort_shape, "passes")    ? CL_SORT_PASSES
+	               : !strcmp(b.sort_shape, "buckets") ? CL_SORT_BUCKETS
+	                                            : CL_SORT_AUTO;
 	if ((rc = cl_lbvh_run(&b, output, err, sizeof(err))) < 0) {
 		host->set_error(ctx, "%s", err);
 		return rc;

@@ -21,6 +21,8 @@ typedef struct cl_lbvh {
 	float c_trav, c_isect;
 	uint32_t leaf_block;  /* leaves per work-item in bounds; 0: by device */
 	const char *hierarchy; /* auto, search or scan */
+	const char *sort_shape; /* option sort: auto, passes or buckets */
+	bool zero_copy;         /* the host's arrays on a CPU device (host[]) */
 
 	cl_dev *dev;
 	cl_sort *sort;

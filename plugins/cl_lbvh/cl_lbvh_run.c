@@ -135,7 +135,7 @@ static int host_buffers(cl_lbvh *b, bvhlab_build_output *out, char *err, size_t 
 	size_t n = b->n;
 	int rc;
 
-	if (!(b->dev->cl.type & CL_DEVICE_TYPE_CPU))
+	if (!b->zero_copy || !(b->dev->cl.type & CL_DEVICE_TYPE_CPU))
 		return 0;
 	if ((rc = wrap(b, &b->host[LB_BOUNDS], CL_MEM_READ_ONLY, b->in->prim_bounds, 24 * n, err,
 	               err_size)) < 0 ||
