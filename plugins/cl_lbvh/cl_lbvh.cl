@@ -75,9 +75,10 @@ __kernel void karras(__global const ulong *keys, uint n, __global uint *parent,
  * short scan: lcp[k] = delta(k, k + 1) as bytes (prefixes), then node i's
  * range grows towards its larger neighbour until lcp[] drops to the
  * smaller one, and the split is the one place in the range where lcp[]
- * equals delta(first, last) (karras_scan). 16 bytes a step, then one at
- * a time inside the 16 that hold the answer; LCP_PAD zero bytes on either
- * side stop the scans.
+ * equals delta(first, last) (karras_scan). 16 bytes a step, the place
+ * inside the 16 that hold the answer by the lanes' bits (a little-endian
+ * device's, as every CPU PoCL runs on); LCP_PAD zero bytes on either side
+ * stop the scans.
  */
 #define LCP_PAD 32
 
@@ -93,6 +94,23 @@ __kernel void prefixes(__global const ulong *keys, uint n, __global uchar *lcp_b
 	}
 }
 
+/* The first and the last of 16 lanes that hold (-1), as lbvh_emit.c
+ * finds them with movemask and ctz: by the two 64-bit halves, no loop
+ * over the bytes (whose exit a CPU mispredicts). 16 or -1 when none. */
+static int first_lane(char16 m)
+{
+	ulong2 w = as_ulong2(m);
+	ulong x = w.s0 ? w.s0 : w.s1;
+	return x ? (w.s0 ? 0 : 8) + (63 - (int)clz(x & -x)) / 8 : 16;
+}
+
+static int last_lane(char16 m)
+{
+	ulong2 w = as_ulong2(m);
+	ulong x = w.s1 ? w.s1 : w.s0;
+	return x ? (w.s1 ? 15 : 7) - (int)clz(x) / 8 : -1;
+}
+
 __kernel void karras_scan(__global const ulong *keys, uint n, __global const uchar *lcp_buf,
 	__global uint *parent, __global uint *end)
 {
@@ -101,26 +119,22 @@ __kernel void karras_scan(__global const ulong *keys, uint n, __global const uch
 	if (i >= (long)n - 1)
 		return;
 	uchar left = lcp[i - 1], right = lcp[i], bound = min(left, right);
+	int lane;
 	if (right > left) {
-		for (k = i + 1; !any(vload16(0, lcp + k) <= bound); k += 16)
+		for (k = i + 1; (lane = first_lane(vload16(0, lcp + k) <= bound)) == 16; k += 16)
 			;
-		while (lcp[k] > bound)
-			k++;
+		k += lane;
 	} else {
-		for (k = i - 2; !any(vload16(0, lcp + k - 15) <= bound); k -= 16)
+		for (k = i - 2; (lane = last_lane(vload16(0, lcp + k - 15) <= bound)) < 0; k -= 16)
 			;
-		while (lcp[k] > bound)
-			k--;
-		k++;
+		k += lane - 15 + 1;
 	}
 	long first = min(i, k), last = max(i, k);
 	uchar value = (uchar)delta(keys, n, first, last);
 	long split = first;
-	for (; !any(vload16(0, lcp + split) == value); split += 16)
+	for (; (lane = first_lane(vload16(0, lcp + split) == value)) == 16; split += 16)
 		;
-	while (lcp[split] != value)
-		split++;
-	emit_node((uint)i, (uint)k, (uint)split, n, parent, end);
+	emit_node((uint)i, (uint)k, (uint)(split + lane), n, parent, end);
 }
 
 static float half_area(float lx, float ly, float lz, float hx, float hy, float hz)
