@@ -3,12 +3,12 @@
  * lbvh plugin for the same options, bit for bit. Morton codes and a stable
  * LSD radix sort (plugins/common/cl), Karras's hierarchy in one kernel,
  * boxes and the SAH collapse bottom-up with atomic counters, then which
- * nodes stay inner (cl_lbvh.cl); the compaction of the collapsed tree, as
- * lbvh_collapse.c's, on the host (cl_lbvh_compact.c).
+ * nodes stay inner (cl_lbvh.cl), and the compaction of the collapsed tree,
+ * as lbvh_collapse.c's (cl_lbvh_compact.cl).
  *
  * Phases reported: upload (boxes and centroids, wall clock), device (the
- * kernels' and fills' own times, from their events), download and convert
- * (the compaction), wall clock.
+ * kernels' and fills' own times, from their events), download (wall
+ * clock) and convert (0: nothing is left to the host).
  */
 #include <errno.h>
 #include <stdlib.h>
@@ -47,6 +47,7 @@ static const plugin_option options[] = {
 
 static const char *const kernel_names[] = {
 	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "prefixes", "karras_scan",
+	"compact_counts", "compact_plan", "compact_movers", "compact_links", "compact_moves",
 };
 
 static const cl_builder program = CL_BUILDER(cl_lbvh_src, kernel_names, UINT32_MAX / 2);

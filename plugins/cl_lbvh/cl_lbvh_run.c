@@ -1,19 +1,16 @@
 /*
  * cl_lbvh's device run: every buffer sized first, the uploads, the sort
- * (plugins/common/cl), then karras, bounds and inner_nodes; the kernels
+ * (plugins/common/cl), then karras, bounds, inner_nodes and the
+ * compaction (cl_lbvh_compact.c); the kernels
  * queue back to back on the in-order queue and the host waits once. On a
  * CPU device (PoCL) the device's memory is the host's: the input's boxes
  * and centroids and the output's nodes and indices are used where they
  * lie (CL_MEM_USE_HOST_PTR), and the copies in and out, some 100 bytes a
  * primitive, go.
  */
-#include <errno.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "cl_lbvh.h"
-
-enum { K_KARRAS = CL_SORT_KERNELS, K_BOUNDS, K_INNER, K_PREFIXES, K_SCAN };
 
 /* Zero bytes on either side of lcp[] (cl_lbvh.cl's LCP_PAD). */
 #define LCP_PAD 32
@@ -40,6 +37,7 @@ static int size_buffers(cl_lbvh *b, char *err, size_t err_size)
 	want[LB_FLAGS] = want[LB_INNER] = n - 1;
 	want[LB_LCP] = n - 1 + 2 * LCP_PAD;
 	want[LB_INDEX] = 4 * n;
+	want[LB_PLAN] = 4 * (3 * (size_t)CL_LBVH_CHUNKS + 1);
 	cl_sort_sizes(b->n, want + LB_COUNT);
 	/* Both sets at once against the device's memory, then each made. */
 	int rc = cl_bufs_fit(b->dev, want, LB_COUNT + SB_COUNT, err, err_size);
@@ -113,7 +111,9 @@ static int hierarchy(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 		return rc;
 	if (!b->collapse)
 		return 0;
-	return cl_launch(d, d->k[K_INNER], n - 1, ia, 6, ev, err, err_size);
+	if ((rc = cl_launch(d, d->k[K_INNER], n - 1, ia, 6, ev, err, err_size)) < 0)
+		return rc;
+	return cl_lbvh_compact(b, ev, err, err_size);
 }
 
 /* A buffer over the host's array p (CL_MEM_USE_HOST_PTR). */
@@ -181,20 +181,22 @@ static int fetch(cl_lbvh *b, int which, size_t bytes, void *to, char *err, size_
 	                       "clEnqueueUnmapMemObject", err, err_size);
 }
 
-/* The tree into out; with collapse, the flags and parents for the
- * compaction into `inner` and `parent` (host memory). */
-static int download(cl_lbvh *b, bvhlab_build_output *out, uint8_t *inner, uint32_t *parent,
-                    char *err, size_t err_size)
+/* The tree into out, and its node count. */
+static int download(cl_lbvh *b, bvhlab_build_output *out, char *err, size_t err_size)
 {
 	size_t n = b->n;
+	cl_uint f = 0;
 	int rc;
 
-	if ((rc = fetch(b, LB_NODES, 32 * (2 * n - 1), out->nodes, err, err_size)) < 0 ||
-	    (rc = fetch(b, LB_INDEX, 4 * n, out->prim_index, err, err_size)) < 0)
-		return rc;
-	if (b->collapse && (rc = fetch(b, LB_INNER, n - 1, inner, err, err_size)) == 0)
-		rc = fetch(b, LB_PARENT, 4 * (n - 1), parent, err, err_size);
-	/* The host writes the nodes next: the buffers over them go first. */
+	if ((rc = fetch(b, LB_NODES, 32 * (2 * n - 1), out->nodes, err, err_size)) == 0 &&
+	    (rc = fetch(b, LB_INDEX, 4 * n, out->prim_index, err, err_size)) == 0 && b->collapse)
+		rc = bvhlab_cl_check(clEnqueueReadBuffer(b->dev->cl.queue, b->b[LB_PLAN].mem,
+		                                         CL_TRUE, b->plan_f, sizeof(f), &f, 0,
+		                                         NULL, NULL),
+		                     "clEnqueueReadBuffer", err, err_size);
+	out->node_count = b->collapse ? 1 + 2 * f : 2 * b->n - 1;
+	out->index_count = b->n;
+	/* The host may write the nodes next: the buffers over them go first. */
 	if (rc == 0)
 		rc = bvhlab_cl_check(clFinish(b->dev->cl.queue), "clFinish", err, err_size);
 	host_release(b);
@@ -217,37 +219,23 @@ static int upload(cl_lbvh *b, char *err, size_t err_size)
 int cl_lbvh_run(cl_lbvh *b, bvhlab_build_output *out, char *err, size_t err_size)
 {
 	cl_events ev = { .count = 0 };
-	uint8_t *inner = NULL;
-	uint32_t *parent = NULL;
 	double t0, up = 0;
 	int rc;
 
 	if ((rc = host_buffers(b, out, err, err_size)) < 0 ||
-	    (rc = size_buffers(b, err, err_size)) < 0 || (rc = upload(b, err, err_size)) < 0)
-		goto out;
-	if (b->collapse && (!(inner = malloc(b->n)) || !(parent = malloc(4 * (size_t)b->n)))) {
-		rc = bvhlab_cl_fail(-ENOMEM, err, err_size, "out of memory for %u primitives", b->n);
-		goto out;
-	}
-	if ((rc = cl_sort_run(b->dev, b->sort, b->in, b->bits, &ev, &up, err, err_size)) < 0 ||
+	    (rc = size_buffers(b, err, err_size)) < 0 || (rc = upload(b, err, err_size)) < 0 ||
+	    (rc = cl_sort_run(b->dev, b->sort, b->in, b->bits, &ev, &up, err, err_size)) < 0 ||
 	    (rc = hierarchy(b, &ev, err, err_size)) < 0 ||
 	    (rc = bvhlab_cl_check(clFinish(b->dev->cl.queue), "clFinish", err, err_size)) < 0)
 		goto out;
 	b->ms[0] += up;
 	t0 = cl_now_ms();
-	if ((rc = download(b, out, inner, parent, err, err_size)) < 0)
-		goto out;
+	rc = download(b, out, err, err_size);
 	b->ms[2] = cl_now_ms() - t0;
-	t0 = cl_now_ms();
-	out->node_count = b->collapse ? cl_lbvh_compact(out->nodes, inner, parent, b->n)
-	                              : 2 * b->n - 1;
-	out->index_count = b->n;
-	b->ms[3] = cl_now_ms() - t0;
+	b->ms[3] = 0;
 out:
 	clFinish(b->dev->cl.queue);
 	host_release(b);
 	b->ms[1] = cl_events_ms(&ev);
-	free(inner);
-	free(parent);
 	return rc;
 }

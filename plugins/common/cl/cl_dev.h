@@ -28,7 +28,7 @@
  * kernels also turn contraction into fma off, by pragma; none divides
  * today: the quantiser's scale comes from the host.) */
 #define CL_DEV_OPTIONS "-cl-fp32-correctly-rounded-divide-sqrt"
-#define CL_DEV_MAX_KERNELS 16
+#define CL_DEV_MAX_KERNELS 24
 
 /* The option every device builder has, in its table (plugin_options.h),
  * into the member `device` (const char *) of its struct `owner`. */
