@@ -1,8 +1,11 @@
 /*
  * Morton codes and their radix sort on the device (kernels in
  * morton_sort.cl), giving the order plugins/common/morton gives: its
- * cells (morton_cells_init) and its spread (morton_spread.h), then stable LSD passes over the 8-bit digits in which some code differs
- * from the first (the rest would move nothing).
+ * cells (morton_cells_init) and its spread (morton_spread.h), then stable
+ * passes over the 8-bit digits in which some code differs from the first
+ * (the rest would move nothing): every one over all keys (a GPU), or, on
+ * a CPU device, the two top ones over all keys and the rest inside each
+ * bucket of those 16 bits, a work-item each, in cache (cl_sort.shape).
  */
 #include <errno.h>
 #include <stdbool.h>
