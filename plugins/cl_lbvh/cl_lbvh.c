@@ -3,12 +3,12 @@
  * lbvh plugin for the same options, bit for bit. Morton codes and a stable
  * LSD radix sort (plugins/common/cl), Karras's hierarchy in one kernel,
  * boxes and the SAH collapse bottom-up with atomic counters, then which
- * nodes stay inner (cl_lbvh.cl); the compaction of the collapsed tree, as
- * lbvh_collapse.c's, on the host (cl_lbvh_compact.c).
+ * nodes stay inner (cl_lbvh.cl), and the compaction of the collapsed tree,
+ * as lbvh_collapse.c's (cl_lbvh_compact.cl).
  *
  * Phases reported: upload (boxes and centroids, wall clock), device (the
- * kernels' and fills' own times, from their events), download and convert
- * (the compaction), wall clock.
+ * kernels' and fills' own times, from their events), download (wall
+ * clock) and convert (0: nothing is left to the host).
  */
 #include <errno.h>
 #include <stdlib.h>
@@ -32,13 +32,24 @@ static const plugin_option options[] = {
 	                      "searches), scan (lbvh's prefix scans), auto (scan on a CPU "
 	                      "device, search on a GPU); the tree is the same",
 	              .def_string = "auto", .choices = "auto|search|scan"),
+	PLUGIN_OPTION(cl_lbvh, sort_shape, STRING, .name = "sort",
+	              .help = "the radix sort's shape: passes (every digit over all keys), "
+	                      "buckets (the two top digits over all keys, then a work-item "
+	                      "per bucket), auto (buckets on a CPU device, passes on a GPU); "
+	                      "the tree is the same",
+	              .def_string = "auto", .choices = "auto|passes|buckets"),
+	PLUGIN_OPTION(cl_lbvh, zero_copy, BOOL, .name = "zero_copy",
+	              .help = "on a CPU device, the input's and the output's arrays used where "
+	                      "they lie (CL_MEM_USE_HOST_PTR) instead of copied in and out; "
+	                      "no effect on a GPU",
+	              .def_bool = true),
 };
 CL_DEVICE_CHECK(cl_lbvh)
 PLUGIN_DECLS(options, cl_lbvh, cl_device_check)
 
 static const char *const kernel_names[] = {
-	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "gather_leaves", "prefixes",
-	"karras_scan",
+	CL_SORT_KERNEL_NAMES, "karras", "bounds", "inner_nodes", "prefixes", "karras_scan",
+	"compact_counts", "compact_plan", "compact_movers", "compact_links", "compact_moves",
 };
 
 static const cl_builder program = CL_BUILDER(cl_lbvh_src, kernel_names, UINT32_MAX / 2);
@@ -71,6 +82,9 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	if (rc < 0 || (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input,
 	                                   output)) != 0)
 		return rc < 0 ? rc : 0;
+	S.sort.shape = !strcmp(b.sort_shape, "passes")    ? CL_SORT_PASSES
+	               : !strcmp(b.sort_shape, "buckets") ? CL_SORT_BUCKETS
+	                                            : CL_SORT_AUTO;
 	if ((rc = cl_lbvh_run(&b, output, err, sizeof(err))) < 0) {
 		host->set_error(ctx, "%s", err);
 		return rc;

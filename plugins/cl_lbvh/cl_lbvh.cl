@@ -75,9 +75,10 @@ __kernel void karras(__global const ulong *keys, uint n, __global uint *parent,
  * short scan: lcp[k] = delta(k, k + 1) as bytes (prefixes), then node i's
  * range grows towards its larger neighbour until lcp[] drops to the
  * smaller one, and the split is the one place in the range where lcp[]
- * equals delta(first, last) (karras_scan). 16 bytes a step, then one at
- * a time inside the 16 that hold the answer; LCP_PAD zero bytes on either
- * side stop the scans.
+ * equals delta(first, last) (karras_scan). 16 bytes a step, the place
+ * inside the 16 that hold the answer by the lanes' bits (a little-endian
+ * device's, as every CPU PoCL runs on); LCP_PAD zero bytes on either side
+ * stop the scans.
  */
 #define LCP_PAD 32
 
@@ -93,6 +94,23 @@ __kernel void prefixes(__global const ulong *keys, uint n, __global uchar *lcp_b
 	}
 }
 
+/* The first and the last of 16 lanes that hold (-1), as lbvh_emit.c
+ * finds them with movemask and ctz: by the two 64-bit halves, no loop
+ * over the bytes (whose exit a CPU mispredicts). 16 or -1 when none. */
+static int first_lane(char16 m)
+{
+	ulong2 w = as_ulong2(m);
+	ulong x = w.s0 ? w.s0 : w.s1;
+	return x ? (w.s0 ? 0 : 8) + (63 - (int)clz(x & -x)) / 8 : 16;
+}
+
+static int last_lane(char16 m)
+{
+	ulong2 w = as_ulong2(m);
+	ulong x = w.s1 ? w.s1 : w.s0;
+	return x ? (w.s1 ? 15 : 7) - (int)clz(x) / 8 : -1;
+}
+
 __kernel void karras_scan(__global const ulong *keys, uint n, __global const uchar *lcp_buf,
 	__global uint *parent, __global uint *end)
 {
@@ -101,26 +119,22 @@ __kernel void karras_scan(__global const ulong *keys, uint n, __global const uch
 	if (i >= (long)n - 1)
 		return;
 	uchar left = lcp[i - 1], right = lcp[i], bound = min(left, right);
+	int lane;
 	if (right > left) {
-		for (k = i + 1; !any(vload16(0, lcp + k) <= bound); k += 16)
+		for (k = i + 1; (lane = first_lane(vload16(0, lcp + k) <= bound)) == 16; k += 16)
 			;
-		while (lcp[k] > bound)
-			k++;
+		k += lane;
 	} else {
-		for (k = i - 2; !any(vload16(0, lcp + k - 15) <= bound); k -= 16)
+		for (k = i - 2; (lane = last_lane(vload16(0, lcp + k - 15) <= bound)) < 0; k -= 16)
 			;
-		while (lcp[k] > bound)
-			k--;
-		k++;
+		k += lane - 15 + 1;
 	}
 	long first = min(i, k), last = max(i, k);
 	uchar value = (uchar)delta(keys, n, first, last);
 	long split = first;
-	for (; !any(vload16(0, lcp + split) == value); split += 16)
+	for (; (lane = first_lane(vload16(0, lcp + split) == value)) == 16; split += 16)
 		;
-	while (lcp[split] != value)
-		split++;
-	emit_node((uint)i, (uint)k, (uint)split, n, parent, end);
+	emit_node((uint)i, (uint)k, (uint)(split + lane), n, parent, end);
 }
 
 static float half_area(float lx, float ly, float lz, float hx, float hy, float hz)
@@ -195,31 +209,32 @@ static void store_node(volatile __global node *p, const node *x)
 	p->count = x->count;
 }
 
-/* The primitives' boxes in sorted order, and their ids into prim_index:
- * the one random read of the build, in a kernel of its own, one work-item
- * per leaf with nothing else to wait for, so that many of its misses are
- * in flight at once (lbvh_emit.c's leaf loop, for the same reason). */
-__kernel void gather_leaves(__global const float *prim_bounds, __global const uint *order,
-	uint n, __global float *leaf_bounds, __global uint *prim_index)
+/* How far ahead a block's leaf loop fetches the boxes (lbvh_emit.c's
+ * LEAF_AHEAD): a miss is some hundreds of nanoseconds, a leaf a few. On a
+ * CPU (PoCL's device is compiled for the host) by the compiler's prefetch
+ * instruction; elsewhere nothing: a GPU hides the misses by its many
+ * work-items. */
+#define LEAF_AHEAD 96
+#if defined(__x86_64__) || defined(__aarch64__)
+#define PREFETCH(p) __builtin_prefetch((p))
+#else
+#define PREFETCH(p) ((void)(p))
+#endif
+
+/* Leaf k's slot: primitive order[k]'s box, and its id into prim_index.
+ * The boxes are the one random read of the build (input order to sorted
+ * order); the leaves of a block are put in a loop of their own, with
+ * nothing else to wait for, so that many of those misses are in flight at
+ * once (lbvh_emit.c's leaf loop, for the same reason). */
+static void put_leaf(__global const float *prim_bounds, __global const uint *order,
+	__global const uint *parent, uint n, uint k, volatile __global node *nodes,
+	__global uint *prim_index)
 {
-	uint k = get_global_id(0);
-	if (k >= n)
-		return;
 	uint id = order[k];
 	__global const float *b = prim_bounds + 6 * (size_t)id;
-	__global float *to = leaf_bounds + 6 * (size_t)k;
-	for (int a = 0; a < 6; a++)
-		to[a] = b[a];
-	prim_index[k] = id;
-}
-
-/* Leaf k's slot. */
-static void put_leaf(__global const float *leaf_bounds, __global const uint *parent, uint n,
-	uint k, volatile __global node *nodes)
-{
-	__global const float *b = leaf_bounds + 6 * (size_t)k;
 	node leaf = { { b[0], b[1], b[2] }, k, { b[3], b[4], b[5] }, 1 };
 	store_node(nodes + 1 + (size_t)parent[n - 1 + k], &leaf);
+	prim_index[k] = id;
 }
 
 /*
@@ -230,17 +245,21 @@ static void put_leaf(__global const float *leaf_bounds, __global const uint *par
  * it needs no counter; the others take the atomic one, whose fences hand
  * the first child's slot over. block is 1 on a GPU (a work-item per leaf),
  * larger on a CPU device, where it keeps the climbs in cache and off the
- * atomics (lbvh_emit.c's blocks). leaf_bounds from gather_leaves;
+ * atomics (lbvh_emit.c's blocks). order[] is the sorted primitive ids;
  * visits[] and flags[] zeroed.
  */
-__kernel void bounds(__global const float *leaf_bounds, uint n, uint block,
+__kernel void bounds(__global const float *prim_bounds, __global const uint *order,
+	__global uint *prim_index, uint n, uint block,
 	__global const uint *parent, __global const uint *end, volatile __global node *nodes,
 	volatile __global uint *visits, __global float *cost, __global uchar *flags,
 	uint collapse, uint max_leaf, float c_trav, float c_isect)
 {
 	size_t lo = get_global_id(0) * (size_t)block, hi = min((size_t)n, lo + block);
-	for (size_t k = lo; k < hi; k++)
-		put_leaf(leaf_bounds, parent, n, (uint)k, nodes);
+	for (size_t k = lo; k < hi; k++) {
+		if (k + LEAF_AHEAD < hi)
+			PREFETCH(prim_bounds + 6 * (size_t)order[k + LEAF_AHEAD]);
+		put_leaf(prim_bounds, order, parent, n, (uint)k, nodes, prim_index);
+	}
 	for (size_t k = lo; k < hi; k++) {
 		uint word = parent[n - 1 + k];
 		while (word != NO_NODE) {

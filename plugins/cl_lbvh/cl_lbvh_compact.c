@@ -1,43 +1,40 @@
 /*
- * cl_lbvh's compaction of a collapsed tree, on the host: lbvh_collapse.c's
- * (the same moves, so the same node order), one thread. The pairs of the
- * F internal nodes that stay inner below F stay; the pairs below F of
- * nodes that did not stay inner are holes, as many as the inner nodes from
- * F on (the movers), and the k-th mover's pair moves into the k-th hole.
- * Every mover's parent slot is pointed at the new place first (that slot
- * may itself lie in a pair that moves), then the pairs move.
+ * cl_lbvh's compaction of a collapsed tree, on the device
+ * (cl_lbvh_compact.cl: lbvh_collapse.c's moves, so the same node order):
+ * the internal nodes in chunks, a work-item each, their counts, the plan
+ * (one work-item), the movers numbered, the links, the moves; F, the
+ * count of internal nodes that stay inner, is read back with the tree.
  */
-#include <string.h>
-
 #include "cl_lbvh.h"
 
-/* The next hole at or after h (below f), the next mover at or after m. */
-static uint32_t next_hole(const uint8_t *inner, uint32_t h, uint32_t f)
+/* Chunks of the internal nodes: at most CL_LBVH_CHUNKS, each at least
+ * MIN_CHUNK nodes (a few hundred keep every core busy, as the sort's). */
+#define MIN_CHUNK 256u
+
+static uint32_t chunk_size(uint32_t m)
 {
-	while (h < f && inner[h])
-		h++;
-	return h;
+	uint32_t c = (m + CL_LBVH_CHUNKS - 1) / CL_LBVH_CHUNKS;
+
+	return c < MIN_CHUNK ? MIN_CHUNK : c;
 }
 
-static uint32_t next_mover(const uint8_t *inner, uint32_t m, uint32_t n)
+int cl_lbvh_compact(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 {
-	while (m < n - 1 && !inner[m])
-		m++;
-	return m;
-}
+	cl_dev *d = b->dev;
+	cl_uint m = b->n - 1, chunk = chunk_size(m), chunks = (m + chunk - 1) / chunk;
+	cl_mem inner = b->b[LB_INNER].mem, plan = b->b[LB_PLAN].mem;
+	/* visits[] is done with once bounds has run: the movers' numbers */
+	cl_mem movers = b->b[LB_VISITS].mem, parent = b->b[LB_PARENT].mem;
+	cl_mem nodes = b->host[LB_NODES] ? b->host[LB_NODES] : b->b[LB_NODES].mem;
+	cl_arg c[] = { CL_ARG(inner), CL_ARG(m), CL_ARG(chunk), CL_ARG(chunks), CL_ARG(plan),
+	               CL_ARG(movers), CL_ARG(parent), CL_ARG(nodes) };
+	int rc;
 
-uint32_t cl_lbvh_compact(bvhlab_node *nodes, const uint8_t *inner, const uint32_t *parent,
-                         uint32_t n)
-{
-	uint32_t f = 0, h, m;
-
-	for (uint32_t i = 0; i < n - 1; i++)
-		f += inner[i];
-	for (h = next_hole(inner, 0, f), m = next_mover(inner, f, n); h < f;
-	     h = next_hole(inner, h + 1, f), m = next_mover(inner, m + 1, n))
-		nodes[1 + parent[m]].first = 1 + 2 * h;
-	for (h = next_hole(inner, 0, f), m = next_mover(inner, f, n); h < f;
-	     h = next_hole(inner, h + 1, f), m = next_mover(inner, m + 1, n))
-		memcpy(&nodes[1 + 2 * (size_t)h], &nodes[1 + 2 * (size_t)m], 2 * sizeof(bvhlab_node));
-	return 1 + 2 * f;
+	b->plan_f = 4 * 3 * (size_t)chunks;
+	if ((rc = cl_launch(d, d->k[K_COUNTS], chunks, c, 5, ev, err, err_size)) < 0 ||
+	    (rc = cl_launch(d, d->k[K_PLAN], 1, c, 5, ev, err, err_size)) < 0 ||
+	    (rc = cl_launch(d, d->k[K_MOVERS], chunks, c, 6, ev, err, err_size)) < 0 ||
+	    (rc = cl_launch(d, d->k[K_LINKS], chunks, c, 8, ev, err, err_size)) < 0)
+		return rc;
+	return cl_launch(d, d->k[K_MOVES], chunks, c, 8, ev, err, err_size);
 }

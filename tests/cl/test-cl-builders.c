@@ -33,7 +33,7 @@
  * builder only (may be NULL). */
 struct setup {
 	const char *opts[4];
-	const char *dev_only[2];
+	const char *dev_only[3];
 };
 
 struct pair {
@@ -48,9 +48,10 @@ static struct pair pairs[] = {
 	{ .ref_name = "lbvh", .dev_name = "cl_lbvh",
 	  .setups = { { { "bits=63", "collapse=true" } },
 	              { { "bits=30", "collapse=false" } },
-	              /* Karras's searches, a work-item per leaf: what a GPU runs */
+	              /* Karras's searches, a work-item per leaf, the sort's passes
+	               * over all keys: what a GPU runs */
 	              { { "max_leaf=3", "c_trav=2.5" },
-	                { "leaf_block=1", "hierarchy=search" } } },
+	                { "leaf_block=1", "hierarchy=search", "sort=passes" } } },
 	  .differ = { { { "max_leaf=2" } }, { { "max_leaf=8" } } } },
 	{ .ref_name = "ploc", .dev_name = "cl_ploc",
 	  .setups = { { { "radius=16", "collapse=true" } },
@@ -88,7 +89,7 @@ static int build(bvhlab_plugin *p, const struct setup *s, const char *device,
 		snprintf(dev, sizeof(dev), "device=%s", device);
 		rc = bvhlab_options_parse(&opts, dev, err);
 	}
-	for (int k = 0; k < 2 && rc == 0 && device && s->dev_only[k]; k++)
+	for (int k = 0; k < 3 && rc == 0 && device && s->dev_only[k]; k++)
 		rc = bvhlab_options_parse(&opts, s->dev_only[k], err);
 	double t0 = now_ms();
 	if (rc == 0)

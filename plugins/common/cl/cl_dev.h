@@ -28,7 +28,7 @@
  * kernels also turn contraction into fma off, by pragma; none divides
  * today: the quantiser's scale comes from the host.) */
 #define CL_DEV_OPTIONS "-cl-fp32-correctly-rounded-divide-sqrt"
-#define CL_DEV_MAX_KERNELS 16
+#define CL_DEV_MAX_KERNELS 24
 
 /* The option every device builder has, in its table (plugin_options.h),
  * into the member `device` (const char *) of its struct `owner`. */
@@ -127,21 +127,36 @@ double cl_now_ms(void);
 /* Kernel names the program must have, first in the names given to
  * cl_dev_open (cl_sort uses d->k[0..CL_SORT_KERNELS - 1]). */
 #define CL_SORT_KERNEL_NAMES "morton_codes", "morton_varying", "radix_hist", \
-	"radix_scan", "radix_scatter"
-#define CL_SORT_KERNELS 5
+	"radix_scan", "radix_scatter", "radix_ranges", "radix_buckets"
+#define CL_SORT_KERNELS 7
 
 /* The sort's buffers. */
-enum { SB_CENTROIDS, SB_KEYS0, SB_KEYS1, SB_VALS0, SB_VALS1, SB_HIST, SB_PART, SB_COUNT };
+enum { SB_CENTROIDS, SB_KEYS0, SB_KEYS1, SB_VALS0, SB_VALS1, SB_HIST, SB_PART, SB_RANGE,
+       SB_COUNT };
 
 typedef struct cl_sort {
 	cl_buf b[SB_COUNT];
 	unsigned sorted; /* after cl_sort_run: keys/vals[sorted] hold the order */
+	/* When set, the centroids' buffer for the next cl_sort_run instead of
+	 * b[SB_CENTROIDS] and its upload: on a CPU device, a buffer over the
+	 * input's own array (CL_MEM_USE_HOST_PTR), no copy. The caller owns it. */
+	cl_mem centroids;
+	/* The sort's shape: CL_SORT_AUTO (buckets on a CPU device, passes
+	 * elsewhere), CL_SORT_PASSES (every varying digit a pass over all
+	 * keys, the GPU's shape) or CL_SORT_BUCKETS (passes on the two top
+	 * digits, then a work-item per bucket of those 16 bits sorts it in
+	 * cache, morton_sort.cl; from 65,536 primitives on, passes below).
+	 * The order is the same. */
+	int shape;
 } cl_sort;
+
+enum { CL_SORT_AUTO, CL_SORT_PASSES, CL_SORT_BUCKETS };
 
 /* Bytes of each of the sort's buffers for n primitives (into want[]). */
 void cl_sort_sizes(uint32_t n, size_t want[SB_COUNT]);
 /*
- * Uploads the centroids (blocking; its wall-clock time into *ms_upload),
+ * Uploads the centroids unless s->centroids holds them (blocking; its
+ * wall-clock time into *ms_upload),
  * computes the codes of `bits` (30 or 63) as plugins/common/morton does,
  * and sorts the (code, id) pairs, the kernels' events into ev. Reads back
  * once, the bits in which the codes vary (which digits need a pass).

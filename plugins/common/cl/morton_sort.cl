@@ -103,3 +103,96 @@ __kernel void radix_scatter(__global const ulong *keys, __global const uint *val
 		vals_out[to] = vals[i];
 	}
 }
+
+/*
+ * The sort's other shape, for a CPU device: passes over all keys on the
+ * two highest varying digits only (radix_hist, radix_scan, radix_scatter),
+ * then a work-item per bucket of those 16 bits sorts it on the lower
+ * varying digits (`digits`: bit k for the digit at 8k): a bucket is some
+ * tens of keys to some thousands on a million, so its passes stream in the
+ * core's cache, where radix_scatter's passes over the whole array write to
+ * 256 places at once across it. 16 bits, not 8, because a scene's
+ * primitives can crowd into a few cells of the top digit (the conference
+ * room subdivided once: 62 % in one). Still stable from the primitives'
+ * order, so the same (code, primitive) order.
+ */
+#define BUCKETS 65536u
+/* Buckets this small are insertion sorted, straight into the buffer where
+ * the passes of the others end. */
+#define SMALL_BUCKET 32
+
+static uint bucket_of(ulong k, uint s1, uint s2)
+{
+	return (uint)(k >> s1 & 0xff) << 8 | (uint)(k >> s2 & 0xff);
+}
+
+/* Bucket b is [range[2b], range[2b + 1]) of the keys sorted on its two
+ * digits (at s1 and s2); range[] zeroed first, so an empty one is [0, 0). */
+__kernel void radix_ranges(__global const ulong *keys, uint n, uint s1, uint s2,
+	__global uint *range)
+{
+	uint i = get_global_id(0);
+	if (i >= n)
+		return;
+	uint b = bucket_of(keys[i], s1, s2);
+	if (i == 0 || bucket_of(keys[i - 1], s1, s2) != b)
+		range[2 * b] = i;
+	if (i == n - 1 || bucket_of(keys[i + 1], s1, s2) != b)
+		range[2 * b + 1] = i + 1;
+}
+
+/* Stable insertion sort of [lo, hi) from (kin, vin) into (kout, vout). */
+static void insertion(__global const ulong *kin, __global const uint *vin,
+	__global ulong *kout, __global uint *vout, size_t lo, size_t hi)
+{
+	for (size_t i = lo; i < hi; i++) {
+		ulong k = kin[i];
+		uint v = vin[i];
+		size_t j = i;
+		for (; j > lo && kout[j - 1] > k; j--) {
+			kout[j] = kout[j - 1];
+			vout[j] = vout[j - 1];
+		}
+		kout[j] = k;
+		vout[j] = v;
+	}
+}
+
+__kernel void radix_buckets(__global ulong *keys, __global uint *vals,
+	__global ulong *keys_tmp, __global uint *vals_tmp, __global const uint *range,
+	uint digits)
+{
+	uint b = get_global_id(0), count[RADIX];
+	if (b >= BUCKETS)
+		return;
+	size_t lo = range[2 * b], hi = range[2 * b + 1];
+	bool odd = popcount(digits) & 1;
+	if (hi - lo <= SMALL_BUCKET) {
+		insertion(keys, vals, odd ? keys_tmp : keys, odd ? vals_tmp : vals, lo, hi);
+		return;
+	}
+	__global ulong *kin = keys, *kout = keys_tmp, *kt;
+	__global uint *vin = vals, *vout = vals_tmp, *vt;
+	for (uint shift = 0; shift < 64; shift += 8) {
+		if (!((digits >> (shift / 8)) & 1))
+			continue;
+		for (uint d = 0; d < RADIX; d++)
+			count[d] = 0;
+		for (size_t i = lo; i < hi; i++)
+			count[(uint)(kin[i] >> shift) & (RADIX - 1)]++;
+		uint at = (uint)lo;
+		for (uint d = 0; d < RADIX; d++) {
+			uint c = count[d];
+			count[d] = at;
+			at += c;
+		}
+		for (size_t i = lo; i < hi; i++) {
+			ulong k = kin[i];
+			uint to = count[(uint)(k >> shift) & (RADIX - 1)]++;
+			kout[to] = k;
+			vout[to] = vin[i];
+		}
+		kt = kin, kin = kout, kout = kt;
+		vt = vin, vin = vout, vout = vt;
+	}
+}
