@@ -1,0 +1,48 @@
+/*
+ * standalone.h: what the three peer programs share (arguments, the scene,
+ * the timing loop). Each program builds from its library's own input
+ * format, made once before timing, and times only the library's build
+ * call, after warm-up builds into the same BVH object, as the libraries'
+ * own benchmarks do; compare.sh runs them beside the in-harness plugins.
+ *
+ *   PROGRAM SCENE [--subdivide K] [--threads N] [--repeat N] [--warmup N]
+ *           [--variant NAME] [--split box|clip]
+ *
+ * prints one line: "LIB VARIANT threads=N wall_ms=MEDIAN cpu_ms=MEDIAN
+ * min_ms=MIN repeats=N" (cpu_ms: the process's CPU time over the call,
+ * all threads, which load elsewhere does not stretch).
+ */
+#ifndef BVHLAB_PEERS_STANDALONE_H
+#define BVHLAB_PEERS_STANDALONE_H
+
+#include <bvhlab/scene.h>
+
+BVHLAB_BEGIN_DECLS
+
+typedef struct sa_args {
+	const char *scene;
+	const char *variant; /* the library's builder, as the plugin's option names it */
+	const char *split;   /* embree high: box (Embree's tutorial) or clip (the plugin's) */
+	unsigned subdivide, threads, repeat, warmup;
+} sa_args;
+
+/* Parses argv into a (defaults: variant `def`, 1 thread, repeat 5,
+ * warmup 1, split "box"); `variants` is "a|b|c". Prints the usage and
+ * returns -1 on a bad command line. */
+int sa_parse(int argc, char **argv, const char *variants, const char *def, sa_args *a);
+
+/* The scene as the harness loads it (file, then subdivide); NULL after a
+ * message on stderr. */
+bvhlab_scene *sa_load(const sa_args *a);
+
+/* One timed build: `prepare` (untimed, may be NULL) then `build`; both
+ * return 0 or a negative errno. */
+typedef int (*sa_step)(void *user);
+
+/* Runs warmup + repeat builds, prints the result line for `lib`; 0 or the
+ * first failing step's code. */
+int sa_time(const char *lib, const sa_args *a, sa_step prepare, sa_step build, void *user);
+
+BVHLAB_END_DECLS
+
+#endif
