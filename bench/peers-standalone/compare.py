@@ -12,9 +12,10 @@ standalone program (build/bench/peers-standalone/) on the same scene, with
 the same warm-up and repeats, interleaved: pair by pair, the order of the
 two flipped every pair, so a drift of the machine's speed falls on both.
 Builders single-threaded in their library (tinybvh quick, bvh2 sweep and
-binned) run at 1 thread only, as bench/peers.json runs them. Embree high
-runs alone twice: with the tutorial's box split and with the plugin's
-triangle clipping (--split clip), so the cost of the callbacks shows.
+binned) run at 1 thread only, as bench/peers.json runs them. Embree runs
+alone twice: with callbacks of its tutorial's kind, and with the plugin's
+own (--callbacks plugin: high clips triangles exactly), so the callbacks'
+share shows apart from the harness's.
 
 The in-harness time is the library's: the median build_ms less the
 median `input` (the library's input made from bvhlab's scene) and
@@ -37,7 +38,7 @@ import tempfile
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 
-# (plugin, variant, single-threaded in the library, standalone extra args)
+# (plugin, variant, single-threaded in the library)
 BUILDERS = [
     ("tinybvh", "quick", True), ("tinybvh", "binned", False), ("tinybvh", "avx", False),
     ("tinybvh", "sweep", False),
@@ -70,8 +71,9 @@ def pairs(args):
             if (serial and t > 1) or args.only not in name:
                 continue
             out.append((name, plugin, variant, t, []))
-            if plugin == "embree" and variant == "high":
-                out.append((name + " (clip)", plugin, variant, t, ["--split", "clip"]))
+            if plugin == "embree":
+                out.append((name + " (plugin's callbacks)", plugin, variant, t,
+                            ["--callbacks", "plugin"]))
     return out
 
 
@@ -127,7 +129,7 @@ def main():
     os.makedirs(keep, exist_ok=True)
     rows, cpu, start = [], "?", datetime.datetime.now(datetime.timezone.utc)
     for k, (name, plugin, variant, t, extra) in enumerate(pairs(args)):
-        folder = os.path.join(keep, f"{name.split(' ')[0]}-{t}t{'-clip' if extra else ''}")
+        folder = os.path.join(keep, f"{name.split(' ')[0]}-{t}t{'-cb' if extra else ''}")
         steps = [lambda: harness(args, plugin, variant, t, folder),
                  lambda: standalone(args, plugin, variant, t, extra)]
         got = [None, None]

@@ -6,10 +6,12 @@
  * reorders it and, for high, splits into its spare capacity), and only
  * rtcBuildBVH timed. The build arguments are the plugin's defaults (binary
  * nodes, depth 64, leaves of 1 to 8, costs 1, high's room 1.2 x the
- * triangles). The callbacks are the tutorial's kind: inner nodes with
- * their children's boxes, leaves with their ids; high splits a reference
- * as --split says: "box" cuts its box at the plane (the tutorial's), "clip"
- * clips the triangle as the plugin does (tri_clip.h).
+ * triangles). --callbacks says which callbacks build the tree:
+ * "tutorial" (the default), the tutorial's kind: inner nodes with their
+ * children's boxes, leaves with their ids, high splitting a reference by
+ * cutting its box at the plane; "plugin", the embree plugin's own
+ * (plugins/embree/embree_tree.c: high clips the triangle exactly), so the
+ * callbacks' share of the plugin's time shows apart from the harness's.
  */
 #include <embree3/rtcore.h>
 #include <errno.h>
@@ -18,8 +20,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "embree_internal.h"
 #include "standalone.h"
-#include "tri_clip.h"
 
 #define MAX_DEPTH 64
 #define MAX_LEAF 8
@@ -42,6 +44,8 @@ typedef struct job {
 	struct RTCBuildPrimitive *prims, *pristine;
 	size_t count, capacity;
 	const bvhlab_scene *scene;
+	bvhlab_prims input;   /* what the plugin's callbacks read */
+	embree_job plugin;    /* their userPtr */
 } job;
 
 static void *create_node(RTCThreadLocalAllocator alloc, unsigned int n, void *user)
@@ -93,19 +97,6 @@ static void split_box(const struct RTCBuildPrimitive *prim, unsigned int dim, fl
 	(&right->lower_x)[dim] = pos;
 }
 
-static void split_clip(const struct RTCBuildPrimitive *prim, unsigned int dim, float pos,
-                       struct RTCBounds *left, struct RTCBounds *right, void *user)
-{
-	const job *j = user;
-	const bvhlab_aabb box = {{prim->lower_x, prim->lower_y, prim->lower_z},
-	                         {prim->upper_x, prim->upper_y, prim->upper_z}};
-	bvhlab_aabb l, r;
-	tri_clip_split(j->scene->vertices, &j->scene->indices[3 * (size_t)prim->primID], &box,
-	               (int)dim, pos, &l, &r);
-	*left = (struct RTCBounds){l.lo[0], l.lo[1], l.lo[2], 0, l.hi[0], l.hi[1], l.hi[2], 0};
-	*right = (struct RTCBounds){r.lo[0], r.lo[1], r.lo[2], 0, r.hi[0], r.hi[1], r.hi[2], 0};
-}
-
 static int fill_pristine(job *j)
 {
 	const bvhlab_scene *s = j->scene;
@@ -146,11 +137,17 @@ static void set_args(job *j, const sa_args *a)
 	g->primitives = j->prims;
 	g->primitiveCount = j->count;
 	g->primitiveArrayCapacity = j->capacity;
+	if (strcmp(a->callbacks, "plugin") == 0) {
+		j->plugin.input = &j->input.input;
+		embree_set_callbacks(g, high);
+		g->userPtr = &j->plugin;
+		return;
+	}
 	g->createNode = create_node;
 	g->setNodeChildren = set_children;
 	g->setNodeBounds = set_bounds;
 	g->createLeaf = create_leaf;
-	g->splitPrimitive = !high ? NULL : strcmp(a->split, "clip") == 0 ? split_clip : split_box;
+	g->splitPrimitive = high ? split_box : NULL;
 	g->userPtr = j;
 }
 
@@ -181,7 +178,9 @@ int main(int argc, char **argv)
 	RTCDevice dev = rtcNewDevice(config);
 	job j = {.scene = scene, .count = scene->triangle_count};
 	j.capacity = strcmp(a.variant, "high") == 0 ? (size_t)ceil(SPLIT_FACTOR * j.count) : j.count;
-	int rc = dev && (j.bvh = rtcNewBVH(dev)) && fill_pristine(&j) == 0 ? 0 : -1;
+	bvhlab_error err;
+	int rc = dev && (j.bvh = rtcNewBVH(dev)) && fill_pristine(&j) == 0 &&
+	         bvhlab_prims_init(&j.input, scene, &err) == 0 ? 0 : -1;
 	if (rc == 0) {
 		set_args(&j, &a);
 		rc = sa_time("embree", &a, prepare, build, &j);
@@ -193,6 +192,7 @@ int main(int argc, char **argv)
 	if (dev)
 		rtcReleaseDevice(dev);
 	free(j.prims), free(j.pristine);
+	bvhlab_prims_finish(&j.input);
 	bvhlab_scene_destroy(scene);
 	return rc < 0 ? 1 : 0;
 }

@@ -18,7 +18,7 @@
 static int usage(const char *prog, const char *variants)
 {
 	fprintf(stderr, "usage: %s SCENE [--subdivide K] [--threads N] [--repeat N] "
-	        "[--warmup N] [--variant %s] [--split box|clip]\n", prog, variants);
+	        "[--warmup N] [--variant %s] [--callbacks tutorial|plugin]\n", prog, variants);
 	return -1;
 }
 
@@ -44,7 +44,7 @@ static int number(const char *s, unsigned lo, unsigned hi, unsigned *out)
 
 int sa_parse(int argc, char **argv, const char *variants, const char *def, sa_args *a)
 {
-	*a = (sa_args){.variant = def, .split = "box", .threads = 1, .repeat = 5, .warmup = 1};
+	*a = (sa_args){.variant = def, .callbacks = "tutorial", .threads = 1, .repeat = 5, .warmup = 1};
 	for (int i = 1; i < argc; i++) {
 		const char *k = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
 		int bad = 0;
@@ -65,8 +65,8 @@ int sa_parse(int argc, char **argv, const char *variants, const char *def, sa_ar
 			bad = number(v, 0, MAX_REPEAT, &a->warmup);
 		else if (strcmp(k, "--variant") == 0)
 			bad = !one_of(v, variants), a->variant = v;
-		else if (strcmp(k, "--split") == 0)
-			bad = !one_of(v, "box|clip"), a->split = v;
+		else if (strcmp(k, "--callbacks") == 0)
+			bad = !one_of(v, "tutorial|plugin"), a->callbacks = v;
 		else
 			bad = 1;
 		if (bad)
@@ -115,7 +115,7 @@ int sa_time(const char *lib, const sa_args *a, sa_step prepare, sa_step build, v
 	double wmed, wmin, wmax, cmed, cmin, cmax;
 	util_summarise(wall, a->repeat, &wmed, &wmin, &wmax);
 	util_summarise(cpu, a->repeat, &cmed, &cmin, &cmax);
-	printf("%s %s threads=%u wall_ms=%.3f cpu_ms=%.3f min_ms=%.3f repeats=%u\n", lib,
-	       a->variant, a->threads, wmed, cmed, wmin, a->repeat);
+	printf("%s %s callbacks=%s threads=%u wall_ms=%.3f cpu_ms=%.3f min_ms=%.3f repeats=%u\n", lib,
+	       a->variant, a->callbacks, a->threads, wmed, cmed, wmin, a->repeat);
 	return 0;
 }

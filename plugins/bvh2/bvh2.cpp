@@ -27,7 +27,6 @@
 
 #include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <exception>
 #include <memory>
 #include <new>
@@ -52,11 +51,17 @@ using clk = std::chrono::steady_clock;
 // The node's 4-bit primitive count caps a leaf at 15.
 constexpr int64_t max_leaf_cap = Node::Index::max_prim_count;
 
-// one_thread's choices, by index.
+// builder's and one_thread's choices, by index.
+enum Builder { low, medium, high, sweep, binned };
 enum OneThread { sequential, pool_of_one };
 
+// What each builder choice runs (the option's help).
+constexpr const char *builder_help =
+	"low, medium, high (DefaultBuilder: mini-tree on a pool of the run's threads; at 1 "
+	"thread the library's single-thread path), sweep, binned (top-down SAH, 1 thread)";
+
 struct Settings {
-	const char *builder = "medium";
+	int builder = medium; // Builder
 	bool reinsertion = false;
 	int one_thread = sequential; // OneThread
 	int64_t min_leaf = 1, max_leaf = 8;
@@ -65,13 +70,9 @@ struct Settings {
 
 // The options and where they go (plugin_options.h): the host has checked them.
 const plugin_option options[] = {
-	PLUGIN_OPTION(Settings, builder, STRING,
-	              bvhlab::string_option("builder",
-	                                    "low, medium, high (DefaultBuilder: mini-tree on a pool "
-	                                    "of the run's threads; at 1 thread the library's "
-	                                    "single-thread path), sweep, binned (top-down SAH, 1 "
-	                                    "thread)",
-	                                    "medium", "low|medium|high|sweep|binned")),
+	PLUGIN_OPTION(Settings, builder, CHOICE,
+	              bvhlab::string_option("builder", builder_help, "medium",
+	                                    "low|medium|high|sweep|binned")),
 	PLUGIN_OPTION(Settings, reinsertion, BOOL,
 	              bvhlab::bool_option("reinsertion",
 	                                  "run its ReinsertionOptimizer after the build (high "
@@ -115,10 +116,9 @@ Default::Config config_of(const Settings &s)
 	c.sah = bvh::v2::SplitHeuristic<float>(0, static_cast<float>(s.cost_ratio));
 	c.min_leaf_size = static_cast<size_t>(s.min_leaf);
 	c.max_leaf_size = static_cast<size_t>(s.max_leaf);
-	const char *b = s.builder;
-	c.quality = std::strcmp(b, "low") == 0    ? Default::Quality::Low
-	            : std::strcmp(b, "high") == 0 ? Default::Quality::High
-	                                          : Default::Quality::Medium;
+	c.quality = s.builder == low    ? Default::Quality::Low
+	            : s.builder == high ? Default::Quality::High
+	                                : Default::Quality::Medium;
 	return c;
 }
 
@@ -128,9 +128,9 @@ Bvh run_builder(const Settings &s, bvh::v2::ThreadPool *pool, const std::vector<
 {
 	Default::Config c = config_of(s);
 	Bvh bvh;
-	if (std::strcmp(s.builder, "sweep") == 0)
+	if (s.builder == sweep)
 		bvh = bvh::v2::SweepSahBuilder<Node>::build(boxes, centers, c);
-	else if (std::strcmp(s.builder, "binned") == 0)
+	else if (s.builder == binned)
 		bvh = bvh::v2::BinnedSahBuilder<Node>::build(boxes, centers, c);
 	else if (pool)
 		bvh = Default::build(*pool, boxes, centers, c);
@@ -184,7 +184,7 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 	}
 	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
 	// sweep and binned are single-threaded: a pool only for what uses one.
-	bool top_down = std::strcmp(s.builder, "sweep") == 0 || std::strcmp(s.builder, "binned") == 0;
+	bool top_down = s.builder == sweep || s.builder == binned;
 	std::optional<bvh::v2::ThreadPool> pool;
 	if ((in->threads > 1 || s.one_thread == pool_of_one) && (!top_down || s.reinsertion))
 		pool.emplace(in->threads);
