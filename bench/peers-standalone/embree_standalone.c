@@ -170,6 +170,8 @@ int main(int argc, char **argv)
 	sa_args a;
 	if (sa_parse(argc, argv, "low|medium|high", "medium", &a) < 0)
 		return 2;
+	if (!a.callbacks)
+		a.callbacks = "tutorial";
 	bvhlab_scene *scene = sa_load(&a);
 	if (!scene)
 		return 1;

@@ -44,7 +44,7 @@ static int number(const char *s, unsigned lo, unsigned hi, unsigned *out)
 
 int sa_parse(int argc, char **argv, const char *variants, const char *def, sa_args *a)
 {
-	*a = (sa_args){.variant = def, .callbacks = "tutorial", .threads = 1, .repeat = 5, .warmup = 1};
+	*a = (sa_args){.variant = def, .callbacks = NULL, .threads = 1, .repeat = 5, .warmup = 1};
 	for (int i = 1; i < argc; i++) {
 		const char *k = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
 		int bad = 0;
@@ -115,7 +115,8 @@ int sa_time(const char *lib, const sa_args *a, sa_step prepare, sa_step build, v
 	double wmed, wmin, wmax, cmed, cmin, cmax;
 	util_summarise(wall, a->repeat, &wmed, &wmin, &wmax);
 	util_summarise(cpu, a->repeat, &cmed, &cmin, &cmax);
-	printf("%s %s callbacks=%s threads=%u wall_ms=%.3f cpu_ms=%.3f min_ms=%.3f repeats=%u\n", lib,
-	       a->variant, a->callbacks, a->threads, wmed, cmed, wmin, a->repeat);
+	printf("%s %s%s%s threads=%u wall_ms=%.3f cpu_ms=%.3f min_ms=%.3f repeats=%u\n", lib,
+	       a->variant, a->callbacks ? " callbacks=" : "", a->callbacks ? a->callbacks : "",
+	       a->threads, wmed, cmed, wmin, a->repeat);
 	return 0;
 }

@@ -8,9 +8,9 @@
  *   PROGRAM SCENE [--subdivide K] [--threads N] [--repeat N] [--warmup N]
  *           [--variant NAME] [--callbacks tutorial|plugin]
  *
- * prints one line: "LIB VARIANT callbacks=C threads=N wall_ms=MEDIAN cpu_ms=MEDIAN
- * min_ms=MIN repeats=N" (cpu_ms: the process's CPU time over the call,
- * all threads, which load elsewhere does not stretch).
+ * prints one line: "LIB VARIANT [callbacks=C] threads=N wall_ms=MEDIAN
+ * cpu_ms=MEDIAN min_ms=MIN repeats=N" (cpu_ms: the process's CPU time over
+ * the call, all threads, which waiting for a CPU does not stretch).
  */
 #ifndef BVHLAB_PEERS_STANDALONE_H
 #define BVHLAB_PEERS_STANDALONE_H
@@ -22,12 +22,13 @@ BVHLAB_BEGIN_DECLS
 typedef struct sa_args {
 	const char *scene;
 	const char *variant; /* the library's builder, as the plugin's option names it */
-	const char *callbacks; /* embree: "tutorial" (its kind) or "plugin" (the plugin's) */
+	const char *callbacks; /* embree only: "tutorial" (its kind, the default) or
+	                        * "plugin" (the plugin's); NULL when not given */
 	unsigned subdivide, threads, repeat, warmup;
 } sa_args;
 
 /* Parses argv into a (defaults: variant `def`, 1 thread, repeat 5,
- * warmup 1, callbacks "tutorial"); `variants` is "a|b|c". Prints the usage and
+ * warmup 1, callbacks NULL); `variants` is "a|b|c". Prints the usage and
  * returns -1 on a bad command line. */
 int sa_parse(int argc, char **argv, const char *variants, const char *def, sa_args *a);
 
