@@ -14,7 +14,6 @@
 #include <bvh/v2/thread_pool.h>
 #include <bvh/v2/tri.h>
 
-#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -34,7 +33,7 @@ struct Job {
 	std::vector<Vec3> centers;
 	std::unique_ptr<bvh::v2::ThreadPool> pool;
 	Default::Config config;
-	const char *variant;
+	int variant; // Variant
 	Bvh bvh;
 };
 
@@ -51,12 +50,15 @@ void inputs(const bvhlab_scene *s, Job &j)
 	}
 }
 
+// By index in the program's list of variants (main).
+enum Variant { low, medium, high, sweep, binned };
+
 int build(void *user)
 {
 	Job &j = *static_cast<Job *>(user);
-	if (std::strcmp(j.variant, "sweep") == 0)
+	if (j.variant == sweep)
 		j.bvh = bvh::v2::SweepSahBuilder<Node>::build(j.boxes, j.centers, j.config);
-	else if (std::strcmp(j.variant, "binned") == 0)
+	else if (j.variant == binned)
 		j.bvh = bvh::v2::BinnedSahBuilder<Node>::build(j.boxes, j.centers, j.config);
 	else if (j.pool)
 		j.bvh = Default::build(*j.pool, j.boxes, j.centers, j.config);
@@ -70,20 +72,17 @@ int build(void *user)
 int main(int argc, char **argv)
 {
 	sa_args a;
-	if (sa_parse(argc, argv, "low|medium|high|sweep|binned", "medium", &a) < 0)
-		return 2;
-	bvhlab_scene *scene = sa_load(&a);
-	if (!scene)
-		return 1;
+	bvhlab_scene *scene;
+	if (int rc = sa_start(argc, argv, "low|medium|high|sweep|binned", "medium", &a, &scene))
+		return rc;
 	Job job;
 	inputs(scene, job);
 	bvhlab_scene_destroy(scene);
-	job.variant = a.variant;
-	job.config.quality = std::strcmp(a.variant, "low") == 0    ? Default::Quality::Low
-	                     : std::strcmp(a.variant, "high") == 0 ? Default::Quality::High
-	                                                           : Default::Quality::Medium;
-	bool top_down = std::strcmp(a.variant, "sweep") == 0 || std::strcmp(a.variant, "binned") == 0;
-	if (a.threads > 1 && !top_down)
+	job.variant = a.which;
+	job.config.quality = a.which == low    ? Default::Quality::Low
+	                     : a.which == high ? Default::Quality::High
+	                                       : Default::Quality::Medium;
+	if (a.threads > 1 && a.which != sweep && a.which != binned)
 		job.pool = std::make_unique<bvh::v2::ThreadPool>(a.threads);
 	return sa_time("bvh2", &a, nullptr, build, &job) < 0 ? 1 : 0;
 }

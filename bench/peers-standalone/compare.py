@@ -24,8 +24,9 @@ time is the median of the build call alone. Prints a Markdown table with
 the CPU model, the ratio in-harness / standalone per builder.
 
 Wall-clock figures: run it on a quiet machine. Default (igea subdivided
-once, 1 and 2 threads, 5 repeats after 1 warm-up): about 5 minutes on a
-2-core AMD EPYC.
+once, 1 and 2 threads, 5 repeats after 1 warm-up): about 5 minutes on the
+2-core AMD EPYC by an estimate from the libraries' earlier quiet times
+(not yet timed quiet); --repeat 3 when that is too long.
 """
 import argparse
 import datetime
@@ -62,13 +63,23 @@ def parse_args():
     return p.parse_args()
 
 
+def program(args, plugin):
+    return os.path.join(args.build, "bench", "peers-standalone", f"{plugin}-standalone")
+
+
 def pairs(args):
-    """(name, plugin, variant, threads, standalone extra args), in run order."""
+    """(name, plugin, variant, threads, standalone extra args), in run order;
+    a library whose program was not built (meson said why) is left out."""
     out = []
+    for plugin in OPTION:
+        if not os.access(program(args, plugin), os.X_OK):
+            print(f"{plugin}: skipped, {program(args, plugin)} not built", file=sys.stderr)
     for t in [int(x) for x in args.threads.split(",")]:
         for plugin, variant, serial in BUILDERS:
             name = f"{plugin}_{variant}"
             if (serial and t > 1) or args.only not in name:
+                continue
+            if not os.access(program(args, plugin), os.X_OK):
                 continue
             out.append((name, plugin, variant, t, []))
             if plugin == "embree":
@@ -105,8 +116,7 @@ def harness(args, plugin, variant, threads, folder):
 
 
 def standalone(args, plugin, variant, threads, extra):
-    prog = os.path.join(args.build, "bench", "peers-standalone", f"{plugin}-standalone")
-    cmd = [prog, args.scene, "--subdivide", str(args.subdivide), "--threads", str(threads),
+    cmd = [program(args, plugin), args.scene, "--subdivide", str(args.subdivide), "--threads", str(threads),
            "--repeat", str(args.repeat), "--warmup", str(args.warmup),
            "--variant", variant] + extra
     line = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
@@ -115,12 +125,19 @@ def standalone(args, plugin, variant, threads, extra):
 
 
 def cpu_model(from_results):
+    """results.json's CPU name (/proc/cpuinfo's when no run was made),
+    with lscpu's family: "AMD EPYC" alone does not say which."""
+    name = from_results
+    if name == "?" and os.path.exists("/proc/cpuinfo"):
+        with open("/proc/cpuinfo") as f:
+            m = re.search(r"model name\s*:\s*(.+)", f.read())
+        name = m.group(1).strip() if m else name
     try:
         out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-        fam = re.search(r"CPU family:\s*(\S+)", out)
-        return from_results + (f" (CPU family {fam.group(1)})" if fam else "")
     except OSError:
-        return from_results
+        return name
+    fam = re.search(r"CPU family:\s*(\S+)", out)
+    return name + (f" (CPU family {fam.group(1)})" if fam else "")
 
 
 def main():

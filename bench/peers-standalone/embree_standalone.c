@@ -168,20 +168,19 @@ static int build(void *user)
 int main(int argc, char **argv)
 {
 	sa_args a;
-	if (sa_parse(argc, argv, "low|medium|high", "medium", &a) < 0)
-		return 2;
+	bvhlab_scene *scene;
+	int rc = sa_start(argc, argv, "low|medium|high", "medium", &a, &scene);
+	if (rc)
+		return rc;
 	if (!a.callbacks)
 		a.callbacks = "tutorial";
-	bvhlab_scene *scene = sa_load(&a);
-	if (!scene)
-		return 1;
 	char config[64];
 	snprintf(config, sizeof(config), "threads=%u,verbose=0", a.threads);
 	RTCDevice dev = rtcNewDevice(config);
 	job j = {.scene = scene, .count = scene->triangle_count};
 	j.capacity = strcmp(a.variant, "high") == 0 ? (size_t)ceil(SPLIT_FACTOR * j.count) : j.count;
 	bvhlab_error err;
-	int rc = dev && (j.bvh = rtcNewBVH(dev)) && fill_pristine(&j) == 0 &&
+	rc = dev && (j.bvh = rtcNewBVH(dev)) && fill_pristine(&j) == 0 &&
 	         bvhlab_prims_init(&j.input, scene, &err) == 0 ? 0 : -1;
 	if (rc == 0) {
 		set_args(&j, &a);

@@ -22,14 +22,15 @@ static int usage(const char *prog, const char *variants)
 	return -1;
 }
 
-/* Whether `v` is one of the '|'-separated names in `list`. */
-static int one_of(const char *v, const char *list)
+/* The index of `v` among the '|'-separated names in `list`, or -1. */
+static int index_in(const char *v, const char *list)
 {
 	size_t n = strlen(v);
-	for (const char *p = list; p; p = strchr(p, '|'), p = p ? p + 1 : NULL)
+	int k = 0;
+	for (const char *p = list; p; p = strchr(p, '|'), p = p ? p + 1 : NULL, k++)
 		if (strncmp(p, v, n) == 0 && (p[n] == '|' || p[n] == '\0'))
-			return 1;
-	return 0;
+			return k;
+	return -1;
 }
 
 static int number(const char *s, unsigned lo, unsigned hi, unsigned *out)
@@ -42,7 +43,7 @@ static int number(const char *s, unsigned lo, unsigned hi, unsigned *out)
 	return 0;
 }
 
-int sa_parse(int argc, char **argv, const char *variants, const char *def, sa_args *a)
+static int parse(int argc, char **argv, const char *variants, const char *def, sa_args *a)
 {
 	*a = (sa_args){.variant = def, .callbacks = NULL, .threads = 1, .repeat = 5, .warmup = 1};
 	for (int i = 1; i < argc; i++) {
@@ -64,29 +65,34 @@ int sa_parse(int argc, char **argv, const char *variants, const char *def, sa_ar
 		else if (strcmp(k, "--warmup") == 0)
 			bad = number(v, 0, MAX_REPEAT, &a->warmup);
 		else if (strcmp(k, "--variant") == 0)
-			bad = !one_of(v, variants), a->variant = v;
+			bad = index_in(v, variants) < 0, a->variant = v;
 		else if (strcmp(k, "--callbacks") == 0)
-			bad = !one_of(v, "tutorial|plugin"), a->callbacks = v;
+			bad = index_in(v, "tutorial|plugin") < 0, a->callbacks = v;
 		else
 			bad = 1;
 		if (bad)
 			return usage(argv[0], variants);
 	}
+	a->which = index_in(a->variant, variants);
 	return a->scene ? 0 : usage(argv[0], variants);
 }
 
-bvhlab_scene *sa_load(const sa_args *a)
+int sa_start(int argc, char **argv, const char *variants, const char *def, sa_args *a,
+             bvhlab_scene **scene)
 {
-	bvhlab_scene *s = NULL;
 	bvhlab_error err;
-	int rc = bvhlab_scene_load(a->scene, &s, &err);
+	*scene = NULL;
+	if (parse(argc, argv, variants, def, a) < 0)
+		return 2;
+	int rc = bvhlab_scene_load(a->scene, scene, &err);
 	if (rc == 0 && a->subdivide)
-		rc = bvhlab_scene_subdivide(s, a->subdivide, &err);
+		rc = bvhlab_scene_subdivide(*scene, a->subdivide, &err);
 	if (rc == 0)
-		return s;
-	fprintf(stderr, "%s: %s\n", a->scene, err.message);
-	bvhlab_scene_destroy(s);
-	return NULL;
+		return 0;
+	fprintf(stderr, "%s\n", err.message);
+	bvhlab_scene_destroy(*scene);
+	*scene = NULL;
+	return 1;
 }
 
 static double cpu_ms(void)

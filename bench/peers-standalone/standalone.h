@@ -22,19 +22,19 @@ BVHLAB_BEGIN_DECLS
 typedef struct sa_args {
 	const char *scene;
 	const char *variant; /* the library's builder, as the plugin's option names it */
+	int which;           /* its index in the program's list of variants */
 	const char *callbacks; /* embree only: "tutorial" (its kind, the default) or
 	                        * "plugin" (the plugin's); NULL when not given */
 	unsigned subdivide, threads, repeat, warmup;
 } sa_args;
 
 /* Parses argv into a (defaults: variant `def`, 1 thread, repeat 5,
- * warmup 1, callbacks NULL); `variants` is "a|b|c". Prints the usage and
- * returns -1 on a bad command line. */
-int sa_parse(int argc, char **argv, const char *variants, const char *def, sa_args *a);
-
-/* The scene as the harness loads it (file, then subdivide); NULL after a
- * message on stderr. */
-bvhlab_scene *sa_load(const sa_args *a);
+ * warmup 1, callbacks NULL; `variants` is "a|b|c") and loads the scene as
+ * the harness does (file, then subdivide) into *scene. 0, or the exit
+ * status after a message on stderr: 2 for a bad command line (with the
+ * usage), 1 when the scene cannot be loaded. */
+int sa_start(int argc, char **argv, const char *variants, const char *def, sa_args *a,
+             bvhlab_scene **scene);
 
 /* One timed build: `prepare` (untimed, may be NULL) then `build`; both
  * return 0 or a negative errno. */

@@ -9,7 +9,6 @@
 #include <tiny_bvh.h>
 
 #include <cstdio>
-#include <cstring>
 #include <vector>
 
 #include "standalone.h"
@@ -23,7 +22,7 @@ using tinybvh::bvhvec4;
 struct Job {
 	BVH bvh;
 	std::vector<bvhvec4> soup;
-	const char *variant;
+	int variant; // Variant
 };
 
 std::vector<bvhvec4> soup_of(const bvhlab_scene *s)
@@ -36,21 +35,21 @@ std::vector<bvhvec4> soup_of(const bvhlab_scene *s)
 	return v;
 }
 
+// By index in the program's list of variants (main).
+enum Variant { quick, binned, avx, sweep, hq };
+
 int build(void *user)
 {
 	Job &j = *static_cast<Job *>(user);
 	const bvhvec4 *v = j.soup.data();
 	uint32_t n = static_cast<uint32_t>(j.soup.size() / 3);
-	if (std::strcmp(j.variant, "quick") == 0)
-		j.bvh.BuildQuick(v, n);
-	else if (std::strcmp(j.variant, "binned") == 0)
-		j.bvh.Build(v, n);
-	else if (std::strcmp(j.variant, "avx") == 0)
-		j.bvh.BuildAVX(v, n);
-	else if (std::strcmp(j.variant, "sweep") == 0)
-		j.bvh.useFullSweep = true, j.bvh.Build(v, n);
-	else
-		j.bvh.BuildHQ(v, n);
+	switch (j.variant) {
+	case quick: j.bvh.BuildQuick(v, n); break;
+	case binned: j.bvh.Build(v, n); break;
+	case avx: j.bvh.BuildAVX(v, n); break;
+	case sweep: j.bvh.useFullSweep = true, j.bvh.Build(v, n); break;
+	default: j.bvh.BuildHQ(v, n); break;
+	}
 	return 0;
 }
 
@@ -59,14 +58,12 @@ int build(void *user)
 int main(int argc, char **argv)
 {
 	sa_args a;
-	if (sa_parse(argc, argv, "quick|binned|avx|sweep|hq", "avx", &a) < 0)
-		return 2;
-	bvhlab_scene *scene = sa_load(&a);
-	if (!scene)
-		return 1;
+	bvhlab_scene *scene;
+	if (int rc = sa_start(argc, argv, "quick|binned|avx|sweep|hq", "avx", &a, &scene))
+		return rc;
 	Job job;
 	job.soup = soup_of(scene);
-	job.variant = a.variant;
+	job.variant = a.which;
 	bvhlab_scene_destroy(scene);
 	job.bvh.threadedBuild = a.threads > 1;
 	tbvh::CpuLimit cpus;
