@@ -98,11 +98,11 @@ def harness(args, plugin, variant, threads, folder):
                     "subdivide": args.subdivide}],
         "builders": [{"plugin": plugin, "name": f"{plugin}_{variant}",
                       "options": {OPTION[plugin]: variant}}]}
-    path = os.path.join(folder + ".json")
+    path = folder + ".json"
     with open(path, "w") as f:
         json.dump(config, f)
-    subprocess.run([os.path.join(args.build, "app", "bvhlab"), "run", path, "--quiet"],
-                   check=True)
+    subprocess.run([os.path.join(args.build, "app", "bvhlab"), "run", path, "--quiet",
+                    "--force"], check=True)
     with open(os.path.join(folder, "results.json")) as f:
         results = json.load(f)
     run = results["runs"][0]
@@ -116,9 +116,9 @@ def harness(args, plugin, variant, threads, folder):
 
 
 def standalone(args, plugin, variant, threads, extra):
-    cmd = [program(args, plugin), args.scene, "--subdivide", str(args.subdivide), "--threads", str(threads),
-           "--repeat", str(args.repeat), "--warmup", str(args.warmup),
-           "--variant", variant] + extra
+    cmd = [program(args, plugin), args.scene, "--subdivide", str(args.subdivide),
+           "--threads", str(threads), "--repeat", str(args.repeat),
+           "--warmup", str(args.warmup), "--variant", variant] + extra
     line = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     fields = dict(re.findall(r"(\w+)=([\d.]+)", line))
     return float(fields["wall_ms"]), float(fields["cpu_ms"])
@@ -142,7 +142,7 @@ def cpu_model(from_results):
 
 def main():
     args = parse_args()
-    keep = args.keep or tempfile.mkdtemp(prefix="peers-compare-")
+    keep = os.path.abspath(args.keep or tempfile.mkdtemp(prefix="peers-compare-"))
     os.makedirs(keep, exist_ok=True)
     rows, cpu, start = [], "?", datetime.datetime.now(datetime.timezone.utc)
     for k, (name, plugin, variant, t, extra) in enumerate(pairs(args)):
