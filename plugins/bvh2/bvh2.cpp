@@ -55,6 +55,11 @@ constexpr int64_t max_leaf_cap = Node::Index::max_prim_count;
 enum Builder { low, medium, high, sweep, binned };
 enum OneThread { sequential, pool_of_one };
 
+// What each builder choice runs (the option's help).
+constexpr const char *builder_help =
+	"low, medium, high (DefaultBuilder: mini-tree on a pool of the run's threads; at 1 "
+	"thread the library's single-thread path), sweep, binned (top-down SAH, 1 thread)";
+
 struct Settings {
 	int builder = medium; // Builder
 	bool reinsertion = false;
@@ -66,12 +71,8 @@ struct Settings {
 // The options and where they go (plugin_options.h): the host has checked them.
 const plugin_option options[] = {
 	PLUGIN_OPTION(Settings, builder, CHOICE,
-	              bvhlab::string_option("builder",
-	                                    "low, medium, high (DefaultBuilder: mini-tree on a pool "
-	                                    "of the run's threads; at 1 thread the library's "
-	                                    "single-thread path), sweep, binned (top-down SAH, 1 "
-	                                    "thread)",
-	                                    "medium", "low|medium|high|sweep|binned")),
+	              bvhlab::string_option("builder", builder_help, "medium",
+	                                    "low|medium|high|sweep|binned")),
 	PLUGIN_OPTION(Settings, reinsertion, BOOL,
 	              bvhlab::bool_option("reinsertion",
 	                                  "run its ReinsertionOptimizer after the build (high "

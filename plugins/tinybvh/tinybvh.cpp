@@ -17,7 +17,9 @@
 // tinybvh takes 16-byte vertices; the plugin copies the indexed mesh into
 // a triangle soup of them first (phase "input"), and the library's tree
 // into the standard layout last (phase "convert"). Both are inside
-// build_ms, as everything in the call is for every plugin.
+// build_ms, as everything in the call is for every plugin; comparisons of
+// the library's own time take both out. One BVH object serves every build
+// of a run (Kept, below).
 #define TINYBVH_IMPLEMENTATION
 #include <tiny_bvh.h>
 
@@ -27,8 +29,10 @@
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <system_error>
+#include <vector>
 
 #include <bvhlab/builder.hpp>
 
@@ -83,16 +87,45 @@ const plugin_option options[] = {
 };
 PLUGIN_DECLS(options, Settings, nullptr)
 
-// Three 16-byte vertices per triangle, in primitive order.
-std::unique_ptr<bvhvec4[]> soup(const bvhlab_build_input *in)
+// What a run keeps between its builds, as the harness keeps a builder's
+// output ("host-kept output"): the BVH object, whose node and index arrays
+// tinybvh reuses (as its own speedtest builds into one object), and the
+// vertex soup. The object is kept only for the same builder over as many
+// triangles, without Optimize: tinybvh sizes its reuse by the node array
+// alone, which another builder's (hq's 3 nodes per triangle) or a larger
+// scene's overflows, and Optimize may leave it not rebuildable (a fatal
+// error). The harness runs one run per process, so a run's repeats reuse
+// it; the lock serialises builds in one process (the tests'), as embree's.
+struct Kept {
+	std::mutex lock;
+	std::unique_ptr<BVH> bvh;
+	int method = -1; // what bvh was last built with
+	uint32_t prims = 0;
+	bool optimized = false;
+	std::vector<bvhvec4> soup;
+};
+Kept kept;
+
+// The kept object for this build, or a new one (see Kept).
+BVH &object_for(const Settings &s, uint32_t prims)
 {
-	std::unique_ptr<bvhvec4[]> v(new bvhvec4[3 * static_cast<size_t>(in->prim_count)]);
+	if (!kept.bvh || kept.method != s.method || kept.prims != prims || kept.optimized)
+		kept.bvh = std::make_unique<BVH>();
+	kept.method = s.method;
+	kept.prims = prims;
+	kept.optimized = s.optimize > 0;
+	return *kept.bvh;
+}
+
+// Three 16-byte vertices per triangle, in primitive order, into `v`.
+void soup(const bvhlab_build_input *in, std::vector<bvhvec4> &v)
+{
+	v.resize(3 * static_cast<size_t>(in->prim_count));
 	for (size_t t = 0; t < in->prim_count; t++)
 		for (size_t k = 0; k < 3; k++) {
 			const float *p = &in->vertices[3 * static_cast<size_t>(in->indices[3 * t + k])];
 			v[3 * t + k] = bvhvec4(p[0], p[1], p[2], 0.0f);
 		}
-	return v;
 }
 
 // tinybvh 1.6.7's Build, BuildAVX and full sweep allocate their node
@@ -161,17 +194,26 @@ struct View {
 	}
 };
 
-int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
-               const Settings &s, bvhlab_build_output *out)
+// The settings into the kept object: every field a build reads, since the
+// previous build may have set them otherwise.
+void configure(BVH &bvh, const Settings &s, uint32_t threads)
 {
-	auto t0 = clk::now();
-	std::unique_ptr<bvhvec4[]> v = soup(in);
-	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
-	BVH bvh;
 	bvh.c_trav = static_cast<float>(s.c_trav);
 	bvh.c_int = static_cast<float>(s.c_int);
 	bvh.hqbvhbins = static_cast<uint32_t>(s.hq_bins);
-	bvh.threadedBuild = in->threads > 1;
+	bvh.threadedBuild = threads > 1;
+	bvh.useFullSweep = false;
+}
+
+int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+               const Settings &s, bvhlab_build_output *out)
+{
+	std::lock_guard<std::mutex> hold(kept.lock);
+	auto t0 = clk::now();
+	soup(in, kept.soup);
+	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
+	BVH &bvh = object_for(s, in->prim_count);
+	configure(bvh, s, in->threads);
 	{
 		tbvh::CpuLimit cpus;
 		int rc = in->threads > 1 ? cpus.limit(in->threads) : 0;
@@ -180,7 +222,7 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 			                in->threads, std::strerror(-rc));
 			return rc;
 		}
-		run_builder(bvh, s, v.get(), in->prim_count);
+		run_builder(bvh, s, kept.soup.data(), in->prim_count);
 	}
 	if (s.optimize > 0)
 		optimize(bvh, s);

@@ -1,0 +1,172 @@
+#!/usr/bin/env python3
+"""Each peer builder in the harness against its library alone (issue 43).
+
+Usage (from the checkout): bench/peers-standalone/compare.py [--build DIR]
+    [--scene PATH] [--subdivide K] [--threads 1,2] [--repeat N] [--warmup N]
+    [--only SUBSTRING] [--keep DIR]
+
+For every peer builder (tinybvh quick, binned, avx, sweep; madmann91/bvh
+low, medium, high, sweep, binned; Embree low, medium, high) and thread
+count, in one window, a `bvhlab run` of that one builder and the library's
+standalone program (build/bench/peers-standalone/) on the same scene, with
+the same warm-up and repeats, interleaved: pair by pair, the order of the
+two flipped every pair, so a drift of the machine's speed falls on both.
+Builders single-threaded in their library (tinybvh quick, bvh2 sweep and
+binned) run at 1 thread only, as bench/peers.json runs them. Embree runs
+alone twice: with callbacks of its tutorial's kind, and with the plugin's
+own (--callbacks plugin: high clips triangles exactly), so the callbacks'
+share shows apart from the harness's.
+
+The in-harness time is the library's: the median build_ms less the
+median `input` (the library's input made from bvhlab's scene) and
+`convert` (its tree written in bvhlab's layout) phases. The standalone
+time is the median of the build call alone. Prints a Markdown table with
+the CPU model, the ratio in-harness / standalone per builder.
+
+Wall-clock figures: run it on a quiet machine. Default (igea subdivided
+once, 1 and 2 threads, 5 repeats after 1 warm-up): about 5 minutes on the
+2-core AMD EPYC by an estimate from the libraries' earlier quiet times
+(not yet timed quiet); --repeat 3 when that is too long.
+"""
+import argparse
+import datetime
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+
+# (plugin, variant, single-threaded in the library)
+BUILDERS = [
+    ("tinybvh", "quick", True), ("tinybvh", "binned", False), ("tinybvh", "avx", False),
+    ("tinybvh", "sweep", False),
+    ("bvh2", "low", False), ("bvh2", "medium", False), ("bvh2", "high", False),
+    ("bvh2", "sweep", True), ("bvh2", "binned", True),
+    ("embree", "low", False), ("embree", "medium", False), ("embree", "high", False),
+]
+OPTION = {"tinybvh": "builder", "bvh2": "builder", "embree": "quality"}
+
+
+def parse_args():
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--build", default=os.path.join(ROOT, "build"))
+    p.add_argument("--scene", default=os.path.join(ROOT, "..", "shared", "scenes", "igea.ply"))
+    p.add_argument("--subdivide", type=int, default=1)
+    p.add_argument("--threads", default="1,2")
+    p.add_argument("--repeat", type=int, default=5)
+    p.add_argument("--warmup", type=int, default=1)
+    p.add_argument("--only", default="", help="run the builders whose name holds this")
+    p.add_argument("--keep", help="folder for the harness's outputs (default: a temporary one)")
+    return p.parse_args()
+
+
+def program(args, plugin):
+    return os.path.join(args.build, "bench", "peers-standalone", f"{plugin}-standalone")
+
+
+def pairs(args):
+    """(name, plugin, variant, threads, standalone extra args), in run order;
+    a library whose program was not built (meson said why) is left out."""
+    out = []
+    for plugin in OPTION:
+        if not os.access(program(args, plugin), os.X_OK):
+            print(f"{plugin}: skipped, {program(args, plugin)} not built", file=sys.stderr)
+    for t in [int(x) for x in args.threads.split(",")]:
+        for plugin, variant, serial in BUILDERS:
+            name = f"{plugin}_{variant}"
+            if (serial and t > 1) or args.only not in name:
+                continue
+            if not os.access(program(args, plugin), os.X_OK):
+                continue
+            out.append((name, plugin, variant, t, []))
+            if plugin == "embree":
+                out.append((name + " (plugin's callbacks)", plugin, variant, t,
+                            ["--callbacks", "plugin"]))
+    return out
+
+
+def harness(args, plugin, variant, threads, folder):
+    """The library's median ms in the harness, and the run's phases."""
+    config = {
+        "format_version": 1, "output": folder, "repeat": args.repeat, "warmup": args.warmup,
+        "threads": [threads], "validate": False,
+        "rays": {"width": 8, "height": 8, "diffuse": 0, "min_ms": 1, "rounds": 1},
+        "scenes": [{"name": "scene", "path": os.path.abspath(args.scene),
+                    "subdivide": args.subdivide}],
+        "builders": [{"plugin": plugin, "name": f"{plugin}_{variant}",
+                      "options": {OPTION[plugin]: variant}}]}
+    path = folder + ".json"
+    with open(path, "w") as f:
+        json.dump(config, f)
+    subprocess.run([os.path.join(args.build, "app", "bvhlab"), "run", path, "--quiet",
+                    "--force"], check=True)
+    with open(os.path.join(folder, "results.json")) as f:
+        results = json.load(f)
+    run = results["runs"][0]
+    if run["status"] != "ok":
+        sys.exit(f"{plugin} {variant} at {threads} threads: {run['status']} "
+                 f"({run.get('error', '')})")
+    phases = run.get("build_phases", {})
+    whole = run["build_ms"]["median"]
+    own = whole - phases.get("input", 0.0) - phases.get("convert", 0.0)
+    return own, whole, phases, results["machine"]["cpu"]
+
+
+def standalone(args, plugin, variant, threads, extra):
+    cmd = [program(args, plugin), args.scene, "--subdivide", str(args.subdivide),
+           "--threads", str(threads), "--repeat", str(args.repeat),
+           "--warmup", str(args.warmup), "--variant", variant] + extra
+    line = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    fields = dict(re.findall(r"(\w+)=([\d.]+)", line))
+    return float(fields["wall_ms"]), float(fields["cpu_ms"])
+
+
+def cpu_model(from_results):
+    """results.json's CPU name (/proc/cpuinfo's when no run was made),
+    with lscpu's family: "AMD EPYC" alone does not say which."""
+    name = from_results
+    if name == "?" and os.path.exists("/proc/cpuinfo"):
+        with open("/proc/cpuinfo") as f:
+            m = re.search(r"model name\s*:\s*(.+)", f.read())
+        name = m.group(1).strip() if m else name
+    try:
+        out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
+    except OSError:
+        return name
+    fam = re.search(r"CPU family:\s*(\S+)", out)
+    return name + (f" (CPU family {fam.group(1)})" if fam else "")
+
+
+def main():
+    args = parse_args()
+    keep = os.path.abspath(args.keep or tempfile.mkdtemp(prefix="peers-compare-"))
+    os.makedirs(keep, exist_ok=True)
+    rows, cpu, start = [], "?", datetime.datetime.now(datetime.timezone.utc)
+    for k, (name, plugin, variant, t, extra) in enumerate(pairs(args)):
+        folder = os.path.join(keep, f"{name.split(' ')[0]}-{t}t{'-cb' if extra else ''}")
+        steps = [lambda: harness(args, plugin, variant, t, folder),
+                 lambda: standalone(args, plugin, variant, t, extra)]
+        got = [None, None]
+        for i in ([0, 1] if k % 2 == 0 else [1, 0]):
+            got[i] = steps[i]()
+        (own, whole, phases, cpu), (alone, alone_cpu) = got
+        rows.append((name, t, whole, phases.get("input", 0.0), phases.get("convert", 0.0),
+                     own, alone, alone_cpu))
+        print(f"{name} {t}T: harness {own:.1f} ms, alone {alone:.1f} ms", file=sys.stderr)
+    end = datetime.datetime.now(datetime.timezone.utc)
+    print(f"{os.path.basename(args.scene)} subdivided {args.subdivide}x, "
+          f"{args.repeat} repeats after {args.warmup} warm-up, {cpu_model(cpu)}, "
+          f"{start:%Y-%m-%d %H:%M} to {end:%H:%M} UTC\n")
+    print("| builder | threads | harness build_ms | input | convert | harness, library "
+          "| standalone | standalone CPU | ratio |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for name, t, whole, inp, conv, own, alone, alone_cpu in rows:
+        print(f"| {name} | {t} | {whole:.1f} | {inp:.1f} | {conv:.1f} | {own:.1f} "
+              f"| {alone:.1f} | {alone_cpu:.1f} | {own / alone:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
