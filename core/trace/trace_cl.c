@@ -12,15 +12,14 @@
 
 #include "trace/trace_cl.h"
 #include "trace/trace_cl_source.h"
+#include "trace/trace_layout.h"
 #include "tree/tree_view.h"
 #include "util/util.h"
 
-/* The private stack of the stack kernel: this many entries, or the next
- * power of two at or above a deeper tree's depth (a program per size). */
-#define MIN_STACK 64
+/* Programs per device: one per stack size (TRACE_MIN_STACK, or the next
+ * power of two at or above a deeper tree's need). */
 #define MAX_PROGRAMS 8
 #define RAYS_PER_GROUP 64
-#define OVERFLOW UINT32_MAX
 
 /* -cl-fp32-correctly-rounded-divide-sqrt: the CPU's divisions are IEEE;
  * OpenCL's default float division may be 2.5 ulp off, which would move t,
@@ -125,14 +124,15 @@ static int get_program(struct device *d, unsigned stack, cl_program *out, bvhlab
 	return 0;
 }
 
-/* Inner nodes on the longest root-to-leaf path of a binary tree: the most
- * far children the stack kernel holds at once. -EINVAL for links that
- * leave the array. */
-static int tree_depth(const bvhlab_tree *tree, unsigned *depth)
+/* The most far children the stack kernel holds at once on this tree: over
+ * the root-to-leaf paths, the most sum of (children - 1) of the inner
+ * nodes on one (a binary tree's depth). -EINVAL for links that leave the
+ * array or a node wider than the ABI allows. */
+static int stack_need(const bvhlab_tree *tree, unsigned *need)
 {
 	uint32_t n = tree->node_count, sp = 0;
 	uint32_t (*stack)[2] = malloc((n ? n : 1) * sizeof(*stack));
-	*depth = 0;
+	*need = 0;
 	if (!stack)
 		return -ENOMEM;
 	if (n)
@@ -140,24 +140,26 @@ static int tree_depth(const bvhlab_tree *tree, unsigned *depth)
 	while (sp) {
 		uint32_t node = stack[--sp][0], d = stack[sp][1];
 		const bvhlab_node *nd = &tree->nodes[node];
+		uint32_t k = tree_child_count(nd);
 		if (tree_is_leaf(nd))
 			continue;
-		if (tree_child(nd, 0) == 0 || tree_children_end(nd) > n || sp + 2 > n) {
+		if (k > TREE_MAX_WIDTH || tree_child(nd, 0) == 0 || tree_children_end(nd) > n ||
+		    sp + k > n) {
 			free(stack);
 			return -EINVAL;
 		}
-		*depth = d + 1 > *depth ? d + 1 : *depth;
-		stack[sp][0] = tree_child(nd, 0), stack[sp++][1] = d + 1;
-		stack[sp][0] = tree_child(nd, 1), stack[sp++][1] = d + 1;
+		*need = d + k - 1 > *need ? d + k - 1 : *need;
+		for (uint32_t i = 0; i < k; i++)
+			stack[sp][0] = tree_child(nd, i), stack[sp++][1] = d + k - 1;
 	}
 	free(stack);
 	return 0;
 }
 
-static unsigned stack_size(unsigned depth)
+static unsigned stack_size(unsigned need)
 {
-	unsigned s = MIN_STACK;
-	while (s < depth + 1)
+	unsigned s = TRACE_MIN_STACK;
+	while (s < need + 1)
 		s *= 2;
 	return s;
 }
@@ -181,13 +183,13 @@ static int upload(struct device *d, const void *data, size_t bytes, cl_mem *out,
 /* The triangles' vertices in leaf-slot order, as the CPU batch copy. */
 static float *slot_vertices(const bvhlab_tree *tree, const bvhlab_scene *scene)
 {
-	float *v = calloc((size_t)tree->index_count * 9 + 1, sizeof(*v));
+	float *v = calloc((size_t)tree->index_count * TRACE_SLOT_FLOATS + 1, sizeof(*v));
 	for (uint32_t i = 0; v && i < tree->index_count; i++) {
 		uint32_t prim = tree->prim_index[i];
 		if (prim >= scene->triangle_count)
 			continue; /* zeros: the kernel skips such slots */
 		for (int k = 0; k < 3; k++)
-			memcpy(v + 9 * (size_t)i + 3 * k,
+			memcpy(v + TRACE_SLOT_FLOATS * (size_t)i + 3 * k,
 			       scene->vertices + 3 * (size_t)scene->indices[3 * (size_t)prim + k],
 			       3 * sizeof(float));
 	}
@@ -208,7 +210,7 @@ static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
 		r = upload(t->dev, tree->nodes, (size_t)tree->node_count * sizeof(bvhlab_node),
 		           &t->nodes, "nodes", err);
 	if (r == 0)
-		r = upload(t->dev, verts, (size_t)tree->index_count * 9 * sizeof(float), &t->tris,
+		r = upload(t->dev, verts, (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(float), &t->tris,
 		           "triangles", err);
 	if (r == 0)
 		r = upload(t->dev, tree->prim_index, (size_t)tree->index_count * sizeof(uint32_t),
@@ -224,13 +226,13 @@ static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
 static int set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
 {
 	char why[256];
-	cl_int rc = clSetKernelArg(t->kernel, 0, sizeof(cl_mem), &t->nodes);
-	rc |= clSetKernelArg(t->kernel, 1, sizeof(cl_mem), &t->tris);
-	rc |= clSetKernelArg(t->kernel, 2, sizeof(cl_mem), &t->prim_index);
-	rc |= clSetKernelArg(t->kernel, 3, sizeof(cl_mem), &t->parents);
-	rc |= clSetKernelArg(t->kernel, 4, sizeof(cl_uint), &t->node_count);
-	rc |= clSetKernelArg(t->kernel, 5, sizeof(cl_uint), &t->index_count);
-	rc |= clSetKernelArg(t->kernel, 6, sizeof(cl_uint), &t->tri_count);
+	cl_int rc = clSetKernelArg(t->kernel, TRACE_ARG_NODES, sizeof(cl_mem), &t->nodes);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_TRIS, sizeof(cl_mem), &t->tris);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_PRIM_INDEX, sizeof(cl_mem), &t->prim_index);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_PARENTS, sizeof(cl_mem), &t->parents);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_NODE_COUNT, sizeof(cl_uint), &t->node_count);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_INDEX_COUNT, sizeof(cl_uint), &t->index_count);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_TRI_COUNT, sizeof(cl_uint), &t->tri_count);
 	int r = bvhlab_cl_check(rc ? CL_INVALID_KERNEL_ARGS : CL_SUCCESS, "clSetKernelArg", why,
 	                        sizeof(why));
 	if (r < 0)
@@ -238,12 +240,12 @@ static int set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
 	return r;
 }
 
-static int make_kernel(struct trace_cl_tree *t, int traversal, unsigned depth,
+static int make_kernel(struct trace_cl_tree *t, int traversal, unsigned need,
                        bvhlab_error *err)
 {
 	char why[512];
 	cl_program prog;
-	int r = get_program(t->dev, stack_size(depth), &prog, err);
+	int r = get_program(t->dev, stack_size(need), &prog, err);
 	if (r == 0)
 		r = bvhlab_cl_kernel(prog, traversal == BVHLAB_TRAVERSAL_CL_STACK ? "trace_stack"
 		                                                                   : "trace_stackless",
@@ -253,43 +255,19 @@ static int make_kernel(struct trace_cl_tree *t, int traversal, unsigned depth,
 	return r;
 }
 
-static int create_binary(const char *device, int traversal, const bvhlab_tree *tree,
-                         const bvhlab_scene *scene, struct trace_cl_tree **out,
-                         bvhlab_error *err);
-
-/* The kernels walk binary nodes: a wider tree goes up as its binary
- * expansion (the same leaves and hits; its node counts are the
- * expansion's). */
+/* The kernels read trees of any width through tree_node.h: a tree goes
+ * up as it is. */
 int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *tree,
                          const bvhlab_scene *scene, struct trace_cl_tree **out,
                          bvhlab_error *err)
 {
+	unsigned need;
 	*out = NULL;
 	if (traversal != BVHLAB_TRAVERSAL_CL_STACK && traversal != BVHLAB_TRAVERSAL_CL_STACKLESS) {
 		error_set(err, "cl: not a device traversal (%d)", traversal);
 		return -EINVAL;
 	}
-	if (tree_width(tree) == 2)
-		return create_binary(device, traversal, tree, scene, out, err);
-	bvhlab_tree bin = *tree;
-	int r = tree_binary_nodes(tree, &bin.nodes, &bin.node_count);
-	if (r < 0) {
-		error_set(err, r == -ENOMEM ? "cl: out of memory" : "cl: the tree's links leave it");
-		return r;
-	}
-	bin.node_capacity = bin.node_count;
-	bin.width = 2;
-	r = create_binary(device, traversal, &bin, scene, out, err);
-	free(bin.nodes);
-	return r;
-}
-
-static int create_binary(const char *device, int traversal, const bvhlab_tree *tree,
-                         const bvhlab_scene *scene, struct trace_cl_tree **out,
-                         bvhlab_error *err)
-{
-	unsigned depth;
-	int r = tree_depth(tree, &depth);
+	int r = stack_need(tree, &need);
 	if (r < 0) {
 		error_set(err, r == -ENOMEM ? "cl: out of memory" : "cl: the tree's links leave it");
 		return r;
@@ -303,7 +281,7 @@ static int create_binary(const char *device, int traversal, const bvhlab_tree *t
 	pthread_mutex_lock(&devices_lock);
 	r = get_device(device, &t->dev, err);
 	if (r == 0)
-		r = make_kernel(t, traversal, depth, err);
+		r = make_kernel(t, traversal, need, err);
 	pthread_mutex_unlock(&devices_lock);
 	if (r == 0)
 		r = upload_tree(t, tree, scene, err);
@@ -388,11 +366,11 @@ static cl_int set_batch_args(struct trace_cl_batch *b)
 {
 	cl_kernel k = b->t->kernel;
 	cl_uint n = (cl_uint)b->count;
-	cl_int rc = clSetKernelArg(k, 7, sizeof(cl_mem), &b->rays);
-	rc |= clSetKernelArg(k, 8, sizeof(cl_uint), &n);
-	rc |= clSetKernelArg(k, 9, sizeof(cl_uint), &b->any);
-	rc |= clSetKernelArg(k, 10, sizeof(cl_mem), &b->hits);
-	rc |= clSetKernelArg(k, 11, sizeof(cl_mem), &b->counts);
+	cl_int rc = clSetKernelArg(k, TRACE_ARG_RAYS, sizeof(cl_mem), &b->rays);
+	rc |= clSetKernelArg(k, TRACE_ARG_RAY_COUNT, sizeof(cl_uint), &n);
+	rc |= clSetKernelArg(k, TRACE_ARG_ANY, sizeof(cl_uint), &b->any);
+	rc |= clSetKernelArg(k, TRACE_ARG_HITS, sizeof(cl_mem), &b->hits);
+	rc |= clSetKernelArg(k, TRACE_ARG_COUNTS, sizeof(cl_mem), &b->counts);
 	return rc ? CL_INVALID_KERNEL_ARGS : CL_SUCCESS;
 }
 
@@ -403,7 +381,7 @@ static int take_counts(const uint32_t *c, size_t n, uint32_t *nodes, bvhlab_trac
 {
 	bvhlab_trace_stats s = {.rays = n};
 	for (size_t i = 0; i < n; i++) {
-		if (c[2 * i] == OVERFLOW) {
+		if (c[2 * i] == TRACE_OVERFLOW) {
 			error_set(err, "cl: ray %zu overflowed the stack kernel's stack", i);
 			return -EIO;
 		}

@@ -5,9 +5,12 @@
  *           to the CPU stack traversal's (rays.traversal_disagreements 0),
  *           and the nodes counted per ray equal to the CPU stack and
  *           stackless traversals' own, on the trees of several builders
- *           over a shared mesh and degenerate scenes (one triangle, two,
- *           50 copies of one triangle: all centroids equal and every hit
- *           a tie in t, zero-area triangles, needles), timed in rounds;
+ *           and on lbvh's collapsed into 4- and 8-wide trees (the
+ *           wide_collapse test stage: the kernels read the open tree as
+ *           the CPU does), over a shared mesh and degenerate scenes (one
+ *           triangle, two, 50 copies of one triangle: all centroids equal
+ *           and every hit a tie in t, zero-area triangles, needles), timed
+ *           in rounds;
  *   errors  a bad rays.device is a config error naming the key; a device
  *           that does not exist, or no OpenCL platform at all, leaves the
  *           runs ok with rays.error saying why; info --machine lists the
@@ -85,9 +88,19 @@ static void check_run(const cJSON *run)
 	}
 }
 
-/* One sweep over these scenes and builders; its runs checked. */
-static void trace_sweep(const char *name, const char *scenes, const char *builders, int runs)
+/* lbvh's tree collapsed into 4- and 8-wide ones (tests/fake/wide_collapse). */
+#define WIDE_BUILDERS                                                                      \
+	"{ \"plugin\": \"lbvh\", \"name\": \"lbvh_w4\", \"refine\": [ { \"plugin\": "          \
+	"\"wide_collapse\", \"options\": { \"width\": 4 } } ] },\n"                               \
+	"    { \"plugin\": \"lbvh\", \"name\": \"lbvh_w8\", \"refine\": [ { \"plugin\": "      \
+	"\"wide_collapse\", \"options\": { \"width\": 8 } } ] }"
+
+/* One sweep over these scenes and builders (`per_builder` runs each); its
+ * runs checked. */
+static void trace_sweep(const char *name, const char *scenes, const char *builders,
+                        int builder_count, int per_builder)
 {
+	int runs = builder_count * per_builder;
 	char config[4096], out[600];
 	snprintf(config, sizeof(config),
 	         "{ \"format_version\": 1, \"output\": \"%s\", \"repeat\": 1, \"warmup\": 0,\n"
@@ -109,7 +122,9 @@ static void trace_sweep(const char *name, const char *scenes, const char *builde
 		n++;
 	}
 	CHECK_INT(n, runs);
-	CHECK_INT(count_runs(doc, "lbvh", "ok"), runs / (strstr(builders, "sbvh") ? 4 : 3));
+	CHECK_INT(count_runs(doc, "lbvh", "ok"), per_builder);
+	CHECK_INT(count_runs(doc, "lbvh_w4", "ok"), per_builder);
+	CHECK_INT(count_runs(doc, "lbvh_w8", "ok"), per_builder);
 	cJSON_Delete(doc);
 }
 
@@ -126,14 +141,14 @@ static void trace_mode(void)
 		printf("the bunny left to the release build (CL_TRACE_NO_MESH)\n");
 	else
 		trace_sweep("mesh", scene, "{ \"plugin\": \"lbvh\" }, { \"plugin\": \"ploc\" }, "
-		            "{ \"plugin\": \"sah_tasks\" }", 3);
+		            "{ \"plugin\": \"sah_tasks\" },\n    " WIDE_BUILDERS, 5, 1);
 	trace_sweep("degenerate",
 	            "{ \"path\": \"one.obj\" }, { \"path\": \"two.obj\" },\n"
 	            "    { \"path\": \"same.obj\" }, { \"path\": \"flat.obj\" },\n"
 	            "    { \"name\": \"needles\", \"generator\": \"needles\", \"count\": 300 }",
 	            "{ \"plugin\": \"lbvh\" }, { \"plugin\": \"ploc\" }, { \"plugin\": \"sah_tasks\" },\n"
-	            "    { \"plugin\": \"sbvh\" }",
-	            20);
+	            "    { \"plugin\": \"sbvh\" }, " WIDE_BUILDERS,
+	            6, 5);
 }
 
 /* A run of one scene with this "rays" object; the document. */
