@@ -1,50 +1,33 @@
 /*
- * The device traversals' host side (trace_cl.h): the process's devices and
- * programs, a tree's buffers, a batch's buffers, one timed pass.
+ * The device traversals' host side (trace_cl.h): a tree's program (from
+ * the process's device layer, core/device) and buffers, a batch's
+ * buffers, one timed pass.
  */
 #include <errno.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <bvhlab/opencl.h>
 #include <bvhlab/trace.h>
 
+#include "device/device.h"
 #include "trace/trace_cl.h"
 #include "trace/trace_cl_source.h"
 #include "trace/trace_layout.h"
 #include "tree/tree_view.h"
 #include "util/util.h"
 
-/* Programs per device: one per stack size (TRACE_MIN_STACK, or the next
- * power of two at or above a deeper tree's need). */
-#define MAX_PROGRAMS 8
 #define RAYS_PER_GROUP 64
 
-/* -cl-fp32-correctly-rounded-divide-sqrt: the CPU's divisions are IEEE;
- * OpenCL's default float division may be 2.5 ulp off, which would move t,
- * u and v. A device that cannot round them correctly is not asked to (the
- * build would fail): its hits may then differ, and the disagreements say
- * so. No -cl-mad-enable, no fast math: the same operations as the CPU,
- * each rounded the same. */
-#define BUILD_OPTIONS "-cl-std=CL1.2 %s-DSTACK_SIZE=%u"
-#define EXACT_DIVIDE "-cl-fp32-correctly-rounded-divide-sqrt "
-
-struct device {
-	char spec[64];
-	bvhlab_cl cl;
-	unsigned stack[MAX_PROGRAMS]; /* the stack size each program was built with */
-	cl_program program[MAX_PROGRAMS];
-	unsigned programs;
-};
-
-/* Kept for the process's life (see trace_cl.h): at most a few specs. */
-static struct device devices[4];
-static unsigned device_count;
-static pthread_mutex_t devices_lock = PTHREAD_MUTEX_INITIALIZER;
+/* The OpenCL C version; the stack kernel's stack size. No -cl-mad-enable,
+ * no fast math: the same operations as the CPU, each rounded the same (the
+ * device layer asks for correctly rounded division where the device has
+ * it; a device without it may then give other hits, and the disagreements
+ * say so). */
+#define BUILD_OPTIONS "-cl-std=CL1.2 -DSTACK_SIZE=%u"
 
 struct trace_cl_tree {
-	struct device *dev;
+	const bvhlab_cl *dev; /* the device layer's */
 	cl_kernel kernel;
 	cl_mem nodes, tris, prim_index, parents;
 	uint32_t node_count, index_count, tri_count;
@@ -65,63 +48,6 @@ bool trace_cl_built(void)
 static void cl_error(bvhlab_error *err, const char *msg)
 {
 	error_set(err, "%s", msg);
-}
-
-/* The device a spec names, made once. */
-static int get_device(const char *spec, struct device **out, bvhlab_error *err)
-{
-	char why[BVHLAB_CL_ERROR_SIZE];
-	spec = spec ? spec : "auto";
-	for (unsigned i = 0; i < device_count; i++) {
-		if (strcmp(devices[i].spec, spec) == 0) {
-			*out = &devices[i];
-			return 0;
-		}
-	}
-	if (device_count == sizeof(devices) / sizeof(devices[0]) ||
-	    strlen(spec) >= sizeof(devices[0].spec)) {
-		error_set(err, "cl: too many device specs in one process (or '%.40s' too long)", spec);
-		return -EINVAL;
-	}
-	struct device *d = &devices[device_count];
-	int r = bvhlab_cl_init(&d->cl, spec, why, sizeof(why));
-	if (r < 0) {
-		cl_error(err, why);
-		return r;
-	}
-	snprintf(d->spec, sizeof(d->spec), "%s", spec);
-	device_count++;
-	*out = d;
-	return 0;
-}
-
-/* The program for a stack of at least `stack` entries, built once. */
-static int get_program(struct device *d, unsigned stack, cl_program *out, bvhlab_error *err)
-{
-	char why[BVHLAB_CL_ERROR_SIZE], options[160];
-	for (unsigned i = 0; i < d->programs; i++) {
-		if (d->stack[i] == stack) {
-			*out = d->program[i];
-			return 0;
-		}
-	}
-	if (d->programs == MAX_PROGRAMS) {
-		error_set(err, "cl: too many stack sizes in one process");
-		return -ENOMEM;
-	}
-	cl_device_fp_config fp = 0;
-	clGetDeviceInfo(d->cl.device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, NULL);
-	snprintf(options, sizeof(options), BUILD_OPTIONS,
-	         fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT ? EXACT_DIVIDE : "", stack);
-	int r = bvhlab_cl_program(&d->cl, trace_cl_source, trace_cl_source_LEN, options,
-	                          &d->program[d->programs], why, sizeof(why));
-	if (r < 0) {
-		cl_error(err, why);
-		return r;
-	}
-	d->stack[d->programs] = stack;
-	*out = d->program[d->programs++];
-	return 0;
 }
 
 /* The most far children the stack kernel holds at once on this tree: over
@@ -165,18 +91,18 @@ static unsigned stack_size(unsigned need)
 }
 
 /* A read-only buffer holding bytes (at least 4, so empty arrays upload). */
-static int upload(struct device *d, const void *data, size_t bytes, cl_mem *out,
+static int upload(const bvhlab_cl *d, const void *data, size_t bytes, cl_mem *out,
                   const char *what, bvhlab_error *err)
 {
 	char why[256];
 	cl_int rc;
 	static const uint32_t zero = 0;
-	*out = clCreateBuffer(d->cl.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+	*out = clCreateBuffer(d->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
 	                      bytes ? bytes : sizeof(zero), bytes ? (void *)data : (void *)&zero,
 	                      &rc);
 	int r = bvhlab_cl_check(rc, what, why, sizeof(why));
 	if (r < 0)
-		error_set(err, "%s (%zu bytes on %s)", why, bytes, d->cl.name);
+		error_set(err, "%s (%zu bytes on %s)", why, bytes, d->name);
 	return r;
 }
 
@@ -210,7 +136,8 @@ static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
 		r = upload(t->dev, tree->nodes, (size_t)tree->node_count * sizeof(bvhlab_node),
 		           &t->nodes, "nodes", err);
 	if (r == 0)
-		r = upload(t->dev, verts, (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(float), &t->tris,
+		r = upload(t->dev, verts,
+		           (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(float), &t->tris,
 		           "triangles", err);
 	if (r == 0)
 		r = upload(t->dev, tree->prim_index, (size_t)tree->index_count * sizeof(uint32_t),
@@ -240,17 +167,24 @@ static int set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
 	return r;
 }
 
-static int make_kernel(struct trace_cl_tree *t, int traversal, unsigned need,
-                       bvhlab_error *err)
+/* The device and the program for a stack of at least `need` entries, from
+ * the process's device layer (core/device), and the traversal's kernel. */
+static int make_kernel(struct trace_cl_tree *t, const char *device, int traversal,
+                       unsigned need, bvhlab_error *err)
 {
-	char why[512];
-	cl_program prog;
-	int r = get_program(t->dev, stack_size(need), &prog, err);
-	if (r == 0)
+	char why[BVHLAB_CL_ERROR_SIZE], options[64];
+	const void *dev;
+	void *prog;
+	snprintf(options, sizeof(options), BUILD_OPTIONS, stack_size(need));
+	int r = device_program(device, trace_cl_source, trace_cl_source_LEN, options, &dev, &prog,
+	                       why, sizeof(why));
+	if (r == 0) {
+		t->dev = dev;
 		r = bvhlab_cl_kernel(prog, traversal == BVHLAB_TRAVERSAL_CL_STACK ? "trace_stack"
 		                                                                   : "trace_stackless",
 		                     &t->kernel, why, sizeof(why));
-	if (r < 0 && !err->message[0])
+	}
+	if (r < 0)
 		cl_error(err, why);
 	return r;
 }
@@ -278,11 +212,7 @@ int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *t
 	t->node_count = tree->node_count;
 	t->index_count = tree->index_count;
 	t->tri_count = scene->triangle_count;
-	pthread_mutex_lock(&devices_lock);
-	r = get_device(device, &t->dev, err);
-	if (r == 0)
-		r = make_kernel(t, traversal, need, err);
-	pthread_mutex_unlock(&devices_lock);
+	r = make_kernel(t, device, traversal, need, err);
 	if (r == 0)
 		r = upload_tree(t, tree, scene, err);
 	if (r == 0)
@@ -309,17 +239,17 @@ void trace_cl_tree_destroy(struct trace_cl_tree *t)
 
 const char *trace_cl_device_name(const struct trace_cl_tree *t)
 {
-	return t->dev->cl.name;
+	return t->dev->name;
 }
 
 static int output_buffer(struct trace_cl_tree *t, size_t bytes, cl_mem *out, bvhlab_error *err)
 {
 	char why[256];
 	cl_int rc;
-	*out = clCreateBuffer(t->dev->cl.context, CL_MEM_WRITE_ONLY, bytes ? bytes : 16, NULL, &rc);
+	*out = clCreateBuffer(t->dev->context, CL_MEM_WRITE_ONLY, bytes ? bytes : 16, NULL, &rc);
 	int r = bvhlab_cl_check(rc, "clCreateBuffer", why, sizeof(why));
 	if (r < 0)
-		error_set(err, "%s (%zu bytes on %s)", why, bytes, t->dev->cl.name);
+		error_set(err, "%s (%zu bytes on %s)", why, bytes, t->dev->name);
 	return r;
 }
 
@@ -399,7 +329,7 @@ static int read_back(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes
                      bvhlab_trace_stats *stats, bvhlab_error *err)
 {
 	char why[256];
-	cl_command_queue q = b->t->dev->cl.queue;
+	cl_command_queue q = b->t->dev->queue;
 	cl_int rc = CL_SUCCESS;
 	uint32_t *c = malloc(b->count * 2 * sizeof(*c) + 1);
 	if (!c)
@@ -432,7 +362,7 @@ int trace_cl_pass(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
 	cl_int rc = set_batch_args(b);
 	double t0 = util_now();
 	if (rc == CL_SUCCESS)
-		rc = clEnqueueNDRangeKernel(b->t->dev->cl.queue, b->t->kernel, 1, NULL, &global, NULL,
+		rc = clEnqueueNDRangeKernel(b->t->dev->queue, b->t->kernel, 1, NULL, &global, NULL,
 		                            0, NULL, &ev);
 	if (rc == CL_SUCCESS)
 		rc = clWaitForEvents(1, &ev);
@@ -442,7 +372,7 @@ int trace_cl_pass(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
 		double ms = bvhlab_cl_event_ms(ev);
 		*kernel_s = ms >= 0 ? ms * 1e-3 : *wall_s; /* no profiling: the wall clock */
 	} else {
-		error_set(err, "%s on %s", why, b->t->dev->cl.name);
+		error_set(err, "%s on %s", why, b->t->dev->name);
 	}
 	bvhlab_cl_release_event(&ev);
 	if (r == 0 && (hits || nodes || stats))

@@ -8,9 +8,11 @@
  * completion). Built only with OpenCL (BVHLAB_HAVE_OPENCL); without it
  * trace_cl_tree_create says so.
  *
- * The device and its compiled program are kept for the life of the
- * process (one per device spec and stack size): PoCL takes seconds to
- * compile a program, and a sweep's child traces many batches.
+ * The device and its compiled program (one per device spec and stack
+ * size) come from the process's device layer (core/device/device.h), which
+ * keeps them for the life of the process and shares them with the device
+ * builders: PoCL takes seconds to compile a program, and a sweep's child
+ * builds and traces many times.
  */
 #ifndef BVHLAB_CORE_TRACE_CL_H
 #define BVHLAB_CORE_TRACE_CL_H

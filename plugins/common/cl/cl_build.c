@@ -13,7 +13,6 @@ int cl_build_begin(const cl_builder *cb, cl_dev *d, const char *spec, const bvhl
                    bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
                    bvhlab_build_output *out)
 {
-	char err[BVHLAB_CL_ERROR_SIZE];
 	uint32_t n = in->prim_count;
 	int rc;
 
@@ -23,12 +22,9 @@ int cl_build_begin(const cl_builder *cb, cl_dev *d, const char *spec, const bvhl
 	}
 	if ((rc = big_ensure_output(host, ctx, n, 0, out)) < 0)
 		return rc;
-	rc = cl_dev_open(d, spec, cb->src, cb->len, cb->kernels, cb->kernel_count, err,
-	                 sizeof(err));
-	if (rc < 0) {
-		host->set_error(ctx, "%s", err);
+	rc = cl_dev_open(d, host, ctx, spec, cb->src, cb->len, cb->kernels, cb->kernel_count);
+	if (rc < 0)
 		return rc;
-	}
 	if (n > 1)
 		return 0;
 	morton_single_leaf(in, out);

@@ -18,55 +18,34 @@ void cl_dev_close(cl_dev *d)
 {
 	for (unsigned k = 0; k < d->kernel_count; k++)
 		bvhlab_cl_release_kernel(&d->k[k]);
-	bvhlab_cl_release_program(&d->prog);
-	bvhlab_cl_finish(&d->cl);
 	memset(d, 0, sizeof(*d));
 }
 
-static int make_kernels(cl_dev *d, const char *const *names, unsigned count, char *err,
-                        size_t err_size)
+int cl_dev_open(cl_dev *d, const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *spec,
+                const char *src, size_t len, const char *const *names, unsigned count)
 {
-	int rc;
+	char err[BVHLAB_CL_ERROR_SIZE];
+	const bvhlab_cl *cl;
+	cl_program prog;
+	int rc = bvhlab_cl_host_program(host, ctx, spec, src, len, NULL, &cl, &prog);
 
+	if (rc < 0 || prog == d->prog)
+		return rc;
+	cl_dev_close(d);
+	if (count > CL_DEV_MAX_KERNELS) {
+		host->set_error(ctx, "cl: more than %d kernels", CL_DEV_MAX_KERNELS);
+		return -EINVAL;
+	}
+	d->cl = *cl;
+	d->prog = prog;
 	for (unsigned k = 0; k < count; k++) {
-		if ((rc = bvhlab_cl_kernel(d->prog, names[k], &d->k[k], err, err_size)) < 0)
+		if ((rc = bvhlab_cl_kernel(prog, names[k], &d->k[k], err, sizeof(err))) < 0) {
+			host->set_error(ctx, "%s", err);
+			cl_dev_close(d);
 			return rc;
+		}
 		d->kernel_count = k + 1;
 	}
-	return 0;
-}
-
-/* CL_DEV_OPTIONS where the device supports it: a device without it may
- * refuse the option. */
-static const char *build_options(const cl_dev *d)
-{
-	cl_device_fp_config fp = 0;
-
-	if (clGetDeviceInfo(d->cl.device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, NULL) !=
-	    CL_SUCCESS)
-		return "";
-	return fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT ? CL_DEV_OPTIONS : "";
-}
-
-int cl_dev_open(cl_dev *d, const char *spec, const char *src, size_t len,
-                const char *const *names, unsigned count, char *err, size_t err_size)
-{
-	int rc;
-
-	if (d->prog && !strcmp(d->spec, spec))
-		return 0;
-	cl_dev_close(d);
-	if (strlen(spec) >= sizeof(d->spec) || count > CL_DEV_MAX_KERNELS)
-		return bvhlab_cl_fail(-EINVAL, err, err_size, "cl: device '%.64s...' is too long",
-		                      spec);
-	if ((rc = bvhlab_cl_init(&d->cl, spec, err, err_size)) < 0 ||
-	    (rc = bvhlab_cl_program(&d->cl, src, len, build_options(d), &d->prog, err,
-	                            err_size)) < 0 ||
-	    (rc = make_kernels(d, names, count, err, err_size)) < 0) {
-		cl_dev_close(d);
-		return rc;
-	}
-	strcpy(d->spec, spec);
 	return 0;
 }
 

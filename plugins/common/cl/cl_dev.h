@@ -3,9 +3,11 @@
  * the device layer of include/bvhlab/opencl.h (a static library linked into
  * each plugin):
  *
- *   - cl_dev: the device, its built program and kernels, kept between
- *     builds (a build is timed whole, and compiling the kernels is not the
- *     builder's work), made again when the `device` option changes;
+ *   - cl_dev: the device and the built program, from the process's device
+ *     layer (the host's, ABI 1.6: shared with every device builder and the
+ *     device tracer, kept for the process's life, so compiling is never a
+ *     build's work), and this builder's kernels, made again when the
+ *     layer hands out another program (the `device` option changed);
  *   - cl_buf: device buffers that grow, all sized before any kernel runs;
  *   - cl_events: the kernels' events, summed into the phase "device";
  *   - the Morton codes and their radix sort (cl_sort.c, kernels in
@@ -23,11 +25,10 @@
 
 #include "plugin_options.h"
 
-/* Build option of every device builder's program where the device has
- * it: correctly rounded division and square root, as the CPU's. (The
- * kernels also turn contraction into fma off, by pragma; none divides
- * today: the quantiser's scale comes from the host.) */
-#define CL_DEV_OPTIONS "-cl-fp32-correctly-rounded-divide-sqrt"
+/* The device layer builds every program with correctly rounded division
+ * and square root where the device has them, as the CPU's. (The kernels
+ * also turn contraction into fma off, by pragma; none divides today: the
+ * quantiser's scale comes from the host.) */
 #define CL_DEV_MAX_KERNELS 16
 
 /* The option every device builder has, in its table (plugin_options.h),
@@ -40,19 +41,19 @@
 	              .def_string = "auto")
 
 typedef struct cl_dev {
-	bvhlab_cl cl;
-	char spec[64];
-	cl_program prog;
+	bvhlab_cl cl;    /* the layer's device, copied: not ours to release */
+	cl_program prog; /* the layer's */
 	cl_kernel k[CL_DEV_MAX_KERNELS];
 	unsigned kernel_count;
 } cl_dev;
 
-/* The device of `spec` with the program of `src` built and its kernels
- * (`names`, in order, into d->k) made; reuses what d holds for the same
- * spec and source. 0, or a negative errno with the message in err. */
-int cl_dev_open(cl_dev *d, const char *spec, const char *src, size_t len,
-                const char *const *names, unsigned count, char *err, size_t err_size);
-/* Releases everything; safe on a zeroed or closed cl_dev. */
+/* The device of `spec` with the program of `src` from the host's device
+ * layer and its kernels (`names`, in order, into d->k) made; keeps the
+ * kernels while the layer hands out the same program. 0, or a negative
+ * errno after host->set_error. */
+int cl_dev_open(cl_dev *d, const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *spec,
+                const char *src, size_t len, const char *const *names, unsigned count);
+/* Releases the kernels; safe on a zeroed or closed cl_dev. */
 void cl_dev_close(cl_dev *d);
 
 /* A device buffer of at least `bytes`, kept and grown between builds. */
