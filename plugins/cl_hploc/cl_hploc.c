@@ -196,26 +196,26 @@ static void convert(cl_hploc *b, bvhlab_build_output *out)
 	b->ms[CL_PHASE_CONVERT] = cl_now_ms() - t0;
 }
 
+static int run(void *p, bvhlab_build_output *out, char *err, size_t err_size)
+{
+	cl_hploc *b = p;
+	int rc = device_run(b, err, err_size);
+
+	if (rc == 0)
+		convert(b, out);
+	return rc;
+}
+
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
 	cl_hploc b = { .in = input, .n = input->prim_count, .dev = &S.dev, .sort = &S.sort,
 	               .b = S.b };
-	char err[BVHLAB_CL_ERROR_SIZE];
-	int rc;
+	int rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), &b);
 
-	if ((rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options),
-	                              &b)) < 0 ||
-	    (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input, output)) != 0)
-		return rc < 0 ? rc : 0;
-	if ((rc = device_run(&b, err, sizeof(err))) < 0) {
-		host->set_error(ctx, "%s", err);
+	if (rc < 0)
 		return rc;
-	}
-	convert(&b, output);
-	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims on %s", b.n, S.dev.cl.name);
-	cl_report_phases(host, ctx, b.ms);
-	return 0;
+	return cl_build_run(&program, &S.dev, b.device, run, &b, b.ms, host, ctx, input, output);
 }
 
 PLUGIN_WITH_OPTIONS(options, .name = "cl_hploc",

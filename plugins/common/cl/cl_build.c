@@ -41,3 +41,21 @@ void cl_report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	for (int k = 0; k < CL_PHASES; k++)
 		host->phase(ctx, names[k], ms[k]);
 }
+
+int cl_build_run(const cl_builder *cb, cl_dev *d, const char *spec, cl_run_fn run, void *b,
+                 const double *ms, const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	char err[BVHLAB_CL_ERROR_SIZE];
+	int rc = cl_build_begin(cb, d, spec, host, ctx, in, out);
+
+	if (rc != 0)
+		return rc < 0 ? rc : 0;
+	if ((rc = run(b, out, err, sizeof(err))) < 0) {
+		host->set_error(ctx, "%s", err);
+		return rc;
+	}
+	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims on %s", in->prim_count, d->cl.name);
+	cl_report_phases(host, ctx, ms);
+	return 0;
+}

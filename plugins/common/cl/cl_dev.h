@@ -167,4 +167,17 @@ enum { CL_PHASE_UPLOAD, CL_PHASE_DEVICE, CL_PHASE_DOWNLOAD, CL_PHASE_CONVERT, CL
 void cl_report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                       const double ms[CL_PHASES]);
 
+/* A device builder's run, after the start: the tree into out, its phases
+ * into the builder's ms[]; 0, or a negative errno with the message in err. */
+typedef int (*cl_run_fn)(void *b, bvhlab_build_output *out, char *err, size_t err_size);
+
+/*
+ * The rest of a device builder's build() once its options are in b:
+ * cl_build_begin, then run(b, ...), its message into host->set_error, and
+ * the phases ms[CL_PHASES] (b's, filled by run) reported. 0 or the errno.
+ */
+int cl_build_run(const cl_builder *cb, cl_dev *d, const char *spec, cl_run_fn run, void *b,
+                 const double *ms, const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *in, bvhlab_build_output *out);
+
 #endif /* BVHLAB_CL_DEV_H */
