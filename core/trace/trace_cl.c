@@ -180,7 +180,7 @@ static int make_kernel(struct trace_cl_tree *t, const char *device, int traversa
 	                       why, sizeof(why));
 	if (r == 0) {
 		t->dev = dev;
-		r = bvhlab_cl_kernel(prog, traversal == BVHLAB_TRAVERSAL_CL_STACK ? "trace_stack"
+		r = bvhlab_cl_kernel(prog, traversal == BVHLAB_TRAVERSAL_DEVICE_STACK ? "trace_stack"
 		                                                                   : "trace_stackless",
 		                     &t->kernel, why, sizeof(why));
 	}
@@ -197,7 +197,7 @@ int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *t
 {
 	unsigned need;
 	*out = NULL;
-	if (traversal != BVHLAB_TRAVERSAL_CL_STACK && traversal != BVHLAB_TRAVERSAL_CL_STACKLESS) {
+	if (traversal != BVHLAB_TRAVERSAL_DEVICE_STACK && traversal != BVHLAB_TRAVERSAL_DEVICE_STACKLESS) {
 		error_set(err, "cl: not a device traversal (%d)", traversal);
 		return -EINVAL;
 	}

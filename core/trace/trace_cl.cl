@@ -1,5 +1,5 @@
 /*
- * The device traversals (rays.traversal "cl_stack" and "cl_stackless"):
+ * The device traversals (rays.traversal "device_stack" and "device_stackless"):
  * one work-item per ray, closest or any hit, the same arithmetic as the
  * CPU kernel (core/trace/trace_kernel.h) operation for operation, so a ray
  * gets the same triangle at the same t, u and v bit for bit. For that the

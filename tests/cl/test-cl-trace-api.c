@@ -23,8 +23,8 @@
 
 #define CHAIN 300
 
-static const int device_traversals[] = {BVHLAB_TRAVERSAL_CL_STACK,
-                                        BVHLAB_TRAVERSAL_CL_STACKLESS};
+static const int device_traversals[] = {BVHLAB_TRAVERSAL_DEVICE_STACK,
+                                        BVHLAB_TRAVERSAL_DEVICE_STACKLESS};
 
 static void grow(bvhlab_node *n, const float *p)
 {
@@ -151,7 +151,7 @@ static void errors(void)
 	bvhlab_hit hit;
 	bvhlab_trace_timing tm;
 	bvhlab_error err = {{0}};
-	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_CL_STACK, .device = "banana"};
+	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_DEVICE_STACK, .device = "banana"};
 	CHECK_INT(trace_measure(&t, &s, &ray, 1, &o, &hit, NULL, &tm, NULL, 0, &err), -EINVAL);
 	CHECK_CONTAINS(err.message, "device 'banana' is not auto, gpu, cpu or P:D");
 	o.device = NULL; /* auto: the device main() found */
