@@ -11,6 +11,7 @@
 #include <bvhlab/trace.h>
 
 #include "device/device.h"
+#include "device/device_run.h"
 #include "trace/trace_cl.h"
 #include "trace/trace_cl_source.h"
 #include "trace/trace_layout.h"
@@ -90,6 +91,17 @@ static unsigned stack_size(unsigned need)
 	return s;
 }
 
+/* Whether buffers of want[] bytes fit the device: the layer's check, so a
+ * tree or batch too big is refused with the figures, not by the driver. */
+static int fits(const bvhlab_cl *d, const size_t *want, unsigned count, bvhlab_error *err)
+{
+	char why[512];
+	int r = cl_bufs_fit_on(d, want, count, why, sizeof(why));
+	if (r < 0)
+		error_set(err, "%s", why);
+	return r;
+}
+
 /* A read-only buffer holding bytes (at least 4, so empty arrays upload). */
 static int upload(const bvhlab_cl *d, const void *data, size_t bytes, cl_mem *out,
                   const char *what, bvhlab_error *err)
@@ -132,19 +144,20 @@ static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
 		error_set(err, "cl: the tree's child links do not make a tree");
 	else if (r < 0)
 		error_set(err, "cl: out of memory");
+	size_t want[] = {(size_t)tree->node_count * sizeof(bvhlab_node),
+	                 (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(float),
+	                 (size_t)tree->index_count * sizeof(uint32_t),
+	                 (size_t)tree->node_count * sizeof(uint32_t)};
 	if (r == 0)
-		r = upload(t->dev, tree->nodes, (size_t)tree->node_count * sizeof(bvhlab_node),
-		           &t->nodes, "nodes", err);
+		r = fits(t->dev, want, 4, err);
 	if (r == 0)
-		r = upload(t->dev, verts,
-		           (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(float), &t->tris,
-		           "triangles", err);
+		r = upload(t->dev, tree->nodes, want[0], &t->nodes, "nodes", err);
 	if (r == 0)
-		r = upload(t->dev, tree->prim_index, (size_t)tree->index_count * sizeof(uint32_t),
-		           &t->prim_index, "prim_index", err);
+		r = upload(t->dev, verts, want[1], &t->tris, "triangles", err);
 	if (r == 0)
-		r = upload(t->dev, parents, (size_t)tree->node_count * sizeof(uint32_t), &t->parents,
-		           "parents", err);
+		r = upload(t->dev, tree->prim_index, want[2], &t->prim_index, "prim_index", err);
+	if (r == 0)
+		r = upload(t->dev, parents, want[3], &t->parents, "parents", err);
 	free(verts);
 	free(parents);
 	return r;
@@ -267,7 +280,11 @@ int trace_cl_batch_create(struct trace_cl_tree *t, const bvhlab_ray *rays, size_
 	b->t = t;
 	b->count = count;
 	b->any = any_hit;
-	int r = upload(t->dev, rays, count * sizeof(*rays), &b->rays, "rays", err);
+	size_t want[] = {count * sizeof(*rays), count * sizeof(bvhlab_hit),
+	                 count * 2 * sizeof(uint32_t)};
+	int r = fits(t->dev, want, 3, err);
+	if (r == 0)
+		r = upload(t->dev, rays, want[0], &b->rays, "rays", err);
 	if (r == 0)
 		r = output_buffer(t, count * sizeof(bvhlab_hit), &b->hits, err);
 	if (r == 0)
@@ -354,28 +371,26 @@ int trace_cl_pass(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
                   bvhlab_error *err)
 {
 	char why[256];
-	cl_event ev = NULL;
-	size_t global = (b->count + RAYS_PER_GROUP - 1) / RAYS_PER_GROUP * RAYS_PER_GROUP;
+	cl_events ev = {.count = 0};
 	*kernel_s = *wall_s = 0;
 	if (b->count == 0)
 		return 0;
 	cl_int rc = set_batch_args(b);
+	int r = bvhlab_cl_check(rc, "clSetKernelArg", why, sizeof(why));
 	double t0 = util_now();
-	if (rc == CL_SUCCESS)
-		rc = clEnqueueNDRangeKernel(b->t->dev->queue, b->t->kernel, 1, NULL, &global, NULL,
-		                            0, NULL, &ev);
-	if (rc == CL_SUCCESS)
-		rc = clWaitForEvents(1, &ev);
+	/* The arguments are set: the layer's launch with none of its own. */
+	if (r == 0)
+		r = cl_launch_on(b->t->dev, b->t->kernel, b->count, NULL, 0, &ev, why, sizeof(why));
+	if (r == 0)
+		r = bvhlab_cl_check(clFinish(b->t->dev->queue), "tracing kernel", why, sizeof(why));
 	*wall_s = util_now() - t0;
-	int r = bvhlab_cl_check(rc, "tracing kernel", why, sizeof(why));
-	if (r == 0) {
-		double ms = bvhlab_cl_event_ms(ev);
-		*kernel_s = ms >= 0 ? ms * 1e-3 : *wall_s; /* no profiling: the wall clock */
-	} else {
+	double ms = cl_events_ms(&ev);
+	if (r < 0) {
 		error_set(err, "%s on %s", why, b->t->dev->name);
+		return r;
 	}
-	bvhlab_cl_release_event(&ev);
-	if (r == 0 && (hits || nodes || stats))
+	*kernel_s = ms > 0 ? ms * 1e-3 : *wall_s; /* no profiling: the wall clock */
+	if (hits || nodes || stats)
 		r = read_back(b, hits, nodes, stats, err);
 	return r;
 }

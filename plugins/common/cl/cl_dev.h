@@ -8,8 +8,9 @@
  *     device tracer, kept for the process's life, so compiling is never a
  *     build's work), and this builder's kernels, made again when the
  *     layer hands out another program (the `device` option changed);
- *   - cl_buf: device buffers that grow, all sized before any kernel runs;
- *   - cl_events: the kernels' events, summed into the phase "device";
+ *   - cl_buf, cl_launch, cl_events: the device layer's buffers that grow
+ *     (all sized before any kernel runs), launches and events (summed
+ *     into the phase "device"), core/device/device_run.h, on d's device;
  *   - the Morton codes and their radix sort (cl_sort.c, kernels in
  *     morton_sort.cl), mirroring plugins/common/morton;
  *   - the start of a build and the report of its phases (cl_build.c).
@@ -23,6 +24,7 @@
 #include <bvhlab/opencl.h>
 #include <bvhlab/builder.h>
 
+#include "device_run.h"
 #include "plugin_options.h"
 
 /* The device layer builds every program with correctly rounded division
@@ -56,53 +58,25 @@ int cl_dev_open(cl_dev *d, const bvhlab_host *host, bvhlab_build_ctx *ctx, const
 /* Releases the kernels; safe on a zeroed or closed cl_dev. */
 void cl_dev_close(cl_dev *d);
 
-/* A device buffer of at least `bytes`, kept and grown between builds. */
-typedef struct cl_buf {
-	cl_mem mem;
-	size_t bytes;
-} cl_buf;
+/* The device layer's buffers, launches and events (core/device/device_run.h)
+ * on a cl_dev's device. */
+static inline int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
+                              size_t err_size)
+{
+	return cl_bufs_fit_on(&d->cl, want, count, err, err_size);
+}
 
-/* Whether buffers of want[k] bytes fit the device (each its largest
- * allocation, the sum its global memory): 0, or -ENOMEM with a message
- * giving both figures, the need and the device's. Every device builder
- * calls it with all its buffers (its own and the sort's) before it makes
- * any, so a scene too big fails here, never in the driver. For tests,
- * $BVHLAB_CL_MEM_CAP_MB caps both limits. */
-int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
-                size_t err_size);
-/* Makes every buffer at least its wanted size (want[k] bytes), after
- * cl_bufs_fit. Done before any kernel runs. */
-int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count,
-                 char *err, size_t err_size);
-void cl_bufs_free(cl_buf *bufs, unsigned count);
+static inline int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count,
+                               char *err, size_t err_size)
+{
+	return cl_bufs_size_on(&d->cl, bufs, want, count, err, err_size);
+}
 
-/* The events of one build's kernels, for the phase "device". */
-#define CL_EVENTS_MAX 256
-typedef struct cl_events {
-	cl_event ev[CL_EVENTS_MAX];
-	unsigned count;
-	double ms; /* of events already summed and released (a full list) */
-} cl_events;
-
-/* Runs kernel k over `items` work-items (rounded up to a work-group
- * multiple; kernels check their bounds) after setting its arguments:
- * pairs of (size, pointer) in args, `nargs` of them. */
-typedef struct cl_arg {
-	size_t size;
-	const void *value;
-} cl_arg;
-#define CL_ARG(x) ((cl_arg){ sizeof(x), &(x) })
-
-int cl_launch(cl_dev *d, cl_kernel k, size_t items, const cl_arg *args, unsigned nargs,
-              cl_events *ev, char *err, size_t err_size);
-/* An event slot for a kernel, copy or fill; a full list is waited for
- * and summed first. */
-cl_event *cl_events_next(cl_events *ev);
-/* Sum of the events' profiled times in ms (after clFinish); releases them. */
-double cl_events_ms(cl_events *ev);
-
-/* Monotonic clock, ms. */
-double cl_now_ms(void);
+static inline int cl_launch(cl_dev *d, cl_kernel k, size_t items, const cl_arg *args,
+                            unsigned nargs, cl_events *ev, char *err, size_t err_size)
+{
+	return cl_launch_on(&d->cl, k, items, args, nargs, ev, err, err_size);
+}
 
 /* ---- Morton codes and sort (cl_sort.c) -------------------------------- */
 
