@@ -97,16 +97,14 @@ static int run(void *p, bvhlab_build_output *out, char *err, size_t err_size)
 	return 0;
 }
 
+static const cl_run_spec job = CL_RUN_SPEC(cl_ploc, options, run);
+
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
-	cl_ploc b = { .in = input, .n = input->prim_count, .dev = &S.dev, .sort = &S.sort,
-	              .b = S.b };
-	int rc = morton_options_fill(host, ctx, options, PLUGIN_OPTION_COUNT(options), &b);
+	cl_ploc b = { .in = input, .n = input->prim_count, .dev = &S.dev, .sort = &S.sort, .b = S.b };
 
-	if (rc < 0)
-		return rc;
-	return cl_build_run(&program, &S.dev, b.device, run, &b, b.ms, host, ctx, input, output);
+	return cl_build_run(&program, &job, &S.dev, &b, host, ctx, input, output);
 }
 
 PLUGIN_WITH_OPTIONS(options, .name = "cl_ploc",

@@ -42,20 +42,23 @@ void cl_report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		host->phase(ctx, names[k], ms[k]);
 }
 
-int cl_build_run(const cl_builder *cb, cl_dev *d, const char *spec, cl_run_fn run, void *b,
-                 const double *ms, const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *in, bvhlab_build_output *out)
+int cl_build_run(const cl_builder *cb, const cl_run_spec *rs, cl_dev *d, void *b,
+                 const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+                 bvhlab_build_output *out)
 {
 	char err[BVHLAB_CL_ERROR_SIZE];
-	int rc = cl_build_begin(cb, d, spec, host, ctx, in, out);
+	int rc = morton_options_fill(host, ctx, rs->options, rs->option_count, b);
+	const char *spec = *(const char **)(void *)((char *)b + rs->device_at);
 
+	if (rc == 0)
+		rc = cl_build_begin(cb, d, spec, host, ctx, in, out);
 	if (rc != 0)
 		return rc < 0 ? rc : 0;
-	if ((rc = run(b, out, err, sizeof(err))) < 0) {
+	if ((rc = rs->run(b, out, err, sizeof(err))) < 0) {
 		host->set_error(ctx, "%s", err);
 		return rc;
 	}
 	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims on %s", in->prim_count, d->cl.name);
-	cl_report_phases(host, ctx, ms);
+	cl_report_phases(host, ctx, (const double *)(void *)((char *)b + rs->ms_at));
 	return 0;
 }

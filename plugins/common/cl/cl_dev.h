@@ -19,6 +19,7 @@
 #define BVHLAB_CL_DEV_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include <bvhlab/opencl.h>
@@ -145,13 +146,30 @@ void cl_report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx,
  * into the builder's ms[]; 0, or a negative errno with the message in err. */
 typedef int (*cl_run_fn)(void *b, bvhlab_build_output *out, char *err, size_t err_size);
 
+/* What cl_build_run needs of a builder besides its program: its options'
+ * table (MORTON_OPTIONS and CL_DEVICE_OPTION in it), where its struct
+ * keeps the `device` spec and the phases `ms[CL_PHASES]`, and its run. */
+typedef struct cl_run_spec {
+	const plugin_option *options;
+	size_t option_count;
+	size_t device_at, ms_at;
+	cl_run_fn run;
+} cl_run_spec;
+
+/* The cl_run_spec of struct `type` (members device and ms), options
+ * table `table` and run `fn`. */
+#define CL_RUN_SPEC(type, table, fn)                                                   \
+	{ .options = table, .option_count = PLUGIN_OPTION_COUNT(table),                \
+	  .device_at = offsetof(type, device), .ms_at = offsetof(type, ms), .run = fn }
+
 /*
- * The rest of a device builder's build() once its options are in b:
- * cl_build_begin, then run(b, ...), its message into host->set_error, and
- * the phases ms[CL_PHASES] (b's, filled by run) reported. 0 or the errno.
+ * A device builder's build() on its struct b (the rest set by the
+ * caller): its options filled into b (morton_options_fill), cl_build_begin
+ * on b's device spec, rs->run(b, ...) with its message into
+ * host->set_error, a debug line, and b's phases reported. 0 or the errno.
  */
-int cl_build_run(const cl_builder *cb, cl_dev *d, const char *spec, cl_run_fn run, void *b,
-                 const double *ms, const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *in, bvhlab_build_output *out);
+int cl_build_run(const cl_builder *cb, const cl_run_spec *rs, cl_dev *d, void *b,
+                 const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+                 bvhlab_build_output *out);
 
 #endif /* BVHLAB_CL_DEV_H */
