@@ -130,7 +130,8 @@ struct trace_series {
 
 static bool on_device(int traversal)
 {
-	return traversal == BVHLAB_TRAVERSAL_DEVICE_STACK || traversal == BVHLAB_TRAVERSAL_DEVICE_STACKLESS;
+	return traversal == BVHLAB_TRAVERSAL_DEVICE_STACK ||
+	       traversal == BVHLAB_TRAVERSAL_DEVICE_STACKLESS;
 }
 
 static int grow(struct trace_series *s)
