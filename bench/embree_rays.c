@@ -37,7 +37,7 @@
 #define MIN_ROUNDS 5
 #define PASSES 3
 /* The CPU's traversals (the cl_ ones come after them in the enum). */
-#define OURS BVHLAB_TRAVERSAL_CL_STACK
+#define OURS BVHLAB_TRAVERSAL_DEVICE_STACK
 #define TRACERS (1 + OURS) /* embree, then ours by enum bvhlab_traversal */
 
 struct args {

@@ -166,19 +166,34 @@ static void test_traversal(void)
 	}
 	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"wid\" } }";
 	EXPECT_ERROR_AT(t, "\"wid\"", 0, "'rays.traversal' must be \"wide\", \"stack\", "
-	                "\"stackless\", \"cl_stack\", \"cl_stackless\", \"both\" (stack and "
-	                "stackless) or an array of those names (an entry may be {\"name\": NAME, "
-	                "\"optional\": true}), not \"wid\"");
+	                "\"stackless\", \"both\" (stack and stackless), an entry {\"name\": NAME, "
+	                "\"device\": true, \"optional\": true} (both settings may be left out) or "
+	                "an array of those, not \"wid\"");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", 2] } }";
-	EXPECT_ERROR_AT(t, "2]", 0, "\"optional\": true}), not 2");
+	EXPECT_ERROR_AT(t, "2]", 0, "an array of those, not 2");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", \"wide\"] } }";
 	EXPECT_ERROR_AT(t, "\"wide\"", 1, "'rays.traversal' names \"wide\" twice");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [] } }";
 	EXPECT_ERROR_AT(t, "[]", 0, "not an array");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [{\"name\": \"stack\", "
 	    "\"opt\": true}] } }";
-	EXPECT_ERROR_AT(t, "\"opt\"", 0, "entries as objects take \"name\" (a string) and "
-	                "\"optional\" (true or false) only");
+	EXPECT_ERROR_AT(t, "\"opt\"", 0, "entries as objects take \"name\" (a string), "
+	                "\"device\" and \"optional\" (true or false) only");
+	/* The device traversals' old names, and results.json's, are refused with
+	 * the config's way to say them. */
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"stack\", \"cl_stack\"] } }";
+	EXPECT_ERROR_AT(t, "\"cl_stack\"", 0, "'rays.traversal' \"cl_stack\" is written "
+	                "{\"name\": \"stack\", \"device\": true}: a traversal is named for what "
+	                "it does");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"device_stackless\" } }";
+	EXPECT_ERROR_AT(t, "\"device_stackless\"", 0, "is written {\"name\": \"stackless\", "
+	                "\"device\": true}");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": {\"name\": \"wide\", "
+	    "\"device\": true} } }";
+	EXPECT_ERROR_AT(t, "\"wide\"", 0, "'rays.traversal' \"wide\" has no device kernel");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [{\"name\": \"stack\", "
+	    "\"device\": true}, {\"device\": true, \"name\": \"stack\"}] } }";
+	EXPECT_ERROR_AT(t, "\"stack\"}", 0, "names \"stack\" on the device twice");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"device\": \"0:x\" } }";
 	EXPECT_ERROR_AT(t, "\"0:x\"", 0, "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or "
 	                "\"P:D\"");
@@ -191,22 +206,25 @@ static void test_device_traversal(void)
 	struct config cfg;
 	bvhlab_error err = {""};
 	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"device\": \"1:0\", \"traversal\": "
-	                "[{\"name\": \"cl_stack\", \"optional\": true}, \"stack\"] } }";
+	                "[{\"name\": \"stack\", \"device\": true, \"optional\": true}, \"stack\"] } }";
 	CHECK_INT(load(&cfg, t, &err), 0);
-	unsigned stack = 1u << BVHLAB_TRAVERSAL_STACK, cl = 1u << BVHLAB_TRAVERSAL_CL_STACK;
+	unsigned stack = 1u << BVHLAB_TRAVERSAL_STACK, cl = 1u << BVHLAB_TRAVERSAL_DEVICE_STACK;
 	CHECK(strcmp(cfg.ray_device, "1:0") == 0);
 	if (trace_cl_built())
-		CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_CL_STACK && cfg.ray_traversals == (stack | cl));
+		CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_DEVICE_STACK &&
+		      cfg.ray_traversals == (stack | cl));
 	else
 		CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_STACK && cfg.ray_traversals == stack);
 	config_finish(&cfg);
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"cl_stackless\" } }";
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": {\"name\": \"stackless\", "
+	    "\"device\": true} } }";
 	if (trace_cl_built()) {
 		CHECK_INT(load(&cfg, t, &err), 0);
 		config_finish(&cfg);
 	} else {
-		EXPECT_ERROR_AT(t, "\"cl_stackless\"", 0, "'rays.traversal' \"cl_stackless\" runs on "
-		                "an OpenCL device, and this bvhlab was built without OpenCL");
+		EXPECT_ERROR_AT(t, "\"stackless\"", 0, "'rays.traversal' \"stackless\" with "
+		                "\"device\": true runs on a device, and this bvhlab was built without "
+		                "OpenCL");
 	}
 }
 

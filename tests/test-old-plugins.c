@@ -1,5 +1,5 @@
 /*
- * Old plugins keep loading unchanged (ABI 1.5 is a minor step): the C and
+ * Old plugins keep loading unchanged (1.5 and 1.6 are minor steps): the C and
  * C++ example templates built against ABI 1.4's headers (tests/abi14) load
  * as 1.4 plugins, and give, for 1 and 2 threads on generated scenes, the
  * very trees (node for node, binary, valid, tracing like brute force) the

@@ -197,7 +197,7 @@ static void test_measure(void)
 	fixture_build(&f, 2);
 	for (int i = 0; i < N; i++)
 		rays[i] = grid_ray(&seed, 20);
-	for (int t = 0; t < BVHLAB_TRAVERSAL_CL_STACK; t++) { /* the CPU's */
+	for (int t = 0; t < BVHLAB_TRAVERSAL_DEVICE_STACK; t++) { /* the CPU's */
 		bvhlab_trace_options o = {.traversal = t, .threads = 2, .min_repeats = 4, .min_ms = 20};
 		bvhlab_trace_timing tm;
 		CHECK_INT(bvhlab_trace_measure(&f.tree, &f.scene, rays, N, &o, hits, nodes, &tm), 0);
@@ -245,7 +245,7 @@ static void test_series(void)
 	for (int i = 0; i < N; i++)
 		rays[i] = grid_ray(&seed, 16);
 	/* The CPU's traversals (the device ones: tests/cl/test-cl-trace.c). */
-	for (int t = 0; t < BVHLAB_TRAVERSAL_CL_STACK; t++) {
+	for (int t = 0; t < BVHLAB_TRAVERSAL_DEVICE_STACK; t++) {
 		/* min_repeats holds until a slice took 10 x min_ms: 200 ms, far
 		 * more than 3 passes of 2000 rays take. */
 		bvhlab_trace_options o = {.traversal = t, .threads = 2, .min_repeats = 3, .min_ms = 20};

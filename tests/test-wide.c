@@ -105,7 +105,7 @@ static bool trace(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhl
 	bvhlab_trace_timing timing;
 	int rc = bvhlab_trace_measure(tree, scene, rays, n, &o, hits, NULL, &timing);
 	static bool told;
-	if (trav >= BVHLAB_TRAVERSAL_CL_STACK && (rc == -ENOTSUP || rc == -ENODEV)) {
+	if (trav >= BVHLAB_TRAVERSAL_DEVICE_STACK && (rc == -ENOTSUP || rc == -ENODEV)) {
 		if (!told)
 			printf("  device traversals skipped: no OpenCL device\n");
 		told = true;

@@ -92,63 +92,92 @@ static int resolve_output(struct config *cfg, bvhlab_error *err)
 	return rc ? out_of_memory(cfg->path, err) : 0;
 }
 
-/* enum bvhlab_traversal of a name; -1 for none. */
+/* enum bvhlab_traversal of a CPU traversal's name; -1 for none (a device
+ * traversal is one of these with "device": true). */
 static int traversal_of(const char *name)
 {
-	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++)
+	for (int k = 0; k < BVHLAB_TRAVERSAL_DEVICE_STACK; k++)
 		if (strcmp(name, bvhlab_traversal_name(k)) == 0)
 			return k;
 	return -1;
 }
 
+/* The names the device traversals had, or have in results.json: refused
+ * with the config's way to say them. 0 for another name. */
+static int old_device_name(struct config *cfg, const cJSON *item, bvhlab_error *err)
+{
+	static const char *const names[][2] = {{"cl_stack", "stack"}, {"cl_stackless", "stackless"},
+	                                       {"device_stack", "stack"},
+	                                       {"device_stackless", "stackless"}};
+	for (size_t i = 0; cJSON_IsString(item) && i < sizeof(names) / sizeof(names[0]); i++)
+		if (strcmp(item->valuestring, names[i][0]) == 0)
+			return config_error(cfg, item, false, err,
+			                    "'rays.traversal' \"%s\" is written {\"name\": \"%s\", "
+			                    "\"device\": true}: a traversal is named for what it does, "
+			                    "and \"device\" runs it on the device rays.device picks",
+			                    names[i][0], names[i][1]);
+	return 0;
+}
+
 static int bad_traversal(struct config *cfg, const cJSON *item, bvhlab_error *err)
 {
 	char got[48];
+	if (old_device_name(cfg, item, err) < 0)
+		return -EINVAL;
 	if (cJSON_IsString(item)) /* a long name shown cut, and said to be */
 		snprintf(got, sizeof(got), "\"%.36s%s\"", item->valuestring,
 		         strlen(item->valuestring) > 36 ? "..." : "");
 	return config_error(cfg, item, false, err,
-	                    "'rays.traversal' must be \"wide\", \"stack\", \"stackless\", "
-	                    "\"cl_stack\", \"cl_stackless\", \"both\" (stack and stackless) or an "
-	                    "array of those names (an entry may be {\"name\": NAME, \"optional\": true}), "
-	                    "not %s",
+	                    "'rays.traversal' must be \"wide\", \"stack\", \"stackless\", \"both\" "
+	                    "(stack and stackless), an entry {\"name\": NAME, \"device\": true, "
+	                    "\"optional\": true} (both settings may be left out) or an array of "
+	                    "those, not %s",
 	                    cJSON_IsString(item) ? got
 	                                         : config_describe(cfg, item, got, sizeof(got)));
 }
 
-/* The device traversals exist only in a build with OpenCL. */
+/* The device traversals exist only in a build with a device backend. */
 static int traversal_built(struct config *cfg, const cJSON *item, int k, bvhlab_error *err)
 {
 #ifdef BVHLAB_HAVE_OPENCL
 	(void)cfg, (void)item, (void)k, (void)err;
 	return 0;
 #else
-	if (k != BVHLAB_TRAVERSAL_CL_STACK && k != BVHLAB_TRAVERSAL_CL_STACKLESS)
+	if (k != BVHLAB_TRAVERSAL_DEVICE_STACK && k != BVHLAB_TRAVERSAL_DEVICE_STACKLESS)
 		return 0;
 	return config_error(cfg, item, false, err,
-	                    "'rays.traversal' \"%s\" runs on an OpenCL device, and this bvhlab "
-	                    "was built without OpenCL (install ocl-icd-opencl-dev and "
-	                    "opencl-c-headers, then meson setup again)", bvhlab_traversal_name(k));
+	                    "'rays.traversal' \"%s\" with \"device\": true runs on a device, and "
+	                    "this bvhlab was built without OpenCL, its device backend (install "
+	                    "ocl-icd-opencl-dev and opencl-c-headers, then meson setup again)",
+	                    bvhlab_traversal_name(k - BVHLAB_TRAVERSAL_DEVICE_STACK));
 #endif
 }
 
-/* {"name": NAME, "optional": BOOL} of the array form: its name (or NULL,
- * an error said) and whether it is optional. */
-static const cJSON *entry_name(struct config *cfg, const cJSON *item, bool *optional,
+/* An entry's settings besides its name. */
+struct entry {
+	bool optional, device;
+};
+
+/* {"name": NAME, "device": BOOL, "optional": BOOL}: its name (or NULL, an
+ * error said) and settings. */
+static const cJSON *entry_name(struct config *cfg, const cJSON *item, struct entry *e,
                                bvhlab_error *err)
 {
 	const cJSON *m, *name = NULL;
-	*optional = false;
+	*e = (struct entry){false, false};
 	if (!cJSON_IsObject(item))
 		return item;
 	cJSON_ArrayForEach(m, item) {
 		if (strcmp(m->string, "name") == 0 && cJSON_IsString(m)) {
 			name = m;
 		} else if (strcmp(m->string, "optional") == 0 && cJSON_IsBool(m)) {
-			*optional = cJSON_IsTrue(m);
+			e->optional = cJSON_IsTrue(m);
+		} else if (strcmp(m->string, "device") == 0 && cJSON_IsBool(m)) {
+			e->device = cJSON_IsTrue(m);
 		} else {
 			config_error(cfg, m, true, err, "'rays.traversal' entries as objects take "
-			             "\"name\" (a string) and \"optional\" (true or false) only");
+			             "\"name\" (a string), \"device\" and \"optional\" (true or false) "
+			             "only");
 			return NULL;
 		}
 	}
@@ -157,34 +186,49 @@ static const cJSON *entry_name(struct config *cfg, const cJSON *item, bool *opti
 	return name;
 }
 
-/* One entry of the array form: the first kept is the main traversal. An
- * optional one that this build lacks (a cl_ one without OpenCL) is left
- * out quietly, like an optional builder whose plugin is missing. */
-static int add_traversal(struct config *cfg, const cJSON *item, bvhlab_error *err)
+/* The traversal an entry asks for: its name's, on the device with
+ * "device": true (stack and stackless have device kernels). */
+static int entry_traversal(struct config *cfg, const cJSON *name, const struct entry *e,
+                           bvhlab_error *err)
 {
-	bool optional;
-	const cJSON *name = entry_name(cfg, item, &optional, err);
-	if (!name)
-		return -EINVAL;
 	int k = cJSON_IsString(name) ? traversal_of(name->valuestring) : -1;
 	if (k < 0)
 		return bad_traversal(cfg, name, err);
-	if (optional && (k == BVHLAB_TRAVERSAL_CL_STACK || k == BVHLAB_TRAVERSAL_CL_STACKLESS) &&
-	    traversal_built(cfg, name, k, NULL) < 0)
+	if (!e->device)
+		return k;
+	if (k == BVHLAB_TRAVERSAL_WIDE)
+		return config_error(cfg, name, false, err, "'rays.traversal' \"wide\" has no device "
+		                    "kernel: \"device\": true is for \"stack\" and \"stackless\"");
+	return BVHLAB_TRAVERSAL_DEVICE_STACK + k;
+}
+
+/* One entry of the array form: the first kept is the main traversal. An
+ * optional one that this build lacks (a device one without OpenCL) is left
+ * out quietly, like an optional builder whose plugin is missing. */
+static int add_traversal(struct config *cfg, const cJSON *item, bvhlab_error *err)
+{
+	struct entry e;
+	const cJSON *name = entry_name(cfg, item, &e, err);
+	if (!name)
+		return -EINVAL;
+	int k = entry_traversal(cfg, name, &e, err);
+	if (k < 0)
+		return -EINVAL;
+	if (e.optional && traversal_built(cfg, name, k, NULL) < 0)
 		return 0;
 	if (traversal_built(cfg, name, k, err) < 0)
 		return -EINVAL;
 	if (cfg->ray_traversals & (1u << k))
-		return config_error(cfg, name, false, err, "'rays.traversal' names \"%s\" twice",
-		                    name->valuestring);
+		return config_error(cfg, name, false, err, "'rays.traversal' names \"%s\"%s twice",
+		                    name->valuestring, e.device ? " on the device" : "");
 	if (cfg->ray_traversals == 0)
 		cfg->ray_traversal = k;
 	cfg->ray_traversals |= 1u << k;
 	return 0;
 }
 
-/* "traversal": a name, "both" (stack, then stackless) or an array of
- * names, the first the main one. */
+/* "traversal": a name, "both" (stack, then stackless), one entry object
+ * or an array of names and entries, the first the main one. */
 static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *err)
 {
 	const cJSON *t = config_member(rays, "traversal");
@@ -195,13 +239,13 @@ static int parse_traversal(struct config *cfg, const cJSON *rays, bvhlab_error *
 		cfg->ray_traversal = BVHLAB_TRAVERSAL_STACK;
 		return 0;
 	}
-	int k = cJSON_IsString(t) ? traversal_of(t->valuestring) : -1;
-	if (k >= 0 && traversal_built(cfg, t, k, err) < 0)
-		return -EINVAL;
-	if (k >= 0) {
-		cfg->ray_traversal = k;
-		cfg->ray_traversals = 1u << k;
-		return 0;
+	if (cJSON_IsString(t) || cJSON_IsObject(t)) {
+		cfg->ray_traversals = 0;
+		int rc = add_traversal(cfg, t, err);
+		if (rc == 0 && cfg->ray_traversals == 0)
+			return config_error(cfg, t, false, err, "'rays.traversal': the one entry is "
+			                    "optional and not built here (OpenCL was not built)");
+		return rc;
 	}
 	if (!cJSON_IsArray(t) || cJSON_GetArraySize(t) == 0)
 		return bad_traversal(cfg, t, err);

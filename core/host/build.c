@@ -13,6 +13,7 @@
 #include <bvhlab/machine.h>
 
 #include "host/options_fill.h"
+#include "device/device.h"
 #include "machine/machine.h"
 #include "tree/tree_view.h"
 #include "util/util.h"
@@ -197,6 +198,17 @@ static void host_phase(bvhlab_build_ctx *ctx, const char *name, double ms)
 	t->phases[k].ms += ms;
 }
 
+static int host_device_program(bvhlab_build_ctx *ctx, const char *spec, const char *source,
+                               size_t len, const char *options, const void **device,
+                               void **program)
+{
+	char why[sizeof(ctx->err->message)];
+	int r = device_program(spec, source, len, options, device, program, why, sizeof(why));
+	if (r < 0)
+		host_set_error(ctx, "%s", why);
+	return r;
+}
+
 static const bvhlab_host host_table = {
 	.abi_version = BVHLAB_ABI_CURRENT,
 	.struct_size = sizeof(bvhlab_host),
@@ -211,6 +223,7 @@ static const bvhlab_host host_table = {
 	.hardware_threads = host_hardware_threads,
 	.pin_thread = host_pin_thread,
 	.phase = host_phase,
+	.device_program = host_device_program,
 };
 
 static int prepare_tree(bvhlab_tree *tree, uint32_t prims)

@@ -1,51 +1,34 @@
 /*
- * The device traversals' host side (trace_cl.h): the process's devices and
- * programs, a tree's buffers, a batch's buffers, one timed pass.
+ * The device traversals' host side (trace_cl.h): a tree's program (from
+ * the process's device layer, core/device) and buffers, a batch's
+ * buffers, one timed pass.
  */
 #include <errno.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <bvhlab/opencl.h>
 #include <bvhlab/trace.h>
 
+#include "device/device.h"
+#include "device/device_run.h"
 #include "trace/trace_cl.h"
 #include "trace/trace_cl_source.h"
+#include "trace/trace_layout.h"
 #include "tree/tree_view.h"
 #include "util/util.h"
 
-/* The private stack of the stack kernel: this many entries, or the next
- * power of two at or above a deeper tree's depth (a program per size). */
-#define MIN_STACK 64
-#define MAX_PROGRAMS 8
 #define RAYS_PER_GROUP 64
-#define OVERFLOW UINT32_MAX
 
-/* -cl-fp32-correctly-rounded-divide-sqrt: the CPU's divisions are IEEE;
- * OpenCL's default float division may be 2.5 ulp off, which would move t,
- * u and v. A device that cannot round them correctly is not asked to (the
- * build would fail): its hits may then differ, and the disagreements say
- * so. No -cl-mad-enable, no fast math: the same operations as the CPU,
- * each rounded the same. */
-#define BUILD_OPTIONS "-cl-std=CL1.2 %s-DSTACK_SIZE=%u"
-#define EXACT_DIVIDE "-cl-fp32-correctly-rounded-divide-sqrt "
-
-struct device {
-	char spec[64];
-	bvhlab_cl cl;
-	unsigned stack[MAX_PROGRAMS]; /* the stack size each program was built with */
-	cl_program program[MAX_PROGRAMS];
-	unsigned programs;
-};
-
-/* Kept for the process's life (see trace_cl.h): at most a few specs. */
-static struct device devices[4];
-static unsigned device_count;
-static pthread_mutex_t devices_lock = PTHREAD_MUTEX_INITIALIZER;
+/* The OpenCL C version; the stack kernel's stack size. No -cl-mad-enable,
+ * no fast math: the same operations as the CPU, each rounded the same (the
+ * device layer asks for correctly rounded division where the device has
+ * it; a device without it may then give other hits, and the disagreements
+ * say so). */
+#define BUILD_OPTIONS "-cl-std=CL1.2 -DSTACK_SIZE=%u"
 
 struct trace_cl_tree {
-	struct device *dev;
+	const bvhlab_cl *dev; /* the device layer's */
 	cl_kernel kernel;
 	cl_mem nodes, tris, prim_index, parents;
 	uint32_t node_count, index_count, tri_count;
@@ -68,71 +51,15 @@ static void cl_error(bvhlab_error *err, const char *msg)
 	error_set(err, "%s", msg);
 }
 
-/* The device a spec names, made once. */
-static int get_device(const char *spec, struct device **out, bvhlab_error *err)
-{
-	char why[BVHLAB_CL_ERROR_SIZE];
-	spec = spec ? spec : "auto";
-	for (unsigned i = 0; i < device_count; i++) {
-		if (strcmp(devices[i].spec, spec) == 0) {
-			*out = &devices[i];
-			return 0;
-		}
-	}
-	if (device_count == sizeof(devices) / sizeof(devices[0]) ||
-	    strlen(spec) >= sizeof(devices[0].spec)) {
-		error_set(err, "cl: too many device specs in one process (or '%.40s' too long)", spec);
-		return -EINVAL;
-	}
-	struct device *d = &devices[device_count];
-	int r = bvhlab_cl_init(&d->cl, spec, why, sizeof(why));
-	if (r < 0) {
-		cl_error(err, why);
-		return r;
-	}
-	snprintf(d->spec, sizeof(d->spec), "%s", spec);
-	device_count++;
-	*out = d;
-	return 0;
-}
-
-/* The program for a stack of at least `stack` entries, built once. */
-static int get_program(struct device *d, unsigned stack, cl_program *out, bvhlab_error *err)
-{
-	char why[BVHLAB_CL_ERROR_SIZE], options[160];
-	for (unsigned i = 0; i < d->programs; i++) {
-		if (d->stack[i] == stack) {
-			*out = d->program[i];
-			return 0;
-		}
-	}
-	if (d->programs == MAX_PROGRAMS) {
-		error_set(err, "cl: too many stack sizes in one process");
-		return -ENOMEM;
-	}
-	cl_device_fp_config fp = 0;
-	clGetDeviceInfo(d->cl.device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, NULL);
-	snprintf(options, sizeof(options), BUILD_OPTIONS,
-	         fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT ? EXACT_DIVIDE : "", stack);
-	int r = bvhlab_cl_program(&d->cl, trace_cl_source, trace_cl_source_LEN, options,
-	                          &d->program[d->programs], why, sizeof(why));
-	if (r < 0) {
-		cl_error(err, why);
-		return r;
-	}
-	d->stack[d->programs] = stack;
-	*out = d->program[d->programs++];
-	return 0;
-}
-
-/* Inner nodes on the longest root-to-leaf path of a binary tree: the most
- * far children the stack kernel holds at once. -EINVAL for links that
- * leave the array. */
-static int tree_depth(const bvhlab_tree *tree, unsigned *depth)
+/* The most far children the stack kernel holds at once on this tree: over
+ * the root-to-leaf paths, the most sum of (children - 1) of the inner
+ * nodes on one (a binary tree's depth). -EINVAL for links that leave the
+ * array or a node wider than the ABI allows. */
+static int stack_need(const bvhlab_tree *tree, unsigned *need)
 {
 	uint32_t n = tree->node_count, sp = 0;
 	uint32_t (*stack)[2] = malloc((n ? n : 1) * sizeof(*stack));
-	*depth = 0;
+	*need = 0;
 	if (!stack)
 		return -ENOMEM;
 	if (n)
@@ -140,54 +67,67 @@ static int tree_depth(const bvhlab_tree *tree, unsigned *depth)
 	while (sp) {
 		uint32_t node = stack[--sp][0], d = stack[sp][1];
 		const bvhlab_node *nd = &tree->nodes[node];
+		uint32_t k = tree_child_count(nd);
 		if (tree_is_leaf(nd))
 			continue;
-		if (tree_child(nd, 0) == 0 || tree_children_end(nd) > n || sp + 2 > n) {
+		if (k > TREE_MAX_WIDTH || tree_child(nd, 0) == 0 || tree_children_end(nd) > n ||
+		    sp + k > n) {
 			free(stack);
 			return -EINVAL;
 		}
-		*depth = d + 1 > *depth ? d + 1 : *depth;
-		stack[sp][0] = tree_child(nd, 0), stack[sp++][1] = d + 1;
-		stack[sp][0] = tree_child(nd, 1), stack[sp++][1] = d + 1;
+		*need = d + k - 1 > *need ? d + k - 1 : *need;
+		for (uint32_t i = 0; i < k; i++)
+			stack[sp][0] = tree_child(nd, i), stack[sp++][1] = d + k - 1;
 	}
 	free(stack);
 	return 0;
 }
 
-static unsigned stack_size(unsigned depth)
+static unsigned stack_size(unsigned need)
 {
-	unsigned s = MIN_STACK;
-	while (s < depth + 1)
+	unsigned s = TRACE_MIN_STACK;
+	while (s < need + 1)
 		s *= 2;
 	return s;
 }
 
+/* Whether buffers of want[] bytes fit the device: the layer's check, so a
+ * tree or batch too big is refused with the figures, not by the driver. */
+static int fits(const bvhlab_cl *d, const size_t *want, unsigned count, bvhlab_error *err)
+{
+	char why[512];
+	int r = cl_bufs_fit_on(d, want, count, why, sizeof(why));
+	if (r < 0)
+		error_set(err, "%s", why);
+	return r;
+}
+
 /* A read-only buffer holding bytes (at least 4, so empty arrays upload). */
-static int upload(struct device *d, const void *data, size_t bytes, cl_mem *out,
+static int upload(const bvhlab_cl *d, const void *data, size_t bytes, cl_mem *out,
                   const char *what, bvhlab_error *err)
 {
 	char why[256];
 	cl_int rc;
 	static const uint32_t zero = 0;
-	*out = clCreateBuffer(d->cl.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+	*out = clCreateBuffer(d->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
 	                      bytes ? bytes : sizeof(zero), bytes ? (void *)data : (void *)&zero,
 	                      &rc);
 	int r = bvhlab_cl_check(rc, what, why, sizeof(why));
 	if (r < 0)
-		error_set(err, "%s (%zu bytes on %s)", why, bytes, d->cl.name);
+		error_set(err, "%s (%zu bytes on %s)", why, bytes, d->name);
 	return r;
 }
 
 /* The triangles' vertices in leaf-slot order, as the CPU batch copy. */
 static float *slot_vertices(const bvhlab_tree *tree, const bvhlab_scene *scene)
 {
-	float *v = calloc((size_t)tree->index_count * 9 + 1, sizeof(*v));
+	float *v = calloc((size_t)tree->index_count * TRACE_SLOT_FLOATS + 1, sizeof(*v));
 	for (uint32_t i = 0; v && i < tree->index_count; i++) {
 		uint32_t prim = tree->prim_index[i];
 		if (prim >= scene->triangle_count)
 			continue; /* zeros: the kernel skips such slots */
 		for (int k = 0; k < 3; k++)
-			memcpy(v + 9 * (size_t)i + 3 * k,
+			memcpy(v + TRACE_SLOT_FLOATS * (size_t)i + 3 * k,
 			       scene->vertices + 3 * (size_t)scene->indices[3 * (size_t)prim + k],
 			       3 * sizeof(float));
 	}
@@ -204,18 +144,20 @@ static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
 		error_set(err, "cl: the tree's child links do not make a tree");
 	else if (r < 0)
 		error_set(err, "cl: out of memory");
+	size_t want[] = {(size_t)tree->node_count * sizeof(bvhlab_node),
+	                 (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(float),
+	                 (size_t)tree->index_count * sizeof(uint32_t),
+	                 (size_t)tree->node_count * sizeof(uint32_t)};
 	if (r == 0)
-		r = upload(t->dev, tree->nodes, (size_t)tree->node_count * sizeof(bvhlab_node),
-		           &t->nodes, "nodes", err);
+		r = fits(t->dev, want, 4, err);
 	if (r == 0)
-		r = upload(t->dev, verts, (size_t)tree->index_count * 9 * sizeof(float), &t->tris,
-		           "triangles", err);
+		r = upload(t->dev, tree->nodes, want[0], &t->nodes, "nodes", err);
 	if (r == 0)
-		r = upload(t->dev, tree->prim_index, (size_t)tree->index_count * sizeof(uint32_t),
-		           &t->prim_index, "prim_index", err);
+		r = upload(t->dev, verts, want[1], &t->tris, "triangles", err);
 	if (r == 0)
-		r = upload(t->dev, parents, (size_t)tree->node_count * sizeof(uint32_t), &t->parents,
-		           "parents", err);
+		r = upload(t->dev, tree->prim_index, want[2], &t->prim_index, "prim_index", err);
+	if (r == 0)
+		r = upload(t->dev, parents, want[3], &t->parents, "parents", err);
 	free(verts);
 	free(parents);
 	return r;
@@ -224,13 +166,13 @@ static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
 static int set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
 {
 	char why[256];
-	cl_int rc = clSetKernelArg(t->kernel, 0, sizeof(cl_mem), &t->nodes);
-	rc |= clSetKernelArg(t->kernel, 1, sizeof(cl_mem), &t->tris);
-	rc |= clSetKernelArg(t->kernel, 2, sizeof(cl_mem), &t->prim_index);
-	rc |= clSetKernelArg(t->kernel, 3, sizeof(cl_mem), &t->parents);
-	rc |= clSetKernelArg(t->kernel, 4, sizeof(cl_uint), &t->node_count);
-	rc |= clSetKernelArg(t->kernel, 5, sizeof(cl_uint), &t->index_count);
-	rc |= clSetKernelArg(t->kernel, 6, sizeof(cl_uint), &t->tri_count);
+	cl_int rc = clSetKernelArg(t->kernel, TRACE_ARG_NODES, sizeof(cl_mem), &t->nodes);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_TRIS, sizeof(cl_mem), &t->tris);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_PRIM_INDEX, sizeof(cl_mem), &t->prim_index);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_PARENTS, sizeof(cl_mem), &t->parents);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_NODE_COUNT, sizeof(cl_uint), &t->node_count);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_INDEX_COUNT, sizeof(cl_uint), &t->index_count);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_TRI_COUNT, sizeof(cl_uint), &t->tri_count);
 	int r = bvhlab_cl_check(rc ? CL_INVALID_KERNEL_ARGS : CL_SUCCESS, "clSetKernelArg", why,
 	                        sizeof(why));
 	if (r < 0)
@@ -238,58 +180,41 @@ static int set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
 	return r;
 }
 
-static int make_kernel(struct trace_cl_tree *t, int traversal, unsigned depth,
-                       bvhlab_error *err)
+/* The device and the program for a stack of at least `need` entries, from
+ * the process's device layer (core/device), and the traversal's kernel. */
+static int make_kernel(struct trace_cl_tree *t, const char *device, int traversal,
+                       unsigned need, bvhlab_error *err)
 {
-	char why[512];
-	cl_program prog;
-	int r = get_program(t->dev, stack_size(depth), &prog, err);
-	if (r == 0)
-		r = bvhlab_cl_kernel(prog, traversal == BVHLAB_TRAVERSAL_CL_STACK ? "trace_stack"
+	char why[BVHLAB_CL_ERROR_SIZE], options[64];
+	const void *dev;
+	void *prog;
+	snprintf(options, sizeof(options), BUILD_OPTIONS, stack_size(need));
+	int r = device_program(device, trace_cl_source, trace_cl_source_LEN, options, &dev, &prog,
+	                       why, sizeof(why));
+	if (r == 0) {
+		t->dev = dev;
+		r = bvhlab_cl_kernel(prog, traversal == BVHLAB_TRAVERSAL_DEVICE_STACK ? "trace_stack"
 		                                                                   : "trace_stackless",
 		                     &t->kernel, why, sizeof(why));
-	if (r < 0 && !err->message[0])
+	}
+	if (r < 0)
 		cl_error(err, why);
 	return r;
 }
 
-static int create_binary(const char *device, int traversal, const bvhlab_tree *tree,
-                         const bvhlab_scene *scene, struct trace_cl_tree **out,
-                         bvhlab_error *err);
-
-/* The kernels walk binary nodes: a wider tree goes up as its binary
- * expansion (the same leaves and hits; its node counts are the
- * expansion's). */
+/* The kernels read trees of any width through tree_node.h: a tree goes
+ * up as it is. */
 int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *tree,
                          const bvhlab_scene *scene, struct trace_cl_tree **out,
                          bvhlab_error *err)
 {
+	unsigned need;
 	*out = NULL;
-	if (traversal != BVHLAB_TRAVERSAL_CL_STACK && traversal != BVHLAB_TRAVERSAL_CL_STACKLESS) {
+	if (traversal != BVHLAB_TRAVERSAL_DEVICE_STACK && traversal != BVHLAB_TRAVERSAL_DEVICE_STACKLESS) {
 		error_set(err, "cl: not a device traversal (%d)", traversal);
 		return -EINVAL;
 	}
-	if (tree_width(tree) == 2)
-		return create_binary(device, traversal, tree, scene, out, err);
-	bvhlab_tree bin = *tree;
-	int r = tree_binary_nodes(tree, &bin.nodes, &bin.node_count);
-	if (r < 0) {
-		error_set(err, r == -ENOMEM ? "cl: out of memory" : "cl: the tree's links leave it");
-		return r;
-	}
-	bin.node_capacity = bin.node_count;
-	bin.width = 2;
-	r = create_binary(device, traversal, &bin, scene, out, err);
-	free(bin.nodes);
-	return r;
-}
-
-static int create_binary(const char *device, int traversal, const bvhlab_tree *tree,
-                         const bvhlab_scene *scene, struct trace_cl_tree **out,
-                         bvhlab_error *err)
-{
-	unsigned depth;
-	int r = tree_depth(tree, &depth);
+	int r = stack_need(tree, &need);
 	if (r < 0) {
 		error_set(err, r == -ENOMEM ? "cl: out of memory" : "cl: the tree's links leave it");
 		return r;
@@ -300,11 +225,7 @@ static int create_binary(const char *device, int traversal, const bvhlab_tree *t
 	t->node_count = tree->node_count;
 	t->index_count = tree->index_count;
 	t->tri_count = scene->triangle_count;
-	pthread_mutex_lock(&devices_lock);
-	r = get_device(device, &t->dev, err);
-	if (r == 0)
-		r = make_kernel(t, traversal, depth, err);
-	pthread_mutex_unlock(&devices_lock);
+	r = make_kernel(t, device, traversal, need, err);
 	if (r == 0)
 		r = upload_tree(t, tree, scene, err);
 	if (r == 0)
@@ -331,17 +252,17 @@ void trace_cl_tree_destroy(struct trace_cl_tree *t)
 
 const char *trace_cl_device_name(const struct trace_cl_tree *t)
 {
-	return t->dev->cl.name;
+	return t->dev->name;
 }
 
 static int output_buffer(struct trace_cl_tree *t, size_t bytes, cl_mem *out, bvhlab_error *err)
 {
 	char why[256];
 	cl_int rc;
-	*out = clCreateBuffer(t->dev->cl.context, CL_MEM_WRITE_ONLY, bytes ? bytes : 16, NULL, &rc);
+	*out = clCreateBuffer(t->dev->context, CL_MEM_WRITE_ONLY, bytes ? bytes : 16, NULL, &rc);
 	int r = bvhlab_cl_check(rc, "clCreateBuffer", why, sizeof(why));
 	if (r < 0)
-		error_set(err, "%s (%zu bytes on %s)", why, bytes, t->dev->cl.name);
+		error_set(err, "%s (%zu bytes on %s)", why, bytes, t->dev->name);
 	return r;
 }
 
@@ -359,7 +280,11 @@ int trace_cl_batch_create(struct trace_cl_tree *t, const bvhlab_ray *rays, size_
 	b->t = t;
 	b->count = count;
 	b->any = any_hit;
-	int r = upload(t->dev, rays, count * sizeof(*rays), &b->rays, "rays", err);
+	size_t want[] = {count * sizeof(*rays), count * sizeof(bvhlab_hit),
+	                 count * 2 * sizeof(uint32_t)};
+	int r = fits(t->dev, want, 3, err);
+	if (r == 0)
+		r = upload(t->dev, rays, want[0], &b->rays, "rays", err);
 	if (r == 0)
 		r = output_buffer(t, count * sizeof(bvhlab_hit), &b->hits, err);
 	if (r == 0)
@@ -388,11 +313,11 @@ static cl_int set_batch_args(struct trace_cl_batch *b)
 {
 	cl_kernel k = b->t->kernel;
 	cl_uint n = (cl_uint)b->count;
-	cl_int rc = clSetKernelArg(k, 7, sizeof(cl_mem), &b->rays);
-	rc |= clSetKernelArg(k, 8, sizeof(cl_uint), &n);
-	rc |= clSetKernelArg(k, 9, sizeof(cl_uint), &b->any);
-	rc |= clSetKernelArg(k, 10, sizeof(cl_mem), &b->hits);
-	rc |= clSetKernelArg(k, 11, sizeof(cl_mem), &b->counts);
+	cl_int rc = clSetKernelArg(k, TRACE_ARG_RAYS, sizeof(cl_mem), &b->rays);
+	rc |= clSetKernelArg(k, TRACE_ARG_RAY_COUNT, sizeof(cl_uint), &n);
+	rc |= clSetKernelArg(k, TRACE_ARG_ANY, sizeof(cl_uint), &b->any);
+	rc |= clSetKernelArg(k, TRACE_ARG_HITS, sizeof(cl_mem), &b->hits);
+	rc |= clSetKernelArg(k, TRACE_ARG_COUNTS, sizeof(cl_mem), &b->counts);
 	return rc ? CL_INVALID_KERNEL_ARGS : CL_SUCCESS;
 }
 
@@ -403,7 +328,7 @@ static int take_counts(const uint32_t *c, size_t n, uint32_t *nodes, bvhlab_trac
 {
 	bvhlab_trace_stats s = {.rays = n};
 	for (size_t i = 0; i < n; i++) {
-		if (c[2 * i] == OVERFLOW) {
+		if (c[2 * i] == TRACE_OVERFLOW) {
 			error_set(err, "cl: ray %zu overflowed the stack kernel's stack", i);
 			return -EIO;
 		}
@@ -421,7 +346,7 @@ static int read_back(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes
                      bvhlab_trace_stats *stats, bvhlab_error *err)
 {
 	char why[256];
-	cl_command_queue q = b->t->dev->cl.queue;
+	cl_command_queue q = b->t->dev->queue;
 	cl_int rc = CL_SUCCESS;
 	uint32_t *c = malloc(b->count * 2 * sizeof(*c) + 1);
 	if (!c)
@@ -446,28 +371,26 @@ int trace_cl_pass(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
                   bvhlab_error *err)
 {
 	char why[256];
-	cl_event ev = NULL;
-	size_t global = (b->count + RAYS_PER_GROUP - 1) / RAYS_PER_GROUP * RAYS_PER_GROUP;
+	cl_events ev = {.count = 0};
 	*kernel_s = *wall_s = 0;
 	if (b->count == 0)
 		return 0;
 	cl_int rc = set_batch_args(b);
+	int r = bvhlab_cl_check(rc, "clSetKernelArg", why, sizeof(why));
 	double t0 = util_now();
-	if (rc == CL_SUCCESS)
-		rc = clEnqueueNDRangeKernel(b->t->dev->cl.queue, b->t->kernel, 1, NULL, &global, NULL,
-		                            0, NULL, &ev);
-	if (rc == CL_SUCCESS)
-		rc = clWaitForEvents(1, &ev);
+	/* The arguments are set: the layer's launch with none of its own. */
+	if (r == 0)
+		r = cl_launch_on(b->t->dev, b->t->kernel, b->count, NULL, 0, &ev, why, sizeof(why));
+	if (r == 0)
+		r = bvhlab_cl_check(clFinish(b->t->dev->queue), "tracing kernel", why, sizeof(why));
 	*wall_s = util_now() - t0;
-	int r = bvhlab_cl_check(rc, "tracing kernel", why, sizeof(why));
-	if (r == 0) {
-		double ms = bvhlab_cl_event_ms(ev);
-		*kernel_s = ms >= 0 ? ms * 1e-3 : *wall_s; /* no profiling: the wall clock */
-	} else {
-		error_set(err, "%s on %s", why, b->t->dev->cl.name);
+	double ms = cl_events_ms(&ev);
+	if (r < 0) {
+		error_set(err, "%s on %s", why, b->t->dev->name);
+		return r;
 	}
-	bvhlab_cl_release_event(&ev);
-	if (r == 0 && (hits || nodes || stats))
+	*kernel_s = ms > 0 ? ms * 1e-3 : *wall_s; /* no profiling: the wall clock */
+	if (hits || nodes || stats)
 		r = read_back(b, hits, nodes, stats, err);
 	return r;
 }

@@ -1,5 +1,5 @@
 /*
- * The device traversals (rays.traversal "cl_stack" and "cl_stackless"):
+ * The device traversals (rays.traversal "device_stack" and "device_stackless"):
  * one work-item per ray, closest or any hit, the same arithmetic as the
  * CPU kernel (core/trace/trace_kernel.h) operation for operation, so a ray
  * gets the same triangle at the same t, u and v bit for bit. For that the
@@ -8,13 +8,13 @@
  * -cl-mad-enable or -cl-fast-relaxed-math, and contraction into fused
  * multiply-adds is off here, as it is in the CPU build (ISO C mode).
  *
- * Buffers: nodes as two float4 each (lo + first, hi + count: bvhlab_node's
- * layout), the triangles' vertices in leaf-slot order (9 floats a slot,
- * as the CPU batch tracer's copy), prim_index, the parent links
- * (stackless), rays as two float4 (org + tmin, dir + tmax), hits as uint4
- * (t, u, v bits, prim) and per ray the nodes entered and triangles tested.
- * STACK_SIZE (the stack traversal's private stack) comes from the host:
- * at least the tree's depth.
+ * The program is tree_node.h (the tree interface's node reads, shared with
+ * the host), trace_layout.h (the buffers' layouts and the constants, also
+ * shared) and this file, so the kernels walk trees of any width (ABI 1.5)
+ * the way the CPU traversals do, in the same order: the same nodes
+ * entered, not only the same hits. STACK_SIZE (the stack traversal's
+ * private stack) comes from the host: at least the most far children a
+ * walk of the tree holds at once.
  */
 #pragma OPENCL FP_CONTRACT OFF
 
@@ -23,11 +23,11 @@
 #endif
 
 #ifndef STACK_SIZE
-#define STACK_SIZE 64
+#define STACK_SIZE TRACE_MIN_STACK
 #endif
 
-#define NO_HIT 0xffffffffu
-#define FAR_SCALE (1.0f + 32.0f * FLT_EPSILON)
+#define NO_HIT TRACE_NO_HIT
+#define NODES __global const tree_node *nodes
 
 typedef struct prep {
 	float org[3];
@@ -129,10 +129,9 @@ static bool take_hit(hit *h, uint prim, const float *out)
 }
 
 /* box_enter(): entry distance, or INFINITY for a miss in (tmin, tmax). */
-static float box_enter(const prep *p, __global const float4 *nodes, uint node, float tmax)
+static float box_enter(const prep *p, NODES, uint node, float tmax)
 {
-	float4 lo = nodes[2 * node], hi = nodes[2 * node + 1];
-	float f[8] = {lo.x, lo.y, lo.z, lo.w, hi.x, hi.y, hi.z, hi.w};
+	const __global float *f = tree_box(&nodes[node]);
 	float t0 = p->tmin, t1 = tmax;
 	for (int k = 0; k < 3; k++) {
 		float tn = (f[p->near[k]] - p->org[k]) * p->inv[k];
@@ -143,22 +142,13 @@ static float box_enter(const prep *p, __global const float4 *nodes, uint node, f
 	return t0 <= t1 * FAR_SCALE ? t0 : INFINITY;
 }
 
-static uint node_first(__global const float4 *nodes, uint node)
-{
-	return as_uint(nodes[2 * node].w);
-}
-
-static uint node_count(__global const float4 *nodes, uint node)
-{
-	return as_uint(nodes[2 * node + 1].w);
-}
-
 /* A leaf's triangles; true when an any-hit ray may stop. */
 static bool leaf(const prep *p, __global const float *tris, __global const uint *prim_index,
-                 uint first, uint count, uint index_count, uint tri_count, bool any, hit *h,
-                 uint *tests)
+                 const __global tree_node *n, uint index_count, uint tri_count, bool any,
+                 hit *h, uint *tests)
 {
 	float out[3];
+	uint first = tree_leaf_first(n), count = tree_leaf_count(n);
 	if (first > index_count || count > index_count - first)
 		return false;
 	for (uint i = first; i < first + count; i++) {
@@ -166,7 +156,8 @@ static bool leaf(const prep *p, __global const float *tris, __global const uint 
 		if (prim >= tri_count)
 			continue;
 		++*tests;
-		if (isect(p, tris + 9 * (size_t)i, h->t, out) && take_hit(h, prim, out) && any)
+		if (isect(p, tris + TRACE_SLOT_FLOATS * (size_t)i, h->t, out) &&
+		    take_hit(h, prim, out) && any)
 			return true;
 	}
 	return false;
@@ -179,31 +170,32 @@ static void store(__global uint4 *hits, __global uint2 *counts, uint i, const hi
 	counts[i] = (uint2)(nodes, tests);
 }
 
-/* The arguments of both traversal kernels, in the order the host sets them. */
+/* The arguments of both traversal kernels, in enum trace_arg's order. */
 #define TRACE_KERNEL_ARGS                                                                  \
-	__global const float4 *nodes, __global const float *tris,                          \
-	__global const uint *prim_index, __global const uint *parents, uint node_total,    \
-	uint index_count, uint tri_count, __global const float4 *rays, uint ray_count,     \
-	uint any, __global uint4 *hits, __global uint2 *counts
+	NODES, __global const float *tris, __global const uint *prim_index,                \
+	__global const uint *parents, uint node_total, uint index_count, uint tri_count,   \
+	__global const float4 *rays, uint ray_count, uint any, __global uint4 *hits,       \
+	__global uint2 *counts
 
-/* Enters `node`: its first and count, counted in *visited; false past
- * node_total entries (a cycle in a broken tree: the walk ends). */
-static bool enter_node(__global const float4 *nodes, uint node, uint node_total, uint *visited,
-                       uint *first, uint *count)
+/* Counts entering a node in *visited; false past node_total entries (a
+ * cycle in a broken tree: the walk ends). */
+static bool enter_node(uint node_total, uint *visited)
 {
-	if (++*visited > node_total)
-		return false;
-	*first = node_first(nodes, node);
-	*count = node_count(nodes, node);
-	return true;
+	return ++*visited <= node_total;
+}
+
+/* Whether an inner node's children lie inside the node array (the CPU
+ * traversals' tree_children_end check). */
+static bool children_inside(const __global tree_node *n, uint node_total)
+{
+	return tree_child_count(n) <= TREE_MAX_WIDTH && tree_children_end(n) <= node_total;
 }
 
 /* The start of both traversals for ray i: no hit yet, the ray prepared;
  * false when there is nothing to trace (past the last ray, or a ray that
  * misses the root box, whose miss is stored). */
-static bool ray_begin(__global const float4 *nodes, uint node_total,
-                      __global const float4 *rays, uint ray_count, uint i,
-                      __global uint4 *hits, __global uint2 *counts, prep *p, hit *h)
+static bool ray_begin(NODES, uint node_total, __global const float4 *rays, uint ray_count,
+                      uint i, __global uint4 *hits, __global uint2 *counts, prep *p, hit *h)
 {
 	if (i >= ray_count)
 		return false;
@@ -218,43 +210,73 @@ static bool ray_begin(__global const float4 *nodes, uint node_total,
 	return false;
 }
 
-/* trace.c's traverse(): near child first, far ones on a stack with their
- * entry distance, popped only while it still beats the closest hit. */
+/* A child on the stack: its node and entry distance. */
+typedef struct entry {
+	uint node;
+	float t;
+} entry;
+
+/* trace.c's descend() and descend_wide(): the children the ray enters,
+ * far to near, into e; how many. Two children: the second is near only
+ * when strictly nearer. More: sorted by insertion, a tie keeping the child
+ * list's order with the later one nearer. */
+static uint children_hit(const prep *p, NODES, const __global tree_node *n, float tmax,
+                         entry *e)
+{
+	uint m = 0, k = tree_child_count(n);
+	if (tree_is_binary_inner(n)) {
+		entry a = {tree_child(n, 0), box_enter(p, nodes, tree_child(n, 0), tmax)};
+		entry b = {tree_child(n, 1), box_enter(p, nodes, tree_child(n, 1), tmax)};
+		entry near = b.t < a.t ? b : a, far = b.t < a.t ? a : b;
+		if (near.t == INFINITY)
+			return 0;
+		if (far.t != INFINITY)
+			e[m++] = far;
+		e[m++] = near;
+		return m;
+	}
+	for (uint i = 0; i < k; i++) {
+		entry c = {tree_child(n, i), box_enter(p, nodes, tree_child(n, i), tmax)};
+		if (c.t == INFINITY)
+			continue;
+		uint j = m++;
+		for (; j > 0 && e[j - 1].t < c.t; j--)
+			e[j] = e[j - 1];
+		e[j] = c;
+	}
+	return m;
+}
+
+/* trace.c's traverse(): nearest child next, the others on a stack with
+ * their entry distance, popped only while it still beats the closest hit. */
 __kernel void trace_stack(TRACE_KERNEL_ARGS)
 {
-	uint i = get_global_id(0), visited = 0, tests = 0, sp = 0, node = 0, first, count;
+	uint i = get_global_id(0), visited = 0, tests = 0, sp = 0, node = 0;
 	uint st_node[STACK_SIZE];
 	float st_t[STACK_SIZE];
+	entry e[TREE_MAX_WIDTH];
 	hit h;
 	prep p;
 	(void)parents;
 	if (!ray_begin(nodes, node_total, rays, ray_count, i, hits, counts, &p, &h))
 		return;
-	while (enter_node(nodes, node, node_total, &visited, &first, &count)) {
-		if (count) {
-			if (leaf(&p, tris, prim_index, first, count, index_count, tri_count, any, &h,
-			         &tests))
+	while (enter_node(node_total, &visited)) {
+		const __global tree_node *n = &nodes[node];
+		if (tree_is_leaf(n)) {
+			if (leaf(&p, tris, prim_index, n, index_count, tri_count, any, &h, &tests))
 				break;
-		} else if (first < node_total - 1) {
-			uint near = first, far = first + 1;
-			float tn = box_enter(&p, nodes, near, h.t), tf = box_enter(&p, nodes, far, h.t);
-			if (tf < tn) {
-				float t = tn;
-				tn = tf;
-				tf = t;
-				near = far;
-				far = first;
-			}
-			if (tn != INFINITY) {
-				if (tf != INFINITY) {
-					if (sp == STACK_SIZE) { /* deeper than the host said: flag it */
-						visited = 0xffffffffu;
-						break;
-					}
-					st_node[sp] = far;
-					st_t[sp++] = tf;
+		} else if (children_inside(n, node_total)) {
+			uint m = children_hit(&p, nodes, n, h.t, e);
+			if (m > 0) {
+				if (sp + m - 1 > STACK_SIZE) { /* deeper than the host said: flag it */
+					visited = TRACE_OVERFLOW;
+					break;
 				}
-				node = near;
+				for (uint k = 0; k + 1 < m; k++) {
+					st_node[sp] = e[k].node;
+					st_t[sp++] = e[k].t;
+				}
+				node = e[m - 1].node;
 				continue;
 			}
 		}
@@ -273,57 +295,99 @@ __kernel void trace_stack(TRACE_KERNEL_ARGS)
 	store(hits, counts, i, &h, visited, tests);
 }
 
-/* trace_stackless.c's near_child(): decided from the box centres along the
- * ray, the same going down and coming back up. */
-static uint near_child(const prep *p, __global const float4 *nodes, uint first)
+/* trace_stackless.c's centre_key(): twice a box centre along the ray. */
+static float centre_key(const prep *p, NODES, uint node)
 {
-	float4 alo = nodes[2 * first], ahi = nodes[2 * first + 1];
-	float4 blo = nodes[2 * first + 2], bhi = nodes[2 * first + 3];
-	float a[3] = {alo.x + ahi.x, alo.y + ahi.y, alo.z + ahi.z};
-	float b[3] = {blo.x + bhi.x, blo.y + bhi.y, blo.z + bhi.z};
+	const __global float *f = tree_box(&nodes[node]);
 	float d = 0.0f;
 	for (int k = 0; k < 3; k++)
-		d += (b[k] - a[k]) * p->dir[k];
-	return d < 0.0f ? first + 1 : first;
+		d += (f[k] + f[4 + k]) * p->dir[k];
+	return d;
+}
+
+/* trace_stackless.c's near_child(): decided from the box centres along the
+ * ray, the same going down and coming back up. */
+static uint near_child(const prep *p, NODES, const __global tree_node *n)
+{
+	uint a = tree_child(n, 0), b = tree_child(n, 1);
+	const __global float *fa = tree_box(&nodes[a]), *fb = tree_box(&nodes[b]);
+	float d = 0.0f;
+	for (int k = 0; k < 3; k++)
+		d += ((fb[k] + fb[4 + k]) - (fa[k] + fa[4 + k])) * p->dir[k];
+	return d < 0.0f ? b : a;
+}
+
+/* trace_stackless.c's next_wide(): the child of wide node n after `after`
+ * in the ray order (by key, then by index), the first for NO_HIT; NO_HIT
+ * past the last. */
+static uint next_wide(const prep *p, NODES, const __global tree_node *n, uint after)
+{
+	float ka = after == NO_HIT ? 0.0f : centre_key(p, nodes, after), kb = 0.0f;
+	uint best = NO_HIT;
+	for (uint i = 0; i < tree_child_count(n); i++) {
+		uint c = tree_child(n, i);
+		float k = centre_key(p, nodes, c);
+		if (after != NO_HIT && !(k > ka || (k == ka && c > after)))
+			continue;
+		if (best == NO_HIT || k < kb || (k == kb && c < best)) {
+			best = c;
+			kb = k;
+		}
+	}
+	return best;
+}
+
+/* trace_stackless.c's enter_next(): the first child of inner node n after
+ * `after` (NO_HIT: from the start) in the ray order that the ray enters,
+ * into *node; false when none is left. */
+static bool enter_next(const prep *p, NODES, const __global tree_node *n, uint after,
+                       float tmax, uint *node)
+{
+	if (tree_is_binary_inner(n)) {
+		uint near = near_child(p, nodes, n);
+		uint far = near == tree_child(n, 0) ? tree_child(n, 1) : tree_child(n, 0);
+		if (after == NO_HIT && box_enter(p, nodes, near, tmax) != INFINITY) {
+			*node = near;
+			return true;
+		}
+		if ((after == NO_HIT || after == near) && box_enter(p, nodes, far, tmax) != INFINITY) {
+			*node = far;
+			return true;
+		}
+		return false;
+	}
+	for (uint c = next_wide(p, nodes, n, after); c != NO_HIT; c = next_wide(p, nodes, n, c))
+		if (box_enter(p, nodes, c, tmax) != INFINITY) {
+			*node = c;
+			return true;
+		}
+	return false;
 }
 
 /* trace_stackless.c's walk(): down into the near child, up through the
- * parent links (Hapala et al. 2011). */
+ * parent links (Hapala et al. 2011), a wide node's children in the ray
+ * order. */
 __kernel void trace_stackless(TRACE_KERNEL_ARGS)
 {
-	uint i = get_global_id(0), visited = 0, tests = 0, node = 0, first, count;
+	uint i = get_global_id(0), visited = 0, tests = 0, node = 0;
 	hit h;
 	prep p;
 	if (!ray_begin(nodes, node_total, rays, ray_count, i, hits, counts, &p, &h))
 		return;
-	while (enter_node(nodes, node, node_total, &visited, &first, &count)) {
-		if (count == 0) {
-			uint near = near_child(&p, nodes, first);
-			uint far = near == first ? first + 1 : first;
-			if (box_enter(&p, nodes, near, h.t) != INFINITY) {
-				node = near;
+	while (enter_node(node_total, &visited)) {
+		const __global tree_node *n = &nodes[node];
+		if (!tree_is_leaf(n)) {
+			if (enter_next(&p, nodes, n, NO_HIT, h.t, &node))
 				continue;
-			}
-			if (box_enter(&p, nodes, far, h.t) != INFINITY) {
-				node = far;
-				continue;
-			}
-		} else if (leaf(&p, tris, prim_index, first, count, index_count, tri_count, any, &h,
-		                &tests)) {
+		} else if (leaf(&p, tris, prim_index, n, index_count, tri_count, any, &h, &tests)) {
 			break;
 		}
-		/* climb(): up to the next far child to enter, or out at the root */
+		/* climb(): up to the next sibling to enter, or out at the root */
 		uint at = node;
 		bool found = false;
-		while (at != 0) {
-			uint parent = parents[at], pf = node_first(nodes, parent);
-			uint near = near_child(&p, nodes, pf);
-			uint far = near == pf ? pf + 1 : pf;
-			if (at == near && box_enter(&p, nodes, far, h.t) != INFINITY) {
-				node = far;
-				found = true;
-				break;
-			}
+		while (at != 0 && !found) {
+			uint parent = parents[at];
+			found = enter_next(&p, nodes, &nodes[parent], at, h.t, &node);
 			at = parent;
 		}
 		if (!found)

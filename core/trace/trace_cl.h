@@ -1,5 +1,5 @@
 /*
- * The device traversals (rays.traversal "cl_stack", "cl_stackless"):
+ * The device traversals (rays.traversal "device_stack", "device_stackless"):
  * trace_cl.cl's kernels on an OpenCL device chosen by a spec (auto, gpu,
  * cpu or P:D, include/bvhlab/opencl.h). A tree is uploaded once (nodes,
  * its triangles' vertices in leaf-slot order, prim_index, parent links);
@@ -8,9 +8,11 @@
  * completion). Built only with OpenCL (BVHLAB_HAVE_OPENCL); without it
  * trace_cl_tree_create says so.
  *
- * The device and its compiled program are kept for the life of the
- * process (one per device spec and stack size): PoCL takes seconds to
- * compile a program, and a sweep's child traces many batches.
+ * The device and its compiled program (one per device spec and stack
+ * size) come from the process's device layer (core/device/device.h), which
+ * keeps them for the life of the process and shares them with the device
+ * builders: PoCL takes seconds to compile a program, and a sweep's child
+ * builds and traces many times.
  */
 #ifndef BVHLAB_CORE_TRACE_CL_H
 #define BVHLAB_CORE_TRACE_CL_H
@@ -28,7 +30,7 @@ struct trace_cl_batch;
 /* Whether this build has the device traversals. */
 bool trace_cl_built(void);
 
-/* The traversal (BVHLAB_TRAVERSAL_CL_STACK or _CL_STACKLESS) of tree on
+/* The traversal (BVHLAB_TRAVERSAL_DEVICE_STACK or _CL_STACKLESS) of tree on
  * the device `device` names (NULL: "auto"). 0, or a negative errno with
  * err saying why: -ENOTSUP OpenCL not built, -ENODEV no platform or device
  * (what to install), -EINVAL a bad spec or tree links, -ENOMEM, -EIO. */

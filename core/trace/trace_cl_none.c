@@ -1,7 +1,7 @@
 /*
  * The device traversals in a build without OpenCL (trace_cl.h): every
  * request is refused with the reason, so a config or caller that names
- * cl_stack or cl_stackless learns why instead of getting nothing.
+ * device_stack or device_stackless learns why instead of getting nothing.
  */
 #include <errno.h>
 

@@ -21,6 +21,8 @@
 #include <bvhlab/trace.h>
 #include <bvhlab/tree.h>
 
+#include "trace/trace_layout.h"
+
 /* The blocked brute force (trace.c) relies on its vector pass computing the very same
  * floats as the scalar test; a fused multiply-add in one and not the other
  * would break that. GCC does not contract in ISO C mode; clang needs telling. */
@@ -28,14 +30,8 @@
 #pragma STDC FP_CONTRACT OFF
 #endif
 
-/*
- * The slab test rounds; Ize ("Robust BVH Ray Traversal", JCGT 2013) shows
- * scaling the far distance by 1 + 2 gamma(3) keeps it conservative. The
- * sheared triangle test has rounding of its own (a hit it reports may lie a
- * few ulps outside the triangle's exact box), so the margin is wider: a few
- * extra boxes visited cost nothing, a missed hit makes validation lie.
- */
-#define FAR_SCALE (1.0f + 32.0f * FLT_EPSILON)
+/* FAR_SCALE, the slab test's margin, is trace_layout.h's (shared with
+ * the device kernels). */
 
 /* Per-ray constants of the triangle and slab tests. */
 typedef struct ray_prep {

@@ -36,10 +36,10 @@ const char *bvhlab_traversal_name(int traversal)
 		return "stackless";
 	case BVHLAB_TRAVERSAL_WIDE:
 		return "wide";
-	case BVHLAB_TRAVERSAL_CL_STACK:
-		return "cl_stack";
-	case BVHLAB_TRAVERSAL_CL_STACKLESS:
-		return "cl_stackless";
+	case BVHLAB_TRAVERSAL_DEVICE_STACK:
+		return "device_stack";
+	case BVHLAB_TRAVERSAL_DEVICE_STACKLESS:
+		return "device_stackless";
 	default:
 		return NULL;
 	}
@@ -130,7 +130,8 @@ struct trace_series {
 
 static bool on_device(int traversal)
 {
-	return traversal == BVHLAB_TRAVERSAL_CL_STACK || traversal == BVHLAB_TRAVERSAL_CL_STACKLESS;
+	return traversal == BVHLAB_TRAVERSAL_DEVICE_STACK ||
+	       traversal == BVHLAB_TRAVERSAL_DEVICE_STACKLESS;
 }
 
 static int grow(struct trace_series *s)

@@ -6,11 +6,13 @@
  * built top-down), with leaves of at most max_leaf primitives.
  *
  * It uses only <bvhlab/opencl.h>, header-only like the rest of the SDK:
- * choose the device from the "device" option (auto, gpu, cpu or P:D),
- * build the kernel with the compiler's log in any error, time the kernel
- * with its profiling event, release everything. The device and program
- * are kept between builds (the host runs one build at a time) and
- * released when the plugin is unloaded; a build reports its phases
+ * the device the "device" option names (auto, gpu, cpu or P:D) and the
+ * program built on it come from the host's device layer (ABI 1.6,
+ * bvhlab_cl_host_program: shared with every device builder and the
+ * tracer, kept for the process's life, the compiler's log in any error);
+ * the kernel made from it is the plugin's, kept between builds (the host
+ * runs one build at a time) and released when the plugin is unloaded; the
+ * kernel is timed with its profiling event; a build reports its phases
  * (ABI 1.3): upload, device (the kernel's own time), download, and host.
  * Build it out of tree (meson.build beside this file), then:
  *   bvhlab build ./build/template_cl.so icosphere:frequency=64 -o device=cpu
@@ -50,10 +52,10 @@ static const char kernel_src[] =
 	"  codes[i] = spread(x) << 2 | spread(y) << 1 | spread(z);\n"
 	"}\n";
 
-/* The device and its kernel, kept between builds. */
+/* The host's device and program (not ours to release), and our kernel
+ * made from that program, kept between builds. */
 static struct {
-	char spec[64];
-	bvhlab_cl cl;
+	const bvhlab_cl *cl;
 	cl_program program;
 	cl_kernel kernel;
 } S;
@@ -61,28 +63,25 @@ static struct {
 __attribute__((destructor)) static void release(void)
 {
 	bvhlab_cl_release_kernel(&S.kernel);
-	bvhlab_cl_release_program(&S.program);
-	bvhlab_cl_finish(&S.cl);
 }
 
-static int open_device(const char *spec, char *err, size_t size)
+/* 0, or a negative errno after host->set_error. */
+static int open_device(const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *spec)
 {
-	if (S.kernel && strcmp(S.spec, spec) == 0)
-		return 0;
-	release();
-	if (strlen(spec) >= sizeof(S.spec))
-		return bvhlab_cl_fail(-EINVAL, err, size, "device '%.40s...' too long", spec);
-	int rc = bvhlab_cl_init(&S.cl, spec, err, size);
-	if (rc == 0)
-		rc = bvhlab_cl_program(&S.cl, kernel_src, 0, "-cl-std=CL1.2", &S.program, err, size);
-	if (rc == 0)
-		rc = bvhlab_cl_kernel(S.program, "morton", &S.kernel, err, size);
-	if (rc < 0) {
-		release();
+	char err[BVHLAB_CL_ERROR_SIZE];
+	const bvhlab_cl *cl;
+	cl_program program;
+	int rc = bvhlab_cl_host_program(host, ctx, spec, kernel_src, 0, "-cl-std=CL1.2", &cl,
+	                                &program);
+	if (rc < 0 || (S.kernel && program == S.program))
 		return rc;
-	}
-	snprintf(S.spec, sizeof(S.spec), "%s", spec);
-	return 0;
+	release();
+	S.cl = cl;
+	S.program = program;
+	rc = bvhlab_cl_kernel(program, "morton", &S.kernel, err, sizeof(err));
+	if (rc < 0)
+		host->set_error(ctx, "%s", err);
+	return rc;
 }
 
 static double now_ms(void)
@@ -127,21 +126,21 @@ static int device_codes(job *j, uint32_t *codes, char *err, size_t size)
 	cl_event ev = NULL;
 	size_t global = n;
 	double t0 = now_ms();
-	cl_mem c = clCreateBuffer(S.cl.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+	cl_mem c = clCreateBuffer(S.cl->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
 	                          3 * sizeof(float) * n, (void *)in->centroids, &rc);
-	cl_mem out = rc == CL_SUCCESS ? clCreateBuffer(S.cl.context, CL_MEM_WRITE_ONLY,
+	cl_mem out = rc == CL_SUCCESS ? clCreateBuffer(S.cl->context, CL_MEM_WRITE_ONLY,
 	                                               sizeof(uint32_t) * n, NULL, &rc) : NULL;
 	j->ms[0] = now_ms() - t0;
 	if (rc == CL_SUCCESS) {
 		set_args(c, out, n, lo, s);
-		rc = clEnqueueNDRangeKernel(S.cl.queue, S.kernel, 1, NULL, &global, NULL, 0, NULL, &ev);
+		rc = clEnqueueNDRangeKernel(S.cl->queue, S.kernel, 1, NULL, &global, NULL, 0, NULL, &ev);
 	}
 	if (rc == CL_SUCCESS)
 		rc = clWaitForEvents(1, &ev);
 	j->ms[1] = rc == CL_SUCCESS ? bvhlab_cl_event_ms(ev) : 0;
 	t0 = now_ms();
 	if (rc == CL_SUCCESS)
-		rc = clEnqueueReadBuffer(S.cl.queue, out, CL_TRUE, 0, sizeof(uint32_t) * n, codes, 0,
+		rc = clEnqueueReadBuffer(S.cl->queue, out, CL_TRUE, 0, sizeof(uint32_t) * n, codes, 0,
 		                         NULL, NULL);
 	j->ms[2] = now_ms() - t0;
 	bvhlab_cl_release_event(&ev);
@@ -252,12 +251,10 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	uint32_t *codes = malloc(sizeof(*codes) * n);
 	if (!codes)
 		return -ENOMEM;
-	rc = open_device(device, err, sizeof(err));
-	if (rc == 0)
-		rc = device_codes(&j, codes, err, sizeof(err));
-	if (rc < 0)
+	rc = open_device(host, ctx, device);
+	if (rc == 0 && (rc = device_codes(&j, codes, err, sizeof(err))) < 0)
 		host->set_error(ctx, "%s", err);
-	else if ((rc = host_part(&j, codes)) < 0)
+	else if (rc == 0 && (rc = host_part(&j, codes)) < 0)
 		host->set_error(ctx, "out of memory");
 	free(codes);
 	for (int k = 0; rc == 0 && k < 4 && BVHLAB_HOST_HAS(host, phase); k++)

@@ -29,6 +29,11 @@
  *        the struct for the run and gives it to every call as
  *        bvhlab_build_input.options), and `choices` on INT options ("30|63").
  *        Older plugins load as before and read their options per build.
+ *        bvhlab_host.device_program: the process's device layer (one
+ *        device and program cache shared by every device builder and the
+ *        core's device tracer; include/bvhlab/opencl.h's
+ *        bvhlab_cl_host_program is the typed call). Older plugins load as
+ *        before and keep their own devices.
  *
  * A plugin is a shared object that exports exactly one symbol,
  *
@@ -228,6 +233,26 @@ typedef struct bvhlab_host {
 	 * which the host times itself (build_ms). Call it from the thread
 	 * that called build(). Check BVHLAB_HOST_HAS(host, phase) first. */
 	void (*phase)(bvhlab_build_ctx *ctx, const char *name, double ms);
+
+	/* since 1.6. The process's device layer, shared by every device
+	 * builder and the core's device tracer and kept for the life of the
+	 * process: the device `spec` names (NULL: "auto"; for OpenCL "auto",
+	 * "gpu", "cpu" or "P:D") opened once, and the program of `len` bytes
+	 * of `source` (0: up to its NUL) built on it with the build `options`
+	 * (may be NULL; the host adds correctly rounded division and square
+	 * root where the device has them) once: the same spec, source and
+	 * options give the same program. *device and *program are the
+	 * backend's handles, owned by the host (never release them): for
+	 * OpenCL, the only backend so far, a const bvhlab_cl * and a
+	 * cl_program, which include/bvhlab/opencl.h's bvhlab_cl_host_program
+	 * hands out typed. 0, or a negative errno after set_error: -ENOTSUP
+	 * (the host was built without a device backend), -ENODEV (no such
+	 * device; the message says what to install), -EINVAL (a bad spec, or
+	 * the source does not compile: the compiler's log), -ENOMEM, -EIO.
+	 * Check BVHLAB_HOST_HAS(host, device_program) first. */
+	int (*device_program)(bvhlab_build_ctx *ctx, const char *spec, const char *source,
+	                      size_t len, const char *options, const void **device,
+	                      void **program);
 } bvhlab_host;
 
 /* Limits of host->phase (ABI 1.3). */

@@ -1,6 +1,20 @@
 /* bvhlab/opencl.h - the OpenCL device layer shared by device builders, the
  * core's device tracer and out-of-tree device plugins.
  *
+ * A device builder gets its device and program from the process's one
+ * device layer, through the host (ABI 1.6), so every builder and the
+ * tracer in a process share one device and compile each program once:
+ *
+ *   const bvhlab_cl *cl;
+ *   cl_program prog;
+ *   if (bvhlab_cl_host_program(host, ctx, spec, src, len, NULL, &cl, &prog) < 0)
+ *       return ...;   (the host has set the build's error)
+ *   ... bvhlab_cl_kernel(prog, "name", &k, err, sizeof err) ...
+ *
+ * The rest (device choice, programs, kernels, events, release helpers)
+ * is what the layer itself is made of, for tools and tests that open a
+ * device of their own:
+ *
  * Header-only (static inline) so a plugin uses it without linking libbvhlab:
  * it needs only the OpenCL headers and the ICD loader (-lOpenCL; Debian
  * ocl-icd-opencl-dev and opencl-c-headers, plus a driver such as
@@ -40,6 +54,8 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+
+#include "builder.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -514,6 +530,37 @@ static inline void bvhlab_cl_release_event(cl_event *e)
 	if (*e)
 		clReleaseEvent(*e);
 	*e = NULL;
+}
+
+/* The process's device (spec: auto, gpu, cpu, P:D; NULL is auto) and the
+ * program of `len` bytes of src (0: up to its NUL) built on it with the
+ * build options (may be NULL), from the host's device layer (ABI 1.6
+ * host->device_program): kept by the host for the process's life, the
+ * same spec, source and options giving the same program. Both are the
+ * host's: never release them (your kernels made from the program are
+ * yours). 0, or a negative errno after host->set_error (-ENOTSUP from a
+ * host older than 1.6, which has no device layer). */
+static inline int bvhlab_cl_host_program(const bvhlab_host *host, bvhlab_build_ctx *ctx,
+	const char *spec, const char *src, size_t len, const char *options,
+	const bvhlab_cl **cl, cl_program *prog)
+{
+	const void *device = NULL;
+	void *program = NULL;
+	int rc;
+	*cl = NULL;
+	*prog = NULL;
+	if (!BVHLAB_HOST_HAS(host, device_program)) {
+		host->set_error(ctx, "cl: this host (ABI %u.%u) has no device layer; ABI 1.6 "
+			"hosts have one", (unsigned)BVHLAB_ABI_VERSION_MAJOR(host->abi_version),
+			(unsigned)BVHLAB_ABI_VERSION_MINOR(host->abi_version));
+		return -ENOTSUP;
+	}
+	rc = host->device_program(ctx, spec, src, len, options, &device, &program);
+	if (rc == 0) {
+		*cl = (const bvhlab_cl *)device;
+		*prog = (cl_program)program;
+	}
+	return rc;
 }
 
 #ifdef __cplusplus

@@ -121,14 +121,20 @@ enum bvhlab_traversal {
 	BVHLAB_TRAVERSAL_STACKLESS = 1, /* bvhlab_trace_stackless: parent links, no stack */
 	BVHLAB_TRAVERSAL_WIDE = 2,      /* the tree collapsed into 4-child nodes, four box
 	                                 * tests at once, nearest child first (batches only) */
-	BVHLAB_TRAVERSAL_CL_STACK = 3,  /* the stack traversal as an OpenCL kernel on a
-	                                 * device (batches only; needs OpenCL built) */
-	BVHLAB_TRAVERSAL_CL_STACKLESS = 4, /* the stackless one likewise */
+	BVHLAB_TRAVERSAL_DEVICE_STACK = 3, /* the stack traversal as a kernel on a device
+	                                    * (batches only; needs a device backend built:
+	                                    * OpenCL) */
+	BVHLAB_TRAVERSAL_DEVICE_STACKLESS = 4, /* the stackless one likewise */
 	BVHLAB_TRAVERSAL_COUNT = 5      /* how many there are */
 };
 
-/* "stack" / "stackless" / "wide" / "cl_stack" / "cl_stackless"; NULL for
- * another value. */
+/* The names before the device traversals said what they are, not which
+ * API (deprecated; the values are the same). */
+#define BVHLAB_TRAVERSAL_CL_STACK BVHLAB_TRAVERSAL_DEVICE_STACK
+#define BVHLAB_TRAVERSAL_CL_STACKLESS BVHLAB_TRAVERSAL_DEVICE_STACKLESS
+
+/* "stack" / "stackless" / "wide" / "device_stack" / "device_stackless"
+ * (the keys of results.json's rays); NULL for another value. */
 const char *bvhlab_traversal_name(int traversal);
 
 /*
@@ -166,7 +172,7 @@ typedef struct bvhlab_trace_options {
 	uint32_t min_repeats; /* ... and at least this many passes (0 counts as 1), unless
 	                       * the passes so far took 10 x min_ms */
 	uint32_t max_repeats; /* at most this many passes (0: 10000) */
-	const char *device;   /* the cl_ traversals' OpenCL device: "auto" (NULL), "gpu",
+	const char *device;   /* the device traversals' device: "auto" (NULL), "gpu",
 	                       * "cpu" or "P:D" (platform and device indices) */
 } bvhlab_trace_options;
 
@@ -187,9 +193,9 @@ typedef struct bvhlab_trace_options {
  * own speed, and it repeats between runs where the medians do not.
  */
 /*
- * The device traversals (cl_stack, cl_stackless) have no tiles or thread
- * CPU time: their mrays_best is from the least kernel time over the
- * passes (OpenCL profiling events), median, min and max are over the
+ * The device traversals (device_stack, device_stackless) have no tiles or
+ * thread CPU time: their mrays_best is from the least kernel time over the
+ * passes (the device's profiling events), median, min and max are over the
  * passes' kernel times, and the wall figures time each launch to its
  * completion (the tree and rays are uploaded once, before the passes).
  */
@@ -216,8 +222,8 @@ typedef struct bvhlab_trace_timing {
  * count the tree's own nodes, from an extra untimed pass of the stack
  * traversal, so they mean the same whatever traversal is timed; hits come
  * from the first wide pass. 0, -EINVAL (bad traversal, tree links for
- * stackless or wide), -ENOMEM, -ENOTSUP (a cl_ traversal in a build
- * without OpenCL), -ENODEV (no OpenCL device), -EIO; then nothing was
+ * stackless or wide), -ENOMEM, -ENOTSUP (a device traversal in a build
+ * without a device backend), -ENODEV (no such device), -EIO; then nothing was
  * measured.
  */
 int bvhlab_trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene,

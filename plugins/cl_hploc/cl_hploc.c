@@ -198,27 +198,29 @@ static void convert(cl_hploc *b, bvhlab_build_output *out)
 	b->ms[CL_PHASE_CONVERT] = cl_now_ms() - t0;
 }
 
+static int run(void *p, bvhlab_build_output *out, char *err, size_t err_size)
+{
+	cl_hploc *b = p;
+	int rc = device_run(b, err, err_size);
+
+	if (rc == 0)
+		convert(b, out);
+	return rc;
+}
+
+static const cl_run_spec job = CL_RUN_SPEC(cl_hploc, run);
+
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
 	cl_hploc b;
-	char err[BVHLAB_CL_ERROR_SIZE];
-	int rc;
-
 	/* The options first: their copy sets the whole struct. */
-	rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);
-	b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, b.b = S.b;
-	if (rc < 0 || (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input,
-	                                   output)) != 0)
-		return rc < 0 ? rc : 0;
-	if ((rc = device_run(&b, err, sizeof(err))) < 0) {
-		host->set_error(ctx, "%s", err);
+	int rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);
+
+	if (rc < 0)
 		return rc;
-	}
-	convert(&b, output);
-	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims on %s", b.n, S.dev.cl.name);
-	cl_report_phases(host, ctx, b.ms);
-	return 0;
+	b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, b.b = S.b;
+	return cl_build_run(&program, &job, &S.dev, &b, host, ctx, input, output);
 }
 
 PLUGIN_WITH_OPTIONS(options, .name = "cl_hploc",

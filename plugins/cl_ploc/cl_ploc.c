@@ -81,44 +81,37 @@ static int host_tree(cl_ploc *b)
 	return 0;
 }
 
-static int run(const bvhlab_host *host, bvhlab_build_ctx *ctx, cl_ploc *b,
-               bvhlab_build_output *out)
+static int run(void *p, bvhlab_build_output *out, char *err, size_t err_size)
 {
-	char err[BVHLAB_CL_ERROR_SIZE];
+	cl_ploc *b = p;
 	double t0;
 	int rc;
 
-	if (host_tree(b) < 0) {
-		host->set_error(ctx, "out of memory for the merge tree of %u primitives", b->n);
-		return -ENOMEM;
-	}
-	if ((rc = cl_ploc_run(b, err, sizeof(err))) < 0) {
-		host->set_error(ctx, "%s", err);
+	if (host_tree(b) < 0)
+		return bvhlab_cl_fail(-ENOMEM, err, err_size,
+		                      "out of memory for the merge tree of %u primitives", b->n);
+	if ((rc = cl_ploc_run(b, err, err_size)) < 0)
 		return rc;
-	}
 	t0 = cl_now_ms();
 	out->node_count = cl_ploc_emit(b, out);
 	out->index_count = b->n;
-	b->ms[3] = cl_now_ms() - t0;
-	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims, %u iterations on %s", b->n, b->iterations,
-	          S.dev.cl.name);
-	cl_report_phases(host, ctx, b->ms);
+	b->ms[CL_PHASE_CONVERT] = cl_now_ms() - t0;
 	return 0;
 }
+
+static const cl_run_spec job = CL_RUN_SPEC(cl_ploc, run);
 
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *input, bvhlab_build_output *output)
 {
 	cl_ploc b;
-	int rc;
-
 	/* The options first: their copy sets the whole struct. */
-	rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);
+	int rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);
+
+	if (rc < 0)
+		return rc;
 	b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, b.b = S.b;
-	if (rc < 0 || (rc = cl_build_begin(&program, &S.dev, b.device, host, ctx, input,
-	                                   output)) != 0)
-		return rc < 0 ? rc : 0;
-	return run(host, ctx, &b, output);
+	return cl_build_run(&program, &job, &S.dev, &b, host, ctx, input, output);
 }
 
 PLUGIN_WITH_OPTIONS(options, .name = "cl_ploc",

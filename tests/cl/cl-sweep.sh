@@ -51,7 +51,7 @@ cap = sys.argv[3]
 if "no OpenCL platform" in by["cl_lbvh"].get("error", "") or "no such OpenCL device" in by["cl_lbvh"].get("error", ""):
     print("skip: no OpenCL device:", by["cl_lbvh"]["error"]); sys.exit(77)
 import re
-want = (r"the build needs (\d+\.\d\d) MiB of device memory, .* has 0\.20 MiB "
+want = (r"cl: (\d+\.\d\d) MiB of device memory needed, .* has 0\.20 MiB "
         if cap == "0.2" else
         r"a buffer of (\d+\.\d\d) MiB is more than .* allows in one allocation, 0\.05 MiB ")
 for b in ("cl_lbvh", "cl_ploc"):

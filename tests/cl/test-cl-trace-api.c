@@ -23,8 +23,8 @@
 
 #define CHAIN 300
 
-static const int device_traversals[] = {BVHLAB_TRAVERSAL_CL_STACK,
-                                        BVHLAB_TRAVERSAL_CL_STACKLESS};
+static const int device_traversals[] = {BVHLAB_TRAVERSAL_DEVICE_STACK,
+                                        BVHLAB_TRAVERSAL_DEVICE_STACKLESS};
 
 static void grow(bvhlab_node *n, const float *p)
 {
@@ -151,10 +151,17 @@ static void errors(void)
 	bvhlab_hit hit;
 	bvhlab_trace_timing tm;
 	bvhlab_error err = {{0}};
-	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_CL_STACK, .device = "banana"};
+	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_DEVICE_STACK, .device = "banana"};
 	CHECK_INT(trace_measure(&t, &s, &ray, 1, &o, &hit, NULL, &tm, NULL, 0, &err), -EINVAL);
 	CHECK_CONTAINS(err.message, "device 'banana' is not auto, gpu, cpu or P:D");
 	o.device = NULL; /* auto: the device main() found */
+	/* A tree that does not fit the device is refused by the device layer's
+	 * check, with the figures, before any upload. */
+	setenv("BVHLAB_CL_MEM_CAP_MB", "0.001", 1);
+	CHECK_INT(trace_measure(&t, &s, &ray, 1, &o, &hit, NULL, &tm, NULL, 0, &err), -ENOMEM);
+	CHECK_CONTAINS(err.message, "allows in one allocation");
+	CHECK_CONTAINS(err.message, "(capped by $BVHLAB_CL_MEM_CAP_MB)");
+	unsetenv("BVHLAB_CL_MEM_CAP_MB");
 	CHECK_INT(trace_measure(&t, &s, &ray, 1, &o, &hit, NULL, &tm, NULL, 0, &err), 0);
 	CHECK_INT(hit.prim, 0);
 }

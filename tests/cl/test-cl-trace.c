@@ -1,13 +1,16 @@
 /*
  * The device traversals through the bvhlab command (rays.traversal
- * cl_stack and cl_stackless, core/trace/trace_cl.cl):
+ * device_stack and device_stackless, core/trace/trace_cl.cl):
  *   trace   every hit of every primary and diffuse ray equal, bit for bit,
  *           to the CPU stack traversal's (rays.traversal_disagreements 0),
  *           and the nodes counted per ray equal to the CPU stack and
  *           stackless traversals' own, on the trees of several builders
- *           over a shared mesh and degenerate scenes (one triangle, two,
- *           50 copies of one triangle: all centroids equal and every hit
- *           a tie in t, zero-area triangles, needles), timed in rounds;
+ *           and on lbvh's collapsed into 4- and 8-wide trees (the
+ *           wide_collapse test stage: the kernels read the open tree as
+ *           the CPU does), over a shared mesh and degenerate scenes (one
+ *           triangle, two, 50 copies of one triangle: all centroids equal
+ *           and every hit a tie in t, zero-area triangles, needles), timed
+ *           in rounds;
  *   errors  a bad rays.device is a config error naming the key; a device
  *           that does not exist, or no OpenCL platform at all, leaves the
  *           runs ok with rays.error saying why; info --machine lists the
@@ -27,7 +30,8 @@
 
 static const char rays_keys[] =
 	"\"rays\": { \"width\": 40, \"height\": 30, \"diffuse\": 2, \"min_ms\": 1, \"rounds\": 2,\n"
-	"  \"traversal\": [\"stack\", \"stackless\", \"cl_stack\", \"cl_stackless\"] },\n";
+	"  \"traversal\": [\"stack\", \"stackless\", {\"name\": \"stack\", \"device\": true},\n"
+	"    {\"name\": \"stackless\", \"device\": true}] },\n";
 
 /* A triangle repeated: every ray that hits one hits all 50 at the same t. */
 static void write_meshes(void)
@@ -69,25 +73,35 @@ static void check_run(const cJSON *run)
 	static const char *const kinds[] = {"primary", "diffuse"};
 	for (int k = 0; k < 2; k++) {
 		double n = num(run, kinds[k], "rays", NULL);
-		CHECK(num(run, "cl_stack", kinds[k], "rays") == n);
-		CHECK(num(run, "cl_stackless", kinds[k], "rays") == n);
+		CHECK(num(run, "device_stack", kinds[k], "rays") == n);
+		CHECK(num(run, "device_stackless", kinds[k], "rays") == n);
 		/* The same walk: the same nodes entered, summed over the rays. */
-		CHECK(num(run, "cl_stack", kinds[k], "nodes_per_ray") ==
+		CHECK(num(run, "device_stack", kinds[k], "nodes_per_ray") ==
 		      num(run, kinds[k], "nodes_per_ray", NULL));
-		CHECK(num(run, "cl_stackless", kinds[k], "nodes_per_ray") ==
+		CHECK(num(run, "device_stackless", kinds[k], "nodes_per_ray") ==
 		      num(run, "stackless", kinds[k], "nodes_per_ray"));
-		CHECK(num(run, "cl_stack", kinds[k], "tris_per_ray") ==
+		CHECK(num(run, "device_stack", kinds[k], "tris_per_ray") ==
 		      num(run, kinds[k], "tris_per_ray", NULL));
 		if (n > 0) {
-			CHECK(num(run, "cl_stack", kinds[k], "mrays_per_s") > 0);
-			CHECK(num(run, "cl_stackless", kinds[k], "wall_mrays_per_s") > 0);
+			CHECK(num(run, "device_stack", kinds[k], "mrays_per_s") > 0);
+			CHECK(num(run, "device_stackless", kinds[k], "wall_mrays_per_s") > 0);
 		}
 	}
 }
 
-/* One sweep over these scenes and builders; its runs checked. */
-static void trace_sweep(const char *name, const char *scenes, const char *builders, int runs)
+/* lbvh's tree collapsed into 4- and 8-wide ones (tests/fake/wide_collapse). */
+#define WIDE_BUILDERS                                                                      \
+	"{ \"plugin\": \"lbvh\", \"name\": \"lbvh_w4\", \"refine\": [ { \"plugin\": "          \
+	"\"wide_collapse\", \"options\": { \"width\": 4 } } ] },\n"                               \
+	"    { \"plugin\": \"lbvh\", \"name\": \"lbvh_w8\", \"refine\": [ { \"plugin\": "      \
+	"\"wide_collapse\", \"options\": { \"width\": 8 } } ] }"
+
+/* One sweep over these scenes and builders (`per_builder` runs each); its
+ * runs checked. */
+static void trace_sweep(const char *name, const char *scenes, const char *builders,
+                        int builder_count, int per_builder)
 {
+	int runs = builder_count * per_builder;
 	char config[4096], out[600];
 	snprintf(config, sizeof(config),
 	         "{ \"format_version\": 1, \"output\": \"%s\", \"repeat\": 1, \"warmup\": 0,\n"
@@ -109,7 +123,9 @@ static void trace_sweep(const char *name, const char *scenes, const char *builde
 		n++;
 	}
 	CHECK_INT(n, runs);
-	CHECK_INT(count_runs(doc, "lbvh", "ok"), runs / (strstr(builders, "sbvh") ? 4 : 3));
+	CHECK_INT(count_runs(doc, "lbvh", "ok"), per_builder);
+	CHECK_INT(count_runs(doc, "lbvh_w4", "ok"), per_builder);
+	CHECK_INT(count_runs(doc, "lbvh_w8", "ok"), per_builder);
 	cJSON_Delete(doc);
 }
 
@@ -126,14 +142,14 @@ static void trace_mode(void)
 		printf("the bunny left to the release build (CL_TRACE_NO_MESH)\n");
 	else
 		trace_sweep("mesh", scene, "{ \"plugin\": \"lbvh\" }, { \"plugin\": \"ploc\" }, "
-		            "{ \"plugin\": \"sah_tasks\" }", 3);
+		            "{ \"plugin\": \"sah_tasks\" },\n    " WIDE_BUILDERS, 5, 1);
 	trace_sweep("degenerate",
 	            "{ \"path\": \"one.obj\" }, { \"path\": \"two.obj\" },\n"
 	            "    { \"path\": \"same.obj\" }, { \"path\": \"flat.obj\" },\n"
 	            "    { \"name\": \"needles\", \"generator\": \"needles\", \"count\": 300 }",
 	            "{ \"plugin\": \"lbvh\" }, { \"plugin\": \"ploc\" }, { \"plugin\": \"sah_tasks\" },\n"
-	            "    { \"plugin\": \"sbvh\" }",
-	            20);
+	            "    { \"plugin\": \"sbvh\" }, " WIDE_BUILDERS,
+	            6, 5);
 }
 
 /* A run of one scene with this "rays" object; the document. */
@@ -171,28 +187,30 @@ static const cJSON *first_rays(const cJSON *doc)
 
 static void errors_mode(void)
 {
-	run_rays("bad", "{ \"traversal\": \"cl_stack\", \"device\": \"banana\" }", 2);
+	run_rays("bad", "{ \"traversal\": {\"name\": \"stack\", \"device\": true}, "
+	         "\"device\": \"banana\" }", 2);
 	CHECK_CONTAINS(err_text, "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or \"P:D\"");
 	CHECK_CONTAINS(err_text, "not \"banana\"");
 
 	/* No such device: the CPU traversal is measured, the device one says why. */
 	cJSON *doc = run_rays("nodev", "{ \"width\": 8, \"height\": 8, \"min_ms\": 1, "
-	                      "\"traversal\": [\"stack\", \"cl_stack\"], \"device\": \"7:3\" }", 0);
+	                      "\"traversal\": [\"stack\", {\"name\": \"stack\", \"device\": true}], "
+	                      "\"device\": \"7:3\" }", 0);
 	const cJSON *rays = first_rays(doc);
 	CHECK(cJSON_GetObjectItem(rays, "primary") != NULL);
-	CHECK(cJSON_GetObjectItem(rays, "cl_stack") == NULL);
-	CHECK_CONTAINS(run_str(rays, "error"), "cl_stack: cl: device '7:3': no such OpenCL device");
+	CHECK(cJSON_GetObjectItem(rays, "device_stack") == NULL);
+	CHECK_CONTAINS(run_str(rays, "error"), "device_stack: cl: device '7:3': no such OpenCL device");
 	cJSON_Delete(doc);
 
 	/* No platform at all (the ICD loader finds no vendor file): the main
 	 * traversal fails, the run stays ok and its rays say why. */
 	setenv("OCL_ICD_VENDORS", "/nonexistent-bvhlab-vendors", 1);
-	doc = run_rays("noplat", "{ \"width\": 8, \"height\": 8, \"traversal\": \"cl_stackless\" }",
-	               0);
+	doc = run_rays("noplat", "{ \"width\": 8, \"height\": 8, \"traversal\": "
+	               "{\"name\": \"stackless\", \"device\": true} }", 0);
 	rays = first_rays(doc);
 	CHECK(cJSON_GetObjectItem(rays, "primary") == NULL);
-	CHECK(strcmp(run_str(rays, "traversal"), "cl_stackless") == 0);
-	CHECK_CONTAINS(run_str(rays, "error"), "cl_stackless: cl: no OpenCL platform found");
+	CHECK(strcmp(run_str(rays, "traversal"), "device_stackless") == 0);
+	CHECK_CONTAINS(run_str(rays, "error"), "device_stackless: cl: no OpenCL platform found");
 	CHECK_CONTAINS(run_str(rays, "error"), "pocl-opencl-icd");
 	cJSON_Delete(doc);
 	CHECK_INT(run(ARGS("info", "--machine")), 0);

@@ -88,7 +88,8 @@ static void status_untraced(void)
 	int status = sweep("nr.json",
 		"{ \"output\": \"out-nr\", \"repeat\": 1, \"warmup\": 0,\n"
 		"  \"rays\": { \"width\": 16, \"height\": 16,\n"
-		"            \"traversal\": [ \"cl_stack\", \"cl_stackless\" ] },\n"
+		"            \"traversal\": [ {\"name\": \"stack\", \"device\": true},\n"
+		"              {\"name\": \"stackless\", \"device\": true} ] },\n"
 		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200,\n"
 		"                \"frames\": 3, \"deform\": \"wave\" } ],\n"
 		"  \"builders\": [ { \"name\": \"a\", \"plugin\": \"lbvh\",\n"
@@ -120,13 +121,14 @@ static void status_untraced(void)
 	CHECK_INT(sweep("nr2.json",
 		"{ \"output\": \"out-nr2\", \"repeat\": 1, \"warmup\": 0,\n"
 		"  \"rays\": { \"width\": 16, \"height\": 16,\n"
-		"            \"traversal\": [ \"stack\", \"cl_stack\", \"cl_stackless\" ] },\n"
+		"            \"traversal\": [ \"stack\", {\"name\": \"stack\", \"device\": true},\n"
+		"              {\"name\": \"stackless\", \"device\": true} ] },\n"
 		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"lbvh\" } ] }\n", "out-nr2", &doc), 0);
 	unsetenv("OCL_ICD_VENDORS");
 	const char *e = run_str(cJSON_GetObjectItem(first_run(doc), "rays"), "error");
-	CHECK_CONTAINS(e, "cl_stack: ");
-	CHECK_CONTAINS(e, "; cl_stackless: ");
+	CHECK_CONTAINS(e, "device_stack: ");
+	CHECK_CONTAINS(e, "; device_stackless: ");
 	CHECK(!strchr(e, '\n'));
 	cJSON_Delete(doc);
 }

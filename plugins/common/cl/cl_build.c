@@ -13,7 +13,6 @@ int cl_build_begin(const cl_builder *cb, cl_dev *d, const char *spec, const bvhl
                    bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
                    bvhlab_build_output *out)
 {
-	char err[BVHLAB_CL_ERROR_SIZE];
 	uint32_t n = in->prim_count;
 	int rc;
 
@@ -23,12 +22,9 @@ int cl_build_begin(const cl_builder *cb, cl_dev *d, const char *spec, const bvhl
 	}
 	if ((rc = big_ensure_output(host, ctx, n, 0, out)) < 0)
 		return rc;
-	rc = cl_dev_open(d, spec, cb->src, cb->len, cb->kernels, cb->kernel_count, err,
-	                 sizeof(err));
-	if (rc < 0) {
-		host->set_error(ctx, "%s", err);
+	rc = cl_dev_open(d, host, ctx, spec, cb->src, cb->len, cb->kernels, cb->kernel_count);
+	if (rc < 0)
 		return rc;
-	}
 	if (n > 1)
 		return 0;
 	morton_single_leaf(in, out);
@@ -44,4 +40,23 @@ void cl_report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		return;
 	for (int k = 0; k < CL_PHASES; k++)
 		host->phase(ctx, names[k], ms[k]);
+}
+
+int cl_build_run(const cl_builder *cb, const cl_run_spec *rs, cl_dev *d, void *b,
+                 const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+                 bvhlab_build_output *out)
+{
+	char err[BVHLAB_CL_ERROR_SIZE];
+	const char *spec = *(const char **)(void *)((char *)b + rs->device_at);
+	int rc = cl_build_begin(cb, d, spec, host, ctx, in, out);
+
+	if (rc != 0)
+		return rc < 0 ? rc : 0;
+	if ((rc = rs->run(b, out, err, sizeof(err))) < 0) {
+		host->set_error(ctx, "%s", err);
+		return rc;
+	}
+	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims on %s", in->prim_count, d->cl.name);
+	cl_report_phases(host, ctx, (const double *)(void *)((char *)b + rs->ms_at));
+	return 0;
 }

@@ -1,200 +1,40 @@
-/* The device builders' device, buffers, launches and events (cl_dev.h). */
+/* The device builders' device, program and kernels (cl_dev.h). */
 #include <errno.h>
-#include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "cl_dev.h"
-
-double cl_now_ms(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
-}
 
 void cl_dev_close(cl_dev *d)
 {
 	for (unsigned k = 0; k < d->kernel_count; k++)
 		bvhlab_cl_release_kernel(&d->k[k]);
-	bvhlab_cl_release_program(&d->prog);
-	bvhlab_cl_finish(&d->cl);
 	memset(d, 0, sizeof(*d));
 }
 
-static int make_kernels(cl_dev *d, const char *const *names, unsigned count, char *err,
-                        size_t err_size)
+int cl_dev_open(cl_dev *d, const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *spec,
+                const char *src, size_t len, const char *const *names, unsigned count)
 {
-	int rc;
+	char err[BVHLAB_CL_ERROR_SIZE];
+	const bvhlab_cl *cl;
+	cl_program prog;
+	int rc = bvhlab_cl_host_program(host, ctx, spec, src, len, NULL, &cl, &prog);
 
+	if (rc < 0 || prog == d->prog)
+		return rc;
+	cl_dev_close(d);
+	if (count > CL_DEV_MAX_KERNELS) {
+		host->set_error(ctx, "cl: more than %d kernels", CL_DEV_MAX_KERNELS);
+		return -EINVAL;
+	}
+	d->cl = *cl;
+	d->prog = prog;
 	for (unsigned k = 0; k < count; k++) {
-		if ((rc = bvhlab_cl_kernel(d->prog, names[k], &d->k[k], err, err_size)) < 0)
+		if ((rc = bvhlab_cl_kernel(prog, names[k], &d->k[k], err, sizeof(err))) < 0) {
+			host->set_error(ctx, "%s", err);
+			cl_dev_close(d);
 			return rc;
+		}
 		d->kernel_count = k + 1;
 	}
 	return 0;
-}
-
-/* CL_DEV_OPTIONS where the device supports it: a device without it may
- * refuse the option. */
-static const char *build_options(const cl_dev *d)
-{
-	cl_device_fp_config fp = 0;
-
-	if (clGetDeviceInfo(d->cl.device, CL_DEVICE_SINGLE_FP_CONFIG, sizeof(fp), &fp, NULL) !=
-	    CL_SUCCESS)
-		return "";
-	return fp & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT ? CL_DEV_OPTIONS : "";
-}
-
-int cl_dev_open(cl_dev *d, const char *spec, const char *src, size_t len,
-                const char *const *names, unsigned count, char *err, size_t err_size)
-{
-	int rc;
-
-	if (d->prog && !strcmp(d->spec, spec))
-		return 0;
-	cl_dev_close(d);
-	if (strlen(spec) >= sizeof(d->spec) || count > CL_DEV_MAX_KERNELS)
-		return bvhlab_cl_fail(-EINVAL, err, err_size, "cl: device '%.64s...' is too long",
-		                      spec);
-	if ((rc = bvhlab_cl_init(&d->cl, spec, err, err_size)) < 0 ||
-	    (rc = bvhlab_cl_program(&d->cl, src, len, build_options(d), &d->prog, err,
-	                            err_size)) < 0 ||
-	    (rc = make_kernels(d, names, count, err, err_size)) < 0) {
-		cl_dev_close(d);
-		return rc;
-	}
-	strcpy(d->spec, spec);
-	return 0;
-}
-
-void cl_bufs_free(cl_buf *bufs, unsigned count)
-{
-	for (unsigned k = 0; k < count; k++) {
-		bvhlab_cl_release_mem(&bufs[k].mem);
-		bufs[k].bytes = 0;
-	}
-}
-
-/* Round sizes up, so that small changes in n do not reallocate. */
-static size_t rounded(size_t bytes)
-{
-	return bytes < 4096 ? 4096 : (bytes + 65535) & ~(size_t)65535;
-}
-
-/* The device's memory and largest allocation, both capped at
- * $BVHLAB_CL_MEM_CAP_MB MiB when that is set: how the tests make a small
- * scene not fit. */
-static void mem_limits(const cl_dev *d, double *global, double *alloc, const char **cap_note)
-{
-	const char *cap = getenv("BVHLAB_CL_MEM_CAP_MB");
-	char *end = NULL;
-	double mb = cap ? strtod(cap, &end) : 0.0;
-
-	*global = (double)d->cl.global_mem;
-	*alloc = (double)d->cl.max_alloc;
-	*cap_note = "";
-	if (!cap || end == cap || *end || !(mb > 0.0))
-		return;
-	mb *= 1024.0 * 1024.0;
-	*cap_note = mb < *global || mb < *alloc ? " (capped by $BVHLAB_CL_MEM_CAP_MB)" : "";
-	*global = mb < *global ? mb : *global;
-	*alloc = mb < *alloc ? mb : *alloc;
-}
-
-#define MIB(x) ((double)(x) / (1024.0 * 1024.0))
-
-int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
-                size_t err_size)
-{
-	double total = 0, global, alloc;
-	const char *note;
-
-	mem_limits(d, &global, &alloc, &note);
-	for (unsigned k = 0; k < count; k++) {
-		total += (double)rounded(want[k]);
-		if ((double)rounded(want[k]) > alloc)
-			return bvhlab_cl_fail(-ENOMEM, err, err_size,
-				"cl: a buffer of %.2f MiB is more than %s allows in one allocation, "
-				"%.2f MiB%s", MIB(rounded(want[k])), d->cl.name, MIB(alloc), note);
-	}
-	if (total > global)
-		return bvhlab_cl_fail(-ENOMEM, err, err_size,
-			"cl: the build needs %.2f MiB of device memory, %s has %.2f MiB%s",
-			MIB(total), d->cl.name, MIB(global), note);
-	return 0;
-}
-
-int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count, char *err,
-                 size_t err_size)
-{
-	cl_int rc = CL_SUCCESS;
-	int fit = cl_bufs_fit(d, want, count, err, err_size);
-
-	if (fit < 0)
-		return fit;
-	for (unsigned k = 0; k < count; k++) {
-		if (bufs[k].bytes >= want[k] && bufs[k].mem)
-			continue;
-		bvhlab_cl_release_mem(&bufs[k].mem);
-		bufs[k].bytes = 0;
-		bufs[k].mem = clCreateBuffer(d->cl.context, CL_MEM_READ_WRITE, rounded(want[k]),
-		                             NULL, &rc);
-		if (rc != CL_SUCCESS) {
-			bufs[k].mem = NULL;
-			return bvhlab_cl_check(rc, "clCreateBuffer", err, err_size);
-		}
-		bufs[k].bytes = rounded(want[k]);
-	}
-	return 0;
-}
-
-static double sum_events(cl_events *ev)
-{
-	double ms = 0;
-
-	for (unsigned k = 0; k < ev->count; k++) {
-		double t = bvhlab_cl_event_ms(ev->ev[k]);
-		ms += t > 0 ? t : 0;
-		bvhlab_cl_release_event(&ev->ev[k]);
-	}
-	ev->count = 0;
-	return ms;
-}
-
-cl_event *cl_events_next(cl_events *ev)
-{
-	if (ev->count == CL_EVENTS_MAX) {
-		clWaitForEvents(ev->count, ev->ev);
-		ev->ms += sum_events(ev);
-	}
-	return &ev->ev[ev->count++];
-}
-
-double cl_events_ms(cl_events *ev)
-{
-	double ms = ev->ms + sum_events(ev);
-
-	ev->ms = 0;
-	return ms;
-}
-
-int cl_launch(cl_dev *d, cl_kernel k, size_t items, const cl_arg *args, unsigned nargs,
-              cl_events *ev, char *err, size_t err_size)
-{
-	size_t local = d->cl.max_work_group < 64 ? d->cl.max_work_group : 64;
-	size_t global = (items + local - 1) / local * local;
-	cl_int rc = CL_SUCCESS;
-
-	for (unsigned a = 0; a < nargs && rc == CL_SUCCESS; a++)
-		rc = clSetKernelArg(k, a, args[a].size, args[a].value);
-	if (rc != CL_SUCCESS)
-		return bvhlab_cl_check(rc, "clSetKernelArg", err, err_size);
-	if (items == 0)
-		return 0;
-	rc = clEnqueueNDRangeKernel(d->cl.queue, k, 1, NULL, &global, &local, 0, NULL,
-	                            cl_events_next(ev));
-	return bvhlab_cl_check(rc, "clEnqueueNDRangeKernel", err, err_size);
 }

@@ -3,11 +3,14 @@
  * the device layer of include/bvhlab/opencl.h (a static library linked into
  * each plugin):
  *
- *   - cl_dev: the device, its built program and kernels, kept between
- *     builds (a build is timed whole, and compiling the kernels is not the
- *     builder's work), made again when the `device` option changes;
- *   - cl_buf: device buffers that grow, all sized before any kernel runs;
- *   - cl_events: the kernels' events, summed into the phase "device";
+ *   - cl_dev: the device and the built program, from the process's device
+ *     layer (the host's, ABI 1.6: shared with every device builder and the
+ *     device tracer, kept for the process's life, so compiling is never a
+ *     build's work), and this builder's kernels, made again when the
+ *     layer hands out another program (the `device` option changed);
+ *   - cl_buf, cl_launch, cl_events: the device layer's buffers that grow
+ *     (all sized before any kernel runs), launches and events (summed
+ *     into the phase "device"), core/device/device_run.h, on d's device;
  *   - the Morton codes and their radix sort (cl_sort.c, kernels in
  *     morton_sort.cl), mirroring plugins/common/morton;
  *   - the start of a build and the report of its phases (cl_build.c).
@@ -16,18 +19,19 @@
 #define BVHLAB_CL_DEV_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include <bvhlab/opencl.h>
 #include <bvhlab/builder.h>
 
+#include "device_run.h"
 #include "plugin_options.h"
 
-/* Build option of every device builder's program where the device has
- * it: correctly rounded division and square root, as the CPU's. (The
- * kernels also turn contraction into fma off, by pragma; none divides
- * today: the quantiser's scale comes from the host.) */
-#define CL_DEV_OPTIONS "-cl-fp32-correctly-rounded-divide-sqrt"
+/* The device layer builds every program with correctly rounded division
+ * and square root where the device has them, as the CPU's. (The kernels
+ * also turn contraction into fma off, by pragma; none divides today: the
+ * quantiser's scale comes from the host.) */
 #define CL_DEV_MAX_KERNELS 24
 
 /* The option every device builder has, in its table (plugin_options.h),
@@ -59,68 +63,40 @@
 	}
 
 typedef struct cl_dev {
-	bvhlab_cl cl;
-	char spec[64];
-	cl_program prog;
+	bvhlab_cl cl;    /* the layer's device, copied: not ours to release */
+	cl_program prog; /* the layer's */
 	cl_kernel k[CL_DEV_MAX_KERNELS];
 	unsigned kernel_count;
 } cl_dev;
 
-/* The device of `spec` with the program of `src` built and its kernels
- * (`names`, in order, into d->k) made; reuses what d holds for the same
- * spec and source. 0, or a negative errno with the message in err. */
-int cl_dev_open(cl_dev *d, const char *spec, const char *src, size_t len,
-                const char *const *names, unsigned count, char *err, size_t err_size);
-/* Releases everything; safe on a zeroed or closed cl_dev. */
+/* The device of `spec` with the program of `src` from the host's device
+ * layer and its kernels (`names`, in order, into d->k) made; keeps the
+ * kernels while the layer hands out the same program. 0, or a negative
+ * errno after host->set_error. */
+int cl_dev_open(cl_dev *d, const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *spec,
+                const char *src, size_t len, const char *const *names, unsigned count);
+/* Releases the kernels; safe on a zeroed or closed cl_dev. */
 void cl_dev_close(cl_dev *d);
 
-/* A device buffer of at least `bytes`, kept and grown between builds. */
-typedef struct cl_buf {
-	cl_mem mem;
-	size_t bytes;
-} cl_buf;
+/* The device layer's buffers, launches and events (core/device/device_run.h)
+ * on a cl_dev's device. */
+static inline int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
+                              size_t err_size)
+{
+	return cl_bufs_fit_on(&d->cl, want, count, err, err_size);
+}
 
-/* Whether buffers of want[k] bytes fit the device (each its largest
- * allocation, the sum its global memory): 0, or -ENOMEM with a message
- * giving both figures, the need and the device's. Every device builder
- * calls it with all its buffers (its own and the sort's) before it makes
- * any, so a scene too big fails here, never in the driver. For tests,
- * $BVHLAB_CL_MEM_CAP_MB caps both limits. */
-int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
-                size_t err_size);
-/* Makes every buffer at least its wanted size (want[k] bytes), after
- * cl_bufs_fit. Done before any kernel runs. */
-int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count,
-                 char *err, size_t err_size);
-void cl_bufs_free(cl_buf *bufs, unsigned count);
+static inline int cl_bufs_size(cl_dev *d, cl_buf *bufs, const size_t *want, unsigned count,
+                               char *err, size_t err_size)
+{
+	return cl_bufs_size_on(&d->cl, bufs, want, count, err, err_size);
+}
 
-/* The events of one build's kernels, for the phase "device". */
-#define CL_EVENTS_MAX 256
-typedef struct cl_events {
-	cl_event ev[CL_EVENTS_MAX];
-	unsigned count;
-	double ms; /* of events already summed and released (a full list) */
-} cl_events;
-
-/* Runs kernel k over `items` work-items (rounded up to a work-group
- * multiple; kernels check their bounds) after setting its arguments:
- * pairs of (size, pointer) in args, `nargs` of them. */
-typedef struct cl_arg {
-	size_t size;
-	const void *value;
-} cl_arg;
-#define CL_ARG(x) ((cl_arg){ sizeof(x), &(x) })
-
-int cl_launch(cl_dev *d, cl_kernel k, size_t items, const cl_arg *args, unsigned nargs,
-              cl_events *ev, char *err, size_t err_size);
-/* An event slot for a kernel, copy or fill; a full list is waited for
- * and summed first. */
-cl_event *cl_events_next(cl_events *ev);
-/* Sum of the events' profiled times in ms (after clFinish); releases them. */
-double cl_events_ms(cl_events *ev);
-
-/* Monotonic clock, ms. */
-double cl_now_ms(void);
+static inline int cl_launch(cl_dev *d, cl_kernel k, size_t items, const cl_arg *args,
+                            unsigned nargs, cl_events *ev, char *err, size_t err_size)
+{
+	return cl_launch_on(&d->cl, k, items, args, nargs, ev, err, err_size);
+}
 
 /* ---- Morton codes and sort (cl_sort.c) -------------------------------- */
 
@@ -199,5 +175,32 @@ enum { CL_PHASE_UPLOAD, CL_PHASE_DEVICE, CL_PHASE_DOWNLOAD, CL_PHASE_CONVERT, CL
  * the host takes phases. */
 void cl_report_phases(const bvhlab_host *host, bvhlab_build_ctx *ctx,
                       const double ms[CL_PHASES]);
+
+/* A device builder's run, after the start: the tree into out, its phases
+ * into the builder's ms[]; 0, or a negative errno with the message in err. */
+typedef int (*cl_run_fn)(void *b, bvhlab_build_output *out, char *err, size_t err_size);
+
+/* What cl_build_run needs of a builder besides its program: its options'
+ * table (MORTON_OPTIONS and CL_DEVICE_OPTION in it), where its struct
+ * keeps the `device` spec and the phases `ms[CL_PHASES]`, and its run. */
+typedef struct cl_run_spec {
+	size_t device_at, ms_at;
+	cl_run_fn run;
+} cl_run_spec;
+
+/* The cl_run_spec of struct `type` (members device and ms) and run `fn`. */
+#define CL_RUN_SPEC(type, fn) \
+	{ .device_at = offsetof(type, device), .ms_at = offsetof(type, ms), .run = fn }
+
+/*
+ * A device builder's build() on its struct b (its options and the rest
+ * set by the caller, PLUGIN_OPTIONS_GET first: it copies the whole
+ * struct): cl_build_begin
+ * on b's device spec, rs->run(b, ...) with its message into
+ * host->set_error, a debug line, and b's phases reported. 0 or the errno.
+ */
+int cl_build_run(const cl_builder *cb, const cl_run_spec *rs, cl_dev *d, void *b,
+                 const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+                 bvhlab_build_output *out);
 
 #endif /* BVHLAB_CL_DEV_H */
