@@ -8,7 +8,9 @@
  * nest (a recursive fork-join sum) and many run at once; the pool is
  * reused (it never holds more workers than were ever busy at once); and a
  * child forked after the pool started runs teams of its own (isolate.c's
- * case: the child has none of the parent's threads).
+ * case: the child has none of the parent's threads). Then the same
+ * operations through the host table (ABI 1.6) from inside a build, at 1,
+ * 2 and 3 threads (pin_probe's expect=executor, exec_probe.c).
  */
 #include <errno.h>
 #include <stdlib.h>
@@ -16,9 +18,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <bvhlab/bvhlab.h>
+
 #include "exec/exec.h"
 #include "peer_threads.h"
 #include "testutil.h"
+
+#define FIXTURE_SEED 46
+#include "scene_fixture.h"
 
 static const uint32_t sizes[] = {0, 1, 4095, 5000, 100003};
 static const uint32_t thread_counts[] = {1, 2, 3, 7};
@@ -257,6 +264,32 @@ static void test_fork(void)
 	CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 0);
 }
 
+/* The host table's executor, checked by the probe plugin from inside. */
+static void test_host_table(void)
+{
+	bvhlab_scene *scene = generate("soup", 20000, 0, 0);
+	bvhlab_plugin *p = NULL;
+	bvhlab_options opts;
+	bvhlab_prims prims;
+	bvhlab_error err = { { 0 } };
+	CHECK_INT(bvhlab_plugin_open(BVHLAB_TEST_BUILDDIR "/pin_probe.so", &p, &err), 0);
+	CHECK_INT(bvhlab_prims_init(&prims, scene, &err), 0);
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(p)), 0);
+	CHECK_INT(bvhlab_options_parse(&opts, "expect=executor", &err), 0);
+	for (uint32_t threads = 1; threads <= 3; threads++) {
+		bvhlab_tree tree = { 0 };
+		int rc = bvhlab_build(p, &opts, &prims.input, threads, &tree, &err);
+		if (rc < 0)
+			fprintf(stderr, "%u threads: %s\n", threads, err.message);
+		CHECK_INT(rc, 0);
+		bvhlab_tree_finish(&tree);
+	}
+	bvhlab_options_finish(&opts);
+	bvhlab_prims_finish(&prims);
+	bvhlab_plugin_close(p);
+	bvhlab_scene_destroy(scene);
+}
+
 int main(void)
 {
 	uint32_t *v = malloc(LONGEST * sizeof(*v));
@@ -283,6 +316,7 @@ int main(void)
 	test_spawn(v, LONGEST);
 	test_fork();
 	exec_place_end(&place);
+	test_host_table();
 	free(v);
 	printf("executor: %u workers started in all\n", atomic_load(&peer_tid_count));
 	return test_finish();
