@@ -247,6 +247,7 @@ int exec_run(const struct exec_place *p, uint32_t members, exec_member_fn fn, vo
 	uint32_t got = 1;
 	if (members > EXEC_MAX_MEMBERS)
 		return -EAGAIN;
+	members = members ? members : 1; /* 0 members: the caller's alone */
 	for (; got < members && (w[got] = acquire()) != NULL; got++)
 		;
 	if (got < members) {

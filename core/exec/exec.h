@@ -16,8 +16,8 @@
  *
  * Nothing is allocated per task: a team's and a task's bookkeeping live in
  * the caller's frame, and a worker is created only when none is idle.
- * exec.c is the pool, teams and spawned tasks; exec_ops.c the parallel
- * operations over ranges (for_each, reduce, scan, partition, sort).
+ * exec.c is the pool, teams and spawned tasks; exec_ops.c for_each and
+ * reduce; exec_scan.c scan, partition and sort.
  */
 #ifndef BVHLAB_CORE_EXEC_H
 #define BVHLAB_CORE_EXEC_H
@@ -69,6 +69,7 @@ typedef void (*exec_member_fn)(void *arg, uint32_t member);
  * when all have returned; their writes are then visible to the caller.
  * All members run at once, so they may wait for each other (a barrier).
  * 0, or -EAGAIN with nothing run when that many threads cannot be had.
+ * 0 members is the caller alone, as 1.
  */
 int exec_run(const struct exec_place *p, uint32_t members, exec_member_fn fn, void *arg);
 
@@ -103,7 +104,7 @@ int exec_spawn(struct exec_place *p, struct exec_task *t, void (*fn)(void *arg),
  * writes are then visible to the caller. */
 void exec_join(struct exec_task *t);
 
-/* ---- operations over [0, count) (exec_ops.c) ---------------------------- */
+/* ---- operations over [0, count) (exec_ops.c, exec_scan.c) --------------- */
 
 /* Items per member below which an operation stays on fewer threads. */
 #define EXEC_MIN_ITEMS 4096
