@@ -25,6 +25,12 @@ typedef int (*pthread_create_fn)(pthread_t *, const pthread_attr_t *, void *(*)(
 static atomic_uint peer_started;  /* threads started */
 static atomic_uint peer_most_cpus; /* the most CPUs one of them was allowed */
 
+/* Every thread started, never reset (test-exec-affinity.c reads the
+ * executor's workers' masks after a call through these). */
+#define PEER_MAX_TIDS 64
+static pthread_t peer_tids[PEER_MAX_TIDS];
+static atomic_uint peer_tid_count;
+
 void peer_threads_reset(void);
 void peer_threads_reset(void)
 {
@@ -41,7 +47,10 @@ static void *peer_thread_start(void *p)
 {
 	trampoline t = *(trampoline *)p;
 	cpu_set_t set;
+	unsigned k = atomic_fetch_add(&peer_tid_count, 1);
 	free(p);
+	if (k < PEER_MAX_TIDS)
+		peer_tids[k] = pthread_self();
 	if (sched_getaffinity(0, sizeof(set), &set) == 0) {
 		unsigned n = (unsigned)CPU_COUNT(&set), most = atomic_load(&peer_most_cpus);
 		while (n > most && !atomic_compare_exchange_weak(&peer_most_cpus, &most, n))

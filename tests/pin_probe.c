@@ -4,7 +4,8 @@
  * fails the build with a message. The tree is one leaf of everything.
  *
  * Option expect (string): "pinned" (each worker bound to one CPU, distinct
- * CPUs for distinct cores) or "free" (pin_thread is a no-op).
+ * CPUs for distinct cores) or "free" (pin_thread is a no-op); or
+ * "executor": the host table's executor checked instead (exec_probe.c).
  */
 #include <errno.h>
 #include <pthread.h>
@@ -12,6 +13,8 @@
 #include <string.h>
 
 #include <bvhlab/builder.h>
+
+#include "exec_probe.h"
 
 #define MAX_WORKERS 64
 
@@ -129,10 +132,14 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		                BVHLAB_ABI_VERSION_MINOR(host->abi_version));
 		return -ENOTSUP;
 	}
-	if ((rc = host->option_string(ctx, "expect", &expect)) < 0 ||
-	    (rc = run_workers(host, ctx, w, n)) < 0)
+	if ((rc = host->option_string(ctx, "expect", &expect)) < 0)
 		return rc;
-	rc = strcmp(expect, "pinned") == 0
+	if (strcmp(expect, "executor") == 0)
+		rc = exec_probe(host, ctx, input);
+	else if ((rc = run_workers(host, ctx, w, n)) < 0)
+		return rc;
+	else
+		rc = strcmp(expect, "pinned") == 0
 		? check_pinned(host, ctx, w, n, host->hardware_threads(ctx))
 		: check_free(host, ctx, w, n);
 	if (rc == 0)
@@ -141,8 +148,8 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 }
 
 static const bvhlab_option_decl options[] = {
-	{.name = "expect", .type = BVHLAB_OPTION_STRING, .help = "pinned or free",
-	 .def_string = "free", .choices = "pinned|free"},
+	{.name = "expect", .type = BVHLAB_OPTION_STRING, .help = "pinned, free or executor",
+	 .def_string = "free", .choices = "pinned|free|executor"},
 };
 
 BVHLAB_PLUGIN(.name = "pin_probe", .flags = BVHLAB_BUILDER_PARALLEL,

@@ -6,7 +6,7 @@
  * are checked on their own call (the base tree is built first).
  *
  * How it is seen: this program defines pthread_setaffinity_np, which the
- * host's pin_thread calls (libbvhlab is linked in statically, so its call
+ * host's pin_thread and the executor's workers call (libbvhlab is linked in statically, so its call
  * binds to this definition), records the calling thread and the mask,
  * and passes the call on to the C library's. A bound mask holds one CPU;
  * the host's restoring of the caller's mask after the build holds the

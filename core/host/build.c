@@ -14,21 +14,9 @@
 
 #include "host/options_fill.h"
 #include "device/device.h"
+#include "host/build_ctx.h"
 #include "machine/machine.h"
 #include "tree/tree_view.h"
-#include "util/util.h"
-
-struct bvhlab_build_ctx {
-	const bvhlab_builder *builder;
-	const bvhlab_options *opts;
-	bvhlab_tree *tree;
-	bvhlab_error *err;
-	bool error_set;
-	char bad_phase[192];   /* the first phase report refused and why, or "" */
-	bool pinning;          /* plan is set: pin_thread binds */
-	struct pin_plan plan;
-	cpu_set_t caller_mask; /* restored after build(): the caller may be a worker */
-};
 
 /* Messages above this level are dropped; BVHLAB_LOG=error|warn|info|debug. */
 static int log_threshold(void)
@@ -142,14 +130,12 @@ static void host_progress(bvhlab_build_ctx *ctx, double fraction)
 
 static uint32_t host_hardware_threads(bvhlab_build_ctx *ctx)
 {
-	/* A pinned worker's own mask holds one CPU; the plan holds the set the
-	 * build started with, which is what the answer must describe. */
-	return ctx->pinning ? ctx->plan.count : bvhlab_hardware_threads();
+	return exec_place_cpus(&ctx->place);
 }
 
 static int host_pin_thread(bvhlab_build_ctx *ctx, uint32_t worker)
 {
-	return ctx->pinning ? pin_plan_apply(&ctx->plan, worker) : 0;
+	return exec_place_pin(&ctx->place, worker);
 }
 
 static bool phase_name_ok(const char *name)
@@ -224,6 +210,14 @@ static const bvhlab_host host_table = {
 	.pin_thread = host_pin_thread,
 	.phase = host_phase,
 	.device_program = host_device_program,
+	.run = host_exec_run,
+	.for_each = host_exec_for_each,
+	.reduce = host_exec_reduce,
+	.scan = host_exec_scan,
+	.partition = host_exec_partition,
+	.sort = host_exec_sort,
+	.spawn = host_exec_spawn,
+	.join = host_exec_join,
 };
 
 static int prepare_tree(bvhlab_tree *tree, uint32_t prims)
@@ -234,32 +228,18 @@ static int prepare_tree(bvhlab_tree *tree, uint32_t prims)
 	return bvhlab_tree_init(tree, nodes, prims);
 }
 
-/* The plan comes from the caller's mask now, before any worker narrows it. */
-static int pinning_begin(struct bvhlab_build_ctx *ctx)
+/* The place comes from the caller's mask now, before any worker (the
+ * caller included) narrows it; the caller gets its mask back after. */
+static int place_begin(struct bvhlab_build_ctx *ctx)
 {
-	if (!machine_pinning())
-		return 0;
-	int r = -pthread_getaffinity_np(pthread_self(), sizeof(ctx->caller_mask),
-	                                &ctx->caller_mask);
-	if (r == 0)
-		r = pin_plan_init(&ctx->plan);
+	int r = exec_place_begin(&ctx->place);
 	if (r < 0) {
-		pin_plan_finish(&ctx->plan);
+		exec_place_end(&ctx->place);
 		error_set(ctx->err, "builder '%s': cannot plan thread pinning (%s)",
 		          ctx->builder->name, strerror(-r));
 		return r;
 	}
-	ctx->pinning = true;
 	return 0;
-}
-
-static void pinning_end(struct bvhlab_build_ctx *ctx)
-{
-	if (!ctx->pinning)
-		return;
-	pthread_setaffinity_np(pthread_self(), sizeof(ctx->caller_mask), &ctx->caller_mask);
-	pin_plan_finish(&ctx->plan);
-	ctx->pinning = false;
 }
 
 /* A phase is part of its build: one longer than the whole call is a
@@ -343,16 +323,17 @@ static int call_plugin(const bvhlab_plugin *plugin, const bvhlab_options *opts,
 		.index_count = in_place ? tree->index_count : 0,
 		.width = in_place ? tree_width(tree) : 2,
 	};
-	struct bvhlab_build_ctx ctx = {.builder = b, .opts = opts, .tree = tree, .err = err};
+	struct bvhlab_build_ctx ctx = {.builder = b, .opts = opts, .tree = tree, .err = err,
+	                               .threads = in.threads};
 	tree->phase_count = 0;
-	int r = pinning_begin(&ctx);
+	int r = place_begin(&ctx);
 	if (r < 0)
 		return r;
 	double t0 = util_now();
 	r = in_place ? in_place(&host_table, &ctx, &in, &out)
 	             : b->build(&host_table, &ctx, &in, &out);
 	phases_within(&ctx, (util_now() - t0) * 1e3);
-	pinning_end(&ctx);
+	exec_place_end(&ctx.place);
 	tree->node_count = out.node_count;
 	tree->index_count = out.index_count;
 	tree->width = out.width;

@@ -1,11 +1,11 @@
 /*
- * Tracing a batch of rays with a pool of threads. Rays are handed out in
+ * Tracing a batch of rays on the process's executor (core/exec), placed on
+ * the caller's CPU set and pinned as builds are. Rays are handed out in
  * tiles from one atomic counter, so threads that draw cheap rays take more
  * tiles; each thread keeps its own counters and they are summed at the
  * end, so nothing is shared in the hot loop but the counter.
  */
 #include <errno.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <time.h>
@@ -13,6 +13,7 @@
 #include <bvhlab/machine.h>
 #include <bvhlab/trace.h>
 
+#include "exec/exec.h"
 #include "util/util.h"
 
 #include "trace/trace_batch.h"
@@ -43,10 +44,10 @@ static double cpu_seconds(void)
 	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-static void *work(void *arg)
+static void work(void *arg, uint32_t member)
 {
-	struct worker *w = arg;
-	struct batch *b = w->b;
+	struct batch *b = arg;
+	struct worker *w = &b->workers[member];
 	double t0 = cpu_seconds();
 	for (;;) {
 		size_t begin = atomic_fetch_add_explicit(&b->next, TILE, memory_order_relaxed);
@@ -60,7 +61,6 @@ static void *work(void *arg)
 			b->tile_cpu[begin / TILE] = cpu_seconds() - c0;
 	}
 	w->cpu_s = cpu_seconds() - t0;
-	return NULL;
 }
 
 uint32_t trace_thread_count(uint32_t threads, size_t count)
@@ -73,19 +73,19 @@ uint32_t trace_thread_count(uint32_t threads, size_t count)
 	return threads;
 }
 
-/* Starts threads - 1 helpers and works on the calling thread too. */
+/* A team of `threads`, the calling thread as member 0; a smaller team
+ * (the pool short of threads) still traces everything. Workers of members
+ * that did not run keep zero counters. A place that cannot be had (the
+ * mask unreadable) leaves the caller alone. */
 void trace_run_workers(struct batch *b, struct worker *w, uint32_t threads)
 {
-	uint32_t started = 0;
-	for (uint32_t k = 1; k < threads; k++, started++) {
-		w[k].b = b;
-		if (pthread_create(&w[k].thread, NULL, work, &w[k]) != 0)
-			break; /* fewer threads still trace everything */
-	}
-	w[0].b = b;
-	work(&w[0]);
-	for (uint32_t k = 1; k <= started; k++)
-		pthread_join(w[k].thread, NULL);
+	struct exec_place place;
+	b->workers = w;
+	if (exec_place_begin(&place) == 0)
+		exec_run_some(&place, threads, work, b);
+	else
+		work(b, 0);
+	exec_place_end(&place);
 }
 
 int bvhlab_trace_batch(const bvhlab_tree *tree, const bvhlab_scene *scene,

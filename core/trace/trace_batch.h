@@ -5,7 +5,6 @@
 #ifndef BVHLAB_CORE_TRACE_BATCH_H
 #define BVHLAB_CORE_TRACE_BATCH_H
 
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
@@ -32,11 +31,10 @@ struct batch {
 	bvhlab_hit *hits;
 	uint32_t *nodes;
 	atomic_size_t next;
+	struct worker *workers; /* [threads] one per team member */
 };
 
 struct worker {
-	struct batch *b;
-	pthread_t thread;
 	bvhlab_trace_stats stats;
 	double cpu_s; /* the thread's CPU time in the batch (CLOCK_THREAD_CPUTIME_ID) */
 };
@@ -51,8 +49,9 @@ static inline size_t trace_tiles(size_t count)
  * never more than there are tiles. */
 uint32_t trace_thread_count(uint32_t threads, size_t count);
 
-/* Traces the batch with w[0] on the calling thread and threads - 1 helpers;
- * each worker's counters are added to its own stats. */
+/* Traces the batch on a team of the executor of up to `threads`, w[0] on
+ * the calling thread; each member's counters are added to its worker's
+ * stats (w[] zeroed by the caller). */
 void trace_run_workers(struct batch *b, struct worker *w, uint32_t threads);
 
 #endif

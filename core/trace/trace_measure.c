@@ -58,7 +58,7 @@ static double pass(struct batch *b, struct worker *w, uint32_t threads,
 {
 	atomic_store_explicit(&b->next, 0, memory_order_relaxed);
 	for (uint32_t k = 0; k < threads; k++)
-		w[k].stats = (bvhlab_trace_stats){0};
+		w[k] = (struct worker){0};
 	double t0 = util_now();
 	trace_run_workers(b, w, threads);
 	double seconds = util_now() - t0;

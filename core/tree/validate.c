@@ -11,15 +11,14 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <bvhlab/trace.h>
 #include <bvhlab/tree.h>
 
+#include "exec/exec.h"
 #include "tree/tree_view.h"
 #include "tree/validate_clip.h"
 #include "util/util.h"
@@ -314,8 +313,7 @@ typedef struct ray_job {
 	float center[3];
 	float radius;
 	float lo[3], size[3]; /* the box targets are drawn from */
-	uint32_t begin, end;  /* rays of this job */
-	uint64_t mismatches;
+	uint64_t mismatches[EXEC_MAX_MEMBERS]; /* per member of the team */
 } ray_job;
 
 static float uniform(uint64_t *state)
@@ -371,21 +369,19 @@ static bool same_hit(const bvhlab_hit *a, const bvhlab_hit *b)
 	return a->prim == BVHLAB_NO_HIT || fabs(ta - tb) <= 1e-4 * fmax(fabs(ta), fabs(tb));
 }
 
-static void *run_rays(void *arg)
+static void run_rays(void *arg, uint32_t lo, uint32_t hi, uint32_t member)
 {
 	ray_job *job = arg;
 	bvhlab_ray ray;
 	bvhlab_hit a, b;
-	uint32_t i;
 
-	for (i = job->begin; i < job->end; i++) {
+	for (uint32_t i = lo; i < hi; i++) {
 		make_ray(job, i, &ray);
 		bvhlab_trace_closest(job->tree, job->scene, &ray, &a, NULL);
 		bvhlab_trace_brute(job->scene, &ray, &b);
 		if (!same_hit(&a, &b))
-			job->mismatches++;
+			job->mismatches[member]++;
 	}
-	return NULL;
 }
 
 /* Sphere and target box from the scene bounds, or the root box if those are
@@ -411,44 +407,49 @@ static void ray_frame(const bvhlab_tree *tree, const bvhlab_scene *scene, ray_jo
 	job->radius = diag2 > 0.0f ? 0.75f * sqrtf(diag2) : 1.0f;
 }
 
-static uint32_t ray_threads(const bvhlab_scene *scene, uint32_t ray_count)
+/* Threads for the check: the place's CPUs (the caller's CPU set, counted
+ * as builds count it), when the work is worth them. */
+static uint32_t ray_threads(const struct exec_place *place, const bvhlab_scene *scene,
+                            uint32_t ray_count)
 {
-	long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-	uint64_t n;
+	uint32_t cpus = exec_place_cpus(place);
 
 	if ((uint64_t)ray_count * scene->triangle_count < THREAD_WORK || cpus <= 1)
 		return 1;
-	n = cpus < MAX_THREADS ? (uint64_t)cpus : MAX_THREADS;
-	return n < ray_count ? (uint32_t)n : ray_count;
+	cpus = cpus < MAX_THREADS ? cpus : MAX_THREADS;
+	return cpus < ray_count ? cpus : ray_count;
 }
 
+/* The rays run on the executor, placed and pinned as a build's threads
+ * are; a place that cannot be had leaves the caller alone with them. */
 int bvhlab_validate_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
                          uint32_t ray_count, uint64_t seed, uint64_t *mismatches,
                          bvhlab_error *err)
 {
-	ray_job jobs[MAX_THREADS];
-	pthread_t threads[MAX_THREADS];
-	bool started[MAX_THREADS];
-	uint32_t n = ray_threads(scene, ray_count), i;
+	ray_job *job = calloc(1, sizeof(*job));
+	struct exec_place place;
+	bool placed = exec_place_begin(&place) == 0;
+	uint32_t n = placed ? ray_threads(&place, scene, ray_count) : 1;
 
-	if (err)
-		err->message[0] = '\0'; /* nothing here fails: threads that do not start run here */
 	*mismatches = 0;
-	for (i = 0; i < n; i++) {
-		jobs[i] = (ray_job){ .tree = tree, .scene = scene, .seed = seed };
-		ray_frame(tree, scene, &jobs[i]);
-		jobs[i].begin = (uint32_t)((uint64_t)ray_count * i / n);
-		jobs[i].end = (uint32_t)((uint64_t)ray_count * (i + 1) / n);
-		/* Job 0 runs here; a thread that cannot start runs here too. */
-		started[i] = i > 0 && pthread_create(&threads[i], NULL, run_rays, &jobs[i]) == 0;
+	if (!job) {
+		exec_place_end(&place);
+		error_set(err, "out of memory for the ray check");
+		return -ENOMEM;
 	}
-	for (i = 0; i < n; i++)
-		if (!started[i])
-			run_rays(&jobs[i]);
-	for (i = 0; i < n; i++) {
-		if (started[i])
-			pthread_join(threads[i], NULL);
-		*mismatches += jobs[i].mismatches;
-	}
+	if (err)
+		err->message[0] = '\0';
+	*job = (ray_job){ .tree = tree, .scene = scene, .seed = seed };
+	ray_frame(tree, scene, job);
+	/* Blocks of a quarter share: a thread slowed by others takes fewer. */
+	uint32_t grain = ray_count / (4 * n) > 0 ? ray_count / (4 * n) : 1;
+	if (placed)
+		exec_for_each(&place, n, ray_count, grain, run_rays, job);
+	else
+		run_rays(job, 0, ray_count, 0);
+	exec_place_end(&place);
+	for (uint32_t i = 0; i < n; i++)
+		*mismatches += job->mismatches[i];
+	free(job);
 	return 0;
 }

@@ -34,6 +34,11 @@
  *        core's device tracer; include/bvhlab/opencl.h's
  *        bvhlab_cl_host_program is the typed call). Older plugins load as
  *        before and keep their own devices.
+ *        And the process's executor in bvhlab_host (run, for_each, reduce,
+ *        scan, partition, sort, spawn, join; check BVHLAB_HOST_HAS(host,
+ *        run)): one pool of threads for the whole process, placed on the
+ *        run's CPU set and pinned as pin_thread pins. Older plugins load
+ *        as before and start no threads through it.
  *
  * A plugin is a shared object that exports exactly one symbol,
  *
@@ -172,6 +177,12 @@ enum bvhlab_log_level {
 
 struct bvhlab_build_output;
 
+/* A task started by host->spawn (ABI 1.6): the caller's storage, opaque,
+ * kept in place from spawn to join. */
+typedef struct bvhlab_task {
+	uint64_t opaque[24];
+} bvhlab_task;
+
 /*
  * Services the host offers a plugin during build(). The table is owned by the
  * host and valid during the call only. A plugin compiled against a newer
@@ -253,6 +264,65 @@ typedef struct bvhlab_host {
 	int (*device_program)(bvhlab_build_ctx *ctx, const char *spec, const char *source,
 	                      size_t len, const char *options, const void **device,
 	                      void **program);
+
+	/*
+	 * since 1.6: the process's executor, one pool of threads kept for the
+	 * whole process and shared by every build, tracing and validation.
+	 * Its threads run on the CPU set the build started with, each bound
+	 * to one core (as pin_thread binds worker `member`) when the user
+	 * enabled pinning: a plugin that uses them does not pin. The calls
+	 * may nest (a task may run a team) and come from any thread of the
+	 * build; `threads` below means input->threads. Nothing is allocated
+	 * per task or per member. Check BVHLAB_HOST_HAS(host, join) (every
+	 * field of 1.6 came together).
+	 */
+	/* Runs fn(arg, member) for member = 0 .. members - 1 all at the same
+	 * time (they may wait for each other, e.g. at a barrier), the calling
+	 * thread as member 0, and returns when all have returned; their
+	 * writes are then visible. 0, or -EAGAIN having run nothing when that
+	 * many threads cannot be had (ask again with fewer). */
+	int (*run)(bvhlab_build_ctx *ctx, uint32_t members,
+	           void (*fn)(void *arg, uint32_t member), void *arg);
+	/* fn(arg, lo, hi, member) over ranges that cover [0, count) once, none
+	 * longer than grain (0: count / threads), handed to whichever of up
+	 * to `threads` members asks first (member < threads: an index for
+	 * per-member scratch). 0, or -EINVAL for a NULL fn. */
+	int (*for_each)(bvhlab_build_ctx *ctx, uint32_t count, uint32_t grain,
+	                void (*fn)(void *arg, uint32_t lo, uint32_t hi, uint32_t member),
+	                void *arg);
+	/* Reduces [0, count): fixed contiguous shares (one per thread, 4096
+	 * items each at least) are each reduced by fn into a copy of *acc
+	 * (`size` bytes, holding join's identity on entry), and the copies
+	 * are joined into *acc in share order. 0 or -ENOMEM. */
+	int (*reduce)(bvhlab_build_ctx *ctx, uint32_t count, void *acc, size_t size,
+	              void (*fn)(void *arg, uint32_t lo, uint32_t hi, void *acc),
+	              void (*join)(void *arg, void *acc, const void *part), void *arg);
+	/* Exclusive prefix sums of in[0 .. count) into out (out may be in);
+	 * *total (may be NULL) the sum, in uint32 arithmetic. The same for
+	 * every thread count. 0 or -ENOMEM. */
+	int (*scan)(bvhlab_build_ctx *ctx, const uint32_t *in, uint32_t *out, uint32_t count,
+	            uint32_t *total);
+	/* Stable partition of in[0 .. count) into out (not in): the values
+	 * pred holds for first, in their order, then the rest; *kept (may be
+	 * NULL) how many held. pred is called twice per value and must give
+	 * the same answer. 0, -EINVAL or -ENOMEM. */
+	int (*partition)(bvhlab_build_ctx *ctx, const uint32_t *in, uint32_t *out,
+	                 uint32_t count, bool (*pred)(void *arg, uint32_t value), void *arg,
+	                 uint32_t *kept);
+	/* Sorts keys[0 .. count), each below 2^key_bits (1 to 64), ascending,
+	 * with values (may be NULL) carried along; stable (a radix sort), so
+	 * the same for every thread count. 0, -EINVAL or -ENOMEM. */
+	int (*sort)(bvhlab_build_ctx *ctx, uint64_t *keys, uint32_t *values, uint32_t count,
+	            uint32_t key_bits);
+	/* Starts fn(arg) on a thread of the pool, as the next worker number
+	 * after the members of a team. 0, or -EAGAIN with fn not run (do the
+	 * work on the calling thread then). *task stays put until join. */
+	int (*spawn)(bvhlab_build_ctx *ctx, bvhlab_task *task, void (*fn)(void *arg),
+	             void *arg);
+	/* Waits for a task that spawn started (nothing for one it refused);
+	 * its writes are then visible. Every started task must be joined
+	 * before build() returns. */
+	void (*join)(bvhlab_build_ctx *ctx, bvhlab_task *task);
 } bvhlab_host;
 
 /* Limits of host->phase (ABI 1.3). */

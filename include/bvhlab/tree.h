@@ -72,7 +72,10 @@ int bvhlab_validate_tree(const bvhlab_tree *tree, const bvhlab_build_input *inpu
 /*
  * Sampled rays (seeded, reproducible) traced through the tree and by brute
  * force over every triangle; a mismatch is a hit/miss disagreement or a hit
- * distance that differs by more than a relative 1e-4. Returns 0 and fills
+ * distance that differs by more than a relative 1e-4. A large check runs
+ * on the process's executor, on as many threads as the calling thread's
+ * CPU set has physical cores (bvhlab_hardware_threads), pinned one a core
+ * when pinning is on, as a build's threads are. Returns 0 and fills
  * *mismatches (may be non-zero), or a negative errno on allocation failure.
  */
 int bvhlab_validate_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,

@@ -18,7 +18,8 @@
  * that meets a child outside its own span reads inside it instead and
  * fails), and a box is a min/max of the same values whoever computes it,
  * so the tree is the same bit for bit, node order included, for any
- * thread count (DETERMINISTIC).
+ * thread count (DETERMINISTIC). The threads are the host's executor's
+ * (team.h), placed and pinned by the host.
  */
 #include <errno.h>
 #include <stdlib.h>
@@ -43,8 +44,7 @@ static void member(void *arg, unsigned t)
 	refit *r = arg;
 	struct refit_scratch w;
 	uint32_t lo, hi;
-	if (BVHLAB_HOST_HAS(r->host, pin_thread))
-		r->host->pin_thread(r->ctx, t);
+	(void)t;
 	while (!atomic_load_explicit(&r->fault, memory_order_relaxed) &&
 	       team_next_block(&r->next, r->span_count, 1, &lo, &hi)) {
 		enum refit_fault f = refit_sweep(r, r->spans[lo], &w);
@@ -59,7 +59,7 @@ static enum refit_fault sweep_spans(refit *r, uint32_t threads, int *rc)
 	atomic_store(&r->next, 0);
 	atomic_store(&r->fault, FAULT_NONE);
 	if (threads > 1 && r->span_count > 1)
-		*rc = team_run(&r->team, threads, r->host->hardware_threads(r->ctx), member, r);
+		*rc = team_run_on(&r->team, &r->th, threads, member, r);
 	else
 		member(r, 0);
 	return (enum refit_fault)atomic_load(&r->fault);
@@ -124,6 +124,7 @@ static int update(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	             .prim_count = input->prim_count, .out = tree, .nodes = tree->nodes,
 	             .node_count = tree->node_count, .prim_index = tree->prim_index,
 	             .index_count = tree->index_count};
+	team_host_init(&r->th, host, ctx);
 	threads = threads < most ? threads : most;
 	threads = threads > TEAM_MAX_THREADS ? TEAM_MAX_THREADS : threads;
 	if (tree->node_count)

@@ -62,6 +62,7 @@ typedef struct refit {
 	atomic_uint next;        /* the next span to take */
 	atomic_uint fault;       /* enum refit_fault: the first problem met */
 	team team;
+	team_host th;             /* the executor the team runs on */
 } refit;
 
 /* Nodes a sweep lists by kind at a time: their 128 KiB stay in L2

@@ -90,8 +90,8 @@ static inline uint32_t sah_job_size(const sah_job *job)
 
 /*
  * Threads worth starting for a root job: one per SAH_PRIMS_PER_THREAD
- * primitives at most. A thread costs its start-up and a TEAM_STACK, and
- * below this size the jobs are too few to keep more of them busy; a
+ * primitives at most. A thread costs its wake-up (the executor's pool),
+ * and below this size the jobs are too few to keep more of them busy; a
  * config asking for 1024 threads on a small scene gets a few.
  */
 #define SAH_PRIMS_PER_THREAD 4096u

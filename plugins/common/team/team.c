@@ -1,5 +1,5 @@
-/* The thread team and its barrier (see team.h); spawned threads and
- * pinning are team_spawn.c. */
+/* The thread team and its barrier (see team.h), on the host's executor;
+ * spawned tasks are team_spawn.c. */
 #include <errno.h>
 
 #include "team.h"
@@ -48,44 +48,6 @@ void team_sync(team *tm)
 	pthread_mutex_unlock(&tm->lock);
 }
 
-/* Holds the started threads until the team size is known. */
-struct gate {
-	pthread_mutex_t lock;
-	pthread_cond_t cond;
-	bool open;
-};
-
-struct member {
-	struct gate *gate;
-	const team_host *th; /* NULL: team_run, no pinning */
-	void (*fn)(void *arg, unsigned t);
-	void *arg;
-	unsigned t;
-	pthread_t tid;
-};
-
-static void *member_main(void *p)
-{
-	struct member *m = p;
-
-	if (m->th)
-		team_pin(m->th, m->t);
-	pthread_mutex_lock(&m->gate->lock);
-	while (!m->gate->open)
-		pthread_cond_wait(&m->gate->cond, &m->gate->lock);
-	pthread_mutex_unlock(&m->gate->lock);
-	m->fn(m->arg, m->t);
-	return NULL;
-}
-
-static void open_gate(struct gate *gate)
-{
-	pthread_mutex_lock(&gate->lock);
-	gate->open = true;
-	pthread_cond_broadcast(&gate->cond);
-	pthread_mutex_unlock(&gate->lock);
-}
-
 static void set_size(team *tm, unsigned threads, uint32_t cpus)
 {
 	tm->threads = threads;
@@ -93,7 +55,7 @@ static void set_size(team *tm, unsigned threads, uint32_t cpus)
 	tm->spins = threads <= cpus ? BARRIER_SPINS : 0;
 }
 
-int team_barrier_init(team *tm, unsigned threads, uint32_t cpus)
+static int team_barrier_init(team *tm, unsigned threads, uint32_t cpus)
 {
 	int rc;
 
@@ -109,64 +71,39 @@ int team_barrier_init(team *tm, unsigned threads, uint32_t cpus)
 	return 0;
 }
 
-void team_barrier_finish(team *tm)
+static void team_barrier_finish(team *tm)
 {
 	pthread_cond_destroy(&tm->wake);
 	pthread_mutex_destroy(&tm->lock);
 }
 
-static int start_member(struct member *m)
-{
-	pthread_attr_t attr;
-	int rc = pthread_attr_init(&attr);
-
-	if (rc != 0)
-		return -rc;
-	rc = pthread_attr_setstacksize(&attr, TEAM_STACK);
-	if (rc == 0)
-		rc = pthread_create(&m->tid, &attr, member_main, m);
-	pthread_attr_destroy(&attr);
-	return -rc;
-}
-
-/* Joining the members is what makes their writes visible to the caller. */
-static int run_team(team *tm, const team_host *th, unsigned want, uint32_t cpus,
-                    void (*fn)(void *arg, unsigned t), void *arg)
-{
-	struct member m[TEAM_MAX_THREADS];
-	struct gate gate = { PTHREAD_MUTEX_INITIALIZER, PTHREAD_COND_INITIALIZER, false };
-	unsigned size = 1;
-	int rc;
-
-	want = want > TEAM_MAX_THREADS ? TEAM_MAX_THREADS : want ? want : 1;
-	/* The size is set again below, once it is known. */
-	if ((rc = team_barrier_init(tm, want, cpus)) < 0)
-		return rc;
-	for (; size < want; size++) {
-		m[size] = (struct member){ .gate = &gate, .th = th, .fn = fn, .arg = arg,
-		                           .t = size };
-		if (start_member(&m[size]) < 0)
-			break;
-	}
-	set_size(tm, size, cpus);
-	if (th)
-		team_pin(th, 0);
-	open_gate(&gate);
-	fn(arg, 0);
-	for (unsigned t = 1; t < size; t++)
-		pthread_join(m[t].tid, NULL);
-	team_barrier_finish(tm);
-	return 0;
-}
-
-int team_run(team *tm, unsigned want, uint32_t cpus, void (*fn)(void *arg, unsigned t),
-             void *arg)
-{
-	return run_team(tm, NULL, want, cpus, fn, arg);
-}
-
+/*
+ * The host's executor runs the members (ABI 1.6: its pool's threads, placed
+ * and pinned by the host), all at once as the barrier needs. A team it
+ * cannot give whole is asked for again at half the size; a host without
+ * an executor runs the caller alone, which every team function allows.
+ */
 int team_run_on(team *tm, const team_host *th, unsigned want,
                 void (*fn)(void *arg, unsigned t), void *arg)
 {
-	return run_team(tm, th, want, team_cpus(th), fn, arg);
+	uint32_t cpus = team_cpus(th);
+	bool pool = BVHLAB_HOST_HAS(th->host, join);
+	int rc;
+
+	want = want > TEAM_MAX_THREADS ? TEAM_MAX_THREADS : want ? want : 1;
+	if ((rc = team_barrier_init(tm, want, cpus)) < 0)
+		return rc;
+	for (; pool && want > 1; want /= 2) {
+		set_size(tm, want, cpus);
+		if ((rc = th->host->run(th->ctx, want, fn, arg)) != -EAGAIN)
+			break;
+	}
+	if (!pool || want <= 1) {
+		set_size(tm, 1, cpus);
+		team_pin(th, 0);
+		fn(arg, 0);
+		rc = 0;
+	}
+	team_barrier_finish(tm);
+	return rc < 0 ? rc : 0;
 }

@@ -1,18 +1,17 @@
 /*
- * The plugins' thread layer: every thread a plugin starts is started here,
- * with a stack big enough for the SAH kernel, and pins itself through
- * host->pin_thread first thing (a no-op unless the user asked for
- * pinning), so `pin` means the same for every plugin. Two shapes:
- *   - a team: team_run_on runs one function on up to T threads, the
- *     calling thread as member 0, with a barrier (team_sync) between its
- *     phases (lbvh, ploc, sbvh, reinsert, treelet, sah_queue, sah_tasks,
- *     the SAH kernel's input copy);
- *   - spawned threads: team_spawn starts one function on a thread of its
- *     own, team_join waits for it (sah_even, sah_uneven: a thread per
+ * The plugins' thread layer, a thin one over the host's executor (ABI 1.6,
+ * core/exec): the threads are the process's pool, placed on the run's CPU
+ * set and pinned by the host (`pin` means the same for every plugin), so
+ * nothing here starts a thread. Two shapes:
+ *   - a team: team_run_on runs one function on up to T threads at once,
+ *     the calling thread as member 0, with a barrier (team_sync) between
+ *     its phases (lbvh, ploc, sbvh, reinsert, treelet, refit, sah_queue,
+ *     sah_tasks, the SAH kernel's input copy);
+ *   - spawned tasks: team_spawn starts one function on a thread of the
+ *     pool, team_join waits for it (sah_even, sah_uneven: a task per
  *     subtree).
- * Members are numbered 0 .. T-1 for pin_thread (a team by member index,
- * spawned threads by a counter in team_host). A static library linked
- * into each plugin that uses it.
+ * With a host older than 1.6 the caller does all the work alone, which
+ * every user allows. A static library linked into each plugin that uses it.
  */
 #ifndef BVHLAB_TEAM_H
 #define BVHLAB_TEAM_H
@@ -26,29 +25,22 @@
 
 #define TEAM_MAX_THREADS 256
 
-/*
- * Every thread's stack: the SAH kernel's binned split keeps ~30 KB of bins
- * on the stack and schedulers may recurse a few levels around it; 8 MiB
- * matches the usual main-thread stack, so nothing is safe there that would
- * fail here.
- */
-#define TEAM_STACK (8u << 20)
-
-/* The build the threads work for: where they pin themselves. */
+/* The build the threads work for: whose executor runs them. */
 typedef struct team_host {
 	const bvhlab_host *host;
 	bvhlab_build_ctx *ctx;
-	atomic_uint next_worker; /* team_spawn's numbers; 0 is the caller's */
 } team_host;
 
-/* Sets th up for one build; the calling thread is worker 0. */
+/* Sets th up for one build. */
 void team_host_init(team_host *th, const bvhlab_host *host, bvhlab_build_ctx *ctx);
 
 /* How many CPUs the build may use (host->hardware_threads). */
 uint32_t team_cpus(const team_host *th);
 
 /* host->pin_thread(worker) where the host has it: binds the calling thread
- * to the worker's core when pinning is on, else nothing. */
+ * to the worker's core when pinning is on, else nothing. Only the caller
+ * of a scheduler that spawns tasks needs it (as worker 0): the executor
+ * places a team's members and the tasks itself. */
 void team_pin(const team_host *th, uint32_t worker);
 
 typedef struct team {
@@ -65,50 +57,33 @@ typedef struct team {
 void team_sync(team *tm);
 
 /*
- * Sets up the barrier alone, for a caller that starts and joins its own
- * threads (sah_tasks): `threads` members meet at team_sync; they poll
- * before sleeping only while threads <= cpus. 0 or a negative errno.
- */
-int team_barrier_init(team *tm, unsigned threads, uint32_t cpus);
-void team_barrier_finish(team *tm);
-
-/*
- * Runs fn(arg, t) on up to `want` threads, t = 0 .. threads - 1, the
- * calling thread as 0, and returns when all have returned. A thread that
- * cannot be started only makes the team smaller, so fn must not depend
- * on the size for its result. `cpus` is how many CPUs the build may use
- * (barriers poll only while every member has one). 0 or a negative errno.
- */
-int team_run(team *tm, unsigned want, uint32_t cpus, void (*fn)(void *arg, unsigned t),
-             void *arg);
-
-/*
- * team_run for a build: the CPUs come from the host, and every member
- * pins itself as worker t first (the caller too, as 0). 0 or a negative
- * errno.
+ * Runs fn(arg, t) on up to `want` threads at once, t = 0 .. threads - 1,
+ * the calling thread as 0, and returns when all have returned (their
+ * writes are then visible). The team may be smaller than asked (the pool
+ * could not give that many, or the host has no executor), so fn must not
+ * depend on the size for its result; tm->threads is the size while it
+ * runs. Barriers poll only while every member has a CPU of the build's.
+ * 0 or a negative errno.
  */
 int team_run_on(team *tm, const team_host *th, unsigned want,
-                void (*fn)(void *arg, unsigned t), void *arg);
+                void (*fn)(void *arg, uint32_t t), void *arg);
 
-/* A thread started by team_spawn. */
+/* A task started by team_spawn. */
 typedef struct team_thread {
-	team_host *th;
-	void (*fn)(void *arg);
-	void *arg;
-	uint32_t worker;
-	pthread_t tid;
-	bool started; /* must be joined */
+	const team_host *th;
+	bvhlab_task task; /* the host's record */
+	bool started;     /* must be joined */
 } team_thread;
 
 /*
- * Starts fn(arg) on a new thread that pins itself as the next worker
- * number. 0, or a negative errno with fn not run: the caller then does
- * the work itself (every scheduler stays correct with fewer threads).
+ * Starts fn(arg) on a thread of the host's pool, placed as the build's
+ * next worker. 0, or a negative errno with fn not run: the caller then
+ * does the work itself (every scheduler stays correct with fewer threads).
  * *t must stay put until team_join.
  */
 int team_spawn(team_host *th, team_thread *t, void (*fn)(void *arg), void *arg);
 
-/* Waits for a started thread (nothing for one that did not start); the
+/* Waits for a started task (nothing for one that did not start); the
  * join makes its writes visible to the caller. */
 void team_join(team_thread *t);
 

@@ -1,6 +1,6 @@
 /*
- * Threads started one at a time (team_spawn, team_join) and the pinning
- * every thread of the layer does first thing (see team.h).
+ * Tasks started one at a time (team_spawn, team_join) on the host's
+ * executor, and the pinning of the calling thread (see team.h).
  */
 #include <errno.h>
 
@@ -10,7 +10,6 @@ void team_host_init(team_host *th, const bvhlab_host *host, bvhlab_build_ctx *ct
 {
 	th->host = host;
 	th->ctx = ctx;
-	atomic_init(&th->next_worker, 1);
 }
 
 uint32_t team_cpus(const team_host *th)
@@ -25,37 +24,22 @@ void team_pin(const team_host *th, uint32_t worker)
 		th->host->pin_thread(th->ctx, worker);
 }
 
-static void *spawned_main(void *arg)
-{
-	team_thread *t = arg;
-
-	team_pin(t->th, t->worker);
-	t->fn(t->arg);
-	return NULL;
-}
-
+/* A host without an executor (before ABI 1.6) gets the work done on the
+ * calling thread, as when the pool has no thread to give. */
 int team_spawn(team_host *th, team_thread *t, void (*fn)(void *arg), void *arg)
 {
-	pthread_attr_t attr;
-	int rc = pthread_attr_init(&attr);
-
-	*t = (team_thread){ .th = th, .fn = fn, .arg = arg };
-	if (rc != 0)
-		return -rc;
-	rc = pthread_attr_setstacksize(&attr, TEAM_STACK);
-	/* A thread that fails to start leaves a gap in the numbers (rare, and
-	 * handing the number back could give it out twice). */
-	t->worker = atomic_fetch_add_explicit(&th->next_worker, 1, memory_order_relaxed);
-	if (rc == 0)
-		rc = pthread_create(&t->tid, &attr, spawned_main, t);
-	pthread_attr_destroy(&attr);
+	t->th = th;
+	t->started = false;
+	if (!BVHLAB_HOST_HAS(th->host, join))
+		return -ENOTSUP;
+	int rc = th->host->spawn(th->ctx, &t->task, fn, arg);
 	t->started = rc == 0;
-	return -rc;
+	return rc;
 }
 
 void team_join(team_thread *t)
 {
 	if (t->started)
-		pthread_join(t->tid, NULL);
+		t->th->host->join(t->th->ctx, &t->task);
 	t->started = false;
 }
