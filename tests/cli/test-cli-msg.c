@@ -12,6 +12,8 @@
  *   escape    names and errors escaped in report.md, CSV cells guarded
  *   images    images that cannot be written (a full disk) named, counted,
  *             the runs kept
+ *   pocl      a POCL_CACHE_DIR PoCL cannot use named as the likely cause of
+ *             a failed kernel build or a missing device, on one line
  * Usage: test-cli-msg BVHLAB_EXE MODE
  */
 #include <sys/resource.h>
@@ -453,6 +455,93 @@ static void test_images(void)
 	cJSON_Delete(doc);
 }
 
+static int count_of(const char *text, const char *needle)
+{
+	int n = 0;
+	for (const char *p = strstr(text, needle); p; p = strstr(p + 1, needle))
+		n++;
+	return n;
+}
+
+/* The line of stderr holding `needle` (to its newline), "" if none. */
+static const char *line_of(const char *text, const char *needle, char *line, size_t size)
+{
+	const char *at = strstr(text, needle), *start = at, *end;
+	line[0] = '\0';
+	if (!at)
+		return line;
+	while (start > text && start[-1] != '\n')
+		start--;
+	end = strchr(at, '\n');
+	size_t n = end ? (size_t)(end - start) : strlen(start);
+	snprintf(line, size, "%.*s", (int)(n < size ? n : size - 1), start);
+	return line;
+}
+
+/* A sweep of cl_lbvh and of lbvh with cl_stack rays under POCL_CACHE_DIR =
+ * `cache`: both failures name it, on one line each (errors and progress
+ * lines alike). False when the device ran anyway (not PoCL: nothing to
+ * check). */
+static bool pocl_sweep(const char *out, const char *cache)
+{
+	char text[1024], name[64], line[4096], want[600];
+	snprintf(text, sizeof(text),
+	         "{ \"output\": \"%s\", \"repeat\": 1, \"warmup\": 0,\n"
+	         "  \"rays\": { \"width\": 8, \"height\": 8, \"traversal\": [\"stack\", \"cl_stack\"] },\n"
+	         "  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200 } ],\n"
+	         "  \"builders\": [ { \"plugin\": \"cl_lbvh\" }, { \"plugin\": \"lbvh\" } ] }\n", out);
+	snprintf(name, sizeof(name), "%s.json", out);
+	setenv("POCL_CACHE_DIR", cache, 1);
+	int status = run_in(tmpdir, ARGS("run", write_config(name, text)));
+	unsetenv("POCL_CACHE_DIR");
+	cJSON *doc = load_results(cli_path_in(out));
+	const cJSON *cl = find_run(doc, "s", "cl_lbvh", 1);
+	const char *rays = run_str(cJSON_GetObjectItem(find_run(doc, "s", "lbvh", 1), "rays"), "error");
+	bool failed = status == 1 && !strcmp(run_str(cl, "status"), "failed");
+	snprintf(want, sizeof(want), "POCL_CACHE_DIR=%s is not a folder PoCL can use", cache);
+	if (failed) {
+		CHECK_CONTAINS(run_str(cl, "error"), want);
+		CHECK_CONTAINS(rays, "cl_stack: cl: ");
+		CHECK_CONTAINS(rays, want);
+		CHECK(!strchr(run_str(cl, "error"), '\n') && !strchr(rays, '\n'));
+		/* The progress lines stay whole: the message and the time on one. */
+		line_of(err_text, "s / cl_lbvh / 1 thread: failed", line, sizeof(line));
+		CHECK_CONTAINS(line, want);
+		CHECK_CONTAINS(line, " elapsed, ");
+		line_of(err_text, "s / lbvh / 1 thread: ok", line, sizeof(line));
+		CHECK_CONTAINS(line, want);
+		CHECK_CONTAINS(line, " elapsed, ");
+	}
+	cJSON_Delete(doc);
+	return failed;
+}
+
+/* 9. An unusable POCL_CACHE_DIR: a regular file (PoCL's kernel build fails,
+ * its log ending in a newline) and a folder under one (PoCL offers no
+ * device), each named as the likely cause. */
+static void test_pocl(void)
+{
+	FILE *f = fopen(cli_path_in("not-a-folder"), "w");
+	CHECK(f != NULL);
+	if (f)
+		fclose(f);
+	run_in(tmpdir, ARGS("list")); /* exit 1: the fake plugins' broken ones */
+	if (!strstr(out_text, "cl_lbvh")) {
+		fprintf(stderr, "built without OpenCL: POCL_CACHE_DIR's messages not checked\n");
+		return;
+	}
+	bool a = pocl_sweep("out-file", cli_path_in("not-a-folder"));
+	bool b = pocl_sweep("out-under", cli_path_in("not-a-folder/cache"));
+	CHECK_INT(run_in(tmpdir, ARGS("info", "--machine")), 0);
+	/* Where every OpenCL device is PoCL's, both must have failed. */
+	int pocl = count_of(out_text, "(Portable Computing Language)");
+	if (pocl > 0 && pocl == count_of(out_text, " compute units, "))
+		CHECK(a && b);
+	else if (!a || !b)
+		fprintf(stderr, "the OpenCL device ran despite POCL_CACHE_DIR (not PoCL): some "
+		        "messages not checked\n");
+}
+
 int main(int argc, char **argv)
 {
 	static const struct cli_mode modes[] = {
@@ -461,6 +550,7 @@ int main(int argc, char **argv)
 		{"config", test_config},
 		{"escape", test_escape},
 		{"images", test_images},
+		{"pocl", test_pocl},
 	};
 	return cli_main_modes(argc, argv, "test-cli-msg", modes, sizeof(modes) / sizeof(modes[0]));
 }
