@@ -458,8 +458,7 @@ static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t s)
 	    images_temp_path(shade, sizeof(shade), h->cfg->output, "shade", s, 0) == 0)
 		images_lost(h, harness_image_lost(scene->name, NULL, shade, h->shade_error,
 		                                  h->progress.tty));
-	if (harness_scene_images(&h->res, h->cfg, &h->list, scene, s, h->progress.tty) < 0)
-		images_lost(h, 1);
+	images_lost(h, harness_scene_images(&h->res, h->cfg, &h->list, scene, s, h->progress.tty));
 }
 
 static void run_scene(struct harness *h, const struct config_scene *cs, size_t s)

@@ -37,21 +37,22 @@ int harness_image_lost(const char *scene, const char *builder, const char *path,
 	return 1;
 }
 
-int harness_scene_images(struct results *res, const struct config *cfg,
+size_t harness_scene_images(struct results *res, const struct config *cfg,
                          const struct run_list *list, const bvhlab_scene *scene, size_t s,
                          bool tty)
 {
 	size_t nb = cfg->builder_count;
 	const struct run_identity **heat_runs = calloc(nb ? nb : 1, sizeof(*heat_runs));
 	bvhlab_error err = {{0}};
+	size_t lost = 0;
 	if (!heat_runs)
-		return -ENOMEM;
+		return fprintf(stderr, "bvhlab: images of scene '%s': out of memory\n", scene->name), 1;
 	for (size_t b = 0; b < nb; b++)
 		heat_runs[b] = &plan_list_first(list, s, b)->key;
 	struct scene_images si = {.dir = cfg->output, .scene_index = s, .scene = scene->name,
 	                          .width = cfg->ray_width, .height = cfg->ray_height,
 	                          .heat_runs = heat_runs, .builder_count = nb};
-	int r = images_write_scene(res, &si, &err);
+	int r = images_write_scene(res, &si, &err, &lost);
 	/* The images that were written are recorded even when others were not. */
 	bvhlab_error write_err = {{0}};
 	int w = results_write(res, &write_err);
@@ -62,5 +63,5 @@ int harness_scene_images(struct results *res, const struct config *cfg,
 		fprintf(stderr, "%sbvhlab: cannot write results: %s\n", tty ? "\n" : "",
 		        write_err.message[0] ? write_err.message : strerror(-w));
 	free(heat_runs);
-	return r < 0 ? r : w;
+	return lost + (w < 0);
 }

@@ -27,9 +27,9 @@ int harness_image_lost(const char *scene, const char *builder, const char *path,
                        bool tty);
 
 /* Turns the raw files of scene number s into its PNGs, records them and
- * rewrites the results; what cannot be written is said on stderr. 0, or a
- * negative errno when some image (or the results) could not be written. */
-int harness_scene_images(struct results *res, const struct config *cfg,
+ * rewrites the results; what cannot be written is said on stderr. How many
+ * images were lost (the results not written count as one). */
+size_t harness_scene_images(struct results *res, const struct config *cfg,
                          const struct run_list *list, const bvhlab_scene *scene, size_t s,
                          bool tty);
 

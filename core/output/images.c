@@ -253,26 +253,29 @@ static int shaded_image(struct results *res, const struct scene_images *si, bvhl
 	return r;
 }
 
-int images_write_scene(struct results *res, const struct scene_images *si, bvhlab_error *err)
+int images_write_scene(struct results *res, const struct scene_images *si, bvhlab_error *err,
+                       size_t *lost)
 {
 	char dir[4096];
 	bvhlab_error e = {{0}};
-	size_t lost = 0;
+	*lost = 0;
 	if ((size_t)snprintf(dir, sizeof(dir), "%s/images", si->dir) >= sizeof(dir))
-		return error_set(err, "path too long: %s/images", si->dir), -ENAMETOOLONG;
+		return error_set(err, "path too long: %s/images", si->dir), ++*lost, -ENAMETOOLONG;
 	if (mkdir(dir, 0777) < 0 && errno != EEXIST) {
 		int k = errno;
 		error_set(err, "cannot create %s: %s", dir, strerror(k));
-		return -k;
+		return ++*lost, -k;
 	}
-	int r = keep_first(0, shaded_image(res, si, &e), &e, err, &lost);
+	int r = keep_first(0, shaded_image(res, si, &e), &e, err, lost);
 	bvhlab_error heat_err = {{0}};
-	int k = heat_images(res, si, &heat_err, &lost);
+	int k = heat_images(res, si, &heat_err, lost);
 	if (r == 0 && k < 0)
 		*err = heat_err;
 	size_t used = strlen(err->message);
-	if (lost > 1)
+	if (*lost > 1)
 		snprintf(err->message + used, sizeof(err->message) - used,
-		         " (and %zu more images lost)", lost - 1);
+		         " (and %zu more images lost)", *lost - 1);
+	if ((r < 0 || k < 0) && *lost == 0)
+		*lost = 1; /* out of memory before any image */
 	return r < 0 ? r : k;
 }
