@@ -30,6 +30,7 @@ aside. Some resumes run as two concurrent writers. After every sweep:
   - the exit status matches the runs: 0 all ok, 1 otherwise.
 
 Usage: soak.py N BUILD_DIR [SEED]   (scripts/soak.sh N wraps it)
+$SOAK_LIMIT_S (default 300): seconds after which a sweep counts as hung.
 """
 import json
 import os
