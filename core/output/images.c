@@ -179,7 +179,8 @@ static int load_heat(const struct scene_images *si, uint32_t **heat, uint32_t *l
 		if (images_temp_path(path, sizeof(path), si->dir, "heat", si->scene_index, b) < 0)
 			continue;
 		uint32_t *counts = malloc(n * sizeof(*counts));
-		int k = counts ? load_raw(path, counts, n * sizeof(*counts), &e) : -ENOMEM;
+		int k = counts ? load_raw(path, counts, n * sizeof(*counts), &e)
+		               : (unlink(path), -ENOMEM);
 		if (k == 0) {
 			for (size_t i = 0; i < n; i++) {
 				*lo = counts[i] < *lo ? counts[i] : *lo;
