@@ -181,10 +181,13 @@ static void print_outcome(const char *dir, int r, const struct harness_tally *t)
 	if (t->unsaved)
 		fprintf(stderr, "; %zu finished run%s could not be saved (see above)", t->unsaved,
 		        t->unsaved == 1 ? "" : "s");
+	if (t->images_lost)
+		fprintf(stderr, "; %zu image%s could not be written (see above)", t->images_lost,
+		        t->images_lost == 1 ? "" : "s");
 	if (t->untraced)
 		fprintf(stderr, "; %zu run%s traced no rays (see their rays.error)", t->untraced,
 		        t->untraced == 1 ? "" : "s");
-	if (t->not_ok || (r && !t->unsaved && !t->untraced))
+	if (t->not_ok || (r && !t->unsaved && !t->untraced && !t->images_lost))
 		fprintf(stderr, "; some runs failed or were invalid");
 	fprintf(stderr, "\n");
 }

@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Soak test of `bvhlab run`: N random configs, each sweep killed at a
 random moment and resumed (sometimes killed again while resuming), its
-config often changed in between (a scene, the rays, repeat, an animation,
-rays_per_frame).
+config often changed in between: a scene (generator parameters, seed,
+subdivide, frames, or the bytes of its file), a builder (options,
+animation) or the measurement (repeat, warmup, validate_rays, the rays'
+size, diffuse and traversal, rays_per_frame).
 
 Each config mixes generated scenes, adversarial scene files (empty, NaN,
 garbage, all-degenerate triangles), real builders
@@ -19,12 +21,16 @@ aside. Some resumes run as two concurrent writers. After every sweep:
     recorded config fragment is the scene, builder and measurement settings
     of that config, and runs of one scene, builder or measurement share one
     hash (no stale run is kept);
+  - after a change, every run made before it that the change concerns is
+    made again and every other one kept (the last lines count both, and
+    that none was kept stale or made again needlessly);
   - --force's move keeps the old results.json whole, in place or as .1;
   - of two concurrent writers one is refused, naming the other;
   - no temporary folder, tree, heat or shade file is left behind;
   - the exit status matches the runs: 0 all ok, 1 otherwise.
 
 Usage: soak.py N BUILD_DIR [SEED]   (scripts/soak.sh N wraps it)
+$SOAK_LIMIT_S (default 300): seconds after which a sweep counts as hung.
 """
 import json
 import os
@@ -38,7 +44,9 @@ import tempfile
 FAKE_FAILS = ["segfault", "abort", "loop", "exit", "invalid", "error", "silent", "alloc"]
 REAL = [("sah_seq", {"method": "sweep"}), ("sah_seq", {"method": "binned"}),
         ("sah_even", {}), ("sah_tasks", {}), ("lbvh", {})]
-LIMIT_S = 300  # a sweep that needs longer than this has hung
+# A sweep that needs longer than this has hung; $SOAK_LIMIT_S for a
+# machine so loaded that a sweep may take longer.
+LIMIT_S = float(os.environ.get("SOAK_LIMIT_S", "300"))
 
 
 def adversarial_file(rng, folder, k):
@@ -125,30 +133,92 @@ def random_config(rng, folder, out, loadcrash, memory_limits):
 SERIAL = {"sah_seq", "fake_good"}
 
 
-def mutate(rng, cfg):
-    """Changes the config the way a user between two attempts might: a
-    scene, the rays, repeat, an animation or rays_per_frame. What changed."""
-    kind = rng.choice(["scene", "rays", "repeat", "animation", "rays_per_frame"])
-    generated = [s for s in cfg["scenes"] if "generator" in s]
-    animated = [b for b in cfg["builders"] if "animation" in b]
-    if kind == "scene" and generated:
-        s = rng.choice(generated)
+def mutate_scene(rng, cfg):
+    """One scene's description or file changed: its generator's parameter,
+    seed, subdivide, frames, or (an adversarial file) the file's bytes at
+    the same path. The scene's name."""
+    s = rng.choice(cfg["scenes"])
+    if "path" in s:
+        with open(s["path"], "ab") as f:
+            f.write(b"\n# changed\n")
+        return s["name"]
+    what = rng.choice(["size", "seed", "subdivide", "frames"])
+    if what == "seed" and "seed" in s:
+        s["seed"] += 1
+    elif what == "subdivide":
+        s["subdivide"] = 1 - s.get("subdivide", 0)
+    elif what == "frames" and "frames" in s:
+        s["frames"] = 5 - s["frames"]  # 2 <-> 3
+    else:
         key = {"icosphere": "frequency", "terrain": "size"}.get(s["generator"], "count")
         s[key] = s.get(key, 4) + rng.randrange(1, 4)
-    elif kind == "animation" and animated:
-        a = rng.choice(animated)["animation"]
+    return s["name"]
+
+
+def mutate_builder(rng, cfg):
+    """One builder's options or animation changed. Its name, or None when
+    this builder has neither to change."""
+    b = rng.choice(cfg["builders"])
+    if "animation" in b:
+        a = b["animation"]
         if "rebuild_every" in a:
             del a["rebuild_every"]
         else:
             a["rebuild_every"] = 2
-    elif kind == "repeat":
-        cfg["repeat"] = 3 - cfg["repeat"]
-    elif kind == "rays_per_frame":
-        cfg["rays_per_frame"] = rng.randrange(1, 1000)
+    elif b["plugin"] == "sah_seq":
+        b["options"]["method"] = "binned" if b["options"].get("method") != "binned" else "sweep"
+    elif b["plugin"] in ("lbvh", "sah_even", "sah_tasks"):
+        b["options"]["max_leaf"] = 4 if b["options"].get("max_leaf") != 4 else 2
+    elif b["plugin"] == "fake_good" and b["options"]["fail"] in ("no", "invalid", "error"):
+        b["options"]["fail"] = rng.choice([f for f in ("no", "invalid", "error")
+                                           if f != b["options"]["fail"]])
     else:
-        kind = "rays"
-        cfg["rays"]["width"] = 24 - cfg["rays"]["width"]  # 16 <-> 8
-    return kind
+        return None
+    return b["name"]
+
+
+def mutate_measure(rng, cfg):
+    """A measurement setting changed. Whether it concerns only animated
+    scenes' runs (rays_per_frame), else every run."""
+    what = rng.choice(["repeat", "warmup", "validate_rays", "width", "height", "diffuse",
+                       "traversal", "rays_per_frame"])
+    rays = cfg["rays"]
+    if what == "repeat":
+        cfg["repeat"] = 3 - cfg["repeat"]
+    elif what == "warmup":
+        cfg["warmup"] = 1 - cfg["warmup"]
+    elif what == "validate_rays":
+        cfg["validate_rays"] = 96 - cfg["validate_rays"]  # 64 <-> 32
+    elif what == "rays_per_frame":
+        cfg["rays_per_frame"] = cfg.get("rays_per_frame", 0) + rng.randrange(1, 1000)
+        return True
+    elif what == "traversal":
+        rays["traversal"] = "stack" if rays.get("traversal") != "stack" else "stackless"
+    elif what == "diffuse":
+        rays["diffuse"] = 1 - rays["diffuse"]
+    else:
+        rays[what] = 24 - rays[what] if what == "width" else 20 - rays[what]  # 16<->8, 12<->8
+    return False
+
+
+def mutate(rng, cfg):
+    """Changes the config the way a user between two attempts might: a
+    scene (its description or its file), a builder (options, animation) or
+    the measurement (repeat, warmup, validation, rays, rays_per_frame).
+    (kind, the test a run's key passes when the change concerns it)."""
+    kind = rng.choice(["scene", "builder", "measure"])
+    if kind == "builder":
+        name = mutate_builder(rng, cfg)
+        if name is not None:
+            return kind, lambda key: key[1] == name
+        kind = "scene"
+    if kind == "scene":
+        name = mutate_scene(rng, cfg)
+        return kind, lambda key: key[0] == name
+    animated = {s["name"] for s in cfg["scenes"] if "frames" in s}
+    if mutate_measure(rng, cfg):
+        return "rays_per_frame", lambda key: key[0] in animated
+    return kind, lambda key: True
 
 
 def check_identity(cfg, runs, where):
@@ -163,13 +233,18 @@ def check_identity(cfg, runs, where):
             raise AssertionError(f"{where}: run {key} has no identity")
         scene, b = scenes[key[0]], builders[key[1]]
         m = c.get("measure", {})
-        want = (cfg["repeat"], cfg["warmup"], cfg["rays"]["width"],
+        rays = m.get("rays", {})
+        want = (cfg["repeat"], cfg["warmup"], cfg["validate_rays"],
+                {k: v for k, v in cfg["rays"].items()},
                 cfg.get("rays_per_frame", 1000000) if "frames" in scene else None)
-        got = (m.get("repeat"), m.get("warmup"), m.get("rays", {}).get("width"),
-               m.get("rays_per_frame"))
+        got = (m.get("repeat"), m.get("warmup"), m.get("validate_rays"),
+               {k: rays.get(k) for k in cfg["rays"]}, m.get("rays_per_frame"))
         if c.get("scene") != scene or got != want:
             raise AssertionError(f"{where}: run {key} kept from another config: "
                                  f"{c.get('scene')} {got}, config now {scene} {want}")
+        opts = c.get("builder", {}).get("options", {})
+        if any(opts.get(k) != v for k, v in b.get("options", {}).items()):
+            raise AssertionError(f"{where}: run {key} kept from other options: {opts}")
         anim = c.get("builder", {}).get("animation")
         if anim and anim.get("rebuild_every") != b["animation"].get("rebuild_every", 0):
             raise AssertionError(f"{where}: run {key} kept from another animation: {anim}")
@@ -179,16 +254,46 @@ def check_identity(cfg, runs, where):
                 raise AssertionError(f"{where}: runs of {part} {name} with two hashes")
 
 
-def expected_runs(cfg):
-    runs = set()
+def count_after_change(before, after, concerned, where, cfg):
+    """A resume after a change: every run made before that the change
+    concerns must be made again (kept, it is stale), every other one kept
+    (provisional ray figures apart, which a resume measures again)."""
+    for key, run in before.items():
+        kept = same_run(after.get(key), run)
+        if not kept and gone(key, cfg, after):
+            continue
+        if concerned(key):
+            COUNTS["stale kept" if kept else "rerun"] += 1
+            if kept:
+                raise AssertionError(f"{where}: run {key} kept though the change concerns it")
+        elif kept:
+            COUNTS["kept"] += 1
+        elif not provisional(run):
+            COUNTS["rerun needlessly"] += 1
+            raise AssertionError(f"{where}: run {key} made again though the change does "
+                                 "not concern it")
+
+
+def unprobed(name, runs):
+    """Whether the sweep could not open builder `name`'s plugin (its probe
+    timed out: a loaded machine): its runs have no builder fragment and its
+    flags were unknown, so every thread count was listed."""
+    return any(k[1] == name and not r.get("config", {}).get("builder") for k, r in runs.items())
+
+
+def expected_runs(cfg, runs=None):
+    """The runs of cfg; of `runs` (results.json's) where a plugin could not
+    be opened."""
+    runs = runs or {}
+    want = set()
     for s in cfg["scenes"]:
         for b in cfg["builders"]:
             threads = b.get("threads", cfg["threads"])
-            if b["plugin"] in SERIAL:
+            if b["plugin"] in SERIAL and not unprobed(b["name"], runs):
                 threads = [1] if 1 in threads else threads[:1]
             for t in threads:
-                runs.add((s["name"], b["name"], t))
-    return runs
+                want.add((s["name"], b["name"], t))
+    return want
 
 
 def load_runs(out):
@@ -222,7 +327,7 @@ def shim_env(shim, nth, to):
 def killed_sweep(rng, bvhlab, config, out, resume, shim):
     """Starts a sweep, kills it at a random moment or at its Nth write of
     results.json (creating the folder, a run, the rounds); the runs it left."""
-    env = shim_env(shim, rng.randrange(1, 8), "/results.json") if rng.random() < 0.4 else None
+    env = shim_env(shim, rng.randrange(1, 9), "/results.json") if rng.random() < 0.6 else None
     p = launch(bvhlab, config, resume, env=env)
     try:
         p.wait(timeout=rng.uniform(0.0, 2.0) if env is None else LIMIT_S)
@@ -282,9 +387,20 @@ def provisional(run):
     return bool(run.get("rays", {}).get("provisional"))
 
 
-def check_kept(before, after, where):
+def gone(key, cfg, after):
+    """A run of a slot the config no longer has: a plugin that could not be
+    probed in time under load was listed at every thread count, and --resume
+    drops those runs once it is known to be serial. Counted, never a loss."""
+    if key in expected_runs(cfg, after):
+        return False
+    COUNTS["dropped"] += 1
+    return True
+
+
+def check_kept(before, after, where, cfg):
     for key, run in before.items():
-        if not provisional(run) and not same_run(after.get(key), run):
+        if (not provisional(run) and not same_run(after.get(key), run) and
+                not gone(key, cfg, after)):
             raise AssertionError(f"{where}: finished run {key} lost or changed")
 
 
@@ -309,13 +425,13 @@ def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
     before = killed_sweep(rng, bvhlab, config, out, False, shim)
     if rng.random() < 0.4:
         again = killed_sweep(rng, bvhlab, config, out, True, shim)
-        check_kept(before, again, f"config {i} (second kill)")
+        check_kept(before, again, f"config {i} (second kill)", cfg)
         before = again
     if rng.random() < 0.2 and os.path.exists(os.path.join(out, "results.json")):
         before = killed_force(rng, bvhlab, config, out, before, shim)
     changed = None
     if rng.random() < 0.5:
-        changed = mutate(rng, cfg)
+        changed, concerned = mutate(rng, cfg)
         with open(config, "w") as f:
             json.dump(cfg, f, indent=1)
     if rng.random() < 0.2:
@@ -328,13 +444,13 @@ def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
         raise AssertionError(f"config {i}: resumed sweep still running after {LIMIT_S} s")
     after = load_runs(out) or {}
     if changed is None:
-        check_kept(before, after, f"config {i}")
+        check_kept(before, after, f"config {i}", cfg)
+        COUNTS["kept"] += sum(1 for k in before if k in after)
     else:
         MUTATED[changed] = MUTATED.get(changed, 0) + 1
-        RERUN[0] += sum(1 for k, r in before.items() if not same_run(after.get(k), r))
-        RERUN[1] += len(before)
+        count_after_change(before, after, concerned, f"config {i}", cfg)
     check_identity(cfg, after, f"config {i}")
-    want = expected_runs(cfg)
+    want = expected_runs(cfg, after)
     if set(after) != want:
         raise AssertionError(f"config {i}: runs {sorted(set(after) ^ want)} missing or extra")
     check_no_leftovers(work, out, f"config {i}")
@@ -346,7 +462,9 @@ def one_config(rng, i, bvhlab, folder, loadcrash, memory_limits):
 
 
 MUTATED = {}  # kind of change: configs resumed after it
-RERUN = [0, 0]  # runs made again after a change, runs there were before it
+# Runs made before a resume: kept, made again after a change that concerns
+# them, kept though it does (must stay 0), made again though it does not.
+COUNTS = {"kept": 0, "rerun": 0, "stale kept": 0, "rerun needlessly": 0, "dropped": 0}
 
 
 def main():
@@ -371,10 +489,14 @@ def main():
         except (AssertionError, ValueError, KeyError) as e:
             print(f"soak: FAILED at config {i} (seed {seed}): {e}; files kept in {folder}")
             sys.exit(1)
-        if (i + 1) % 10 == 0 or i + 1 == n:
-            print(f"soak: {i + 1}/{n} configs ok", flush=True)
-    print(f"soak: configs changed before resuming: {MUTATED or 'none'}; "
-          f"{RERUN[0]} of the {RERUN[1]} runs made before a change made again")
+        # Every config: a soak stopped early still says how far it got.
+        print(f"soak: {i + 1}/{n} configs ok; runs made before a resume: "
+              + ", ".join(f"{v} {k}" for k, v in COUNTS.items()), flush=True)
+    print(f"soak: configs changed before resuming: {MUTATED or 'none'}")
+    print(f"soak: runs made before a resume: {COUNTS['kept']} kept, {COUNTS['rerun']} made "
+          f"again after a change that concerns them, {COUNTS['stale kept']} stale kept, "
+          f"{COUNTS['rerun needlessly']} made again needlessly, {COUNTS['dropped']} dropped "
+          "(a slot no longer listed); none lost or duplicated")
     shutil.rmtree(folder)
 
 

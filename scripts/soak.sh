@@ -2,15 +2,17 @@
 # Soak test of `bvhlab run`: N random configs (generated and adversarial
 # scenes, real builders, plugins that crash, hang, leak or return broken
 # trees), each sweep killed at a random moment and resumed, half of them
-# after the config changed; checks that results.json always parses, no
-# finished run is lost or duplicated, every kept run was made under the
-# config it is resumed under, and the exit status matches the runs. Builds
+# after the config changed (a scene or its file, a builder's options or
+# animation, the measurement or rays); checks that results.json always
+# parses, no finished run is lost or duplicated, every kept run was made
+# under the config it is resumed under, every run the change concerns is
+# made again (and no other), and the exit status matches the runs. Builds
 # the release tree first if needed.
 # Usage: scripts/soak.sh N [BUILD_DIR] [SEED]
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 case "${1:-}" in
-''|-h|--help) sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
+''|-h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
 esac
 n=$1
 build=${2:-$here/../build}

@@ -15,6 +15,7 @@
 #include "harness/harness.h"
 #include "harness/harness_builders.h"
 #include "harness/harness_frames.h"
+#include "harness/harness_images.h"
 #include "harness/harness_measure.h"
 #include "harness/harness_memory.h"
 #include "harness/harness_rays.h"
@@ -27,7 +28,6 @@
 #include "harness/progress.h"
 #include "machine/machine.h"
 #include "output/results.h"
-#include "output/image.h"
 #include "output/images.h"
 #include "output/safe_file.h"
 #include "plan/plan.h"
@@ -44,6 +44,7 @@ struct harness {
 	struct harness_tally tally;
 	bool images;     /* images asked for, and the images module is there */
 	bool shade_done; /* this scene's shaded render is on its way */
+	int shade_error; /* the last failure to leave it (-errno), said if no run does */
 	bool rounds_on;  /* this scene's rays are timed in interleaved rounds */
 	struct harness_rounds rounds; /* this scene's trees waiting for them */
 	struct harness_anim anim; /* this scene's animation, frames 0 if none (harness_anim.c) */
@@ -65,7 +66,8 @@ struct series_report {
 	bool has_device;       /* a device builder's run: its device opened */
 	struct run_device device;
 	struct ray_metrics rays;
-	bool heat_written, shade_written;
+	int heat_error, shade_error; /* writing the raw image files: 0 or -errno */
+	bool shade_written;
 	bool tree_written; /* the tree is in the job's tree_path */
 	uint32_t stage_count;
 	struct stage_metrics stages[HARNESS_MAX_STAGES];
@@ -224,9 +226,10 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 	/* One slice, until the scene's rounds replace it. */
 	rep->rays.provisional = r == 0 && rep->tree_written;
 	if (r == 0 && nodes)
-		rep->heat_written = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes)) == 0;
+		rep->heat_error = images_write_raw(job->heat_path, nodes, n * sizeof(*nodes));
 	if (r == 0 && shade)
-		rep->shade_written = images_write_raw(job->shade_path, shade, 3 * n) == 0;
+		rep->shade_error = images_write_raw(job->shade_path, shade, 3 * n);
+	rep->shade_written = r == 0 && shade && rep->shade_error == 0;
 	/* The run stays ok (its tree is); its "rays" says why there are no figures. */
 	if (r < 0 && !rep->rays.error[0])
 		harness_rays_error(r, harness_run_limits(job->h->cfg, job->hb->cb).memory_bytes,
@@ -356,6 +359,14 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	record(h, run);
 }
 
+/* An image asked for and not written counts as a run not saved would:
+ * named above, in the last line and the exit status. */
+static void images_lost(struct harness *h, size_t lost)
+{
+	h->tally.images_lost += lost;
+	h->all_ok = h->all_ok && lost == 0;
+}
+
 /* Images are drawn in the children: the heat map by each builder's first
  * thread count, the shaded render by the first run to get that far. */
 static void image_paths(struct harness *h, struct series_job *job, size_t scene_index,
@@ -414,6 +425,10 @@ static void run_one(struct harness *h, struct series_job *job)
 		job->tree_path = tree_path;
 	progress_start(&h->progress, &run);
 	run_series(h, job, &run, rep, size);
+	images_lost(h, harness_image_lost(job->scene->name, job->hb->cb->name, job->heat_path,
+	                                  rep->heat_error, h->progress.tty));
+	if (job->shade_path && rep->shade_error < 0)
+		h->shade_error = rep->shade_error; /* a later run may still leave it */
 	queue_tree(h, job, &run, rep);
 	h->shade_done = h->shade_done || (job->shade_path && rep->shade_written);
 	munmap(rep, size);
@@ -435,26 +450,15 @@ static void run_list_scene(struct harness *h, const bvhlab_scene *scene,
 	}
 }
 
-/* Turns the children's raw files into the scene's PNGs. */
+/* The scene's PNGs; a shaded render no run could leave is said once. */
 static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t s)
 {
-	size_t nb = h->cfg->builder_count;
-	const struct run_identity **heat_runs = calloc(nb ? nb : 1, sizeof(*heat_runs));
-	bvhlab_error err = {{0}};
-	int r = heat_runs ? 0 : -ENOMEM;
-	for (size_t b = 0; r == 0 && b < nb; b++)
-		heat_runs[b] = &plan_list_first(&h->list, s, b)->key;
-	struct scene_images si = {.dir = h->cfg->output, .scene_index = s, .scene = scene->name,
-	                          .width = h->cfg->ray_width, .height = h->cfg->ray_height,
-	                          .heat_runs = heat_runs, .builder_count = nb};
-	if (r == 0)
-		r = images_write_scene(&h->res, &si, &err);
-	if (r == 0)
-		r = results_write(&h->res, &err);
-	if (r < 0)
-		fprintf(stderr, "%sbvhlab: images of scene '%s': %s\n", h->progress.tty ? "\n" : "",
-		        scene->name, err.message[0] ? err.message : strerror(-r));
-	free(heat_runs);
+	char shade[4096];
+	if (!h->shade_done &&
+	    images_temp_path(shade, sizeof(shade), h->cfg->output, "shade", s, 0) == 0)
+		images_lost(h, harness_image_lost(scene->name, NULL, shade, h->shade_error,
+		                                  h->progress.tty));
+	images_lost(h, harness_scene_images(&h->res, h->cfg, &h->list, scene, s, h->progress.tty));
 }
 
 static void run_scene(struct harness *h, const struct config_scene *cs, size_t s)
@@ -481,6 +485,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	                  scene->triangle_count, NULL);
 	free(shown);
 	h->shade_done = false;
+	h->shade_error = 0;
 	h->rounds_on = harness_rounds_start(h->cfg, scene, h->progress.tty);
 	run_list_scene(h, scene, &prims, s);
 	harness_rounds_end(&h->rounds, &h->res, h->cfg, scene, &prims, h->progress.tty);
@@ -520,19 +525,6 @@ static int make_list(struct harness *h, const struct harness_options *opts, bvhl
 	return r;
 }
 
-/* Images when asked for and drawable; a bundle without the images module
- * says so in one line and runs on. */
-static bool want_images(const struct config *cfg)
-{
-	const char *why;
-	if (!cfg->images || cfg->ray_width == 0 || cfg->ray_height == 0)
-		return false;
-	if (image_module_ready(&why))
-		return true;
-	fprintf(stderr, "bvhlab: images skipped (%s); the run goes on\n", why);
-	return false;
-}
-
 /* The folder locked and claimed, the document started (resumed). */
 static int start(struct harness *h, const struct harness_options *opts, bvhlab_error *err)
 {
@@ -566,7 +558,7 @@ int harness_run(const struct config *cfg, const struct harness_options *opts,
 	struct harness h = {.cfg = cfg, .all_ok = true};
 	progress_init(&h.progress, opts->quiet);
 	bvhlab_set_pinning(cfg->pin);
-	h.images = want_images(cfg);
+	h.images = harness_want_images(cfg);
 	/* Every builder's plugin and options and every scene file first, before
 	 * the folder is touched; the files' errors printed even after the
 	 * builders' (err keeps the first). */

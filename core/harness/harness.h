@@ -20,6 +20,7 @@ struct harness_tally {
 	size_t not_ok;   /* runs of this process that did not end ok */
 	size_t untraced; /* ok runs without ray figures (their "rays": "error" says why) */
 	size_t unsaved;  /* runs that finished but could not be written */
+	size_t images_lost; /* images asked for that could not be written (named above) */
 };
 
 struct harness_options {

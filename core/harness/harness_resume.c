@@ -68,7 +68,7 @@ int harness_resume(struct results *res, const struct run_list *list, bool quiet,
                    bvhlab_error *err)
 {
 	const struct config *cfg = list->cfg;
-	size_t kept = 0, not_ok = 0, changed = 0;
+	size_t kept = 0, not_ok = 0, changed = 0, gone = 0;
 	struct reasons why = {0};
 	struct run_identity *keys = calloc(list->count + 1, sizeof(*keys));
 	if (!keys)
@@ -76,6 +76,8 @@ int harness_resume(struct results *res, const struct run_list *list, bool quiet,
 	for (size_t k = 0; k < list->count; k++)
 		keys[k] = list->runs[k].key;
 	int r = results_resume(res, keys, list->count, &kept, &not_ok, err);
+	if (r == 0)
+		gone = results_drop_gone(res, keys, list->count);
 	if (r == 0)
 		changed = results_forget_changed(res, keys, list->count, note_change, &why);
 	free(keys);
@@ -90,7 +92,11 @@ int harness_resume(struct results *res, const struct run_list *list, bool quiet,
 	*all_ok = not_ok == 0;
 	if (!quiet)
 		fprintf(stderr, "bvhlab: resuming %s/: %zu finished run%s kept\n", cfg->output,
-		        kept - changed, plural(kept - changed));
+		        kept - gone - changed, plural(kept - gone - changed));
+	if (!quiet && gone)
+		fprintf(stderr, "bvhlab: %zu run%s dropped: made at a thread count its builder no "
+		        "longer runs at (its threads changed, or its plugin was not known then)\n",
+		        gone, plural(gone));
 	if (!quiet && changed)
 		say_changes(&why, changed);
 	return 0;

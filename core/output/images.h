@@ -35,7 +35,10 @@ struct scene_images {
 };
 
 /* Writes the scene's PNGs (shaded, heat maps on one scale, legend),
- * removes the temporary files and records the names in the results. */
-int images_write_scene(struct results *res, const struct scene_images *si, bvhlab_error *err);
+ * removes the temporary files and records the names in the results. An
+ * image that cannot be written does not stop the others: the first
+ * failure is returned (err names its file), *lost counts them all. */
+int images_write_scene(struct results *res, const struct scene_images *si, bvhlab_error *err,
+                       size_t *lost);
 
 #endif /* BVHLAB_CORE_IMAGES_H */

@@ -274,6 +274,11 @@ size_t results_forget_runs(struct results *res, const char *builder, const char 
 size_t results_mark_stale(struct results *res, struct cJSON *run);
 /* Whether run is marked to be made again. */
 bool results_is_stale(const struct results *res, const struct cJSON *run);
+/* Removes the kept runs in no slot of keys[] (of a scene and builder the
+ * sweep has, at a thread count it no longer makes: results_check_runs
+ * accepts only those); how many. They are gone from the file at the next
+ * write. */
+size_t results_drop_gone(struct results *res, const struct run_identity *keys, size_t count);
 /*
  * Marks every kept run whose identity differs from the run of keys[] in
  * its slot to be made again (run_identity_compare: RUN_CHANGED), calling

@@ -44,6 +44,18 @@ static const char *string_of(const cJSON *run, const char *key)
 	return cJSON_IsString(v) ? v->valuestring : NULL;
 }
 
+/* A run of a scene and builder the sweep has, at a thread count it no
+ * longer makes: the config's threads changed, or the builder's plugin
+ * could not be probed then (every thread count) and is serial now. */
+static bool slot_gone(const struct run_identity *keys, size_t count, const cJSON *run)
+{
+	const char *scene = string_of(run, "scene"), *builder = string_of(run, "builder");
+	for (size_t k = 0; scene && builder && k < count; k++)
+		if (!strcmp(keys[k].scene, scene) && !strcmp(keys[k].builder, builder))
+			return true;
+	return false;
+}
+
 static bool is_count(const cJSON *v, double max)
 {
 	return cJSON_IsNumber(v) && isfinite(v->valuedouble) && v->valuedouble >= 1 &&
@@ -128,16 +140,17 @@ static const char *check_run(struct claims *c, const cJSON *run, char *why, size
 	if (!known_status(string_of(run, "status")))
 		return "\"status\" is none of ok, invalid, failed, crashed, timeout";
 	long k = find_key(c->keys, c->count, run);
-	if (k < 0)
-		return "is not a run of this config (scene, builder or thread count unknown)";
+	if (k < 0 && !slot_gone(c->keys, c->count, run))
+		return "is not a run of this config (scene or builder unknown)";
 	const char *field = optional_fields(run);
 	if (*field) {
 		snprintf(why, size, "\"%s\" has the wrong type or a value out of range", field);
 		return why;
 	}
-	if (c->seen[k])
+	if (k >= 0 && c->seen[k])
 		return "repeats an earlier run of the same scene, builder and thread count";
-	c->seen[k] = 1;
+	if (k >= 0)
+		c->seen[k] = 1;
 	return NULL;
 }
 
@@ -198,6 +211,21 @@ size_t results_forget_changed(struct results *res, const struct run_identity *ke
 		n++;
 		if (changed)
 			changed(ctx, &keys[k], what);
+	}
+	return n;
+}
+
+size_t results_drop_gone(struct results *res, const struct run_identity *keys, size_t count)
+{
+	size_t n = 0;
+	cJSON *run = res->runs ? res->runs->child : NULL;
+	while (run) {
+		cJSON *next = run->next;
+		if (find_key(keys, count, run) < 0) {
+			cJSON_Delete(cJSON_DetachItemViaPointer(res->runs, run));
+			n++;
+		}
+		run = next;
 	}
 	return n;
 }

@@ -4,7 +4,8 @@
  *   rerun      --resume makes again every run whose scene (count,
  *              subdivide), builder (its animation) or measurement (rays,
  *              repeat, rays_per_frame) changed, saying why; each run keeps
- *              the config fragment it was made with
+ *              the config fragment it was made with; runs at a thread count
+ *              no longer made are dropped
  *   planpaths  a plan in a deep folder of a composite and a frame-file
  *              scene runs every part; a frame changed after planning is
  *              refused; plan --missing gives failed runs again
@@ -105,6 +106,19 @@ static void test_rerun(void)
 	CHECK_CONTAINS(err_text, "1 run rerun: measurement settings changed");
 	CHECK_CONTAINS(member_text("A", "config", "measure"), "\"rays_per_frame\":1");
 	CHECK(strlen(member_text("A", "identity", "hash")) == 18); /* 16 digits, quoted */
+
+	/* A thread count dropped from the config: its runs dropped, the others
+	 * kept (a plugin unknown then, now serial, drops its runs alike). */
+	static const char two[] = "\"threads\": [1, 2], \"repeat\": 1, \"rays\": { \"width\": 4, "
+	                          "\"height\": 4, \"min_ms\": 1, \"rounds\": 1 },";
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", "--force", rerun_config(soup, "", two))), 0);
+	CHECK_INT(resume(rerun_config(soup, "", two + strlen("\"threads\": [1, 2],"))), 0);
+	CHECK_CONTAINS(err_text, "1 finished run kept\n");
+	CHECK_CONTAINS(err_text, "1 run dropped: made at a thread count its builder no longer runs");
+	cJSON *doc = load_results(cli_path_in("out-r"));
+	CHECK_INT(cJSON_GetArraySize(cJSON_GetObjectItem(doc, "runs")), 1);
+	CHECK(find_run(doc, "s", "A", 1) != NULL);
+	cJSON_Delete(doc);
 }
 
 /* A composite of two mesh parts and a frame-file scene, planned into a deep

@@ -10,8 +10,13 @@
  *             plan part refused
  *   config    bad options, names and coordinates refused before any output
  *   escape    names and errors escaped in report.md, CSV cells guarded
+ *   images    images that cannot be written (a full disk) named, counted,
+ *             the runs kept
+ *   pocl      a POCL_CACHE_DIR PoCL cannot use named as the likely cause of
+ *             a failed kernel build or a missing device, on one line
  * Usage: test-cli-msg BVHLAB_EXE MODE
  */
+#include <sys/resource.h>
 #include <sys/stat.h>
 
 #include "cliutil.h"
@@ -205,8 +210,10 @@ static void config_errors(void)
 		"  \"builders\": [ { \"plugin\": \"bvh2\", \"options\": { \"min_leaf\": 9 } },\n"
 		"                  { \"plugin\": \"embree\", \"name\": \"e\",\n"
 		"                    \"options\": { \"min_leaf\": 6, \"max_leaf\": 4 } } ] }\n",
-		"out-leaf", "builder 'bvh2': option 'min_leaf' of plugin 'bvh2' is 9, more than "
-		"'max_leaf' (8)");
+		"out-leaf", "");
+	if (!strstr(err_text, "plugin 'bvh2' not found")) /* built with bvh2 (optional) */
+		CHECK_CONTAINS(err_text, "builder 'bvh2': option 'min_leaf' of plugin 'bvh2' is 9, "
+		               "more than 'max_leaf' (8)");
 	if (strstr(err_text, "'embree'")) /* built with Embree */
 		CHECK_CONTAINS(err_text, "builder 'e': option 'min_leaf' of plugin 'embree' is 6");
 	refused("dev.json",
@@ -350,6 +357,183 @@ static void test_escape(void)
 	}
 }
 
+/* Runs config `text` as `name` with files limited to `kib` KiB
+ * (RLIMIT_FSIZE, SIGXFSZ ignored: writes past it fail with EFBIG, as on a
+ * full disk); its exit status and results, like sweep(). */
+static int sweep_limited(const char *format, const char *out, rlim_t kib, cJSON **doc)
+{
+	char text[1024], name[64];
+	snprintf(text, sizeof(text), format, out);
+	snprintf(name, sizeof(name), "%s.json", out);
+	const char *cfg = write_config(name, text);
+	struct rlimit old, rl;
+	CHECK_INT(getrlimit(RLIMIT_FSIZE, &old), 0);
+	rl = (struct rlimit){.rlim_cur = kib << 10, .rlim_max = old.rlim_max};
+	void (*was)(int) = signal(SIGXFSZ, SIG_IGN);
+	CHECK_INT(setrlimit(RLIMIT_FSIZE, &rl), 0);
+	int status = run_in(tmpdir, ARGS("run", cfg));
+	CHECK_INT(setrlimit(RLIMIT_FSIZE, &old), 0);
+	signal(SIGXFSZ, was);
+	*doc = load_results(cli_path_in(out));
+	return status;
+}
+
+/* Both runs kept, ok and measured, and no raw image file left behind. */
+static void check_runs_kept(const cJSON *doc, const char *out)
+{
+	for (const char *const *b = (const char *const[]){"a", "b", NULL}; *b; b++) {
+		const cJSON *run = find_run(doc, "s", *b, 1);
+		CHECK_CONTAINS(run_str(run, "status"), "ok");
+		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(cJSON_GetObjectItem(run, "tree"), "sah_cost")));
+		CHECK(!cJSON_GetObjectItem(run, "heat_image"));
+	}
+	char *md = read_file(cli_path_in(out), "report.md");
+	CHECK(md != NULL);
+	free(md);
+	char raw[64];
+	snprintf(raw, sizeof(raw), "%s/.heat-0-0.raw", out);
+	CHECK(!cli_exists(cli_path_in(raw)));
+	snprintf(raw, sizeof(raw), "%s/.shade-0-0.raw", out);
+	CHECK(!cli_exists(cli_path_in(raw)));
+}
+
+/* stderr's line for an image of scene 's' lost, naming its file in tmpdir. */
+static void check_lost(const char *what, const char *file)
+{
+	char line[1024];
+	snprintf(line, sizeof(line), "bvhlab: images of scene 's': %s lost: cannot write %s: "
+	         "File too large\n", what, cli_path_in(file));
+	CHECK_CONTAINS(err_text, line);
+}
+
+/* 8. Images lost on a full disk: each lost one named with its file on
+ * stderr, counted in the last line, exit status 1; the runs, the results
+ * and the images that fit are kept. The heat maps' raw files (160 x 120 x
+ * 4 bytes) do not fit 64 KiB, the shaded render's (x 3) does; in 40 KiB
+ * neither does. */
+static void test_images(void)
+{
+	static const char format[] =
+		"{ \"output\": \"%s\", \"repeat\": 1, \"warmup\": 0, \"images\": true,\n"
+		"  \"rays\": { \"width\": 160, \"height\": 120, \"min_ms\": 1 },\n"
+		"  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 300 } ],\n"
+		"  \"builders\": [ { \"plugin\": \"lbvh\", \"name\": \"a\" },\n"
+		"                  { \"plugin\": \"sah_seq\", \"name\": \"b\" } ] }\n";
+	cJSON *doc;
+	int status = sweep_limited(format, "out-img", 64, &doc);
+	if (strstr(err_text, "images skipped")) { /* built without the images module */
+		fprintf(stderr, "no images module: images on a full disk not checked\n");
+		cJSON_Delete(doc);
+		return;
+	}
+	CHECK_INT(status, 1);
+	check_lost("the heat map of builder 'a'", "out-img/.heat-0-0.raw");
+	check_lost("the heat map of builder 'b'", "out-img/.heat-0-1.raw");
+	CHECK(!strstr(err_text, "shaded render"));
+	CHECK_CONTAINS(err_text, "; 2 images could not be written (see above)\n");
+	check_runs_kept(doc, "out-img");
+	const cJSON *images = cJSON_GetObjectItem(
+		cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "scenes"), 0), "images");
+	CHECK_CONTAINS(run_str(images, "shaded"), "images/s.png");
+	CHECK(cli_exists(cli_path_in("out-img/images/s.png")));
+	cJSON_Delete(doc);
+
+	CHECK_INT(sweep_limited(format, "out-full", 40, &doc), 1);
+	check_lost("the shaded render", "out-full/.shade-0-0.raw");
+	CHECK_CONTAINS(err_text, "; 3 images could not be written (see above)\n");
+	check_runs_kept(doc, "out-full");
+	CHECK(!cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "scenes"), 0),
+	                           "images"));
+	cJSON_Delete(doc);
+}
+
+static int count_of(const char *text, const char *needle)
+{
+	int n = 0;
+	for (const char *p = strstr(text, needle); p; p = strstr(p + 1, needle))
+		n++;
+	return n;
+}
+
+/* The line of stderr holding `needle` (to its newline), "" if none. */
+static const char *line_of(const char *text, const char *needle, char *line, size_t size)
+{
+	const char *at = strstr(text, needle), *start = at, *end;
+	line[0] = '\0';
+	if (!at)
+		return line;
+	while (start > text && start[-1] != '\n')
+		start--;
+	end = strchr(at, '\n');
+	size_t n = end ? (size_t)(end - start) : strlen(start);
+	snprintf(line, size, "%.*s", (int)(n < size ? n : size - 1), start);
+	return line;
+}
+
+/* A sweep of cl_lbvh and of lbvh with cl_stack rays under POCL_CACHE_DIR =
+ * `cache`: both failures name it, on one line each (errors and progress
+ * lines alike). False when the device ran anyway (not PoCL: nothing to
+ * check). */
+static bool pocl_sweep(const char *out, const char *cache)
+{
+	char text[1024], name[64], line[4096], want[600];
+	snprintf(text, sizeof(text),
+	         "{ \"output\": \"%s\", \"repeat\": 1, \"warmup\": 0,\n"
+	         "  \"rays\": { \"width\": 8, \"height\": 8, \"traversal\": [\"stack\", \"cl_stack\"] },\n"
+	         "  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200 } ],\n"
+	         "  \"builders\": [ { \"plugin\": \"cl_lbvh\" }, { \"plugin\": \"lbvh\" } ] }\n", out);
+	snprintf(name, sizeof(name), "%s.json", out);
+	setenv("POCL_CACHE_DIR", cache, 1);
+	int status = run_in(tmpdir, ARGS("run", write_config(name, text)));
+	unsetenv("POCL_CACHE_DIR");
+	cJSON *doc = load_results(cli_path_in(out));
+	const cJSON *cl = find_run(doc, "s", "cl_lbvh", 1);
+	const char *rays = run_str(cJSON_GetObjectItem(find_run(doc, "s", "lbvh", 1), "rays"), "error");
+	bool failed = status == 1 && !strcmp(run_str(cl, "status"), "failed");
+	snprintf(want, sizeof(want), "POCL_CACHE_DIR=%s is not a folder PoCL can use", cache);
+	if (failed) {
+		CHECK_CONTAINS(run_str(cl, "error"), want);
+		CHECK_CONTAINS(rays, "cl_stack: cl: ");
+		CHECK_CONTAINS(rays, want);
+		CHECK(!strchr(run_str(cl, "error"), '\n') && !strchr(rays, '\n'));
+		/* The progress lines stay whole: the message and the time on one. */
+		line_of(err_text, "s / cl_lbvh / 1 thread: failed", line, sizeof(line));
+		CHECK_CONTAINS(line, want);
+		CHECK_CONTAINS(line, " elapsed, ");
+		line_of(err_text, "s / lbvh / 1 thread: ok", line, sizeof(line));
+		CHECK_CONTAINS(line, want);
+		CHECK_CONTAINS(line, " elapsed, ");
+	}
+	cJSON_Delete(doc);
+	return failed;
+}
+
+/* 9. An unusable POCL_CACHE_DIR: a regular file (PoCL's kernel build fails,
+ * its log ending in a newline) and a folder under one (PoCL offers no
+ * device), each named as the likely cause. */
+static void test_pocl(void)
+{
+	FILE *f = fopen(cli_path_in("not-a-folder"), "w");
+	CHECK(f != NULL);
+	if (f)
+		fclose(f);
+	run_in(tmpdir, ARGS("list")); /* exit 1: the fake plugins' broken ones */
+	if (!strstr(out_text, "cl_lbvh")) {
+		fprintf(stderr, "built without OpenCL: POCL_CACHE_DIR's messages not checked\n");
+		return;
+	}
+	bool a = pocl_sweep("out-file", cli_path_in("not-a-folder"));
+	bool b = pocl_sweep("out-under", cli_path_in("not-a-folder/cache"));
+	CHECK_INT(run_in(tmpdir, ARGS("info", "--machine")), 0);
+	/* Where every OpenCL device is PoCL's, both must have failed. */
+	int pocl = count_of(out_text, "(Portable Computing Language)");
+	if (pocl > 0 && pocl == count_of(out_text, " compute units, "))
+		CHECK(a && b);
+	else if (!a || !b)
+		fprintf(stderr, "the OpenCL device ran despite POCL_CACHE_DIR (not PoCL): some "
+		        "messages not checked\n");
+}
+
 int main(int argc, char **argv)
 {
 	static const struct cli_mode modes[] = {
@@ -357,6 +541,8 @@ int main(int argc, char **argv)
 		{"version", test_version},
 		{"config", test_config},
 		{"escape", test_escape},
+		{"images", test_images},
+		{"pocl", test_pocl},
 	};
 	return cli_main_modes(argc, argv, "test-cli-msg", modes, sizeof(modes) / sizeof(modes[0]));
 }
