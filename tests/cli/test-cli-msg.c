@@ -470,7 +470,7 @@ static const char *line_of(const char *text, const char *needle, char *line, siz
 	return line;
 }
 
-/* A sweep of cl_lbvh and of lbvh with cl_stack rays under POCL_CACHE_DIR =
+/* A sweep of cl_lbvh and of lbvh with device stack rays under POCL_CACHE_DIR =
  * `cache`: both failures name it, on one line each (errors and progress
  * lines alike). False when the device ran anyway (not PoCL: nothing to
  * check). */
@@ -479,7 +479,8 @@ static bool pocl_sweep(const char *out, const char *cache)
 	char text[1024], name[64], line[4096], want[600];
 	snprintf(text, sizeof(text),
 	         "{ \"output\": \"%s\", \"repeat\": 1, \"warmup\": 0,\n"
-	         "  \"rays\": { \"width\": 8, \"height\": 8, \"traversal\": [\"stack\", \"cl_stack\"] },\n"
+	         "  \"rays\": { \"width\": 8, \"height\": 8, \"traversal\": [\"stack\",\n"
+	         "    { \"name\": \"stack\", \"device\": true }] },\n"
 	         "  \"scenes\": [ { \"name\": \"s\", \"generator\": \"soup\", \"count\": 200 } ],\n"
 	         "  \"builders\": [ { \"plugin\": \"cl_lbvh\" }, { \"plugin\": \"lbvh\" } ] }\n", out);
 	snprintf(name, sizeof(name), "%s.json", out);
@@ -493,7 +494,7 @@ static bool pocl_sweep(const char *out, const char *cache)
 	snprintf(want, sizeof(want), "POCL_CACHE_DIR=%s is not a folder PoCL can use", cache);
 	if (failed) {
 		CHECK_CONTAINS(run_str(cl, "error"), want);
-		CHECK_CONTAINS(rays, "cl_stack: cl: ");
+		CHECK_CONTAINS(rays, "device_stack: cl: ");
 		CHECK_CONTAINS(rays, want);
 		CHECK(!strchr(run_str(cl, "error"), '\n') && !strchr(rays, '\n'));
 		/* The progress lines stay whole: the message and the time on one. */
