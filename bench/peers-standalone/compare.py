@@ -101,14 +101,16 @@ def harness(args, plugin, variant, threads, folder):
     path = folder + ".json"
     with open(path, "w") as f:
         json.dump(config, f)
-    subprocess.run([os.path.join(args.build, "app", "bvhlab"), "run", path, "--quiet",
-                    "--force"], check=True)
+    # Exit 1 is a run that did not end ok: its status goes into the table.
+    rc = subprocess.run([os.path.join(args.build, "app", "bvhlab"), "run", path, "--quiet",
+                         "--force"]).returncode
+    if rc not in (0, 1):
+        sys.exit(f"{plugin} {variant} at {threads} threads: bvhlab run exited {rc}")
     with open(os.path.join(folder, "results.json")) as f:
         results = json.load(f)
     run = results["runs"][0]
     if run["status"] != "ok":
-        sys.exit(f"{plugin} {variant} at {threads} threads: {run['status']} "
-                 f"({run.get('error', '')})")
+        return None, f"{run['status']}: {run.get('error', '')}", {}, results["machine"]["cpu"]
     phases = run.get("build_phases", {})
     whole = run["build_ms"]["median"]
     own = whole - phases.get("input", 0.0) - phases.get("convert", 0.0)
@@ -155,7 +157,8 @@ def main():
         (own, whole, phases, cpu), (alone, alone_cpu) = got
         rows.append((name, t, whole, phases.get("input", 0.0), phases.get("convert", 0.0),
                      own, alone, alone_cpu))
-        print(f"{name} {t}T: harness {own:.1f} ms, alone {alone:.1f} ms", file=sys.stderr)
+        print(f"{name} {t}T: harness {own if own is None else round(own, 1)} ms "
+              f"({whole}), alone {alone:.1f} ms", file=sys.stderr)
     end = datetime.datetime.now(datetime.timezone.utc)
     print(f"{os.path.basename(args.scene)} subdivided {args.subdivide}x, "
           f"{args.repeat} repeats after {args.warmup} warm-up, {cpu_model(cpu)}, "
@@ -164,6 +167,9 @@ def main():
           "| standalone | standalone CPU | ratio |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, t, whole, inp, conv, own, alone, alone_cpu in rows:
+        if own is None:  # the harness's run did not end ok: whole says why
+            print(f"| {name} | {t} | {whole} | | | | {alone:.1f} | {alone_cpu:.1f} | - |")
+            continue
         print(f"| {name} | {t} | {whole:.1f} | {inp:.1f} | {conv:.1f} | {own:.1f} "
               f"| {alone:.1f} | {alone_cpu:.1f} | {own / alone:.2f} |")
 
