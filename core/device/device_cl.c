@@ -51,6 +51,26 @@ static void forget_if_forked(void)
 	owner = getpid();
 }
 
+/*
+ * At exit() (registered with the first device, so before the handlers
+ * registered earlier, LeakSanitizer's among them) the layer releases what it made, so the driver can
+ * stop its threads (PoCL's pthread device keeps workers while a context
+ * lives; LeakSanitizer's scan at exit crashed on them, test-rays under
+ * ASan). A forked child's entries are its parent's: left alone.
+ */
+static void release_all(void)
+{
+	pthread_mutex_lock(&lock);
+	if (owner == getpid()) {
+		for (unsigned i = 0; i < program_count; i++)
+			bvhlab_cl_release_program(&programs[i].prog);
+		for (unsigned i = 0; i < device_count; i++)
+			bvhlab_cl_finish(&devices[i].cl);
+		device_count = program_count = 0;
+	}
+	pthread_mutex_unlock(&lock);
+}
+
 static uint64_t fnv1a(uint64_t h, const char *s, size_t n)
 {
 	for (size_t i = 0; i < n; i++)
@@ -69,6 +89,9 @@ static int get_device(const char *spec, struct device **out, char *err, size_t e
 		return bvhlab_cl_fail(-EINVAL, err, err_size, "cl: too many device specs in one "
 		                      "process (or '%.40s' too long)", spec);
 	struct device *d = &devices[device_count];
+	static bool registered;
+	if (!registered)
+		registered = atexit(release_all) == 0;
 	int r = bvhlab_cl_init(&d->cl, spec, err, err_size);
 	if (r < 0)
 		return r;

@@ -32,6 +32,7 @@ struct worker {
 	pthread_mutex_t lock;
 	pthread_cond_t wake;
 	bool has_job;
+	bool stop; /* leave worker_main: the process is ending */
 	struct job job;
 	cpu_set_t mask;          /* its affinity now: set again only on a change */
 	struct worker *next_idle;
@@ -56,9 +57,36 @@ static void forget_workers(void)
 	pool.count = 0;
 }
 
+static void stop_workers(void);
+
+/* Once, at the pool's first use: atexit runs stop_workers before the
+ * handlers registered earlier (LeakSanitizer's among them). */
 static void register_fork(void)
 {
 	pthread_atfork(NULL, NULL, forget_workers);
+	atexit(stop_workers);
+}
+
+/*
+ * At exit() the idle workers are stopped and joined, so the process
+ * ends with no thread of ours parked: LeakSanitizer's scan at exit
+ * crashed on the parked pool ("Tracer caught signal 11", test-rays
+ * under ASan). Only idle workers are taken: every task is joined before
+ * its build returns, and a forked child's list is empty (forget_workers).
+ */
+static void stop_workers(void)
+{
+	pthread_mutex_lock(&pool.lock);
+	struct worker *w = pool.idle;
+	pool.idle = NULL;
+	pthread_mutex_unlock(&pool.lock);
+	for (; w; w = w->next_idle) {
+		pthread_mutex_lock(&w->lock);
+		w->stop = true;
+		pthread_cond_signal(&w->wake);
+		pthread_mutex_unlock(&w->lock);
+		pthread_join(w->tid, NULL);
+	}
 }
 
 /* ---- places ---------------------------------------------------------------- */
@@ -164,8 +192,12 @@ static void *worker_main(void *p)
 	struct worker *w = p;
 	for (;;) {
 		pthread_mutex_lock(&w->lock);
-		while (!w->has_job)
+		while (!w->has_job && !w->stop)
 			pthread_cond_wait(&w->wake, &w->lock);
+		if (w->stop) {
+			pthread_mutex_unlock(&w->lock);
+			return NULL;
+		}
 		struct job job = w->job;
 		w->has_job = false;
 		pthread_mutex_unlock(&w->lock);
