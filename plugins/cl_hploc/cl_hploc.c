@@ -210,18 +210,7 @@ static int run(void *p, bvhlab_build_output *out, char *err, size_t err_size)
 
 static const cl_run_spec job = CL_RUN_SPEC(cl_hploc, run);
 
-static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *input, bvhlab_build_output *output)
-{
-	cl_hploc b;
-	/* The options first: their copy sets the whole struct. */
-	int rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);
-
-	if (rc < 0)
-		return rc;
-	b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, b.b = S.b;
-	return cl_build_run(&program, &job, &S.dev, &b, host, ctx, input, output);
-}
+CL_BUILD_FN(cl_hploc)
 
 PLUGIN_WITH_OPTIONS(options, .name = "cl_hploc",
 	.flags = BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_DEVICE,

@@ -203,4 +203,24 @@ int cl_build_run(const cl_builder *cb, const cl_run_spec *rs, cl_dev *d, void *b
                  const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
                  bvhlab_build_output *out);
 
+/*
+ * The build() of a device builder on cl_build_run: its struct `type` (with
+ * members in, n, dev, sort, b) gets its options first (PLUGIN_OPTIONS_GET
+ * copies the whole struct), then the input and the plugin's state; the
+ * file keeps that state in `S` (dev, sort, b), its cl_builder `program` and
+ * its cl_run_spec `job`.
+ */
+#define CL_BUILD_FN(type)                                                                \
+	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,                 \
+	                 const bvhlab_build_input *input, bvhlab_build_output *output)   \
+	{                                                                                \
+		type b;                                                                  \
+		int rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);                       \
+		if (rc < 0)                                                              \
+			return rc;                                                       \
+		b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, \
+		b.b = S.b;                                                               \
+		return cl_build_run(&program, &job, &S.dev, &b, host, ctx, input, output); \
+	}
+
 #endif /* BVHLAB_CL_DEV_H */
