@@ -297,6 +297,7 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, uint32_t f
 	run->sample_count = rep->sample_count;
 	run->cold_ms = rep->cold_ms;
 	run->stats = rep->tree.has_stats ? &rep->tree.stats : NULL;
+	run->width = rep->tree.width;
 	run->epo = rep->tree.has_epo ? &rep->tree.epo : NULL;
 	run->memory = rep->memory.measured ? &rep->memory : NULL;
 	run->device = rep->has_device ? harness_memory_device_checked(&rep->device) : NULL;

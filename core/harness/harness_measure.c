@@ -8,6 +8,7 @@
 #include <bvhlab/epo.h>
 
 #include "harness/harness_measure.h"
+#include "tree/tree_view.h"
 #include "util/util.h"
 
 /* EPO points: a relative standard error of a few per mille on the scenes
@@ -51,6 +52,7 @@ enum tree_verdict harness_measure_tree(const bvhlab_tree *tree, const bvhlab_sce
 	m->has_stats = m->valid || (m->mismatches && m->rays_checked);
 	if (m->has_stats)
 		bvhlab_tree_stats_compute(tree, &m->stats);
+	m->width = tree_width(tree);
 	if (v == TREE_OK)
 		m->has_epo = bvhlab_tree_epo(tree, scene, EPO_SAMPLES, EPO_SEED, &m->epo) == 0;
 	return v;

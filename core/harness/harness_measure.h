@@ -25,6 +25,7 @@ struct tree_measure {
 	uint64_t rays_checked, mismatches;
 	bool has_stats;             /* valid, or well-formed with rays that disagree */
 	bvhlab_tree_stats stats;
+	uint32_t width;             /* the tree's branching factor, 2 to 8 (with stats) */
 	bool has_epo;
 	double epo;                 /* end-point overlap (bvhlab_tree_epo) */
 };

@@ -78,6 +78,9 @@ static const char *const csv_numbers[][2] = {
 	{"load_after", "%.2f"},
 	{"device.compute_units", "%.0f"},
 	{"memory.runtime_bytes", "%.0f"},
+	{"tree.width", "%.0f"},
+	{"tree.bytes_per_triangle", "%.3f"},
+	{"tree.packed_bytes_per_triangle", "%.3f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary
@@ -242,6 +245,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	report_front_md(sb, ix, runs, n);
 	report_budget_md(sb, ix, name);
 	report_breakeven_md(sb, ix, ref, runs, n);
+	report_wide_md(sb, ix, runs, n);
 	md_images(sb, scene, runs, n);
 	report_frames_md(sb, ix, scene); /* an animated scene's frames */
 }

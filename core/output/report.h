@@ -286,4 +286,19 @@ const char *report_summary_metric(int m);
 /* The summary section of report.md / report.html. */
 void report_summary_md(struct strbuf *sb, const struct report_index *ix);
 void report_summary_html(struct strbuf *sb, const struct report_index *ix);
+/* ---- wide trees (report_wide.c) ------------------------------------------ */
+
+/* A scene's wide trees: every run's width, collapse, SAH before and after
+ * it, nodes and triangles per ray and bytes per triangle; per collapse
+ * method the 8-wide runs ranked by binary SAH and by measured 8-wide cost
+ * with the Spearman correlation; the wide runs on the front of build time
+ * against wide ray cost. Nothing for a scene without a wide tree. */
+void report_wide_md(struct strbuf *sb, const struct report_index *ix, const cJSON *const *runs,
+                    size_t n);
+void report_wide_html(struct strbuf *sb, const struct report_index *ix,
+                      const cJSON *const *runs, size_t n);
+/* Spearman's rank correlation of a[0 .. n) and b (ties get their mean
+ * rank); NaN for n < 3 or a ranking of all ties. */
+double report_spearman(const double *a, const double *b, size_t n);
+
 #endif

@@ -461,6 +461,7 @@ static void scene_section(struct strbuf *sb, const struct report_index *ix, cons
 	report_front_html(sb, ix, runs, n);
 	report_budget_html(sb, ix, name);
 	report_breakeven_html(sb, ix, ref, runs, n);
+	report_wide_html(sb, ix, runs, n);
 	images(sb, ix, scene);
 	report_frames_html(sb, ix, scene); /* an animated scene's frames */
 }

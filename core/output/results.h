@@ -160,6 +160,7 @@ struct run_record {
 	double cold_ms;        /* the first build, before any warm-up repeat */
 	uint32_t triangles;
 	const bvhlab_tree_stats *stats; /* or NULL */
+	uint32_t width;        /* with stats: the tree's branching factor, 2 to 8 */
 	const double *epo;     /* end-point overlap (bvhlab_tree_epo), or NULL */
 	const struct build_memory *memory; /* peak memory of the builds, or NULL */
 	const struct run_device *device; /* a device builder's device, or NULL */

@@ -58,8 +58,21 @@ static cJSON *memory_json(const struct build_memory *m)
 	return o;
 }
 
+/* A tree's memory per triangle in two layouts: as stored (32-byte nodes,
+ * 4 bytes a reference: memory_bytes), and packed as wide tracers store it,
+ * each inner node one block of `width` child slots (a box, 24 bytes, and a
+ * 32-bit reference: 28 bytes a slot, Embree's BVH4/BVH8 node with 32-bit
+ * references), leaves as ranges of the 4-byte references. */
+static void bytes_json(cJSON *o, const bvhlab_tree_stats *st, uint32_t width, uint32_t triangles)
+{
+	double inner = (double)st->nodes - st->leaves;
+	double packed = inner * width * 28.0 + (double)st->refs * sizeof(uint32_t);
+	cJSON_AddNumberToObject(o, "bytes_per_triangle", (double)st->memory_bytes / triangles);
+	cJSON_AddNumberToObject(o, "packed_bytes_per_triangle", packed / triangles);
+}
+
 /* dup_ratio: references per triangle, 1 unless spatial splits duplicated some. */
-static cJSON *tree_json(const bvhlab_tree_stats *st, uint32_t triangles)
+static cJSON *tree_json(const bvhlab_tree_stats *st, uint32_t width, uint32_t triangles)
 {
 	cJSON *o = cJSON_CreateObject();
 	const struct results_number shape[] = {
@@ -71,8 +84,11 @@ static cJSON *tree_json(const bvhlab_tree_stats *st, uint32_t triangles)
 		{"refs", (double)st->refs},
 	};
 	results_add_numbers(o, shape, RESULTS_NUMBERS(shape));
+	cJSON_AddNumberToObject(o, "width", width < 2 ? 2 : width);
 	if (triangles)
 		cJSON_AddNumberToObject(o, "dup_ratio", (double)st->refs / triangles);
+	if (triangles)
+		bytes_json(o, st, width < 2 ? 2 : width, triangles);
 	cJSON_AddNumberToObject(o, "memory_bytes", (double)st->memory_bytes);
 	cJSON *hist = cJSON_AddArrayToObject(o, "leaf_size_histogram");
 	for (int k = 0; k < BVHLAB_LEAF_HISTOGRAM; k++)
@@ -120,7 +136,7 @@ cJSON *results_run_json(const struct run_record *run)
 	if (run->stage_count)
 		cJSON_AddItemToObject(o, "stages", results_stages_json(run->stages, run->stage_count));
 	if (run->stats)
-		cJSON_AddItemToObject(o, "tree", tree_json(run->stats, run->triangles));
+		cJSON_AddItemToObject(o, "tree", tree_json(run->stats, run->width, run->triangles));
 	if (run->stats && run->epo)
 		cJSON_AddNumberToObject(cJSON_GetObjectItem(o, "tree"), "epo", *run->epo);
 	if (run->memory)
