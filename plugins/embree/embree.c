@@ -105,6 +105,7 @@ static int device_failed(const bvhlab_host *host, bvhlab_build_ctx *ctx, uint32_
 typedef struct settings {
 	enum RTCBuildQuality quality;
 	int quality_choice; /* low|medium|high, as the option says */
+	int64_t width;      /* Embree's maxBranchingFactor: 2, or its 4- and 8-wide trees */
 	int64_t max_leaf, min_leaf;
 	double c_trav, c_isect, split_factor;
 } settings;
@@ -114,6 +115,10 @@ static const plugin_option options[] = {
 	              .help = "low (Morton), medium (binned SAH) or high (SAH with spatial "
 	                      "splits)",
 	              .def_string = "medium", .choices = "low|medium|high"),
+	PLUGIN_OPTION(settings, width, I64, .name = "width",
+	              .help = "children per inner node (maxBranchingFactor): 2, or Embree's own "
+	                      "4- and 8-wide trees (BVH4, BVH8), written as bvhlab wide trees",
+	              .def_int = 2, .min = 2, .max = 8, .choices = "2|4|8"),
 	PLUGIN_MAX_LEAF(settings, max_leaf, I64, RTC_BUILD_MAX_PRIMITIVES_PER_LEAF,
 	                "most primitives in a leaf (Embree allows up to 32)"),
 	PLUGIN_OPTION(settings, min_leaf, I64, .name = "min_leaf",
@@ -184,7 +189,7 @@ static void fill_args(struct RTCBuildArguments *a, const settings *s, RTCBVH bvh
 {
 	*a = rtcDefaultBuildArguments();
 	a->buildQuality = s->quality;
-	a->maxBranchingFactor = 2;
+	a->maxBranchingFactor = (unsigned int)s->width;
 	a->maxDepth = MAX_DEPTH;
 	a->minLeafSize = (unsigned int)s->min_leaf;
 	a->maxLeafSize = (unsigned int)s->max_leaf;
@@ -236,6 +241,8 @@ static int build_locked(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 		return -EIO;
 	}
 	int rc = embree_write_tree(host, ctx, root, output);
+	if (rc == 0)
+		output->width = (uint32_t)s->width;
 	double t4 = now_ms();
 	/* The input and the conversion are bvhlab's cost, not Embree's:
 	 * reported apart so the report shows the library's own time beside

@@ -13,7 +13,9 @@
 /*
  * A node of the temporary tree, allocated in Embree's thread-local arena
  * (freed all at once with the RTCBVH). count 0: inner node with `arity`
- * children (Embree may emit one-child nodes; they are skipped on output);
+ * children, up to the build's branching factor (the `width` option: 2, or
+ * Embree's own 4- and 8-wide trees); Embree may emit one-child nodes,
+ * which are skipped on output;
  * count > 0: leaf whose primitive ids follow the header.
  */
 typedef struct tnode {
@@ -23,7 +25,7 @@ typedef struct tnode {
 
 typedef struct tinner {
 	tnode head;
-	tnode *child[2];
+	tnode *child[BVHLAB_MAX_WIDTH];
 } tinner;
 
 typedef struct tleaf {
@@ -44,8 +46,9 @@ void embree_set_callbacks(struct RTCBuildArguments *args, bool spatial);
 /*
  * Writes the tree under `root` into `out` (growing it through the host
  * when spatial splits made more references than primitives): leaf boxes
- * as Embree gave them, inner boxes the union of their children's. 0, or a negative errno
- * after host->set_error.
+ * as Embree gave them, inner boxes the union of their children's, an
+ * inner node of k > 2 children marked BVHLAB_NODE_INNER | k (ABI 1.5; the
+ * caller sets out->width). 0, or a negative errno after host->set_error.
  */
 int embree_write_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const tnode *root,
                       bvhlab_build_output *out);

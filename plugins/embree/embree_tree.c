@@ -24,8 +24,8 @@ static void *create_node(RTCThreadLocalAllocator alloc, unsigned int children, v
 	(void)user;
 	tinner *n = rtcThreadLocalAlloc(alloc, sizeof(tinner), 16);
 	n->head.count = 0;
-	n->head.arity = children < 2 ? children : 2;
-	n->child[0] = n->child[1] = NULL;
+	n->head.arity = children < BVHLAB_MAX_WIDTH ? children : BVHLAB_MAX_WIDTH;
+	memset(n->child, 0, sizeof(n->child));
 	return n;
 }
 
@@ -33,7 +33,7 @@ static void set_children(void *node, void **children, unsigned int count, void *
 {
 	(void)user;
 	tinner *n = node;
-	for (unsigned int k = 0; k < count && k < 2; k++)
+	for (unsigned int k = 0; k < count && k < BVHLAB_MAX_WIDTH; k++)
 		n->child[k] = children[k];
 }
 
@@ -161,15 +161,16 @@ static int write_leaf(writer *w, const tleaf *l, uint32_t slot)
 static int write_inner(writer *w, const tinner *n, uint32_t slot)
 {
 	bvhlab_build_output *o = w->out;
-	uint32_t first = o->node_count;
-	int rc = ensure(w, first + 2, o->index_count);
+	uint32_t first = o->node_count, k = n->head.arity;
+	int rc = ensure(w, first + k, o->index_count);
 	if (rc == 0) {
 		o->nodes[slot].first = first;
-		o->nodes[slot].count = 0;
-		o->node_count += 2;
-		rc = push(w, n->child[1], first + 1);
+		o->nodes[slot].count = k == 2 ? 0 : BVHLAB_NODE_INNER | k;
+		o->node_count += k;
 	}
-	return rc < 0 ? rc : push(w, n->child[0], first);
+	for (uint32_t c = k; rc == 0 && c-- > 0;)
+		rc = push(w, n->child[c], first + c);
+	return rc;
 }
 
 /* Depth first, children as adjacent pairs: each child's index exceeds its parent's. */
@@ -183,7 +184,7 @@ static int write_nodes(writer *w, const tnode *root)
 		const tnode *t = p.t;
 		while (t && t->count == 0 && t->arity == 1)
 			t = ((const tinner *)t)->child[0];
-		if (!t || (t->count == 0 && t->arity != 2)) {
+		if (!t || (t->count == 0 && (t->arity < 2 || t->arity > BVHLAB_MAX_WIDTH))) {
 			w->host->set_error(w->ctx, "Embree produced a malformed node");
 			return -EPROTO;
 		}
@@ -200,11 +201,12 @@ static void compute_boxes(bvhlab_build_output *o)
 	for (uint32_t i = o->node_count; i-- > 0;) {
 		bvhlab_node *n = &o->nodes[i];
 		bvhlab_aabb box;
-		if (n->count != 0)
+		if (n->count != 0 && !(n->count & BVHLAB_NODE_INNER))
 			continue;
+		uint32_t k = n->count ? n->count & ~BVHLAB_NODE_INNER : 2;
 		bvhlab_aabb_empty(&box);
-		bvhlab_aabb_grow_corners(&box, o->nodes[n->first].lo, o->nodes[n->first].hi);
-		bvhlab_aabb_grow_corners(&box, o->nodes[n->first + 1].lo, o->nodes[n->first + 1].hi);
+		for (uint32_t c = 0; c < k; c++)
+			bvhlab_aabb_grow_corners(&box, o->nodes[n->first + c].lo, o->nodes[n->first + c].hi);
 		memcpy(n->lo, box.lo, sizeof(n->lo));
 		memcpy(n->hi, box.hi, sizeof(n->hi));
 	}
