@@ -9,7 +9,8 @@
  * every tinybvh builder; bvh2's sweep and binned, and its low/medium/high
  * on a one-thread pool against two threads (its single-thread path is a
  * different algorithm); tinybvh's Optimize after a threaded build also on
- * sponza.obj, where it once differed. Threads: a 1-thread build starts no thread at all
+ * sponza.obj, where it once differed; tinybvh's `width` 4 and 8 (its
+ * BVH4_CPU and BVH8_CPU) give trees of that width. Threads: a 1-thread build starts no thread at all
  * (the build runs on the calling thread: one CPU at a time); at 2 threads
  * every thread started may run on at most 2 CPUs, the threaded builders
  * do start threads (so the count is not vacuous), and the caller's CPU
@@ -49,6 +50,9 @@ static const row tinybvh_rows[] = {
 	 * the threads came) it gave another tree on sponza until the plugin
 	 * compacted the tree first. */
 	{"avx", "optimize=2", false, ANY, NULL, true},
+	/* The library's BVH4_CPU and BVH8_CPU trees (MBVH<4>, MBVH<8>). */
+	{"avx", "width=4", false, ANY, NULL, false},
+	{"avx", "width=8", false, ANY, NULL, false},
 };
 static const row bvh2_rows[] = {
 	{"low", NULL, false, 2, "one_thread=pool", false},
@@ -148,6 +152,8 @@ static void check_row(const bvhlab_scene *s, const bvhlab_prims *prims, const ro
 			continue;
 		}
 		check_threads(r, threads, what);
+		if (r->extra && !strncmp(r->extra, "width=", 6))
+			CHECK_INT(t[threads - 1].width, (uint32_t)atoi(r->extra + 6));
 		if (judge(s, prims, r, &t[threads - 1], what) == 0)
 			printf("ok: %s, %u nodes, %u references\n", what, t[threads - 1].node_count,
 			       t[threads - 1].index_count);
@@ -202,6 +208,20 @@ static void check_mesh(const row *rows, size_t n)
 	bvhlab_scene_destroy(s);
 }
 
+/* tinybvh's wide layouts come from its own Build: another builder or
+ * Optimize with them is refused when the options are read. */
+static void check_width_rule(void)
+{
+	bvhlab_options opts;
+	bvhlab_error err = {{0}};
+	CHECK_INT(bvhlab_options_init(&opts, bvhlab_plugin_builder(plugin)), 0);
+	CHECK_INT(bvhlab_options_parse(&opts, "width=8", &err), 0);
+	CHECK_INT(bvhlab_options_parse(&opts, "builder=hq", &err), 0);
+	CHECK(bvhlab_options_check(&opts, &err) < 0);
+	CHECK_CONTAINS(err.message, "width 8 is the library's BVH8_CPU");
+	bvhlab_options_finish(&opts);
+}
+
 static void check_scene(const char *gen, uint32_t frequency, uint32_t count, const row *rows,
                         size_t n)
 {
@@ -239,6 +259,8 @@ int main(int argc, char **argv)
 	check_scene("icosphere", 50, 0, rows, n); /* 20 f^2 = 50,000 triangles */
 	check_scene("soup", 0, SCALE(3000, 1000), rows, n);
 	check_mesh(rows, n);
+	if (tiny)
+		check_width_rule();
 	bvhlab_plugin_close(plugin);
 	return test_finish();
 }

@@ -9,6 +9,11 @@
 // triangle, so the descriptor declares spatial splits, as embree's does;
 // the other builders reference each triangle once, which the tests check).
 // optimize: iterations of tinybvh's Optimize (reinsertion) after it.
+// width 4 or 8: the library's own BVH4_CPU or BVH8_CPU, built by its Build
+// (its default binary builder, BuildAVX, collapsed by its MBVH ConvertFrom,
+// leaves combined and split to at most 4 triangles), written out from the
+// MBVH<4>/<8> that layout traces: the tree tinybvh's wide traversal walks,
+// judged as a bvhlab wide tree (builder and optimize are width 2's).
 //
 // Threads: see tinybvh_cpus.h (the library spawns a fixed tree of
 // std::threads; the calling thread's CPU affinity holds them to the run's
@@ -54,6 +59,7 @@ struct Settings {
 	int64_t optimize = 0, hq_bins = HQBVHBINS;
 	bool extreme = false;
 	double c_trav = 1, c_int = 1;
+	int64_t width = 2;
 };
 
 // The options and where they go (plugin_options.h): the host has checked them.
@@ -84,8 +90,26 @@ const plugin_option options[] = {
 	PLUGIN_OPTION(Settings, hq_bins, I64,
 	              bvhlab::int_option("hq_bins", "hq: bins per axis for object and spatial "
 	                                 "splits", HQBVHBINS, 2, MAXHQBINS)),
+	PLUGIN_OPTION(Settings, width, I64,
+	              bvhlab_option_decl{"width", BVHLAB_OPTION_INT,
+	                                 "2, or 4 and 8: the library's BVH4_CPU and BVH8_CPU (its "
+	                                 "Build, its collapse and leaves of at most 4), written as "
+	                                 "a bvhlab wide tree; builder and optimize are width 2's",
+	                                 false, 2, 0.0, nullptr, 2.0, 8.0, "2|4|8"}),
 };
-PLUGIN_DECLS(options, Settings, nullptr)
+
+// Optimize works on the binary tree only; the wide layouts build their own.
+int check_width(const bvhlab_host *host, bvhlab_build_ctx *ctx, void *out)
+{
+	const Settings *s = static_cast<const Settings *>(out);
+	if (s->width == 2 || (s->optimize == 0 && s->method == avx))
+		return 0;
+	host->set_error(ctx, "width %lld is the library's BVH%lld_CPU, built by its own Build: "
+	                "leave builder (avx) and optimize (0) at their defaults",
+	                static_cast<long long>(s->width), static_cast<long long>(s->width));
+	return -EINVAL;
+}
+PLUGIN_DECLS(options, Settings, check_width)
 
 // What a run keeps between its builds, as the harness keeps a builder's
 // output ("host-kept output"): the BVH object, whose node and index arrays
@@ -194,6 +218,49 @@ struct View {
 	}
 };
 
+// MBVH<M>'s tree (what BVH4_CPU and BVH8_CPU hold and trace) as
+// peer::write_tree reads it; a root leaf sits under a one-child root.
+template <int M> struct WideView {
+	const tinybvh::MBVH<M> &m;
+	uint64_t max_nodes() const { return m.usedNodes; }
+	uint64_t max_refs() const { return m.bvh.idxCount; }
+	uint32_t root() const { return m.mbvhNode[0].childCount == 1 ? m.mbvhNode[0].child[0] : 0; }
+	bool leaf(uint32_t n) const { return m.mbvhNode[n].isLeaf(); }
+	uint32_t child_count(uint32_t n) const { return m.mbvhNode[n].childCount; }
+	uint32_t child(uint32_t n, int k) const { return m.mbvhNode[n].child[k]; }
+	uint32_t prim_count(uint32_t n) const { return m.mbvhNode[n].triCount; }
+	uint32_t prim(uint32_t n, uint32_t k) const
+	{
+		return m.bvh.primIdx[m.mbvhNode[n].firstTri + k];
+	}
+	void box(uint32_t n, float lo[3], float hi[3]) const
+	{
+		const auto &x = m.mbvhNode[n];
+		lo[0] = x.aabbMin.x, lo[1] = x.aabbMin.y, lo[2] = x.aabbMin.z;
+		hi[0] = x.aabbMax.x, hi[1] = x.aabbMax.y, hi[2] = x.aabbMax.z;
+	}
+};
+
+// The MBVH each CPU layout keeps and traces.
+tinybvh::MBVH<4> &wide_tree(tinybvh::BVH4_CPU &l) { return l.bvh4; }
+tinybvh::MBVH<8> &wide_tree(tinybvh::BVH8_CPU &l) { return l.bvh8; }
+
+// The library's M-wide CPU layout over the soup, converted: a fresh object
+// per build (its Build allocates as it goes), its binary build threaded as
+// a width-2 build is (the caller narrowed the CPUs).
+template <class Layout, int M>
+int build_wide(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+               bvhlab_build_output *out)
+{
+	auto layout = std::make_unique<Layout>();
+	wide_tree(*layout).bvh.threadedBuild = in->threads > 1;
+	layout->Build(kept.soup.data(), in->prim_count);
+	int rc = peer::convert(host, ctx, WideView<M>{wide_tree(*layout)}, out);
+	if (rc == 0)
+		out->width = M;
+	return rc;
+}
+
 // The settings into the kept object: every field a build reads, since the
 // previous build may have set them otherwise.
 void configure(BVH &bvh, const Settings &s, uint32_t threads)
@@ -212,8 +279,7 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 	auto t0 = clk::now();
 	soup(in, kept.soup);
 	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
-	BVH &bvh = object_for(s, in->prim_count);
-	configure(bvh, s, in->threads);
+	BVH *bvh = nullptr;
 	{
 		tbvh::CpuLimit cpus;
 		int rc = in->threads > 1 ? cpus.limit(in->threads) : 0;
@@ -222,11 +288,16 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 			                in->threads, std::strerror(-rc));
 			return rc;
 		}
-		run_builder(bvh, s, kept.soup.data(), in->prim_count);
+		if (s.width != 2)
+			return s.width == 4 ? build_wide<tinybvh::BVH4_CPU, 4>(host, ctx, in, out)
+			                    : build_wide<tinybvh::BVH8_CPU, 8>(host, ctx, in, out);
+		bvh = &object_for(s, in->prim_count);
+		configure(*bvh, s, in->threads);
+		run_builder(*bvh, s, kept.soup.data(), in->prim_count);
 	}
 	if (s.optimize > 0)
-		optimize(bvh, s);
-	return peer::convert(host, ctx, View{bvh}, out);
+		optimize(*bvh, s);
+	return peer::convert(host, ctx, View{*bvh}, out);
 }
 
 int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,

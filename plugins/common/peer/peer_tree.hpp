@@ -1,9 +1,10 @@
-// peer_tree.hpp: a peer library's binary tree written out in bvhlab's
-// standard layout (tinybvh, bvh2), header-only C++.
+// peer_tree.hpp: a peer library's tree, binary or wide (tinybvh's 4- and
+// 8-wide), written out in bvhlab's standard layout (tinybvh, bvh2),
+// header-only C++.
 //
 // The library's tree is read through a small view (see peer_write_tree)
-// and written depth first with the children of each inner node as an
-// adjacent pair, so the output's order is the same whatever order the
+// and written depth first with the children of each inner node adjacent,
+// so the output's order is the same whatever order the
 // library's threads numbered its nodes in. Boxes are copied as the library
 // made them, never recomputed: the validator judges the library's own tree
 // (a box that misses its contents is the library's finding, not fixed up).
@@ -53,10 +54,25 @@ inline int reserve(const bvhlab_host *host, bvhlab_build_ctx *ctx, bvhlab_build_
 	return 0;
 }
 
+// An inner node's children: the view's child_count(n) where it has one (a
+// wide tree's), else 2.
+template <class View>
+auto child_count(const View &view, uint32_t n, int) -> decltype(view.child_count(n))
+{
+	return view.child_count(n);
+}
+template <class View> uint32_t child_count(const View &, uint32_t, long)
+{
+	return 2;
+}
+
 // Writes the tree seen through `view` into `out`. The view provides:
 //   uint64_t max_nodes(), max_refs()   upper bounds of what will be written
 //   uint32_t root()
-//   bool leaf(n); uint32_t child(n, k) for k = 0, 1 (inner nodes)
+//   bool leaf(n); uint32_t child(n, k) for k = 0, 1 (inner nodes), or
+//   k < child_count(n) when it has child_count (2 to BVHLAB_MAX_WIDTH: a
+//   node of more than 2 is written as ABI 1.5's BVHLAB_NODE_INNER | k; the
+//   caller sets out->width)
 //   uint32_t prim_count(n); uint32_t prim(n, k) (leaves)
 //   void box(n, float lo[3], float hi[3])
 // 0, or a negative errno after host->set_error (-EPROTO when the library's
@@ -79,16 +95,19 @@ int write_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const View &view,
 		bvhlab_node &n = out->nodes[slot];
 		view.box(src, n.lo, n.hi);
 		if (!view.leaf(src)) {
-			if (uint64_t{out->node_count} + 2 > view.max_nodes()) {
-				host->set_error(ctx, "the library's tree has more nodes than its %llu "
-				                "(a cycle?)", static_cast<unsigned long long>(view.max_nodes()));
+			uint32_t k = child_count(view, src, 0);
+			if (k < 2 || k > BVHLAB_MAX_WIDTH ||
+			    uint64_t{out->node_count} + k > view.max_nodes()) {
+				host->set_error(ctx, "the library's node %u has %u children, or its tree "
+				                "more nodes than its %llu (a cycle?)", src, k,
+				                static_cast<unsigned long long>(view.max_nodes()));
 				return -EPROTO;
 			}
 			n.first = out->node_count;
-			n.count = 0;
-			out->node_count += 2;
-			stack.emplace_back(view.child(src, 1), n.first + 1);
-			stack.emplace_back(view.child(src, 0), n.first);
+			n.count = k == 2 ? 0 : BVHLAB_NODE_INNER | k;
+			out->node_count += k;
+			for (uint32_t c = k; c-- > 0;)
+				stack.emplace_back(view.child(src, static_cast<int>(c)), n.first + c);
 			continue;
 		}
 		uint32_t count = view.prim_count(src);
