@@ -73,6 +73,9 @@ static cJSON *document(bool wide)
 	add_run(runs, "a+greedy8", 8, "greedy", 40, 38, 1.5, 12, 2, 6);
 	add_run(runs, "b+greedy8", 8, "greedy", 30, 29, 5.5, 10, 2, 7);
 	add_run(runs, "c+greedy8", 8, "greedy", 35, 33, 3.5, 11, 2, 6.5);
+	/* A method name from an edited document reaches no page as markup. */
+	add_run(runs, "a+odd", 8, "<i>odd</i>", 40, 39, 9, 30, 2, 1);
+	add_run(runs, "b+odd", 8, "<i>odd</i>", 30, 29, 9, 31, 2, 1);
 	return doc;
 }
 
@@ -101,6 +104,9 @@ static void test_sections(void)
 		                   "(8-wide greedy, 1 thread: 1.50 ms, 14.0).");
 		CHECK_CONTAINS(html, "<h3>Wide trees</h3>");
 		CHECK_CONTAINS(html, "<h3>Does the collapse change the ranking? 8-wide, greedy</h3>");
+		CHECK_CONTAINS(html, "8-wide, &lt;i&gt;odd&lt;/i&gt;</h3>");
+		CHECK(!strstr(html, "<i>odd") && !strstr(md, "<i>odd"));
+		CHECK_CONTAINS(md, "(2 builders; 1 the same order");
 	}
 	free(md);
 	free(html);

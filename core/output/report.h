@@ -286,6 +286,7 @@ const char *report_summary_metric(int m);
 /* The summary section of report.md / report.html. */
 void report_summary_md(struct strbuf *sb, const struct report_index *ix);
 void report_summary_html(struct strbuf *sb, const struct report_index *ix);
+
 /* ---- wide trees (report_wide.c) ------------------------------------------ */
 
 /* A scene's wide trees: every run's width, collapse, SAH before and after

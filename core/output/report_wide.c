@@ -32,9 +32,12 @@ static void text(const struct out *o, const char *s)
 		report_md_text(o->sb, s);
 }
 
+/* A heading; its text escaped (a method name comes from the document). */
 static void heading(const struct out *o, const char *title)
 {
-	sb_printf(o->sb, o->html ? "<h3>%s</h3>\n" : "\n### %s\n\n", title);
+	sb_printf(o->sb, o->html ? "<h3>" : "\n### ");
+	text(o, title);
+	sb_printf(o->sb, o->html ? "</h3>\n" : "\n\n");
 }
 
 static void table_begin(const struct out *o, const char *const *heads, size_t n)
@@ -220,20 +223,23 @@ static size_t rank_runs(const cJSON *const *runs, size_t n, const char *method,
 	return m;
 }
 
+/* v: the m runs' three figures (binary SAH, ray cost, -Mrays/s), then
+ * room for their ranks. */
 static void rank_table(const struct out *o, const cJSON **r, size_t m, double *v)
 {
 	static const char *const heads[] = {"builder", "binary SAH", "rank", "8-wide ray cost",
 	                                    "rank", "primary Mrays/s", "rank"};
 	double *rank = v + 3 * m;
 	char b[6][32];
+	for (size_t f = 0; f < 3; f++)
+		ranks(v + f * m, m, rank + f * m);
 	table_begin(o, heads, 7);
 	for (size_t k = 0; k < m; k++) {
 		const char *cells[7] = {report_str(r[k], "builder")};
-		for (int f = 0; f < 3; f++) {
-			ranks(v + f * m, m, rank);
-			cells[1 + 2 * f] = fig(b[2 * f], 32, f == 2 ? -v[f * m + k] : v[f * m + k],
-			                       f == 2 ? 2 : 3);
-			cells[2 + 2 * f] = fig(b[2 * f + 1], 32, rank[k], rank[k] == floor(rank[k]) ? 0 : 1);
+		for (size_t f = 0; f < 3; f++) {
+			double x = v[f * m + k], at = rank[f * m + k];
+			cells[1 + 2 * f] = fig(b[2 * f], 32, f == 2 ? -x : x, f == 2 ? 2 : 3);
+			cells[2 + 2 * f] = fig(b[2 * f + 1], 32, at, at == floor(at) ? 0 : 1);
 		}
 		table_row(o, cells, 7);
 	}
