@@ -194,6 +194,32 @@ static void test_traversal(void)
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [{\"name\": \"stack\", "
 	    "\"device\": true}, {\"device\": true, \"name\": \"stack\"}] } }";
 	EXPECT_ERROR_AT(t, "\"stack\"}", 0, "names \"stack\" on the device twice");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"primary\", \"shade\"] } }";
+	EXPECT_ERROR_AT(t, "\"shade\"", 0, "'rays.kinds' must be an array of \"primary\", "
+	                "\"diffuse\", \"shadow\" and \"ao\", each at most once, not \"shade\"");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"primary\", \"ao\", \"ao\"] } }";
+	EXPECT_ERROR_AT(t, "\"ao\"", 1, "each at most once, not \"ao\"");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": \"shadow\" } }";
+	EXPECT_ERROR_AT(t, "\"shadow\"", 0, "'rays.kinds' must be an array");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"shadow\"] } }";
+	EXPECT_ERROR_AT(t, "[\"shadow\"]", 0, "'rays.kinds' must name \"primary\"");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"diffuse\": 0, \"kinds\": [\"primary\", "
+	    "\"diffuse\"] } }";
+	EXPECT_ERROR_AT(t, "[\"primary\"", 0, "'rays.kinds' names \"diffuse\" but 'rays.diffuse' is 0");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"light\": [1, 2] } }";
+	EXPECT_ERROR_AT(t, "[1, 2]", 0, "'rays.light' must be an array of 3 finite numbers");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"ao_length\": 0 } }";
+	EXPECT_ERROR_AT(t, "0 }", 0, "'rays.ao_length' must be");
+	{
+		struct config cfg;
+		bvhlab_error err = {""};
+		t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"ao\", \"primary\", "
+		    "\"shadow\"], \"light\": [1, 2, 3], \"ao_length\": 0.25 } }";
+		CHECK_INT(load(&cfg, t, &err), 0);
+		CHECK(cfg.ray_kinds == (1u << RAY_PRIMARY | 1u << RAY_SHADOW | 1u << RAY_AO));
+		CHECK(cfg.has_light && cfg.ray_light[2] == 3.0f && cfg.ray_ao_length == 0.25);
+		config_finish(&cfg);
+	}
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"device\": \"0:x\" } }";
 	EXPECT_ERROR_AT(t, "\"0:x\"", 0, "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or "
 	                "\"P:D\"");

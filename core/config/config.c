@@ -40,6 +40,8 @@ static int set_defaults(struct config *cfg)
 	cfg->ray_rounds = DEFAULT_RAY_ROUNDS;
 	cfg->ray_traversals = 1u << BVHLAB_TRAVERSAL_WIDE;
 	cfg->ray_traversal = BVHLAB_TRAVERSAL_WIDE;
+	cfg->ray_kinds = RAY_KINDS_DEFAULT;
+	cfg->ray_ao_length = DEFAULT_AO_LENGTH;
 	cfg->report_reference = strdup("sah_seq");
 	if (!cfg->report_reference)
 		return -ENOMEM;
@@ -279,6 +281,51 @@ static int check_device(struct config *cfg, const cJSON *rays, bvhlab_error *err
 	                    "not \"%.40s\"", d);
 }
 
+const char *ray_kind_name(int kind)
+{
+	static const char *const names[RAY_KINDS] = {"primary", "diffuse", "shadow", "ao"};
+	return kind >= 0 && kind < RAY_KINDS ? names[kind] : NULL;
+}
+
+static int bad_kinds(struct config *cfg, const cJSON *item, bvhlab_error *err)
+{
+	char got[48];
+	if (cJSON_IsString(item))
+		snprintf(got, sizeof(got), "\"%.40s\"", item->valuestring);
+	else
+		config_describe(cfg, item, got, sizeof(got));
+	return config_error(cfg, item, false, err, "'rays.kinds' must be an array of \"primary\", "
+	                    "\"diffuse\", \"shadow\" and \"ao\", each at most once, not %s", got);
+}
+
+/* "kinds": primary must be among them (the others start at its hits), and
+ * diffuse needs bounces to make ("diffuse" above 0). */
+static int parse_kinds(struct config *cfg, const cJSON *rays, bvhlab_error *err)
+{
+	const cJSON *t = config_member(rays, "kinds"), *item;
+	cfg->has_light = config_member(rays, "light") != NULL;
+	if (!t)
+		return 0;
+	if (!cJSON_IsArray(t) || cJSON_GetArraySize(t) == 0)
+		return bad_kinds(cfg, t, err);
+	cfg->ray_kinds = 0;
+	cJSON_ArrayForEach(item, t) {
+		int k = RAY_KINDS;
+		while (cJSON_IsString(item) && --k >= 0 && strcmp(item->valuestring, ray_kind_name(k)))
+			;
+		if (!cJSON_IsString(item) || k < 0 || (cfg->ray_kinds & (1u << k)))
+			return bad_kinds(cfg, item, err);
+		cfg->ray_kinds |= 1u << k;
+	}
+	if (!(cfg->ray_kinds & (1u << RAY_PRIMARY)))
+		return config_error(cfg, t, false, err, "'rays.kinds' must name \"primary\": the "
+		                    "other kinds of rays start at the primary rays' hits");
+	if ((cfg->ray_kinds & (1u << RAY_DIFFUSE)) && cfg->ray_diffuse == 0)
+		return config_error(cfg, t, false, err, "'rays.kinds' names \"diffuse\" but "
+		                    "'rays.diffuse' is 0 (bounces per primary hit)");
+	return 0;
+}
+
 static int parse_rays(struct config *cfg, bvhlab_error *err)
 {
 	const cJSON *rays = config_member(cfg->root, "rays");
@@ -297,6 +344,8 @@ static int parse_rays(struct config *cfg, bvhlab_error *err)
 		rc = parse_traversal(cfg, rays, err);
 	if (!rc)
 		rc = check_device(cfg, rays, err);
+	if (!rc)
+		rc = parse_kinds(cfg, rays, err);
 	if (!rc)
 		rc = config_parse_camera(cfg, rays, err);
 	return rc;

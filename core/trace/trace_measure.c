@@ -363,9 +363,10 @@ int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
 }
 
 int trace_series_create_like(const struct trace_series *base, const bvhlab_ray *rays,
-                             size_t count, struct trace_series **out)
+                             size_t count, bool any, struct trace_series **out)
 {
 	struct batch b = base->b;
+	b.any = any;
 	b.rays = rays;
 	b.count = count;
 	b.hits = NULL;

@@ -98,6 +98,31 @@ int bvhlab_rays_diffuse(const bvhlab_scene *scene, const bvhlab_ray *primary,
                         const bvhlab_hit *hits, size_t count, uint32_t per_hit, uint64_t seed,
                         bvhlab_ray **rays, size_t *ray_count);
 
+/*
+ * Shadow rays: for every hit of the primary rays, one ray from the hit
+ * point (offset as bvhlab_rays_diffuse's) toward the point `light`, tmax
+ * its distance to the light: an any-hit ray that hits something is in
+ * shadow. *rays is malloc'd, *count rays (may be 0, then *rays is NULL).
+ * 0 or -ENOMEM.
+ */
+int bvhlab_rays_shadow(const bvhlab_scene *scene, const bvhlab_ray *primary,
+                       const bvhlab_hit *hits, size_t count, const float light[3],
+                       bvhlab_ray **rays, size_t *ray_count);
+
+/*
+ * Ambient-occlusion rays: for every hit of the primary rays, one
+ * cosine-weighted ray as bvhlab_rays_diffuse's, of length `length` times
+ * the scene's bounding-box diagonal (tmax): short any-hit rays that mostly
+ * stay near the surface. The same seed gives the same rays. 0 or -ENOMEM.
+ */
+int bvhlab_rays_ao(const bvhlab_scene *scene, const bvhlab_ray *primary,
+                   const bvhlab_hit *hits, size_t count, float length, uint64_t seed,
+                   bvhlab_ray **rays, size_t *ray_count);
+
+/* The default point light of a scene's box: above it by its diagonal,
+ * off to the side of the default camera (an empty box: around the origin). */
+void bvhlab_light_frame(const bvhlab_aabb *bounds, float light[3]);
+
 /* The geometric normal of a triangle (unit length; 0 for a degenerate one). */
 void bvhlab_triangle_normal(const bvhlab_scene *scene, uint32_t prim, float normal[3]);
 
