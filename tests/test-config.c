@@ -151,6 +151,8 @@ static void test_traversal(void)
 		{"\"both\"", BVHLAB_TRAVERSAL_STACK, 3u},
 		{"[\"stackless\", \"wide\"]", BVHLAB_TRAVERSAL_STACKLESS, 6u},
 		{"[\"wide\", \"stack\", \"stackless\"]", BVHLAB_TRAVERSAL_WIDE, 7u},
+		{"[\"wide8\", \"wide4\"]", BVHLAB_TRAVERSAL_WIDE8,
+		 1u << BVHLAB_TRAVERSAL_WIDE4 | 1u << BVHLAB_TRAVERSAL_WIDE8},
 	};
 	for (size_t i = 0; i < sizeof(ok) / sizeof(ok[0]); i++) {
 		char text[256];
@@ -165,8 +167,8 @@ static void test_traversal(void)
 		config_finish(&cfg);
 	}
 	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"wid\" } }";
-	EXPECT_ERROR_AT(t, "\"wid\"", 0, "'rays.traversal' must be \"wide\", \"stack\", "
-	                "\"stackless\", \"both\" (stack and stackless), an entry {\"name\": NAME, "
+	EXPECT_ERROR_AT(t, "\"wid\"", 0, "'rays.traversal' must be \"wide\", \"wide4\", "
+	                "\"wide8\", \"stack\", \"stackless\", \"both\" (stack and stackless), an entry {\"name\": NAME, "
 	                "\"device\": true, \"optional\": true} (both settings may be left out) or "
 	                "an array of those, not \"wid\"");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", 2] } }";
@@ -191,6 +193,9 @@ static void test_traversal(void)
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": {\"name\": \"wide\", "
 	    "\"device\": true} } }";
 	EXPECT_ERROR_AT(t, "\"wide\"", 0, "'rays.traversal' \"wide\" has no device kernel");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": {\"name\": \"wide8\", "
+	    "\"device\": true} } }";
+	EXPECT_ERROR_AT(t, "\"wide8\"", 0, "'rays.traversal' \"wide8\" has no device kernel");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [{\"name\": \"stack\", "
 	    "\"device\": true}, {\"device\": true, \"name\": \"stack\"}] } }";
 	EXPECT_ERROR_AT(t, "\"stack\"}", 0, "names \"stack\" on the device twice");

@@ -346,7 +346,8 @@ static size_t check_kind(const bvhlab_tree *tree, const bvhlab_scene *s, int kin
                          const char *what)
 {
 	static const int traversals[] = {BVHLAB_TRAVERSAL_STACK, BVHLAB_TRAVERSAL_STACKLESS,
-	                                 BVHLAB_TRAVERSAL_WIDE};
+	                                 BVHLAB_TRAVERSAL_WIDE, BVHLAB_TRAVERSAL_WIDE4,
+	                                 BVHLAB_TRAVERSAL_WIDE8};
 	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_STACK, .threads = 2};
 	bvhlab_trace_timing tm;
 	size_t blocked = 0;

@@ -98,8 +98,9 @@ static int resolve_output(struct config *cfg, bvhlab_error *err)
  * traversal is one of these with "device": true). */
 static int traversal_of(const char *name)
 {
-	for (int k = 0; k < BVHLAB_TRAVERSAL_DEVICE_STACK; k++)
-		if (strcmp(name, bvhlab_traversal_name(k)) == 0)
+	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++)
+		if (k != BVHLAB_TRAVERSAL_DEVICE_STACK && k != BVHLAB_TRAVERSAL_DEVICE_STACKLESS &&
+		    strcmp(name, bvhlab_traversal_name(k)) == 0)
 			return k;
 	return -1;
 }
@@ -130,7 +131,8 @@ static int bad_traversal(struct config *cfg, const cJSON *item, bvhlab_error *er
 		snprintf(got, sizeof(got), "\"%.36s%s\"", item->valuestring,
 		         strlen(item->valuestring) > 36 ? "..." : "");
 	return config_error(cfg, item, false, err,
-	                    "'rays.traversal' must be \"wide\", \"stack\", \"stackless\", \"both\" "
+	                    "'rays.traversal' must be \"wide\", \"wide4\", \"wide8\", \"stack\", "
+	                    "\"stackless\", \"both\" "
 	                    "(stack and stackless), an entry {\"name\": NAME, \"device\": true, "
 	                    "\"optional\": true} (both settings may be left out) or an array of "
 	                    "those, not %s",
@@ -188,6 +190,12 @@ static const cJSON *entry_name(struct config *cfg, const cJSON *item, struct ent
 	return name;
 }
 
+static bool trace_is_wide_name(int k)
+{
+	return k == BVHLAB_TRAVERSAL_WIDE || k == BVHLAB_TRAVERSAL_WIDE4 ||
+	       k == BVHLAB_TRAVERSAL_WIDE8;
+}
+
 /* The traversal an entry asks for: its name's, on the device with
  * "device": true (stack and stackless have device kernels). */
 static int entry_traversal(struct config *cfg, const cJSON *name, const struct entry *e,
@@ -198,9 +206,10 @@ static int entry_traversal(struct config *cfg, const cJSON *name, const struct e
 		return bad_traversal(cfg, name, err);
 	if (!e->device)
 		return k;
-	if (k == BVHLAB_TRAVERSAL_WIDE)
-		return config_error(cfg, name, false, err, "'rays.traversal' \"wide\" has no device "
-		                    "kernel: \"device\": true is for \"stack\" and \"stackless\"");
+	if (trace_is_wide_name(k))
+		return config_error(cfg, name, false, err, "'rays.traversal' \"%s\" has no device "
+		                    "kernel: \"device\": true is for \"stack\" and \"stackless\"",
+		                    bvhlab_traversal_name(k));
 	return BVHLAB_TRAVERSAL_DEVICE_STACK + k;
 }
 

@@ -90,6 +90,12 @@ static const char *const csv_numbers[][2] = {
 	{"rays.stackless.ao.mrays_per_s", "%.4f"},
 	{"rays.wide.shadow.mrays_per_s", "%.4f"},
 	{"rays.wide.ao.mrays_per_s", "%.4f"},
+	{"rays.wide4.primary.mrays_per_s", "%.4f"},
+	{"rays.wide4.diffuse.mrays_per_s", "%.4f"},
+	{"rays.wide8.primary.mrays_per_s", "%.4f"},
+	{"rays.wide8.diffuse.mrays_per_s", "%.4f"},
+	{"rays.wide8.shadow.mrays_per_s", "%.4f"},
+	{"rays.wide8.ao.mrays_per_s", "%.4f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary

@@ -54,7 +54,7 @@ static void range_cell(struct strbuf *sb, const cJSON *run, const char *kind)
 
 /* Traversals a scene's table may show beside the main one, by name. */
 static const char *const other_traversals[] = {"wide", "stack", "stackless", "device_stack",
-                                                 "device_stackless"};
+                                                 "device_stackless", "wide4", "wide8"};
 #define OTHERS (sizeof(other_traversals) / sizeof(other_traversals[0]))
 
 static double other_num(const cJSON *run, const char *traversal, const char *what)

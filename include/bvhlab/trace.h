@@ -150,7 +150,12 @@ enum bvhlab_traversal {
 	                                    * (batches only; needs a device backend built:
 	                                    * OpenCL) */
 	BVHLAB_TRAVERSAL_DEVICE_STACKLESS = 4, /* the stackless one likewise */
-	BVHLAB_TRAVERSAL_COUNT = 5      /* how many there are */
+	BVHLAB_TRAVERSAL_WIDE4 = 5,     /* a tree of width 3 or 4 as built, 4 lanes per node
+	                                 * (a binary or wider tree: wide's collapse) */
+	BVHLAB_TRAVERSAL_WIDE8 = 6,     /* a tree of width 5 to 8 as built, 8 lanes per node
+	                                 * with AVX-512VL, AVX2 or portable code chosen at run
+	                                 * time (width 3 or 4: wide4's; binary: wide's) */
+	BVHLAB_TRAVERSAL_COUNT = 7      /* how many there are */
 };
 
 /* The names before the device traversals said what they are, not which
