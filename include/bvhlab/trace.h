@@ -163,7 +163,7 @@ enum bvhlab_traversal {
 #define BVHLAB_TRAVERSAL_CL_STACK BVHLAB_TRAVERSAL_DEVICE_STACK
 #define BVHLAB_TRAVERSAL_CL_STACKLESS BVHLAB_TRAVERSAL_DEVICE_STACKLESS
 
-/* "stack" / "stackless" / "wide" / "device_stack" / "device_stackless"
+/* "stack" / "stackless" / "wide" / "device_stack" / "device_stackless" / "wide4" / "wide8"
  * (the keys of results.json's rays); NULL for another value. */
 const char *bvhlab_traversal_name(int traversal);
 
