@@ -70,7 +70,8 @@ static void test_unknown_keys(void)
 	             "mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
-	                "diffuse, camera, threads, min_ms, rounds, traversal, device); did you mean "
+	                "diffuse, camera, threads, min_ms, rounds, traversal, device, kinds, light, "
+	                "ao_length); did you mean "
 	                "'width'?");
 }
 

@@ -151,6 +151,8 @@ static void test_traversal(void)
 		{"\"both\"", BVHLAB_TRAVERSAL_STACK, 3u},
 		{"[\"stackless\", \"wide\"]", BVHLAB_TRAVERSAL_STACKLESS, 6u},
 		{"[\"wide\", \"stack\", \"stackless\"]", BVHLAB_TRAVERSAL_WIDE, 7u},
+		{"[\"wide8\", \"wide4\"]", BVHLAB_TRAVERSAL_WIDE8,
+		 1u << BVHLAB_TRAVERSAL_WIDE4 | 1u << BVHLAB_TRAVERSAL_WIDE8},
 	};
 	for (size_t i = 0; i < sizeof(ok) / sizeof(ok[0]); i++) {
 		char text[256];
@@ -165,8 +167,8 @@ static void test_traversal(void)
 		config_finish(&cfg);
 	}
 	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"wid\" } }";
-	EXPECT_ERROR_AT(t, "\"wid\"", 0, "'rays.traversal' must be \"wide\", \"stack\", "
-	                "\"stackless\", \"both\" (stack and stackless), an entry {\"name\": NAME, "
+	EXPECT_ERROR_AT(t, "\"wid\"", 0, "'rays.traversal' must be \"wide\", \"wide4\", "
+	                "\"wide8\", \"stack\", \"stackless\", \"both\" (stack and stackless), an entry {\"name\": NAME, "
 	                "\"device\": true, \"optional\": true} (both settings may be left out) or "
 	                "an array of those, not \"wid\"");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", 2] } }";
@@ -191,9 +193,38 @@ static void test_traversal(void)
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": {\"name\": \"wide\", "
 	    "\"device\": true} } }";
 	EXPECT_ERROR_AT(t, "\"wide\"", 0, "'rays.traversal' \"wide\" has no device kernel");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": {\"name\": \"wide8\", "
+	    "\"device\": true} } }";
+	EXPECT_ERROR_AT(t, "\"wide8\"", 0, "'rays.traversal' \"wide8\" has no device kernel");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [{\"name\": \"stack\", "
 	    "\"device\": true}, {\"device\": true, \"name\": \"stack\"}] } }";
 	EXPECT_ERROR_AT(t, "\"stack\"}", 0, "names \"stack\" on the device twice");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"primary\", \"shade\"] } }";
+	EXPECT_ERROR_AT(t, "\"shade\"", 0, "'rays.kinds' must be an array of \"primary\", "
+	                "\"diffuse\", \"shadow\" and \"ao\", each at most once, not \"shade\"");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"primary\", \"ao\", \"ao\"] } }";
+	EXPECT_ERROR_AT(t, "\"ao\"", 1, "each at most once, not \"ao\"");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": \"shadow\" } }";
+	EXPECT_ERROR_AT(t, "\"shadow\"", 0, "'rays.kinds' must be an array");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"shadow\"] } }";
+	EXPECT_ERROR_AT(t, "[\"shadow\"]", 0, "'rays.kinds' must name \"primary\"");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"diffuse\": 0, \"kinds\": [\"primary\", "
+	    "\"diffuse\"] } }";
+	EXPECT_ERROR_AT(t, "[\"primary\"", 0, "'rays.kinds' names \"diffuse\" but 'rays.diffuse' is 0");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"light\": [1, 2] } }";
+	EXPECT_ERROR_AT(t, "[1, 2]", 0, "'rays.light' must be an array of 3 finite numbers");
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"ao_length\": 0 } }";
+	EXPECT_ERROR_AT(t, "0 }", 0, "'rays.ao_length' must be");
+	{
+		struct config cfg;
+		bvhlab_error err = {""};
+		t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"ao\", \"primary\", "
+		    "\"shadow\"], \"light\": [1, 2, 3], \"ao_length\": 0.25 } }";
+		CHECK_INT(load(&cfg, t, &err), 0);
+		CHECK(cfg.ray_kinds == (1u << RAY_PRIMARY | 1u << RAY_SHADOW | 1u << RAY_AO));
+		CHECK(cfg.has_light && cfg.ray_light[2] == 3.0f && cfg.ray_ao_length == 0.25);
+		config_finish(&cfg);
+	}
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"device\": \"0:x\" } }";
 	EXPECT_ERROR_AT(t, "\"0:x\"", 0, "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or "
 	                "\"P:D\"");

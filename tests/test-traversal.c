@@ -2,7 +2,9 @@
  * The stackless and wide traversals against the stack traversal and brute
  * force: the same closest hit (triangle, and t, u, v bit for bit) on
  * hand-made trees with shared edges, coincident triangles (ties) and a
- * deep chain, and on every shared mesh with trees of two builders. The
+ * deep chain; on every shared mesh with trees of two builders and on the
+ * degenerate generated scenes (brute force too there), with primary,
+ * diffuse, shadow and AO rays (the last two any-hit: blocked or not). The
  * timed batch tracer: exact counters of one pass (the binary tree's for
  * every traversal), its repeats and its errors.
  */
@@ -272,7 +274,7 @@ static void test_series(void)
 			bvhlab_trace_closest(&f.tree, &f.scene, &rays[i], &h, NULL);
 			CHECK(same_hit(&h, &hits[i]));
 		}
-		CHECK_INT(trace_series_create_like(s, rays + N / 2, N / 2, &like), 0);
+		CHECK_INT(trace_series_create_like(s, rays + N / 2, N / 2, false, &like), 0);
 		CHECK_INT(trace_series_slice(like, &o), 0);
 		trace_series_timing(like, &tm);
 		CHECK(tm.repeats >= 3 && tm.mrays_median > 0);
@@ -283,64 +285,128 @@ static void test_series(void)
 	fixture_free(&f);
 }
 
-/* Rays of traversal t whose hits differ from a's (n primary, nd diffuse). */
-static size_t differ_from(const bvhlab_tree *tree, const bvhlab_scene *s, int t,
-                          const bvhlab_ray *rays, size_t n, const bvhlab_ray *diffuse,
-                          size_t nd, const bvhlab_hit *a, bvhlab_hit *b)
+/* The kinds of rays a run may measure: primary, then from the primary
+ * hits diffuse bounces, shadow rays and AO rays (the any-hit ones). */
+enum { PRIMARY, DIFFUSE, SHADOW, AO, KINDS };
+static const char *const kind_names[KINDS] = {"primary", "diffuse", "shadow", "ao"};
+
+/* The secondary rays of a kind from the primary rays' hits. */
+static void make_kind(const bvhlab_scene *s, int kind, const bvhlab_ray *primary,
+                      const bvhlab_hit *hits, size_t n, bvhlab_ray **rays, size_t *count)
 {
-	bvhlab_trace_options o = {.traversal = t, .threads = 2};
+	float light[3];
+	bvhlab_light_frame(&s->bounds, light);
+	if (kind == DIFFUSE)
+		CHECK_INT(bvhlab_rays_diffuse(s, primary, hits, n, 1, 5, rays, count), 0);
+	else if (kind == SHADOW)
+		CHECK_INT(bvhlab_rays_shadow(s, primary, hits, n, light, rays, count), 0);
+	else
+		CHECK_INT(bvhlab_rays_ao(s, primary, hits, n, 0.05f, 9, rays, count), 0);
+}
+
+/* Rays of a batch on which traversal t disagrees with the stack
+ * traversal's closest hits ref: another closest hit (bit for bit), or
+ * for the any-hit kinds a ray blocked when ref has no hit or the other way. */
+static size_t kind_differs(const bvhlab_tree *tree, const bvhlab_scene *s, int t, bool any,
+                           const bvhlab_ray *rays, size_t n, const bvhlab_hit *ref)
+{
+	bvhlab_trace_options o = {.traversal = t, .threads = 2, .any_hit = any};
 	bvhlab_trace_timing tm;
+	bvhlab_hit *b = calloc(n, sizeof(*b));
 	size_t differ = 0;
+	CHECK(b != NULL);
+	if (!b)
+		return n;
 	CHECK_INT(bvhlab_trace_measure(tree, s, rays, n, &o, b, NULL, &tm), 0);
-	if (nd)
-		CHECK_INT(bvhlab_trace_measure(tree, s, diffuse, nd, &o, b + n, NULL, &tm), 0);
-	for (size_t i = 0; i < n + nd; i++)
-		differ += !same_hit(&a[i], &b[i]);
+	for (size_t i = 0; i < n; i++)
+		differ += any ? (b[i].prim == BVHLAB_NO_HIT) != (ref[i].prim == BVHLAB_NO_HIT)
+		              : !same_hit(&ref[i], &b[i]);
+	free(b);
 	return differ;
 }
 
-/* Stack, stackless and wide on a builder's tree of a shared mesh: primary
- * and diffuse rays, hits compared bit for bit. */
-static void shared_mesh(const char *file, const char *plugin)
+/* Brute force against the stack traversal's closest hits. */
+static size_t brute_differs(const bvhlab_scene *s, const bvhlab_ray *rays, size_t n,
+                            const bvhlab_hit *ref)
 {
-	bvhlab_scene *s = load_shared(file);
+	size_t differ = 0;
+	for (size_t i = 0; i < n; i++) {
+		bvhlab_hit h;
+		bvhlab_trace_brute(s, &rays[i], &h);
+		differ += !same_hit(&h, &ref[i]);
+	}
+	return differ;
+}
+
+/* One kind's batch on tree: stack closest hits as the reference (their
+ * hits into ref), every traversal (any-hit for shadow and AO) and, when
+ * brute, brute force against it. Rays blocked, for the caller's checks. */
+static size_t check_kind(const bvhlab_tree *tree, const bvhlab_scene *s, int kind,
+                         const bvhlab_ray *rays, size_t n, bvhlab_hit *ref, bool brute,
+                         const char *what)
+{
+	static const int traversals[] = {BVHLAB_TRAVERSAL_STACK, BVHLAB_TRAVERSAL_STACKLESS,
+	                                 BVHLAB_TRAVERSAL_WIDE, BVHLAB_TRAVERSAL_WIDE4,
+	                                 BVHLAB_TRAVERSAL_WIDE8};
+	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_STACK, .threads = 2};
+	bvhlab_trace_timing tm;
+	size_t blocked = 0;
+	CHECK_INT(bvhlab_trace_measure(tree, s, rays, n, &o, ref, NULL, &tm), 0);
+	for (size_t i = 0; i < n; i++)
+		blocked += ref[i].prim != BVHLAB_NO_HIT;
+	bool any = kind == SHADOW || kind == AO;
+	for (size_t t = 0; t < sizeof(traversals) / sizeof(traversals[0]); t++) {
+		if (!any && traversals[t] == BVHLAB_TRAVERSAL_STACK)
+			continue;
+		size_t d = kind_differs(tree, s, traversals[t], any, rays, n, ref);
+		if (d)
+			fprintf(stderr, "%s: %s rays: %zu of %zu differ by %s\n", what, kind_names[kind],
+			        d, n, bvhlab_traversal_name(traversals[t]));
+		CHECK_INT(d, 0);
+	}
+	if (brute)
+		CHECK_INT(brute_differs(s, rays, n, ref), 0);
+	return blocked;
+}
+
+/* Every kind of rays on a builder's tree of a scene, side x side primary
+ * rays: each traversal as the stack one on every ray; brute force too
+ * when brute. blocked[kind] gets the rays that hit something. */
+static void check_scene(const bvhlab_scene *s, const char *plugin, uint32_t side, bool brute,
+                        const char *what, size_t blocked[KINDS])
+{
 	bvhlab_plugin *p = NULL;
 	bvhlab_options opts = {0};
 	bvhlab_prims prims = {0};
 	bvhlab_tree tree = {0};
 	bvhlab_error err = {{0}};
 	bvhlab_camera cam;
-	bvhlab_ray *rays = NULL, *diffuse = NULL;
-	uint32_t side = SCALE(160, 48);
-	size_t n = (size_t)side * side, nd = 0;
-	bvhlab_hit *a = calloc(n * 2, sizeof(*a)), *b = calloc(n * 2, sizeof(*b));
+	bvhlab_ray *primary = NULL;
+	size_t n = (size_t)side * side;
+	bvhlab_hit *a = calloc(n, sizeof(*a)), *b = calloc(n, sizeof(*b));
 	if (!s || !a || !b || bvhlab_prims_init(&prims, s, &err) < 0 ||
 	    bvhlab_plugin_open(plugin, &p, &err) < 0 ||
 	    bvhlab_options_init(&opts, bvhlab_plugin_builder(p)) < 0 ||
 	    bvhlab_build(p, &opts, &prims.input, 1, &tree, &err) < 0) {
-		fprintf(stderr, "%s, %s: %s\n", file, plugin, err.message);
+		fprintf(stderr, "%s, %s: %s\n", what, plugin, err.message);
 		CHECK(0);
 		goto out;
 	}
 	bvhlab_camera_frame(&s->bounds, &cam);
-	CHECK_INT(bvhlab_rays_primary(&cam, side, side, &rays), 0);
-	bvhlab_trace_options o = {.traversal = BVHLAB_TRAVERSAL_STACK, .threads = 2};
-	bvhlab_trace_timing tm;
-	CHECK_INT(bvhlab_trace_measure(&tree, s, rays, n, &o, a, NULL, &tm), 0);
-	CHECK_INT(bvhlab_rays_diffuse(s, rays, a, n, 1, 5, &diffuse, &nd), 0);
-	CHECK(nd > 0 && nd <= n);
-	if (nd)
-		CHECK_INT(bvhlab_trace_measure(&tree, s, diffuse, nd, &o, a + n, NULL, &tm), 0);
-	size_t stackless = differ_from(&tree, s, BVHLAB_TRAVERSAL_STACKLESS, rays, n, diffuse, nd,
-	                               a, b);
-	size_t wide = differ_from(&tree, s, BVHLAB_TRAVERSAL_WIDE, rays, n, diffuse, nd, a, b);
-	printf("%s, %s: %zu primary and %zu diffuse rays, %zu differ stackless, %zu wide\n",
-	       file, plugin, n, nd, stackless, wide);
-	CHECK_INT(stackless, 0);
-	CHECK_INT(wide, 0);
+	CHECK_INT(bvhlab_rays_primary(&cam, side, side, &primary), 0);
+	blocked[PRIMARY] = check_kind(&tree, s, PRIMARY, primary, n, a, brute, what);
+	for (int kind = DIFFUSE; kind < KINDS; kind++) {
+		bvhlab_ray *rays = NULL;
+		size_t count = 0;
+		make_kind(s, kind, primary, a, n, &rays, &count);
+		CHECK(count <= n);
+		blocked[kind] = count ? check_kind(&tree, s, kind, rays, count, b, brute, what) : 0;
+		printf("%s, %s: %zu %s rays, %zu hit something\n", what, plugin, count,
+		       kind_names[kind], blocked[kind]);
+		free(rays);
+	}
 out:
-	free(rays);
-	free(diffuse);
+	free(primary);
 	free(a);
 	free(b);
 	bvhlab_tree_finish(&tree);
@@ -348,9 +414,10 @@ out:
 		bvhlab_options_finish(&opts);
 	bvhlab_plugin_close(p);
 	bvhlab_prims_finish(&prims);
-	bvhlab_scene_destroy(s);
 }
 
+/* Stack, stackless and wide on two builders' trees of the shared meshes:
+ * primary, diffuse, shadow and AO rays. */
 static void test_shared_meshes(void)
 {
 	static const char *const files[] = {"stanford-bunny.obj", "ogre.obj", "nefertiti.obj",
@@ -361,9 +428,48 @@ static void test_shared_meshes(void)
 		return;
 	}
 	for (size_t i = 0; i < sizeof(files) / sizeof(files[0]); i++) {
-		shared_mesh(files[i], "sah_seq");
-		shared_mesh(files[i], "lbvh");
+		bvhlab_scene *s = load_shared(files[i]);
+		size_t blocked[KINDS];
+		check_scene(s, "sah_seq", SCALE(160, 48), false, files[i], blocked);
+		/* The default light is above and aside: a closed mesh shadows
+		 * its own far side, so some shadow rays must be blocked. */
+		CHECK(blocked[SHADOW] > 0);
+		check_scene(s, "lbvh", SCALE(160, 48), false, files[i], blocked);
+		bvhlab_scene_destroy(s);
 	}
+}
+
+/* The degenerate generated scenes (needles, a sparse stadium, a soup of
+ * crossing triangles, a room seen from outside), small enough for brute
+ * force on every ray of every kind. */
+static void test_generated(void)
+{
+	static const struct {
+		const char *generator;
+		uint32_t count;
+	} scenes[] = {{"needles", 300}, {"stadium", 300}, {"soup", 400}, {"room", 0}};
+	size_t any_blocked[KINDS] = {0};
+	for (size_t i = 0; i < sizeof(scenes) / sizeof(scenes[0]); i++) {
+		bvhlab_scene *s = NULL;
+		bvhlab_error err = {{0}};
+		size_t blocked[KINDS] = {0};
+		bvhlab_gen_params params;
+		bvhlab_gen_params_init(&params);
+		params.count = scenes[i].count ? scenes[i].count : params.count;
+		params.seed = 3 + i;
+		if (bvhlab_scene_generate(scenes[i].generator, &params, &s, &err) < 0) {
+			fprintf(stderr, "%s: %s\n", scenes[i].generator, err.message);
+			CHECK(0);
+			continue;
+		}
+		check_scene(s, "sah_seq", 40, true, scenes[i].generator, blocked);
+		for (int k = 0; k < KINDS; k++)
+			any_blocked[k] += blocked[k];
+		bvhlab_scene_destroy(s);
+	}
+	/* Not vacuous: some rays of every kind hit something. */
+	for (int k = 0; k < KINDS; k++)
+		CHECK(any_blocked[k] > 0);
 }
 
 int main(void)
@@ -373,6 +479,7 @@ int main(void)
 	test_chain();
 	test_measure();
 	test_series();
+	test_generated();
 	test_shared_meshes();
 	return test_finish();
 }

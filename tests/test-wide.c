@@ -4,9 +4,11 @@
  * shared mesh, is validated, compared, measured and traced like a binary
  * one: valid, equal to itself in another node order and to the collapse of
  * a rebuild, unequal to the binary tree, the same leaves, a lower depth,
- * and every traversal (stack, stackless, the wide view, the device ones
+ * and every traversal (stack, stackless, the wide view, wide4 and wide8
+ * on the tree as built, wide8 on each of its code paths, the device ones
  * where a device is there) finds the same closest hits as in the binary
- * tree it came from. The binary-only stages refuse it by name. Builds over
+ * tree it came from, and the CPU ones the same rays blocked as any-hit
+ * primary and shadow rays. The binary-only stages refuse it by name. Builds over
  * boxes (ABI 1.5 prim_kind): lbvh, ploc and sah_seq build a top-level tree
  * over instance boxes that validates (every box inside its leaf's box,
  * every id once); a triangle-only builder is refused by name.
@@ -115,21 +117,81 @@ static bool trace(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhl
 	return rc == 0;
 }
 
+/* Rays of an any-hit batch by traversal `trav` blocked exactly when the
+ * closest hits `ref` have a hit: how many are not. */
+static size_t any_differs(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                          const bvhlab_ray *rays, size_t n, int trav, const bvhlab_hit *ref,
+                          bvhlab_hit *hits)
+{
+	bvhlab_trace_options o = { .traversal = trav, .threads = 2, .min_repeats = 1,
+	                           .max_repeats = 1, .any_hit = true };
+	bvhlab_trace_timing timing;
+	size_t bad = 0;
+	CHECK_INT(bvhlab_trace_measure(tree, scene, rays, n, &o, hits, NULL, &timing), 0);
+	for (size_t i = 0; i < n; i++)
+		bad += (hits[i].prim == BVHLAB_NO_HIT) != (ref[i].prim == BVHLAB_NO_HIT);
+	return bad;
+}
+
+/* One CPU traversal on `wide`: the closest hits of ref, and as any-hit
+ * rays the same rays blocked, and the shadow rays blocked as the stack
+ * traversal's closest hits (shadow_ref) say. */
+static void check_cpu(const char *what, const bvhlab_scene *scene, const bvhlab_tree *wide,
+                      int trav, const bvhlab_ray *rays, size_t n, const bvhlab_hit *ref,
+                      const bvhlab_ray *shadow, size_t ns, const bvhlab_hit *shadow_ref,
+                      bvhlab_hit *hits)
+{
+	if (!trace(wide, scene, rays, n, trav, hits))
+		return;
+	check_same_hits(what, scene, rays, ref, hits, n);
+	size_t bad = any_differs(wide, scene, rays, n, trav, ref, hits);
+	if (ns)
+		bad += any_differs(wide, scene, shadow, ns, trav, shadow_ref, hits);
+	if (bad)
+		fprintf(stderr, "%s: %zu any-hit rays (primary and shadow) disagree\n", what, bad);
+	CHECK_INT(bad, 0);
+}
+
 /* Every traversal finds in `wide` the closest hits `ref` (the binary
- * tree's, stack traversal) has. */
+ * tree's, stack traversal) has; the CPU ones also agree on any-hit
+ * primary and shadow rays, wide8 with each code path this CPU runs. */
 static void check_traced(const char *name, const bvhlab_scene *scene, const bvhlab_tree *wide,
                          const bvhlab_ray *rays, size_t n, const bvhlab_hit *ref)
 {
-	bvhlab_hit *hits = malloc(n * sizeof(*hits));
+	static const char *const isas[] = { "portable", "avx2", "avx512" };
+	bvhlab_hit *hits = malloc(n * sizeof(*hits)), *shadow_ref = NULL;
+	bvhlab_ray *shadow = NULL;
+	size_t ns = 0;
+	float light[3];
+	bvhlab_light_frame(&scene->bounds, light);
+	CHECK_INT(bvhlab_rays_shadow(scene, rays, ref, n, light, &shadow, &ns), 0);
+	shadow_ref = ns ? malloc(ns * sizeof(*shadow_ref)) : NULL;
+	if (ns && (!shadow_ref || !trace(wide, scene, shadow, ns, BVHLAB_TRAVERSAL_STACK,
+	                                 shadow_ref)))
+		ns = 0;
 	CHECK(hits != NULL);
 	for (int trav = 0; hits && trav < BVHLAB_TRAVERSAL_COUNT; trav++) {
 		char what[96];
 		snprintf(what, sizeof(what), "%s %u-wide %s", name, wide->width,
 		         bvhlab_traversal_name(trav));
-		if (trace(wide, scene, rays, n, trav, hits))
-			check_same_hits(what, scene, rays, ref, hits, n);
+		if (trav == BVHLAB_TRAVERSAL_DEVICE_STACK || trav == BVHLAB_TRAVERSAL_DEVICE_STACKLESS) {
+			if (trace(wide, scene, rays, n, trav, hits))
+				check_same_hits(what, scene, rays, ref, hits, n);
+			continue;
+		}
+		for (size_t k = 0; k < (trav == BVHLAB_TRAVERSAL_WIDE8 ? 3u : 1u); k++) {
+			char isa[128];
+			snprintf(isa, sizeof(isa), "%s%s%s", what, trav == BVHLAB_TRAVERSAL_WIDE8 ? " " : "",
+			         trav == BVHLAB_TRAVERSAL_WIDE8 ? isas[k] : "");
+			if (trav == BVHLAB_TRAVERSAL_WIDE8)
+				setenv("BVHLAB_WIDE8_ISA", isas[k], 1);
+			check_cpu(isa, scene, wide, trav, rays, n, ref, shadow, ns, shadow_ref, hits);
+		}
+		unsetenv("BVHLAB_WIDE8_ISA");
 	}
 	free(hits);
+	free(shadow);
+	free(shadow_ref);
 }
 
 /* One width on one scene: the judges on the collapsed tree. */

@@ -40,6 +40,8 @@ static int set_defaults(struct config *cfg)
 	cfg->ray_rounds = DEFAULT_RAY_ROUNDS;
 	cfg->ray_traversals = 1u << BVHLAB_TRAVERSAL_WIDE;
 	cfg->ray_traversal = BVHLAB_TRAVERSAL_WIDE;
+	cfg->ray_kinds = RAY_KINDS_DEFAULT;
+	cfg->ray_ao_length = DEFAULT_AO_LENGTH;
 	cfg->report_reference = strdup("sah_seq");
 	if (!cfg->report_reference)
 		return -ENOMEM;
@@ -96,8 +98,9 @@ static int resolve_output(struct config *cfg, bvhlab_error *err)
  * traversal is one of these with "device": true). */
 static int traversal_of(const char *name)
 {
-	for (int k = 0; k < BVHLAB_TRAVERSAL_DEVICE_STACK; k++)
-		if (strcmp(name, bvhlab_traversal_name(k)) == 0)
+	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++)
+		if (k != BVHLAB_TRAVERSAL_DEVICE_STACK && k != BVHLAB_TRAVERSAL_DEVICE_STACKLESS &&
+		    strcmp(name, bvhlab_traversal_name(k)) == 0)
 			return k;
 	return -1;
 }
@@ -128,7 +131,8 @@ static int bad_traversal(struct config *cfg, const cJSON *item, bvhlab_error *er
 		snprintf(got, sizeof(got), "\"%.36s%s\"", item->valuestring,
 		         strlen(item->valuestring) > 36 ? "..." : "");
 	return config_error(cfg, item, false, err,
-	                    "'rays.traversal' must be \"wide\", \"stack\", \"stackless\", \"both\" "
+	                    "'rays.traversal' must be \"wide\", \"wide4\", \"wide8\", \"stack\", "
+	                    "\"stackless\", \"both\" "
 	                    "(stack and stackless), an entry {\"name\": NAME, \"device\": true, "
 	                    "\"optional\": true} (both settings may be left out) or an array of "
 	                    "those, not %s",
@@ -186,6 +190,12 @@ static const cJSON *entry_name(struct config *cfg, const cJSON *item, struct ent
 	return name;
 }
 
+static bool trace_is_wide_name(int k)
+{
+	return k == BVHLAB_TRAVERSAL_WIDE || k == BVHLAB_TRAVERSAL_WIDE4 ||
+	       k == BVHLAB_TRAVERSAL_WIDE8;
+}
+
 /* The traversal an entry asks for: its name's, on the device with
  * "device": true (stack and stackless have device kernels). */
 static int entry_traversal(struct config *cfg, const cJSON *name, const struct entry *e,
@@ -196,9 +206,10 @@ static int entry_traversal(struct config *cfg, const cJSON *name, const struct e
 		return bad_traversal(cfg, name, err);
 	if (!e->device)
 		return k;
-	if (k == BVHLAB_TRAVERSAL_WIDE)
-		return config_error(cfg, name, false, err, "'rays.traversal' \"wide\" has no device "
-		                    "kernel: \"device\": true is for \"stack\" and \"stackless\"");
+	if (trace_is_wide_name(k))
+		return config_error(cfg, name, false, err, "'rays.traversal' \"%s\" has no device "
+		                    "kernel: \"device\": true is for \"stack\" and \"stackless\"",
+		                    bvhlab_traversal_name(k));
 	return BVHLAB_TRAVERSAL_DEVICE_STACK + k;
 }
 
@@ -279,6 +290,51 @@ static int check_device(struct config *cfg, const cJSON *rays, bvhlab_error *err
 	                    "not \"%.40s\"", d);
 }
 
+const char *ray_kind_name(int kind)
+{
+	static const char *const names[RAY_KINDS] = {"primary", "diffuse", "shadow", "ao"};
+	return kind >= 0 && kind < RAY_KINDS ? names[kind] : NULL;
+}
+
+static int bad_kinds(struct config *cfg, const cJSON *item, bvhlab_error *err)
+{
+	char got[48];
+	if (cJSON_IsString(item))
+		snprintf(got, sizeof(got), "\"%.40s\"", item->valuestring);
+	else
+		config_describe(cfg, item, got, sizeof(got));
+	return config_error(cfg, item, false, err, "'rays.kinds' must be an array of \"primary\", "
+	                    "\"diffuse\", \"shadow\" and \"ao\", each at most once, not %s", got);
+}
+
+/* "kinds": primary must be among them (the others start at its hits), and
+ * diffuse needs bounces to make ("diffuse" above 0). */
+static int parse_kinds(struct config *cfg, const cJSON *rays, bvhlab_error *err)
+{
+	const cJSON *t = config_member(rays, "kinds"), *item;
+	cfg->has_light = config_member(rays, "light") != NULL;
+	if (!t)
+		return 0;
+	if (!cJSON_IsArray(t) || cJSON_GetArraySize(t) == 0)
+		return bad_kinds(cfg, t, err);
+	cfg->ray_kinds = 0;
+	cJSON_ArrayForEach(item, t) {
+		int k = RAY_KINDS;
+		while (cJSON_IsString(item) && --k >= 0 && strcmp(item->valuestring, ray_kind_name(k)))
+			;
+		if (!cJSON_IsString(item) || k < 0 || (cfg->ray_kinds & (1u << k)))
+			return bad_kinds(cfg, item, err);
+		cfg->ray_kinds |= 1u << k;
+	}
+	if (!(cfg->ray_kinds & (1u << RAY_PRIMARY)))
+		return config_error(cfg, t, false, err, "'rays.kinds' must name \"primary\": the "
+		                    "other kinds of rays start at the primary rays' hits");
+	if ((cfg->ray_kinds & (1u << RAY_DIFFUSE)) && cfg->ray_diffuse == 0)
+		return config_error(cfg, t, false, err, "'rays.kinds' names \"diffuse\" but "
+		                    "'rays.diffuse' is 0 (bounces per primary hit)");
+	return 0;
+}
+
 static int parse_rays(struct config *cfg, bvhlab_error *err)
 {
 	const cJSON *rays = config_member(cfg->root, "rays");
@@ -297,6 +353,8 @@ static int parse_rays(struct config *cfg, bvhlab_error *err)
 		rc = parse_traversal(cfg, rays, err);
 	if (!rc)
 		rc = check_device(cfg, rays, err);
+	if (!rc)
+		rc = parse_kinds(cfg, rays, err);
 	if (!rc)
 		rc = config_parse_camera(cfg, rays, err);
 	return rc;

@@ -118,6 +118,22 @@ struct config_grid_pick {
 	size_t index;
 };
 
+/* The kinds of rays a run is measured with ("rays": "kinds"): primary from
+ * the camera; from their hits diffuse bounces (closest hit), shadow rays
+ * toward a point light and short ambient-occlusion rays (both any hit). */
+enum ray_kind { RAY_PRIMARY, RAY_DIFFUSE, RAY_SHADOW, RAY_AO, RAY_KINDS };
+#define RAY_KINDS_DEFAULT (1u << RAY_PRIMARY | 1u << RAY_DIFFUSE)
+#define DEFAULT_AO_LENGTH 0.05
+
+/* "primary", "diffuse", "shadow", "ao" (the keys of results.json's rays);
+ * NULL for another value. (config.c) */
+const char *ray_kind_name(int kind);
+/* Whether a kind's rays are any-hit (occlusion) rays. */
+static inline bool ray_kind_any(int kind)
+{
+	return kind == RAY_SHADOW || kind == RAY_AO;
+}
+
 struct config {
 	char *path;        /* the file as given */
 	char *dir;         /* its folder: relative paths resolve against it */
@@ -144,6 +160,13 @@ struct config {
 	                          * of names, default wide: bit (1 << enum
 	                          * bvhlab_traversal) per traversal */
 	int ray_traversal; /* the main one (stack for "both", the first of an array) */
+	unsigned ray_kinds; /* "rays": "kinds", an array of ray_kind names, default
+	                     * ["primary", "diffuse"]: bit (1 << enum ray_kind) per kind
+	                     * measured; primary always (the others start at its hits) */
+	float ray_light[3]; /* "rays": "light", the shadow rays' point light */
+	bool has_light;     /* "light" given; else bvhlab_light_frame of each scene */
+	double ray_ao_length; /* "rays": "ao_length", the AO rays' length as a fraction of
+	                       * the scene's diagonal, default 0.05 */
 	char *ray_device; /* "rays": "device", the cl_ traversals' OpenCL device spec
 	                   * (auto|gpu|cpu|P:D); NULL: auto */
 	char *report_reference; /* "report": {"reference"}, default "sah_seq": a builder

@@ -60,6 +60,9 @@ const struct config_key config_ray_keys[] = {
 	TOP("rounds", CONFIG_U32, ray_rounds, 1, MAX_RAY_ROUNDS),
 	CUSTOM("traversal"), /* a name, "both" or an array of names: config.c */
 	TOP("device", CONFIG_STRING, ray_device, 0, 0), /* checked in config.c */
+	CUSTOM("kinds"), /* an array of ray kind names: config.c */
+	TOP("light", CONFIG_VEC3, ray_light, 0, 0),
+	TOP("ao_length", CONFIG_POSITIVE, ray_ao_length, 0, 0),
 	END,
 };
 

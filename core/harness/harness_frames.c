@@ -137,6 +137,7 @@ static void measure(const struct frames_job *job, const bvhlab_scene *scene,
 	fm->sah = st.sah_cost;
 	harness_ray_settings(job->cfg, &rs);
 	rs.diffuse = 0;
+	rs.kinds = 1u << RAY_PRIMARY; /* a frame reports its primary rays only */
 	rs.min_ms /= rs.rounds;
 	rs.min_repeats = 1;
 	if (rs.width && rs.height && harness_trace_rays(tree, scene, cam, &rs, &m, NULL, NULL) == 0) {

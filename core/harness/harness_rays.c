@@ -36,19 +36,28 @@ void harness_ray_settings(const struct config *cfg, struct ray_settings *rs)
 {
 	if (!cfg) {
 		*rs = (struct ray_settings){.traversals = 1u << BVHLAB_TRAVERSAL_STACK,
-		                            .main = BVHLAB_TRAVERSAL_STACK, .rounds = 1};
+		                            .main = BVHLAB_TRAVERSAL_STACK, .rounds = 1,
+		                            .kinds = RAY_KINDS_DEFAULT};
 		return;
 	}
 	*rs = (struct ray_settings){.width = cfg->ray_width, .height = cfg->ray_height,
-	                            .diffuse = cfg->ray_diffuse, .threads = cfg->ray_threads,
+	                            .diffuse = cfg->ray_diffuse, .kinds = cfg->ray_kinds,
+	                            .has_light = cfg->has_light,
+	                            .light = {cfg->ray_light[0], cfg->ray_light[1],
+	                                      cfg->ray_light[2]},
+	                            .ao_length = (float)cfg->ray_ao_length,
+	                            .threads = cfg->ray_threads,
 	                            .min_ms = cfg->ray_min_ms, .min_repeats = HARNESS_MIN_REPEATS,
 	                            .rounds = cfg->ray_rounds, .traversals = cfg->ray_traversals,
 	                            .main = cfg->ray_traversal, .device = cfg->ray_device};
 }
 
-/* Same triangle at bit-identical t, u, v. */
-static bool same_hit(const bvhlab_hit *a, const bvhlab_hit *b)
+/* Same triangle at bit-identical t, u, v; for any-hit rays, which may
+ * stop at any hit, whether either hit anything. */
+static bool same_hit(const bvhlab_hit *a, const bvhlab_hit *b, bool any)
 {
+	if (any)
+		return (a->prim == BVHLAB_NO_HIT) == (b->prim == BVHLAB_NO_HIT);
 	return a->prim == b->prim && memcmp(&a->t, &b->t, sizeof(a->t)) == 0 &&
 	       memcmp(&a->u, &b->u, sizeof(a->u)) == 0 && memcmp(&a->v, &b->v, sizeof(a->v)) == 0;
 }
@@ -102,10 +111,11 @@ static int measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvh
  */
 static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
                       const bvhlab_ray *rays, size_t n, const struct ray_settings *rs,
-                      bvhlab_trace_timing *out, bvhlab_hit *hits, uint32_t *nodes,
-                      struct ray_metrics *m)
+                      int kind, bvhlab_hit *hits, uint32_t *nodes, struct ray_metrics *m)
 {
+	bvhlab_trace_timing *out = ray_metrics_kind(m, kind);
 	bvhlab_trace_options o = {.traversal = rs->main, .threads = rs->threads,
+	                          .any_hit = ray_kind_any(kind),
 	                          .min_ms = rs->min_ms, .min_repeats = rs->min_repeats,
 	                          .device = rs->device};
 	int r = measure(tree, scene, rays, n, &o, hits, nodes, &out[rs->main], m);
@@ -119,7 +129,7 @@ static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
 		o.traversal = k;
 		if (measure(tree, scene, rays, n, &o, other, NULL, &out[k], m) == 0) {
 			for (size_t i = 0; i < n; i++)
-				m->disagreements += !same_hit(&hits[i], &other[i]);
+				m->disagreements += !same_hit(&hits[i], &other[i], o.any_hit);
 		} else { /* this traversal only (no device, say): the others go on */
 			m->traversals &= ~(1u << k);
 			out[k] = (bvhlab_trace_timing){0};
@@ -129,19 +139,49 @@ static int trace_kind(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	return r;
 }
 
-static int trace_diffuse(const bvhlab_tree *tree, const bvhlab_scene *scene,
-                         const bvhlab_ray *primary, const bvhlab_hit *hits, size_t n,
-                         const struct ray_settings *rs, struct ray_metrics *m)
+int harness_secondary_rays(int kind, const bvhlab_scene *scene, const struct ray_settings *rs,
+                           const bvhlab_ray *primary, const bvhlab_hit *hits, size_t n,
+                           bvhlab_ray **rays, size_t *count)
 {
-	bvhlab_ray *rays = NULL;
-	size_t count = 0;
-	int r = bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, HARNESS_DIFFUSE_SEED,
-	                            &rays, &count);
-	bvhlab_hit *dh = r == 0 && count ? malloc(count * sizeof(*dh)) : NULL;
-	if (r == 0 && count)
-		r = dh ? trace_kind(tree, scene, rays, count, rs, m->diffuse, dh, NULL, m) : -ENOMEM;
-	free(dh);
-	free(rays);
+	float light[3];
+	*rays = NULL;
+	*count = 0;
+	if (!(rs->kinds & (1u << kind)))
+		return 0;
+	switch (kind) {
+	case RAY_DIFFUSE:
+		return bvhlab_rays_diffuse(scene, primary, hits, n, rs->diffuse, HARNESS_DIFFUSE_SEED,
+		                           rays, count);
+	case RAY_SHADOW:
+		if (rs->has_light)
+			memcpy(light, rs->light, sizeof(light));
+		else
+			bvhlab_light_frame(&scene->bounds, light);
+		return bvhlab_rays_shadow(scene, primary, hits, n, light, rays, count);
+	case RAY_AO:
+		return bvhlab_rays_ao(scene, primary, hits, n, rs->ao_length, HARNESS_AO_SEED, rays,
+		                      count);
+	default:
+		return 0;
+	}
+}
+
+/* Every secondary kind of rs from the primary rays' hits. */
+static int trace_secondary(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                           const bvhlab_ray *primary, const bvhlab_hit *hits, size_t n,
+                           const struct ray_settings *rs, struct ray_metrics *m)
+{
+	int r = 0;
+	for (int kind = RAY_DIFFUSE; r == 0 && kind < RAY_KINDS; kind++) {
+		bvhlab_ray *rays = NULL;
+		size_t count = 0;
+		r = harness_secondary_rays(kind, scene, rs, primary, hits, n, &rays, &count);
+		bvhlab_hit *h = r == 0 && count ? malloc(count * sizeof(*h)) : NULL;
+		if (r == 0 && count)
+			r = h ? trace_kind(tree, scene, rays, count, rs, kind, h, NULL, m) : -ENOMEM;
+		free(h);
+		free(rays);
+	}
 	return r;
 }
 
@@ -154,6 +194,7 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	memset(m, 0, sizeof(*m));
 	m->traversals = rs->traversals;
 	m->main = rs->main;
+	m->kinds = rs->kinds;
 	m->rounds = 1;
 	int r = bvhlab_rays_primary(cam, rs->width, rs->height, &rays);
 	if (r < 0) {
@@ -165,11 +206,11 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
 		r = -ENOMEM;
 		goto out;
 	}
-	r = trace_kind(tree, scene, rays, n, rs, m->primary, hits, nodes, m);
+	r = trace_kind(tree, scene, rays, n, rs, RAY_PRIMARY, hits, nodes, m);
 	if (r == 0 && shade)
 		image_shade(scene, rays, hits, n, shade);
 	if (r == 0)
-		r = trace_diffuse(tree, scene, rays, hits, n, rs, m);
+		r = trace_secondary(tree, scene, rays, hits, n, rs, m);
 	m->measured = r == 0;
 	if (r < 0 && !m->error[0])
 		snprintf(m->error, sizeof(m->error), "%s", strerror(-r));

@@ -14,13 +14,18 @@
 /* Each tile keeps its best of at least this many passes (see
  * bvhlab_trace_timing): enough chances to run undisturbed. */
 #define HARNESS_MIN_REPEATS 10
-/* Diffuse rays: the same for every builder of a scene. */
+/* Diffuse and AO rays: the same for every builder of a scene. */
 #define HARNESS_DIFFUSE_SEED 0xd1ff05eULL
+#define HARNESS_AO_SEED 0xa0a0a0ULL
 
 /* What rays a run is measured with: the config's "rays". */
 struct ray_settings {
 	uint32_t width, height; /* primary rays: one per pixel */
 	uint32_t diffuse;       /* bounces per primary hit */
+	unsigned kinds;         /* bit (1 << enum ray_kind) per kind measured */
+	bool has_light;         /* light given; else bvhlab_light_frame per scene */
+	float light[3];         /* the shadow rays' point light */
+	float ao_length;        /* the AO rays' length, a fraction of the scene's diagonal */
 	uint32_t threads;       /* tracing threads; 0: all hardware threads */
 	double min_ms;          /* each batch is repeated for at least this long */
 	uint32_t min_repeats;   /* ... and at least this many passes */
@@ -37,7 +42,18 @@ void harness_ray_settings(const struct config *cfg, struct ray_settings *rs);
 void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam);
 
 /*
- * Primary rays (width x height) and `diffuse` bounces per primary hit,
+ * The rays of a secondary kind (diffuse, shadow, ao) from the primary
+ * rays' hits, as rs asks for them: the same for every tree of a scene
+ * given the same hits. *rays malloc'd (NULL when *count is 0); no rays
+ * when rs does not measure the kind. 0 or -ENOMEM.
+ */
+int harness_secondary_rays(int kind, const bvhlab_scene *scene, const struct ray_settings *rs,
+                           const bvhlab_ray *primary, const bvhlab_hit *hits, size_t n,
+                           bvhlab_ray **rays, size_t *count);
+
+/*
+ * Primary rays (width x height) and, from their hits, the secondary kinds
+ * of rs (`diffuse` bounces per hit, shadow and AO rays),
  * each batch timed (bvhlab_trace_measure) with every traversal of rs.
  * nodes ([width * height], may be NULL) gets nodes visited per pixel,
  * shade ([3 * width * height], may be NULL) the shaded render, both from

@@ -148,17 +148,18 @@ void harness_rounds_finish(struct harness_rounds *r)
 struct timed_tree {
 	bvhlab_tree tree;
 	bvhlab_hit *hits; /* the main primary series' first pass, until the
-	                   * diffuse rays are made from it */
-	bvhlab_ray *diffuse;
-	size_t diffuse_count;
-	struct trace_series *primary[BVHLAB_TRAVERSAL_COUNT], *bounce[BVHLAB_TRAVERSAL_COUNT];
+	                   * secondary rays are made from it */
+	bvhlab_ray *secondary[RAY_KINDS]; /* by enum ray_kind, primary's unused */
+	size_t secondary_count[RAY_KINDS];
+	struct trace_series *primary[BVHLAB_TRAVERSAL_COUNT];
+	struct trace_series *bounce[RAY_KINDS][BVHLAB_TRAVERSAL_COUNT]; /* by kind */
 };
 
 /* What comes back per entry. */
 struct rounds_slot {
 	uint32_t ok;
-	uint64_t diffuse_rays; /* the rounds' diffuse batch: the run's, or none is taken */
-	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
+	uint64_t rays[RAY_KINDS]; /* the rounds' secondary batches: the run's, or none is taken */
+	bvhlab_trace_timing timing[RAY_KINDS][BVHLAB_TRAVERSAL_COUNT]; /* by kind */
 };
 
 struct rounds_job {
@@ -211,11 +212,13 @@ static int load_tree(const char *path, bvhlab_tree *t)
 static void free_timed(struct timed_tree *tt)
 {
 	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
-		trace_series_destroy(tt->bounce[k]); /* borrows primary[k]'s copies */
+		for (int kind = 0; kind < RAY_KINDS; kind++) /* borrow primary[k]'s copies */
+			trace_series_destroy(tt->bounce[kind][k]);
 		trace_series_destroy(tt->primary[k]);
 	}
 	free(tt->hits);
-	free(tt->diffuse);
+	for (int kind = 0; kind < RAY_KINDS; kind++)
+		free(tt->secondary[kind]);
 	free(tt->tree.nodes);
 	free(tt->tree.prim_index);
 	*tt = (struct timed_tree){0};
@@ -249,22 +252,23 @@ static int prepare(const struct rounds_job *job, const struct rounds_entry *e,
 	return r;
 }
 
-/* After the main primary series' first slice: the diffuse rays from its
- * hits, as the run's child made them, and a series for them beside each
- * primary one, on its copies. */
+/* After the main primary series' first slice: the secondary rays from
+ * its hits, as the run's child made them, and a series for each kind
+ * beside each primary one, on its copies. */
 static int make_bounces(const struct rounds_job *job, struct timed_tree *tt)
 {
-	const struct ray_settings *rs = &job->rs;
 	int r = 0;
-	if (rs->diffuse)
-		r = bvhlab_rays_diffuse(job->scene, job->primary, tt->hits, job->n, rs->diffuse,
-		                        HARNESS_DIFFUSE_SEED, &tt->diffuse, &tt->diffuse_count);
+	for (int kind = RAY_DIFFUSE; r == 0 && kind < RAY_KINDS; kind++)
+		r = harness_secondary_rays(kind, job->scene, &job->rs, job->primary, tt->hits, job->n,
+		                           &tt->secondary[kind], &tt->secondary_count[kind]);
 	free(tt->hits);
 	tt->hits = NULL;
-	for (int k = 0; r == 0 && tt->diffuse_count && k < BVHLAB_TRAVERSAL_COUNT; k++) {
-		if (tt->primary[k])
-			r = trace_series_create_like(tt->primary[k], tt->diffuse, tt->diffuse_count,
-			                             &tt->bounce[k]);
+	for (int kind = RAY_DIFFUSE; r == 0 && kind < RAY_KINDS; kind++) {
+		for (int k = 0; r == 0 && tt->secondary_count[kind] && k < BVHLAB_TRAVERSAL_COUNT; k++)
+			if (tt->primary[k])
+				r = trace_series_create_like(tt->primary[k], tt->secondary[kind],
+				                             tt->secondary_count[kind], ray_kind_any(kind),
+				                             &tt->bounce[kind][k]);
 	}
 	return r;
 }
@@ -299,7 +303,8 @@ static void one_round(const struct rounds_job *job, struct timed_tree *tt,
 		for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
 			if (k != rs->main)
 				slice(tt[i].primary[k], &all, &o);
-			slice(tt[i].bounce[k], &all, &o);
+			for (int kind = RAY_DIFFUSE; kind < RAY_KINDS; kind++)
+				slice(tt[i].bounce[kind][k], &all, &o);
 		}
 	}
 }
@@ -308,14 +313,15 @@ static void one_round(const struct rounds_job *job, struct timed_tree *tt,
  * leaves the run its own figures. */
 static void collect(struct timed_tree *tt, struct rounds_slot *slot)
 {
-	slot->diffuse_rays = tt->diffuse_count;
+	for (int kind = 0; kind < RAY_KINDS; kind++)
+		slot->rays[kind] = tt->secondary_count[kind];
 	for (int k = 0; slot->ok && k < BVHLAB_TRAVERSAL_COUNT; k++) {
-		if (tt->primary[k])
-			trace_series_timing(tt->primary[k], &slot->primary[k]);
-		if (tt->bounce[k])
-			trace_series_timing(tt->bounce[k], &slot->diffuse[k]);
-		slot->ok = (!tt->primary[k] || slot->primary[k].repeats) &&
-		           (!tt->bounce[k] || slot->diffuse[k].repeats);
+		for (int kind = 0; kind < RAY_KINDS; kind++) {
+			struct trace_series *s = kind ? tt->bounce[kind][k] : tt->primary[k];
+			if (s)
+				trace_series_timing(s, &slot->timing[kind][k]);
+			slot->ok = slot->ok && (!s || slot->timing[kind][k].repeats);
+		}
 	}
 }
 
@@ -350,11 +356,21 @@ out:
 	free(primary);
 }
 
-/* Long enough for every slice at ten times its time (see
- * bvhlab_trace_options.min_repeats), plus the config's own limit. */
+/* Long enough for every slice of every kind of rays at ten times its time
+ * (see bvhlab_trace_options.min_repeats), plus the config's own limit. */
 static double rounds_timeout(const struct config *cfg, size_t count)
 {
-	return cfg->timeout_s + 20.0 * cfg->ray_min_ms * 1e-3 * traversal_count(cfg) * (double)count;
+	double batches = traversal_count(cfg) * (double)__builtin_popcount(cfg->ray_kinds);
+	return cfg->timeout_s + 10.0 * cfg->ray_min_ms * 1e-3 * batches * (double)count;
+}
+
+/* The rounds' secondary batches are the run's (same rays, so same counts). */
+static bool same_batches(const struct rounds_slot *slot, struct ray_metrics *m)
+{
+	for (int kind = RAY_DIFFUSE; kind < RAY_KINDS; kind++)
+		if (slot->rays[kind] != ray_metrics_kind(m, kind)[m->main].stats.rays)
+			return false;
+	return true;
 }
 
 static void take(struct rounds_entry *entries, size_t count, const struct rounds_slot *slots,
@@ -363,14 +379,15 @@ static void take(struct rounds_entry *entries, size_t count, const struct rounds
 	for (size_t i = 0; i < count; i++) {
 		struct ray_metrics *m = &entries[i].rays;
 		if (!slots[i].ok || m->main < 0 || m->main >= BVHLAB_TRAVERSAL_COUNT ||
-		    slots[i].diffuse_rays != m->diffuse[m->main].stats.rays)
+		    !same_batches(&slots[i], m))
 			continue;
-		for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
-			bvhlab_trace_stats p = m->primary[k].stats, d = m->diffuse[k].stats;
-			m->primary[k] = slots[i].primary[k];
-			m->diffuse[k] = slots[i].diffuse[k];
-			m->primary[k].stats = p; /* the run's exact counters stay */
-			m->diffuse[k].stats = d;
+		for (int kind = 0; kind < RAY_KINDS; kind++) {
+			bvhlab_trace_timing *t = ray_metrics_kind(m, kind);
+			for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++) {
+				bvhlab_trace_stats st = t[k].stats; /* the run's exact counters stay */
+				t[k] = slots[i].timing[kind][k];
+				t[k].stats = st;
+			}
 		}
 		m->rounds = rounds;
 		m->provisional = false;

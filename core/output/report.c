@@ -81,6 +81,24 @@ static const char *const csv_numbers[][2] = {
 	{"tree.width", "%.0f"},
 	{"tree.bytes_per_triangle", "%.3f"},
 	{"tree.packed_bytes_per_triangle", "%.3f"},
+	{"rays.shadow.mrays_per_s", "%.4f"},
+	{"rays.shadow.nodes_per_ray", "%.4f"},
+	{"rays.shadow.tris_per_ray", "%.4f"},
+	{"rays.ao.mrays_per_s", "%.4f"},
+	{"rays.ao.nodes_per_ray", "%.4f"},
+	{"rays.ao.tris_per_ray", "%.4f"},
+	{"rays.stack.shadow.mrays_per_s", "%.4f"},
+	{"rays.stack.ao.mrays_per_s", "%.4f"},
+	{"rays.stackless.shadow.mrays_per_s", "%.4f"},
+	{"rays.stackless.ao.mrays_per_s", "%.4f"},
+	{"rays.wide.shadow.mrays_per_s", "%.4f"},
+	{"rays.wide.ao.mrays_per_s", "%.4f"},
+	{"rays.wide4.primary.mrays_per_s", "%.4f"},
+	{"rays.wide4.diffuse.mrays_per_s", "%.4f"},
+	{"rays.wide8.primary.mrays_per_s", "%.4f"},
+	{"rays.wide8.diffuse.mrays_per_s", "%.4f"},
+	{"rays.wide8.shadow.mrays_per_s", "%.4f"},
+	{"rays.wide8.ao.mrays_per_s", "%.4f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary
@@ -242,6 +260,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	          phases ? " build phases ms |" : "", phases ? "---|" : "");
 	for (size_t k = 0; k < n; k++)
 		md_run_row(sb, ix, runs[k], phases);
+	report_kinds(sb, runs, n, false);
 	report_front_md(sb, ix, runs, n);
 	report_budget_md(sb, ix, name);
 	report_breakeven_md(sb, ix, ref, runs, n);

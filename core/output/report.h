@@ -285,6 +285,9 @@ int report_summary(const struct report_index *ix, struct summary_row **rows, con
 const char *report_summary_metric(int m);
 /* The summary section of report.md / report.html. */
 void report_summary_md(struct strbuf *sb, const struct report_index *ix);
+/* A scene's "Rays by kind" table when some run measured shadow or AO rays
+ * (nothing otherwise), in HTML or Markdown. (report_kinds.c) */
+void report_kinds(struct strbuf *sb, const cJSON *const *runs, size_t n, bool html);
 void report_summary_html(struct strbuf *sb, const struct report_index *ix);
 
 /* ---- wide trees (report_wide.c) ------------------------------------------ */

@@ -54,7 +54,7 @@ static void range_cell(struct strbuf *sb, const cJSON *run, const char *kind)
 
 /* Traversals a scene's table may show beside the main one, by name. */
 static const char *const other_traversals[] = {"wide", "stack", "stackless", "device_stack",
-                                                 "device_stackless"};
+                                                 "device_stackless", "wide4", "wide8"};
 #define OTHERS (sizeof(other_traversals) / sizeof(other_traversals[0]))
 
 static double other_num(const cJSON *run, const char *traversal, const char *what)
@@ -458,6 +458,7 @@ static void scene_section(struct strbuf *sb, const struct report_index *ix, cons
 	charts(sb, ix, name);
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
+	report_kinds(sb, runs, n, true);
 	report_front_html(sb, ix, runs, n);
 	report_budget_html(sb, ix, name);
 	report_breakeven_html(sb, ix, ref, runs, n);

@@ -91,10 +91,22 @@ struct ray_metrics {
 	                        * true; a resumed sweep runs such a run again) */
 	/* by enum bvhlab_traversal */
 	bvhlab_trace_timing primary[BVHLAB_TRAVERSAL_COUNT], diffuse[BVHLAB_TRAVERSAL_COUNT];
-	uint64_t disagreements; /* rays whose hits differ from the main traversal's */
+	/* the any-hit kinds, by enum bvhlab_traversal, measured when kinds says */
+	bvhlab_trace_timing shadow[BVHLAB_TRAVERSAL_COUNT], ao[BVHLAB_TRAVERSAL_COUNT];
+	unsigned kinds;         /* bit (1 << enum ray_kind) per kind asked for
+	                         * (config.h); 0 is read as primary and diffuse */
+	uint64_t disagreements; /* rays whose hits differ from the main traversal's
+	                         * (for the any-hit kinds: whether anything is hit) */
 	char device[96];        /* the OpenCL device of the cl_ traversals ("" if none ran) */
 	char error[512];        /* why the rays, or one traversal, could not be traced ("") */
 };
+
+/* m's timings of one kind of rays, by enum bvhlab_traversal. */
+static inline bvhlab_trace_timing *ray_metrics_kind(struct ray_metrics *m, int kind)
+{
+	bvhlab_trace_timing *t[RAY_KINDS] = {m->primary, m->diffuse, m->shadow, m->ao};
+	return t[kind];
+}
 
 /* Peak memory of one run's builds (harness/harness_memory.c measures it). */
 struct build_memory {

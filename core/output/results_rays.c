@@ -30,10 +30,17 @@ static cJSON *kind_json(const bvhlab_trace_timing *t)
 	return o;
 }
 
+/* primary and diffuse always (as before kinds existed); shadow and ao
+ * when asked for. */
 static void add_kinds(cJSON *o, const struct ray_metrics *m, int k)
 {
+	unsigned kinds = m->kinds ? m->kinds : RAY_KINDS_DEFAULT;
 	cJSON_AddItemToObject(o, "primary", kind_json(&m->primary[k]));
 	cJSON_AddItemToObject(o, "diffuse", kind_json(&m->diffuse[k]));
+	if (kinds & (1u << RAY_SHADOW))
+		cJSON_AddItemToObject(o, "shadow", kind_json(&m->shadow[k]));
+	if (kinds & (1u << RAY_AO))
+		cJSON_AddItemToObject(o, "ao", kind_json(&m->ao[k]));
 }
 
 cJSON *results_rays_json(const struct ray_metrics *m)
@@ -61,8 +68,9 @@ cJSON *results_rays_json(const struct ray_metrics *m)
 		cJSON_AddItemToObject(o, bvhlab_traversal_name(k), other);
 		others = true;
 	}
-	/* Rays (primary and diffuse) whose hit differs from the main traversal's,
-	 * summed over the others. */
+	/* Rays (of every kind) whose hit differs from the main traversal's,
+	 * summed over the others; a shadow or AO ray differs when one
+	 * traversal finds it blocked and the other not. */
 	if (others)
 		cJSON_AddNumberToObject(o, "traversal_disagreements", (double)m->disagreements);
 	return o;

@@ -63,6 +63,22 @@ static int scene_hash(const struct config *cfg, size_t s, char out[17])
 	return 0;
 }
 
+/* The kinds, light and AO length only when not the default, so configs
+ * from before rays.kinds keep their identity. */
+static void add_kinds(cJSON *r, const struct config *cfg)
+{
+	if (cfg->ray_kinds == RAY_KINDS_DEFAULT)
+		return;
+	cJSON *kinds = cJSON_AddArrayToObject(r, "kinds");
+	for (int k = 0; k < RAY_KINDS; k++)
+		if (cfg->ray_kinds & (1u << k))
+			cJSON_AddItemToArray(kinds, cJSON_CreateString(ray_kind_name(k)));
+	if ((cfg->ray_kinds & (1u << RAY_SHADOW)) && cfg->has_light)
+		cJSON_AddItemToObject(r, "light", cJSON_CreateFloatArray(cfg->ray_light, 3));
+	if (cfg->ray_kinds & (1u << RAY_AO))
+		cJSON_AddNumberToObject(r, "ao_length", cfg->ray_ao_length);
+}
+
 static cJSON *rays_json(const struct config *cfg)
 {
 	cJSON *r = cJSON_CreateObject(), *names = cJSON_AddArrayToObject(r, "traversals");
@@ -78,6 +94,7 @@ static cJSON *rays_json(const struct config *cfg)
 			cJSON_AddItemToArray(names, cJSON_CreateString(bvhlab_traversal_name(k)));
 	if (cfg->ray_device)
 		cJSON_AddStringToObject(r, "device", cfg->ray_device);
+	add_kinds(r, cfg);
 	if (cfg->has_camera) {
 		const bvhlab_camera *c = &cfg->camera;
 		const float v[10] = {c->position[0], c->position[1], c->position[2], c->target[0],

@@ -1,6 +1,7 @@
 /*
- * Ray generation: a pinhole camera's primary rays and cosine-weighted
- * diffuse bounces from their hits. Every number here is derived from the
+ * Ray generation: a pinhole camera's primary rays, and from their hits
+ * cosine-weighted diffuse bounces, shadow rays toward a point light and
+ * short ambient-occlusion rays. Every number here is derived from the
  * scene and a seed, so two builders are always measured with identical rays.
  */
 #include <errno.h>
@@ -177,11 +178,12 @@ static float scene_offset(const bvhlab_scene *scene)
 	return len > 0.0f ? len * OFFSET_SCALE : OFFSET_SCALE;
 }
 
-/* The bounces of one hit; false when its triangle has no normal. */
-static bool bounce(const bvhlab_scene *scene, const bvhlab_ray *in, const bvhlab_hit *hit,
-                   uint32_t per_hit, float offset, uint64_t *state, bvhlab_ray *out)
+/* Where secondary rays leave a hit: the hit point lifted by offset along
+ * the geometric normal turned to face the incoming ray (n, p); false when
+ * the triangle has no normal. */
+static bool hit_frame(const bvhlab_scene *scene, const bvhlab_ray *in, const bvhlab_hit *hit,
+                      float offset, float n[3], float p[3])
 {
-	float n[3], p[3];
 	bvhlab_triangle_normal(scene, hit->prim, n);
 	if (n[0] == 0.0f && n[1] == 0.0f && n[2] == 0.0f)
 		return false;
@@ -190,35 +192,60 @@ static bool bounce(const bvhlab_scene *scene, const bvhlab_ray *in, const bvhlab
 			n[k] = -n[k];
 	for (int k = 0; k < 3; k++)
 		p[k] = in->org[k] + hit->t * in->dir[k] + offset * n[k];
-	for (uint32_t j = 0; j < per_hit; j++) {
-		memcpy(out[j].org, p, sizeof(p));
-		cosine_dir(n, state, out[j].dir);
+	return true;
+}
+
+/* What one kind of secondary ray makes of a hit frame: per_hit rays. */
+struct secondary {
+	uint32_t per_hit;
+	uint64_t state;      /* the random directions' */
+	float tmax;          /* ao: the rays' length */
+	const float *light;  /* shadow: the point light, or NULL */
+};
+
+/* The rays of one hit frame into out; false when there are none (a hit
+ * on the light itself). */
+static bool emit(struct secondary *k, const float n[3], const float p[3], bvhlab_ray *out)
+{
+	for (uint32_t j = 0; j < k->per_hit; j++) {
+		memcpy(out[j].org, p, 3 * sizeof(*p));
 		out[j].tmin = 0.0f;
-		out[j].tmax = INFINITY;
+		out[j].tmax = k->tmax;
+		if (!k->light) {
+			cosine_dir(n, &k->state, out[j].dir);
+			continue;
+		}
+		/* Toward the light and no further: what lies behind it casts no shadow. */
+		sub3(k->light, p, out[j].dir);
+		float dist = sqrtf(dot3(out[j].dir, out[j].dir));
+		if (!normalize3(out[j].dir))
+			return false;
+		out[j].tmax = dist;
 	}
 	return true;
 }
 
-int bvhlab_rays_diffuse(const bvhlab_scene *scene, const bvhlab_ray *primary,
-                        const bvhlab_hit *hits, size_t count, uint32_t per_hit, uint64_t seed,
-                        bvhlab_ray **rays, size_t *ray_count)
+/* Secondary rays of kind k from every hit of the primary rays. */
+static int secondary_rays(const bvhlab_scene *scene, const bvhlab_ray *primary,
+                          const bvhlab_hit *hits, size_t count, struct secondary *k,
+                          bvhlab_ray **rays, size_t *ray_count)
 {
 	size_t n_hits = 0, n = 0;
 	*rays = NULL;
 	*ray_count = 0;
 	for (size_t i = 0; i < count; i++)
 		n_hits += hits[i].prim != BVHLAB_NO_HIT;
-	if (n_hits == 0 || per_hit == 0)
+	if (n_hits == 0 || k->per_hit == 0)
 		return 0;
-	bvhlab_ray *out = malloc(n_hits * per_hit * sizeof(*out));
+	bvhlab_ray *out = malloc(n_hits * k->per_hit * sizeof(*out));
 	if (!out)
 		return -ENOMEM;
-	float offset = scene_offset(scene);
-	uint64_t state = seed;
+	float offset = scene_offset(scene), nrm[3], p[3];
 	for (size_t i = 0; i < count; i++) {
 		if (hits[i].prim != BVHLAB_NO_HIT &&
-		    bounce(scene, &primary[i], &hits[i], per_hit, offset, &state, out + n))
-			n += per_hit;
+		    hit_frame(scene, &primary[i], &hits[i], offset, nrm, p) &&
+		    emit(k, nrm, p, out + n))
+			n += k->per_hit;
 	}
 	if (n == 0) {
 		free(out);
@@ -228,3 +255,46 @@ int bvhlab_rays_diffuse(const bvhlab_scene *scene, const bvhlab_ray *primary,
 	*ray_count = n;
 	return 0;
 }
+
+int bvhlab_rays_diffuse(const bvhlab_scene *scene, const bvhlab_ray *primary,
+                        const bvhlab_hit *hits, size_t count, uint32_t per_hit, uint64_t seed,
+                        bvhlab_ray **rays, size_t *ray_count)
+{
+	struct secondary k = {.per_hit = per_hit, .state = seed, .tmax = INFINITY};
+	return secondary_rays(scene, primary, hits, count, &k, rays, ray_count);
+}
+
+int bvhlab_rays_shadow(const bvhlab_scene *scene, const bvhlab_ray *primary,
+                       const bvhlab_hit *hits, size_t count, const float light[3],
+                       bvhlab_ray **rays, size_t *ray_count)
+{
+	struct secondary k = {.per_hit = 1, .light = light};
+	return secondary_rays(scene, primary, hits, count, &k, rays, ray_count);
+}
+
+int bvhlab_rays_ao(const bvhlab_scene *scene, const bvhlab_ray *primary,
+                   const bvhlab_hit *hits, size_t count, float length, uint64_t seed,
+                   bvhlab_ray **rays, size_t *ray_count)
+{
+	/* scene_offset is OFFSET_SCALE of the diagonal (or OFFSET_SCALE itself). */
+	float diagonal = scene_offset(scene) / OFFSET_SCALE;
+	struct secondary k = {.per_hit = 1, .state = seed, .tmax = length * diagonal};
+	return secondary_rays(scene, primary, hits, count, &k, rays, ray_count);
+}
+
+void bvhlab_light_frame(const bvhlab_aabb *bounds, float light[3])
+{
+	float c[3] = {0, 0, 0}, diag[3] = {1, 1, 1};
+	if (!bvhlab_aabb_is_empty(bounds)) {
+		sub3(bounds->hi, bounds->lo, diag);
+		for (int k = 0; k < 3; k++)
+			c[k] = 0.5f * (bounds->lo[k] + bounds->hi[k]);
+	}
+	float len = sqrtf(dot3(diag, diag));
+	/* Above the scene and off to the camera's side, so shadows fall across
+	 * what the camera sees instead of straight down behind everything. */
+	light[0] = c[0] + 0.3f * len;
+	light[1] = c[1] + len;
+	light[2] = c[2] + 0.5f * len;
+}
+

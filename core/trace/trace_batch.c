@@ -18,13 +18,16 @@
 
 #include "trace/trace_batch.h"
 #include "trace/trace_kernel.h"
+#include "trace/trace_wide8.h"
 
 static void trace_tile(struct batch *b, size_t begin, size_t end, bvhlab_trace_stats *st)
 {
 	for (size_t i = begin; i < end; i++) {
 		bvhlab_hit hit;
 		uint64_t before = st->nodes_visited;
-		if (b->traversal == BVHLAB_TRAVERSAL_WIDE)
+		if (b->traversal == BVHLAB_TRAVERSAL_WIDE8 && b->view.wide8)
+			trace_ray_wide8(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
+		else if (trace_is_wide(b->traversal))
 			trace_ray_wide(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
 		else if (b->traversal == BVHLAB_TRAVERSAL_STACKLESS)
 			trace_ray_stackless(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);

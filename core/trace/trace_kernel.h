@@ -218,27 +218,40 @@ static inline bool isect_slot(const ray_prep *p, const bvhlab_tree *tree,
  * view of a tree; trace_view_copy the batch tracer's copies.
  */
 struct wide_bvh; /* trace_wide.h */
+struct wide8_bvh; /* trace_wide8.h */
 
 struct trace_view {
 	const bvhlab_node *nodes;
 	const float *tris;
 	const uint32_t *parents;
-	const struct wide_bvh *wide; /* the wide traversal's nodes */
+	const struct wide_bvh *wide;   /* the 4-lane traversals' nodes (wide, wide4, and
+	                                * wide8 on a tree of width 4 or less) */
+	const struct wide8_bvh *wide8; /* wide8's nodes of a tree of width 5 to 8 */
+	int wide8_isa;                 /* trace_wide8.c's code path for them */
 	void *owned; /* what trace_view_free releases */
 	float *owned_tris;
 	struct wide_bvh *owned_wide;
+	struct wide8_bvh *owned_wide8;
 };
 
 static inline struct trace_view trace_view_plain(const bvhlab_tree *tree)
 {
-	return (struct trace_view){tree->nodes, NULL, NULL, NULL, NULL, NULL, NULL};
+	return (struct trace_view){.nodes = tree->nodes};
 }
 
 /* Node copy aligned for sibling pairs, plus the vertex copy. 0 or -ENOMEM. */
 int trace_view_copy(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v);
-/* Adds the wide nodes to a view: 0, -EINVAL (links that do not make a
- * tree), -ENOMEM. */
-int trace_view_wide(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v);
+/* Adds the wide nodes of `traversal` (wide, wide4, wide8: trace_view.c
+ * says which layout each gets) to a view: 0, -EINVAL (links that do not
+ * make a tree), -ENOMEM. */
+int trace_view_wide(const bvhlab_tree *tree, const bvhlab_scene *scene, int traversal,
+                    struct trace_view *v);
+/* Whether a traversal walks a wide view (wide, wide4, wide8). */
+static inline bool trace_is_wide(int traversal)
+{
+	return traversal == BVHLAB_TRAVERSAL_WIDE || traversal == BVHLAB_TRAVERSAL_WIDE4 ||
+	       traversal == BVHLAB_TRAVERSAL_WIDE8;
+}
 void trace_view_free(struct trace_view *v);
 
 /* The stack traversal of trace.c through a view: what bvhlab_trace_closest

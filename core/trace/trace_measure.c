@@ -40,6 +40,10 @@ const char *bvhlab_traversal_name(int traversal)
 		return "device_stack";
 	case BVHLAB_TRAVERSAL_DEVICE_STACKLESS:
 		return "device_stackless";
+	case BVHLAB_TRAVERSAL_WIDE4:
+		return "wide4";
+	case BVHLAB_TRAVERSAL_WIDE8:
+		return "wide8";
 	default:
 		return NULL;
 	}
@@ -161,7 +165,7 @@ static double timed_pass(struct trace_series *s)
 	bvhlab_trace_stats st;
 	double c, w = pass(&s->b, s->w, s->threads, &st, &c);
 	if (!s->counted) {
-		if (s->b.traversal != BVHLAB_TRAVERSAL_WIDE)
+		if (!trace_is_wide(s->b.traversal))
 			s->stats = st;
 		s->counted = true;
 		s->b.hits = NULL; /* filled once; later passes only time */
@@ -254,14 +258,15 @@ static int count_binary(struct trace_series *s)
 {
 	struct batch *b = &s->b;
 	bvhlab_hit *hits = b->hits;
+	int traversal = b->traversal;
 	double cpu;
 	b->traversal = BVHLAB_TRAVERSAL_STACK;
 	b->hits = NULL;
 	pass(b, s->w, s->threads, &s->stats, &cpu);
-	b->traversal = BVHLAB_TRAVERSAL_WIDE;
+	b->traversal = traversal;
 	b->hits = hits;
 	b->nodes = NULL;
-	return trace_view_wide(b->tree, b->scene, &b->view);
+	return trace_view_wide(b->tree, b->scene, traversal, &b->view);
 }
 
 void trace_series_destroy(struct trace_series *s)
@@ -290,8 +295,9 @@ static int series_views(struct trace_series *s, int traversal, bool counters)
 	}
 	int r = trace_view_copy(s->b.tree, s->b.scene, &s->b.view);
 	s->b.view.parents = s->parents;
-	if (r == 0 && traversal == BVHLAB_TRAVERSAL_WIDE && s->b.count)
-		r = counters ? count_binary(s) : trace_view_wide(s->b.tree, s->b.scene, &s->b.view);
+	if (r == 0 && trace_is_wide(traversal) && s->b.count)
+		r = counters ? count_binary(s)
+		             : trace_view_wide(s->b.tree, s->b.scene, traversal, &s->b.view);
 	return r;
 }
 
@@ -363,9 +369,10 @@ int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
 }
 
 int trace_series_create_like(const struct trace_series *base, const bvhlab_ray *rays,
-                             size_t count, struct trace_series **out)
+                             size_t count, bool any, struct trace_series **out)
 {
 	struct batch b = base->b;
+	b.any = any;
 	b.rays = rays;
 	b.count = count;
 	b.hits = NULL;
@@ -373,6 +380,7 @@ int trace_series_create_like(const struct trace_series *base, const bvhlab_ray *
 	b.view.owned = NULL; /* borrowed: base frees them */
 	b.view.owned_tris = NULL;
 	b.view.owned_wide = NULL;
+	b.view.owned_wide8 = NULL;
 	*out = series_alloc(&b, base->threads, base->max_repeats);
 	if (!*out)
 		return -ENOMEM;

@@ -34,13 +34,13 @@ int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
                         bvhlab_hit *hits, uint32_t *nodes, bool counters,
                         struct trace_series **out, bvhlab_error *err);
 
-/* A series of other rays through base's tree with base's traversal,
- * threads and tracing copies (base must outlive it). Its timing's
+/* A series of other rays (any-hit ones when any) through base's tree with
+ * base's traversal, threads and tracing copies (base must outlive it). Its timing's
  * counters are those of its first pass for the stack and stackless
  * traversals and zero for the wide one (no counting pass). 0 or a
  * negative errno (trace_series_error says why). */
 int trace_series_create_like(const struct trace_series *base, const bvhlab_ray *rays,
-                             size_t count, struct trace_series **out);
+                             size_t count, bool any, struct trace_series **out);
 
 /* Timed passes until this slice meets opts' min_ms, min_rays and
  * min_repeats (counted within the slice); max_repeats bounds the series'

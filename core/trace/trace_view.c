@@ -12,6 +12,7 @@
 
 #include "trace/trace_kernel.h"
 #include "trace/trace_wide.h"
+#include "trace/trace_wide8.h"
 #include "tree/tree_view.h"
 
 #define LINE 64
@@ -80,16 +81,53 @@ int trace_view_copy(const bvhlab_tree *tree, const bvhlab_scene *scene, struct t
 	return r;
 }
 
-int trace_view_wide(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v)
+/* The 4-lane nodes: the tree as built when wide4/wide8 get one of width
+ * 3 or 4, else today's collapse (wide_bvh.c: a binary tree, or a tree
+ * too wide for 4 lanes). */
+static int view_wide4(const bvhlab_tree *tree, const bvhlab_scene *scene, bool built,
+                      struct trace_view *v)
 {
 	struct wide_bvh *w = malloc(sizeof(*w));
-	int r = w ? wide_bvh_init(w, tree, scene) : -ENOMEM;
+	int r = w ? -ERANGE : -ENOMEM;
+	if (w && built && tree_width(tree) <= 4) {
+		struct wide_built b;
+		r = wide_built_init(&b, tree, scene, 4);
+		if (r == 0)
+			*w = (struct wide_bvh){b.nodes, b.tris, b.node_count, b.tri_groups, b.depth};
+	}
+	if (r == -ERANGE)
+		r = wide_bvh_init(w, tree, scene);
 	if (r < 0) {
 		free(w);
 		return r;
 	}
 	v->wide = v->owned_wide = w;
 	return 0;
+}
+
+/* The 8-lane nodes of a tree of width 5 to 8, as built. */
+static int view_wide8(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v)
+{
+	struct wide8_bvh *w = malloc(sizeof(*w));
+	struct wide_built b;
+	int r = w ? wide_built_init(&b, tree, scene, WIDE8) : -ENOMEM;
+	if (r < 0) {
+		free(w);
+		return r;
+	}
+	*w = (struct wide8_bvh){b.nodes, b.tris, b.node_count, b.tri_groups, b.depth};
+	v->wide8 = v->owned_wide8 = w;
+	v->wide8_isa = trace_wide8_pick();
+	return 0;
+}
+
+int trace_view_wide(const bvhlab_tree *tree, const bvhlab_scene *scene, int traversal,
+                    struct trace_view *v)
+{
+	if (traversal == BVHLAB_TRAVERSAL_WIDE8 && tree_width(tree) > 4)
+		return view_wide8(tree, scene, v);
+	return view_wide4(tree, scene, traversal != BVHLAB_TRAVERSAL_WIDE && tree_width(tree) > 2,
+	                  v);
 }
 
 void trace_view_free(struct trace_view *v)
@@ -99,6 +137,13 @@ void trace_view_free(struct trace_view *v)
 	if (v->owned_wide)
 		wide_bvh_finish(v->owned_wide);
 	free(v->owned_wide);
+	if (v->owned_wide8) {
+		free(v->owned_wide8->nodes);
+		free(v->owned_wide8->tris);
+	}
+	free(v->owned_wide8);
+	v->owned_wide8 = NULL;
+	v->wide8 = NULL;
 	v->owned = NULL;
 	v->owned_tris = NULL;
 	v->owned_wide = NULL;

@@ -63,4 +63,19 @@ struct wide_bvh {
 int wide_bvh_init(struct wide_bvh *w, const bvhlab_tree *tree, const bvhlab_scene *scene);
 void wide_bvh_finish(struct wide_bvh *w);
 
+/*
+ * A tree of width 3 to `lanes` (4 or 8) as built, without re-collapse:
+ * nodes and triangle groups of `lanes` lanes, struct wide_node and
+ * wide_tris for 4 (so a struct wide_bvh over them), trace_wide8.h's for 8.
+ * 0; -ERANGE when some node has more than `lanes` children; -EINVAL for
+ * links that do not make a tree; -ENOMEM. (wide_built.c; the arrays are
+ * freed with free())
+ */
+struct wide_built {
+	void *nodes, *tris;
+	uint32_t node_count, tri_groups, depth;
+};
+int wide_built_init(struct wide_built *out, const bvhlab_tree *tree, const bvhlab_scene *scene,
+                    uint32_t lanes);
+
 #endif

@@ -98,6 +98,31 @@ int bvhlab_rays_diffuse(const bvhlab_scene *scene, const bvhlab_ray *primary,
                         const bvhlab_hit *hits, size_t count, uint32_t per_hit, uint64_t seed,
                         bvhlab_ray **rays, size_t *ray_count);
 
+/*
+ * Shadow rays: for every hit of the primary rays, one ray from the hit
+ * point (offset as bvhlab_rays_diffuse's) toward the point `light`, tmax
+ * its distance to the light: an any-hit ray that hits something is in
+ * shadow. *rays is malloc'd, *count rays (may be 0, then *rays is NULL).
+ * 0 or -ENOMEM.
+ */
+int bvhlab_rays_shadow(const bvhlab_scene *scene, const bvhlab_ray *primary,
+                       const bvhlab_hit *hits, size_t count, const float light[3],
+                       bvhlab_ray **rays, size_t *ray_count);
+
+/*
+ * Ambient-occlusion rays: for every hit of the primary rays, one
+ * cosine-weighted ray as bvhlab_rays_diffuse's, of length `length` times
+ * the scene's bounding-box diagonal (tmax): short any-hit rays that mostly
+ * stay near the surface. The same seed gives the same rays. 0 or -ENOMEM.
+ */
+int bvhlab_rays_ao(const bvhlab_scene *scene, const bvhlab_ray *primary,
+                   const bvhlab_hit *hits, size_t count, float length, uint64_t seed,
+                   bvhlab_ray **rays, size_t *ray_count);
+
+/* The default point light of a scene's box: above it by its diagonal,
+ * off to the side of the default camera (an empty box: around the origin). */
+void bvhlab_light_frame(const bvhlab_aabb *bounds, float light[3]);
+
 /* The geometric normal of a triangle (unit length; 0 for a degenerate one). */
 void bvhlab_triangle_normal(const bvhlab_scene *scene, uint32_t prim, float normal[3]);
 
@@ -125,7 +150,12 @@ enum bvhlab_traversal {
 	                                    * (batches only; needs a device backend built:
 	                                    * OpenCL) */
 	BVHLAB_TRAVERSAL_DEVICE_STACKLESS = 4, /* the stackless one likewise */
-	BVHLAB_TRAVERSAL_COUNT = 5      /* how many there are */
+	BVHLAB_TRAVERSAL_WIDE4 = 5,     /* a tree of width 3 or 4 as built, 4 lanes per node
+	                                 * (a binary or wider tree: wide's collapse) */
+	BVHLAB_TRAVERSAL_WIDE8 = 6,     /* a tree of width 5 to 8 as built, 8 lanes per node
+	                                 * with AVX-512VL, AVX2 or portable code chosen at run
+	                                 * time (width 3 or 4: wide4's; binary: wide's) */
+	BVHLAB_TRAVERSAL_COUNT = 7      /* how many there are */
 };
 
 /* The names before the device traversals said what they are, not which
@@ -133,7 +163,7 @@ enum bvhlab_traversal {
 #define BVHLAB_TRAVERSAL_CL_STACK BVHLAB_TRAVERSAL_DEVICE_STACK
 #define BVHLAB_TRAVERSAL_CL_STACKLESS BVHLAB_TRAVERSAL_DEVICE_STACKLESS
 
-/* "stack" / "stackless" / "wide" / "device_stack" / "device_stackless"
+/* "stack" / "stackless" / "wide" / "device_stack" / "device_stackless" / "wide4" / "wide8"
  * (the keys of results.json's rays); NULL for another value. */
 const char *bvhlab_traversal_name(int traversal);
 

@@ -17,7 +17,8 @@
 static const char config[] =
 	"{ \"format_version\": 1, \"output\": \"out-rays\", \"repeat\": 1, \"threads\": [1, 2],\n"
 	"  \"images\": true, \"rays\": { \"width\": 40, \"height\": 30, \"diffuse\": 2,\n"
-	"    \"min_ms\": 1, \"traversal\": [\"wide\", \"stack\", \"stackless\"] },\n"
+	"    \"min_ms\": 1, \"traversal\": [\"wide\", \"stack\", \"stackless\"],\n"
+	"    \"kinds\": [\"primary\", \"diffuse\", \"shadow\", \"ao\"], \"ao_length\": 0.1 },\n"
 	"  \"scenes\": [ { \"name\": \"ico<1>\", \"generator\": \"icosphere\", \"frequency\": 10 },\n"
 	"              { \"name\": \"terrain\", \"generator\": \"terrain\", \"size\": 16 } ],\n"
 	"  \"builders\": [ { \"plugin\": \"sah_seq\", \"name\": \"sweep\" },\n"
@@ -110,6 +111,19 @@ static void check_measures(const cJSON *doc)
 		CHECK(cJSON_IsNumber(cJSON_GetObjectItem(rays, "traversal_disagreements")) &&
 		      cJSON_GetObjectItem(rays, "traversal_disagreements")->valuedouble == 0);
 		CHECK(sl && cJSON_GetObjectItem(sl, "rays")->valueint == 40 * 30);
+		/* Shadow and AO rays, from every primary hit, by every traversal
+		 * (traversal_disagreements above covers their hits), timed in
+		 * the rounds like the others. */
+		for (int k = 0; k < 3; k++) {
+			const cJSON *by = k ? cJSON_GetObjectItem(rays, k == 1 ? "stack" : "stackless")
+			                    : rays;
+			const cJSON *sh = cJSON_GetObjectItem(by, "shadow");
+			const cJSON *ao = cJSON_GetObjectItem(by, "ao");
+			CHECK(sh && cJSON_GetObjectItem(sh, "rays")->valueint > 0 && ten_passes(sh));
+			CHECK(ao && cJSON_GetObjectItem(ao, "rays")->valueint > 0 && ten_passes(ao));
+			CHECK(cJSON_GetObjectItem(sh, "rays")->valueint ==
+			      cJSON_GetObjectItem(cJSON_GetObjectItem(rays, "shadow"), "rays")->valueint);
+		}
 		/* The default 8 rounds, slices of 2 passes until the batch has
 		 * its 10: more than the run's own provisional timing (one pass
 		 * of min_ms / 8) makes. */
@@ -166,6 +180,8 @@ static void test_run(void)
 	check_no_trees(dir);
 	char *csv = read_file(dir, "results.csv");
 	CHECK_CONTAINS(csv, "rays.primary.mrays_per_s");
+	CHECK_CONTAINS(csv, "rays.shadow.mrays_per_s");
+	CHECK_CONTAINS(csv, "rays.ao.nodes_per_ray");
 	free(csv);
 	snprintf(regen, sizeof(regen), "%s/regen", tmpdir);
 	snprintf(json, sizeof(json), "%s/results.json", dir);
@@ -173,6 +189,8 @@ static void test_run(void)
 	check_html(regen);
 	char *md = read_file(regen, "report.md");
 	CHECK_CONTAINS(md, "primary Mrays/s");
+	CHECK_CONTAINS(md, "**Rays by kind.**");
+	CHECK_CONTAINS(md, "| shadow Mrays/s | shadow nodes/ray | ao Mrays/s |");
 	/* No sah_seq-labelled builder: the reference falls back to the plugin's
 	 * first builder, sweep, which is 1.00x itself on every scene. */
 	CHECK_CONTAINS(md, "## Summary");
@@ -183,6 +201,7 @@ static void test_run(void)
 	CHECK_CONTAINS(html, "<h2 id=\"summary\">Summary</h2>");
 	CHECK_CONTAINS(html, "stackless primary Mrays/s");
 	CHECK_CONTAINS(html, "stack primary Mrays/s");
+	CHECK_CONTAINS(html, "<h3>Rays by kind</h3>");
 	free(html);
 	CHECK_INT(run(ARGS("report", "/nonexistent/results.json")), 2);
 }

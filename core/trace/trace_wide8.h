@@ -1,0 +1,48 @@
+/*
+ * The 8-lane wide traversal's copy of a tree (trace_wide8.c): an 8-wide
+ * tree as built (wide_built.c), eight child boxes side by side per node
+ * and triangles in groups of eight, so one node visit is one 256-bit slab
+ * test (AVX2 or AVX-512VL, chosen at run time) and a leaf of up to eight
+ * triangles one vector sign test. Empty lanes and groups are as in
+ * trace_wide.h: count WIDE_EMPTY with an inverted box, NaN vertices.
+ */
+#ifndef BVHLAB_CORE_TRACE_WIDE8_H
+#define BVHLAB_CORE_TRACE_WIDE8_H
+
+#include <stdint.h>
+
+#include "trace/trace_kernel.h"
+#include "trace/trace_wide.h"
+
+#define WIDE8 8
+
+/* 256 bytes, four cache lines. */
+struct wide8_node {
+	float box[6][WIDE8];
+	uint32_t child[WIDE8];
+	uint32_t count[WIDE8];
+};
+
+struct wide8_tris {
+	float v[9][WIDE8];
+	uint32_t prim[WIDE8];
+};
+
+struct wide8_bvh {
+	struct wide8_node *nodes; /* [0] is the root */
+	struct wide8_tris *tris;
+	uint32_t node_count, tri_groups, depth;
+};
+
+/* The 8-lane traversal of view->wide8, as trace_ray_wide (trace_kernel.h). */
+void trace_ray_wide8(const bvhlab_tree *tree, const bvhlab_scene *scene,
+                     const struct trace_view *view, const bvhlab_ray *ray, bool any,
+                     bvhlab_hit *hit, bvhlab_trace_stats *stats);
+
+/* Which code path trace_ray_wide8 takes on this CPU: "avx512", "avx2" or
+ * "portable" (GCC's generic vectors). */
+const char *trace_wide8_isa(void);
+/* The same as a code for trace_view.wide8_isa. */
+int trace_wide8_pick(void);
+
+#endif
