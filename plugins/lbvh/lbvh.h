@@ -58,7 +58,6 @@ typedef struct lbvh {
 	const bvhlab_build_input *in;
 	uint32_t n;          /* primitives, >= 2 when the team runs */
 	uint32_t threads;    /* threads asked for; the team (team.threads) may be smaller */
-	unsigned bits;       /* Morton code bits: 30 or 63 */
 	bool collapse;
 	uint32_t max_leaf;
 	float c_trav, c_isect;
