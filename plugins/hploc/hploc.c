@@ -108,27 +108,18 @@ static void emit(hploc *h, unsigned t)
 	team_sync(&h->team);
 }
 
-/* The sort, then one cluster per primitive in sorted order. */
-static void sort_phase(void *arg, unsigned t)
-{
-	hploc *h = arg;
-
-	morton_sort_team(&h->sort, &h->team, t, NULL, NULL);
-	first_clusters(h, t);
-	team_sync(&h->team);
-}
-
+MORTON_PHASE_FN(hploc, first_clusters)
 MORTON_PHASE_FN(hploc, hploc_climb)
 MORTON_PHASE_FN(hploc, emit)
 
 static const morton_phase phases[] = {
-	{ "sort", sort_phase }, { "climb", hploc_climb_phase }, { "emit", emit_phase }, { NULL, NULL },
+	{ "climb", hploc_climb_phase }, { "emit", emit_phase }, { NULL, NULL },
 };
 
 /* ---- build --------------------------------------------------------------- */
 
-MORTON_BUILD_FN(hploc, .max_prims = HPLOC_PRIMS, .spare = spare_nodes(b.n),
-                .place = scratch_alloc, .phases = phases)
+MORTON_BUILD_FN(hploc, .max_prims = HPLOC_PRIMS, .spare = spare_nodes(b.n), .place = scratch_alloc,
+                .sorted = first_clusters_phase, .phases = phases)
 
 PLUGIN_WITH_OPTIONS(options, .name = "hploc",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,

@@ -72,18 +72,18 @@ static int scratch_alloc(void *arg, bvhlab_build_output *out, morton_scratch *s)
 
 /* ---- build --------------------------------------------------------------- */
 
-MORTON_PHASE_FN(lbvh, lbvh_sort)
 MORTON_PHASE_FN(lbvh, lbvh_karras)
 MORTON_PHASE_FN(lbvh, lbvh_bounds)
 MORTON_PHASE_FN(lbvh, lbvh_compact)
 
 static const morton_phase phases[] = {
-	{ "sort", lbvh_sort_phase }, { "karras", lbvh_karras_phase },
-	{ "bounds", lbvh_bounds_phase }, { "compact", lbvh_compact_phase }, { NULL, NULL },
+	{ "karras", lbvh_karras_phase }, { "bounds", lbvh_bounds_phase },
+	{ "compact", lbvh_compact_phase }, { NULL, NULL },
 };
 
 MORTON_BUILD_FN(lbvh, .max_prims = UINT32_MAX / 2, .spare = spare_nodes(b.n, b.collapse),
-                .place = scratch_alloc, .phases = phases)
+                .place = scratch_alloc, .bucket_done = lbvh_bucket_done,
+                .sorted = lbvh_sorted, .phases = phases)
 
 PLUGIN_WITH_OPTIONS(options, .name = "lbvh",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |

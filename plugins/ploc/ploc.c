@@ -118,27 +118,18 @@ static void first_clusters(ploc *p, unsigned t)
 	}
 }
 
-/* The sort, then one cluster per primitive in sorted order. */
-static void sort_phase(void *arg, unsigned t)
-{
-	ploc *p = arg;
-
-	morton_sort_team(&p->sort, &p->team, t, NULL, NULL);
-	first_clusters(p, t);
-	team_sync(&p->team);
-}
-
+MORTON_PHASE_FN(ploc, first_clusters)
 MORTON_PHASE_FN(ploc, ploc_cluster)
 MORTON_PHASE_FN(ploc, ploc_emit)
 
 static const morton_phase phases[] = {
-	{ "sort", sort_phase }, { "cluster", ploc_cluster_phase }, { "emit", ploc_emit_phase }, { NULL, NULL },
+	{ "cluster", ploc_cluster_phase }, { "emit", ploc_emit_phase }, { NULL, NULL },
 };
 
 /* ---- build --------------------------------------------------------------- */
 
-MORTON_BUILD_FN(ploc, .max_prims = REC_PRIMS, .spare = spare_nodes(b.n),
-                .place = scratch_alloc, .phases = phases, .iterations = &b.iterations)
+MORTON_BUILD_FN(ploc, .max_prims = REC_PRIMS, .spare = spare_nodes(b.n), .place = scratch_alloc,
+                .sorted = first_clusters_phase, .phases = phases, .iterations = &b.iterations)
 
 PLUGIN_WITH_OPTIONS(options, .name = "ploc",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |

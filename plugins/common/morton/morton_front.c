@@ -124,25 +124,32 @@ static void log_phases(const morton_job *j, const bvhlab_host *host, bvhlab_buil
 		at += (size_t)snprintf(line + at, sizeof(line) - at, ", %u iterations",
 		                       *j->iterations);
 	if (at < sizeof(line))
-		at += (size_t)snprintf(line + at, sizeof(line) - at, ": setup %.2f", j->ms[0] - start);
+		at += (size_t)snprintf(line + at, sizeof(line) - at, ": setup %.2f, sort %.2f",
+		                       j->ms[0] - start, j->ms[1] - j->ms[0]);
 	for (size_t k = 0; j->phases[k].run && at < sizeof(line); k++)
 		at += (size_t)snprintf(line + at, sizeof(line) - at, ", %s %.2f", j->phases[k].name,
-		                       j->ms[k + 1] - j->ms[k]);
+		                       j->ms[k + 2] - j->ms[k + 1]);
 	host->log(ctx, BVHLAB_LOG_DEBUG, "%s ms", line);
 }
 
-/* By every member t of the team: the job's phases, member 0 taking the
- * times. */
+/* By every member t of the team: the sort and the job's phases, member 0
+ * taking the times. */
 static void run_phases(void *arg, unsigned t)
 {
 	const morton_job *j = arg;
 
 	if (t == 0)
 		j->ms[0] = morton_now_ms();
+	morton_sort_team(j->sort, j->team, t, j->bucket_done, j->b);
+	if (j->sorted)
+		j->sorted(j->b, t);
+	team_sync(j->team);
+	if (t == 0)
+		j->ms[1] = morton_now_ms();
 	for (size_t k = 0; j->phases[k].run; k++) {
 		j->phases[k].run(j->b, t);
 		if (t == 0)
-			j->ms[k + 1] = morton_now_ms();
+			j->ms[k + 2] = morton_now_ms();
 	}
 }
 
@@ -176,6 +183,7 @@ out:
 	morton_scratch_free(&s);
 	return rc;
 }
+
 int morton_build(const morton_job *j, const bvhlab_host *host, bvhlab_build_ctx *ctx,
                  const bvhlab_build_input *in, bvhlab_build_output *out)
 {

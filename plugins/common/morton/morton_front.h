@@ -95,8 +95,8 @@ void morton_sort_team(morton_sort *s, team *tm, unsigned t,
 /* The whole tree of a single primitive: one leaf. */
 void morton_single_leaf(const bvhlab_build_input *in, bvhlab_build_output *out);
 
-/* A phase of a CPU Morton builder: run(b, t) by every member t of the
- * team, on the builder's state b. */
+/* A phase of a CPU Morton builder after the sort: run(b, t) by every
+ * member t of the team, on the builder's state b. */
 typedef struct morton_phase {
 	const char *name; /* in the debug line */
 	void (*run)(void *b, unsigned t);
@@ -110,9 +110,10 @@ typedef struct morton_phase {
 	}
 
 /*
- * A CPU Morton builder's build around its phases (lbvh, ploc, hploc), for
- * morton_build(): its state `b`, and in it the sort, the team, the count of
- * threads to ask for, the node count its phases set and its phase times.
+ * A CPU Morton builder's build (lbvh, ploc, hploc), for morton_build():
+ * the sort, its first phase, then the builder's own; its state `b`, and in
+ * it the sort, the team, the count of threads to ask for, the node count
+ * its phases set and its phase times.
  */
 typedef struct morton_job {
 	void *b;
@@ -121,7 +122,8 @@ typedef struct morton_job {
 	uint32_t *threads;          /* set to morton_team_size() */
 	const uint32_t *node_count; /* set by the phases */
 	double *ms;                 /* member 0's clock (morton_now_ms) at the
-	                             * team's start, [0], and after phase k, [k + 1] */
+	                             * team's start, [0], after the sort, [1], and
+	                             * after phase k of `phases`, [k + 2] */
 	uint32_t max_prims;         /* most primitives it builds over */
 	uint32_t spare;             /* nodes of room past the tree for its scratch,
 	                             * big_spare_nodes(), 0 for none */
@@ -129,7 +131,13 @@ typedef struct morton_job {
 	 * frees) and the rest of b set, with the threads and the output's room
 	 * known; 0 or -ENOMEM. */
 	int (*place)(void *b, bvhlab_build_output *out, morton_scratch *s);
-	const morton_phase *phases; /* in order, ended by one with run NULL */
+	/* The sort phase's part (may be NULL): morton_sort_team's done, and
+	 * sorted(b, t) by every member after the sort, before the barrier
+	 * that ends the phase. */
+	void (*bucket_done)(void *b, uint32_t first, uint32_t end);
+	void (*sorted)(void *b, unsigned t);
+	const morton_phase *phases; /* after the sort, in order, ended by one
+	                             * with run NULL */
 	const uint32_t *iterations; /* in the debug line where not NULL */
 } morton_job;
 
