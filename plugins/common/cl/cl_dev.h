@@ -1,7 +1,7 @@
 /*
- * What the device builders (cl_lbvh, cl_ploc) share on the host side, over
- * the device layer of include/bvhlab/opencl.h (a static library linked into
- * each plugin):
+ * What the device builders (cl_lbvh, cl_ploc, cl_hploc) share on the host
+ * side, over the device layer of include/bvhlab/opencl.h (a static library
+ * linked into each plugin):
  *
  *   - cl_dev: the device and the built program, from the process's device
  *     layer (the host's, ABI 1.6: shared with every device builder and the
@@ -11,9 +11,12 @@
  *   - cl_buf, cl_launch, cl_events: the device layer's buffers that grow
  *     (all sized before any kernel runs), launches and events (summed
  *     into the phase "device"), core/device/device_run.h, on d's device;
+ *   - what a builder keeps between builds (CL_KEPT) and the chunks of its
+ *     one-work-item-each kernels (cl_chunks);
  *   - the Morton codes and their radix sort (cl_sort.c, kernels in
- *     morton_sort.cl), mirroring plugins/common/morton;
- *   - the start of a build and the report of its phases (cl_build.c).
+ *     morton_sort.cl after box.cl), mirroring plugins/common/morton;
+ *   - the start of a build and the report of its phases (cl_build.c), and
+ *     the build() and descriptor of a builder on it (CL_PLUGIN).
  */
 #ifndef BVHLAB_CL_DEV_H
 #define BVHLAB_CL_DEV_H
