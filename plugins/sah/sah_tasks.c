@@ -94,7 +94,7 @@ struct crew {
 static void run_tasks(struct crew *tm)
 {
 	sah_builder local;
-	sah_job *tasks = TEAM_LIST_AT(&tm->tasks, sah_job, 0);
+	sah_job *tasks = tm->tasks.items;
 	size_t i, cap = tm->tasks.n ? 2 * sah_job_size(&tasks[0]) : 0;
 	bvhlab_node *scratch = cap ? malloc(cap * sizeof(*scratch)) : NULL;
 
