@@ -60,18 +60,14 @@ static const cl_builder program = CL_BUILDER(cl_hploc_src, kernel_names, HPLOC_P
 /* Kept between builds (one build at a time, ABI rule), with the host's
  * copy of the merge tree; released when the plugin is unloaded. */
 static struct {
-	cl_dev dev;
-	cl_sort sort;
-	cl_buf b[HB_BUFS];
+	CL_KEPT(HB_BUFS);
 	hploc_rec *rec;
 	uint32_t cap;
 } S;
 
 __attribute__((destructor)) static void release_device(void)
 {
-	cl_bufs_free(S.b, HB_BUFS);
-	cl_bufs_free(S.sort.b, SB_COUNT);
-	cl_dev_close(&S.dev);
+	CL_KEPT_FREE(S, HB_BUFS);
 	free(S.rec);
 }
 
@@ -208,12 +204,6 @@ static int run(void *p, bvhlab_build_output *out, char *err, size_t err_size)
 	return rc;
 }
 
-static const cl_run_spec job = CL_RUN_SPEC(cl_hploc, run);
-
-CL_BUILD_FN(cl_hploc)
-
-PLUGIN_WITH_OPTIONS(options, .name = "cl_hploc",
-	.flags = BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_DEVICE,
+CL_PLUGIN(cl_hploc, run, .name = "cl_hploc",
 	.summary = "H-PLOC on an OpenCL device (Benthin et al. 2024): the hploc plugin's tree, "
-	           "the hierarchy in one kernel launch",
-	.build = build)
+	           "the hierarchy in one kernel launch")

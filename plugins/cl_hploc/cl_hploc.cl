@@ -34,10 +34,7 @@ static bool joins_right(__global const ulong *keys, uint n, uint first, uint las
 static hploc_cluster load(volatile __global const hploc_cluster *p)
 {
 	hploc_cluster x;
-	for (int k = 0; k < 3; k++) {
-		x.lo[k] = p->lo[k];
-		x.hi[k] = p->hi[k];
-	}
+	box_load(x.lo, x.hi, p->lo, p->hi);
 	x.node = p->node;
 	x.info = p->info;
 	x.cost = p->cost;
@@ -47,10 +44,7 @@ static hploc_cluster load(volatile __global const hploc_cluster *p)
 
 static void store(volatile __global hploc_cluster *p, const hploc_cluster *x)
 {
-	for (int k = 0; k < 3; k++) {
-		p->lo[k] = x->lo[k];
-		p->hi[k] = x->hi[k];
-	}
+	box_store(p->lo, p->hi, x->lo, x->hi);
 	p->node = x->node;
 	p->info = x->info;
 	p->cost = x->cost;

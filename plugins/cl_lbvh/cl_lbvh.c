@@ -27,17 +27,14 @@ static const plugin_option options[] = {
 	              .help = "leaves per work-item of the bounds kernel (0: 512 on a CPU "
 	                      "device, 1 on a GPU); the tree is the same for every value",
 	              .def_int = 0, .min = 0, .max = 1 << 20),
-	PLUGIN_OPTION(cl_lbvh, hierarchy, STRING, .name = "hierarchy",
-	              .help = "how each node's range and split are found: search (Karras's "
-	                      "searches), scan (lbvh's prefix scans), auto (scan on a CPU "
-	                      "device, search on a GPU); the tree is the same",
-	              .def_string = "auto", .choices = "auto|search|scan"),
-	PLUGIN_OPTION(cl_lbvh, sort_shape, STRING, .name = "sort",
-	              .help = "the radix sort's shape: passes (every digit over all keys), "
-	                      "buckets (the two top digits over all keys, then a work-item "
-	                      "per bucket), auto (buckets on a CPU device, passes on a GPU); "
-	                      "the tree is the same",
-	              .def_string = "auto", .choices = "auto|passes|buckets"),
+	CL_SHAPE_OPTION(cl_lbvh, hierarchy, "hierarchy",
+	                "how each node's range and split are found: search (Karras's "
+	                "searches), scan (lbvh's prefix scans), auto (scan on a CPU device, "
+	                "search on a GPU)", "search|scan"),
+	CL_SHAPE_OPTION(cl_lbvh, sort_shape, "sort",
+	                "the radix sort's shape: passes (every digit over all keys), buckets "
+	                "(the two top digits over all keys, then a work-item per bucket), auto "
+	                "(buckets on a CPU device, passes on a GPU)", "passes|buckets"),
 	PLUGIN_OPTION(cl_lbvh, zero_copy, BOOL, .name = "zero_copy",
 	              .help = "on a CPU device, the input's and the output's arrays used where "
 	                      "they lie (CL_MEM_USE_HOST_PTR) instead of copied in and out; "
@@ -57,16 +54,12 @@ static const cl_builder program = CL_BUILDER(cl_lbvh_src, kernel_names, UINT32_M
 /* Kept between builds (one build at a time, ABI rule); released when the
  * plugin is unloaded. */
 static struct {
-	cl_dev dev;
-	cl_sort sort;
-	cl_buf b[LB_COUNT];
+	CL_KEPT(LB_COUNT);
 } S;
 
 __attribute__((destructor)) static void release_device(void)
 {
-	cl_bufs_free(S.b, LB_COUNT);
-	cl_bufs_free(S.sort.b, SB_COUNT);
-	cl_dev_close(&S.dev);
+	CL_KEPT_FREE(S, LB_COUNT);
 }
 
 static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,

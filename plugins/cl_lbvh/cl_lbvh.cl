@@ -160,10 +160,7 @@ static float child_cost(const node *c, __global const float *cost, float c_isect
 static node load_node(volatile __global const node *p)
 {
 	node x;
-	for (int k = 0; k < 3; k++) {
-		x.lo[k] = p->lo[k];
-		x.hi[k] = p->hi[k];
-	}
+	box_load(x.lo, x.hi, p->lo, p->hi);
 	x.first = p->first;
 	x.count = p->count;
 	return x;
@@ -201,10 +198,7 @@ static node finish(volatile __global node *nodes, uint p, uint size, uint first,
 
 static void store_node(volatile __global node *p, const node *x)
 {
-	for (int k = 0; k < 3; k++) {
-		p->lo[k] = x->lo[k];
-		p->hi[k] = x->hi[k];
-	}
+	box_store(p->lo, p->hi, x->lo, x->hi);
 	p->first = x->first;
 	p->count = x->count;
 }

@@ -11,17 +11,10 @@
  * MIN_CHUNK nodes (a few hundred keep every core busy, as the sort's). */
 #define MIN_CHUNK 256u
 
-static uint32_t chunk_size(uint32_t m)
-{
-	uint32_t c = (m + CL_LBVH_CHUNKS - 1) / CL_LBVH_CHUNKS;
-
-	return c < MIN_CHUNK ? MIN_CHUNK : c;
-}
-
 int cl_lbvh_compact(cl_lbvh *b, cl_events *ev, char *err, size_t err_size)
 {
 	cl_dev *d = b->dev;
-	cl_uint m = b->n - 1, chunk = chunk_size(m), chunks = (m + chunk - 1) / chunk;
+	cl_uint m = b->n - 1, chunk, chunks = cl_chunks(m, CL_LBVH_CHUNKS, MIN_CHUNK, &chunk);
 	cl_mem inner = b->b[LB_INNER].mem, plan = b->b[LB_PLAN].mem;
 	/* visits[] is done with once bounds has run: the movers' numbers */
 	cl_mem movers = b->b[LB_VISITS].mem, parent = b->b[LB_PARENT].mem;

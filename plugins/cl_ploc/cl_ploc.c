@@ -45,9 +45,7 @@ static const cl_builder program = CL_BUILDER(cl_ploc_src, kernel_names, REC_PRIM
 /* Kept between builds (one build at a time, ABI rule), with the host's
  * copy of the merge tree; released when the plugin is unloaded. */
 static struct {
-	cl_dev dev;
-	cl_sort sort;
-	cl_buf b[PB_COUNT];
+	CL_KEPT(PB_COUNT);
 	bvhlab_node *tree;
 	uint32_t *desc;
 	uint32_t cap;
@@ -55,9 +53,7 @@ static struct {
 
 __attribute__((destructor)) static void release_device(void)
 {
-	cl_bufs_free(S.b, PB_COUNT);
-	cl_bufs_free(S.sort.b, SB_COUNT);
-	cl_dev_close(&S.dev);
+	CL_KEPT_FREE(S, PB_COUNT);
 	free(S.tree);
 	free(S.desc);
 }
@@ -99,12 +95,6 @@ static int run(void *p, bvhlab_build_output *out, char *err, size_t err_size)
 	return 0;
 }
 
-static const cl_run_spec job = CL_RUN_SPEC(cl_ploc, run);
-
-CL_BUILD_FN(cl_ploc)
-
-PLUGIN_WITH_OPTIONS(options, .name = "cl_ploc",
-	.flags = BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_DEVICE,
+CL_PLUGIN(cl_ploc, run, .name = "cl_ploc",
 	.summary = "PLOC on an OpenCL device (Meister & Bittner 2018): the ploc plugin's tree, "
-	           "built by kernels",
-	.build = build)
+	           "built by kernels")

@@ -21,13 +21,6 @@ enum { K_FIRST = CL_SORT_KERNELS, K_NEAREST, K_COUNT, K_PREFIX, K_WRITE, K_NEARE
 #define MIN_CHUNK 64u
 #define CHUNKS 512u
 
-static uint32_t chunk_size(uint32_t m)
-{
-	uint32_t c = (m + CHUNKS - 1) / CHUNKS;
-
-	return c < MIN_CHUNK ? MIN_CHUNK : c;
-}
-
 static int size_buffers(cl_ploc *b, char *err, size_t err_size)
 {
 	size_t n = b->n, want[PB_COUNT + SB_COUNT];
@@ -91,7 +84,7 @@ static int iteration(cl_ploc *b, cl_uint bound, cl_uint cur, cl_events *ev, char
                      size_t err_size)
 {
 	cl_dev *d = b->dev;
-	cl_uint chunk = chunk_size(bound), chunks = (bound + chunk - 1) / chunk;
+	cl_uint chunk, chunks = cl_chunks(bound, CHUNKS, MIN_CHUNK, &chunk);
 	cl_uint collapse = b->collapse, max_leaf = b->max_leaf;
 	cl_mem c = b->b[PB_CL0 + cur].mem, to = b->b[PB_CL1 - cur].mem;
 	cl_mem state = b->b[PB_STATE].mem, counts = b->b[PB_COUNTS].mem, nn = b->b[PB_NN].mem;

@@ -2,7 +2,8 @@
  * hploc: H-PLOC (Benthin et al. 2024) on the CPU, with lbvh's SAH
  * collapse. The phases are described in hploc.h.
  *
- * This file: options, scratch memory, the first clusters, build().
+ * This file: options, scratch memory, the first clusters, build() on
+ * morton_build.
  */
 #include <errno.h>
 #include <string.h>
@@ -41,8 +42,9 @@ static char *take(char **at, size_t bytes)
 	return p;
 }
 
-static int scratch_alloc(hploc *h, const bvhlab_build_output *out, morton_scratch *s)
+static int scratch_alloc(void *arg, bvhlab_build_output *out, morton_scratch *s)
 {
+	hploc *h = arg;
 	uint32_t *unused;
 	size_t n = h->n;
 	char *at = morton_scratch_place(s, out, h->n, work_size(n), spare_nodes(h->n), &h->sort,
@@ -56,6 +58,8 @@ static int scratch_alloc(hploc *h, const bvhlab_build_output *out, morton_scratc
 	h->count = (uint32_t *)(void *)take(&at, 4 * n);
 	h->meet = (atomic_uint *)(void *)take(&at, 4 * n);
 	h->tasks = (hploc_place *)(void *)take(&at, sizeof(hploc_place) * n);
+	h->out = out;
+	h->merge = (hploc_params){ h->radius, h->collapse, h->max_leaf, h->c_trav, h->c_isect };
 	return 0;
 }
 
@@ -104,84 +108,18 @@ static void emit(hploc *h, unsigned t)
 	team_sync(&h->team);
 }
 
-static void run_phases(void *arg, unsigned t)
-{
-	hploc *h = arg;
+MORTON_PHASE_FN(hploc, first_clusters)
+MORTON_PHASE_FN(hploc, hploc_climb)
+MORTON_PHASE_FN(hploc, emit)
 
-	if (t == 0)
-		h->phase_ms[3] = morton_now_ms();
-	morton_sort_team(&h->sort, &h->team, t, NULL, NULL);
-	first_clusters(h, t);
-	team_sync(&h->team);
-	if (t == 0)
-		h->phase_ms[0] = morton_now_ms();
-	hploc_climb(h, t);
-	if (t == 0)
-		h->phase_ms[1] = morton_now_ms();
-	emit(h, t);
-	if (t == 0)
-		h->phase_ms[2] = morton_now_ms();
-}
+static const morton_phase phases[] = {
+	{ "climb", hploc_climb_phase }, { "emit", emit_phase }, { NULL, NULL },
+};
 
 /* ---- build --------------------------------------------------------------- */
 
-static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, hploc *h,
-                      bvhlab_build_output *out)
-{
-	morton_scratch s = { 0 };
-	double start = morton_now_ms();
-	team_host th;
-	int rc;
-
-	h->threads = morton_team_size(h->in);
-	h->sort.n = h->n;
-	h->sort.centroids = h->in->centroids;
-	h->sort.centroid_bounds = h->in->centroid_bounds;
-	if ((rc = scratch_alloc(h, out, &s)) < 0) {
-		host->set_error(ctx, "out of memory for the scratch of %u primitives", h->n);
-		goto out;
-	}
-	h->out = out;
-	team_host_init(&th, host, ctx);
-	if ((rc = team_run_on(&h->team, &th, h->threads, run_phases, h)) < 0) {
-		host->set_error(ctx, "cannot set up the thread team");
-		goto out;
-	}
-	out->node_count = h->node_count;
-	out->index_count = h->n;
-	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims, %u threads: setup %.2f, sort %.2f, "
-	          "climb %.2f, emit %.2f ms", h->n, h->team.threads, h->phase_ms[3] - start,
-	          h->phase_ms[0] - h->phase_ms[3], h->phase_ms[1] - h->phase_ms[0],
-	          h->phase_ms[2] - h->phase_ms[1]);
-out:
-	morton_scratch_free(&s);
-	return rc;
-}
-
-static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *input, bvhlab_build_output *output)
-{
-	hploc h;
-	int rc;
-
-	if (input->prim_count == 0 || input->prim_count > HPLOC_PRIMS) {
-		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
-		return -EINVAL;
-	}
-	/* The options first: the copy sets the whole struct, the rest zero. */
-	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &h)) < 0)
-		return rc;
-	h.in = input;
-	h.n = input->prim_count;
-	if ((rc = big_ensure_output(host, ctx, h.n, spare_nodes(h.n), output)) < 0)
-		return rc;
-	h.merge = (hploc_params){ h.radius, h.collapse, h.max_leaf, h.c_trav, h.c_isect };
-	if (input->prim_count == 1) {
-		morton_single_leaf(input, output);
-		return 0;
-	}
-	return build_team(host, ctx, &h, output);
-}
+MORTON_BUILD_FN(hploc, .max_prims = HPLOC_PRIMS, .spare = spare_nodes(b.n), .place = scratch_alloc,
+                .sorted = first_clusters_phase, .phases = phases)
 
 PLUGIN_WITH_OPTIONS(options, .name = "hploc",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,

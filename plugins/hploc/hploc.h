@@ -73,7 +73,8 @@ typedef struct hploc {
 	uint32_t node_count;
 	atomic_uint blocks;   /* blocks of leaves, then of tasks, handed out */
 	team team;
-	double phase_ms[4];   /* thread 0's phase end times, [3] the start */
+	double phase_ms[4];   /* member 0's clock at the start and after each
+	                       * phase (morton_job's ms) */
 } hploc;
 
 /* Emit tasks per thread: subtrees of at most n / (this x T) primitives,

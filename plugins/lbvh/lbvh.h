@@ -58,7 +58,6 @@ typedef struct lbvh {
 	const bvhlab_build_input *in;
 	uint32_t n;          /* primitives, >= 2 when the team runs */
 	uint32_t threads;    /* threads asked for; the team (team.threads) may be smaller */
-	unsigned bits;       /* Morton code bits: 30 or 63 */
 	bool collapse;
 	uint32_t max_leaf;
 	float c_trav, c_isect;
@@ -72,7 +71,8 @@ typedef struct lbvh {
 	 * which the bounds phase is the first to write (see lbvh.c), so the
 	 * sorted words last through Karras. keys[0][k] holds the code of
 	 * sorted position k from bit sort.base up, shifted above
-	 * sort.id_bits of primitive id (base 0 when the whole code fits). */
+	 * sort.id_bits of primitive id (base 0 when the whole code fits).
+	 * sort.bits is the option `bits`. */
 	morton_sort sort;
 
 	/* hierarchy: past the tree in the output, or a fresh mapping */
@@ -93,7 +93,8 @@ typedef struct lbvh {
 	atomic_uint blocks[2];    /* blocks handed out in karras and bounds */
 
 	team team;                /* the threads (plugins/common/team) */
-	double phase_ms[5];       /* thread 0's phase end times, [4] the start */
+	double phase_ms[5];       /* member 0's clock at the start and after each
+	                           * phase (morton_job's ms) */
 } lbvh;
 
 /* The [lo, hi) share of thread t of `count` items. */
@@ -141,9 +142,11 @@ static inline uint32_t internal_index(const bvhlab_node *node)
 	return (node->first - 1) / 2;
 }
 
-/* Phases, run by every thread t of the team; each ends with lbvh_sync
+/* The sort phase's parts (morton_job's bucket_done and sorted), then the
+ * phases, run by every thread t of the team; each ends with lbvh_sync
  * except the last, which the caller's join ends. */
-void lbvh_sort(lbvh *b, unsigned t);      /* lbvh_sort.c */
+void lbvh_bucket_done(void *arg, uint32_t first, uint32_t end); /* lbvh_sort.c */
+void lbvh_sorted(void *arg, unsigned t);                         /* lbvh_sort.c */
 void lbvh_karras(lbvh *b, unsigned t);    /* lbvh_emit.c */
 void lbvh_bounds(lbvh *b, unsigned t);    /* lbvh_emit.c */
 void lbvh_compact(lbvh *b, unsigned t);   /* lbvh_collapse.c */

@@ -1,10 +1,10 @@
 /*
- * lbvh phase 1: Morton codes of the centroids and their sort into (code,
- * primitive) order (plugins/common/morton, shared with ploc), and what
- * the hierarchy needs from that order: the ids into output->prim_index,
- * and the common prefix lengths of neighbours, taken per bucket while the
- * sort still has it in cache. Karras compares the sorted words
- * (morton_common_prefix()).
+ * lbvh phase 1, around the sort that morton_build runs (Morton codes of
+ * the centroids sorted into (code, primitive) order, plugins/common/morton,
+ * shared with ploc and hploc): what the hierarchy needs from that order,
+ * the ids into output->prim_index and the common prefix lengths of
+ * neighbours, taken per bucket while the sort still has it in cache.
+ * Karras compares the sorted words (morton_common_prefix()).
  */
 #include <string.h>
 
@@ -13,7 +13,8 @@
 
 /* Zeroes the arrival counters and flags of thread t's chunk (of n; n - 1
  * flags), which are left from the build before when the scratch is in the
- * output; they are read from the bounds phase on. */
+ * output; they are read from the bounds phase on (apart from the sort's
+ * buffers, so zeroed after it). */
 static void clear_counters(lbvh *b, unsigned t)
 {
 	uint32_t lo, hi;
@@ -28,7 +29,7 @@ static void clear_counters(lbvh *b, unsigned t)
 
 /* A bucket [s, e) is sorted: its ids, and the common prefixes of its
  * neighbours (those across buckets come after). */
-static void bucket_done(void *arg, uint32_t s, uint32_t e)
+void lbvh_bucket_done(void *arg, uint32_t s, uint32_t e)
 {
 	lbvh *b = arg;
 
@@ -58,10 +59,10 @@ static void border_prefixes(lbvh *b, unsigned t)
 	}
 }
 
-void lbvh_sort(lbvh *b, unsigned t)
+void lbvh_sorted(void *arg, unsigned t)
 {
+	lbvh *b = arg;
+
 	clear_counters(b, t);
-	morton_sort_team(&b->sort, &b->team, t, bucket_done, b);
 	border_prefixes(b, t);
-	lbvh_sync(b);
 }

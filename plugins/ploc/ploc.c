@@ -2,7 +2,8 @@
  * ploc: a parallel PLOC builder (Meister & Bittner 2018) with lbvh's SAH
  * collapse. The phases are described in ploc.h.
  *
- * This file: options, scratch memory, the first clusters, build().
+ * This file: options, scratch memory, the first clusters, build() on
+ * morton_build.
  */
 #include <errno.h>
 #include <string.h>
@@ -72,14 +73,19 @@ static void place_work(ploc *p, char *at)
 
 /* The sort's buffers: in the output's first nodes, which only the emit
  * phase writes, after the sort is read for the last time. */
-static int scratch_alloc(ploc *p, const bvhlab_build_output *out, morton_scratch *s)
+static int scratch_alloc(void *arg, bvhlab_build_output *out, morton_scratch *s)
 {
+	ploc *p = arg;
 	char *work = morton_scratch_place(s, out, p->n, work_size(p->n), spare_nodes(p->n),
 	                                  &p->sort, p->threads, 2, &p->count, NULL);
 
 	if (!work)
 		return -ENOMEM;
 	place_work(p, work);
+	p->nodes = out->nodes;
+	p->prim_index = out->prim_index;
+	p->emit_cut = p->n / (PLOC_EMIT_TASKS * p->threads);
+	p->emit_cut = p->emit_cut ? p->emit_cut : 1;
 	return 0;
 }
 
@@ -112,86 +118,18 @@ static void first_clusters(ploc *p, unsigned t)
 	}
 }
 
-static void run_phases(void *arg, unsigned t)
-{
-	ploc *p = arg;
+MORTON_PHASE_FN(ploc, first_clusters)
+MORTON_PHASE_FN(ploc, ploc_cluster)
+MORTON_PHASE_FN(ploc, ploc_emit)
 
-	if (t == 0)
-		p->phase_ms[3] = morton_now_ms();
-	morton_sort_team(&p->sort, &p->team, t, NULL, NULL);
-	first_clusters(p, t);
-	team_sync(&p->team);
-	if (t == 0)
-		p->phase_ms[0] = morton_now_ms();
-	ploc_cluster(p, t);
-	if (t == 0)
-		p->phase_ms[1] = morton_now_ms();
-	ploc_emit(p, t);
-	if (t == 0)
-		p->phase_ms[2] = morton_now_ms();
-}
+static const morton_phase phases[] = {
+	{ "cluster", ploc_cluster_phase }, { "emit", ploc_emit_phase }, { NULL, NULL },
+};
 
 /* ---- build --------------------------------------------------------------- */
 
-static int build_team(const bvhlab_host *host, bvhlab_build_ctx *ctx, ploc *p,
-                      bvhlab_build_output *out)
-{
-	morton_scratch s = { 0 };
-	double start = morton_now_ms();
-	team_host th;
-	int rc;
-
-	p->threads = morton_team_size(p->in);
-	p->emit_cut = p->n / (PLOC_EMIT_TASKS * p->threads);
-	p->emit_cut = p->emit_cut ? p->emit_cut : 1;
-	p->sort.n = p->n;
-	p->sort.centroids = p->in->centroids;
-	p->sort.centroid_bounds = p->in->centroid_bounds;
-	if ((rc = scratch_alloc(p, out, &s)) < 0) {
-		host->set_error(ctx, "out of memory for the scratch of %u primitives", p->n);
-		goto out;
-	}
-	p->nodes = out->nodes;
-	p->prim_index = out->prim_index;
-	team_host_init(&th, host, ctx);
-	if ((rc = team_run_on(&p->team, &th, p->threads, run_phases, p)) < 0) {
-		host->set_error(ctx, "cannot set up the thread team");
-		goto out;
-	}
-	out->node_count = p->node_count;
-	out->index_count = p->n;
-	host->log(ctx, BVHLAB_LOG_DEBUG, "%u prims, %u threads, %u iterations: setup %.2f, "
-	          "sort %.2f, cluster %.2f, emit %.2f ms", p->n, p->team.threads, p->iterations,
-	          p->phase_ms[3] - start, p->phase_ms[0] - p->phase_ms[3],
-	          p->phase_ms[1] - p->phase_ms[0], p->phase_ms[2] - p->phase_ms[1]);
-out:
-	morton_scratch_free(&s);
-	return rc;
-}
-
-static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
-                 const bvhlab_build_input *input, bvhlab_build_output *output)
-{
-	ploc p;
-	int rc;
-
-	if (input->prim_count == 0 || input->prim_count > REC_PRIMS) {
-		host->set_error(ctx, "cannot build over %u primitives", input->prim_count);
-		return -EINVAL;
-	}
-	/* The options first: the copy sets the whole struct, the rest zero. */
-	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &p)) < 0)
-		return rc;
-	p.in = input;
-	p.n = input->prim_count;
-	if ((rc = big_ensure_output(host, ctx, p.n, spare_nodes(p.n), output)) < 0)
-		return rc;
-	if (input->prim_count == 1) {
-		morton_single_leaf(input, output);
-		return 0;
-	}
-	return build_team(host, ctx, &p, output);
-}
+MORTON_BUILD_FN(ploc, .max_prims = REC_PRIMS, .spare = spare_nodes(b.n), .place = scratch_alloc,
+                .sorted = first_clusters_phase, .phases = phases, .iterations = &b.iterations)
 
 PLUGIN_WITH_OPTIONS(options, .name = "ploc",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |

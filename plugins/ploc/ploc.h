@@ -107,7 +107,8 @@ typedef struct ploc {
 	uint32_t *count;        /* [2 T] per-chunk counts of merges, survivors */
 	atomic_uint blocks[2];  /* blocks handed out, by iteration parity */
 	team team;
-	double phase_ms[4];     /* thread 0's phase end times, [3] the start */
+	double phase_ms[4];     /* member 0's clock at the start and after each
+	                         * phase (morton_job's ms) */
 } ploc;
 
 static inline float half_area3(float dx, float dy, float dz)

@@ -189,10 +189,7 @@ static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return leaves_run(host, ctx, input, tree, o.leaves, false, (uint32_t)o.max_leaf, stage, &st);
 }
 
-PLUGIN_WITH_OPTIONS(options,
+LEAVES_STAGE_PLUGIN(options,
 	.name = "reinsert",
 	.summary = "refinement: parallel search, exact one-thread application of subtree "
-	           "reinsertions (Bittner et al. 2013, Meister & Bittner 2018)",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.build = NULL,
-	.refine = refine)
+	           "reinsertions (Bittner et al. 2013, Meister & Bittner 2018)")

@@ -32,6 +32,7 @@
 #include "sah_nodes.h"
 #include "sah_threads.h"
 #include "tasks_split.h"
+#include "team_list.h"
 #include "team.h"
 
 /* Where the options go. */
@@ -78,9 +79,7 @@ struct crew {
 	const sah_job *root;
 	tasks_split split;
 	sah_builder *b;
-	sah_job *tasks;
-	uint32_t task_count, task_cap;
-	atomic_uint next;     /* first unclaimed task */
+	team_list tasks;      /* of sah_job: the subtrees below parallel_min */
 };
 
 /*
@@ -95,14 +94,14 @@ struct crew {
 static void run_tasks(struct crew *tm)
 {
 	sah_builder local;
-	uint32_t i, cap = tm->task_count ? 2 * sah_job_size(&tm->tasks[0]) : 0;
+	sah_job *tasks = tm->tasks.items;
+	size_t i, cap = tm->tasks.n ? 2 * sah_job_size(&tasks[0]) : 0;
 	bvhlab_node *scratch = cap ? malloc(cap * sizeof(*scratch)) : NULL;
 
 	memcpy(&local, tm->b, sizeof(local));
 	local.nodes = scratch;
-	while ((i = atomic_fetch_add_explicit(&tm->next, 1, memory_order_relaxed)) <
-	       tm->task_count) {
-		sah_job job = tm->tasks[i];
+	while (team_list_claim(&tm->tasks, &i)) {
+		sah_job job = tasks[i];
 		if (!scratch) { /* no memory for it: the shared counter still works */
 			sah_build_subtree(tm->b, &job);
 			continue;
@@ -110,7 +109,7 @@ static void run_tasks(struct crew *tm)
 		job.node = 0;
 		atomic_init(&local.node_counter, 1);
 		sah_build_subtree(&local, &job);
-		sah_place_scratch(tm->b, tm->tasks[i].node, scratch,
+		sah_place_scratch(tm->b, tasks[i].node, scratch,
 		                  atomic_load_explicit(&local.node_counter, memory_order_relaxed));
 	}
 	free(scratch);
@@ -150,20 +149,6 @@ static void crew_run(struct crew *tm, int cmd)
 		team_sync(&tm->bar);
 }
 
-static int add_task(struct crew *tm, const sah_job *job)
-{
-	if (tm->task_count == tm->task_cap) {
-		uint32_t cap = tm->task_cap ? 2 * tm->task_cap : 64;
-		sah_job *t = realloc(tm->tasks, cap * sizeof(*t));
-		if (!t)
-			return -ENOMEM;
-		tm->tasks = t;
-		tm->task_cap = cap;
-	}
-	tm->tasks[tm->task_count++] = *job;
-	return 0;
-}
-
 /* Splits one large node: by the team for binned, else by the kernel. */
 static unsigned split_large(struct crew *tm, const sah_job *job, sah_job child[2])
 {
@@ -194,7 +179,7 @@ static int split_top(struct crew *tm, uint32_t parallel_min, const sah_job *root
 	while (sp > 0 && rc == 0) {
 		sah_job job = stack[--sp];
 		if (sah_job_size(&job) <= parallel_min) {
-			rc = add_task(tm, &job);
+			rc = team_list_push(&tm->tasks, &job);
 			continue;
 		}
 		if (split_large(tm, &job, child) == 0)
@@ -224,7 +209,7 @@ static int run_build(struct crew *tm)
 
 	if (rc < 0)
 		return rc;
-	qsort(tm->tasks, tm->task_count, sizeof(*tm->tasks), by_size_desc);
+	team_list_order(&tm->tasks, by_size_desc);
 	crew_run(tm, CMD_TASKS);
 	return 0;
 }
@@ -257,17 +242,15 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 	const struct tasks_options *o = arg;
 	/* no more OS threads than the scene has work for */
 	uint32_t threads = sah_useful_threads(asked, root);
-	struct crew tm = { .b = b, .parallel_min = o->parallel_min, .root = root };
-	int rc;
-
-	atomic_init(&tm.next, 0);
-	rc = tasks_split_init(&tm.split, b, threads);
+	struct crew tm = { .b = b, .parallel_min = o->parallel_min, .root = root,
+	                   .tasks = TEAM_LIST(sah_job) };
+	int rc = tasks_split_init(&tm.split, b, threads);
 	if (rc == 0)
 		rc = team_run_on(&tm.bar, th, threads, crew_member, &tm);
 	if (rc == 0)
 		rc = tm.rc;
 	tasks_split_free(&tm.split);
-	free(tm.tasks);
+	team_list_free(&tm.tasks);
 	if (rc < 0)
 		th->host->set_error(th->ctx, "sah_tasks: cannot set up the build (%d)", rc);
 	return rc;

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "sbvh.h"
+#include "team_list.h"
 
 enum phase { PH_OBJECT, PH_SPATIAL, PH_COUNT, PH_WRITE };
 
@@ -220,26 +221,6 @@ static bool crew_split(crew *tm, const sbvh_job *job, sbvh_job *left, sbvh_job *
 	return true;
 }
 
-/* A growable list of jobs. */
-typedef struct job_list {
-	sbvh_job *jobs;
-	size_t n, cap;
-} job_list;
-
-static int push(job_list *l, const sbvh_job *j)
-{
-	if (l->n == l->cap) {
-		size_t cap = l->cap ? 2 * l->cap : 64;
-		sbvh_job *grown = realloc(l->jobs, cap * sizeof(*grown));
-		if (!grown)
-			return -ENOMEM;
-		l->jobs = grown;
-		l->cap = cap;
-	}
-	l->jobs[l->n++] = *j;
-	return 0;
-}
-
 /* Largest first, so a big subtree does not start last. */
 static int by_size(const void *a, const void *b)
 {
@@ -250,29 +231,28 @@ static int by_size(const void *a, const void *b)
 }
 
 /* The big jobs, breadth first with the whole team; the rest into `small`. */
-static int top_phase(crew *tm, const sbvh_job *root, job_list *small)
+static int top_phase(crew *tm, const sbvh_job *root, team_list *small)
 {
-	job_list big = { 0 };
+	team_list big = TEAM_LIST(sbvh_job);
 	size_t next = 0;
-	int rc = push(&big, root);
+	int rc = team_list_push(&big, root);
 
 	while (rc == 0 && next < big.n) {
-		sbvh_job job = big.jobs[next++], child[2];
+		sbvh_job job = *TEAM_LIST_AT(&big, sbvh_job, next++), child[2];
 		if (!crew_split(tm, &job, &child[0], &child[1]))
 			continue;
-		for (int c = 0; c < 2 && rc == 0; c++)
-			rc = push(child[c].end - child[c].begin >= tm->B->opt.parallel_min ? &big
-			                                                                  : small,
-			          &child[c]);
+		for (int c = 0; c < 2 && rc == 0; c++) {
+			bool large = child[c].end - child[c].begin >= tm->B->opt.parallel_min;
+			rc = team_list_push(large ? &big : small, &child[c]);
+		}
 	}
-	free(big.jobs);
+	team_list_free(&big);
 	return rc;
 }
 
 typedef struct worker {
 	sbvh_build *B;
-	const job_list *small;
-	_Atomic size_t *next;
+	team_list *small;
 	int rc;
 	sbvh_bins bins;
 } worker;
@@ -282,27 +262,24 @@ static void run_worker(void *arg, unsigned t)
 	worker *w = (worker *)arg + t;
 	size_t i;
 
-	while (w->rc == 0 &&
-	       (i = atomic_fetch_add_explicit(w->next, 1, memory_order_relaxed)) < w->small->n)
-		w->rc = sbvh_build_subtree(w->B, &w->small->jobs[i], &w->bins);
+	while (w->rc == 0 && team_list_claim(w->small, &i))
+		w->rc = sbvh_build_subtree(w->B, TEAM_LIST_AT(w->small, sbvh_job, i), &w->bins);
 }
 
 /* The small jobs, claimed largest first by a team of the thread layer
  * (the caller alone when no team is to be had). */
-static int task_phase(sbvh_build *B, job_list *small)
+static int task_phase(sbvh_build *B, team_list *small)
 {
 	uint32_t T = B->threads;
 	worker *w = calloc(T, sizeof(*w));
-	_Atomic size_t next = 0;
 	team tm;
 	int rc = 0;
 
 	if (!w)
 		return -ENOMEM;
-	if (small->n > 1) /* qsort may not take the NULL of an empty list */
-		qsort(small->jobs, small->n, sizeof(*small->jobs), by_size);
+	team_list_order(small, by_size);
 	for (uint32_t t = 0; t < T; t++)
-		w[t] = (worker){ .B = B, .small = small, .next = &next };
+		w[t] = (worker){ .B = B, .small = small };
 	if (team_run_on(&tm, &B->th, T, run_worker, w) < 0)
 		run_worker(w, 0);
 	for (uint32_t t = 0; t < T; t++)
@@ -314,7 +291,7 @@ static int task_phase(sbvh_build *B, job_list *small)
 int sbvh_build_all(sbvh_build *B, const sbvh_job *root)
 {
 	crew tm = { .B = B, .m = calloc(B->threads, sizeof(member)) };
-	job_list small = { 0 };
+	team_list small = TEAM_LIST(sbvh_job);
 	int rc = tm.m ? 0 : -ENOMEM;
 
 	for (uint32_t t = 0; rc == 0 && t < B->threads; t++)
@@ -324,6 +301,6 @@ int sbvh_build_all(sbvh_build *B, const sbvh_job *root)
 	if (rc == 0)
 		rc = task_phase(B, &small);
 	free(tm.m);
-	free(small.jobs);
+	team_list_free(&small);
 	return rc;
 }

@@ -126,10 +126,7 @@ static int refine(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	                  &o);
 }
 
-PLUGIN_WITH_OPTIONS(options,
+LEAVES_STAGE_PLUGIN(options,
 	.name = "treelet",
 	.summary = "refinement: every shape of small treelets tried by dynamic programming, "
-	           "the best kept (Karras & Aila 2013); parallel over subtrees, deterministic",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
-	.build = NULL,
-	.refine = refine)
+	           "the best kept (Karras & Aila 2013); parallel over subtrees, deterministic")

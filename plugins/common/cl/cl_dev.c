@@ -11,6 +11,13 @@ void cl_dev_close(cl_dev *d)
 	memset(d, 0, sizeof(*d));
 }
 
+void cl_kept_free(cl_dev *d, cl_sort *s, cl_buf *b, unsigned count)
+{
+	cl_bufs_free(b, count);
+	cl_bufs_free(s->b, SB_COUNT);
+	cl_dev_close(d);
+}
+
 int cl_dev_open(cl_dev *d, const bvhlab_host *host, bvhlab_build_ctx *ctx, const char *spec,
                 const char *src, size_t len, const char *const *names, unsigned count)
 {

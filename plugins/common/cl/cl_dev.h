@@ -1,7 +1,7 @@
 /*
- * What the device builders (cl_lbvh, cl_ploc) share on the host side, over
- * the device layer of include/bvhlab/opencl.h (a static library linked into
- * each plugin):
+ * What the device builders (cl_lbvh, cl_ploc, cl_hploc) share on the host
+ * side, over the device layer of include/bvhlab/opencl.h (a static library
+ * linked into each plugin):
  *
  *   - cl_dev: the device and the built program, from the process's device
  *     layer (the host's, ABI 1.6: shared with every device builder and the
@@ -11,9 +11,12 @@
  *   - cl_buf, cl_launch, cl_events: the device layer's buffers that grow
  *     (all sized before any kernel runs), launches and events (summed
  *     into the phase "device"), core/device/device_run.h, on d's device;
+ *   - what a builder keeps between builds (CL_KEPT) and the chunks of its
+ *     one-work-item-each kernels (cl_chunks);
  *   - the Morton codes and their radix sort (cl_sort.c, kernels in
- *     morton_sort.cl), mirroring plugins/common/morton;
- *   - the start of a build and the report of its phases (cl_build.c).
+ *     morton_sort.cl after box.cl), mirroring plugins/common/morton;
+ *   - the start of a build and the report of its phases (cl_build.c), and
+ *     the build() and descriptor of a builder on it (CL_PLUGIN).
  */
 #ifndef BVHLAB_CL_DEV_H
 #define BVHLAB_CL_DEV_H
@@ -78,6 +81,17 @@ int cl_dev_open(cl_dev *d, const bvhlab_host *host, bvhlab_build_ctx *ctx, const
 /* Releases the kernels; safe on a zeroed or closed cl_dev. */
 void cl_dev_close(cl_dev *d);
 
+/* The head of what a device builder keeps between builds (one build at a
+ * time, ABI rule) in its static struct S, which CL_BUILD_FN reads: the
+ * device, the sort, and its own `count` buffers. */
+#define CL_KEPT(count) \
+	cl_dev dev;    \
+	cl_sort sort;  \
+	cl_buf b[count]
+
+/* Releases what CL_KEPT(count) holds (the plugin's destructor). */
+#define CL_KEPT_FREE(kept, count) cl_kept_free(&(kept).dev, &(kept).sort, (kept).b, count)
+
 /* The device layer's buffers, launches and events (core/device/device_run.h)
  * on a cl_dev's device. */
 static inline int cl_bufs_fit(const cl_dev *d, const size_t *want, unsigned count, char *err,
@@ -96,6 +110,17 @@ static inline int cl_launch(cl_dev *d, cl_kernel k, size_t items, const cl_arg *
                             unsigned nargs, cl_events *ev, char *err, size_t err_size)
 {
 	return cl_launch_on(&d->cl, k, items, args, nargs, ev, err, err_size);
+}
+
+/* Work on n items in chunks of one work-item each, in order: the count of
+ * chunks, at most `most` (but for n = 0), with the size of each, at least
+ * `least` items, into *chunk. */
+static inline uint32_t cl_chunks(uint32_t n, uint32_t most, uint32_t least, uint32_t *chunk)
+{
+	uint32_t c = (n + most - 1) / most;
+
+	*chunk = c < least ? least : c;
+	return (n + *chunk - 1) / *chunk;
 }
 
 /* ---- Morton codes and sort (cl_sort.c) -------------------------------- */
@@ -139,6 +164,9 @@ void cl_sort_sizes(uint32_t n, size_t want[SB_COUNT]);
  */
 int cl_sort_run(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned bits,
                 cl_events *ev, double *ms_upload, char *err, size_t err_size);
+
+/* The sort's and the builder's buffers freed, d closed (CL_KEPT_FREE). */
+void cl_kept_free(cl_dev *d, cl_sort *s, cl_buf *b, unsigned count);
 
 /* ---- a build's start and phases (cl_build.c) ------------------------- */
 
@@ -210,17 +238,30 @@ int cl_build_run(const cl_builder *cb, const cl_run_spec *rs, cl_dev *d, void *b
  * file keeps that state in `S` (dev, sort, b), its cl_builder `program` and
  * its cl_run_spec `job`.
  */
-#define CL_BUILD_FN(type)                                                                \
-	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,                 \
-	                 const bvhlab_build_input *input, bvhlab_build_output *output)   \
-	{                                                                                \
-		type b;                                                                  \
-		int rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);                       \
-		if (rc < 0)                                                              \
-			return rc;                                                       \
-		b.in = input, b.n = input->prim_count, b.dev = &S.dev, b.sort = &S.sort, \
-		b.b = S.b;                                                               \
-		return cl_build_run(&program, &job, &S.dev, &b, host, ctx, input, output); \
-	}
+#define CL_BUILD_FN(type)                                                         \
+	PLUGIN_BUILD_FN(type, b.dev = &S.dev, b.sort = &S.sort, b.b = S.b;           \
+	                return cl_build_run(&program, &job, &S.dev, &b, host, ctx, input, \
+	                                    output);)
+
+/*
+ * A device builder on cl_build_run, at the end of its file: its cl_run_spec
+ * `job` (struct `type`, run `fn`), its build() (CL_BUILD_FN) and its
+ * descriptor, deterministic and a device builder's; the arguments after
+ * fn name and describe it (.name, .summary).
+ */
+#define CL_PLUGIN(type, fn, ...)                                                        \
+	static const cl_run_spec job = CL_RUN_SPEC(type, fn);                           \
+	CL_BUILD_FN(type)                                                               \
+	PLUGIN_WITH_OPTIONS(options,                                                    \
+	                    .flags = BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_DEVICE, \
+	                    .build = build, __VA_ARGS__)
+
+/* A device builder's option of how it runs, a string of `choices` after
+ * auto, its default, which picks by the device's kind (`help` says how);
+ * the tree is the same for every value. */
+#define CL_SHAPE_OPTION(owner, member, option, text, more)                              \
+	PLUGIN_OPTION(owner, member, STRING, .name = option,                            \
+	              .help = text "; the tree is the same", .def_string = "auto",      \
+	              .choices = "auto|" more)
 
 #endif /* BVHLAB_CL_DEV_H */

@@ -25,16 +25,9 @@ enum { K_CODES, K_VARYING, K_HIST, K_SCAN, K_SCATTER, K_RANGES, K_BUCKETS };
 #define MIN_CHUNK 256u
 #define CHUNKS 512u
 
-static uint32_t chunk_size(uint32_t n)
-{
-	uint32_t c = (n + CHUNKS - 1) / CHUNKS;
-
-	return c < MIN_CHUNK ? MIN_CHUNK : c;
-}
-
 void cl_sort_sizes(uint32_t n, size_t want[SB_COUNT])
 {
-	uint32_t chunks = (n + chunk_size(n) - 1) / chunk_size(n);
+	uint32_t chunk, chunks = cl_chunks(n, CHUNKS, MIN_CHUNK, &chunk);
 
 	want[SB_CENTROIDS] = 12 * (size_t)n;
 	want[SB_KEYS0] = want[SB_KEYS1] = 8 * (size_t)n;
@@ -64,7 +57,7 @@ static int codes(cl_dev *d, cl_sort *s, const bvhlab_build_input *in, unsigned b
 static int varying(cl_dev *d, cl_sort *s, uint32_t n, uint64_t *bits, cl_events *ev,
                    char *err, size_t err_size)
 {
-	uint32_t chunk = chunk_size(n), chunks = (n + chunk - 1) / chunk;
+	uint32_t chunk, chunks = cl_chunks(n, CHUNKS, MIN_CHUNK, &chunk);
 	uint64_t part[CHUNKS + 1];
 	cl_arg args[] = {
 		CL_ARG(s->b[SB_KEYS0].mem), CL_ARG(n), CL_ARG(chunk), CL_ARG(s->b[SB_PART].mem),
@@ -87,7 +80,7 @@ static int varying(cl_dev *d, cl_sort *s, uint32_t n, uint64_t *bits, cl_events 
 static int pass(cl_dev *d, cl_sort *s, uint32_t n, uint32_t shift, unsigned from,
                 cl_events *ev, char *err, size_t err_size)
 {
-	uint32_t chunk = chunk_size(n), chunks = (n + chunk - 1) / chunk, total = 256 * chunks;
+	uint32_t chunk, chunks = cl_chunks(n, CHUNKS, MIN_CHUNK, &chunk), total = 256 * chunks;
 	cl_mem kin = s->b[SB_KEYS0 + from].mem, kout = s->b[SB_KEYS0 + 1 - from].mem;
 	cl_mem vin = s->b[SB_VALS0 + from].mem, vout = s->b[SB_VALS0 + 1 - from].mem;
 	cl_mem hist = s->b[SB_HIST].mem;

@@ -1,6 +1,7 @@
 /*
  * Morton codes and their stable LSD radix sort on the device, shared by
- * cl_lbvh and cl_ploc (concatenated before each plugin's own kernels).
+ * cl_lbvh, cl_ploc and cl_hploc (concatenated before each plugin's own
+ * kernels).
  *
  * The codes mirror plugins/common/morton exactly (the host passes the
  * quantiser's lo, scale and top, computed by the same C), and the sort

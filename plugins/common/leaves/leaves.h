@@ -42,4 +42,13 @@ int leaves_run(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
                bvhlab_build_output *tree, bool split, bool cut, uint32_t max_leaf,
                leaves_stage_fn stage, void *arg);
 
+/* At the end of a stage's file: its descriptor (PLUGIN_WITH_OPTIONS over
+ * `table`), a refinement stage's: no build, its refine(), parallel and
+ * deterministic; the arguments after the table name and describe it
+ * (.name, .summary). */
+#define LEAVES_STAGE_PLUGIN(table, ...)                                             \
+	PLUGIN_WITH_OPTIONS(table,                                                  \
+	                    .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC, \
+	                    .build = NULL, .refine = refine, __VA_ARGS__)
+
 #endif /* BVHLAB_LEAVES_H */

@@ -1,5 +1,6 @@
 /* The Morton builders' shared front end (see morton_front.h). */
 #include <errno.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -109,4 +110,95 @@ void morton_single_leaf(const bvhlab_build_input *in, bvhlab_build_output *out)
 	out->prim_index[0] = 0;
 	out->node_count = 1;
 	out->index_count = 1;
+}
+
+/* The debug line: the phase times of j's team, started at `start` (ms). */
+static void log_phases(const morton_job *j, const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                       uint32_t n, double start)
+{
+	char line[256];
+	size_t at = 0;
+
+	at += (size_t)snprintf(line, sizeof(line), "%u prims, %u threads", n, j->team->threads);
+	if (j->iterations && at < sizeof(line))
+		at += (size_t)snprintf(line + at, sizeof(line) - at, ", %u iterations",
+		                       *j->iterations);
+	if (at < sizeof(line))
+		at += (size_t)snprintf(line + at, sizeof(line) - at, ": setup %.2f, sort %.2f",
+		                       j->ms[0] - start, j->ms[1] - j->ms[0]);
+	for (size_t k = 0; j->phases[k].run && at < sizeof(line); k++)
+		at += (size_t)snprintf(line + at, sizeof(line) - at, ", %s %.2f", j->phases[k].name,
+		                       j->ms[k + 2] - j->ms[k + 1]);
+	host->log(ctx, BVHLAB_LOG_DEBUG, "%s ms", line);
+}
+
+/* By every member t of the team: the sort and the job's phases, member 0
+ * taking the times. */
+static void run_phases(void *arg, unsigned t)
+{
+	const morton_job *j = arg;
+
+	if (t == 0)
+		j->ms[0] = morton_now_ms();
+	morton_sort_team(j->sort, j->team, t, j->bucket_done, j->b);
+	if (j->sorted)
+		j->sorted(j->b, t);
+	team_sync(j->team);
+	if (t == 0)
+		j->ms[1] = morton_now_ms();
+	for (size_t k = 0; j->phases[k].run; k++) {
+		j->phases[k].run(j->b, t);
+		if (t == 0)
+			j->ms[k + 2] = morton_now_ms();
+	}
+}
+
+/* The team over the phases, with the sort's input and the scratch set. */
+static int run_team(const morton_job *j, const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                    const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	morton_scratch s = { 0 };
+	double start = morton_now_ms();
+	team_host th;
+	int rc;
+
+	*j->threads = morton_team_size(in);
+	j->sort->n = in->prim_count;
+	j->sort->centroids = in->centroids;
+	j->sort->centroid_bounds = in->centroid_bounds;
+	if ((rc = j->place(j->b, out, &s)) < 0) {
+		host->set_error(ctx, "out of memory for the scratch of %u primitives",
+		                in->prim_count);
+		goto out;
+	}
+	team_host_init(&th, host, ctx);
+	if ((rc = team_run_on(j->team, &th, *j->threads, run_phases, (void *)j)) < 0) {
+		host->set_error(ctx, "cannot set up the thread team");
+		goto out;
+	}
+	out->node_count = *j->node_count;
+	out->index_count = in->prim_count;
+	log_phases(j, host, ctx, in->prim_count, start);
+out:
+	morton_scratch_free(&s);
+	return rc;
+}
+
+int morton_build(const morton_job *j, const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *in, bvhlab_build_output *out)
+{
+	uint32_t n = in->prim_count;
+	int rc;
+
+	if (n == 0 || n > j->max_prims) {
+		host->set_error(ctx, "cannot build over %u primitives", n);
+		return -EINVAL;
+	}
+	if ((rc = big_ensure_output(host, ctx, n, j->spare, out)) < 0)
+		return rc;
+	if (n == 1) {
+		morton_single_leaf(in, out);
+		return 0;
+	}
+	return run_team(j, host, ctx, in, out);
 }

@@ -1,8 +1,9 @@
 /*
- * What lbvh and ploc share around the Morton sort (a part of the same
- * static library): their common options, the team's size, the output's
- * room with scratch past the tree, the scratch mappings, the sort run by
- * a team, and the tree of a single primitive.
+ * What lbvh, ploc and hploc share around the Morton sort (a part of the
+ * same static library): their common options, the team's size, the
+ * output's room with scratch past the tree, the scratch mappings, the sort
+ * run by a team, the tree of a single primitive, and the build around the
+ * builder's own phases (morton_build).
  */
 #ifndef BVHLAB_MORTON_FRONT_H
 #define BVHLAB_MORTON_FRONT_H
@@ -93,5 +94,76 @@ void morton_sort_team(morton_sort *s, team *tm, unsigned t,
 
 /* The whole tree of a single primitive: one leaf. */
 void morton_single_leaf(const bvhlab_build_input *in, bvhlab_build_output *out);
+
+/* A phase of a CPU Morton builder after the sort: run(b, t) by every
+ * member t of the team, on the builder's state b. */
+typedef struct morton_phase {
+	const char *name; /* in the debug line */
+	void (*run)(void *b, unsigned t);
+} morton_phase;
+
+/* The morton_phase's run of fn(type *, unsigned t), as fn##_phase. */
+#define MORTON_PHASE_FN(type, fn)                          \
+	static void fn##_phase(void *b, unsigned t) \
+	{                                           \
+		fn((type *)b, t);                   \
+	}
+
+/*
+ * A CPU Morton builder's build (lbvh, ploc, hploc), for morton_build():
+ * the sort, its first phase, then the builder's own; its state `b`, and in
+ * it the sort, the team, the count of threads to ask for, the node count
+ * its phases set and its phase times.
+ */
+typedef struct morton_job {
+	void *b;
+	morton_sort *sort;          /* the sort's bits set (the `bits` option) */
+	team *team;
+	uint32_t *threads;          /* set to morton_team_size() */
+	const uint32_t *node_count; /* set by the phases */
+	double *ms;                 /* member 0's clock (morton_now_ms) at the
+	                             * team's start, [0], after the sort, [1], and
+	                             * after phase k of `phases`, [k + 2] */
+	uint32_t max_prims;         /* most primitives it builds over */
+	uint32_t spare;             /* nodes of room past the tree for its scratch,
+	                             * big_spare_nodes(), 0 for none */
+	/* Its scratch placed (morton_scratch_place into s, which morton_build
+	 * frees) and the rest of b set, with the threads and the output's room
+	 * known; 0 or -ENOMEM. */
+	int (*place)(void *b, bvhlab_build_output *out, morton_scratch *s);
+	/* The sort phase's part (may be NULL): morton_sort_team's done, and
+	 * sorted(b, t) by every member after the sort, before the barrier
+	 * that ends the phase. */
+	void (*bucket_done)(void *b, uint32_t first, uint32_t end);
+	void (*sorted)(void *b, unsigned t);
+	const morton_phase *phases; /* after the sort, in order, ended by one
+	                             * with run NULL */
+	const uint32_t *iterations; /* in the debug line where not NULL */
+} morton_job;
+
+/* The job's members in a builder's struct *p: members sort, team, threads,
+ * node_count and phase_ms. */
+#define MORTON_JOB(p)                                                               \
+	.b = (p), .sort = &(p)->sort, .team = &(p)->team, .threads = &(p)->threads, \
+	.node_count = &(p)->node_count, .ms = (p)->phase_ms
+
+/*
+ * The build() of a CPU Morton builder on morton_build (PLUGIN_BUILD_FN: its
+ * struct `type`, with members in, n and those of MORTON_JOB, named b and
+ * its options read first); the arguments after the type are the rest of
+ * its job, designated initialisers of morton_job that may read b.
+ */
+#define MORTON_BUILD_FN(type, ...)                                       \
+	PLUGIN_BUILD_FN(type, morton_job j = { MORTON_JOB(&b), __VA_ARGS__ }; \
+	                return morton_build(&j, host, ctx, input, output);)
+
+/*
+ * The build of j (its options read by the caller): the count of primitives
+ * checked, the output's room, the tree of a single primitive, else the
+ * sort's input, the threads, the scratch, the team running the phases, and
+ * the output's counts. 0, or a negative errno after host->set_error.
+ */
+int morton_build(const morton_job *j, const bvhlab_host *host, bvhlab_build_ctx *ctx,
+                 const bvhlab_build_input *in, bvhlab_build_output *out);
 
 #endif /* BVHLAB_MORTON_FRONT_H */

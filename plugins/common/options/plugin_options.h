@@ -186,6 +186,26 @@ BVHLAB_END_DECLS
 	                           0 * sizeof((out) == (plugin_options_type *)0), \
 	                   out)
 
+/*
+ * After PLUGIN_DECLS: a build() whose state is a struct `type` (PLUGIN_DECLS's
+ * options_type, with members in and n) named b, its options first
+ * (PLUGIN_OPTIONS_GET copies the whole struct), then the input and the
+ * primitive count; the arguments after the type are the rest of its body,
+ * which returns (the Morton builders' MORTON_BUILD_FN, the device
+ * builders' CL_BUILD_FN).
+ */
+#define PLUGIN_BUILD_FN(type, ...)                                                    \
+	static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,               \
+	                 const bvhlab_build_input *input, bvhlab_build_output *output) \
+	{                                                                              \
+		type b;                                                                \
+		int rc = PLUGIN_OPTIONS_GET(host, ctx, input, &b);                     \
+		if (rc < 0)                                                            \
+			return rc;                                                     \
+		b.in = input, b.n = input->prim_count;                                 \
+		__VA_ARGS__                                                            \
+	}
+
 /* The entry point (BVHLAB_PLUGIN_EXPORT's), after PLUGIN_DECLS and the
  * descriptor: plugin_decls filled, once, before the descriptor is returned
  * (NULL, as for another major, in the unlikely case pthread_once fails). */
