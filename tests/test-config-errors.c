@@ -58,7 +58,8 @@ static void test_unknown_keys(void)
 	t = "{ \"scenes\": [ { \"generator\": \"icosphere\", \"frequncy\": 4 } ], " BUILDERS " }";
 	EXPECT_ERROR_AT(t, "\"frequncy\"", 0,
 	                "unknown key 'frequncy' in scenes[0] (known: name, path, generator, parts, "
-	                "frequency, count, size, seed, width, subdivide, frames, animate, deform, "
+	                "meshes, instances, frequency, count, size, seed, width, subdivide, frames, "
+	                "animate, deform, "
 	                "amplitude, camera); did you mean "
 	                "'frequency'?");
 	EXPECT_ERROR("{ " SCENES ",\n"

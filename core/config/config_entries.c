@@ -153,6 +153,7 @@ static int scene_name_and_path(struct config *cfg, struct config_scene *sc,
 	if (!sc->name) {
 		sc->name = sc->path        ? config_stem(sc->path)
 		           : sc->generator ? strdup(sc->generator)
+		           : sc->meshes    ? strdup("instances")
 		                           : strdup("composite");
 		if (!sc->name)
 			return out_of_memory(cfg, err);
@@ -184,7 +185,9 @@ static int parse_scene(struct config *cfg, const cJSON *obj, size_t index,
 		rc = config_read_keys(cfg, obj, config_scene_keys, prefix, sc, err);
 	if (!rc) /* animation: frames, motion (config_anim.c) */
 		rc = config_parse_frames(cfg, obj, prefix, sc, err);
-	if (!rc && config_member(obj, "parts"))
+	if (!rc && (config_member(obj, "instances") || config_member(obj, "meshes")))
+		rc = config_parse_instances(cfg, obj, prefix, sc, err);
+	else if (!rc && config_member(obj, "parts"))
 		rc = config_parse_parts(cfg, obj, prefix, sc, err);
 	else if (!rc)
 		rc = config_scene_source(cfg, obj, prefix, config_scene_keys, sc, err);

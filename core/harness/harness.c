@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "harness/harness.h"
+#include "harness/harness_instances.h"
 #include "harness/harness_builders.h"
 #include "harness/harness_frames.h"
 #include "harness/harness_images.h"
@@ -48,6 +49,7 @@ struct harness {
 	bool rounds_on;  /* this scene's rays are timed in interleaved rounds */
 	struct harness_rounds rounds; /* this scene's trees waiting for them */
 	struct harness_anim anim; /* this scene's animation, frames 0 if none (harness_anim.c) */
+	struct scene_instanced inst; /* this scene's two-level form, if it has "instances" */
 };
 
 enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };
@@ -469,7 +471,9 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (scene_done(h, s))
 		return;
 	int r = h->cfg->isolate ? harness_probe_scene(h->cfg, cs, &err) : 0;
-	if (r == 0) /* an animated scene's frame 0 (harness_anim.c) */
+	if (r == 0 && cs->meshes) /* a two-level scene: its meshes once, then flattened */
+		r = harness_scene_instanced(h->cfg, cs, &h->inst, &scene, &err);
+	else if (r == 0) /* an animated scene's frame 0 (harness_anim.c) */
 		r = harness_anim_load(cs, &h->anim, &scene, &err);
 	if (r == 0)
 		r = bvhlab_prims_init(&prims, scene, &err);
@@ -484,6 +488,8 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	results_add_scene(&h->res, scene->name, shown ? shown : scene->source,
 	                  scene->triangle_count, NULL);
 	free(shown);
+	if (cs->meshes)
+		harness_record_instances(&h->res, scene->name, &h->inst);
 	h->shade_done = false;
 	h->shade_error = 0;
 	h->rounds_on = harness_rounds_start(h->cfg, scene, h->progress.tty);
@@ -494,6 +500,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 		scene_images(h, scene, s);
 out:
 	harness_anim_close(&h->anim);
+	scene_instanced_finish(&h->inst);
 	bvhlab_prims_finish(&prims);
 	bvhlab_scene_destroy(scene);
 }

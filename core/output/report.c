@@ -223,6 +223,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	sb_printf(sb, "\n\n");
 	report_md_text(sb, report_str(scene, "source"));
 	sb_printf(sb, ", %s triangles", num(buf, sizeof(buf), scene, "triangles", "%.0f"));
+	report_scene_instances(sb, scene);
 	if (*report_str(scene, "error")) {
 		sb_printf(sb, ". **Could not be loaded:** ");
 		report_md_text(sb, report_str(scene, "error"));

@@ -194,6 +194,14 @@ void results_finish(struct results *res);
 
 int results_add_scene(struct results *res, const char *name, const char *source,
                       uint32_t triangles, const char *error);
+/* A two-level scene's counts, added to scene `name` (added before) as
+ * "instances": {meshes, instances, unique_triangles, instanced_triangles}. */
+struct results_instances {
+	uint32_t meshes, instances;
+	uint64_t unique_triangles, instanced_triangles;
+};
+int results_scene_instances(struct results *res, const char *name,
+                            const struct results_instances *in);
 int results_add_run(struct results *res, const struct run_record *run);
 /* The run's record as results_add_run adds it (results_run.c); NULL when
  * out of memory. */

@@ -1,0 +1,197 @@
+/*
+ * Two-level scenes: "meshes" and "instances" in configs (parsing and every
+ * error), and the scene they make: matrices and their inverses, scatters,
+ * world boxes and the flattened scene.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "config/config.h"
+#include "harness/harness_instances.h"
+#include "testutil.h"
+
+#define BUILDERS "\"builders\": [ { \"plugin\": \"sah_seq\" } ]"
+#define MESHES "\"meshes\": [ { \"name\": \"ball\", \"generator\": \"icosphere\", " \
+	"\"frequency\": 2 }, { \"name\": \"rock\", \"generator\": \"soup\", \"count\": 30 } ]"
+
+static int parse(struct config *cfg, const char *scene, bvhlab_error *err)
+{
+	char text[4096];
+	snprintf(text, sizeof(text), "{ \"scenes\": [ { \"name\": \"grove\", %s } ], " BUILDERS
+	         " }", scene);
+	return config_parse(cfg, "/cfg/c.json", text, err);
+}
+
+static void expect_error(const char *scene, const char *needle)
+{
+	struct config cfg;
+	bvhlab_error err = { "" };
+	CHECK_INT(parse(&cfg, scene, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "/cfg/c.json:1:");
+	CHECK_CONTAINS(err.message, needle);
+	config_finish(&cfg);
+}
+
+static const char *const ok_scene =
+	MESHES ", \"instances\": ["
+	" { \"mesh\": \"ball\", \"scale\": 2, \"rotate\": [0, 30, 0], \"translate\": [1, 2, 3] },"
+	" { \"mesh\": \"rock\", \"matrix\": [0, 0, 1, 5, 0, 1, 0, 0, -1, 0, 0, 0] },"
+	" { \"scatter\": { \"mesh\": \"ball\", \"count\": 40, \"seed\": 9,"
+	"   \"bounds\": [[-10, 0, -10], [10, 1, 10]], \"scale\": [0.5, 2],"
+	"   \"rotate\": \"random-y\" } } ]";
+
+static void test_parse(void)
+{
+	struct config cfg;
+	bvhlab_error err = { "" };
+	CHECK_INT(parse(&cfg, ok_scene, &err), 0);
+	const struct config_scene *sc = &cfg.scenes[0];
+	CHECK(sc->mesh_count == 2 && sc->instance_count == 3 && sc->instance_total == 42);
+	CHECK(strcmp(sc->meshes[1].name, "rock") == 0 && sc->meshes[1].src.gen.count == 30);
+	CHECK(sc->instances[1].mesh == 1 && sc->instances[1].xf[2] == 1.0 &&
+	      sc->instances[1].xf[3] == 5.0 && sc->instances[1].xf[8] == -1.0);
+	const struct config_instance *s = &sc->instances[2];
+	CHECK(s->scatter && s->count == 40 && s->seed == 9 && s->mesh == 0);
+	CHECK(s->lo[0] == -10 && s->hi[1] == 1 && s->scale[0] == 0.5 && s->scale[1] == 2);
+	CHECK(s->rotate == CONFIG_SCATTER_RANDOM_Y);
+	config_finish(&cfg);
+}
+
+static void test_errors(void)
+{
+	expect_error(MESHES ", \"instances\": [ { \"mesh\": \"bal\" } ]",
+	             "'scenes[0].instances[0].mesh': scene 'grove' has no mesh 'bal' (did you "
+	             "mean 'ball'?)");
+	expect_error(MESHES ", \"instances\": [ { \"scatter\": { \"mesh\": \"tree\", "
+	             "\"count\": 3, \"bounds\": [[0, 0, 0], [1, 1, 1]] } } ]",
+	             "has no mesh 'tree'");
+	expect_error(MESHES ", \"instances\": [ { \"mesh\": \"ball\", "
+	             "\"matrix\": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0] } ]",
+	             "'scenes[0].instances[0].matrix' must be an array of 12 finite numbers");
+	expect_error(MESHES ", \"instances\": [ { \"mesh\": \"ball\", "
+	             "\"matrix\": [1, 0, 0, 0, 2, 0, 0, 0, 0, 0, 1, 0] } ]",
+	             "'scenes[0].instances[0].matrix' is singular");
+	expect_error(MESHES ", \"instances\": [ { \"mesh\": \"ball\", \"scale\": 2, "
+	             "\"matrix\": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0] } ]",
+	             "'scenes[0].instances[0].scale' and 'scenes[0].instances[0].matrix' both");
+	expect_error(MESHES ", \"instances\": [ { \"scatter\": { \"mesh\": \"ball\", "
+	             "\"count\": 0, \"bounds\": [[0, 0, 0], [1, 1, 1]] } } ]",
+	             "'scenes[0].instances[0].scatter.count'");
+	expect_error(MESHES ", \"instances\": [ { \"scatter\": { \"mesh\": \"ball\", "
+	             "\"count\": 16777217, \"bounds\": [[0, 0, 0], [1, 1, 1]] } } ]",
+	             "'scenes[0].instances[0].scatter.count'");
+	expect_error(MESHES ", \"instances\": ["
+	             " { \"scatter\": { \"mesh\": \"ball\", \"count\": 16777216,"
+	             " \"bounds\": [[0, 0, 0], [1, 1, 1]] } }, { \"mesh\": \"rock\" } ]",
+	             "16777217 instances in all, more than the 16777216");
+	expect_error(MESHES ", \"instances\": [ { \"scatter\": { \"mesh\": \"ball\" } } ]",
+	             "'scenes[0].instances[0].scatter.count' is missing");
+	expect_error(MESHES ", \"instances\": [ { \"scatter\": { \"mesh\": \"ball\", "
+	             "\"count\": 2, \"bounds\": [[0, 0, 0], [1, -1, 1]] } } ]",
+	             "'scenes[0].instances[0].scatter.bounds' must be [[x, y, z], [x, y, z]]");
+	expect_error(MESHES ", \"instances\": [ { \"scatter\": { \"mesh\": \"ball\", "
+	             "\"count\": 2, \"bounds\": [[0, 0, 0], [1, 1, 1]], \"scale\": [2, 1] } } ]",
+	             "'scenes[0].instances[0].scatter.scale' must be [a, b] with 0 < a <= b");
+	expect_error(MESHES ", \"instances\": [ { \"scatter\": { \"mesh\": \"ball\", "
+	             "\"count\": 2, \"bounds\": [[0, 0, 0], [1, 1, 1]], \"rotate\": \"y\" } } ]",
+	             "'scenes[0].instances[0].scatter.rotate' must be \"none\" or \"random-y\"");
+	expect_error(MESHES ", \"instances\": [ { \"mesh\": \"ball\", \"scatter\": {} } ]",
+	             "'scenes[0].instances[0].mesh' beside 'scatter'");
+	expect_error(MESHES ", \"instances\": [ { \"mesh\": \"ball\", \"translat\": [0, 0, 0] } ]",
+	             "unknown key 'translat' in scenes[0].instances[0]");
+	expect_error(MESHES ", \"instances\": [ ]", "'scenes[0].instances' must be a non-empty");
+	expect_error(MESHES, "'scenes[0].meshes' without 'instances'");
+	expect_error("\"meshes\": [ { \"generator\": \"soup\" } ], \"instances\": [ { \"mesh\": "
+	             "\"a\" } ]", "'scenes[0].meshes[0]' needs a 'name'");
+	expect_error("\"meshes\": [ { \"name\": \"a\", \"generator\": \"soup\" }, { \"name\": "
+	             "\"a\", \"generator\": \"room\" } ], \"instances\": [ { \"mesh\": \"a\" } ]",
+	             "mesh 'a' is also scenes[0].meshes[0]'s name");
+	expect_error("\"generator\": \"soup\", " MESHES ", \"instances\": [ { \"mesh\": \"a\" } ]",
+	             "'scenes[0].generator' does not apply to a scene with 'meshes'");
+	expect_error("\"frames\": 4, " MESHES ", \"instances\": [ { \"mesh\": \"ball\" } ]",
+	             "'scenes[0].frames' does not apply to a scene with 'instances'");
+}
+
+static double xf_of(const struct scene_instanced *s, uint32_t i, int k)
+{
+	return s->instances[i].xf[k];
+}
+
+/* The scene a config makes: the meshes once, a scatter drawn from its
+ * seed (the same twice), every box holding its instance's vertices, and
+ * the flattened scene the composite placement would give, bit for bit. */
+static void test_scene(void)
+{
+	struct config cfg;
+	bvhlab_error err = { "" };
+	struct scene_instanced a, b;
+	CHECK_INT(parse(&cfg, ok_scene, &err), 0);
+	CHECK_INT(harness_load_instanced(&cfg.scenes[0], &a, &err), 0);
+	CHECK_INT(harness_load_instanced(&cfg.scenes[0], &b, &err), 0);
+	CHECK(a.mesh_count == 2 && a.instance_count == 42);
+	CHECK(scene_instanced_unique_triangles(&a) == 80 + 30);
+	CHECK(scene_instanced_triangles(&a) == 41 * 80 + 30);
+	CHECK(memcmp(a.instances, b.instances, 42 * sizeof(*a.instances)) == 0);
+	bool spread = false;
+	for (uint32_t i = 2; i < a.instance_count; i++) {
+		CHECK(xf_of(&a, i, 3) >= -10 && xf_of(&a, i, 3) <= 10);
+		CHECK(xf_of(&a, i, 7) >= 0 && xf_of(&a, i, 7) <= 1);
+		spread = spread || fabs(xf_of(&a, i, 3) - xf_of(&a, 2, 3)) > 1;
+		/* turned about y only: the y axis stays put, scaled */
+		CHECK(xf_of(&a, i, 4) == 0 && xf_of(&a, i, 6) == 0 && xf_of(&a, i, 5) >= 0.5);
+	}
+	CHECK(spread);
+	bvhlab_scene *flat = NULL, *ball = NULL;
+	CHECK_INT(scene_instanced_flatten(&a, "grove", &flat, &err), 0);
+	CHECK(flat && flat->triangle_count == 41 * 80 + 30 && flat->part_count == 42);
+	bvhlab_gen_params p;
+	bvhlab_gen_params_init(&p);
+	p.frequency = 2;
+	CHECK_INT(bvhlab_scene_generate("icosphere", &p, &ball, &err), 0);
+	bvhlab_transform xf = {.scale = 2, .rotate = {0, 30, 0}, .translate = {1, 2, 3}};
+	bvhlab_scene_transform(ball, &xf);
+	CHECK(flat && ball && memcmp(flat->vertices, ball->vertices,
+	                             3 * ball->vertex_count * sizeof(float)) == 0);
+	/* every instance's vertices inside its world box */
+	size_t v = 0;
+	for (uint32_t i = 0; flat && i < a.instance_count; i++) {
+		bvhlab_aabb box;
+		scene_instanced_box(&a, i, &box);
+		for (uint32_t k = 0; k < a.meshes[a.instances[i].mesh]->vertex_count; k++, v++)
+			for (int c = 0; c < 3; c++)
+				CHECK(flat->vertices[3 * v + c] >= box.lo[c] &&
+				      flat->vertices[3 * v + c] <= box.hi[c]);
+	}
+	bvhlab_scene_destroy(flat);
+	bvhlab_scene_destroy(ball);
+	scene_instanced_finish(&a);
+	scene_instanced_finish(&b);
+	config_finish(&cfg);
+}
+
+/* m * inv is the identity; a singular matrix is refused. */
+static void test_inverse(void)
+{
+	bvhlab_transform xf = {.scale = 3, .rotate = {10, 20, 30}, .translate = {4, -5, 6}};
+	double m[12], inv[12], p[3] = {1.5, -2, 0.25}, q[3], r[3];
+	scene_transform_matrix(&xf, m);
+	CHECK_INT(scene_matrix_invert(m, inv), 0);
+	scene_matrix_apply(m, p, 1.0, q);
+	scene_matrix_apply(inv, q, 1.0, r);
+	for (int k = 0; k < 3; k++)
+		CHECK(fabs(r[k] - p[k]) < 1e-12);
+	double flat[12] = {1, 0, 0, 0, 0, 1, 0, 0, 1, 1, 0, 0};
+	CHECK_INT(scene_matrix_invert(flat, inv), -EINVAL);
+}
+
+int main(void)
+{
+	test_parse();
+	test_errors();
+	test_scene();
+	test_inverse();
+	return test_finish();
+}
