@@ -11,6 +11,9 @@
 
 #include "config/config.h"
 #include "harness/harness_instances.h"
+#include "harness/harness_two_level.h"
+#define FIXTURE_SEED 0x42ULL
+#include "scene_fixture.h"
 #include "testutil.h"
 
 #define BUILDERS "\"builders\": [ { \"plugin\": \"sah_seq\" } ]"
@@ -115,6 +118,45 @@ static void test_errors(void)
 	             "'scenes[0].frames' does not apply to a scene with 'instances'");
 }
 
+/* Two-level builders: "bottom" and "top" together, on two-level scenes only. */
+static void test_builder_errors(void)
+{
+	static const char *const bad[][2] = {
+		{"{ \"bottom\": \"lbvh\" }", "'builders[0].bottom' without 'builders[0].top'"},
+		{"{ \"top\": \"lbvh\" }", "'builders[0].top' without 'builders[0].bottom'"},
+		{"{ \"top\": \"lbvh\", \"bottom\": \"ploc\", \"plugin\": \"ploc\" }",
+		 "'builders[0].plugin' does not apply to a two-level builder"},
+		{"{ \"top\": \"lbvh\", \"bottom\": 3 }", "'builders[0].bottom' must be a plugin"},
+		{"{ \"plugin\": \"lbvh\", \"top_options\": {} }",
+		 "'builders[0].top_options' without 'builders[0].top'"},
+		{"{ \"top\": \"lbvh\", \"bottom\": \"ploc\", \"top_options\": 1 }",
+		 "'builders[0].top_options' must be an object"},
+	};
+	char text[4096];
+	struct config cfg;
+	bvhlab_error err = { "" };
+	for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
+		snprintf(text, sizeof(text), "{ \"scenes\": [ { \"name\": \"g\", %s } ], "
+		         "\"builders\": [ %s ] }", ok_scene, bad[k][0]);
+		CHECK_INT(config_parse(&cfg, "/cfg/c.json", text, &err), -EINVAL);
+		CHECK_CONTAINS(err.message, bad[k][1]);
+		config_finish(&cfg);
+	}
+	snprintf(text, sizeof(text), "{ \"scenes\": [ { \"name\": \"g\", %s }, { \"generator\": "
+	         "\"soup\" } ], \"builders\": [ { \"top\": \"lbvh\", \"bottom\": \"ploc\" } ] }",
+	         ok_scene);
+	CHECK_INT(config_parse(&cfg, "/cfg/c.json", text, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "a two-level builder runs on two-level scenes only, and "
+	                            "scene 'soup' has no 'instances'");
+	config_finish(&cfg);
+	snprintf(text, sizeof(text), "{ \"scenes\": [ { \"name\": \"g\", %s } ], \"builders\": "
+	         "[ { \"top\": \"lbvh\", \"bottom\": \"ploc\" } ] }", ok_scene);
+	CHECK_INT(config_parse(&cfg, "/cfg/c.json", text, &err), 0);
+	CHECK(strcmp(cfg.builders[0].name, "two-level[top=lbvh,bottom=ploc]") == 0 &&
+	      strcmp(cfg.builders[0].plugin, "ploc") == 0 && strcmp(cfg.builders[0].top, "lbvh") == 0);
+	config_finish(&cfg);
+}
+
 static double xf_of(const struct scene_instanced *s, uint32_t i, int k)
 {
 	return s->instances[i].xf[k];
@@ -187,11 +229,79 @@ static void test_inverse(void)
 	CHECK_INT(scene_matrix_invert(flat, inv), -EINVAL);
 }
 
+/* The two-level SAH recomputed from the trees the series left. */
+static double two_level_sah(const struct scene_instanced *s, const struct two_level_trees *t)
+{
+	bvhlab_tree_stats st;
+	double mesh[2], root = bvhlab_box_area(t->top.nodes[0].lo, t->top.nodes[0].hi);
+	for (uint32_t m = 0; m < 2; m++) {
+		bvhlab_tree_stats_compute(&t->bottom[m], &st);
+		mesh[m] = st.sah_cost;
+	}
+	bvhlab_tree_stats_compute(&t->top, &st);
+	double sah = st.sah_cost;
+	for (uint32_t i = 0; i < s->instance_count; i++) {
+		bvhlab_aabb b;
+		scene_instanced_box(s, i, &b);
+		sah += bvhlab_box_area(b.lo, b.hi) / root * mesh[s->instances[i].mesh];
+	}
+	return sah;
+}
+
+/* Each box-taking builder as a top (sbvh without spatial splits: every
+ * instance once), over bottoms of another builder; both levels valid and
+ * measured apart, the whole's figures their sums. */
+static void test_two_level(void)
+{
+	static const char *const pairs[][2] = {{"sah_seq", "lbvh"}, {"ploc", "sah_tasks"},
+	                                       {"lbvh", "sbvh"}, {"sbvh", "ploc"}};
+	struct config cfg;
+	bvhlab_error err = { "" };
+	struct scene_instanced inst;
+	CHECK_INT(parse(&cfg, ok_scene, &err), 0);
+	CHECK_INT(harness_load_instanced(&cfg.scenes[0], &inst, &err), 0);
+	for (size_t p = 0; p < sizeof(pairs) / sizeof(pairs[0]); p++) {
+		bvhlab_plugin *bottom = NULL, *top = NULL;
+		bvhlab_options bo, to;
+		if (!plugin_loads(pairs[p][0], &bottom) || !plugin_loads(pairs[p][1], &top))
+			continue;
+		CHECK_INT(bvhlab_options_init(&bo, bvhlab_plugin_builder(bottom)), 0);
+		CHECK_INT(bvhlab_options_init(&to, bvhlab_plugin_builder(top)), 0);
+		struct two_level_job job = {.inst = &inst, .bottom = bottom, .top = top,
+		                            .bottom_opts = &bo, .top_opts = &to, .warmup = 0,
+		                            .repeat = 2, .threads = 2, .validate_rays = 32};
+		double samples[2], cold;
+		struct tree_measure whole;
+		struct results_two_level lv;
+		struct two_level_trees trees;
+		int v = harness_two_level_series(&job, samples, &cold, &whole, &lv, &trees, &err);
+		if (v != TREE_OK)
+			fprintf(stderr, "%s under %s: %s\n", pairs[p][0], pairs[p][1], err.message);
+		CHECK_INT(v, TREE_OK);
+		CHECK(whole.valid && whole.rays_checked == 64 && samples[0] > 0 && samples[1] > 0);
+		CHECK(lv.bottom.trees == 2 && lv.top.trees == 1 && trees.top.index_count == 42);
+		CHECK(strcmp(lv.bottom.plugin, pairs[p][0]) == 0 && strcmp(lv.top.plugin,
+		                                                           pairs[p][1]) == 0);
+		CHECK(whole.stats.nodes == lv.bottom.nodes + lv.top.nodes);
+		CHECK(lv.sah > lv.top.sah && fabs(lv.sah - two_level_sah(&inst, &trees)) < 1e-9);
+		CHECK(whole.stats.sah_cost == lv.sah);
+		harness_two_level_finish(&trees);
+		bvhlab_options_finish(&bo);
+		bvhlab_options_finish(&to);
+		bvhlab_plugin_close(bottom);
+		bvhlab_plugin_close(top);
+	}
+	scene_instanced_finish(&inst);
+	config_finish(&cfg);
+}
+
 int main(void)
 {
 	test_parse();
 	test_errors();
+	test_builder_errors();
 	test_scene();
 	test_inverse();
+	test_two_level();
 	return test_finish();
 }

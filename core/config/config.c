@@ -450,6 +450,7 @@ void config_finish(struct config *cfg)
 	}
 	for (size_t i = 0; cfg->builders && i < cfg->builder_count; i++) {
 		free(cfg->builders[i].plugin);
+		free(cfg->builders[i].top);
 		free(cfg->builders[i].name);
 		free(cfg->builders[i].threads);
 		free(cfg->builders[i].picks);

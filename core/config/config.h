@@ -142,6 +142,12 @@ struct config_builder {
 	size_t refine_count;
 	int line, column;  /* where the builder's object starts */
 	const struct config_animation *animation; /* "animation", or NULL: rebuild */
+	/* A two-level builder (docs/instances.md): "bottom" (the plugin above,
+	 * building one tree per mesh, with "options") and "top", a plugin that
+	 * builds over boxes (BVHLAB_BUILDER_BOXES) with "top_options"; NULL
+	 * for a one-level builder. Two-level scenes only. */
+	char *top;
+	const struct cJSON *top_options; /* "top_options" object (may be NULL), owned by root */
 	/* An option grid's builder (config_grid.c): the value it takes of each grid. */
 	struct config_grid_pick *picks;
 	size_t pick_count;

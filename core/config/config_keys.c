@@ -164,6 +164,9 @@ const struct config_key config_builder_keys[] = {
 	BUILDER("optional", CONFIG_BOOL, optional, 0, 0),
 	CUSTOM("refine"), /* config_refine.c */
 	CUSTOM("animation"), /* config_anim.c */
+	CUSTOM("bottom"), /* a two-level builder: config_entries.c */
+	BUILDER("top", CONFIG_STRING, top, 0, 0),
+	CUSTOM("top_options"),
 	END,
 };
 

@@ -25,6 +25,7 @@
 #include "harness/harness_scene.h"
 #include "harness/harness_series.h"
 #include "harness/harness_threads.h"
+#include "harness/harness_two_level.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
 #include "machine/machine.h"
@@ -76,6 +77,8 @@ struct series_report {
 	uint32_t phase_count;
 	bvhlab_phase phases[BVHLAB_MAX_PHASES];
 	uint32_t frame_count;  /* frames done, after samples[] (an animated scene) */
+	bool has_two_level;    /* a two-level builder's run: its levels apart */
+	struct results_two_level two_level;
 	bool in_frames;        /* the frames began: a death after keeps the frames done */
 	char error[sizeof(((bvhlab_error *)0)->message)];
 	double samples[];      /* [repeat], then struct frame_metrics [frames] */
@@ -88,6 +91,7 @@ struct series_job {
 	const bvhlab_prims *prims;
 	const struct harness_builder *hb;
 	const struct plan_run *run;
+	const struct scene_instanced *inst; /* the scene's two-level form, or NULL */
 	const char *heat_path;  /* where the child leaves nodes per pixel, or NULL */
 	const char *shade_path; /* where it leaves the shaded render, or NULL */
 	const char *tree_path;  /* where it leaves its tree for the rounds, or NULL */
@@ -240,12 +244,41 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 	free(shade);
 }
 
+/* A two-level builder's series (harness_two_level.c): both levels timed,
+ * validated and measured; the run's samples are their sums. */
+static void two_level_work(const struct series_job *job, struct series_report *rep)
+{
+	const struct config *cfg = job->h->cfg;
+	const struct harness_builder *hb = job->hb;
+	struct two_level_job tj = {.inst = job->inst, .bottom = hb->plugin, .top = hb->top.plugin,
+	                           .bottom_opts = &hb->opts, .top_opts = &hb->top.opts,
+	                           .warmup = cfg->warmup, .repeat = cfg->repeat,
+	                           .threads = job->run->key.threads,
+	                           .validate_rays = cfg->validate ? cfg->validate_rays : 0};
+	struct two_level_trees trees;
+	bvhlab_error err = {{0}};
+	static const uint32_t status[] = {SERIES_OK, SERIES_INVALID, SERIES_FAILED};
+	enum tree_verdict v = harness_two_level_series(&tj, rep->samples, &rep->cold_ms,
+	                                               &rep->tree, &rep->two_level, &trees, &err);
+	rep->status = status[v];
+	rep->validated = v != TREE_FAILED;
+	rep->has_two_level = v == TREE_OK;
+	rep->sample_count = v == TREE_OK ? cfg->repeat : 0;
+	if (rep->status != SERIES_OK)
+		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
+	harness_two_level_finish(&trees);
+}
+
 /* Warm-up, timed builds, validation and metrics: what runs in the child. */
 static void series_work(void *arg, void *report, size_t size)
 {
 	const struct series_job *job = arg;
 	struct series_report *rep = report;
 	const struct config *cfg = job->h->cfg;
+	if (job->hb->top.plugin) {
+		two_level_work(job, rep);
+		return;
+	}
 	struct build_series s = {.warmup = cfg->warmup, .repeat = cfg->repeat,
 	                         .threads = job->run->key.threads, .samples_ms = rep->samples,
 	                         .stages = job->hb->refine,
@@ -319,6 +352,9 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, uint32_t f
 	run->phase_count = rep->phase_count;
 	run->frames = (const struct frame_metrics *)(rep->samples + repeat);
 	run->frame_count = rep->frame_count;
+	rep->two_level.bottom.plugin[sizeof(rep->two_level.bottom.plugin) - 1] = '\0';
+	rep->two_level.top.plugin[sizeof(rep->two_level.top.plugin) - 1] = '\0';
+	run->two_level = rep->has_two_level ? &rep->two_level : NULL;
 }
 
 /* Runs the series in a child (or here, with "isolate": false) and records it. */
@@ -444,7 +480,7 @@ static void run_list_scene(struct harness *h, const bvhlab_scene *scene,
 		const struct plan_run *run = &h->list.runs[k];
 		struct harness_builder *hb = &h->builders[run->builder];
 		struct series_job job = {.h = h, .scene = scene, .prims = prims, .hb = hb,
-		                         .run = run};
+		                         .run = run, .inst = h->inst.meshes ? &h->inst : NULL};
 		if (!hb->plugin || !hb->opts_ok)
 			record_failed(h, run, hb->status, hb->error.message);
 		else

@@ -78,6 +78,14 @@ static const char *const csv_numbers[][2] = {
 	{"load_after", "%.2f"},
 	{"device.compute_units", "%.0f"},
 	{"memory.runtime_bytes", "%.0f"},
+	{"two_level.bottom.build_ms", "%.4f"},
+	{"two_level.top.build_ms", "%.4f"},
+	{"two_level.build_ms", "%.4f"},
+	{"two_level.bottom.nodes", "%.0f"},
+	{"two_level.top.nodes", "%.0f"},
+	{"two_level.bottom.sah_cost", "%.4f"},
+	{"two_level.top.sah_cost", "%.4f"},
+	{"two_level.sah_cost", "%.4f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary

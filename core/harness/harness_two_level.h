@@ -1,0 +1,50 @@
+/*
+ * A two-level run's builds (harness_two_level.c; docs/instances.md): the
+ * bottom plugin once per mesh, the top plugin over the instances' world
+ * boxes, each level timed, validated and measured apart.
+ */
+#ifndef BVHLAB_CORE_HARNESS_TWO_LEVEL_H
+#define BVHLAB_CORE_HARNESS_TWO_LEVEL_H
+
+#include <bvhlab/bvhlab.h>
+
+#include "harness/harness_measure.h"
+#include "output/results.h"
+#include "scene/instances.h"
+
+struct two_level_job {
+	const struct scene_instanced *inst;
+	const bvhlab_plugin *bottom, *top;
+	const bvhlab_options *bottom_opts, *top_opts;
+	uint32_t warmup, repeat, threads;
+	uint32_t validate_rays; /* sampled rays per bottom tree against brute force; 0: none */
+};
+
+/* The trees a two-level series leaves: one per mesh, and the top over
+ * boxes (its input kept: primitive i is instance i). */
+struct two_level_trees {
+	bvhlab_tree *bottom; /* [mesh_count] */
+	uint32_t mesh_count;
+	bvhlab_tree top;
+	bvhlab_prims top_prims;
+};
+
+/*
+ * warmup + repeat builds of each level; samples_ms[k] ([repeat]) the k-th
+ * timed bottom builds of every mesh plus the k-th top build, *cold_ms the
+ * same of the first builds. Every bottom tree is validated (structure and
+ * validate_rays sampled rays against brute force over its mesh) and the
+ * top over the boxes; *whole gets the two-level tree's statistics (every
+ * tree's nodes once, the two-level SAH), *levels the levels apart.
+ * Returns TREE_OK, TREE_INVALID (err naming the level and mesh) or
+ * TREE_FAILED (err saying why); trees are filled in every case and freed
+ * by harness_two_level_finish.
+ */
+enum tree_verdict harness_two_level_series(const struct two_level_job *job,
+                                           double *samples_ms, double *cold_ms,
+                                           struct tree_measure *whole,
+                                           struct results_two_level *levels,
+                                           struct two_level_trees *trees, bvhlab_error *err);
+void harness_two_level_finish(struct two_level_trees *trees);
+
+#endif
