@@ -12,6 +12,7 @@
 #include "config/config.h"
 #include "harness/harness_instances.h"
 #include "harness/harness_two_level.h"
+#include "trace/trace_instances.h"
 #define FIXTURE_SEED 0x42ULL
 #include "scene_fixture.h"
 #include "testutil.h"
@@ -248,6 +249,40 @@ static double two_level_sah(const struct scene_instanced *s, const struct two_le
 	return sah;
 }
 
+/* Rays through both levels: the brute force over every instanced triangle
+ * gives the same (instance, primitive, t), and the flattened scene the
+ * same hits; a top tree whose leaves name the wrong instances is caught. */
+static void check_trace(const struct scene_instanced *inst, struct two_level_trees *trees)
+{
+	struct trace_two_level tl = {.inst = inst, .top = &trees->top, .bottom = trees->bottom};
+	bvhlab_scene *flat = NULL;
+	bvhlab_error err = { "" };
+	uint64_t mismatches = 1, flat_mismatches = 1, hits = 0;
+	CHECK_INT(scene_instanced_flatten(inst, "flat", &flat, &err), 0);
+	trace_two_level_check(&tl, flat, 1000, 7, &mismatches, &flat_mismatches);
+	CHECK(mismatches == 0 && flat_mismatches == 0);
+	for (uint32_t i = 0; i < 1000; i++) { /* and the check saw hits, not only misses */
+		bvhlab_ray ray;
+		struct trace_inst_hit h;
+		bvhlab_aabb b;
+		memcpy(b.lo, trees->top.nodes[0].lo, sizeof(b.lo));
+		memcpy(b.hi, trees->top.nodes[0].hi, sizeof(b.hi));
+		trace_two_level_ray(inst, &b, 7, i, &ray);
+		trace_two_level_closest(&tl, &ray, &h, NULL);
+		hits += h.hit.prim != BVHLAB_NO_HIT;
+		CHECK(h.hit.prim == BVHLAB_NO_HIT || h.instance < inst->instance_count);
+	}
+	CHECK(hits > 300);
+	uint32_t *ix = trees->top.prim_index, keep = ix[0];
+	ix[0] = ix[trees->top.index_count - 1];
+	ix[trees->top.index_count - 1] = keep;
+	trace_two_level_check(&tl, NULL, 1000, 7, &mismatches, NULL);
+	CHECK(mismatches > 0);
+	ix[trees->top.index_count - 1] = ix[0];
+	ix[0] = keep;
+	bvhlab_scene_destroy(flat);
+}
+
 /* Each box-taking builder as a top (sbvh without spatial splits: every
  * instance once), over bottoms of another builder; both levels valid and
  * measured apart, the whole's figures their sums. */
@@ -278,13 +313,14 @@ static void test_two_level(void)
 		if (v != TREE_OK)
 			fprintf(stderr, "%s under %s: %s\n", pairs[p][0], pairs[p][1], err.message);
 		CHECK_INT(v, TREE_OK);
-		CHECK(whole.valid && whole.rays_checked == 64 && samples[0] > 0 && samples[1] > 0);
+		CHECK(whole.valid && whole.rays_checked == 96 && whole.mismatches == 0 && samples[0] > 0 && samples[1] > 0);
 		CHECK(lv.bottom.trees == 2 && lv.top.trees == 1 && trees.top.index_count == 42);
 		CHECK(strcmp(lv.bottom.plugin, pairs[p][0]) == 0 && strcmp(lv.top.plugin,
 		                                                           pairs[p][1]) == 0);
 		CHECK(whole.stats.nodes == lv.bottom.nodes + lv.top.nodes);
 		CHECK(lv.sah > lv.top.sah && fabs(lv.sah - two_level_sah(&inst, &trees)) < 1e-9);
 		CHECK(whole.stats.sah_cost == lv.sah);
+		check_trace(&inst, &trees);
 		harness_two_level_finish(&trees);
 		bvhlab_options_finish(&bo);
 		bvhlab_options_finish(&to);

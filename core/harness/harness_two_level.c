@@ -12,6 +12,7 @@
 
 #include "harness/harness_series.h"
 #include "harness/harness_two_level.h"
+#include "trace/trace_instances.h"
 #include "util/util.h"
 
 /* One level's series into `into` (summed), its median into *median_ms. */
@@ -126,6 +127,29 @@ static enum tree_verdict top_level(const struct two_level_job *job, double *samp
 	return TREE_OK;
 }
 
+/* Sampled rays through both levels against brute force over every
+ * instanced triangle (trace_instances.c): any disagreement makes the run
+ * invalid. */
+static enum tree_verdict check_rays(const struct two_level_job *job,
+                                    const struct two_level_trees *trees,
+                                    struct tree_measure *whole, bvhlab_error *err)
+{
+	struct trace_two_level tl = {.inst = job->inst, .top = &trees->top,
+	                             .bottom = trees->bottom};
+	uint64_t mismatches;
+	if (!job->validate_rays)
+		return TREE_OK;
+	trace_two_level_check(&tl, NULL, job->validate_rays, HARNESS_RAY_SEED, &mismatches, NULL);
+	whole->rays_checked += job->validate_rays;
+	whole->mismatches += mismatches;
+	if (!mismatches)
+		return TREE_OK;
+	error_set(err, "%llu of %u sampled rays through both levels disagree with brute force "
+	          "over the instanced triangles", (unsigned long long)mismatches,
+	          job->validate_rays);
+	return TREE_INVALID;
+}
+
 enum tree_verdict harness_two_level_series(const struct two_level_job *job,
                                            double *samples_ms, double *cold_ms,
                                            struct tree_measure *whole,
@@ -154,6 +178,8 @@ enum tree_verdict harness_two_level_series(const struct two_level_job *job,
 	                                   trees, err);
 	if (v == TREE_OK)
 		v = top_level(job, samples_ms, cold_ms, whole, levels, mesh_sah, trees, err);
+	if (v == TREE_OK)
+		v = check_rays(job, trees, whole, err);
 	free(mesh_sah);
 	whole->valid = v == TREE_OK;
 	whole->has_stats = whole->valid;

@@ -33,8 +33,9 @@ struct two_level_trees {
  * warmup + repeat builds of each level; samples_ms[k] ([repeat]) the k-th
  * timed bottom builds of every mesh plus the k-th top build, *cold_ms the
  * same of the first builds. Every bottom tree is validated (structure and
- * validate_rays sampled rays against brute force over its mesh) and the
- * top over the boxes; *whole gets the two-level tree's statistics (every
+ * validate_rays sampled rays against brute force over its mesh), the top
+ * over the boxes, and validate_rays rays through both levels against brute
+ * force over every instanced triangle; *whole gets the two-level tree's statistics (every
  * tree's nodes once, the two-level SAH), *levels the levels apart.
  * Returns TREE_OK, TREE_INVALID (err naming the level and mesh) or
  * TREE_FAILED (err saying why); trees are filled in every case and freed
