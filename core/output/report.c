@@ -248,6 +248,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	          phases ? " build phases ms |" : "", phases ? "---|" : "");
 	for (size_t k = 0; k < n; k++)
 		md_run_row(sb, ix, runs[k], phases);
+	report_two_level_md(sb, runs, n);
 	report_front_md(sb, ix, runs, n);
 	report_budget_md(sb, ix, name);
 	report_breakeven_md(sb, ix, ref, runs, n);

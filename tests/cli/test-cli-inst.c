@@ -70,6 +70,7 @@ static void sweep(void)
 	free(csv);
 	char *md = read_file(cli_path_in("out"), "report.md");
 	CHECK(md && strstr(md, "31 instances of 2 meshes (220 unique triangles, 5440 instanced)"));
+	CHECK(md && strstr(md, "| two-level[top=sah_tasks,bottom=sah_seq] | 2 | sah_seq | sah_tasks |"));
 	free(md);
 }
 
