@@ -13,7 +13,6 @@
 #include <unistd.h>
 
 #include "harness/harness.h"
-#include "harness/harness_instances.h"
 #include "harness/harness_builders.h"
 #include "harness/harness_frames.h"
 #include "harness/harness_images.h"
@@ -77,8 +76,7 @@ struct series_report {
 	uint32_t phase_count;
 	bvhlab_phase phases[BVHLAB_MAX_PHASES];
 	uint32_t frame_count;  /* frames done, after samples[] (an animated scene) */
-	bool has_two_level;    /* a two-level builder's run: its levels apart */
-	struct results_two_level two_level;
+	struct results_two_level two_level; /* a two-level builder's run: its levels apart */
 	bool in_frames;        /* the frames began: a death after keeps the frames done */
 	char error[sizeof(((bvhlab_error *)0)->message)];
 	double samples[];      /* [repeat], then struct frame_metrics [frames] */
@@ -91,7 +89,6 @@ struct series_job {
 	const bvhlab_prims *prims;
 	const struct harness_builder *hb;
 	const struct plan_run *run;
-	const struct scene_instanced *inst; /* the scene's two-level form, or NULL */
 	const char *heat_path;  /* where the child leaves nodes per pixel, or NULL */
 	const char *shade_path; /* where it leaves the shaded render, or NULL */
 	const char *tree_path;  /* where it leaves its tree for the rounds, or NULL */
@@ -244,41 +241,12 @@ static void trace_rays(const struct series_job *job, const bvhlab_tree *tree,
 	free(shade);
 }
 
-/* A two-level builder's series (harness_two_level.c): both levels timed,
- * validated and measured; the run's samples are their sums. */
-static void two_level_work(const struct series_job *job, struct series_report *rep)
-{
-	const struct config *cfg = job->h->cfg;
-	const struct harness_builder *hb = job->hb;
-	struct two_level_job tj = {.inst = job->inst, .bottom = hb->plugin, .top = hb->top.plugin,
-	                           .bottom_opts = &hb->opts, .top_opts = &hb->top.opts,
-	                           .warmup = cfg->warmup, .repeat = cfg->repeat,
-	                           .threads = job->run->key.threads,
-	                           .validate_rays = cfg->validate ? cfg->validate_rays : 0};
-	struct two_level_trees trees;
-	bvhlab_error err = {{0}};
-	static const uint32_t status[] = {SERIES_OK, SERIES_INVALID, SERIES_FAILED};
-	enum tree_verdict v = harness_two_level_series(&tj, rep->samples, &rep->cold_ms,
-	                                               &rep->tree, &rep->two_level, &trees, &err);
-	rep->status = status[v];
-	rep->validated = v != TREE_FAILED;
-	rep->has_two_level = v == TREE_OK;
-	rep->sample_count = v == TREE_OK ? cfg->repeat : 0;
-	if (rep->status != SERIES_OK)
-		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
-	harness_two_level_finish(&trees);
-}
-
 /* Warm-up, timed builds, validation and metrics: what runs in the child. */
 static void series_work(void *arg, void *report, size_t size)
 {
 	const struct series_job *job = arg;
 	struct series_report *rep = report;
 	const struct config *cfg = job->h->cfg;
-	if (job->hb->top.plugin) {
-		two_level_work(job, rep);
-		return;
-	}
 	struct build_series s = {.warmup = cfg->warmup, .repeat = cfg->repeat,
 	                         .threads = job->run->key.threads, .samples_ms = rep->samples,
 	                         .stages = job->hb->refine,
@@ -287,6 +255,12 @@ static void series_work(void *arg, void *report, size_t size)
 	bvhlab_error err = {{0}};
 	(void)size;
 	rep->status = SERIES_OK;
+	if (job->hb->top.plugin) { /* two-level (harness_two_level.c): status in the same order */
+		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst, job->run->key.threads,
+		                                    rep->samples, &rep->cold_ms, &rep->tree, &rep->two_level,
+		                                    &rep->sample_count, &rep->validated, &err);
+		goto out;
+	}
 	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);
 	harness_memory_begin(&rep->memory);
 	int r = harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err);
@@ -308,6 +282,7 @@ static void series_work(void *arg, void *report, size_t size)
 			&rep->frame_count, &err); /* an animated scene's frames: harness_frames.c */
 		rep->status = f > 0 ? SERIES_INVALID : f < 0 ? SERIES_FAILED : rep->status;
 	}
+out:
 	if (rep->status != SERIES_OK)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
 	bvhlab_tree_finish(&s.tree);
@@ -352,9 +327,7 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, uint32_t f
 	run->phase_count = rep->phase_count;
 	run->frames = (const struct frame_metrics *)(rep->samples + repeat);
 	run->frame_count = rep->frame_count;
-	rep->two_level.bottom.plugin[sizeof(rep->two_level.bottom.plugin) - 1] = '\0';
-	rep->two_level.top.plugin[sizeof(rep->two_level.top.plugin) - 1] = '\0';
-	run->two_level = rep->has_two_level ? &rep->two_level : NULL;
+	run->two_level = rep->status == SERIES_OK ? harness_two_level_checked(&rep->two_level) : NULL;
 }
 
 /* Runs the series in a child (or here, with "isolate": false) and records it. */
@@ -480,7 +453,7 @@ static void run_list_scene(struct harness *h, const bvhlab_scene *scene,
 		const struct plan_run *run = &h->list.runs[k];
 		struct harness_builder *hb = &h->builders[run->builder];
 		struct series_job job = {.h = h, .scene = scene, .prims = prims, .hb = hb,
-		                         .run = run, .inst = h->inst.meshes ? &h->inst : NULL};
+		                         .run = run};
 		if (!hb->plugin || !hb->opts_ok)
 			record_failed(h, run, hb->status, hb->error.message);
 		else
@@ -507,10 +480,9 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (scene_done(h, s))
 		return;
 	int r = h->cfg->isolate ? harness_probe_scene(h->cfg, cs, &err) : 0;
-	if (r == 0 && cs->meshes) /* a two-level scene: its meshes once, then flattened */
-		r = harness_scene_instanced(h->cfg, cs, &h->inst, &scene, &err);
-	else if (r == 0) /* an animated scene's frame 0 (harness_anim.c) */
-		r = harness_anim_load(cs, &h->anim, &scene, &err);
+	if (r == 0) /* two-level: meshes once, flattened; animated: frame 0 (harness_anim.c) */
+		r = cs->meshes ? harness_scene_instanced(cs, &h->inst, &scene, &err)
+		               : harness_anim_load(cs, &h->anim, &scene, &err);
 	if (r == 0)
 		r = bvhlab_prims_init(&prims, scene, &err);
 	if (r < 0) {
@@ -524,8 +496,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	results_add_scene(&h->res, scene->name, shown ? shown : scene->source,
 	                  scene->triangle_count, NULL);
 	free(shown);
-	if (cs->meshes)
-		harness_record_instances(&h->res, scene->name, &h->inst);
+	harness_record_instances(&h->res, scene->name, &h->inst);
 	h->shade_done = false;
 	h->shade_error = 0;
 	h->rounds_on = harness_rounds_start(h->cfg, scene, h->progress.tty);

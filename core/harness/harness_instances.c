@@ -87,11 +87,9 @@ int harness_load_flattened(const struct config_scene *cs, bvhlab_scene **out,
 	return r;
 }
 
-int harness_scene_instanced(const struct config *cfg, const struct config_scene *cs,
-                            struct scene_instanced *inst, bvhlab_scene **flat,
-                            bvhlab_error *err)
+int harness_scene_instanced(const struct config_scene *cs, struct scene_instanced *inst,
+                            bvhlab_scene **flat, bvhlab_error *err)
 {
-	(void)cfg;
 	int r = harness_load_instanced(cs, inst, err);
 	if (r == 0)
 		r = scene_instanced_flatten(inst, cs->name, flat, err);
@@ -101,6 +99,8 @@ int harness_scene_instanced(const struct config *cfg, const struct config_scene 
 void harness_record_instances(struct results *res, const char *scene,
                               const struct scene_instanced *inst)
 {
+	if (!inst->meshes)
+		return;
 	struct results_instances in = {
 		.meshes = inst->mesh_count, .instances = inst->instance_count,
 		.unique_triangles = scene_instanced_unique_triangles(inst),

@@ -21,11 +21,11 @@ int harness_load_flattened(const struct config_scene *cs, bvhlab_scene **out,
 
 /* For a sweep: the two-level form into inst and the flattened scene (the
  * one-level builders' input) into *flat, both from one loading. */
-int harness_scene_instanced(const struct config *cfg, const struct config_scene *cs,
-                            struct scene_instanced *inst, bvhlab_scene **flat,
-                            bvhlab_error *err);
+int harness_scene_instanced(const struct config_scene *cs, struct scene_instanced *inst,
+                            bvhlab_scene **flat, bvhlab_error *err);
 
-/* The scene's meshes, instances and triangle counts into its results entry. */
+/* The scene's meshes, instances and triangle counts into its results
+ * entry; nothing for a one-level scene (inst zeroed). */
 void harness_record_instances(struct results *res, const char *scene,
                               const struct scene_instanced *inst);
 

@@ -198,3 +198,33 @@ void harness_two_level_finish(struct two_level_trees *trees)
 	bvhlab_prims_finish(&trees->top_prims);
 	memset(trees, 0, sizeof(*trees));
 }
+
+enum tree_verdict harness_two_level_run(const struct config *cfg,
+                                        const struct harness_builder *hb,
+                                        const struct scene_instanced *inst, uint32_t threads,
+                                        double *samples_ms, double *cold_ms,
+                                        struct tree_measure *whole,
+                                        struct results_two_level *levels,
+                                        uint32_t *sample_count, bool *validated,
+                                        bvhlab_error *err)
+{
+	struct two_level_job job = {.inst = inst, .bottom = hb->plugin, .top = hb->top.plugin,
+	                            .bottom_opts = &hb->opts, .top_opts = &hb->top.opts,
+	                            .warmup = cfg->warmup, .repeat = cfg->repeat,
+	                            .threads = threads,
+	                            .validate_rays = cfg->validate ? cfg->validate_rays : 0};
+	struct two_level_trees trees;
+	enum tree_verdict v = harness_two_level_series(&job, samples_ms, cold_ms, whole, levels,
+	                                               &trees, err);
+	*sample_count = v == TREE_OK ? cfg->repeat : 0;
+	*validated = v != TREE_FAILED;
+	harness_two_level_finish(&trees);
+	return v;
+}
+
+const struct results_two_level *harness_two_level_checked(struct results_two_level *levels)
+{
+	levels->bottom.plugin[sizeof(levels->bottom.plugin) - 1] = '\0';
+	levels->top.plugin[sizeof(levels->top.plugin) - 1] = '\0';
+	return levels->top.trees ? levels : NULL;
+}

@@ -8,6 +8,9 @@
 
 #include <bvhlab/bvhlab.h>
 
+#include "config/config.h"
+#include "harness/harness_builders.h"
+#include "harness/harness_instances.h"
 #include "harness/harness_measure.h"
 #include "output/results.h"
 #include "scene/instances.h"
@@ -47,5 +50,26 @@ enum tree_verdict harness_two_level_series(const struct two_level_job *job,
                                            struct results_two_level *levels,
                                            struct two_level_trees *trees, bvhlab_error *err);
 void harness_two_level_finish(struct two_level_trees *trees);
+
+/*
+ * A sweep's two-level run, in its child: builder hb's bottom plugin and
+ * options and its top's over inst, with the config's warmup, repeat and
+ * validation, at `threads`. The verdict (TREE_OK, _INVALID, _FAILED: the
+ * run's status, in the same order), the samples and the measurements as
+ * harness_two_level_series gives them; *sample_count the repeats timed,
+ * *validated whether the trees were judged (TREE_OK or TREE_INVALID).
+ */
+enum tree_verdict harness_two_level_run(const struct config *cfg,
+                                        const struct harness_builder *hb,
+                                        const struct scene_instanced *inst, uint32_t threads,
+                                        double *samples_ms, double *cold_ms,
+                                        struct tree_measure *whole,
+                                        struct results_two_level *levels,
+                                        uint32_t *sample_count, bool *validated,
+                                        bvhlab_error *err);
+
+/* levels as a run's child sent them, its strings ended, for the record;
+ * NULL when it holds no levels (a one-level run's zeroed report). */
+const struct results_two_level *harness_two_level_checked(struct results_two_level *levels);
 
 #endif

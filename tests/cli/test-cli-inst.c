@@ -19,7 +19,8 @@
 	"    \"meshes\": [ { \"name\": \"ball\", \"generator\": \"icosphere\", \"frequency\": 3 },\n" \
 	"                  { \"name\": \"rock\", \"generator\": \"soup\", \"count\": 40 } ],\n" \
 	"    \"instances\": [ { \"mesh\": \"%s\", \"translate\": [0, 0, 0] },\n" \
-	"      { \"scatter\": { \"mesh\": \"ball\", \"count\": 30, \"bounds\": [[-5, 0, -5], [5, 1, 5]],\n" \
+	"      { \"scatter\": { \"mesh\": \"ball\", \"count\": 30,\n" \
+	"                       \"bounds\": [[-5, 0, -5], [5, 1, 5]],\n" \
 	"                       \"scale\": [0.5, 1.5], \"rotate\": \"random-y\" } } ] } ],\n"
 
 static double num_at(const cJSON *o, const char *a, const char *b, const char *c)
