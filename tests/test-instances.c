@@ -215,6 +215,21 @@ static void test_scene(void)
 	config_finish(&cfg);
 }
 
+/* A mesh that does not load fails the scene, naming scene and mesh. */
+static void test_load_error(void)
+{
+	struct config cfg;
+	bvhlab_error err = { "" };
+	bvhlab_scene *flat = NULL;
+	CHECK_INT(parse(&cfg, "\"meshes\": [ { \"name\": \"a\", \"generator\": \"room\" }, "
+	                "{ \"name\": \"b\", \"path\": \"/tmp/bvhlab-no-such-mesh.obj\" } ], "
+	                "\"instances\": [ { \"mesh\": \"b\" } ]", &err), 0);
+	CHECK(harness_load_flattened(&cfg.scenes[0], &flat, &err) < 0 && !flat);
+	CHECK_CONTAINS(err.message, "scene 'grove' mesh 1: ");
+	CHECK_CONTAINS(err.message, "bvhlab-no-such-mesh.obj");
+	config_finish(&cfg);
+}
+
 /* m * inv is the identity; a singular matrix is refused. */
 static void test_inverse(void)
 {
@@ -339,6 +354,7 @@ int main(void)
 	test_builder_errors();
 	test_scene();
 	test_inverse();
+	test_load_error();
 	test_two_level();
 	return test_finish();
 }

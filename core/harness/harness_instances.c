@@ -79,7 +79,7 @@ int harness_load_instanced(const struct config_scene *cs, struct scene_instanced
 int harness_load_flattened(const struct config_scene *cs, bvhlab_scene **out,
                            bvhlab_error *err)
 {
-	struct scene_instanced s;
+	struct scene_instanced s = {0}; /* left zeroed by a load that fails */
 	int r = harness_load_instanced(cs, &s, err);
 	if (r == 0)
 		r = scene_instanced_flatten(&s, cs->name, out, err);

@@ -10,7 +10,7 @@
 #include "scene/instances.h"
 
 /* cs has "instances": 0, or a negative errno with err naming the scene and
- * the mesh or instance entry at fault. */
+ * the mesh or instance entry at fault, *out then as it was or zeroed. */
 int harness_load_instanced(const struct config_scene *cs, struct scene_instanced *out,
                            bvhlab_error *err);
 
