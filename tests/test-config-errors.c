@@ -58,7 +58,8 @@ static void test_unknown_keys(void)
 	t = "{ \"scenes\": [ { \"generator\": \"icosphere\", \"frequncy\": 4 } ], " BUILDERS " }";
 	EXPECT_ERROR_AT(t, "\"frequncy\"", 0,
 	                "unknown key 'frequncy' in scenes[0] (known: name, path, generator, parts, "
-	                "frequency, count, size, seed, width, subdivide, frames, animate, deform, "
+	                "meshes, instances, frequency, count, size, seed, width, subdivide, frames, "
+	                "animate, deform, "
 	                "amplitude, camera); did you mean "
 	                "'frequency'?");
 	EXPECT_ERROR("{ " SCENES ",\n"
@@ -66,8 +67,8 @@ static void test_unknown_keys(void)
 	             "    { \"plugin\": \"b\", \"threds\": [2] } ] }",
 	             3, 22,
 	             "unknown key 'threds' in builders[1] (known: plugin, name, threads, "
-	             "timeout_s, memory_limit_mb, options, optional, refine, animation); did you "
-	             "mean 'threads'?");
+	             "timeout_s, memory_limit_mb, options, optional, refine, animation, bottom, "
+	             "top, top_options); did you mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
 	                "diffuse, camera, threads, min_ms, rounds, traversal, device, kinds, light, "

@@ -504,9 +504,11 @@ void config_finish(struct config *cfg)
 		free(cfg->scenes[i].generator);
 		free(cfg->scenes[i].frame_pattern);
 		config_parts_free(&cfg->scenes[i]);
+		config_instances_free(&cfg->scenes[i]);
 	}
 	for (size_t i = 0; cfg->builders && i < cfg->builder_count; i++) {
 		free(cfg->builders[i].plugin);
+		free(cfg->builders[i].top);
 		free(cfg->builders[i].name);
 		free(cfg->builders[i].threads);
 		free(cfg->builders[i].picks);

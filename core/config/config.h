@@ -23,6 +23,8 @@ struct cJSON;
 struct json_locations;
 
 struct config_part;
+struct config_mesh;
+struct config_instance;
 
 /* What a scene's or part's "deform" names (config_anim.c). */
 enum config_deform { CONFIG_DEFORM_NONE, CONFIG_DEFORM_WAVE, CONFIG_DEFORM_EXPLODE };
@@ -47,6 +49,13 @@ struct config_scene {
 	int line, column;  /* where the scene's object starts */
 	struct config_part *parts; /* "parts" of a composite scene, or NULL */
 	size_t part_count;
+	/* A two-level scene (config_instances.c; docs/instances.md): its "meshes",
+	 * each loaded once, and its "instances" placing them; NULL otherwise. */
+	struct config_mesh *meshes;
+	size_t mesh_count;
+	struct config_instance *instances;
+	size_t instance_count;   /* entries of "instances" (a scatter is one) */
+	uint64_t instance_total; /* instances once every scatter is expanded */
 	/* Animation (config_anim.c): "frames": N, or {"pattern", "count", "first"}. */
 	uint32_t frames;     /* frames of the animation; 0: a static scene */
 	char *frame_pattern; /* frame files, one %d conversion (resolved), or NULL */
@@ -64,6 +73,33 @@ struct config_part {
 	bvhlab_transform xf;
 	struct config_motion motion; /* "animate", "deform", "amplitude" */
 };
+
+/* One of a two-level scene's "meshes": a source named for its instances. */
+struct config_mesh {
+	char *name;             /* "name", required, unique in the scene */
+	struct config_scene src; /* path or generator (its name unused) */
+};
+
+/* How a scatter turns its instances: "rotate" "none" or "random-y". */
+enum config_scatter_rotate { CONFIG_SCATTER_NONE, CONFIG_SCATTER_RANDOM_Y };
+
+/* One entry of "instances": one placed mesh, or a "scatter" of many. */
+struct config_instance {
+	uint32_t mesh;       /* index into the scene's meshes ("mesh" names it) */
+	double xf[12];       /* row-major 3x4 object-to-world matrix: "matrix", or
+	                      * "scale", "rotate", "translate" as a composite part's */
+	bool scatter;        /* "scatter": {...}: the fields below, xf unused */
+	uint32_t count;      /* "count": instances, 1 .. CONFIG_MAX_INSTANCES */
+	uint64_t seed;       /* "seed", default 1 */
+	double lo[3], hi[3]; /* "bounds": [[x, y, z], [x, y, z]] the positions are drawn in */
+	double scale[2];     /* "scale": [a, b], 0 < a <= b, drawn uniformly; default [1, 1] */
+	int rotate;          /* "rotate": enum config_scatter_rotate, default none */
+};
+
+/* Most instances a scene may hold, all entries and scatters together: the
+ * top level's primitive ids are 32 bits, and a 16 M-instance scene is far
+ * beyond what the two-level experiments need. */
+#define CONFIG_MAX_INSTANCES (UINT32_C(1) << 24)
 
 /* One refinement stage of a builder (config_refine.c). */
 struct config_refine {
@@ -106,6 +142,12 @@ struct config_builder {
 	size_t refine_count;
 	int line, column;  /* where the builder's object starts */
 	const struct config_animation *animation; /* "animation", or NULL: rebuild */
+	/* A two-level builder (docs/instances.md): "bottom" (the plugin above,
+	 * building one tree per mesh, with "options") and "top", a plugin that
+	 * builds over boxes (BVHLAB_BUILDER_BOXES) with "top_options"; NULL
+	 * for a one-level builder. Two-level scenes only. */
+	char *top;
+	const struct cJSON *top_options; /* "top_options" object (may be NULL), owned by root */
 	/* An option grid's builder (config_grid.c): the value it takes of each grid. */
 	struct config_grid_pick *picks;
 	size_t pick_count;

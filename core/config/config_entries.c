@@ -153,6 +153,7 @@ static int scene_name_and_path(struct config *cfg, struct config_scene *sc,
 	if (!sc->name) {
 		sc->name = sc->path        ? config_stem(sc->path)
 		           : sc->generator ? strdup(sc->generator)
+		           : sc->meshes    ? strdup("instances")
 		                           : strdup("composite");
 		if (!sc->name)
 			return out_of_memory(cfg, err);
@@ -184,7 +185,9 @@ static int parse_scene(struct config *cfg, const cJSON *obj, size_t index,
 		rc = config_read_keys(cfg, obj, config_scene_keys, prefix, sc, err);
 	if (!rc) /* animation: frames, motion (config_anim.c) */
 		rc = config_parse_frames(cfg, obj, prefix, sc, err);
-	if (!rc && config_member(obj, "parts"))
+	if (!rc && (config_member(obj, "instances") || config_member(obj, "meshes")))
+		rc = config_parse_instances(cfg, obj, prefix, sc, err);
+	else if (!rc && config_member(obj, "parts"))
 		rc = config_parse_parts(cfg, obj, prefix, sc, err);
 	else if (!rc)
 		rc = config_scene_source(cfg, obj, prefix, config_scene_keys, sc, err);
@@ -253,6 +256,54 @@ static int builder_plugin(struct config *cfg, const cJSON *obj, const char *pref
 	return 0;
 }
 
+/* "bottom" and "top" come together; "bottom" is the builder's plugin (its
+ * "options" are the bottom's), default name "two-level[top=T,bottom=B]".
+ * Refinement and animation of two-level trees are not there yet. */
+static int two_level(struct config *cfg, const cJSON *obj, const char *prefix,
+                     struct config_builder *b, bvhlab_error *err)
+{
+	const cJSON *bottom = config_member(obj, "bottom"), *other;
+	const cJSON *top_options = config_member(obj, "top_options");
+	char got[48];
+	if (top_options && !b->top)
+		return config_error(cfg, top_options, true, err, "'%stop_options' without '%stop'",
+		                    prefix, prefix);
+	if (top_options && !cJSON_IsObject(top_options))
+		return config_error(cfg, top_options, false, err, "'%stop_options' must be an "
+		                    "object, not %s", prefix,
+		                    config_describe(cfg, top_options, got, sizeof(got)));
+	b->top_options = top_options;
+	if (!bottom && !b->top)
+		return 0;
+	if (!bottom || !b->top)
+		return config_error(cfg, bottom ? bottom : config_member(obj, "top"), true, err,
+		                    "'%s%s' without '%s%s': a two-level builder names both",
+		                    prefix, bottom ? "bottom" : "top", prefix, bottom ? "top" : "bottom");
+	if (!cJSON_IsString(bottom) || !bottom->valuestring[0])
+		return config_error(cfg, bottom, false, err, "'%sbottom' must be a plugin name, "
+		                    "not %s", prefix, config_describe(cfg, bottom, got, sizeof(got)));
+	static const char *const not_with[] = {"plugin", "refine", "animation"};
+	for (size_t k = 0; k < 3; k++)
+		if ((other = config_member(obj, not_with[k])))
+			return config_error(cfg, other, true, err, "'%s%s' does not apply to a "
+			                    "two-level builder ('bottom' and 'top')%s", prefix,
+			                    not_with[k], k ? " yet" : ": 'bottom' is its plugin");
+	for (size_t k = 0; k < cfg->scene_count; k++)
+		if (!cfg->scenes[k].meshes)
+			return config_error(cfg, bottom, true, err, "'%sbottom': a two-level builder "
+			                    "runs on two-level scenes only, and scene '%s' has no "
+			                    "'instances'", prefix, cfg->scenes[k].name);
+	if (!(b->plugin = strdup(bottom->valuestring)))
+		return out_of_memory(cfg, err);
+	if (!b->name) {
+		size_t n = strlen(b->top) + strlen(b->plugin) + 32;
+		if (!(b->name = malloc(n)))
+			return out_of_memory(cfg, err);
+		snprintf(b->name, n, "two-level[top=%s,bottom=%s]", b->top, b->plugin);
+	}
+	return 0;
+}
+
 static int builder_options(struct config *cfg, const cJSON *obj, size_t index,
                            struct config_builder *b, bvhlab_error *err)
 {
@@ -283,6 +334,8 @@ static int parse_builder(struct config *cfg, const cJSON *obj, size_t index,
 	int rc = config_check_keys(cfg, obj, config_builder_keys, where, err);
 	if (!rc)
 		rc = config_read_keys(cfg, obj, config_builder_keys, prefix, b, err);
+	if (!rc)
+		rc = two_level(cfg, obj, prefix, b, err);
 	if (!rc)
 		rc = builder_plugin(cfg, obj, prefix, b, err);
 	if (!rc)

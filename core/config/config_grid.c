@@ -112,13 +112,14 @@ static int make_builder(const struct config *cfg, const struct config_builder *b
 	struct strbuf sb = {0};
 	*out = *b;
 	out->plugin = strdup(b->plugin);
+	out->top = b->top ? strdup(b->top) : NULL;
 	out->picks = calloc(grids, sizeof(*out->picks));
 	out->pick_count = grids;
 	out->threads = NULL;
 	out->name = NULL;
 	if (b->threads && (out->threads = malloc(b->thread_count * sizeof(*b->threads))))
 		memcpy(out->threads, b->threads, b->thread_count * sizeof(*b->threads));
-	if (!out->plugin || !out->picks || (b->threads && !out->threads))
+	if (!out->plugin || !out->picks || (b->threads && !out->threads) || (b->top && !out->top))
 		return -ENOMEM;
 	fill_picks(b, combo, grids, out->picks);
 	sb_printf(&sb, "%s[", b->name);
@@ -132,6 +133,7 @@ static int make_builder(const struct config *cfg, const struct config_builder *b
 static void free_builder(struct config_builder *b)
 {
 	free(b->plugin);
+	free(b->top);
 	free(b->name);
 	free(b->threads);
 	free(b->picks);

@@ -72,6 +72,9 @@ extern const struct config_key config_ray_keys[];   /* struct config */
 extern const struct config_key config_report_keys[]; /* struct config */
 extern const struct config_key config_scene_keys[]; /* struct config_scene */
 extern const struct config_key config_part_keys[];  /* struct config_part */
+extern const struct config_key config_mesh_keys[];  /* struct config_mesh */
+extern const struct config_key config_instance_keys[]; /* read by config_instances.c */
+extern const struct config_key config_scatter_keys[]; /* struct config_instance */
 extern const struct config_key config_builder_keys[]; /* struct config_builder */
 extern const struct config_key config_camera_keys[]; /* bvhlab_camera */
 extern const struct config_key config_refine_keys[]; /* struct config_refine */
@@ -142,6 +145,16 @@ int config_scene_source(struct config *cfg, const cJSON *obj, const char *prefix
 int config_parse_parts(struct config *cfg, const cJSON *obj, const char *prefix,
                        struct config_scene *sc, bvhlab_error *err);
 void config_parts_free(struct config_scene *sc);
+/* A scene's own source keys ("path", "generator", generator parameters)
+ * beside "parts" or "meshes" (what) would be ignored: an error saying to
+ * give them to `to` ("a part"). */
+int config_no_own_source(struct config *cfg, const cJSON *obj, const char *prefix,
+                         const char *what, const char *to, bvhlab_error *err);
+/* "meshes" and "instances" of the two-level scene obj (config_instances.c);
+ * freed in config_finish by config_instances_free. */
+int config_parse_instances(struct config *cfg, const cJSON *obj, const char *prefix,
+                           struct config_scene *sc, bvhlab_error *err);
+void config_instances_free(struct config_scene *sc);
 int config_parse_builders(struct config *cfg, bvhlab_error *err);
 /* Expands builders with {"grid": [...]} option values into one builder per
  * combination, named "NAME[key=value,...]" (config_grid.c); `array` is the

@@ -78,6 +78,8 @@ const struct config_key config_scene_keys[] = {
 	SCENE("path", CONFIG_STRING, path, 0, 0, 0),
 	SCENE("generator", CONFIG_STRING, generator, 0, 0, 0),
 	CUSTOM("parts"), /* a composite scene: config_parts.c */
+	CUSTOM("meshes"), /* a two-level scene: config_instances.c */
+	CUSTOM("instances"),
 	SCENE("frequency", CONFIG_U32, gen.frequency, 1, UINT32_MAX, CONFIG_GENERATED),
 	SCENE("count", CONFIG_U32, gen.count, 1, UINT32_MAX, CONFIG_GENERATED),
 	SCENE("size", CONFIG_U32, gen.size, 1, UINT32_MAX, CONFIG_GENERATED),
@@ -113,6 +115,46 @@ const struct config_key config_part_keys[] = {
 	END,
 };
 
+/* One of a two-level scene's "meshes": a name and a scene's source keys. */
+#define MESH(name, kind, field, min, max, flags) \
+	KEY(struct config_mesh, name, kind, field, min, max, flags)
+const struct config_key config_mesh_keys[] = {
+	MESH("name", CONFIG_STRING, name, 0, 0, 0),
+	MESH("path", CONFIG_STRING, src.path, 0, 0, 0),
+	MESH("generator", CONFIG_STRING, src.generator, 0, 0, 0),
+	MESH("frequency", CONFIG_U32, src.gen.frequency, 1, UINT32_MAX, CONFIG_GENERATED),
+	MESH("count", CONFIG_U32, src.gen.count, 1, UINT32_MAX, CONFIG_GENERATED),
+	MESH("size", CONFIG_U32, src.gen.size, 1, UINT32_MAX, CONFIG_GENERATED),
+	MESH("seed", CONFIG_U64, src.gen.seed, 0, UINT64_MAX, CONFIG_GENERATED),
+	MESH("width", CONFIG_POSITIVE, src.gen.width, 0, 0, CONFIG_GENERATED),
+	MESH("subdivide", CONFIG_U32, src.subdivide, 0, MAX_SUBDIVIDE, 0),
+	END,
+};
+
+/* One of a two-level scene's "instances": a mesh placed by a matrix or by a
+ * part's keys, or a "scatter" of many (config_instances.c). */
+const struct config_key config_instance_keys[] = {
+	CUSTOM("mesh"),
+	CUSTOM("matrix"),
+	CUSTOM("scale"),
+	CUSTOM("rotate"),
+	CUSTOM("translate"),
+	CUSTOM("scatter"),
+	END,
+};
+
+#define SCATTER(name, kind, field, min, max) \
+	KEY(struct config_instance, name, kind, field, min, max, 0)
+const struct config_key config_scatter_keys[] = {
+	CUSTOM("mesh"),
+	SCATTER("count", CONFIG_U32, count, 1, CONFIG_MAX_INSTANCES),
+	SCATTER("seed", CONFIG_U64, seed, 0, UINT64_MAX),
+	CUSTOM("bounds"),
+	CUSTOM("scale"),
+	CUSTOM("rotate"),
+	END,
+};
+
 #define BUILDER(name, kind, field, min, max) \
 	KEY(struct config_builder, name, kind, field, min, max, 0)
 const struct config_key config_builder_keys[] = {
@@ -125,6 +167,9 @@ const struct config_key config_builder_keys[] = {
 	BUILDER("optional", CONFIG_BOOL, optional, 0, 0),
 	CUSTOM("refine"), /* config_refine.c */
 	CUSTOM("animation"), /* config_anim.c */
+	CUSTOM("bottom"), /* a two-level builder: config_entries.c */
+	BUILDER("top", CONFIG_STRING, top, 0, 0),
+	CUSTOM("top_options"),
 	END,
 };
 

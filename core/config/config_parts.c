@@ -55,17 +55,16 @@ static int parse_part(struct config *cfg, const cJSON *obj, const char *scene_pr
 	return rc ? rc : part_path(cfg, &part->src, err);
 }
 
-/* A composite's own source keys would be silently ignored: refuse them. */
-static int no_own_source(struct config *cfg, const cJSON *obj, const char *prefix,
-                         bvhlab_error *err)
+int config_no_own_source(struct config *cfg, const cJSON *obj, const char *prefix,
+                         const char *what, const char *to, bvhlab_error *err)
 {
 	for (const struct config_key *k = config_scene_keys; k->name; k++) {
 		const cJSON *item = config_member(obj, k->name);
 		bool source = strcmp(k->name, "path") == 0 || strcmp(k->name, "generator") == 0;
 		if (item && (source || (k->flags & CONFIG_GENERATED)))
 			return config_error(cfg, item, true, err,
-			                    "'%s%s' does not apply to a scene with 'parts': give it "
-			                    "to a part", prefix, k->name);
+			                    "'%s%s' does not apply to a scene with '%s': give it "
+			                    "to %s", prefix, k->name, what, to);
 	}
 	return 0;
 }
@@ -76,7 +75,7 @@ int config_parse_parts(struct config *cfg, const cJSON *obj, const char *prefix,
 	const cJSON *parts = config_member(obj, "parts");
 	char got[48];
 	size_t n, i = 0;
-	int rc = no_own_source(cfg, obj, prefix, err);
+	int rc = config_no_own_source(cfg, obj, prefix, "parts", "a part", err);
 
 	if (rc)
 		return rc;

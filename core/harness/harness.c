@@ -24,6 +24,7 @@
 #include "harness/harness_scene.h"
 #include "harness/harness_series.h"
 #include "harness/harness_threads.h"
+#include "harness/harness_two_level.h"
 #include "harness/isolate.h"
 #include "harness/progress.h"
 #include "machine/machine.h"
@@ -48,6 +49,7 @@ struct harness {
 	bool rounds_on;  /* this scene's rays are timed in interleaved rounds */
 	struct harness_rounds rounds; /* this scene's trees waiting for them */
 	struct harness_anim anim; /* this scene's animation, frames 0 if none (harness_anim.c) */
+	struct scene_instanced inst; /* this scene's two-level form, if it has "instances" */
 };
 
 enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };
@@ -74,6 +76,7 @@ struct series_report {
 	uint32_t phase_count;
 	bvhlab_phase phases[BVHLAB_MAX_PHASES];
 	uint32_t frame_count;  /* frames done, after samples[] (an animated scene) */
+	struct results_two_level two_level; /* a two-level builder's run: its levels apart */
 	bool in_frames;        /* the frames began: a death after keeps the frames done */
 	char error[sizeof(((bvhlab_error *)0)->message)];
 	double samples[];      /* [repeat], then struct frame_metrics [frames] */
@@ -252,6 +255,12 @@ static void series_work(void *arg, void *report, size_t size)
 	bvhlab_error err = {{0}};
 	(void)size;
 	rep->status = SERIES_OK;
+	if (job->hb->top.plugin) { /* two-level (harness_two_level.c): status in the same order */
+		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst, job->run->key.threads,
+		                                    rep->samples, &rep->cold_ms, &rep->tree, &rep->two_level,
+		                                    &rep->sample_count, &rep->validated, &err);
+		goto out;
+	}
 	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);
 	harness_memory_begin(&rep->memory);
 	int r = harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err);
@@ -273,6 +282,7 @@ static void series_work(void *arg, void *report, size_t size)
 			&rep->frame_count, &err); /* an animated scene's frames: harness_frames.c */
 		rep->status = f > 0 ? SERIES_INVALID : f < 0 ? SERIES_FAILED : rep->status;
 	}
+out:
 	if (rep->status != SERIES_OK)
 		snprintf(rep->error, sizeof(rep->error), "%s", err.message);
 	bvhlab_tree_finish(&s.tree);
@@ -318,6 +328,7 @@ static void report_to_run(struct series_report *rep, uint32_t repeat, uint32_t f
 	run->phase_count = rep->phase_count;
 	run->frames = (const struct frame_metrics *)(rep->samples + repeat);
 	run->frame_count = rep->frame_count;
+	run->two_level = rep->status == SERIES_OK ? harness_two_level_checked(&rep->two_level) : NULL;
 }
 
 /* Runs the series in a child (or here, with "isolate": false) and records it. */
@@ -470,8 +481,9 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (scene_done(h, s))
 		return;
 	int r = h->cfg->isolate ? harness_probe_scene(h->cfg, cs, &err) : 0;
-	if (r == 0) /* an animated scene's frame 0 (harness_anim.c) */
-		r = harness_anim_load(cs, &h->anim, &scene, &err);
+	if (r == 0) /* two-level: meshes once, flattened; animated: frame 0 (harness_anim.c) */
+		r = cs->meshes ? harness_scene_instanced(cs, &h->inst, &scene, &err)
+		               : harness_anim_load(cs, &h->anim, &scene, &err);
 	if (r == 0)
 		r = bvhlab_prims_init(&prims, scene, &err);
 	if (r < 0) {
@@ -485,6 +497,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	results_add_scene(&h->res, scene->name, shown ? shown : scene->source,
 	                  scene->triangle_count, NULL);
 	free(shown);
+	harness_record_instances(&h->res, scene->name, &h->inst);
 	h->shade_done = false;
 	h->shade_error = 0;
 	h->rounds_on = harness_rounds_start(h->cfg, scene, h->progress.tty);
@@ -495,6 +508,7 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 		scene_images(h, scene, s);
 out:
 	harness_anim_close(&h->anim);
+	scene_instanced_finish(&h->inst);
 	bvhlab_prims_finish(&prims);
 	bvhlab_scene_destroy(scene);
 }

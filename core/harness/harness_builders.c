@@ -176,6 +176,32 @@ static int open_animation(const struct config *cfg, bool probed, struct harness_
 	return r;
 }
 
+/* A two-level builder's top plugin: there, and able to build over boxes
+ * (BVHLAB_BUILDER_BOXES), refused by name before the sweep otherwise. */
+static int open_top(const struct config *cfg, bool probed, struct harness_builder *hb,
+                    bool *ok)
+{
+	*ok = true;
+	if (!hb->cb->top)
+		return 0;
+	int r = open_anim_plugin(cfg, probed, hb, hb->cb->top, "top", &hb->top, ok);
+	if (r == 0 && *ok && !bvhlab_builder_takes_boxes(bvhlab_plugin_builder(hb->top.plugin))) {
+		error_set(&hb->error, "top: plugin '%s' cannot build over boxes (no "
+		          "BVHLAB_BUILDER_BOXES flag; `bvhlab list` marks those that can)",
+		          hb->cb->top);
+		*ok = false;
+	}
+	if (r == 0 && *ok) { /* "top_options" checked as "options" are, against the top's */
+		struct config_builder as_top = *hb->cb;
+		as_top.options = hb->cb->top_options;
+		as_top.pick_count = 0;
+		*ok = config_apply_options(cfg, &as_top, &hb->top.opts, &hb->error) == 0;
+	}
+	if (r == 0 && !*ok)
+		config_locate_builder_error(cfg, hb->cb, SIZE_MAX, &hb->error);
+	return r;
+}
+
 /*
  * The hash of what a builder's runs are made with beyond its name: its
  * plugin and resolved options, each stage's plugin and options. Part of a
@@ -239,6 +265,8 @@ static int builder_identity(struct harness_builder *hb)
 		cJSON_AddItemToObject(anim, "refine", stages_json(hb->anim_stages, a->refine_count));
 		cJSON_AddItemToObject(o, "animation", anim);
 	}
+	if (hb->top.plugin)
+		cJSON_AddItemToObject(o, "top", plugin_json(hb->top.plugin, &hb->top.opts));
 	char *text = o ? cJSON_PrintUnformatted(o) : NULL;
 	if (!text)
 		return cJSON_Delete(o), -ENOMEM;
@@ -265,6 +293,8 @@ static int open_one(const struct config *cfg, bool probed, struct harness_builde
 	if (hb->opts_ok && open_stages(cfg, hb, &hb->opts_ok) < 0)
 		return -ENOMEM;
 	if (hb->opts_ok && open_animation(cfg, probed, hb, &hb->opts_ok) < 0)
+		return -ENOMEM;
+	if (hb->opts_ok && open_top(cfg, probed, hb, &hb->opts_ok) < 0)
 		return -ENOMEM;
 	if (hb->opts_ok && (hash_options(hb) < 0 || builder_identity(hb) < 0))
 		return -ENOMEM;
@@ -341,6 +371,7 @@ void harness_close_builders(const struct config *cfg, struct harness_builder *bu
 			close_stage(&builders[b].anim_stages[k]);
 		}
 		close_stage(&builders[b].update);
+		close_stage(&builders[b].top);
 		cJSON_Delete(builders[b].identity);
 	}
 	free(builders);

@@ -40,6 +40,9 @@ struct harness_builder {
 	 * opened to check them before the sweep (open when opts_ok) */
 	struct harness_stage update, anim_stages[HARNESS_MAX_STAGES];
 	struct refine_stage refine[HARNESS_MAX_STAGES]; /* views of stages[] */
+	/* A two-level builder's "top" (its default options; plugin NULL for a
+	 * one-level builder): it builds over boxes, checked before the sweep. */
+	struct harness_stage top;
 };
 
 /* The resource limits of a builder's children (its own or the config's). */

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "harness/harness_instances.h"
 #include "harness/harness_scene.h"
 #include "harness/isolate.h"
 #include "plan/plan.h"
@@ -47,7 +48,8 @@ static int load_parts(const struct config_scene *cs, bvhlab_scene **out, bvhlab_
 
 int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab_error *err)
 {
-	int r = cs->parts  ? load_parts(cs, out, err)
+	int r = cs->meshes ? harness_load_flattened(cs, out, err)
+	        : cs->parts  ? load_parts(cs, out, err)
 	        : cs->path ? bvhlab_scene_load(cs->path, out, err)
 	                   : bvhlab_scene_generate(cs->generator, &cs->gen, out, err);
 	if (r < 0)

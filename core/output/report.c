@@ -99,6 +99,14 @@ static const char *const csv_numbers[][2] = {
 	{"rays.wide8.diffuse.mrays_per_s", "%.4f"},
 	{"rays.wide8.shadow.mrays_per_s", "%.4f"},
 	{"rays.wide8.ao.mrays_per_s", "%.4f"},
+	{"two_level.bottom.build_ms", "%.4f"},
+	{"two_level.top.build_ms", "%.4f"},
+	{"two_level.build_ms", "%.4f"},
+	{"two_level.bottom.nodes", "%.0f"},
+	{"two_level.top.nodes", "%.0f"},
+	{"two_level.bottom.sah_cost", "%.4f"},
+	{"two_level.top.sah_cost", "%.4f"},
+	{"two_level.sah_cost", "%.4f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary
@@ -244,6 +252,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	sb_printf(sb, "\n\n");
 	report_md_text(sb, report_str(scene, "source"));
 	sb_printf(sb, ", %s triangles", num(buf, sizeof(buf), scene, "triangles", "%.0f"));
+	report_scene_instances(sb, scene);
 	if (*report_str(scene, "error")) {
 		sb_printf(sb, ". **Could not be loaded:** ");
 		report_md_text(sb, report_str(scene, "error"));
@@ -261,6 +270,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	for (size_t k = 0; k < n; k++)
 		md_run_row(sb, ix, runs[k], phases);
 	report_kinds(sb, runs, n, false);
+	report_two_level_md(sb, runs, n);
 	report_front_md(sb, ix, runs, n);
 	report_budget_md(sb, ix, name);
 	report_breakeven_md(sb, ix, ref, runs, n);

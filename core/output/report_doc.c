@@ -202,3 +202,13 @@ void report_csv_field(struct strbuf *sb, const char *s, bool last)
 	}
 	sb_printf(sb, last ? "\n" : ",");
 }
+
+void report_scene_instances(struct strbuf *sb, const cJSON *scene)
+{
+	if (!report_at(scene, "instances"))
+		return;
+	sb_printf(sb, ", %.0f instances of %.0f meshes (%.0f unique triangles, %.0f instanced)",
+	          report_num(scene, "instances.instances"), report_num(scene, "instances.meshes"),
+	          report_num(scene, "instances.unique_triangles"),
+	          report_num(scene, "instances.instanced_triangles"));
+}

@@ -21,6 +21,10 @@ const char *report_str(const cJSON *o, const char *path);
 /* The number at path, or NaN. */
 double report_num(const cJSON *o, const char *path);
 
+/* A two-level scene's counts, ", N instances of M meshes (U unique
+ * triangles, I instanced)", or nothing for a one-level scene. */
+void report_scene_instances(struct strbuf *sb, const cJSON *scene);
+
 /* The machine a run was measured on: its own "machine" (a merged sweep's
  * runs carry their part's), else the document's. */
 const cJSON *report_machine(const cJSON *doc, const cJSON *run);

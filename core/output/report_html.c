@@ -449,6 +449,7 @@ static void scene_section(struct strbuf *sb, const struct report_index *ix, cons
 	sb_printf(sb, "</h2>\n<p>");
 	esc(sb, report_str(scene, "source"));
 	sb_printf(sb, ", %.0f triangles", report_num(scene, "triangles"));
+	report_scene_instances(sb, scene);
 	if (*report_str(scene, "error")) {
 		sb_printf(sb, ". <b class=\"bad\">Could not be loaded:</b> ");
 		esc(sb, report_str(scene, "error"));

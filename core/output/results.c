@@ -120,6 +120,22 @@ int results_add_scene(struct results *res, const char *name, const char *source,
 	return 0;
 }
 
+int results_scene_instances(struct results *res, const char *name,
+                            const struct results_instances *in)
+{
+	cJSON *scene = find_scene(res, name), *o = cJSON_CreateObject();
+	if (!scene || !o) {
+		cJSON_Delete(o);
+		return -ENOMEM;
+	}
+	cJSON_AddNumberToObject(o, "meshes", in->meshes);
+	cJSON_AddNumberToObject(o, "instances", in->instances);
+	cJSON_AddNumberToObject(o, "unique_triangles", (double)in->unique_triangles);
+	cJSON_AddNumberToObject(o, "instanced_triangles", (double)in->instanced_triangles);
+	cJSON_AddItemToObject(scene, "instances", o);
+	return 0;
+}
+
 static cJSON *find_any(const struct results *res, const struct run_identity *key, bool stale);
 
 /* A run made again takes its stale record's place (which stayed on disk

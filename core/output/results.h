@@ -153,6 +153,26 @@ struct frame_metrics {
 	bool costed;           /* cost_ms known: traced, or no rays per frame to pay for */
 };
 
+/* One level of a two-level run (docs/instances.md): its plugin, build
+ * time (the bottom's: the sum over meshes of each mesh's median) and tree
+ * (the bottom's: summed over the meshes' trees; sah the mean of theirs,
+ * each mesh counted once). */
+struct results_level {
+	char plugin[64];
+	double build_ms;
+	uint32_t trees, nodes, leaves;
+	double sah;
+	uint64_t memory_bytes;
+};
+
+/* A two-level run's levels apart, and the whole tree's two-level SAH:
+ * SAH(top) + sum over instances i of SA(world box i) / SA(top root) *
+ * SAH(bottom tree of i's mesh). */
+struct results_two_level {
+	struct results_level bottom, top;
+	double sah;
+};
+
 /* Everything known about one run; fields beyond status are optional. */
 struct run_record {
 	uint32_t id;           /* position in the config's run order (plan.h) */
@@ -186,6 +206,7 @@ struct run_record {
 	uint32_t phase_count;
 	const struct frame_metrics *frames; /* [frame_count] an animated scene's frames */
 	uint32_t frame_count;
+	const struct results_two_level *two_level; /* a two-level build's levels, or NULL */
 	/* The machine's 1-minute load average just before and after the run's
 	 * series (-1: unreadable), so a report can tell a busy machine;
 	 * recorded when load_read. */
@@ -207,6 +228,14 @@ void results_finish(struct results *res);
 
 int results_add_scene(struct results *res, const char *name, const char *source,
                       uint32_t triangles, const char *error);
+/* A two-level scene's counts, added to scene `name` (added before) as
+ * "instances": {meshes, instances, unique_triangles, instanced_triangles}. */
+struct results_instances {
+	uint32_t meshes, instances;
+	uint64_t unique_triangles, instanced_triangles;
+};
+int results_scene_instances(struct results *res, const char *name,
+                            const struct results_instances *in);
 int results_add_run(struct results *res, const struct run_record *run);
 /* The run's record as results_add_run adds it (results_run.c); NULL when
  * out of memory. */

@@ -105,6 +105,30 @@ static cJSON *validation_json(const struct run_record *run)
 	return o;
 }
 
+static cJSON *level_json(const struct results_level *l)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddStringToObject(o, "plugin", l->plugin);
+	cJSON_AddNumberToObject(o, "build_ms", l->build_ms);
+	cJSON_AddNumberToObject(o, "trees", l->trees);
+	cJSON_AddNumberToObject(o, "nodes", l->nodes);
+	cJSON_AddNumberToObject(o, "leaves", l->leaves);
+	cJSON_AddNumberToObject(o, "sah_cost", l->sah);
+	cJSON_AddNumberToObject(o, "memory_bytes", (double)l->memory_bytes);
+	return o;
+}
+
+/* "two_level": {"bottom", "top", "build_ms": their sum, "sah_cost"}. */
+static cJSON *two_level_json(const struct results_two_level *t)
+{
+	cJSON *o = cJSON_CreateObject();
+	cJSON_AddItemToObject(o, "bottom", level_json(&t->bottom));
+	cJSON_AddItemToObject(o, "top", level_json(&t->top));
+	cJSON_AddNumberToObject(o, "build_ms", t->bottom.build_ms + t->top.build_ms);
+	cJSON_AddNumberToObject(o, "sah_cost", t->sah);
+	return o;
+}
+
 cJSON *results_run_json(const struct run_record *run)
 {
 	cJSON *o = cJSON_CreateObject();
@@ -147,6 +171,8 @@ cJSON *results_run_json(const struct run_record *run)
 		cJSON_AddItemToObject(o, "validation", validation_json(run));
 	if (run->rays)
 		cJSON_AddItemToObject(o, "rays", results_rays_json(run->rays));
+	if (run->two_level)
+		cJSON_AddItemToObject(o, "two_level", two_level_json(run->two_level));
 	if (run->frame_count) /* an animated scene: results_frames.c */
 		cJSON_AddItemToObject(o, "frames", results_frames_json(run->frames, run->frame_count));
 	if (run->load_read) {

@@ -76,13 +76,15 @@ static int absolute_member(const struct config *cfg, cJSON *obj, const char *key
 	return 0;
 }
 
-/* Every path a scene of the copy reads: its own, its parts', its frame
+/* Every path a scene of the copy reads: its own, its parts' and meshes', its frame
  * pattern (the plan runs from its own folder, not the config's). */
 static int absolute_scene(const struct config *cfg, cJSON *scene)
 {
 	cJSON *part;
 	int r = absolute_member(cfg, scene, "path", false);
 	cJSON_ArrayForEach(part, cJSON_GetObjectItemCaseSensitive(scene, "parts"))
+		r = r ? r : absolute_member(cfg, part, "path", false);
+	cJSON_ArrayForEach(part, cJSON_GetObjectItemCaseSensitive(scene, "meshes"))
 		r = r ? r : absolute_member(cfg, part, "path", false);
 	cJSON *frames = cJSON_GetObjectItemCaseSensitive(scene, "frames");
 	return r ? r : absolute_member(cfg, frames, "pattern", true);

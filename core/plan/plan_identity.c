@@ -23,6 +23,8 @@ static void strip_paths(cJSON *scene)
 	cJSON_DeleteItemFromObjectCaseSensitive(scene, "path");
 	cJSON_ArrayForEach(part, cJSON_GetObjectItemCaseSensitive(scene, "parts"))
 		cJSON_DeleteItemFromObjectCaseSensitive(part, "path");
+	cJSON_ArrayForEach(part, cJSON_GetObjectItemCaseSensitive(scene, "meshes"))
+		cJSON_DeleteItemFromObjectCaseSensitive(part, "path");
 	cJSON_DeleteItemFromObjectCaseSensitive(cJSON_GetObjectItemCaseSensitive(scene, "frames"),
 	                                        "pattern");
 }

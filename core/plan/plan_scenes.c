@@ -56,6 +56,11 @@ int plan_scene_each_file(const struct config_scene *cs, plan_file_fn fn, size_t 
 		if (cs->parts[p].src.path)
 			r = fn(cs->parts[p].src.path, what, (*k)++, ctx);
 	}
+	for (size_t m = 0; r == 0 && m < cs->mesh_count; m++) {
+		snprintf(what, sizeof(what), "mesh '%.40s': ", cs->meshes[m].name);
+		if (cs->meshes[m].src.path)
+			r = fn(cs->meshes[m].src.path, what, (*k)++, ctx);
+	}
 	for (uint32_t f = 0; r == 0 && cs->frame_pattern && f < cs->frames; f++) {
 		snprintf(frame, sizeof(frame), cs->frame_pattern, (int)(cs->frame_first + f));
 		snprintf(what, sizeof(what), "frame %u: ", f);

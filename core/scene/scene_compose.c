@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/instances.h"
 #include "scene/scene_private.h"
 
 void bvhlab_transform_init(bvhlab_transform *xf)
@@ -18,8 +19,9 @@ void bvhlab_transform_init(bvhlab_transform *xf)
 	xf->scale = 1.0;
 }
 
-/* Row-major 3x3: scale, then rotations about x, y, z in that order. */
-static void transform_matrix(const bvhlab_transform *xf, double m[3][3])
+/* Row-major 3x4: scale, then rotations about x, y, z in that order, then
+ * the translation. */
+void scene_transform_matrix(const bvhlab_transform *xf, double m[12])
 {
 	const double deg = 3.14159265358979323846 / 180.0;
 	double cx = cos(xf->rotate[0] * deg), sx = sin(xf->rotate[0] * deg);
@@ -32,23 +34,31 @@ static void transform_matrix(const bvhlab_transform *xf, double m[3][3])
 		{ -sy, cy * sx, cy * cx },
 	};
 
-	for (int i = 0; i < 3; i++)
+	for (int i = 0; i < 3; i++) {
 		for (int j = 0; j < 3; j++)
-			m[i][j] = r[i][j] * xf->scale;
+			m[4 * i + j] = r[i][j] * xf->scale;
+		m[4 * i + 3] = xf->translate[i];
+	}
+}
+
+void scene_matrix_apply(const double m[12], const double p[3], double w, double out[3])
+{
+	for (int i = 0; i < 3; i++)
+		out[i] = m[4 * i] * p[0] + m[4 * i + 1] * p[1] + m[4 * i + 2] * p[2] + m[4 * i + 3] * w;
 }
 
 void bvhlab_scene_transform(bvhlab_scene *scene, const bvhlab_transform *xf)
 {
-	double m[3][3];
+	double m[12];
 
-	transform_matrix(xf, m);
+	scene_transform_matrix(xf, m);
 	for (size_t v = 0; v < scene->vertex_count; v++) {
 		float *p = scene->vertices + 3 * v;
-		double q[3] = { p[0], p[1], p[2] };
+		double q[3] = { p[0], p[1], p[2] }, r[3];
 
+		scene_matrix_apply(m, q, 1.0, r);
 		for (int i = 0; i < 3; i++)
-			p[i] = (float)(m[i][0] * q[0] + m[i][1] * q[1] + m[i][2] * q[2] +
-			               xf->translate[i]);
+			p[i] = (float)r[i];
 	}
 	bvhlab_scene_update(scene);
 }

@@ -256,6 +256,7 @@ static int schedule(team_host *th, sah_builder *b, const sah_job *root, uint32_t
 	return rc;
 }
 
-SAH_PLUGIN("sah_tasks", BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+SAH_PLUGIN("sah_tasks",
+	BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC | BVHLAB_BUILDER_BOXES,
 	"parallel binned SAH: large nodes split by all threads, small ones as tasks",
 	struct tasks_options)

@@ -114,7 +114,11 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	if (rc < 0)
 		return rc;
 	team_host_init(&B.th, host, ctx);
-	want = ceil(B.opt.split_factor * input->prim_count);
+	/* Over boxes (a top level) there is no triangle to clip: object
+	 * splits only, with no room for duplicates, so no spatial split and
+	 * no pre-split is ever tried (sbvh_job_has_room is false). */
+	bool boxes = input->prim_kind == BVHLAB_PRIM_BOXES;
+	want = boxes ? input->prim_count : ceil(B.opt.split_factor * input->prim_count);
 	B.capacity = want >= (double)UINT32_MAX / 2 ? UINT32_MAX / 2 : (uint32_t)want;
 	if (B.capacity < input->prim_count)
 		B.capacity = input->prim_count;
@@ -131,7 +135,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	}
 	init_refs(&B);
 	uint32_t count = input->prim_count;
-	if (B.opt.presplit > 0.0) {
+	if (B.opt.presplit > 0.0 && !boxes) {
 		uint32_t room = B.capacity - count;
 		rc = sbvh_presplit(&B, count, count + (uint32_t)(B.opt.presplit * room), &count);
 		if (rc < 0) {
@@ -164,5 +168,5 @@ PLUGIN_WITH_OPTIONS(options, .name = "sbvh",
 	.summary = "SAH with object and spatial splits (Stich et al. 2009): exact triangle "
 	           "clipping, reference unsplitting, split_factor budget; parallel, deterministic",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
-	         BVHLAB_BUILDER_SPATIAL_SPLITS,
+	         BVHLAB_BUILDER_SPATIAL_SPLITS | BVHLAB_BUILDER_BOXES,
 	.build = build)

@@ -1,0 +1,230 @@
+/*
+ * Two-level builds: one bottom tree per mesh, reused by all its
+ * instances, and a top tree over the instances' world boxes (a build over
+ * boxes, ABI 1.5 BVHLAB_PRIM_BOXES). The two-level SAH (docs/instances.md)
+ * weighs each instance's bottom tree by the chance a ray through the top
+ * root enters its box.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness/harness_series.h"
+#include "harness/harness_two_level.h"
+#include "trace/trace_instances.h"
+#include "util/util.h"
+
+/* One level's series into `into` (summed), its median into *median_ms. */
+static int time_level(const struct two_level_job *job, const bvhlab_plugin *plugin,
+                      const bvhlab_options *opts, const bvhlab_build_input *input,
+                      double *into, double *cold_ms, double *median_ms, bvhlab_tree *tree,
+                      bvhlab_error *err)
+{
+	double *samples = calloc(job->repeat, sizeof(*samples)), mn, mx, med;
+	struct build_series s = {.warmup = job->warmup, .repeat = job->repeat,
+	                         .threads = job->threads, .samples_ms = samples};
+	if (!samples)
+		return -ENOMEM;
+	int r = harness_time_builds(plugin, opts, input, &s, err);
+	if (r == 0) {
+		for (uint32_t k = 0; k < job->repeat; k++)
+			into[k] += samples[k];
+		*cold_ms += s.cold_ms;
+		util_summarise(samples, job->repeat, &med, &mn, &mx);
+		*median_ms += med;
+	}
+	*tree = s.tree;
+	free(samples);
+	return r;
+}
+
+/* The level's figures gain one tree's. */
+static void add_tree(struct results_level *l, const bvhlab_tree_stats *st,
+                     bvhlab_tree_stats *whole)
+{
+	l->trees++;
+	l->nodes += st->nodes;
+	l->leaves += st->leaves;
+	l->sah += st->sah_cost;
+	l->memory_bytes += st->memory_bytes;
+	whole->nodes += st->nodes;
+	whole->leaves += st->leaves;
+	whole->refs += st->refs;
+	whole->memory_bytes += st->memory_bytes;
+	for (int k = 0; k < BVHLAB_LEAF_HISTOGRAM; k++)
+		whole->leaf_histogram[k] += st->leaf_histogram[k];
+}
+
+static enum tree_verdict bottom_level(const struct two_level_job *job, double *samples,
+                                      double *cold_ms, struct tree_measure *whole,
+                                      struct results_two_level *lv, double *mesh_sah,
+                                      struct two_level_trees *trees, bvhlab_error *err)
+{
+	bool spatial = bvhlab_plugin_builder(job->bottom)->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
+	uint32_t depth = 0;
+	for (uint32_t m = 0; m < job->inst->mesh_count; m++) {
+		const bvhlab_scene *mesh = job->inst->meshes[m];
+		bvhlab_prims prims = {0};
+		struct tree_measure tm;
+		int r = bvhlab_prims_init(&prims, mesh, err);
+		if (r == 0)
+			r = time_level(job, job->bottom, job->bottom_opts, &prims.input, samples, cold_ms,
+			               &lv->bottom.build_ms, &trees->bottom[m], err);
+		enum tree_verdict v = r < 0 ? TREE_FAILED
+			: harness_measure_tree(&trees->bottom[m], mesh, &prims.input, spatial,
+			                       job->validate_rays, &tm, err);
+		bvhlab_prims_finish(&prims);
+		if (v != TREE_OK) {
+			error_prefix(err, "bottom tree of mesh '%s': ", mesh->name);
+			return v;
+		}
+		whole->rays_checked += tm.rays_checked;
+		mesh_sah[m] = tm.stats.sah_cost;
+		depth = tm.stats.max_depth > depth ? tm.stats.max_depth : depth;
+		add_tree(&lv->bottom, &tm.stats, &whole->stats);
+	}
+	lv->bottom.sah /= job->inst->mesh_count;
+	whole->stats.max_depth = depth;
+	return TREE_OK;
+}
+
+static enum tree_verdict top_level(const struct two_level_job *job, double *samples,
+                                   double *cold_ms, struct tree_measure *whole,
+                                   struct results_two_level *lv, const double *mesh_sah,
+                                   struct two_level_trees *trees, bvhlab_error *err)
+{
+	const struct scene_instanced *inst = job->inst;
+	bvhlab_aabb *boxes = malloc((size_t)inst->instance_count * sizeof(*boxes));
+	bvhlab_tree_stats st;
+	if (!boxes)
+		return error_set(err, "out of memory for %u instance boxes", inst->instance_count),
+		       TREE_FAILED;
+	for (uint32_t i = 0; i < inst->instance_count; i++)
+		scene_instanced_box(inst, i, &boxes[i]);
+	int r = bvhlab_prims_init_boxes(&trees->top_prims, boxes, inst->instance_count, err);
+	if (r == 0)
+		r = time_level(job, job->top, job->top_opts, &trees->top_prims.input, samples, cold_ms,
+		               &lv->top.build_ms, &trees->top, err);
+	if (r == 0 && bvhlab_validate_tree(&trees->top, &trees->top_prims.input, false, err) != 0) {
+		error_prefix(err, "top tree: ");
+		free(boxes);
+		return TREE_INVALID;
+	}
+	if (r < 0) {
+		free(boxes);
+		return TREE_FAILED;
+	}
+	bvhlab_tree_stats_compute(&trees->top, &st);
+	add_tree(&lv->top, &st, &whole->stats);
+	double root = bvhlab_box_area(trees->top.nodes[0].lo, trees->top.nodes[0].hi);
+	lv->sah = st.sah_cost;
+	for (uint32_t i = 0; root > 0 && i < inst->instance_count; i++)
+		lv->sah += bvhlab_box_area(boxes[i].lo, boxes[i].hi) / root *
+		           mesh_sah[inst->instances[i].mesh];
+	whole->stats.max_depth += st.max_depth + 1; /* a top leaf, then an instance's root */
+	free(boxes);
+	return TREE_OK;
+}
+
+/* Sampled rays through both levels against brute force over every
+ * instanced triangle (trace_instances.c): any disagreement makes the run
+ * invalid. */
+static enum tree_verdict check_rays(const struct two_level_job *job,
+                                    const struct two_level_trees *trees,
+                                    struct tree_measure *whole, bvhlab_error *err)
+{
+	struct trace_two_level tl = {.inst = job->inst, .top = &trees->top,
+	                             .bottom = trees->bottom};
+	uint64_t mismatches;
+	if (!job->validate_rays)
+		return TREE_OK;
+	trace_two_level_check(&tl, NULL, job->validate_rays, HARNESS_RAY_SEED, &mismatches, NULL);
+	whole->rays_checked += job->validate_rays;
+	whole->mismatches += mismatches;
+	if (!mismatches)
+		return TREE_OK;
+	error_set(err, "%llu of %u sampled rays through both levels disagree with brute force "
+	          "over the instanced triangles", (unsigned long long)mismatches,
+	          job->validate_rays);
+	return TREE_INVALID;
+}
+
+enum tree_verdict harness_two_level_series(const struct two_level_job *job,
+                                           double *samples_ms, double *cold_ms,
+                                           struct tree_measure *whole,
+                                           struct results_two_level *levels,
+                                           struct two_level_trees *trees, bvhlab_error *err)
+{
+	const struct scene_instanced *inst = job->inst;
+	memset(whole, 0, sizeof(*whole));
+	memset(levels, 0, sizeof(*levels));
+	memset(trees, 0, sizeof(*trees));
+	memset(samples_ms, 0, job->repeat * sizeof(*samples_ms));
+	*cold_ms = 0;
+	snprintf(levels->bottom.plugin, sizeof(levels->bottom.plugin), "%s",
+	         bvhlab_plugin_builder(job->bottom)->name);
+	snprintf(levels->top.plugin, sizeof(levels->top.plugin), "%s",
+	         bvhlab_plugin_builder(job->top)->name);
+	trees->bottom = calloc(inst->mesh_count, sizeof(*trees->bottom));
+	double *mesh_sah = calloc(inst->mesh_count, sizeof(*mesh_sah));
+	trees->mesh_count = trees->bottom ? inst->mesh_count : 0;
+	if (!trees->bottom || !mesh_sah) {
+		free(mesh_sah);
+		error_set(err, "out of memory for %u bottom trees", inst->mesh_count);
+		return TREE_FAILED;
+	}
+	enum tree_verdict v = bottom_level(job, samples_ms, cold_ms, whole, levels, mesh_sah,
+	                                   trees, err);
+	if (v == TREE_OK)
+		v = top_level(job, samples_ms, cold_ms, whole, levels, mesh_sah, trees, err);
+	if (v == TREE_OK)
+		v = check_rays(job, trees, whole, err);
+	free(mesh_sah);
+	whole->valid = v == TREE_OK;
+	whole->has_stats = whole->valid;
+	whole->stats.sah_cost = levels->sah;
+	whole->stats.avg_leaf_size =
+		whole->stats.leaves ? (double)whole->stats.refs / whole->stats.leaves : 0;
+	return v;
+}
+
+void harness_two_level_finish(struct two_level_trees *trees)
+{
+	for (uint32_t m = 0; trees->bottom && m < trees->mesh_count; m++)
+		bvhlab_tree_finish(&trees->bottom[m]);
+	free(trees->bottom);
+	bvhlab_tree_finish(&trees->top);
+	bvhlab_prims_finish(&trees->top_prims);
+	memset(trees, 0, sizeof(*trees));
+}
+
+enum tree_verdict harness_two_level_run(const struct config *cfg,
+                                        const struct harness_builder *hb,
+                                        const struct scene_instanced *inst, uint32_t threads,
+                                        double *samples_ms, double *cold_ms,
+                                        struct tree_measure *whole,
+                                        struct results_two_level *levels,
+                                        uint32_t *sample_count, bool *validated,
+                                        bvhlab_error *err)
+{
+	struct two_level_job job = {.inst = inst, .bottom = hb->plugin, .top = hb->top.plugin,
+	                            .bottom_opts = &hb->opts, .top_opts = &hb->top.opts,
+	                            .warmup = cfg->warmup, .repeat = cfg->repeat,
+	                            .threads = threads,
+	                            .validate_rays = cfg->validate ? cfg->validate_rays : 0};
+	struct two_level_trees trees;
+	enum tree_verdict v = harness_two_level_series(&job, samples_ms, cold_ms, whole, levels,
+	                                               &trees, err);
+	*sample_count = v == TREE_OK ? cfg->repeat : 0;
+	*validated = v != TREE_FAILED;
+	harness_two_level_finish(&trees);
+	return v;
+}
+
+const struct results_two_level *harness_two_level_checked(struct results_two_level *levels)
+{
+	levels->bottom.plugin[sizeof(levels->bottom.plugin) - 1] = '\0';
+	levels->top.plugin[sizeof(levels->top.plugin) - 1] = '\0';
+	return levels->top.trees ? levels : NULL;
+}

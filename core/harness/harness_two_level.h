@@ -1,0 +1,75 @@
+/*
+ * A two-level run's builds (harness_two_level.c; docs/instances.md): the
+ * bottom plugin once per mesh, the top plugin over the instances' world
+ * boxes, each level timed, validated and measured apart.
+ */
+#ifndef BVHLAB_CORE_HARNESS_TWO_LEVEL_H
+#define BVHLAB_CORE_HARNESS_TWO_LEVEL_H
+
+#include <bvhlab/bvhlab.h>
+
+#include "config/config.h"
+#include "harness/harness_builders.h"
+#include "harness/harness_instances.h"
+#include "harness/harness_measure.h"
+#include "output/results.h"
+#include "scene/instances.h"
+
+struct two_level_job {
+	const struct scene_instanced *inst;
+	const bvhlab_plugin *bottom, *top;
+	const bvhlab_options *bottom_opts, *top_opts;
+	uint32_t warmup, repeat, threads;
+	uint32_t validate_rays; /* sampled rays per bottom tree against brute force; 0: none */
+};
+
+/* The trees a two-level series leaves: one per mesh, and the top over
+ * boxes (its input kept: primitive i is instance i). */
+struct two_level_trees {
+	bvhlab_tree *bottom; /* [mesh_count] */
+	uint32_t mesh_count;
+	bvhlab_tree top;
+	bvhlab_prims top_prims;
+};
+
+/*
+ * warmup + repeat builds of each level; samples_ms[k] ([repeat]) the k-th
+ * timed bottom builds of every mesh plus the k-th top build, *cold_ms the
+ * same of the first builds. Every bottom tree is validated (structure and
+ * validate_rays sampled rays against brute force over its mesh), the top
+ * over the boxes, and validate_rays rays through both levels against brute
+ * force over every instanced triangle; *whole gets the two-level tree's statistics (every
+ * tree's nodes once, the two-level SAH), *levels the levels apart.
+ * Returns TREE_OK, TREE_INVALID (err naming the level and mesh) or
+ * TREE_FAILED (err saying why); trees are filled in every case and freed
+ * by harness_two_level_finish.
+ */
+enum tree_verdict harness_two_level_series(const struct two_level_job *job,
+                                           double *samples_ms, double *cold_ms,
+                                           struct tree_measure *whole,
+                                           struct results_two_level *levels,
+                                           struct two_level_trees *trees, bvhlab_error *err);
+void harness_two_level_finish(struct two_level_trees *trees);
+
+/*
+ * A sweep's two-level run, in its child: builder hb's bottom plugin and
+ * options and its top's over inst, with the config's warmup, repeat and
+ * validation, at `threads`. The verdict (TREE_OK, _INVALID, _FAILED: the
+ * run's status, in the same order), the samples and the measurements as
+ * harness_two_level_series gives them; *sample_count the repeats timed,
+ * *validated whether the trees were judged (TREE_OK or TREE_INVALID).
+ */
+enum tree_verdict harness_two_level_run(const struct config *cfg,
+                                        const struct harness_builder *hb,
+                                        const struct scene_instanced *inst, uint32_t threads,
+                                        double *samples_ms, double *cold_ms,
+                                        struct tree_measure *whole,
+                                        struct results_two_level *levels,
+                                        uint32_t *sample_count, bool *validated,
+                                        bvhlab_error *err);
+
+/* levels as a run's child sent them, its strings ended, for the record;
+ * NULL when it holds no levels (a one-level run's zeroed report). */
+const struct results_two_level *harness_two_level_checked(struct results_two_level *levels);
+
+#endif
