@@ -253,7 +253,7 @@ static void series_work(void *arg, void *report, size_t size)
 	(void)size;
 	rep->status = SERIES_OK;
 	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);
-	harness_memory_begin(&rep->memory);
+	harness_memory_begin(&rep->memory, &job->prims->input);
 	int r = harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err);
 	harness_memory_end(&rep->memory, &s.tree);
 	if (r < 0) {

@@ -78,6 +78,11 @@ static const char *const csv_numbers[][2] = {
 	{"load_after", "%.2f"},
 	{"device.compute_units", "%.0f"},
 	{"memory.runtime_bytes", "%.0f"},
+	{"memory.scene_bytes", "%.0f"},
+	{"memory.build_bytes_per_triangle", "%.2f"},
+	{"memory.with_scene_bytes_per_triangle", "%.2f"},
+	{"memory.child_bytes_per_triangle", "%.2f"},
+	{"memory.scene_bytes_per_triangle", "%.2f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary
@@ -239,6 +244,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 	          phases ? " build phases ms |" : "", phases ? "---|" : "");
 	for (size_t k = 0; k < n; k++)
 		md_run_row(sb, ix, runs[k], phases);
+	report_memory_md(sb, runs, n);
 	report_front_md(sb, ix, runs, n);
 	report_budget_md(sb, ix, name);
 	report_breakeven_md(sb, ix, ref, runs, n);

@@ -65,6 +65,12 @@ void report_machines_html(struct strbuf *sb, const cJSON *doc);
 void report_frames_md(struct strbuf *sb, const struct report_index *ix, const cJSON *scene);
 void report_frames_html(struct strbuf *sb, const struct report_index *ix, const cJSON *scene);
 
+/* A scene's memory per triangle (report_memory.c): the builds' peak, with
+ * the scene, and the whole child's, per run; nothing when no run has a
+ * memory figure. */
+void report_memory_md(struct strbuf *sb, const cJSON *const *runs, size_t n);
+void report_memory_html(struct strbuf *sb, const cJSON *const *runs, size_t n);
+
 /* ---- Pareto fronts (report_front.c) -------------------------------------- */
 
 /* One candidate: its build time and a tree figure, both lower-is-better;

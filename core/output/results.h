@@ -105,6 +105,8 @@ struct build_memory {
 	uint64_t peak_bytes;      /* peak_rss - start_rss: what the builds added at peak
 	                           * (0 when the mark could not be reset) */
 	uint64_t output_bytes;    /* the output buffers the host allocated, capacity */
+	uint64_t scene_bytes;     /* the scene's own arrays (harness_memory_scene_bytes):
+	                           * resident before the builds, part of start_rss */
 };
 
 /* The device a device builder's run built on (BVHLAB_BUILDER_DEVICE) and
