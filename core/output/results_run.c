@@ -77,6 +77,24 @@ static cJSON *memory_json(const struct build_memory *m, uint32_t triangles)
 	return o;
 }
 
+static cJSON *estimate_json(const struct memory_estimate *e)
+{
+	cJSON *o = cJSON_CreateObject();
+	const struct results_number bytes[] = {
+		{"bytes", (double)e->bytes},
+		{"scene_bytes", (double)e->scene_bytes},
+		{"bytes_per_triangle", (double)e->bytes_per_prim},
+	};
+	results_add_numbers(o, bytes, RESULTS_NUMBERS(bytes));
+	cJSON_AddBoolToObject(o, "declared", e->declared);
+	if (e->known)
+		cJSON_AddNumberToObject(o, "limit_bytes", (double)e->limit_bytes);
+	cJSON_AddStringToObject(o, "limit", !e->known ? "unknown"
+	                                    : e->limit_from_config ? "memory_limit_mb"
+	                                                           : "available");
+	return o;
+}
+
 /* dup_ratio: references per triangle, 1 unless spatial splits duplicated some. */
 static cJSON *tree_json(const bvhlab_tree_stats *st, uint32_t triangles)
 {
@@ -144,6 +162,8 @@ cJSON *results_run_json(const struct run_record *run)
 		cJSON_AddNumberToObject(cJSON_GetObjectItem(o, "tree"), "epo", *run->epo);
 	if (run->memory)
 		cJSON_AddItemToObject(o, "memory", memory_json(run->memory, run->triangles));
+	if (run->estimate)
+		cJSON_AddItemToObject(o, "memory_estimate", estimate_json(run->estimate));
 	if (run->device) /* after "memory", which it adds to */
 		results_device_add(o, run->device);
 	if (run->validated)
