@@ -291,6 +291,7 @@ char *report_markdown(const cJSON *doc)
 	report_summary_md(&sb, &ix);
 	report_machines_md(&sb, doc);
 	report_thesis(&sb, doc, &ix);
+	report_scale_md(&sb, &ix);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		md_scene(&sb, &ix, ref, scene);
 	report_index_finish(&ix);

@@ -503,6 +503,7 @@ char *report_html(const cJSON *doc)
 	}
 	report_summary_html(&sb, &ix);
 	report_machines_html(&sb, doc);
+	report_scale_html(&sb, &ix);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		scene_section(&sb, &ix, ref, scene);
 	report_index_finish(&ix);
