@@ -93,6 +93,16 @@ static bool any_scaling(const struct scale_point *p, size_t n)
 	return false;
 }
 
+/* collect's points where some series scales (malloc'd), else NULL. */
+static struct scale_point *scaling_points(const struct report_index *ix, size_t *n)
+{
+	struct scale_point *p = collect(ix, n);
+	if (p && any_scaling(p, *n))
+		return p;
+	free(p);
+	return NULL;
+}
+
 /* The series' point nearest a million triangles (log distance): what the
  * others' ns per triangle are held against. */
 static size_t million(const struct scale_point *p, size_t a, size_t b)
@@ -121,11 +131,9 @@ static const char intro[] =
 void report_scale_md(struct strbuf *sb, const struct report_index *ix)
 {
 	size_t n;
-	struct scale_point *p = collect(ix, &n);
-	if (!p || !any_scaling(p, n)) {
-		free(p);
+	struct scale_point *p = scaling_points(ix, &n);
+	if (!p)
 		return;
-	}
 	sb_printf(sb, "\n## Cost per triangle against N\n\n%s\n\n| builder | threads | mesh "
 	              "| triangles | warm ns/tri | cold ns/tri | cold/warm | B/tri | vs. 1M |\n"
 	              "|---|---:|---|---:|---:|---:|---:|---:|---:|\n", intro);
@@ -205,11 +213,9 @@ static void builder_charts(struct strbuf *sb, const struct scale_point *p, size_
 void report_scale_html(struct strbuf *sb, const struct report_index *ix)
 {
 	size_t n;
-	struct scale_point *p = collect(ix, &n);
-	if (!p || !any_scaling(p, n)) {
-		free(p);
+	struct scale_point *p = scaling_points(ix, &n);
+	if (!p)
 		return;
-	}
 	sb_printf(sb, "<h2>Cost per triangle against N</h2>\n<p>%s Figures: report.md's table "
 	              "of the same name.</p>\n<div class=\"charts\">\n", intro);
 	for (size_t a = 0, b; a < n; a = b) {
