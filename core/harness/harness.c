@@ -14,6 +14,7 @@
 
 #include "harness/harness.h"
 #include "harness/harness_builders.h"
+#include "harness/harness_estimate.h"
 #include "harness/harness_frames.h"
 #include "harness/harness_images.h"
 #include "harness/harness_measure.h"
@@ -262,7 +263,7 @@ static void series_work(void *arg, void *report, size_t size)
 		goto out;
 	}
 	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);
-	harness_memory_begin(&rep->memory);
+	harness_memory_begin(&rep->memory, &job->prims->input);
 	int r = harness_time_builds(job->hb->plugin, &job->hb->opts, &job->prims->input, &s, &err);
 	harness_memory_end(&rep->memory, &s.tree);
 	if (r < 0) {
@@ -421,6 +422,15 @@ static void run_one(struct harness *h, struct series_job *job)
 	run.triangles = job->scene->triangle_count;
 	if (skip_run(h, pr))
 		return;
+	struct memory_estimate est;
+	char refused[512];
+	run.estimate = &est;
+	if (harness_estimate_run(h->cfg, job->hb, job->scene->name, &job->prims->input, &est,
+	                         refused, sizeof(refused)) < 0) {
+		run.error = refused; /* nothing built: the sweep goes on */
+		record(h, &run);
+		return;
+	}
 	size_t size = sizeof(struct series_report) + h->cfg->repeat * sizeof(double) +
 	              harness_frames_size(&h->anim);
 	/* Shared with the run's child: what it finished survives its death. */

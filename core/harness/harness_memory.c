@@ -39,10 +39,18 @@ static uint64_t status_bytes(const char *name)
 	return kb * 1024;
 }
 
-void harness_memory_begin(struct build_memory *m)
+uint64_t harness_memory_scene_bytes(const bvhlab_build_input *in)
+{
+	uint64_t per_prim = sizeof(bvhlab_aabb) + 3 * sizeof(float) +
+	                    (in->indices ? 3 * sizeof(uint32_t) : 0);
+	return (uint64_t)in->vertex_count * 3 * sizeof(float) + per_prim * in->prim_count;
+}
+
+void harness_memory_begin(struct build_memory *m, const bvhlab_build_input *in)
 {
 	FILE *f = fopen("/proc/self/clear_refs", "w");
 	memset(m, 0, sizeof(*m));
+	m->scene_bytes = harness_memory_scene_bytes(in);
 	/* Without the reset the peak may predate the builds; then the growth
 	 * is not known and is left at 0 (peak_rss still tells the peak). */
 	m->reset = f && fputs("5", f) >= 0;

@@ -6,9 +6,17 @@
 
 struct build_memory; /* output/results.h */
 
-/* Before the first build (warm-up included), and after the last one. */
-void harness_memory_begin(struct build_memory *m);
+/* Before the first build (warm-up included), and after the last one;
+ * in is the run's input (its scene's share is recorded). */
+void harness_memory_begin(struct build_memory *m, const bvhlab_build_input *in);
 void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree);
+
+/*
+ * The scene's own bytes as the builds get it: vertices, indices and the
+ * per-primitive boxes and centroids (bvhlab_prims); what every run of the
+ * scene holds whatever the builder, so per-triangle figures can state it.
+ */
+uint64_t harness_memory_scene_bytes(const bvhlab_build_input *in);
 
 struct run_device; /* output/results.h */
 

@@ -133,6 +133,17 @@ bool bvhlab_builder_int_choices(const bvhlab_builder *b)
 	return BVHLAB_ABI_VERSION_MINOR(b->abi_version) >= 6;
 }
 
+uint32_t bvhlab_builder_peak_bytes_per_prim(const bvhlab_builder *b, const void *filled,
+                                            bool *declared)
+{
+	uint32_t bytes = BVHLAB_BUILDER_HAS(b, peak_bytes_per_prim) ? b->peak_bytes_per_prim : 0;
+	if (filled && BVHLAB_BUILDER_HAS(b, peak_bytes_for) && b->peak_bytes_for &&
+	    b->peak_bytes_for(filled))
+		bytes = b->peak_bytes_for(filled);
+	*declared = bytes != 0;
+	return bytes ? bytes : BVHLAB_UNDECLARED_BYTES_PER_PRIM;
+}
+
 static int load(bvhlab_plugin *p, bvhlab_error *err)
 {
 	p->handle = dlopen(p->path, RTLD_NOW | RTLD_LOCAL);

@@ -95,3 +95,17 @@ double machine_other_load(const struct machine_cpu_mark *before,
 	double other = (after->machine_s - before->machine_s) - (after->own_s - before->own_s);
 	return other > 0 ? other / wall : 0;
 }
+
+uint64_t machine_memory_available(void)
+{
+	FILE *f = fopen("/proc/meminfo", "r");
+	char line[256];
+	unsigned long long kb = 0;
+	if (!f)
+		return 0;
+	while (fgets(line, sizeof(line), f))
+		if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1)
+			break;
+	fclose(f);
+	return (uint64_t)kb * 1024;
+}

@@ -36,6 +36,10 @@ struct machine_info {
 
 void machine_info_read(struct machine_info *info);
 
+/* The memory the kernel says is available for new work (MemAvailable of
+ * /proc/meminfo) in bytes; 0 when it cannot be read. */
+uint64_t machine_memory_available(void);
+
 /* One OpenCL device: its "P:D" indices, names and size. */
 struct machine_cl_device {
 	unsigned platform_index, device_index;

@@ -107,6 +107,11 @@ static const char *const csv_numbers[][2] = {
 	{"two_level.bottom.sah_cost", "%.4f"},
 	{"two_level.top.sah_cost", "%.4f"},
 	{"two_level.sah_cost", "%.4f"},
+	{"memory.scene_bytes", "%.0f"},
+	{"memory.build_bytes_per_triangle", "%.2f"},
+	{"memory.with_scene_bytes_per_triangle", "%.2f"},
+	{"memory.child_bytes_per_triangle", "%.2f"},
+	{"memory.scene_bytes_per_triangle", "%.2f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary
@@ -271,6 +276,7 @@ static void md_scene(struct strbuf *sb, const struct report_index *ix, const cha
 		md_run_row(sb, ix, runs[k], phases);
 	report_kinds(sb, runs, n, false);
 	report_two_level_md(sb, runs, n);
+	report_memory_md(sb, runs, n);
 	report_front_md(sb, ix, runs, n);
 	report_budget_md(sb, ix, name);
 	report_breakeven_md(sb, ix, ref, runs, n);
@@ -318,6 +324,7 @@ char *report_markdown(const cJSON *doc)
 	report_summary_md(&sb, &ix);
 	report_machines_md(&sb, doc);
 	report_thesis(&sb, doc, &ix);
+	report_scale_md(&sb, &ix);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		md_scene(&sb, &ix, ref, scene);
 	report_index_finish(&ix);

@@ -67,6 +67,18 @@ void report_frames_md(struct strbuf *sb, const struct report_index *ix, const cJ
 void report_two_level_md(struct strbuf *sb, const cJSON *const *runs, size_t n);
 void report_frames_html(struct strbuf *sb, const struct report_index *ix, const cJSON *scene);
 
+/* A scene's memory per triangle (report_memory.c): the builds' peak, with
+ * the scene, and the whole child's, per run; nothing when no run has a
+ * memory figure. */
+void report_memory_md(struct strbuf *sb, const cJSON *const *runs, size_t n);
+void report_memory_html(struct strbuf *sb, const cJSON *const *runs, size_t n);
+
+/* "Cost per triangle against N" (report_scale.c): ns and bytes per
+ * triangle of each builder, thread count and mesh over the mesh's sizes;
+ * nothing unless some series has three sizes. */
+void report_scale_md(struct strbuf *sb, const struct report_index *ix);
+void report_scale_html(struct strbuf *sb, const struct report_index *ix);
+
 /* ---- Pareto fronts (report_front.c) -------------------------------------- */
 
 /* One candidate: its build time and a tree figure, both lower-is-better;

@@ -460,6 +460,7 @@ static void scene_section(struct strbuf *sb, const struct report_index *ix, cons
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
 	report_kinds(sb, runs, n, true);
+	report_memory_html(sb, runs, n);
 	report_front_html(sb, ix, runs, n);
 	report_budget_html(sb, ix, name);
 	report_breakeven_html(sb, ix, ref, runs, n);
@@ -505,6 +506,7 @@ char *report_html(const cJSON *doc)
 	}
 	report_summary_html(&sb, &ix);
 	report_machines_html(&sb, doc);
+	report_scale_html(&sb, &ix);
 	cJSON_ArrayForEach(scene, cJSON_GetObjectItem(doc, "scenes"))
 		scene_section(&sb, &ix, ref, scene);
 	report_index_finish(&ix);

@@ -117,6 +117,20 @@ struct build_memory {
 	uint64_t peak_bytes;      /* peak_rss - start_rss: what the builds added at peak
 	                           * (0 when the mark could not be reset) */
 	uint64_t output_bytes;    /* the output buffers the host allocated, capacity */
+	uint64_t scene_bytes;     /* the scene's own arrays (harness_memory_scene_bytes):
+	                           * resident before the builds, part of start_rss */
+};
+
+/* A run's peak memory as estimated before it started
+ * (harness/harness_estimate.c). */
+struct memory_estimate {
+	bool known;             /* a limit was known (the config's, or MemAvailable) */
+	bool declared;          /* the builder and its stages declared their bytes */
+	bool limit_from_config; /* memory_limit_mb, not the memory available */
+	uint64_t bytes;         /* scene_bytes + bytes_per_prim x primitives */
+	uint64_t scene_bytes;   /* the scene's arrays (harness_memory_scene_bytes) */
+	uint64_t bytes_per_prim; /* the builder's and its stages' declarations, summed */
+	uint64_t limit_bytes;   /* what it was held against */
 };
 
 /* The device a device builder's run built on (BVHLAB_BUILDER_DEVICE) and
@@ -195,6 +209,7 @@ struct run_record {
 	uint32_t width;        /* with stats: the tree's branching factor, 2 to 8 */
 	const double *epo;     /* end-point overlap (bvhlab_tree_epo), or NULL */
 	const struct build_memory *memory; /* peak memory of the builds, or NULL */
+	const struct memory_estimate *estimate; /* the peak estimated beforehand, or NULL */
 	const struct run_device *device; /* a device builder's device, or NULL */
 	bool validated;
 	bool valid;

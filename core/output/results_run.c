@@ -45,7 +45,23 @@ static cJSON *timing_json(const struct run_record *run)
 	return o;
 }
 
-static cJSON *memory_json(const struct build_memory *m)
+/* Bytes per triangle: the build's peak alone and with the scene it read
+ * (the figure to hold against a budget), the whole child's, the scene's.
+ * Without the high-water mark's reset the build's own peak is unknown. */
+static void per_triangle_json(cJSON *o, const struct build_memory *m, uint32_t triangles)
+{
+	double n = triangles;
+	const struct results_number per[] = {
+		{"build_bytes_per_triangle", (double)m->peak_bytes / n},
+		{"with_scene_bytes_per_triangle", (double)(m->peak_bytes + m->scene_bytes) / n},
+	};
+	if (m->reset)
+		results_add_numbers(o, per, RESULTS_NUMBERS(per));
+	cJSON_AddNumberToObject(o, "child_bytes_per_triangle", (double)m->peak_rss_bytes / n);
+	cJSON_AddNumberToObject(o, "scene_bytes_per_triangle", (double)m->scene_bytes / n);
+}
+
+static cJSON *memory_json(const struct build_memory *m, uint32_t triangles)
 {
 	cJSON *o = cJSON_CreateObject();
 	const struct results_number bytes[] = {
@@ -53,8 +69,29 @@ static cJSON *memory_json(const struct build_memory *m)
 		{"peak_rss_bytes", (double)m->peak_rss_bytes},
 		{"start_rss_bytes", (double)m->start_rss_bytes},
 		{"output_bytes", (double)m->output_bytes},
+		{"scene_bytes", (double)m->scene_bytes},
 	};
 	results_add_numbers(o, bytes, RESULTS_NUMBERS(bytes));
+	if (triangles)
+		per_triangle_json(o, m, triangles);
+	return o;
+}
+
+static cJSON *estimate_json(const struct memory_estimate *e)
+{
+	cJSON *o = cJSON_CreateObject();
+	const struct results_number bytes[] = {
+		{"bytes", (double)e->bytes},
+		{"scene_bytes", (double)e->scene_bytes},
+		{"bytes_per_triangle", (double)e->bytes_per_prim},
+	};
+	results_add_numbers(o, bytes, RESULTS_NUMBERS(bytes));
+	cJSON_AddBoolToObject(o, "declared", e->declared);
+	if (e->known)
+		cJSON_AddNumberToObject(o, "limit_bytes", (double)e->limit_bytes);
+	cJSON_AddStringToObject(o, "limit", !e->known ? "unknown"
+	                                    : e->limit_from_config ? "memory_limit_mb"
+	                                                           : "available");
 	return o;
 }
 
@@ -164,7 +201,9 @@ cJSON *results_run_json(const struct run_record *run)
 	if (run->stats && run->epo)
 		cJSON_AddNumberToObject(cJSON_GetObjectItem(o, "tree"), "epo", *run->epo);
 	if (run->memory)
-		cJSON_AddItemToObject(o, "memory", memory_json(run->memory));
+		cJSON_AddItemToObject(o, "memory", memory_json(run->memory, run->triangles));
+	if (run->estimate)
+		cJSON_AddItemToObject(o, "memory_estimate", estimate_json(run->estimate));
 	if (run->device) /* after "memory", which it adds to */
 		results_device_add(o, run->device);
 	if (run->validated)

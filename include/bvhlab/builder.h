@@ -39,6 +39,11 @@
  *        run)): one pool of threads for the whole process, placed on the
  *        run's CPU set and pinned as pin_thread pins. Older plugins load
  *        as before and start no threads through it.
+ *   1.7  bvhlab_builder.peak_bytes_per_prim: the bytes per primitive a
+ *        build adds at its peak, as the plugin declares them, from which
+ *        the harness estimates a run's memory before it starts, and
+ *        peak_bytes_for, the same for one run's options. Older plugins
+ *        load as before and declare none (the host's default).
  *
  * A plugin is a shared object that exports exactly one symbol,
  *
@@ -69,7 +74,7 @@
 BVHLAB_BEGIN_DECLS
 
 #define BVHLAB_ABI_MAJOR 1
-#define BVHLAB_ABI_MINOR 6
+#define BVHLAB_ABI_MINOR 7
 #define BVHLAB_ABI_VERSION(major, minor) (((uint32_t)(major) << 16) | (uint32_t)(minor))
 #define BVHLAB_ABI_VERSION_MAJOR(v) ((uint32_t)(v) >> 16)
 #define BVHLAB_ABI_VERSION_MINOR(v) ((uint32_t)(v) & 0xffffu)
@@ -500,7 +505,37 @@ typedef struct bvhlab_builder {
 	int (*fill_options)(const bvhlab_host *host, bvhlab_build_ctx *ctx, void *out);
 	uint32_t options_size; /* since 1.6: bytes fill_options writes; 0 without it */
 	uint32_t reserved;     /* zero */
+
+	/*
+	 * since 1.7, 0: not declared. The most bytes per primitive one build
+	 * (or, for a refine or update stage, one call) adds to the process's
+	 * resident memory at its peak, for any of its options and thread
+	 * counts: its scratch and the output it grows, as a run's
+	 * memory.peak_bytes / triangles measures it (the host's output buffers
+	 * of 2n - 1 nodes and n indices, 68 bytes, included; the input's
+	 * arrays, the scene's share, not). Round up: the harness multiplies it
+	 * by the primitive count, adds the scene's own bytes and the stages',
+	 * and refuses before building a run whose estimate exceeds
+	 * memory_limit_mb (or the memory available), naming both. A builder
+	 * that declares none is estimated at BVHLAB_UNDECLARED_BYTES_PER_PRIM.
+	 */
+	uint32_t peak_bytes_per_prim;
+	uint32_t reserved3; /* zero */
+	/*
+	 * since 1.7, may be NULL. peak_bytes_per_prim for one run's options,
+	 * where they differ by option (the SAH plugins' exact sweep keeps
+	 * sorted arrays that binning does not): given the struct fill_options
+	 * filled for the run (options_size bytes), or 0 to use
+	 * peak_bytes_per_prim, which stays the most over all options.
+	 */
+	uint32_t (*peak_bytes_for)(const void *options);
 } bvhlab_builder;
+
+/* What the harness assumes of a builder that declares no
+ * peak_bytes_per_prim (one of before 1.7, or 0): above every in-tree
+ * builder's declaration, so an undeclared one is not let into a run that
+ * the declared ones would not fit. */
+#define BVHLAB_UNDECLARED_BYTES_PER_PRIM 400u
 
 /* True when descriptor `b` has `field`: one built against an older minor
  * lacks the fields that came later, e.g. BVHLAB_BUILDER_HAS(b, refine). */

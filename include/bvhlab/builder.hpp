@@ -116,7 +116,7 @@ constexpr bvhlab_builder make_builder(const char *name, const char *summary, uin
 {
 	return bvhlab_builder{BVHLAB_ABI_CURRENT, sizeof(bvhlab_builder), name, summary, flags,
 	                      static_cast<uint32_t>(N), options, build, refine, update,
-	                      nullptr, 0, 0};
+	                      nullptr, 0, 0, 0, 0, nullptr};
 }
 
 /* The descriptor of a plugin without options. */
@@ -125,7 +125,7 @@ constexpr bvhlab_builder make_builder(const char *name, const char *summary, uin
                                       build_fn update = nullptr)
 {
 	return bvhlab_builder{BVHLAB_ABI_CURRENT, sizeof(bvhlab_builder), name, summary, flags,
-	                      0, nullptr, build, refine, update, nullptr, 0, 0};
+	                      0, nullptr, build, refine, update, nullptr, 0, 0, 0, 0, nullptr};
 }
 
 /* The signature of fill_options (ABI 1.6). */
@@ -140,6 +140,14 @@ constexpr bvhlab_builder with_fill_options(bvhlab_builder descriptor, fill_optio
 {
 	descriptor.fill_options = fill;
 	descriptor.options_size = static_cast<uint32_t>(size);
+	return descriptor;
+}
+
+/* `descriptor` with peak_bytes_per_prim (ABI 1.7): what one build adds
+ * per primitive at its peak (builder.h says what counts). */
+constexpr bvhlab_builder with_peak_bytes(bvhlab_builder descriptor, uint32_t bytes_per_prim)
+{
+	descriptor.peak_bytes_per_prim = bytes_per_prim;
 	return descriptor;
 }
 

@@ -48,6 +48,13 @@ typedef int (*bvhlab_fill_options_fn)(const bvhlab_host *host, bvhlab_build_ctx 
 bvhlab_fill_options_fn bvhlab_builder_fill_options(const bvhlab_builder *b);
 /* Whether the descriptor's INT options' `choices` are meant (ABI 1.6). */
 bool bvhlab_builder_int_choices(const bvhlab_builder *b);
+/* The bytes per primitive a build with the options `filled` (its
+ * fill_options struct, or NULL) declares: peak_bytes_for's answer, else
+ * peak_bytes_per_prim (ABI 1.7), else BVHLAB_UNDECLARED_BYTES_PER_PRIM when
+ * it declares none (0, or a plugin built against an older minor);
+ * *declared says which. */
+uint32_t bvhlab_builder_peak_bytes_per_prim(const bvhlab_builder *b, const void *filled,
+                                            bool *declared);
 /* The file the plugin was loaded from. */
 const char *bvhlab_plugin_path(const bvhlab_plugin *plugin);
 

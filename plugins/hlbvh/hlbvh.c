@@ -170,4 +170,5 @@ PLUGIN_WITH_OPTIONS(options, .name = "hlbvh",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "SAH over Morton clusters (HLBVH, Garanzha et al. 2011): each cluster "
 	           "built whole by exact SAH, the SAH top over the clusters",
-	.build = build)
+	.build = build,
+	.peak_bytes_per_prim = 200 /* measured 78-178 */)

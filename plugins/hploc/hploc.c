@@ -125,4 +125,5 @@ PLUGIN_WITH_OPTIONS(options, .name = "hploc",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
 	.summary = "H-PLOC (Benthin et al. 2024): PLOC merging inside the LBVH's subtrees, "
 	           "bottom-up from Morton order, SAH collapse",
-	.build = build)
+	.build = build,
+	.peak_bytes_per_prim = 192 /* measured 134-168 */)

@@ -169,4 +169,5 @@ PLUGIN_WITH_OPTIONS(options, .name = "sbvh",
 	           "clipping, reference unsplitting, split_factor budget; parallel, deterministic",
 	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
 	         BVHLAB_BUILDER_SPATIAL_SPLITS | BVHLAB_BUILDER_BOXES,
-	.build = build)
+	.build = build,
+	.peak_bytes_per_prim = 320 /* measured 129-157; splits vary */)

@@ -1,0 +1,25 @@
+/* A run's peak memory estimated before it starts (harness_estimate.c). */
+#ifndef BVHLAB_CORE_HARNESS_ESTIMATE_H
+#define BVHLAB_CORE_HARNESS_ESTIMATE_H
+
+#include <stddef.h>
+
+#include <bvhlab/bvhlab.h>
+
+#include "config/config.h"
+#include "harness/harness_builders.h"
+#include "output/results.h"
+
+/*
+ * The run's peak from the scene's size and what its builder and refine
+ * stages declare per primitive (bvhlab_builder.peak_bytes_per_prim, ABI
+ * 1.7), against the builder's or the config's memory_limit_mb, or without
+ * one the memory available now plus the scene's (resident already). 0 when
+ * it fits or the limit is unknown; -E2BIG when it does not, `why` naming
+ * scene, builder, the estimate and the limit. *e is filled either way.
+ */
+int harness_estimate_run(const struct config *cfg, const struct harness_builder *hb,
+                         const char *scene, const bvhlab_build_input *in,
+                         struct memory_estimate *e, char *why, size_t size);
+
+#endif

@@ -1,0 +1,106 @@
+/*
+ * Issue 44's up-front memory estimate (cli-rel-estimate): a run whose
+ * estimated peak (the scene's arrays plus the bytes per triangle its
+ * builder declares, or the host's assumption for one that declares none)
+ * exceeds memory_limit_mb is refused before anything is built, naming
+ * scene, builder, estimate and limit; the sweep goes on, and a run that
+ * fits records its estimate beside its measured memory per triangle, and
+ * lbvh's measured bytes per triangle are within what it declares.
+ * Usage: test-cli-scale BVHLAB_EXE MODE
+ */
+#include <math.h>
+
+#include "cliutil.h"
+
+static double num_at(const cJSON *run, const char *object, const char *key)
+{
+	const cJSON *v = cJSON_GetObjectItem(cJSON_GetObjectItem(run, object), key);
+	return cJSON_IsNumber(v) ? v->valuedouble : NAN;
+}
+
+/* A soup holds 3 vertices per triangle: 36 + 12 bytes of scene, 24 + 12
+ * of primitive box and centroid. */
+#define SOUP_SCENE_BYTES 84.0
+#define TRIANGLES 300000
+
+/* "capped" would crash in build() (fail: segfault): refused first, it is
+ * "failed" with the estimate's message, no build figure, no memory. */
+static void check_refused(const cJSON *doc)
+{
+	const cJSON *run = find_run(doc, "big", "capped", 1);
+	CHECK(run != NULL);
+	if (!run)
+		return;
+	CHECK_CONTAINS(run_str(run, "status"), "failed");
+	const char *error = run_str(run, "error");
+	CHECK_CONTAINS(error, "scene 'big', builder 'capped': refused before building: "
+	                      "estimated peak ");
+	CHECK_CONTAINS(error, "bytes per triangle assumed, not declared x 300000 triangles) "
+	                      "exceeds memory_limit_mb = 100");
+	CHECK(!strstr(error, "SIGSEGV"));
+	CHECK(!cJSON_GetObjectItem(run, "build_ms") && !cJSON_GetObjectItem(run, "memory") &&
+	      !cJSON_GetObjectItem(run, "tree"));
+	CHECK(num_at(run, "memory_estimate", "bytes") > num_at(run, "memory_estimate",
+	                                                        "limit_bytes"));
+	CHECK(num_at(run, "memory_estimate", "limit_bytes") == 100.0 * 1048576);
+	CHECK(num_at(run, "memory_estimate", "scene_bytes") == SOUP_SCENE_BYTES * TRIANGLES);
+}
+
+/* "free" (no limit: the memory available) fits and runs: its figures per
+ * triangle add up, and its estimate is recorded. */
+static void check_fitted(const cJSON *doc)
+{
+	const cJSON *run = find_run(doc, "big", "free", 1);
+	CHECK(run != NULL);
+	if (!run)
+		return;
+	CHECK_CONTAINS(run_str(run, "status"), "ok");
+	double peak = num_at(run, "memory", "peak_bytes"), scene = num_at(run, "memory",
+	                                                                   "scene_bytes");
+	CHECK(scene == SOUP_SCENE_BYTES * TRIANGLES);
+	CHECK(num_at(run, "memory", "scene_bytes_per_triangle") == SOUP_SCENE_BYTES);
+	CHECK(fabs(num_at(run, "memory", "with_scene_bytes_per_triangle") -
+	           (peak + scene) / TRIANGLES) < 1e-6);
+	CHECK(num_at(run, "memory", "child_bytes_per_triangle") * TRIANGLES ==
+	      num_at(run, "memory", "peak_rss_bytes"));
+	CHECK_CONTAINS(run_str(cJSON_GetObjectItem(run, "memory_estimate"), "limit"), "available");
+}
+
+/* lbvh declares its bytes per triangle (ABI 1.7): what it measured is
+ * within them. */
+static void check_declared(const cJSON *doc)
+{
+	const cJSON *run = find_run(doc, "big", "lbvh", 1);
+	CHECK(run != NULL);
+	if (!run)
+		return;
+	const cJSON *est = cJSON_GetObjectItem(run, "memory_estimate");
+	CHECK(cJSON_IsTrue(cJSON_GetObjectItem(est, "declared")));
+	double declared = num_at(run, "memory_estimate", "bytes_per_triangle");
+	CHECK(declared > 0 && declared < 400);
+	CHECK(num_at(run, "memory", "build_bytes_per_triangle") <= declared);
+}
+
+static void estimate(void)
+{
+	int status = run_in(tmpdir, ARGS("run", "--quiet", write_config("est.json",
+		"{ \"output\": \"out-est\", \"repeat\": 1, \"warmup\": 0, \"threads\": [1],\n"
+		"  \"rays\": { \"width\": 8, \"height\": 8, \"min_ms\": 1, \"rounds\": 1 },\n"
+		"  \"scenes\": [ { \"name\": \"big\", \"generator\": \"soup\", \"count\": 300000 } ],\n"
+		"  \"builders\": [ { \"name\": \"capped\", \"plugin\": \"fake_good\",\n"
+		"                    \"memory_limit_mb\": 100, \"options\": { \"fail\": \"segfault\" } },\n"
+		"                  { \"name\": \"free\", \"plugin\": \"fake_good\" },\n"
+		"                  { \"plugin\": \"lbvh\" } ] }\n")));
+	CHECK_INT(status, 1);
+	cJSON *doc = load_results(cli_path_in("out-est"));
+	check_refused(doc);
+	check_fitted(doc);
+	check_declared(doc);
+	cJSON_Delete(doc);
+}
+
+int main(int argc, char **argv)
+{
+	static const struct cli_mode modes[] = {{"estimate", estimate}};
+	return cli_main_modes(argc, argv, "test-cli-scale", modes, 1);
+}
