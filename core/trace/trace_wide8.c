@@ -2,8 +2,8 @@
  * The 8-lane wide traversal (rays.traversal "wide8") of an 8-wide tree as
  * built: trace_wide_body.h's kernel at eight lanes, compiled three
  * times, portable (GCC's generic vectors, two SSE halves on a plain x86-64
- * build), with AVX2 and with AVX-512VL (256-bit vectors, compares into mask registers), and the
- * widest the CPU has is taken when the view is made (BVHLAB_WIDE8_ISA
+ * build), with AVX2 and with AVX-512VL (256-bit vectors, compares into
+ * mask registers), and the widest the CPU has is taken when the view is made (BVHLAB_WIDE8_ISA
  * = portable|avx2|avx512 picks one, for tests and comparisons).
  */
 #include <stdlib.h>
