@@ -166,68 +166,64 @@ static void test_traversal(void)
 			CHECK(cfg.ray_traversal == ok[i].main && cfg.ray_traversals == ok[i].all);
 		config_finish(&cfg);
 	}
-	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"wid\" } }";
-	EXPECT_ERROR_AT(t, "\"wid\"", 0, "'rays.traversal' must be \"wide\", \"wide4\", "
-	                "\"wide8\", \"stack\", \"stackless\", \"both\" (stack and stackless), an entry {\"name\": NAME, "
-	                "\"device\": true, \"optional\": true} (both settings may be left out) or "
-	                "an array of those, not \"wid\"");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", 2] } }";
-	EXPECT_ERROR_AT(t, "2]", 0, "an array of those, not 2");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide\", \"wide\"] } }";
-	EXPECT_ERROR_AT(t, "\"wide\"", 1, "'rays.traversal' names \"wide\" twice");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [] } }";
-	EXPECT_ERROR_AT(t, "[]", 0, "not an array");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [{\"name\": \"stack\", "
-	    "\"opt\": true}] } }";
-	EXPECT_ERROR_AT(t, "\"opt\"", 0, "entries as objects take \"name\" (a string), "
-	                "\"device\" and \"optional\" (true or false) only");
-	/* The device traversals' old names, and results.json's, are refused with
-	 * the config's way to say them. */
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"stack\", \"cl_stack\"] } }";
-	EXPECT_ERROR_AT(t, "\"cl_stack\"", 0, "'rays.traversal' \"cl_stack\" is written "
-	                "{\"name\": \"stack\", \"device\": true}: a traversal is named for what "
-	                "it does");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": \"device_stackless\" } }";
-	EXPECT_ERROR_AT(t, "\"device_stackless\"", 0, "is written {\"name\": \"stackless\", "
-	                "\"device\": true}");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": {\"name\": \"wide\", "
-	    "\"device\": true} } }";
-	EXPECT_ERROR_AT(t, "\"wide\"", 0, "'rays.traversal' \"wide\" has no device kernel");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": {\"name\": \"wide8\", "
-	    "\"device\": true} } }";
-	EXPECT_ERROR_AT(t, "\"wide8\"", 0, "'rays.traversal' \"wide8\" has no device kernel");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [{\"name\": \"stack\", "
-	    "\"device\": true}, {\"device\": true, \"name\": \"stack\"}] } }";
-	EXPECT_ERROR_AT(t, "\"stack\"}", 0, "names \"stack\" on the device twice");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"primary\", \"shade\"] } }";
-	EXPECT_ERROR_AT(t, "\"shade\"", 0, "'rays.kinds' must be an array of \"primary\", "
-	                "\"diffuse\", \"shadow\" and \"ao\", each at most once, not \"shade\"");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"primary\", \"ao\", \"ao\"] } }";
-	EXPECT_ERROR_AT(t, "\"ao\"", 1, "each at most once, not \"ao\"");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": \"shadow\" } }";
-	EXPECT_ERROR_AT(t, "\"shadow\"", 0, "'rays.kinds' must be an array");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"shadow\"] } }";
-	EXPECT_ERROR_AT(t, "[\"shadow\"]", 0, "'rays.kinds' must name \"primary\"");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"diffuse\": 0, \"kinds\": [\"primary\", "
-	    "\"diffuse\"] } }";
-	EXPECT_ERROR_AT(t, "[\"primary\"", 0, "'rays.kinds' names \"diffuse\" but 'rays.diffuse' is 0");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"light\": [1, 2] } }";
-	EXPECT_ERROR_AT(t, "[1, 2]", 0, "'rays.light' must be an array of 3 finite numbers");
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"ao_length\": 0 } }";
-	EXPECT_ERROR_AT(t, "0 }", 0, "'rays.ao_length' must be");
-	{
-		struct config cfg;
-		bvhlab_error err = {""};
-		t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"ao\", \"primary\", "
-		    "\"shadow\"], \"light\": [1, 2, 3], \"ao_length\": 0.25 } }";
-		CHECK_INT(load(&cfg, t, &err), 0);
-		CHECK(cfg.ray_kinds == (1u << RAY_PRIMARY | 1u << RAY_SHADOW | 1u << RAY_AO));
-		CHECK(cfg.has_light && cfg.ray_light[2] == 3.0f && cfg.ray_ao_length == 0.25);
-		config_finish(&cfg);
+	static const struct {
+		const char *rays, *at; /* inside "rays": { }; the error at the n-th at */
+		int n;
+		const char *needle;
+	} bad[] = {
+		{"\"traversal\": \"wid\"", "\"wid\"", 0,
+		 "'rays.traversal' must be \"wide\", \"wide4\", \"wide8\", \"stack\", \"stackless\", "
+		 "\"both\" (stack and stackless), an entry {\"name\": NAME, \"device\": true, "
+		 "\"optional\": true} (both settings may be left out) or an array of those, not "
+		 "\"wid\""},
+		{"\"traversal\": [\"wide\", 2]", "2]", 0, "an array of those, not 2"},
+		{"\"traversal\": [\"wide\", \"wide\"]", "\"wide\"", 1,
+		 "'rays.traversal' names \"wide\" twice"},
+		{"\"traversal\": []", "[]", 0, "not an array"},
+		{"\"traversal\": [{\"name\": \"stack\", \"opt\": true}]", "\"opt\"", 0,
+		 "entries as objects take \"name\" (a string), \"device\" and \"optional\" (true or "
+		 "false) only"},
+		/* The device traversals' old names, and results.json's, are refused
+		 * with the config's way to say them. */
+		{"\"traversal\": [\"stack\", \"cl_stack\"]", "\"cl_stack\"", 0,
+		 "'rays.traversal' \"cl_stack\" is written {\"name\": \"stack\", \"device\": true}: a "
+		 "traversal is named for what it does"},
+		{"\"traversal\": \"device_stackless\"", "\"device_stackless\"", 0,
+		 "is written {\"name\": \"stackless\", \"device\": true}"},
+		{"\"traversal\": {\"name\": \"wide\", \"device\": true}", "\"wide\"", 0,
+		 "'rays.traversal' \"wide\" has no device kernel"},
+		{"\"traversal\": {\"name\": \"wide8\", \"device\": true}", "\"wide8\"", 0,
+		 "'rays.traversal' \"wide8\" has no device kernel"},
+		{"\"traversal\": [{\"name\": \"stack\", \"device\": true}, {\"device\": true, "
+		 "\"name\": \"stack\"}]",
+		 "\"stack\"}", 0, "names \"stack\" on the device twice"},
+		{"\"kinds\": [\"primary\", \"shade\"]", "\"shade\"", 0,
+		 "'rays.kinds' must be an array of \"primary\", \"diffuse\", \"shadow\" and \"ao\", "
+		 "each at most once, not \"shade\""},
+		{"\"kinds\": [\"primary\", \"ao\", \"ao\"]", "\"ao\"", 1, "each at most once, not \"ao\""},
+		{"\"kinds\": \"shadow\"", "\"shadow\"", 0, "'rays.kinds' must be an array"},
+		{"\"kinds\": [\"shadow\"]", "[\"shadow\"]", 0, "'rays.kinds' must name \"primary\""},
+		{"\"diffuse\": 0, \"kinds\": [\"primary\", \"diffuse\"]", "[\"primary\"", 0,
+		 "'rays.kinds' names \"diffuse\" but 'rays.diffuse' is 0"},
+		{"\"light\": [1, 2]", "[1, 2]", 0, "'rays.light' must be an array of 3 finite numbers"},
+		{"\"ao_length\": 0", "0 }", 0, "'rays.ao_length' must be"},
+		{"\"device\": \"0:x\"", "\"0:x\"", 0,
+		 "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or \"P:D\""},
+	};
+	for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+		char text[512];
+		snprintf(text, sizeof(text), "{ " SCENES ", " BUILDERS ", \"rays\": { %s } }",
+		         bad[i].rays);
+		EXPECT_ERROR_AT(text, bad[i].at, bad[i].n, bad[i].needle);
 	}
-	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"device\": \"0:x\" } }";
-	EXPECT_ERROR_AT(t, "\"0:x\"", 0, "'rays.device' must be \"auto\", \"gpu\", \"cpu\" or "
-	                "\"P:D\"");
+	struct config cfg;
+	bvhlab_error err = {""};
+	const char *t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"kinds\": [\"ao\", \"primary\", "
+	                "\"shadow\"], \"light\": [1, 2, 3], \"ao_length\": 0.25 } }";
+	CHECK_INT(load(&cfg, t, &err), 0);
+	CHECK(cfg.ray_kinds == (1u << RAY_PRIMARY | 1u << RAY_SHADOW | 1u << RAY_AO));
+	CHECK(cfg.has_light && cfg.ray_light[2] == 3.0f && cfg.ray_ao_length == 0.25);
+	config_finish(&cfg);
 }
 
 /* The device traversals: refused, naming the key, in a build without

@@ -19,40 +19,45 @@
 #define TRI_LANES 4 /* triangles per group */
 
 /*
- * 128 bytes, two cache lines. box[k] for k < 3 is the low bound on axis k,
- * box[3 + k] the high bound, for all four lanes. A lane with count 0 is an
- * inner child (child: its wide node), 0 < count < WIDE_EMPTY a leaf
- * (child: its first group of wide_bvh.tris, count its triangles), and
- * count WIDE_EMPTY an empty lane: its box is inverted, +inf to -inf, and
- * the traversal masks it out besides, since a ray with a NaN origin enters
- * every box.
+ * The layout at `lanes` lanes (4 here, 8 in trace_wide8.h), its types
+ * named node_name, tris_name and bvh_name, so that trace_wide_body.h
+ * serves both widths.
+ *
+ * node: 32 * lanes bytes. box[k] for k < 3 is the low bound on axis k,
+ * box[3 + k] the high bound, for all lanes. A lane with count 0 is an
+ * inner child (child: its node), 0 < count < WIDE_EMPTY a leaf (child: its
+ * first group of bvh.tris, count its triangles), and count WIDE_EMPTY an
+ * empty lane: its box is inverted, +inf to -inf, and the traversal masks
+ * it out besides, since a ray with a NaN origin enters every box.
+ *
+ * tris: up to `lanes` triangles of a leaf, one lane each, so the sign test
+ * of the triangle test runs on all at once: v[3 * j + k] is coordinate k
+ * of vertex j. prim holds the primitive ids of the lanes. A leaf's
+ * triangles take consecutive groups in slot order; lanes past the leaf's
+ * count and ids outside the scene have NaN vertices, which no ray hits.
+ *
+ * bvh: nodes[0] is the root; depth counts wide levels on the longest
+ * root-to-leaf path.
  */
 #define WIDE_EMPTY UINT32_MAX
 
-struct wide_node {
-	float box[6][WIDE];
-	uint32_t child[WIDE];
-	uint32_t count[WIDE];
-};
+#define WIDE_LAYOUT(node_name, tris_name, bvh_name, lanes) \
+	struct node_name {                                 \
+		float box[6][lanes];                       \
+		uint32_t child[lanes];                     \
+		uint32_t count[lanes];                     \
+	};                                                 \
+	struct tris_name {                                 \
+		float v[9][lanes];                         \
+		uint32_t prim[lanes];                      \
+	};                                                 \
+	struct bvh_name {                                  \
+		struct node_name *nodes;                   \
+		struct tris_name *tris;                    \
+		uint32_t node_count, tri_groups, depth;    \
+	}
 
-/*
- * Up to four triangles of a leaf, one lane each, so the sign test of the
- * triangle test runs on all four at once: v[3 * j + k] is coordinate k of
- * vertex j. prim holds the primitive ids of the lanes. A leaf's triangles
- * take consecutive groups in slot order; lanes past the leaf's count and
- * ids outside the scene have NaN vertices, which no ray hits.
- */
-struct wide_tris {
-	float v[9][TRI_LANES];
-	uint32_t prim[TRI_LANES];
-};
-
-struct wide_bvh {
-	struct wide_node *nodes; /* [0] is the root */
-	struct wide_tris *tris;
-	uint32_t node_count, tri_groups;
-	uint32_t depth; /* wide levels on the longest root-to-leaf path */
-};
+WIDE_LAYOUT(wide_node, wide_tris, wide_bvh, WIDE);
 
 /*
  * Collapses tree into *w: each wide node takes a binary inner node's two

@@ -16,23 +16,8 @@
 
 #define WIDE8 8
 
-/* 256 bytes, four cache lines. */
-struct wide8_node {
-	float box[6][WIDE8];
-	uint32_t child[WIDE8];
-	uint32_t count[WIDE8];
-};
-
-struct wide8_tris {
-	float v[9][WIDE8];
-	uint32_t prim[WIDE8];
-};
-
-struct wide8_bvh {
-	struct wide8_node *nodes; /* [0] is the root */
-	struct wide8_tris *tris;
-	uint32_t node_count, tri_groups, depth;
-};
+/* trace_wide.h's layout at 8 lanes: a node is 256 bytes, four cache lines. */
+WIDE_LAYOUT(wide8_node, wide8_tris, wide8_bvh, WIDE8);
 
 /* The 8-lane traversal of view->wide8, as trace_ray_wide (trace_kernel.h). */
 void trace_ray_wide8(const bvhlab_tree *tree, const bvhlab_scene *scene,
