@@ -20,6 +20,7 @@
 #include "harness/harness_measure.h"
 #include "harness/harness_memory.h"
 #include "harness/harness_rays.h"
+#include "harness/harness_report.h"
 #include "harness/harness_resume.h"
 #include "harness/harness_rounds.h"
 #include "harness/harness_scene.h"
@@ -51,36 +52,6 @@ struct harness {
 	struct harness_rounds rounds; /* this scene's trees waiting for them */
 	struct harness_anim anim; /* this scene's animation, frames 0 if none (harness_anim.c) */
 	struct scene_instanced inst; /* this scene's two-level form, if it has "instances" */
-};
-
-enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };
-
-/*
- * What one run's build series produces, sent back from its child as plain
- * bytes: the tree stays behind, only its measurements come back.
- */
-struct series_report {
-	uint32_t status;       /* enum series_status */
-	uint32_t sample_count; /* repeat, or 0 when the builds failed */
-	double cold_ms;        /* the first build */
-	bool validated;
-	struct tree_measure tree;
-	struct build_memory memory;
-	bool has_device;       /* a device builder's run: its device opened */
-	struct run_device device;
-	struct ray_metrics rays;
-	int heat_error, shade_error; /* writing the raw image files: 0 or -errno */
-	bool shade_written;
-	bool tree_written; /* the tree is in the job's tree_path */
-	uint32_t stage_count;
-	struct stage_metrics stages[HARNESS_MAX_STAGES];
-	uint32_t phase_count;
-	bvhlab_phase phases[BVHLAB_MAX_PHASES];
-	uint32_t frame_count;  /* frames done, after samples[] (an animated scene) */
-	struct results_two_level two_level; /* a two-level builder's run: its levels apart */
-	bool in_frames;        /* the frames began: a death after keeps the frames done */
-	char error[sizeof(((bvhlab_error *)0)->message)];
-	double samples[];      /* [repeat], then struct frame_metrics [frames] */
 };
 
 /* One run's build series, as handed to the child. */
@@ -289,49 +260,6 @@ out:
 	bvhlab_tree_finish(&s.tree);
 }
 
-/* A report from a child is checked before use: the child ran foreign code. */
-static void report_to_run(struct series_report *rep, uint32_t repeat, uint32_t frames,
-                          struct run_record *run)
-{
-	static const char *const names[] = {"ok", "invalid", "failed"};
-	rep->error[sizeof(rep->error) - 1] = '\0';
-	if (rep->status > SERIES_FAILED || rep->sample_count > repeat ||
-	    rep->stage_count > HARNESS_MAX_STAGES || rep->phase_count > BVHLAB_MAX_PHASES ||
-	    rep->frame_count > frames) {
-		run->status = "crashed";
-		run->error = "sent back a malformed report";
-		return;
-	}
-	run->status = names[rep->status];
-	run->error = rep->status != SERIES_OK ? rep->error : NULL;
-	run->samples_ms = rep->samples;
-	run->sample_count = rep->sample_count;
-	run->cold_ms = rep->cold_ms;
-	run->stats = rep->tree.has_stats ? &rep->tree.stats : NULL;
-	run->width = rep->tree.width;
-	run->epo = rep->tree.has_epo ? &rep->tree.epo : NULL;
-	run->memory = rep->memory.measured ? &rep->memory : NULL;
-	run->device = rep->has_device ? harness_memory_device_checked(&rep->device) : NULL;
-	run->validated = rep->validated;
-	run->valid = rep->tree.valid;
-	run->rays_checked = rep->tree.rays_checked;
-	run->mismatches = rep->tree.mismatches;
-	rep->rays.error[sizeof(rep->rays.error) - 1] = '\0';
-	rep->rays.device[sizeof(rep->rays.device) - 1] = '\0';
-	run->rays = rep->rays.measured || rep->rays.error[0] ? &rep->rays : NULL;
-	for (uint32_t k = 0; k < rep->stage_count; k++)
-		rep->stages[k].plugin[sizeof(rep->stages[k].plugin) - 1] = '\0';
-	run->stages = rep->stages;
-	run->stage_count = rep->stage_count;
-	for (uint32_t k = 0; k < rep->phase_count; k++)
-		rep->phases[k].name[sizeof(rep->phases[k].name) - 1] = '\0';
-	run->phases = rep->phases;
-	run->phase_count = rep->phase_count;
-	run->frames = (const struct frame_metrics *)(rep->samples + repeat);
-	run->frame_count = rep->frame_count;
-	run->two_level = rep->status == SERIES_OK ? harness_two_level_checked(&rep->two_level) : NULL;
-}
-
 /* Runs the series in a child (or here, with "isolate": false) and records it. */
 static void run_series(struct harness *h, struct series_job *job, struct run_record *run,
                        struct series_report *rep, size_t size)
@@ -352,11 +280,11 @@ static void run_series(struct harness *h, struct series_job *job, struct run_rec
 	run->load_other = machine_other_load(&m0, &m1);
 	run->load_read = true;
 	if (outcome == ISOLATE_REPORTED) {
-		report_to_run(rep, h->cfg->repeat, h->anim.frames, run);
+		harness_report_to_run(rep, h->cfg->repeat, h->anim.frames, run);
 	} else {
 		/* Dead among the frames: those done stay, the one that killed it is named. */
 		if (outcome > 0 && rep->in_frames) {
-			report_to_run(rep, h->cfg->repeat, h->anim.frames, run);
+			harness_report_to_run(rep, h->cfg->repeat, h->anim.frames, run);
 			harness_frames_death(job->hb->cb, rep->frame_count, why, sizeof(why));
 		}
 		run->status = outcome < 0 ? "failed" : outcomes[outcome];
