@@ -4,20 +4,20 @@
 Usage: bench/peers_table.py RESULTS_DIR [--scene NAME | --summary]
 
 RESULTS_DIR holds the run's results.json and the report.md that bvhlab
-wrote beside it. Prints Markdown:
+wrote beside it (--summary reads results.json alone). Prints Markdown:
 
-  1. per scene, one row per builder: build ms, SAH cost and primary nodes
+  1. per scene, one row per builder: build ms (own_ms, as in 2), SAH cost and primary nodes
      per ray at 1 and 2 threads, and whether the run is on the Pareto front
      of time x SAH, as the report's "Pareto fronts" table says (the front
      is the report's own verdict, read from report.md, not recomputed);
   2. per scene and thread count, every peer run (plugins tinybvh, bvh2,
      embree) against the fastest bvhlab run whose SAH cost is no higher,
-     with the peer's time taken without its `input` and `convert` phases
-     (making the library's input from bvhlab's scene, writing its tree in
-     bvhlab's layout: what is left is the library's own build, the
-     strictest reading): the ratio, and whether it is at
-     most 0.9. A peer run that failed validation has nothing to beat and
-     is listed with its reason.
+     every time the run's own_ms as the report's fronts take it (build_ms
+     without the phases `input` and `convert`: making the library's input
+     from bvhlab's scene, writing its tree in bvhlab's layout; what is left
+     is the library's own build, the strictest reading): the ratio, and
+     whether it is at most 0.9. A peer run that failed validation has
+     nothing to beat and is listed with its reason.
 
 With --summary, only one line per scene and thread count: how many valid
 peer runs are dominated at <= 0.9x, and the highest ratio (the closest
@@ -32,9 +32,13 @@ import sys
 PEERS = ("tinybvh", "bvh2", "embree")
 
 
-def load(path):
+def load(path, summary):
+    """results.json, and report.md beside it (not needed with --summary,
+    which reads results.json alone)."""
     with open(os.path.join(path, "results.json")) as f:
         results = json.load(f)
+    if summary:
+        return results, ""
     with open(os.path.join(path, "report.md")) as f:
         report = f.read()
     return results, report
@@ -92,7 +96,7 @@ def scene_table(runs, fronts, scene):
             short = "**front**" if verdict == "front" else (
                 "dominated by " + verdict.split("dominated by ")[1].split(" (")[0]
                 if "dominated by" in verdict else verdict)
-            cells += [fmt_ms(r["build_ms"]["median"]), f"{r['tree']['sah_cost']:.3f}"]
+            cells += [fmt_ms(own_ms(r)), f"{r['tree']['sah_cost']:.3f}"]
             if t == 1:
                 cells.append(f"{r['rays']['primary']['nodes_per_ray']:.1f}")
             cells.append(short)
@@ -101,10 +105,14 @@ def scene_table(runs, fronts, scene):
 
 
 def own_ms(run):
-    """The library's own time: build_ms without the input and convert
-    phases (bvhlab's cost, as bench/peers-standalone/compare.py takes it)."""
-    phases = run.get("build_phases", {})
-    return run["build_ms"]["median"] - phases.get("input", 0.0) - phases.get("convert", 0.0)
+    """The build time the report's fronts and verdicts compare: results.json's
+    own_ms (build_ms's median less the phases `input` and `convert`, the
+    harness's translation to and from a library's formats; defined once, in
+    core/output/results_stages.c)."""
+    if "own_ms" not in run:
+        sys.exit(f"peers_table: run {run.get('id')} has no own_ms: results.json is older "
+                 "than it (rerun the sweep)")
+    return run["own_ms"]
 
 
 def comparisons(runs, scenes):
@@ -122,9 +130,9 @@ def comparisons(runs, scenes):
                 if p["status"] == "ok":
                     sah = p["tree"]["sah_cost"]
                     c["best"] = min((r for r in ours if r["tree"]["sah_cost"] <= sah),
-                                    key=lambda r: r["build_ms"]["median"], default=None)
+                                    key=own_ms, default=None)
                     if c["best"] is not None:
-                        c["ratio"] = c["best"]["build_ms"]["median"] / own_ms(p)
+                        c["ratio"] = own_ms(c["best"]) / own_ms(p)
                 yield c
 
 
@@ -146,7 +154,7 @@ def verdicts(runs, scenes):
         if best is None:
             out.append(f"{head} none | | | | **no** |")
             continue
-        out.append(f"{head} {best['builder']} | {fmt_ms(best['build_ms']['median'])} | "
+        out.append(f"{head} {best['builder']} | {fmt_ms(own_ms(best))} | "
                    f"{best['tree']['sah_cost']:.3f} | {c['ratio']:.2f} | {'yes' if met(c) else '**no**'} |")
     out.append("")
     out.append(f"Peer runs not dominated at <= 0.9x: {misses}.")
@@ -168,7 +176,7 @@ def summary(runs, scenes):
             close = (f"{worst['peer']['builder']}: none with SAH <=" if worst["best"] is None else
                      f"{worst['ratio']:.2f}: {worst['peer']['builder']} "
                      f"({fmt_ms(own_ms(worst['peer']))} ms, SAH {worst['peer']['tree']['sah_cost']:.3f}), "
-                     f"{worst['best']['builder']} ({fmt_ms(worst['best']['build_ms']['median'])} ms, "
+                     f"{worst['best']['builder']} ({fmt_ms(own_ms(worst['best']))} ms, "
                      f"SAH {worst['best']['tree']['sah_cost']:.3f})")
             out.append(f"| {scene} | {t} | {len(cs)} | {sum(map(met, cs))} | {close} |")
     return out
@@ -182,7 +190,7 @@ def main():
                     help="only one line per scene and thread count: peers dominated, the closest call")
     args = ap.parse_args()
     try:
-        results, report = load(args.results_dir)
+        results, report = load(args.results_dir, args.summary)
     except OSError as e:
         sys.exit(f"peers_table: {e}")
     runs = results["runs"]

@@ -13,6 +13,7 @@
 #include <cJSON.h>
 
 #include "output/report.h"
+#include "output/results.h"
 #include "testutil.h"
 
 static void test_front_points(void)
@@ -529,6 +530,32 @@ static void test_budget(void)
 	cJSON_Delete(doc);
 }
 
+/* Fronts and verdicts compare a build's own time: a peer whose whole call
+ * (2.5 ms) is slower than lbvh's 2 ms, but whose library took 1.0 of it
+ * (input 1.0 and convert 0.5 are bvhlab's translation), dominates lbvh at
+ * a lower SAH; upload, a device builder's own work, is not taken out. */
+static void test_own_time(void)
+{
+	cJSON *doc = cJSON_Parse(
+		"{\"machine\": {\"cpu\": \"test\", \"cores\": 2, \"threads_available\": 2}, "
+		"\"config\": {}, \"scenes\": [{\"name\": \"s\", \"triangles\": 100}], "
+		"\"runs\": []}");
+	cJSON *runs = cJSON_GetObjectItem(doc, "runs");
+	add_run(runs, "ours", "lbvh", 1, (double[]){2, 2, 2}, 50, 12, 10, 5);
+	add_run(runs, "peer", "tinybvh", 1, (double[]){2.5, 2.5, 2.5}, 45, 12, 10, 5);
+	cJSON *peer = cJSON_GetArrayItem(runs, 1);
+	cJSON_AddItemToObject(peer, "build_phases",
+	                      cJSON_Parse("{\"input\": 1.0, \"upload\": 0.25, \"convert\": 0.5}"));
+	CHECK(fabs(results_own_ms(peer) - 1.0) < 1e-12);
+	CHECK(fabs(results_own_ms(cJSON_GetArrayItem(runs, 0)) - 2.0) < 1e-12);
+	char *md = report_markdown(doc);
+	CHECK_CONTAINS(md, "| ours | 1 | 2.00 | 50.000 | dominated by peer (0.50× time, −10.0 % SAH) ");
+	CHECK_CONTAINS(md, "| peer | 1 | 1.00 | 45.000 | front |");
+	CHECK_CONTAINS(md, "dominated on 1 of 1 scene by peer |");
+	free(md);
+	cJSON_Delete(doc);
+}
+
 int main(void)
 {
 	test_front_points();
@@ -543,5 +570,6 @@ int main(void)
 	test_whole_ticks();
 	test_off_chart();
 	test_budget();
+	test_own_time();
 	return test_finish();
 }

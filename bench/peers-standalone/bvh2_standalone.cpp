@@ -14,6 +14,7 @@
 #include <bvh/v2/thread_pool.h>
 #include <bvh/v2/tri.h>
 
+#include <cstdio>
 #include <memory>
 #include <vector>
 
@@ -75,6 +76,11 @@ int main(int argc, char **argv)
 	bvhlab_scene *scene;
 	if (int rc = sa_start(argc, argv, "low|medium|high|sweep|binned", "medium", &a, &scene))
 		return rc;
+	if (a.input_each >= 0) {
+		std::fprintf(stderr, "bvh2-standalone: --input is tinybvh-standalone's only\n");
+		bvhlab_scene_destroy(scene);
+		return 2;
+	}
 	Job job;
 	inputs(scene, job);
 	bvhlab_scene_destroy(scene);

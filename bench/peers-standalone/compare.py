@@ -17,9 +17,10 @@ alone twice: with callbacks of its tutorial's kind, and with the plugin's
 own (--callbacks plugin: high clips triangles exactly), so the callbacks'
 share shows apart from the harness's.
 
-The in-harness time is the library's: the median build_ms less the
-median `input` (the library's input made from bvhlab's scene) and
-`convert` (its tree written in bvhlab's layout) phases. The standalone
+The in-harness time is the library's: results.json's own_ms, the median
+build_ms less the median `input` (the library's input made from
+bvhlab's scene) and `convert` (its tree written in bvhlab's layout)
+phases, as the report's fronts take it. The standalone
 time is the median of the build call alone. Prints a Markdown table with
 the CPU model, the ratio in-harness / standalone per builder.
 
@@ -113,7 +114,7 @@ def harness(args, plugin, variant, threads, folder):
         return None, f"{run['status']}: {run.get('error', '')}", {}, results["machine"]["cpu"]
     phases = run.get("build_phases", {})
     whole = run["build_ms"]["median"]
-    own = whole - phases.get("input", 0.0) - phases.get("convert", 0.0)
+    own = run["own_ms"]  # less input and convert, as the report's fronts take it
     return own, whole, phases, results["machine"]["cpu"]
 
 

@@ -172,6 +172,11 @@ int main(int argc, char **argv)
 	int rc = sa_start(argc, argv, "low|medium|high", "medium", &a, &scene);
 	if (rc)
 		return rc;
+	if (a.input_each >= 0) { /* its array is refilled before every build anyway */
+		fprintf(stderr, "embree-standalone: --input is tinybvh-standalone's only\n");
+		bvhlab_scene_destroy(scene);
+		return 2;
+	}
 	if (!a.callbacks)
 		a.callbacks = "tutorial";
 	char config[64];

@@ -18,7 +18,7 @@
 static int usage(const char *prog, const char *variants)
 {
 	fprintf(stderr, "usage: %s SCENE [--subdivide K] [--threads N] [--repeat N] "
-	        "[--warmup N] [--variant %s] [--callbacks tutorial|plugin]\n", prog, variants);
+	        "[--warmup N] [--variant %s] [--callbacks tutorial|plugin] [--input once|each]\n", prog, variants);
 	return -1;
 }
 
@@ -45,7 +45,8 @@ static int number(const char *s, unsigned lo, unsigned hi, unsigned *out)
 
 static int parse(int argc, char **argv, const char *variants, const char *def, sa_args *a)
 {
-	*a = (sa_args){.variant = def, .callbacks = NULL, .threads = 1, .repeat = 5, .warmup = 1};
+	*a = (sa_args){.variant = def, .callbacks = NULL, .input_each = -1, .threads = 1, .repeat = 5,
+	               .warmup = 1};
 	for (int i = 1; i < argc; i++) {
 		const char *k = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
 		int bad = 0;
@@ -68,6 +69,8 @@ static int parse(int argc, char **argv, const char *variants, const char *def, s
 			bad = index_in(v, variants) < 0, a->variant = v;
 		else if (strcmp(k, "--callbacks") == 0)
 			bad = index_in(v, "tutorial|plugin") < 0, a->callbacks = v;
+		else if (strcmp(k, "--input") == 0)
+			a->input_each = index_in(v, "once|each"), bad = a->input_each < 0;
 		else
 			bad = 1;
 		if (bad)

@@ -6,7 +6,7 @@
  * own benchmarks do; compare.sh runs them beside the in-harness plugins.
  *
  *   PROGRAM SCENE [--subdivide K] [--threads N] [--repeat N] [--warmup N]
- *           [--variant NAME] [--callbacks tutorial|plugin]
+ *           [--variant NAME] [--callbacks tutorial|plugin] [--input once|each]
  *
  * prints one line: "LIB VARIANT [callbacks=C] threads=N wall_ms=MEDIAN
  * cpu_ms=MEDIAN min_ms=MIN repeats=N" (cpu_ms: the process's CPU time over
@@ -25,6 +25,10 @@ typedef struct sa_args {
 	int which;           /* its index in the program's list of variants */
 	const char *callbacks; /* embree only: "tutorial" (its kind, the default) or
 	                        * "plugin" (the plugin's); NULL when not given */
+	int input_each; /* tinybvh only. --input each (1): the library's input
+	                 * remade, untimed, before every build (as the plugin makes
+	                 * it in its build call, phase "input"); once (0): made
+	                 * once; -1 when not given (once) */
 	unsigned subdivide, threads, repeat, warmup;
 } sa_args;
 

@@ -22,17 +22,25 @@ using tinybvh::bvhvec4;
 struct Job {
 	BVH bvh;
 	std::vector<bvhvec4> soup;
-	int variant; // Variant
+	const bvhlab_scene *scene; // kept for --input each
+	int variant;               // Variant
 };
 
-std::vector<bvhvec4> soup_of(const bvhlab_scene *s)
+void soup_of(const bvhlab_scene *s, std::vector<bvhvec4> &v)
 {
-	std::vector<bvhvec4> v(3 * static_cast<size_t>(s->triangle_count));
+	v.resize(3 * static_cast<size_t>(s->triangle_count));
 	for (size_t k = 0; k < v.size(); k++) {
 		const float *p = &s->vertices[3 * static_cast<size_t>(s->indices[k])];
 		v[k] = bvhvec4(p[0], p[1], p[2], 0.0f);
 	}
-	return v;
+}
+
+// --input each: the soup rewritten before every build, untimed.
+int refill(void *user)
+{
+	Job &j = *static_cast<Job *>(user);
+	soup_of(j.scene, j.soup);
+	return 0;
 }
 
 // By index in the program's list of variants (main).
@@ -62,14 +70,16 @@ int main(int argc, char **argv)
 	if (int rc = sa_start(argc, argv, "quick|binned|avx|sweep|hq", "avx", &a, &scene))
 		return rc;
 	Job job;
-	job.soup = soup_of(scene);
+	soup_of(scene, job.soup);
+	job.scene = scene;
 	job.variant = a.which;
-	bvhlab_scene_destroy(scene);
 	job.bvh.threadedBuild = a.threads > 1;
 	tbvh::CpuLimit cpus;
 	if (a.threads > 1 && cpus.limit(a.threads) < 0) {
 		std::perror("sched_setaffinity");
 		return 1;
 	}
-	return sa_time("tinybvh", &a, nullptr, build, &job) < 0 ? 1 : 0;
+	int rc = sa_time("tinybvh", &a, a.input_each == 1 ? refill : nullptr, build, &job);
+	bvhlab_scene_destroy(scene);
+	return rc < 0 ? 1 : 0;
 }

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "output/report.h"
+#include "output/results.h"
 
 size_t report_budget_intervals(const double *build, const double *ray, size_t n,
                                struct budget_interval *out)
@@ -72,7 +73,7 @@ static int group_init(struct budget_group *g, const struct front_entry *e, size_
 	for (size_t k = 0; k < n; k++) {
 		bool ok = strcmp(report_str(e[k].run, "status"), "ok") == 0;
 		double mrays = report_num(e[k].run, "rays.primary.mrays_per_s");
-		g->build[k] = ok ? report_num(e[k].run, "build_ms.median") / 1e3 : NAN;
+		g->build[k] = ok ? results_own_ms(e[k].run) / 1e3 : NAN;
 		g->ray[k] = ok && mrays > 0 ? 1 / (mrays * 1e6) : NAN;
 		g->traced |= isfinite(g->build[k]) && isfinite(g->ray[k]);
 		p[k] = (struct front_point){g->build[k], g->ray[k], 0};

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "output/report.h"
+#include "output/results.h"
 
 /* Figures this close count as equal: a parallel build summing in another
  * order, or a tree that differs in a leaf, is not a better tree, and a
@@ -187,7 +188,7 @@ void report_entries_front(const struct front_entry *e, size_t m, int view,
 {
 	for (size_t k = 0; k < m; k++) {
 		bool ok = strcmp(report_str(e[k].run, "status"), "ok") == 0;
-		p[k] = (struct front_point){ok ? report_num(e[k].run, "build_ms.median") : NAN,
+		p[k] = (struct front_point){ok ? results_own_ms(e[k].run) : NAN,
 		                            report_front_figure(view, e[k].run),
 		                            report_front_group(e[k].machine, e[k].threads)};
 	}
@@ -280,7 +281,10 @@ static const char intro[] =
 	"fastest builder on the front that dominates it, its build time as a multiple of "
 	"this one's and the change in the figure. A builder that ran on 1 thread only "
 	"competes with its 1-thread run at every thread count; a device builder's runs "
-	"(OpenCL) compete among themselves, as \"device: NAME\".";
+	"(OpenCL) compete among themselves, as \"device: NAME\". Build time here is a build's "
+	"own (results.json's own_ms): the median less its phases input and convert, where a "
+	"builder translates bvhlab's input into its own format and its tree into bvhlab's "
+	"(a peer library, a device builder), which a user of its library does not pay.";
 
 void report_front_md(struct strbuf *sb, const struct report_index *ix,
                      const cJSON *const *runs, size_t n)

@@ -274,6 +274,14 @@ struct cJSON *results_rays_json(const struct ray_metrics *m);
 /* "build_phases": {"upload": ms, "device": ms, ...} (results_stages.c). */
 struct cJSON *results_phases_json(const bvhlab_phase *phases, uint32_t count);
 
+/* A run's build time of record ("own_ms" in results.json; fronts and
+ * dominance verdicts compare it): build_ms.median less the medians of the
+ * phases "input" and "convert", which a builder reports for translating
+ * bvhlab's input into its own format and its tree into the standard
+ * layout (the peer libraries; the device builders' conversion). NAN when
+ * the run has no build_ms. */
+double results_own_ms(const struct cJSON *run);
+
 /* "stages": [{"plugin", "ms", "sah_before", "sah_after"}, ...] (results_stages.c). */
 struct cJSON *results_stages_json(const struct stage_metrics *stages, uint32_t count);
 

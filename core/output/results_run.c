@@ -194,6 +194,8 @@ cJSON *results_run_json(const struct run_record *run)
 	if (run->phase_count)
 		cJSON_AddItemToObject(o, "build_phases",
 		                      results_phases_json(run->phases, run->phase_count));
+	if (run->sample_count)
+		cJSON_AddNumberToObject(o, "own_ms", results_own_ms(o));
 	if (run->stage_count)
 		cJSON_AddItemToObject(o, "stages", results_stages_json(run->stages, run->stage_count));
 	if (run->stats)

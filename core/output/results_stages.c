@@ -5,8 +5,11 @@
  * the SAH cost of the tree just before and after it, on the last repeat;
  * and the "build_phases" member of a run whose builder reported phases of
  * its build (ABI 1.3): each phase's median over the timed repeats, part of
- * build_ms too.
+ * build_ms too; and "own_ms", the build time fronts and verdicts compare.
  */
+#include <math.h>
+#include <string.h>
+
 #include <cJSON.h>
 
 #include "output/results.h"
@@ -33,4 +36,26 @@ cJSON *results_phases_json(const bvhlab_phase *phases, uint32_t count)
 	for (uint32_t k = 0; o && k < count; k++)
 		cJSON_AddNumberToObject(o, phases[k].name, phases[k].ms);
 	return o;
+}
+
+/* The phases that translate between bvhlab's layouts and a builder's own
+ * (a peer library's input made from the host's, its tree written in the
+ * standard layout): harness work a user of the library never pays. */
+static const char *const translation_phases[] = {"input", "convert"};
+
+double results_own_ms(const cJSON *run)
+{
+	const cJSON *t = cJSON_GetObjectItemCaseSensitive(run, "build_ms");
+	const cJSON *med = cJSON_GetObjectItemCaseSensitive(t, "median");
+	const cJSON *phases = cJSON_GetObjectItemCaseSensitive(run, "build_phases");
+	if (!cJSON_IsNumber(med))
+		return NAN;
+	double ms = med->valuedouble;
+	for (size_t k = 0; k < sizeof(translation_phases) / sizeof(*translation_phases); k++) {
+		const cJSON *p = cJSON_GetObjectItemCaseSensitive(phases, translation_phases[k]);
+		if (cJSON_IsNumber(p))
+			ms -= p->valuedouble;
+	}
+	/* Each phase's median is taken apart from the whole's: never below 0. */
+	return ms > 0 ? ms : 0;
 }

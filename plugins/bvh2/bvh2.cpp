@@ -13,6 +13,8 @@
 // Threads: the pool (bvh::v2::ThreadPool) has exactly input->threads
 // workers; the calling thread only waits while they run, so at most
 // input->threads threads work at a time. At 1 thread no pool is made.
+// The pool is kept between builds (Kept, below), as the library's own
+// benchmark makes one pool for all its builds.
 //
 // The inputs are the host's boxes and centroids, copied into the
 // library's types (phase "input"); its tree is turned into the standard
@@ -29,10 +31,12 @@
 #include <chrono>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <new>
-#include <optional>
 #include <system_error>
 #include <vector>
+
+#include <sched.h>
 
 #include <bvhlab/builder.hpp>
 
@@ -159,12 +163,49 @@ struct View {
 	}
 };
 
+// What a run's builds share, as the harness keeps a builder's output
+// between repeats: the library's input arrays (refilled, not remade) and
+// the thread pool. Starting and joining the workers on every build
+// put thread starts, and the first touches of their stacks and malloc
+// arenas, inside the timed call where the library's benchmark has none.
+// Its workers took the CPU mask of the thread that made it, so it is
+// remade when the thread count or the caller's mask changes; it is joined
+// when the plugin is unloaded (or at exit). The lock serialises builds in
+// one process (the tests'), as tinybvh's and embree's keeps do.
+struct Kept {
+	std::mutex lock;
+	std::unique_ptr<bvh::v2::ThreadPool> pool;
+	size_t threads = 0;
+	cpu_set_t mask;
+	std::vector<BBox> boxes;
+	std::vector<Vec3> centers;
+};
+Kept kept;
+
+// The kept pool of `threads` workers on the caller's CPUs, made if needed.
+bvh::v2::ThreadPool &pool_for(size_t threads)
+{
+	cpu_set_t mask;
+	CPU_ZERO(&mask);
+	sched_getaffinity(0, sizeof(mask), &mask);
+	if (!kept.pool || kept.threads != threads || !CPU_EQUAL(&mask, &kept.mask)) {
+		kept.pool.reset(); // joins the old workers first
+		kept.pool = std::make_unique<bvh::v2::ThreadPool>(threads);
+		kept.threads = threads;
+		kept.mask = mask;
+	}
+	return *kept.pool;
+}
+
 int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
                const Settings &s, bvhlab_build_output *out)
 {
+	std::lock_guard<std::mutex> hold(kept.lock);
 	auto t0 = clk::now();
-	std::vector<BBox> boxes(in->prim_count);
-	std::vector<Vec3> centers(in->prim_count);
+	std::vector<BBox> &boxes = kept.boxes;
+	std::vector<Vec3> &centers = kept.centers;
+	boxes.resize(in->prim_count);
+	centers.resize(in->prim_count);
 	for (size_t i = 0; i < in->prim_count; i++) {
 		const bvhlab_aabb &b = in->prim_bounds[i];
 		const float *c = &in->centroids[3 * i];
@@ -174,11 +215,8 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
 	// sweep and binned are single-threaded: a pool only for what uses one.
 	bool top_down = s.builder == sweep || s.builder == binned;
-	std::optional<bvh::v2::ThreadPool> pool;
-	if ((in->threads > 1 || s.one_thread == pool_of_one) && (!top_down || s.reinsertion))
-		pool.emplace(in->threads);
-	Bvh bvh = run_builder(s, pool ? &*pool : nullptr, boxes, centers);
-	pool.reset(); // joins the workers inside the call
+	bool pooled = (in->threads > 1 || s.one_thread == pool_of_one) && (!top_down || s.reinsertion);
+	Bvh bvh = run_builder(s, pooled ? &pool_for(in->threads) : nullptr, boxes, centers);
 	return peer::convert(host, ctx, View{bvh}, out);
 }
 

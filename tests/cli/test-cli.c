@@ -55,7 +55,8 @@ static const char good_config[] =
 	"                { \"plugin\": \"fake_good\", \"options\": { \"phases\": \"two\" } } ] }\n";
 
 /* fake_good reports upload twice (1 + 0.5 ms) and device (2.5 ms) in every
- * build: build_phases holds their medians, sah_seq's runs have none. */
+ * build: build_phases holds their medians, sah_seq's runs have none; own_ms
+ * is build_ms's median, as neither is a translation phase. */
 static void check_phases(const cJSON *doc, const char *csv)
 {
 	const cJSON *run;
@@ -71,6 +72,10 @@ static void check_phases(const cJSON *doc, const char *csv)
 		CHECK(!strcmp(cJSON_GetArrayItem(ph, 0)->string, "upload"));
 		CHECK(cJSON_GetObjectItem(ph, "upload")->valuedouble == 1.5);
 		CHECK(cJSON_GetObjectItem(ph, "device")->valuedouble == 2.5);
+		/* own_ms takes out input and convert only: a device's upload stays. */
+		const cJSON *t = cJSON_GetObjectItem(run, "build_ms");
+		CHECK(cJSON_GetObjectItem(run, "own_ms")->valuedouble ==
+		      cJSON_GetObjectItem(t, "median")->valuedouble);
 	}
 	CHECK_INT(with, 2); /* fake_good is not PARALLEL: one run per scene */
 	CHECK_CONTAINS(csv, ",build_phases,error\n");
