@@ -48,43 +48,52 @@ static cJSON *document(bool three)
 	return doc;
 }
 
+/* A document (document(three)) and both reports of it. */
+struct rendered {
+	cJSON *doc;
+	char *md, *html;
+};
+
+static struct rendered render(bool three)
+{
+	cJSON *doc = document(three);
+	return (struct rendered){doc, report_markdown(doc), report_html(doc)};
+}
+
+static void rendered_free(struct rendered *r)
+{
+	free(r->md);
+	free(r->html);
+	cJSON_Delete(r->doc);
+}
+
 static void test_scale_section(void)
 {
-	cJSON *doc = document(true);
-	char *md = report_markdown(doc), *html = report_html(doc);
-	CHECK_CONTAINS(md, "## Cost per triangle against N");
-	CHECK_CONTAINS(md, "| lbvh | 2 | mesh.ply | 100000 | 20.0 | 60.0 | 3.00 | 150.0 | 0.80 |");
-	CHECK_CONTAINS(md, "| lbvh | 2 | mesh.ply | 1000000 | 25.0 | 75.0 | 3.00 | 140.0 | 1.00 |");
-	CHECK_CONTAINS(md, "| lbvh | 2 | mesh.ply | 16000000 | 50.0 | 150.0 | 3.00 | 142.0 | 2.00 |");
-	CHECK_CONTAINS(md, "| lbvh | 2 | other.obj | 2000000 | 30.0 | 90.0 | 3.00 | 141.0 | 1.00 |");
-	CHECK_CONTAINS(html, "<h2>Cost per triangle against N</h2>");
-	CHECK_CONTAINS(html, "lbvh: ns per triangle");
-	CHECK_CONTAINS(html, "triangles (log scale)"); /* 100 k to 16 M */
-	free(md);
-	free(html);
-	cJSON_Delete(doc);
-	doc = document(false); /* two sizes at most: not a scaling sweep */
-	md = report_markdown(doc);
-	html = report_html(doc);
-	CHECK(md && !strstr(md, "Cost per triangle against N"));
-	CHECK(html && !strstr(html, "Cost per triangle against N"));
-	free(md);
-	free(html);
-	cJSON_Delete(doc);
+	struct rendered r = render(true);
+	CHECK_CONTAINS(r.md, "## Cost per triangle against N");
+	CHECK_CONTAINS(r.md, "| lbvh | 2 | mesh.ply | 100000 | 20.0 | 60.0 | 3.00 | 150.0 | 0.80 |");
+	CHECK_CONTAINS(r.md, "| lbvh | 2 | mesh.ply | 1000000 | 25.0 | 75.0 | 3.00 | 140.0 | 1.00 |");
+	CHECK_CONTAINS(r.md, "| lbvh | 2 | mesh.ply | 16000000 | 50.0 | 150.0 | 3.00 | 142.0 | 2.00 |");
+	CHECK_CONTAINS(r.md, "| lbvh | 2 | other.obj | 2000000 | 30.0 | 90.0 | 3.00 | 141.0 | 1.00 |");
+	CHECK_CONTAINS(r.html, "<h2>Cost per triangle against N</h2>");
+	CHECK_CONTAINS(r.html, "lbvh: ns per triangle");
+	CHECK_CONTAINS(r.html, "triangles (log scale)"); /* 100 k to 16 M */
+	rendered_free(&r);
+	r = render(false); /* two sizes at most: not a scaling sweep */
+	CHECK(r.md && !strstr(r.md, "Cost per triangle against N"));
+	CHECK(r.html && !strstr(r.html, "Cost per triangle against N"));
+	rendered_free(&r);
 }
 
 static void test_memory_table(void)
 {
-	cJSON *doc = document(false);
-	char *md = report_markdown(doc), *html = report_html(doc);
-	CHECK_CONTAINS(md, "### Memory per triangle");
-	CHECK_CONTAINS(md, "are 54.0 bytes per triangle (5.1 MiB)");
-	CHECK_CONTAINS(md, "| lbvh | 2 | 86.0 | 140.0 | 200.0 |");
-	CHECK_CONTAINS(html, "<h3>Memory per triangle</h3>");
-	CHECK_CONTAINS(html, "<td>86.0</td><td>140.0</td><td>200.0</td>");
-	free(md);
-	free(html);
-	cJSON_Delete(doc);
+	struct rendered r = render(false);
+	CHECK_CONTAINS(r.md, "### Memory per triangle");
+	CHECK_CONTAINS(r.md, "are 54.0 bytes per triangle (5.1 MiB)");
+	CHECK_CONTAINS(r.md, "| lbvh | 2 | 86.0 | 140.0 | 200.0 |");
+	CHECK_CONTAINS(r.html, "<h3>Memory per triangle</h3>");
+	CHECK_CONTAINS(r.html, "<td>86.0</td><td>140.0</td><td>200.0</td>");
+	rendered_free(&r);
 }
 
 int main(void)

@@ -94,18 +94,23 @@ const struct config_key config_scene_keys[] = {
 	END,
 };
 
+/* The keys that say where a part's or a mesh's triangles come from: both
+ * structs keep them in a `src` (a struct config_scene). */
+#define SOURCE_KEYS(K) \
+	K("path", CONFIG_STRING, src.path, 0, 0, 0), \
+	K("generator", CONFIG_STRING, src.generator, 0, 0, 0), \
+	K("frequency", CONFIG_U32, src.gen.frequency, 1, UINT32_MAX, CONFIG_GENERATED), \
+	K("count", CONFIG_U32, src.gen.count, 1, UINT32_MAX, CONFIG_GENERATED), \
+	K("size", CONFIG_U32, src.gen.size, 1, UINT32_MAX, CONFIG_GENERATED), \
+	K("seed", CONFIG_U64, src.gen.seed, 0, UINT64_MAX, CONFIG_GENERATED), \
+	K("width", CONFIG_POSITIVE, src.gen.width, 0, 0, CONFIG_GENERATED), \
+	K("subdivide", CONFIG_U32, src.subdivide, 0, MAX_SUBDIVIDE, 0)
+
 /* One of a composite scene's "parts": a scene's source keys, and where it goes. */
 #define PART(name, kind, field, min, max, flags) \
 	KEY(struct config_part, name, kind, field, min, max, flags)
 const struct config_key config_part_keys[] = {
-	PART("path", CONFIG_STRING, src.path, 0, 0, 0),
-	PART("generator", CONFIG_STRING, src.generator, 0, 0, 0),
-	PART("frequency", CONFIG_U32, src.gen.frequency, 1, UINT32_MAX, CONFIG_GENERATED),
-	PART("count", CONFIG_U32, src.gen.count, 1, UINT32_MAX, CONFIG_GENERATED),
-	PART("size", CONFIG_U32, src.gen.size, 1, UINT32_MAX, CONFIG_GENERATED),
-	PART("seed", CONFIG_U64, src.gen.seed, 0, UINT64_MAX, CONFIG_GENERATED),
-	PART("width", CONFIG_POSITIVE, src.gen.width, 0, 0, CONFIG_GENERATED),
-	PART("subdivide", CONFIG_U32, src.subdivide, 0, MAX_SUBDIVIDE, 0),
+	SOURCE_KEYS(PART),
 	PART("scale", CONFIG_POSITIVE, xf.scale, 0, 0, 0),
 	CUSTOM("rotate"),    /* degrees, doubles: config_parts.c */
 	CUSTOM("translate"),
@@ -120,14 +125,7 @@ const struct config_key config_part_keys[] = {
 	KEY(struct config_mesh, name, kind, field, min, max, flags)
 const struct config_key config_mesh_keys[] = {
 	MESH("name", CONFIG_STRING, name, 0, 0, 0),
-	MESH("path", CONFIG_STRING, src.path, 0, 0, 0),
-	MESH("generator", CONFIG_STRING, src.generator, 0, 0, 0),
-	MESH("frequency", CONFIG_U32, src.gen.frequency, 1, UINT32_MAX, CONFIG_GENERATED),
-	MESH("count", CONFIG_U32, src.gen.count, 1, UINT32_MAX, CONFIG_GENERATED),
-	MESH("size", CONFIG_U32, src.gen.size, 1, UINT32_MAX, CONFIG_GENERATED),
-	MESH("seed", CONFIG_U64, src.gen.seed, 0, UINT64_MAX, CONFIG_GENERATED),
-	MESH("width", CONFIG_POSITIVE, src.gen.width, 0, 0, CONFIG_GENERATED),
-	MESH("subdivide", CONFIG_U32, src.subdivide, 0, MAX_SUBDIVIDE, 0),
+	SOURCE_KEYS(MESH),
 	END,
 };
 

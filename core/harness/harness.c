@@ -229,8 +229,7 @@ static void series_work(void *arg, void *report, size_t size)
 	rep->status = SERIES_OK;
 	if (job->hb->top.plugin) { /* two-level (harness_two_level.c): status in the same order */
 		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst, job->run->key.threads,
-		                                    rep->samples, &rep->cold_ms, &rep->tree, &rep->two_level,
-		                                    &rep->sample_count, &rep->validated, &err);
+		                                    rep, &err);
 		goto out;
 	}
 	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);

@@ -2,6 +2,7 @@
  * A run's report from its child, into the run's record (harness_report.h).
  */
 #include "harness/harness_report.h"
+#include "harness/harness_two_level.h"
 
 /* A report from a child is checked before use: the child ran foreign code. */
 void harness_report_to_run(struct series_report *rep, uint32_t repeat, uint32_t frames,

@@ -15,7 +15,6 @@
 #include "harness/harness_memory.h"
 #include "harness/harness_rays.h"
 #include "harness/harness_series.h"
-#include "harness/harness_two_level.h"
 #include "output/results.h"
 
 enum series_status { SERIES_OK, SERIES_INVALID, SERIES_FAILED };

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "harness/harness_report.h"
 #include "harness/harness_series.h"
 #include "harness/harness_two_level.h"
 #include "trace/trace_instances.h"
@@ -202,11 +203,7 @@ void harness_two_level_finish(struct two_level_trees *trees)
 enum tree_verdict harness_two_level_run(const struct config *cfg,
                                         const struct harness_builder *hb,
                                         const struct scene_instanced *inst, uint32_t threads,
-                                        double *samples_ms, double *cold_ms,
-                                        struct tree_measure *whole,
-                                        struct results_two_level *levels,
-                                        uint32_t *sample_count, bool *validated,
-                                        bvhlab_error *err)
+                                        struct series_report *rep, bvhlab_error *err)
 {
 	struct two_level_job job = {.inst = inst, .bottom = hb->plugin, .top = hb->top.plugin,
 	                            .bottom_opts = &hb->opts, .top_opts = &hb->top.opts,
@@ -214,10 +211,10 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
 	                            .threads = threads,
 	                            .validate_rays = cfg->validate ? cfg->validate_rays : 0};
 	struct two_level_trees trees;
-	enum tree_verdict v = harness_two_level_series(&job, samples_ms, cold_ms, whole, levels,
-	                                               &trees, err);
-	*sample_count = v == TREE_OK ? cfg->repeat : 0;
-	*validated = v != TREE_FAILED;
+	enum tree_verdict v = harness_two_level_series(&job, rep->samples, &rep->cold_ms, &rep->tree,
+	                                               &rep->two_level, &trees, err);
+	rep->sample_count = v == TREE_OK ? cfg->repeat : 0;
+	rep->validated = v != TREE_FAILED;
 	harness_two_level_finish(&trees);
 	return v;
 }

@@ -51,22 +51,21 @@ enum tree_verdict harness_two_level_series(const struct two_level_job *job,
                                            struct two_level_trees *trees, bvhlab_error *err);
 void harness_two_level_finish(struct two_level_trees *trees);
 
+struct series_report; /* harness_report.h */
+
 /*
  * A sweep's two-level run, in its child: builder hb's bottom plugin and
  * options and its top's over inst, with the config's warmup, repeat and
- * validation, at `threads`. The verdict (TREE_OK, _INVALID, _FAILED: the
- * run's status, in the same order), the samples and the measurements as
- * harness_two_level_series gives them; *sample_count the repeats timed,
- * *validated whether the trees were judged (TREE_OK or TREE_INVALID).
+ * validation, at `threads`. Fills rep's samples, cold_ms, tree (the
+ * two-level tree's statistics) and two_level (the levels apart) as
+ * harness_two_level_series gives them, sample_count (the repeats timed) and
+ * validated (whether the trees were judged: TREE_OK or TREE_INVALID); returns
+ * the verdict (TREE_OK, _INVALID, _FAILED: the run's status, in the same order).
  */
 enum tree_verdict harness_two_level_run(const struct config *cfg,
                                         const struct harness_builder *hb,
                                         const struct scene_instanced *inst, uint32_t threads,
-                                        double *samples_ms, double *cold_ms,
-                                        struct tree_measure *whole,
-                                        struct results_two_level *levels,
-                                        uint32_t *sample_count, bool *validated,
-                                        bvhlab_error *err);
+                                        struct series_report *rep, bvhlab_error *err);
 
 /* levels as a run's child sent them, its strings ended, for the record;
  * NULL when it holds no levels (a one-level run's zeroed report). */

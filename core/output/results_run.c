@@ -144,14 +144,17 @@ static cJSON *validation_json(const struct run_record *run)
 
 static cJSON *level_json(const struct results_level *l)
 {
+	const struct {
+		const char *key;
+		double value;
+	} numbers[] = {
+		{"build_ms", l->build_ms}, {"trees", l->trees},     {"nodes", l->nodes},
+		{"leaves", l->leaves},     {"sah_cost", l->sah}, {"memory_bytes", (double)l->memory_bytes},
+	};
 	cJSON *o = cJSON_CreateObject();
 	cJSON_AddStringToObject(o, "plugin", l->plugin);
-	cJSON_AddNumberToObject(o, "build_ms", l->build_ms);
-	cJSON_AddNumberToObject(o, "trees", l->trees);
-	cJSON_AddNumberToObject(o, "nodes", l->nodes);
-	cJSON_AddNumberToObject(o, "leaves", l->leaves);
-	cJSON_AddNumberToObject(o, "sah_cost", l->sah);
-	cJSON_AddNumberToObject(o, "memory_bytes", (double)l->memory_bytes);
+	for (size_t k = 0; k < sizeof(numbers) / sizeof(numbers[0]); k++)
+		cJSON_AddNumberToObject(o, numbers[k].key, numbers[k].value);
 	return o;
 }
 

@@ -220,16 +220,8 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 	return peer::convert(host, ctx, View{bvh}, out);
 }
 
-int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
-          bvhlab_build_output *out)
-{
-	Settings s;
-	int rc = PLUGIN_OPTIONS_GET(host, ctx, in, &s);
-	// 28 bits of the node's index address children and primitives.
-	if (rc == 0)
-		rc = peer::check_prims(host, ctx, in, Node::Index::max_first_id / 2);
-	return rc < 0 ? rc : build_tree(host, ctx, in, s, out);
-}
+// 28 bits of the node's index address children and primitives.
+PEER_BUILD_FN(Node::Index::max_first_id / 2)
 
 // Any exception out of build() becomes the run's error (bvhlab::guarded_build).
 // Peak bytes per triangle (issue 44): measured 140-203, high at 2 threads the most.

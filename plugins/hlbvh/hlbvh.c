@@ -166,9 +166,7 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	return build_team(host, ctx, &h);
 }
 
-PLUGIN_WITH_OPTIONS(options, .name = "hlbvh",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_PARALLEL_BUILDER(options, 0, .name = "hlbvh",
 	.summary = "SAH over Morton clusters (HLBVH, Garanzha et al. 2011): each cluster "
 	           "built whole by exact SAH, the SAH top over the clusters",
-	.build = build,
 	.peak_bytes_per_prim = 200 /* measured 78-178 */)

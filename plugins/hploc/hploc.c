@@ -121,9 +121,7 @@ static const morton_phase phases[] = {
 MORTON_BUILD_FN(hploc, .max_prims = HPLOC_PRIMS, .spare = spare_nodes(b.n), .place = scratch_alloc,
                 .sorted = first_clusters_phase, .phases = phases)
 
-PLUGIN_WITH_OPTIONS(options, .name = "hploc",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC,
+PLUGIN_PARALLEL_BUILDER(options, 0, .name = "hploc",
 	.summary = "H-PLOC (Benthin et al. 2024): PLOC merging inside the LBVH's subtrees, "
 	           "bottom-up from Morton order, SAH collapse",
-	.build = build,
 	.peak_bytes_per_prim = 192 /* measured 134-168 */)

@@ -85,9 +85,6 @@ MORTON_BUILD_FN(lbvh, .max_prims = UINT32_MAX / 2, .spare = spare_nodes(b.n, b.c
                 .place = scratch_alloc, .bucket_done = lbvh_bucket_done,
                 .sorted = lbvh_sorted, .phases = phases)
 
-PLUGIN_WITH_OPTIONS(options, .name = "lbvh",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
-	         BVHLAB_BUILDER_BOXES,
+PLUGIN_PARALLEL_BUILDER(options, BVHLAB_BUILDER_BOXES, .name = "lbvh",
 	.summary = "parallel LBVH: Morton codes, radix sort, Karras 2012 emission, SAH collapse",
-	.build = build,
 	.peak_bytes_per_prim = 100 /* measured 86-88 per triangle (issue 44) */)

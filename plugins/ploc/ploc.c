@@ -131,10 +131,7 @@ static const morton_phase phases[] = {
 MORTON_BUILD_FN(ploc, .max_prims = REC_PRIMS, .spare = spare_nodes(b.n), .place = scratch_alloc,
                 .sorted = first_clusters_phase, .phases = phases, .iterations = &b.iterations)
 
-PLUGIN_WITH_OPTIONS(options, .name = "ploc",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
-	         BVHLAB_BUILDER_BOXES,
+PLUGIN_PARALLEL_BUILDER(options, BVHLAB_BUILDER_BOXES, .name = "ploc",
 	.summary = "parallel locally-ordered clustering (Meister & Bittner 2018) from Morton "
 	           "order, SAH collapse",
-	.build = build,
 	.peak_bytes_per_prim = 256 /* measured 190-232 */)

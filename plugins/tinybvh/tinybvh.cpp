@@ -300,16 +300,8 @@ int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_buil
 	return peer::convert(host, ctx, View{*bvh}, out);
 }
 
-int build(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
-          bvhlab_build_output *out)
-{
-	Settings s;
-	int rc = PLUGIN_OPTIONS_GET(host, ctx, in, &s);
-	// tinybvh's counts are 32-bit and hq keeps 3 nodes per triangle.
-	if (rc == 0)
-		rc = peer::check_prims(host, ctx, in, UINT32_MAX / 8);
-	return rc < 0 ? rc : build_tree(host, ctx, in, s, out);
-}
+// tinybvh's counts are 32-bit and hq keeps 3 nodes per triangle.
+PEER_BUILD_FN(UINT32_MAX / 8)
 
 // Any exception out of build() becomes the run's error (bvhlab::guarded_build).
 // Peak bytes per triangle (issue 44): measured 160-254, hq on a soup the most.

@@ -206,6 +206,15 @@ BVHLAB_END_DECLS
 		__VA_ARGS__                                                            \
 	}
 
+/* The descriptor of a parallel, deterministic builder whose build() is
+ * this file's `build` (the Morton builders: lbvh, ploc, hploc, hlbvh);
+ * `more` adds flags to those two (0 for none), the rest is .name,
+ * .summary and what else it sets. */
+#define PLUGIN_PARALLEL_BUILDER(table, more, ...)                                       \
+	PLUGIN_WITH_OPTIONS(table,                                                    \
+	                    .flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC | (more), \
+	                    .build = build, __VA_ARGS__)
+
 /* The entry point (BVHLAB_PLUGIN_EXPORT's), after PLUGIN_DECLS and the
  * descriptor: plugin_decls filled, once, before the descriptor is returned
  * (NULL, as for another major, in the unlikely case pthread_once fails). */

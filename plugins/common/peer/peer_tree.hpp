@@ -151,4 +151,20 @@ inline int check_prims(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 
 } // namespace peer
 
+// A peer plugin's build(), after PLUGIN_DECLS(options, Settings, ...) and
+// its build_tree(host, ctx, in, settings, out): the options first, then the
+// primitive count against what the library's indices address (`max`,
+// peer::check_prims), then the library's build.
+#define PEER_BUILD_FN(max)                                                            \
+	int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,                        \
+	          const bvhlab_build_input *in, bvhlab_build_output *out)                 \
+	{                                                                              \
+		Settings s;                                                            \
+		int rc = PLUGIN_OPTIONS_GET(host, ctx, in, &s);                        \
+		if (rc == 0)                                                           \
+			rc = peer::check_prims(host, ctx, in, (max));                  \
+		return rc < 0 ? rc : build_tree(host, ctx, in, s, out);                \
+	}
+
+
 #endif
