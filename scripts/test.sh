@@ -86,7 +86,13 @@ build_or_count release "$BVHLAB_ROOT/build" && run_suite release "$BVHLAB_ROOT/b
 if [ $quick = 0 ]; then
 	[ -x "$BVHLAB_ROOT/build/app/bvhlab" ] && run_slurm_smoke
 	san_opts=(-Dbuildtype=debugoptimized -Db_lundef=false)
-	export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+	# intercept_tls_get_addr=0: gcc 12's interceptor can misread a thread's
+	# dynamic TLS block and LeakSanitizer then crashes at exit ("Tracer caught
+	# signal 11", google/sanitizers#1322; tests/meson.build). Leaks are still
+	# checked: cli-plan-parallel's in-process run crashed 3 of 3 without it and
+	# passed 3 of 3 with it.
+	export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:intercept_tls_get_addr=0
+	export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 	build_or_count asan "$BVHLAB_ROOT/build-asan" "${san_opts[@]}" -Db_sanitize=address,undefined &&
 		run_suite "asan+ubsan" "$BVHLAB_ROOT/build-asan" --timeout-multiplier 4
 	export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1

@@ -78,7 +78,9 @@ static void check_declared(const cJSON *doc)
 	CHECK(cJSON_IsTrue(cJSON_GetObjectItem(est, "declared")));
 	double declared = num_at(run, "memory_estimate", "bytes_per_triangle");
 	CHECK(declared > 0 && declared < 400);
+#ifndef __SANITIZE_ADDRESS__ /* ASan's redzones and quarantine add to what is resident */
 	CHECK(num_at(run, "memory", "build_bytes_per_triangle") <= declared);
+#endif
 }
 
 static void estimate(void)
