@@ -15,6 +15,7 @@ case "${1:-}" in
 esac
 
 passed=0 failed=0 skipped=0
+suite_s=0 # wall seconds in meson test, all suites (goal: well under 15 min)
 
 # Counts one failure of the suite itself (not of a test), with the reason.
 suite_broken() {
@@ -34,8 +35,11 @@ run_suite() {
 	local defined rc ran ok fail skip
 	defined=$(meson test -C "$dir" --list "$@" 2>/dev/null | grep -c ' / ' || true)
 	rm -f "$log"
+	local start=$SECONDS
 	meson test -C "$dir" --print-errorlogs "$@"
 	rc=$?
+	suite_s=$((suite_s + SECONDS - start))
+	echo "== $label: $((SECONDS - start)) s of wall time ==" >&2
 	if [ ! -f "$log" ]; then
 		suite_broken "$label: meson test did not run (exit status $rc)"
 		return
@@ -97,8 +101,10 @@ if [ $quick = 0 ]; then
 		run_suite "asan+ubsan" "$BVHLAB_ROOT/build-asan" --timeout-multiplier 4
 	export TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1
 	build_or_count tsan "$BVHLAB_ROOT/build-tsan" "${san_opts[@]}" -Db_sanitize=thread &&
-		run_suite tsan "$BVHLAB_ROOT/build-tsan" --suite plugins --suite core --timeout-multiplier 6
+		run_suite tsan "$BVHLAB_ROOT/build-tsan" --suite plugins --suite core \
+			--no-suite sequential --timeout-multiplier 6
 fi
 
+echo "test.sh: $((suite_s / 60)) min $((suite_s % 60)) s of wall time in the test suites" >&2
 echo "$passed passed, $failed failed, $skipped skipped"
 [ "$failed" = 0 ]

@@ -427,7 +427,10 @@ static void test_shared_meshes(void)
 		printf("no shared scenes at %s: that part skipped\n", BVHLAB_SHARED_SCENES);
 		return;
 	}
-	for (size_t i = 0; i < sizeof(files) / sizeof(files[0]); i++) {
+	/* Under TSan the bunny alone: the other meshes take the same threaded
+	 * paths (ray batches) and cost 2.5 of its 3 minutes there. */
+	size_t count = UNDER_TSAN ? 1 : sizeof(files) / sizeof(files[0]);
+	for (size_t i = 0; i < count; i++) {
 		bvhlab_scene *s = load_shared(files[i]);
 		size_t blocked[KINDS];
 		check_scene(s, "sah_seq", SCALE(160, 48), false, files[i], blocked);
