@@ -21,7 +21,9 @@ The in-harness time is the library's: results.json's own_ms, the median
 build_ms less the median `input` (the library's input made from
 bvhlab's scene) and `convert` (its tree written in bvhlab's layout)
 phases, as the report's fronts take it. The standalone
-time is the median of the build call alone. Prints a Markdown table with
+time is the median of the build call alone. A run whose tree is invalid
+(tinybvh avx on igea subdivided once: the library's own boxes) keeps its
+time, its ratio marked "(note)" and the reason printed under the table. Prints a Markdown table with
 the CPU model, the ratio in-harness / standalone per builder.
 
 Wall-clock figures: run it on a quiet machine. Default (igea subdivided
@@ -110,12 +112,14 @@ def harness(args, plugin, variant, threads, folder):
     with open(os.path.join(folder, "results.json")) as f:
         results = json.load(f)
     run = results["runs"][0]
-    if run["status"] != "ok":
-        return None, f"{run['status']}: {run.get('error', '')}", {}, results["machine"]["cpu"]
+    note = "" if run["status"] == "ok" else f"{run['status']}: {run.get('error', '')}"
+    if run.get("own_ms") is None:  # not built: the note says why
+        return None, note, {}, results["machine"]["cpu"], note
+    # An invalid tree was still built and timed: its time stands, marked.
     phases = run.get("build_phases", {})
     whole = run["build_ms"]["median"]
     own = run["own_ms"]  # less input and convert, as the report's fronts take it
-    return own, whole, phases, results["machine"]["cpu"]
+    return own, whole, phases, results["machine"]["cpu"], note
 
 
 def standalone(args, plugin, variant, threads, extra):
@@ -155,9 +159,9 @@ def main():
         got = [None, None]
         for i in ([0, 1] if k % 2 == 0 else [1, 0]):
             got[i] = steps[i]()
-        (own, whole, phases, cpu), (alone, alone_cpu) = got
+        (own, whole, phases, cpu, note), (alone, alone_cpu) = got
         rows.append((name, t, whole, phases.get("input", 0.0), phases.get("convert", 0.0),
-                     own, alone, alone_cpu))
+                     own, alone, alone_cpu, note))
         print(f"{name} {t}T: harness {own if own is None else round(own, 1)} ms "
               f"({whole}), alone {alone:.1f} ms", file=sys.stderr)
     end = datetime.datetime.now(datetime.timezone.utc)
@@ -167,12 +171,15 @@ def main():
     print("| builder | threads | harness build_ms | input | convert | harness, library "
           "| standalone | standalone CPU | ratio |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
-    for name, t, whole, inp, conv, own, alone, alone_cpu in rows:
+    for name, t, whole, inp, conv, own, alone, alone_cpu, note in rows:
         if own is None:  # the harness's run did not end ok: whole says why
             print(f"| {name} | {t} | {whole} | | | | {alone:.1f} | {alone_cpu:.1f} | - |")
             continue
         print(f"| {name} | {t} | {whole:.1f} | {inp:.1f} | {conv:.1f} | {own:.1f} "
-              f"| {alone:.1f} | {alone_cpu:.1f} | {own / alone:.2f} |")
+              f"| {alone:.1f} | {alone_cpu:.1f} | {own / alone:.2f}{' (note)' if note else ''} |")
+    for name, t, *_, note in rows:
+        if note:
+            print(f"\n{name} at {t} threads: {note}")
 
 
 if __name__ == "__main__":

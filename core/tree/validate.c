@@ -77,15 +77,14 @@ static bool non_finite(const float *lo, const float *hi)
 	return false;
 }
 
-/* Exact comparison on purpose: builders must produce conservative boxes. */
-static bool contains(const bvhlab_node *n, const float *lo, const float *hi)
+/* Exact comparison on purpose: builders must produce conservative boxes.
+ * The first axis on which the child sticks out, or -1. */
+static int outside_axis(const bvhlab_node *n, const float *lo, const float *hi)
 {
-	int k;
-
-	for (k = 0; k < 3; k++)
+	for (int k = 0; k < 3; k++)
 		if (!(n->lo[k] <= lo[k] && hi[k] <= n->hi[k]))
-			return false;
-	return true;
+			return k;
+	return -1;
 }
 
 static bool test_and_set(uint64_t *bitmap, uint32_t i)
@@ -107,9 +106,15 @@ static int reach(vstate *st, uint32_t node, uint32_t parent)
 		            "again from node %" PRIu32 ")", node, parent);
 	if (non_finite(n->lo, n->hi))
 		return FAIL(st, "node %" PRIu32 ": box has NaN or an infinite bound", node);
-	if (parent != NONE && !contains(&st->tree->nodes[parent], n->lo, n->hi))
-		return FAIL(st, "node %" PRIu32 ": box does not contain child %" PRIu32, parent,
-		            node);
+	int k = parent == NONE ? -1 : outside_axis(&st->tree->nodes[parent], n->lo, n->hi);
+	if (k >= 0) {
+		/* The bounds, so that a rounding slip (a few ulps) reads apart
+		 * from a wrong box. */
+		const bvhlab_node *p = &st->tree->nodes[parent];
+		return FAIL(st, "node %" PRIu32 ": box does not contain child %" PRIu32 " (%c: child "
+		            "[%.9g, %.9g], node [%.9g, %.9g])", parent, node, "xyz"[k],
+		            (double)n->lo[k], (double)n->hi[k], (double)p->lo[k], (double)p->hi[k]);
+	}
 	st->stack[st->sp++] = node;
 	st->reached++;
 	return 0;
@@ -177,7 +182,7 @@ static int check_slot(vstate *st, uint32_t node, uint32_t slot)
 		st->prim_leaf[prim] = node;
 	box = &in->prim_bounds[prim];
 	/* Spatial splits may clip a reference's box: validate_coverage judges it. */
-	if (!st->allow_duplicates && !contains(&st->tree->nodes[node], box->lo, box->hi))
+	if (!st->allow_duplicates && outside_axis(&st->tree->nodes[node], box->lo, box->hi) >= 0)
 		return FAIL(st, "node %" PRIu32 ": box does not contain primitive %" PRIu32, node,
 		            prim);
 	return 0;
