@@ -33,12 +33,10 @@
 	              .def_bool = true),                                                        \
 	PLUGIN_MAX_LEAF(owner, max_leaf, U32, 64,                                               \
 	                "most primitives in a collapsed leaf (8, as the SAH builders)"),        \
-	PLUGIN_OPTION(owner, c_trav, FLOAT, .name = "c_trav",                                   \
-	              .help = "SAH cost of traversing an inner node (> 0), for collapse",       \
-	              .def_float = 1.0, .min = 1e-6, .max = 1e6),                               \
-	PLUGIN_OPTION(owner, c_isect, FLOAT, .name = "c_isect",                                 \
-	              .help = "SAH cost of intersecting one primitive (> 0), for collapse",     \
-	              .def_float = 1.0, .min = 1e-6, .max = 1e6)
+	PLUGIN_C_TRAV(owner, c_trav, FLOAT, 1e-6,                                               \
+	              "SAH cost of traversing an inner node (> 0), for collapse"),              \
+	PLUGIN_C_ISECT(owner, c_isect, FLOAT,                                                   \
+	               "SAH cost of intersecting one primitive (> 0), for collapse")
 
 /* Monotonic clock in milliseconds, for the phase times in the debug log. */
 double morton_now_ms(void);
