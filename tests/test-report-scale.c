@@ -67,38 +67,55 @@ static void rendered_free(struct rendered *r)
 	cJSON_Delete(r->doc);
 }
 
-static void test_scale_section(void)
+/* What the reports of document(three) hold: lines of report.md, then of
+ * report.html, each list ended by NULL. */
+struct holds {
+	bool three;
+	const char *md[6], *html[4];
+};
+
+static const struct holds sections[] = {
+	{ true, /* the scaling section */
+	  { "## Cost per triangle against N",
+	    "| lbvh | 2 | mesh.ply | 100000 | 20.0 | 60.0 | 3.00 | 150.0 | 0.80 |",
+	    "| lbvh | 2 | mesh.ply | 1000000 | 25.0 | 75.0 | 3.00 | 140.0 | 1.00 |",
+	    "| lbvh | 2 | mesh.ply | 16000000 | 50.0 | 150.0 | 3.00 | 142.0 | 2.00 |",
+	    "| lbvh | 2 | other.obj | 2000000 | 30.0 | 90.0 | 3.00 | 141.0 | 1.00 |", NULL },
+	  { "<h2>Cost per triangle against N</h2>", "lbvh: ns per triangle",
+	    "triangles (log scale)" /* 100 k to 16 M */, NULL } },
+	{ false, /* the memory table */
+	  { "### Memory per triangle", "are 54.0 bytes per triangle (5.1 MiB)",
+	    "| lbvh | 2 | 86.0 | 140.0 | 200.0 |", NULL },
+	  { "<h3>Memory per triangle</h3>", "<td>86.0</td><td>140.0</td><td>200.0</td>", NULL } },
+};
+
+static void test_sections(void)
 {
-	struct rendered r = render(true);
-	CHECK_CONTAINS(r.md, "## Cost per triangle against N");
-	CHECK_CONTAINS(r.md, "| lbvh | 2 | mesh.ply | 100000 | 20.0 | 60.0 | 3.00 | 150.0 | 0.80 |");
-	CHECK_CONTAINS(r.md, "| lbvh | 2 | mesh.ply | 1000000 | 25.0 | 75.0 | 3.00 | 140.0 | 1.00 |");
-	CHECK_CONTAINS(r.md, "| lbvh | 2 | mesh.ply | 16000000 | 50.0 | 150.0 | 3.00 | 142.0 | 2.00 |");
-	CHECK_CONTAINS(r.md, "| lbvh | 2 | other.obj | 2000000 | 30.0 | 90.0 | 3.00 | 141.0 | 1.00 |");
-	CHECK_CONTAINS(r.html, "<h2>Cost per triangle against N</h2>");
-	CHECK_CONTAINS(r.html, "lbvh: ns per triangle");
-	CHECK_CONTAINS(r.html, "triangles (log scale)"); /* 100 k to 16 M */
-	rendered_free(&r);
-	r = render(false); /* two sizes at most: not a scaling sweep */
+	for (size_t k = 0; k < sizeof(sections) / sizeof(sections[0]); k++) {
+		const struct holds *h = &sections[k];
+		struct rendered r = render(h->three);
+
+		for (size_t j = 0; h->md[j]; j++)
+			CHECK_CONTAINS(r.md, h->md[j]);
+		for (size_t j = 0; h->html[j]; j++)
+			CHECK_CONTAINS(r.html, h->html[j]);
+		rendered_free(&r);
+	}
+}
+
+/* Two sizes at most: not a scaling sweep. */
+static void test_no_scale_section(void)
+{
+	struct rendered r = render(false);
+
 	CHECK(r.md && !strstr(r.md, "Cost per triangle against N"));
 	CHECK(r.html && !strstr(r.html, "Cost per triangle against N"));
 	rendered_free(&r);
 }
 
-static void test_memory_table(void)
-{
-	struct rendered r = render(false);
-	CHECK_CONTAINS(r.md, "### Memory per triangle");
-	CHECK_CONTAINS(r.md, "are 54.0 bytes per triangle (5.1 MiB)");
-	CHECK_CONTAINS(r.md, "| lbvh | 2 | 86.0 | 140.0 | 200.0 |");
-	CHECK_CONTAINS(r.html, "<h3>Memory per triangle</h3>");
-	CHECK_CONTAINS(r.html, "<td>86.0</td><td>140.0</td><td>200.0</td>");
-	rendered_free(&r);
-}
-
 int main(void)
 {
-	test_scale_section();
-	test_memory_table();
+	test_sections();
+	test_no_scale_section();
 	return test_finish();
 }

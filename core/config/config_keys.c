@@ -129,14 +129,17 @@ const struct config_key config_mesh_keys[] = {
 	END,
 };
 
+/* What an instance and a scatter both name: the mesh they place, its
+ * scale and its rotation (one instance's values, or a scatter's range and
+ * rule: config_instances.c). */
+#define PLACEMENT_KEYS CUSTOM("mesh"), CUSTOM("scale"), CUSTOM("rotate")
+
 /* One of a two-level scene's "instances": a mesh placed by a matrix or by a
  * part's keys, or a "scatter" of many (config_instances.c). */
 const struct config_key config_instance_keys[] = {
-	CUSTOM("mesh"),
-	CUSTOM("matrix"),
-	CUSTOM("scale"),
-	CUSTOM("rotate"),
+	PLACEMENT_KEYS,
 	CUSTOM("translate"),
+	CUSTOM("matrix"),
 	CUSTOM("scatter"),
 	END,
 };
@@ -144,12 +147,10 @@ const struct config_key config_instance_keys[] = {
 #define SCATTER(name, kind, field, min, max) \
 	KEY(struct config_instance, name, kind, field, min, max, 0)
 const struct config_key config_scatter_keys[] = {
-	CUSTOM("mesh"),
+	PLACEMENT_KEYS,
 	SCATTER("count", CONFIG_U32, count, 1, CONFIG_MAX_INSTANCES),
 	SCATTER("seed", CONFIG_U64, seed, 0, UINT64_MAX),
 	CUSTOM("bounds"),
-	CUSTOM("scale"),
-	CUSTOM("rotate"),
 	END,
 };
 

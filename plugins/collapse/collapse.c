@@ -29,13 +29,11 @@ static const plugin_option options[] = {
 	              .help = "sah: cost of visiting a wide node, whatever its children "
 	                      "(a node of k children costs c_node + c_trav * k / 2)",
 	              .def_float = 0.0, .min = 0.0, .max = 1e6),
-	PLUGIN_OPTION(struct collapse_params, c_trav, DOUBLE, .name = "c_trav",
-	              .help = "sah: cost of a binary inner node, one half per child box "
-	                      "tested (the defaults are the reported wide SAH's)",
-	              .def_float = 1.0, .min = 0.0, .max = 1e6),
-	PLUGIN_OPTION(struct collapse_params, c_isect, DOUBLE, .name = "c_isect",
-	              .help = "sah: cost of intersecting one primitive",
-	              .def_float = 1.0, .min = 1e-6, .max = 1e6),
+	PLUGIN_C_TRAV(struct collapse_params, c_trav, DOUBLE, 0.0,
+	              "sah: cost of a binary inner node, one half per child box tested (the "
+	              "defaults are the reported wide SAH's)"),
+	PLUGIN_C_ISECT(struct collapse_params, c_isect, DOUBLE,
+	               "sah: cost of intersecting one primitive"),
 };
 PLUGIN_DECLS(options, struct collapse_params, NULL)
 

@@ -41,21 +41,21 @@
 #include "sah_kernel.h"
 #include "team.h"
 
-/* The options: the kernel's (method and bins steer the top's search,
- * quality the clusters'), then the cluster size. */
-typedef struct hlbvh_options {
-	sah_options sah;
-	uint32_t cluster; /* most primitives in a cluster, 2 .. SAH_SMALL_MAX */
-} hlbvh_options;
-
+/* The build's state, its options first (filled by the host, as lbvh's):
+ * the kernel's (method and bins steer the top's search, quality the
+ * clusters'), then the cluster size. */
 typedef struct hlbvh {
+	sah_options sah;
+	uint32_t cluster;        /* most primitives in a cluster, 2 .. SAH_SMALL_MAX */
+
 	const bvhlab_build_input *in;
 	bvhlab_build_output *out;
-	const team_host *th;
-	hlbvh_options opt;
-	uint32_t n;              /* primitives, >= 2 */
+	const team_host *th;     /* morton_job's th */
+	uint32_t n;              /* primitives, >= 2 when the team runs */
+	uint32_t threads;        /* threads asked for (morton_job's) */
+	uint32_t node_count;     /* the bottom's node counter, after the team */
 	team team;
-	morton_sort sort;
+	morton_sort sort;        /* 63 code bits */
 	sah_prim *sorted;        /* [n] the primitives' records in sorted order */
 	uint32_t *bounds;        /* [n + 1] cluster c is [bounds[c], bounds[c + 1]) */
 	uint32_t cluster_count;
@@ -64,8 +64,8 @@ typedef struct hlbvh {
 	uint32_t *slot;          /* [cluster_count] the node each cluster fills */
 	sah_builder bottom;      /* the clusters' builds: prims[0] = sorted */
 	atomic_uint next;        /* blocks of clusters handed out */
-	int rc;                  /* member 0's result of the top */
-	double ms[5];            /* member 0's clock after each phase */
+	int rc;                  /* member 0's result of the cut and the top */
+	double phase_ms[6];      /* morton_job's ms: start, sort, 4 phases */
 } hlbvh;
 
 /* Step 2, by member 0 after the sort: h->bounds and h->cluster_count. */

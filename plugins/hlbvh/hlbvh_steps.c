@@ -58,7 +58,7 @@ void hlbvh_cut(hlbvh *h)
 	stack[sp++][1] = h->n;
 	while (sp > 0) {
 		uint32_t lo = stack[--sp][0], hi = stack[sp][1];
-		if (hi - lo <= h->opt.cluster) {
+		if (hi - lo <= h->cluster) {
 			h->bounds[count++] = lo;
 			continue;
 		}
@@ -134,7 +134,7 @@ static void bottom_init(hlbvh *h, uint32_t top_nodes)
 	sah_builder *b = &h->bottom;
 
 	memset(b, 0, sizeof(*b));
-	b->opt = h->opt.sah;
+	b->opt = h->sah;
 	/* The small builders sort a cluster themselves; sweep's would read
 	 * presorted arrays this builder does not keep. */
 	b->opt.method = SAH_BINNED;
@@ -155,7 +155,7 @@ int hlbvh_top(hlbvh *h)
 	bvhlab_build_output out = { .struct_size = sizeof(out), .nodes = h->out->nodes,
 	                            .node_capacity = 2 * cc - 1,
 	                            .prim_index = ids, .index_capacity = cc };
-	sah_options opt = h->opt.sah;
+	sah_options opt = h->sah;
 	bvhlab_build_input in;
 	sah_builder top;
 	sah_job root;

@@ -129,7 +129,8 @@ static const morton_phase phases[] = {
 /* ---- build --------------------------------------------------------------- */
 
 MORTON_BUILD_FN(ploc, .max_prims = REC_PRIMS, .spare = spare_nodes(b.n), .place = scratch_alloc,
-                .sorted = first_clusters_phase, .phases = phases, .iterations = &b.iterations)
+                .sorted = first_clusters_phase, .phases = phases, .count = &b.iterations,
+                .count_name = "iterations")
 
 PLUGIN_PARALLEL_BUILDER(options, BVHLAB_BUILDER_BOXES, .name = "ploc",
 	.summary = "parallel locally-ordered clustering (Meister & Bittner 2018) from Morton "

@@ -88,12 +88,9 @@
 	              .def_int = 32, .min = 2, .max = SAH_MAX_BINS),                             \
 	PLUGIN_MAX_LEAF(owner, sah.max_leaf, U32, 64,                                            \
 	                "most primitives in a leaf (unless all their centroids coincide)"),      \
-	PLUGIN_OPTION(owner, sah.c_trav, FLOAT, .name = "c_trav",                                \
-	              .help = "SAH cost of traversing an inner node (> 0)",                      \
-	              .def_float = 1.0, .min = 1e-6, .max = 1e6),                                \
-	PLUGIN_OPTION(owner, sah.c_isect, FLOAT, .name = "c_isect",                              \
-	              .help = "SAH cost of intersecting one primitive (> 0)",                    \
-	              .def_float = 1.0, .min = 1e-6, .max = 1e6)
+	PLUGIN_C_TRAV(owner, sah.c_trav, FLOAT, 1e-6,                                            \
+	              "SAH cost of traversing an inner node (> 0)"),                             \
+	PLUGIN_C_ISECT(owner, sah.c_isect, FLOAT, "SAH cost of intersecting one primitive (> 0)")
 
 #define SAH_SIMD_OPTION(owner)                                                                   \
 	PLUGIN_OPTION(owner, sah.simd_asked, CHOICE, .name = "simd",                             \

@@ -120,9 +120,9 @@ static void log_phases(const morton_job *j, const bvhlab_host *host, bvhlab_buil
 	size_t at = 0;
 
 	at += (size_t)snprintf(line, sizeof(line), "%u prims, %u threads", n, j->team->threads);
-	if (j->iterations && at < sizeof(line))
-		at += (size_t)snprintf(line + at, sizeof(line) - at, ", %u iterations",
-		                       *j->iterations);
+	if (j->count && at < sizeof(line))
+		at += (size_t)snprintf(line + at, sizeof(line) - at, ", %u %s", *j->count,
+		                       j->count_name);
 	if (at < sizeof(line))
 		at += (size_t)snprintf(line + at, sizeof(line) - at, ": setup %.2f, sort %.2f",
 		                       j->ms[0] - start, j->ms[1] - j->ms[0]);
@@ -166,20 +166,26 @@ static int run_team(const morton_job *j, const bvhlab_host *host, bvhlab_build_c
 	j->sort->n = in->prim_count;
 	j->sort->centroids = in->centroids;
 	j->sort->centroid_bounds = in->centroid_bounds;
+	team_host_init(&th, host, ctx);
+	if (j->th)
+		*j->th = &th;
 	if ((rc = j->place(j->b, out, &s)) < 0) {
 		host->set_error(ctx, "out of memory for the scratch of %u primitives",
 		                in->prim_count);
 		goto out;
 	}
-	team_host_init(&th, host, ctx);
 	if ((rc = team_run_on(j->team, &th, *j->threads, run_phases, (void *)j)) < 0) {
 		host->set_error(ctx, "cannot set up the thread team");
 		goto out;
 	}
+	if (j->finish && (rc = j->finish(j->b, host, ctx)) < 0)
+		goto out;
 	out->node_count = *j->node_count;
 	out->index_count = in->prim_count;
 	log_phases(j, host, ctx, in->prim_count, start);
 out:
+	if (j->cleanup)
+		j->cleanup(j->b);
 	morton_scratch_free(&s);
 	return rc;
 }

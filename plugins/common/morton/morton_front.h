@@ -33,12 +33,10 @@
 	              .def_bool = true),                                                        \
 	PLUGIN_MAX_LEAF(owner, max_leaf, U32, 64,                                               \
 	                "most primitives in a collapsed leaf (8, as the SAH builders)"),        \
-	PLUGIN_OPTION(owner, c_trav, FLOAT, .name = "c_trav",                                   \
-	              .help = "SAH cost of traversing an inner node (> 0), for collapse",       \
-	              .def_float = 1.0, .min = 1e-6, .max = 1e6),                               \
-	PLUGIN_OPTION(owner, c_isect, FLOAT, .name = "c_isect",                                 \
-	              .help = "SAH cost of intersecting one primitive (> 0), for collapse",     \
-	              .def_float = 1.0, .min = 1e-6, .max = 1e6)
+	PLUGIN_C_TRAV(owner, c_trav, FLOAT, 1e-6,                                               \
+	              "SAH cost of traversing an inner node (> 0), for collapse"),              \
+	PLUGIN_C_ISECT(owner, c_isect, FLOAT,                                                   \
+	               "SAH cost of intersecting one primitive (> 0), for collapse")
 
 /* Monotonic clock in milliseconds, for the phase times in the debug log. */
 double morton_now_ms(void);
@@ -110,10 +108,10 @@ typedef struct morton_phase {
 	}
 
 /*
- * A CPU Morton builder's build (lbvh, ploc, hploc), for morton_build():
- * the sort, its first phase, then the builder's own; its state `b`, and in
- * it the sort, the team, the count of threads to ask for, the node count
- * its phases set and its phase times.
+ * A CPU Morton builder's build (lbvh, ploc, hploc, hlbvh), for
+ * morton_build(): the sort, its first phase, then the builder's own; its
+ * state `b`, and in it the sort, the team, the count of threads to ask
+ * for, the node count its phases set and its phase times.
  */
 typedef struct morton_job {
 	void *b;
@@ -138,7 +136,18 @@ typedef struct morton_job {
 	void (*sorted)(void *b, unsigned t);
 	const morton_phase *phases; /* after the sort, in order, ended by one
 	                             * with run NULL */
-	const uint32_t *iterations; /* in the debug line where not NULL */
+	const uint32_t *count;      /* in the debug line where not NULL, */
+	const char *count_name;     /* as "<count> <count_name>" */
+	/* Where not NULL: set to the build's team_host before place, for
+	 * phases that start the SAH kernel (hlbvh). */
+	const team_host **th;
+	/* After the team ran (may be NULL): the rest of b's results (such as
+	 * the node count), then 0, or the negative errno a phase failed with
+	 * (its other members skipping the rest) after host->set_error. */
+	int (*finish)(void *b, const bvhlab_host *host, bvhlab_build_ctx *ctx);
+	/* Frees what the phases allocated (may be NULL), at the end of every
+	 * build of two or more primitives, whether the team ran or not. */
+	void (*cleanup)(void *b);
 } morton_job;
 
 /* The job's members in a builder's struct *p: members sort, team, threads,

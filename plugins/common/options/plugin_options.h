@@ -121,6 +121,19 @@ typedef struct plugin_option {
 	PLUGIN_OPTION(struct_type, member, field_type, .name = "max_leaf", \
 	              .help = text, .def_int = 8, .min = 1, .max = most)
 
+/* C: the entries of "c_trav" and "c_isect", the SAH's costs of an inner
+ * node and of one primitive, which every builder and stage that weighs the
+ * SAH offers with one name, one default (1, the reported SAH's) and one
+ * ceiling (1e6); c_isect's floor is above 0, c_trav's `floor` 1e-6 where
+ * the node's cost is c_trav alone, 0 where another cost prices it
+ * (collapse's c_node); `text` is the help. */
+#define PLUGIN_C_TRAV(struct_type, member, field_type, floor, text)      \
+	PLUGIN_OPTION(struct_type, member, field_type, .name = "c_trav", \
+	              .help = text, .def_float = 1.0, .min = floor, .max = 1e6)
+#define PLUGIN_C_ISECT(struct_type, member, field_type, text)             \
+	PLUGIN_OPTION(struct_type, member, field_type, .name = "c_isect", \
+	              .help = text, .def_float = 1.0, .min = 1e-6, .max = 1e6)
+
 /* Copies the declarations of table[0 .. count) into decls, in order. */
 void plugin_options_decls(const plugin_option *table, size_t count, bvhlab_option_decl *decls);
 
