@@ -192,8 +192,11 @@ static void test_traversal(void)
 		 "is written {\"name\": \"stackless\", \"device\": true}"},
 		{"\"traversal\": {\"name\": \"wide\", \"device\": true}", "\"wide\"", 0,
 		 "'rays.traversal' \"wide\" has no device kernel"},
-		{"\"traversal\": {\"name\": \"wide8\", \"device\": true}", "\"wide8\"", 0,
-		 "'rays.traversal' \"wide8\" has no device kernel"},
+		{"\"traversal\": {\"name\": \"wide4\", \"device\": true}", "\"wide4\"", 0,
+		 "'rays.traversal' \"wide4\" has no device kernel: \"device\": true is for "
+		 "\"stack\", \"stackless\" and \"wide8\""},
+		{"\"traversal\": [\"wide8\", \"device_wide8\"]", "\"device_wide8\"", 0,
+		 "is written {\"name\": \"wide8\", \"device\": true}"},
 		{"\"traversal\": [{\"name\": \"stack\", \"device\": true}, {\"device\": true, "
 		 "\"name\": \"stack\"}]",
 		 "\"stack\"}", 0, "names \"stack\" on the device twice"},
@@ -242,6 +245,14 @@ static void test_device_traversal(void)
 		      cfg.ray_traversals == (stack | cl));
 	else
 		CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_STACK && cfg.ray_traversals == stack);
+	config_finish(&cfg);
+	/* wide8 on the device is the compressed layout's traversal */
+	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": [\"wide8\", {\"name\": "
+	    "\"wide8\", \"device\": true, \"optional\": true}] } }";
+	CHECK_INT(load(&cfg, t, &err), 0);
+	CHECK(cfg.ray_traversal == BVHLAB_TRAVERSAL_WIDE8 &&
+	      cfg.ray_traversals == (1u << BVHLAB_TRAVERSAL_WIDE8 |
+	                             (trace_cl_built() ? 1u << BVHLAB_TRAVERSAL_DEVICE_WIDE8 : 0)));
 	config_finish(&cfg);
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"traversal\": {\"name\": \"stackless\", "
 	    "\"device\": true} } }";

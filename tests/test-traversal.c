@@ -224,7 +224,7 @@ static void test_measure(void)
 			CHECK_INT(tm.stats.tris_tested, ref.tris_tested);
 		}
 	}
-	bvhlab_trace_options bad = {.traversal = 7};
+	bvhlab_trace_options bad = {.traversal = BVHLAB_TRAVERSAL_COUNT};
 	bvhlab_trace_timing tm;
 	CHECK_INT(bvhlab_trace_measure(&f.tree, &f.scene, rays, N, &bad, NULL, NULL, &tm), -EINVAL);
 	CHECK(bvhlab_traversal_name(0) && !strcmp(bvhlab_traversal_name(1), "stackless"));

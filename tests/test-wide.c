@@ -174,7 +174,8 @@ static void check_traced(const char *name, const bvhlab_scene *scene, const bvhl
 		char what[96];
 		snprintf(what, sizeof(what), "%s %u-wide %s", name, wide->width,
 		         bvhlab_traversal_name(trav));
-		if (trav == BVHLAB_TRAVERSAL_DEVICE_STACK || trav == BVHLAB_TRAVERSAL_DEVICE_STACKLESS) {
+		if (trav == BVHLAB_TRAVERSAL_DEVICE_STACK || trav == BVHLAB_TRAVERSAL_DEVICE_STACKLESS ||
+		    trav == BVHLAB_TRAVERSAL_DEVICE_WIDE8) {
 			if (trace(wide, scene, rays, n, trav, hits))
 				check_same_hits(what, scene, rays, ref, hits, n);
 			continue;

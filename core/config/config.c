@@ -94,13 +94,18 @@ static int resolve_output(struct config *cfg, bvhlab_error *err)
 	return rc ? out_of_memory(cfg->path, err) : 0;
 }
 
+static bool on_device(int k)
+{
+	return k == BVHLAB_TRAVERSAL_DEVICE_STACK || k == BVHLAB_TRAVERSAL_DEVICE_STACKLESS ||
+	       k == BVHLAB_TRAVERSAL_DEVICE_WIDE8;
+}
+
 /* enum bvhlab_traversal of a CPU traversal's name; -1 for none (a device
  * traversal is one of these with "device": true). */
 static int traversal_of(const char *name)
 {
 	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++)
-		if (k != BVHLAB_TRAVERSAL_DEVICE_STACK && k != BVHLAB_TRAVERSAL_DEVICE_STACKLESS &&
-		    strcmp(name, bvhlab_traversal_name(k)) == 0)
+		if (!on_device(k) && strcmp(name, bvhlab_traversal_name(k)) == 0)
 			return k;
 	return -1;
 }
@@ -111,7 +116,8 @@ static int old_device_name(struct config *cfg, const cJSON *item, bvhlab_error *
 {
 	static const char *const names[][2] = {{"cl_stack", "stack"}, {"cl_stackless", "stackless"},
 	                                       {"device_stack", "stack"},
-	                                       {"device_stackless", "stackless"}};
+	                                       {"device_stackless", "stackless"},
+	                                       {"device_wide8", "wide8"}};
 	for (size_t i = 0; cJSON_IsString(item) && i < sizeof(names) / sizeof(names[0]); i++)
 		if (strcmp(item->valuestring, names[i][0]) == 0)
 			return config_error(cfg, item, false, err,
@@ -147,13 +153,13 @@ static int traversal_built(struct config *cfg, const cJSON *item, int k, bvhlab_
 	(void)cfg, (void)item, (void)k, (void)err;
 	return 0;
 #else
-	if (k != BVHLAB_TRAVERSAL_DEVICE_STACK && k != BVHLAB_TRAVERSAL_DEVICE_STACKLESS)
+	if (!on_device(k))
 		return 0;
 	return config_error(cfg, item, false, err,
 	                    "'rays.traversal' \"%s\" with \"device\": true runs on a device, and "
 	                    "this bvhlab was built without OpenCL, its device backend (install "
 	                    "ocl-icd-opencl-dev and opencl-c-headers, then meson setup again)",
-	                    bvhlab_traversal_name(k - BVHLAB_TRAVERSAL_DEVICE_STACK));
+	                    bvhlab_traversal_name(k) + strlen("device_"));
 #endif
 }
 
@@ -197,7 +203,7 @@ static bool trace_is_wide_name(int k)
 }
 
 /* The traversal an entry asks for: its name's, on the device with
- * "device": true (stack and stackless have device kernels). */
+ * "device": true (stack, stackless and wide8 have device kernels). */
 static int entry_traversal(struct config *cfg, const cJSON *name, const struct entry *e,
                            bvhlab_error *err)
 {
@@ -206,10 +212,12 @@ static int entry_traversal(struct config *cfg, const cJSON *name, const struct e
 		return bad_traversal(cfg, name, err);
 	if (!e->device)
 		return k;
+	if (k == BVHLAB_TRAVERSAL_WIDE8)
+		return BVHLAB_TRAVERSAL_DEVICE_WIDE8;
 	if (trace_is_wide_name(k))
 		return config_error(cfg, name, false, err, "'rays.traversal' \"%s\" has no device "
-		                    "kernel: \"device\": true is for \"stack\" and \"stackless\"",
-		                    bvhlab_traversal_name(k));
+		                    "kernel: \"device\": true is for \"stack\", \"stackless\" and "
+		                    "\"wide8\"", bvhlab_traversal_name(k));
 	return BVHLAB_TRAVERSAL_DEVICE_STACK + k;
 }
 

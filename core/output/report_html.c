@@ -54,8 +54,17 @@ static void range_cell(struct strbuf *sb, const cJSON *run, const char *kind)
 
 /* Traversals a scene's table may show beside the main one, by name. */
 static const char *const other_traversals[] = {"wide", "stack", "stackless", "device_stack",
-                                                 "device_stackless", "wide4", "wide8"};
+                                                 "device_stackless", "wide4", "wide8",
+                                                 "device_wide8"};
 #define OTHERS (sizeof(other_traversals) / sizeof(other_traversals[0]))
+
+/* Whether a traversal counts its own nodes (the others count the binary
+ * tree's, as the stack traversal walks it): stackless, and device_wide8
+ * its compressed nodes. */
+static bool counts_own_nodes(const char *name)
+{
+	return strstr(name, "stackless") || strcmp(name, "device_wide8") == 0;
+}
 
 static double other_num(const cJSON *run, const char *traversal, const char *what)
 {
@@ -167,7 +176,7 @@ static void others_row(struct strbuf *sb, const cJSON *run, const bool *others)
 			continue;
 		num_cell(sb, other_num(run, other_traversals[t], "primary.mrays_per_s"), "%.2f");
 		num_cell(sb, other_num(run, other_traversals[t], "diffuse.mrays_per_s"), "%.2f");
-		if (strstr(other_traversals[t], "stackless")) /* it counts its own nodes */
+		if (counts_own_nodes(other_traversals[t]))
 			num_cell(sb, other_num(run, other_traversals[t], "primary.nodes_per_ray"),
 			         "%.1f");
 	}
@@ -235,7 +244,7 @@ static void others_table(struct strbuf *sb, const cJSON *const *runs, size_t n,
 		if (!others[t])
 			continue;
 		sb_printf(sb, "<th>%s primary Mrays/s</th><th>%s diffuse Mrays/s</th>", name, name);
-		if (strstr(name, "stackless"))
+		if (counts_own_nodes(name))
 			sb_printf(sb, "<th>%s primary nodes/ray</th>", name);
 	}
 	sb_printf(sb, "<th>hits differing</th></tr>\n");

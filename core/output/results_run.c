@@ -106,6 +106,14 @@ static void bytes_json(cJSON *o, const bvhlab_tree_stats *st, uint32_t width, ui
 	double packed = inner * width * 28.0 + (double)st->refs * sizeof(uint32_t);
 	cJSON_AddNumberToObject(o, "bytes_per_triangle", (double)st->memory_bytes / triangles);
 	cJSON_AddNumberToObject(o, "packed_bytes_per_triangle", packed / triangles);
+	/* The compressed 8-wide layout of device_wide8 (core/trace/cwbvh.h):
+	 * an 80-byte node per inner node and an 8-byte range per leaf, with
+	 * the same references. Only for trees it takes as built: a narrower
+	 * one is collapsed first, into nodes these counts do not give. */
+	if (width > 4) {
+		double cw = inner * 80.0 + (double)st->leaves * 8.0 + (double)st->refs * 4.0;
+		cJSON_AddNumberToObject(o, "cwbvh_bytes_per_triangle", cw / triangles);
+	}
 }
 
 /* dup_ratio: references per triangle, 1 unless spatial splits duplicated some. */

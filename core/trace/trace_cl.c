@@ -12,6 +12,7 @@
 
 #include "device/device.h"
 #include "device/device_run.h"
+#include "trace/cwbvh.h"
 #include "trace/trace_cl.h"
 #include "trace/trace_cl_source.h"
 #include "trace/trace_layout.h"
@@ -30,7 +31,8 @@
 struct trace_cl_tree {
 	const bvhlab_cl *dev; /* the device layer's */
 	cl_kernel kernel;
-	cl_mem nodes, tris, prim_index, parents;
+	cl_mem nodes, tris, prim_index;
+	cl_mem extra; /* parent links (stackless), leaf ranges (wide8) */
 	uint32_t node_count, index_count, tri_count;
 };
 
@@ -134,32 +136,68 @@ static float *slot_vertices(const bvhlab_tree *tree, const bvhlab_scene *scene)
 	return v;
 }
 
-static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
-                       const bvhlab_scene *scene, bvhlab_error *err)
+/* What goes up for a traversal: the tree's nodes and parent links, or
+ * (wide8) its compressed nodes and leaf ranges; and the stack it needs. */
+struct tree_arrays {
+	const void *nodes, *extra; /* extra: parent links or leaf ranges */
+	size_t node_bytes, extra_bytes;
+	uint32_t node_count;
+	unsigned need;
+	uint32_t *parents;
+	struct cwbvh cw;
+};
+
+static int tree_arrays(const bvhlab_tree *tree, int traversal, struct tree_arrays *a,
+                       bvhlab_error *err)
 {
-	uint32_t *parents = NULL;
-	float *verts = slot_vertices(tree, scene);
-	int r = verts ? bvhlab_tree_parents(tree, &parents) : -ENOMEM;
+	*a = (struct tree_arrays){.nodes = tree->nodes, .node_count = tree->node_count,
+	                          .node_bytes = (size_t)tree->node_count * sizeof(bvhlab_node)};
+	int r = stack_need(tree, &a->need);
+	if (r < 0) {
+		error_set(err, r == -ENOMEM ? "cl: out of memory" : "cl: the tree's links leave it");
+		return r;
+	}
+	if (traversal == BVHLAB_TRAVERSAL_DEVICE_WIDE8) {
+		r = cwbvh_encode(tree, &a->cw, err);
+		a->nodes = a->cw.nodes;
+		a->node_count = a->cw.node_count;
+		a->node_bytes = (size_t)a->cw.node_count * sizeof(cw_node);
+		a->extra = a->cw.leaves;
+		a->extra_bytes = (size_t)a->cw.leaf_count * sizeof(*a->cw.leaves);
+		a->need = a->cw.depth;
+		return r;
+	}
+	r = bvhlab_tree_parents(tree, &a->parents);
 	if (r == -EINVAL)
 		error_set(err, "cl: the tree's child links do not make a tree");
 	else if (r < 0)
 		error_set(err, "cl: out of memory");
-	size_t want[] = {(size_t)tree->node_count * sizeof(bvhlab_node),
-	                 (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(float),
-	                 (size_t)tree->index_count * sizeof(uint32_t),
-	                 (size_t)tree->node_count * sizeof(uint32_t)};
+	a->extra = a->parents;
+	a->extra_bytes = (size_t)tree->node_count * sizeof(uint32_t);
+	return r;
+}
+
+static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
+                       const bvhlab_scene *scene, const struct tree_arrays *a,
+                       bvhlab_error *err)
+{
+	float *verts = slot_vertices(tree, scene);
+	int r = verts ? 0 : -ENOMEM;
+	if (r < 0)
+		error_set(err, "cl: out of memory");
+	size_t want[] = {a->node_bytes, (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(float),
+	                 (size_t)tree->index_count * sizeof(uint32_t), a->extra_bytes};
 	if (r == 0)
 		r = fits(t->dev, want, 4, err);
 	if (r == 0)
-		r = upload(t->dev, tree->nodes, want[0], &t->nodes, "nodes", err);
+		r = upload(t->dev, a->nodes, want[0], &t->nodes, "nodes", err);
 	if (r == 0)
 		r = upload(t->dev, verts, want[1], &t->tris, "triangles", err);
 	if (r == 0)
 		r = upload(t->dev, tree->prim_index, want[2], &t->prim_index, "prim_index", err);
 	if (r == 0)
-		r = upload(t->dev, parents, want[3], &t->parents, "parents", err);
+		r = upload(t->dev, a->extra, want[3], &t->extra, "links", err);
 	free(verts);
-	free(parents);
 	return r;
 }
 
@@ -169,7 +207,7 @@ static int set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
 	cl_int rc = clSetKernelArg(t->kernel, TRACE_ARG_NODES, sizeof(cl_mem), &t->nodes);
 	rc |= clSetKernelArg(t->kernel, TRACE_ARG_TRIS, sizeof(cl_mem), &t->tris);
 	rc |= clSetKernelArg(t->kernel, TRACE_ARG_PRIM_INDEX, sizeof(cl_mem), &t->prim_index);
-	rc |= clSetKernelArg(t->kernel, TRACE_ARG_PARENTS, sizeof(cl_mem), &t->parents);
+	rc |= clSetKernelArg(t->kernel, TRACE_ARG_PARENTS, sizeof(cl_mem), &t->extra);
 	rc |= clSetKernelArg(t->kernel, TRACE_ARG_NODE_COUNT, sizeof(cl_uint), &t->node_count);
 	rc |= clSetKernelArg(t->kernel, TRACE_ARG_INDEX_COUNT, sizeof(cl_uint), &t->index_count);
 	rc |= clSetKernelArg(t->kernel, TRACE_ARG_TRI_COUNT, sizeof(cl_uint), &t->tri_count);
@@ -178,6 +216,20 @@ static int set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
 	if (r < 0)
 		cl_error(err, why);
 	return r;
+}
+
+static const char *kernel_name(int traversal)
+{
+	switch (traversal) {
+	case BVHLAB_TRAVERSAL_DEVICE_STACK:
+		return "trace_stack";
+	case BVHLAB_TRAVERSAL_DEVICE_STACKLESS:
+		return "trace_stackless";
+	case BVHLAB_TRAVERSAL_DEVICE_WIDE8:
+		return "trace_wide8";
+	default:
+		return NULL;
+	}
 }
 
 /* The device and the program for a stack of at least `need` entries, from
@@ -193,43 +245,41 @@ static int make_kernel(struct trace_cl_tree *t, const char *device, int traversa
 	                       why, sizeof(why));
 	if (r == 0) {
 		t->dev = dev;
-		r = bvhlab_cl_kernel(prog, traversal == BVHLAB_TRAVERSAL_DEVICE_STACK ? "trace_stack"
-		                                                                   : "trace_stackless",
-		                     &t->kernel, why, sizeof(why));
+		r = bvhlab_cl_kernel(prog, kernel_name(traversal), &t->kernel, why, sizeof(why));
 	}
 	if (r < 0)
 		cl_error(err, why);
 	return r;
 }
 
-/* The kernels read trees of any width through tree_node.h: a tree goes
- * up as it is. */
+/* The stack and stackless kernels read trees of any width through
+ * tree_node.h: a tree goes up as it is; wide8's compressed (cwbvh.c). */
 int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *tree,
                          const bvhlab_scene *scene, struct trace_cl_tree **out,
                          bvhlab_error *err)
 {
-	unsigned need;
+	struct tree_arrays a;
 	*out = NULL;
-	if (traversal != BVHLAB_TRAVERSAL_DEVICE_STACK && traversal != BVHLAB_TRAVERSAL_DEVICE_STACKLESS) {
+	if (!kernel_name(traversal)) {
 		error_set(err, "cl: not a device traversal (%d)", traversal);
 		return -EINVAL;
 	}
-	int r = stack_need(tree, &need);
-	if (r < 0) {
-		error_set(err, r == -ENOMEM ? "cl: out of memory" : "cl: the tree's links leave it");
-		return r;
+	int r = tree_arrays(tree, traversal, &a, err);
+	struct trace_cl_tree *t = r == 0 ? calloc(1, sizeof(*t)) : NULL;
+	if (r == 0 && !t)
+		r = -ENOMEM;
+	if (t) {
+		t->node_count = a.node_count;
+		t->index_count = tree->index_count;
+		t->tri_count = scene->triangle_count;
+		r = make_kernel(t, device, traversal, a.need, err);
 	}
-	struct trace_cl_tree *t = calloc(1, sizeof(*t));
-	if (!t)
-		return -ENOMEM;
-	t->node_count = tree->node_count;
-	t->index_count = tree->index_count;
-	t->tri_count = scene->triangle_count;
-	r = make_kernel(t, device, traversal, need, err);
 	if (r == 0)
-		r = upload_tree(t, tree, scene, err);
+		r = upload_tree(t, tree, scene, &a, err);
 	if (r == 0)
 		r = set_tree_args(t, err);
+	free(a.parents);
+	cwbvh_free(&a.cw);
 	if (r < 0) {
 		trace_cl_tree_destroy(t);
 		return r;
@@ -246,7 +296,7 @@ void trace_cl_tree_destroy(struct trace_cl_tree *t)
 	bvhlab_cl_release_mem(&t->nodes);
 	bvhlab_cl_release_mem(&t->tris);
 	bvhlab_cl_release_mem(&t->prim_index);
-	bvhlab_cl_release_mem(&t->parents);
+	bvhlab_cl_release_mem(&t->extra);
 	free(t);
 }
 

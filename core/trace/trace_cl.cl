@@ -128,10 +128,10 @@ static bool take_hit(hit *h, uint prim, const float *out)
 	return true;
 }
 
-/* box_enter(): entry distance, or INFINITY for a miss in (tmin, tmax). */
-static float box_enter(const prep *p, NODES, uint node, float tmax)
+/* box_enter() on a box as 8 floats (lo k at k, hi k at 4 + k): entry
+ * distance, or INFINITY for a miss in (tmin, tmax). */
+static float slab(const prep *p, const float *f, float tmax)
 {
-	const __global float *f = tree_box(&nodes[node]);
 	float t0 = p->tmin, t1 = tmax;
 	for (int k = 0; k < 3; k++) {
 		float tn = (f[p->near[k]] - p->org[k]) * p->inv[k];
@@ -142,13 +142,21 @@ static float box_enter(const prep *p, NODES, uint node, float tmax)
 	return t0 <= t1 * FAR_SCALE ? t0 : INFINITY;
 }
 
-/* A leaf's triangles; true when an any-hit ray may stop. */
-static bool leaf(const prep *p, __global const float *tris, __global const uint *prim_index,
-                 const __global tree_node *n, uint index_count, uint tri_count, bool any,
-                 hit *h, uint *tests)
+/* box_enter(): slab() on node's box. */
+static float box_enter(const prep *p, NODES, uint node, float tmax)
+{
+	float f[8];
+	vstore8(vload8(0, tree_box(&nodes[node])), 0, f);
+	return slab(p, f, tmax);
+}
+
+/* The triangles of leaf slots first .. first + count; true when an
+ * any-hit ray may stop. */
+static bool leaf_range(const prep *p, __global const float *tris,
+                       __global const uint *prim_index, uint first, uint count,
+                       uint index_count, uint tri_count, bool any, hit *h, uint *tests)
 {
 	float out[3];
-	uint first = tree_leaf_first(n), count = tree_leaf_count(n);
 	if (first > index_count || count > index_count - first)
 		return false;
 	for (uint i = first; i < first + count; i++) {
@@ -161,6 +169,15 @@ static bool leaf(const prep *p, __global const float *tris, __global const uint 
 			return true;
 	}
 	return false;
+}
+
+/* A leaf node's triangles (leaf_range). */
+static bool leaf(const prep *p, __global const float *tris, __global const uint *prim_index,
+                 const __global tree_node *n, uint index_count, uint tri_count, bool any,
+                 hit *h, uint *tests)
+{
+	return leaf_range(p, tris, prim_index, tree_leaf_first(n), tree_leaf_count(n), index_count,
+	                  tri_count, any, h, tests);
 }
 
 static void store(__global uint4 *hits, __global uint2 *counts, uint i, const hit *h,
@@ -191,6 +208,18 @@ static bool children_inside(const __global tree_node *n, uint node_total)
 	return tree_child_count(n) <= TREE_MAX_WIDTH && tree_children_end(n) <= node_total;
 }
 
+/* Ray i (< ray_count) prepared, no hit yet; false for a ray with no
+ * direction to trace. */
+static bool ray_load(__global const float4 *rays, uint i, prep *p, hit *h)
+{
+	float4 o = rays[2 * i], d = rays[2 * i + 1];
+	h->t = d.w;
+	h->u = 0.0f;
+	h->v = 0.0f;
+	h->prim = NO_HIT;
+	return prep_ray(o, d, p);
+}
+
 /* The start of both traversals for ray i: no hit yet, the ray prepared;
  * false when there is nothing to trace (past the last ray, or a ray that
  * misses the root box, whose miss is stored). */
@@ -199,12 +228,7 @@ static bool ray_begin(NODES, uint node_total, __global const float4 *rays, uint 
 {
 	if (i >= ray_count)
 		return false;
-	float4 o = rays[2 * i], d = rays[2 * i + 1];
-	h->t = d.w;
-	h->u = 0.0f;
-	h->v = 0.0f;
-	h->prim = NO_HIT;
-	if (prep_ray(o, d, p) && node_total != 0 && box_enter(p, nodes, 0, h->t) != INFINITY)
+	if (ray_load(rays, i, p, h) && node_total != 0 && box_enter(p, nodes, 0, h->t) != INFINITY)
 		return true;
 	store(hits, counts, i, h, 0, 0);
 	return false;

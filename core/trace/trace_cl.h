@@ -1,8 +1,10 @@
 /*
- * The device traversals (rays.traversal "device_stack", "device_stackless"):
- * trace_cl.cl's kernels on an OpenCL device chosen by a spec (auto, gpu,
- * cpu or P:D, include/bvhlab/opencl.h). A tree is uploaded once (nodes,
- * its triangles' vertices in leaf-slot order, prim_index, parent links);
+ * The device traversals (results' "device_stack", "device_stackless",
+ * "device_wide8"): trace_cl.cl's and trace_cl_wide8.cl's kernels on an
+ * OpenCL device chosen by a spec (auto, gpu, cpu or P:D,
+ * include/bvhlab/opencl.h). A tree is uploaded once (nodes, its
+ * triangles' vertices in leaf-slot order, prim_index, parent links; for
+ * wide8 its compressed nodes and leaf ranges, cwbvh.h, instead);
  * each batch of rays once; a pass is one kernel launch, timed by its
  * profiling event (the kernel's own time) and by the wall clock (launch to
  * completion). Built only with OpenCL (BVHLAB_HAVE_OPENCL); without it
@@ -30,10 +32,11 @@ struct trace_cl_batch;
 /* Whether this build has the device traversals. */
 bool trace_cl_built(void);
 
-/* The traversal (BVHLAB_TRAVERSAL_DEVICE_STACK or _CL_STACKLESS) of tree on
- * the device `device` names (NULL: "auto"). 0, or a negative errno with
- * err saying why: -ENOTSUP OpenCL not built, -ENODEV no platform or device
- * (what to install), -EINVAL a bad spec or tree links, -ENOMEM, -EIO. */
+/* The traversal (BVHLAB_TRAVERSAL_DEVICE_STACK, _STACKLESS or _WIDE8) of
+ * tree on the device `device` names (NULL: "auto"). 0, or a negative errno
+ * with err saying why: -ENOTSUP OpenCL not built, -ENODEV no platform or
+ * device (what to install), -EINVAL a bad spec, tree links, or (wide8) a
+ * box that is not finite, -ENOMEM, -EIO. */
 int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *tree,
                          const bvhlab_scene *scene, struct trace_cl_tree **out,
                          bvhlab_error *err);

@@ -1,7 +1,8 @@
 /*
  * The device traversals in a build without OpenCL (trace_cl.h): every
  * request is refused with the reason, so a config or caller that names
- * device_stack or device_stackless learns why instead of getting nothing.
+ * device_stack, device_stackless or device_wide8 learns why instead of
+ * getting nothing.
  */
 #include <errno.h>
 

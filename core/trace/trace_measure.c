@@ -44,6 +44,8 @@ const char *bvhlab_traversal_name(int traversal)
 		return "wide4";
 	case BVHLAB_TRAVERSAL_WIDE8:
 		return "wide8";
+	case BVHLAB_TRAVERSAL_DEVICE_WIDE8:
+		return "device_wide8";
 	default:
 		return NULL;
 	}
@@ -135,7 +137,8 @@ struct trace_series {
 static bool on_device(int traversal)
 {
 	return traversal == BVHLAB_TRAVERSAL_DEVICE_STACK ||
-	       traversal == BVHLAB_TRAVERSAL_DEVICE_STACKLESS;
+	       traversal == BVHLAB_TRAVERSAL_DEVICE_STACKLESS ||
+	       traversal == BVHLAB_TRAVERSAL_DEVICE_WIDE8;
 }
 
 static int grow(struct trace_series *s)

@@ -24,7 +24,7 @@ struct trace_series;
  * meaning bvhlab_trace_measure gives them; they must live until then.
  * counters false spares the wide traversal its counting pass: its
  * timing's counters and nodes then stay zero. The device traversals
- * (device_stack, device_stackless) upload the tree and rays to opts->device and
+ * (device_stack, device_stackless, device_wide8) upload the tree and rays to opts->device and
  * count on the device. 0, or a negative errno with err saying why:
  * -EINVAL (bad traversal or tree links), -ENOMEM, and for the device
  * -ENOTSUP (OpenCL not built), -ENODEV (no device), -EIO.

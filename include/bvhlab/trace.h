@@ -155,7 +155,11 @@ enum bvhlab_traversal {
 	BVHLAB_TRAVERSAL_WIDE8 = 6,     /* a tree of width 5 to 8 as built, 8 lanes per node
 	                                 * with AVX-512VL, AVX2 or portable code chosen at run
 	                                 * time (width 3 or 4: wide4's; binary: wide's) */
-	BVHLAB_TRAVERSAL_COUNT = 7      /* how many there are */
+	BVHLAB_TRAVERSAL_DEVICE_WIDE8 = 7, /* the tree as compressed 8-wide nodes (Ylitie et al.
+	                                    * 2017: 80 bytes, quantised child boxes, children
+	                                    * by octant) traced on a device (batches only;
+	                                    * OpenCL); narrower trees collapsed to 8 first */
+	BVHLAB_TRAVERSAL_COUNT = 8      /* how many there are */
 };
 
 /* The names before the device traversals said what they are, not which
@@ -163,8 +167,8 @@ enum bvhlab_traversal {
 #define BVHLAB_TRAVERSAL_CL_STACK BVHLAB_TRAVERSAL_DEVICE_STACK
 #define BVHLAB_TRAVERSAL_CL_STACKLESS BVHLAB_TRAVERSAL_DEVICE_STACKLESS
 
-/* "stack" / "stackless" / "wide" / "device_stack" / "device_stackless" / "wide4" / "wide8"
- * (the keys of results.json's rays); NULL for another value. */
+/* "stack" / "stackless" / "wide" / "device_stack" / "device_stackless" / "wide4" / "wide8" /
+ * "device_wide8" (the keys of results.json's rays); NULL for another value. */
 const char *bvhlab_traversal_name(int traversal);
 
 /*

@@ -1,8 +1,9 @@
 /*
  * The device traversals through the bvhlab command (rays.traversal
- * device_stack and device_stackless, core/trace/trace_cl.cl):
+ * device_stack, device_stackless and device_wide8, core/trace/trace_cl*.cl):
  *   trace   every hit of every primary and diffuse ray equal, bit for bit,
- *           to the CPU stack traversal's (rays.traversal_disagreements 0),
+ *           to the CPU stack traversal's, and every shadow and AO ray
+ *           blocked or not as the CPU's (rays.traversal_disagreements 0),
  *           and the nodes counted per ray equal to the CPU stack and
  *           stackless traversals' own, on the trees of several builders
  *           and on lbvh's collapsed into 4- and 8-wide trees (the
@@ -30,8 +31,9 @@
 
 static const char rays_keys[] =
 	"\"rays\": { \"width\": 40, \"height\": 30, \"diffuse\": 2, \"min_ms\": 1, \"rounds\": 2,\n"
+	"  \"kinds\": [\"primary\", \"diffuse\", \"shadow\", \"ao\"],\n"
 	"  \"traversal\": [\"stack\", \"stackless\", {\"name\": \"stack\", \"device\": true},\n"
-	"    {\"name\": \"stackless\", \"device\": true}] },\n";
+	"    {\"name\": \"stackless\", \"device\": true}, {\"name\": \"wide8\", \"device\": true}] },\n";
 
 /* A triangle repeated: every ray that hits one hits all 50 at the same t. */
 static void write_meshes(void)
@@ -70,11 +72,14 @@ static void check_run(const cJSON *run)
 	CHECK(cJSON_GetObjectItem(rays, "error") == NULL);
 	CHECK(strlen(run_str(rays, "device")) > 0);
 	CHECK(num(run, "traversal_disagreements", NULL, NULL) == 0);
-	static const char *const kinds[] = {"primary", "diffuse"};
-	for (int k = 0; k < 2; k++) {
+	static const char *const kinds[] = {"primary", "diffuse", "shadow", "ao"};
+	for (int k = 0; k < 4; k++) {
 		double n = num(run, kinds[k], "rays", NULL);
 		CHECK(num(run, "device_stack", kinds[k], "rays") == n);
 		CHECK(num(run, "device_stackless", kinds[k], "rays") == n);
+		CHECK(num(run, "device_wide8", kinds[k], "rays") == n);
+		if (k >= 2) /* any hit: blocked or not, agreement checked above */
+			continue;
 		/* The same walk: the same nodes entered, summed over the rays. */
 		CHECK(num(run, "device_stack", kinds[k], "nodes_per_ray") ==
 		      num(run, kinds[k], "nodes_per_ray", NULL));
@@ -85,6 +90,9 @@ static void check_run(const cJSON *run)
 		if (n > 0) {
 			CHECK(num(run, "device_stack", kinds[k], "mrays_per_s") > 0);
 			CHECK(num(run, "device_stackless", kinds[k], "wall_mrays_per_s") > 0);
+			CHECK(num(run, "device_wide8", kinds[k], "mrays_per_s") > 0);
+			/* its own count: compressed nodes entered */
+			CHECK(num(run, "device_wide8", kinds[k], "nodes_per_ray") > 0);
 		}
 	}
 }

@@ -39,6 +39,13 @@ static void check_tree(const cJSON *run, int width)
 	CHECK(fabs(num(run, "tree", "bytes_per_triangle") - (nodes * 32 + refs * 4) / 1500) < 1e-9);
 	CHECK(fabs(num(run, "tree", "packed_bytes_per_triangle") -
 	           ((nodes - leaves) * width * 28 + refs * 4) / 1500) < 1e-9);
+	/* the compressed 8-wide layout, for trees device_wide8 takes as built */
+	const cJSON *cw = cJSON_GetObjectItem(cJSON_GetObjectItem(run, "tree"),
+	                                      "cwbvh_bytes_per_triangle");
+	CHECK(width > 4 ? cJSON_IsNumber(cw) && fabs(cw->valuedouble - ((nodes - leaves) * 80 +
+	                                                                leaves * 8 + refs * 4) /
+	                                                               1500) < 1e-9
+	                : cw == NULL);
 }
 
 static void test_sweep(void)
@@ -63,7 +70,8 @@ static void test_sweep(void)
 	}
 	cJSON_Delete(doc);
 	char *csv = read_file(dir, "results.csv");
-	CHECK_CONTAINS(csv, ",tree.width,tree.bytes_per_triangle,tree.packed_bytes_per_triangle,");
+	CHECK_CONTAINS(csv, ",tree.width,tree.bytes_per_triangle,tree.packed_bytes_per_triangle,"
+	                    "tree.cwbvh_bytes_per_triangle,");
 	free(csv);
 	char *md = read_file(dir, "report.md");
 	CHECK_CONTAINS(md, "### Wide trees");
