@@ -13,8 +13,8 @@
  *
  * Over boxes (BVHLAB_PRIM_BOXES: a two-level scene's top, over the
  * instances' world boxes) the same rtcBuildBVH builds from the boxes
- * alone, as Embree builds its own top level over instance bounds; "high"
- * is refused there, since its spatial splits clip triangles.
+ * alone (the primitive id the instance); "high" is refused there, since
+ * its spatial splits clip triangles.
  *
  * Embree's tasking (TBB on Debian) sizes its thread pool per device, and
  * creating one costs far more than a small build, so one device is kept
