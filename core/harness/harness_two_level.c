@@ -16,11 +16,28 @@
 #include "trace/trace_instances.h"
 #include "util/util.h"
 
-/* One level's series into `into` (summed), its median into *median_ms. */
+/* A build's phase medians added to the run's, by name. */
+static void add_phases(struct two_level_trees *trees, const struct build_series *s)
+{
+	for (uint32_t j = 0; j < s->phase_count; j++) {
+		uint32_t row = 0;
+		while (row < trees->phase_count && strcmp(trees->phases[row].name, s->phases[j].name))
+			row++;
+		if (row == BVHLAB_MAX_PHASES)
+			continue;
+		if (row == trees->phase_count)
+			trees->phases[trees->phase_count++] = (bvhlab_phase){.ms = 0};
+		memcpy(trees->phases[row].name, s->phases[j].name, sizeof(s->phases[j].name));
+		trees->phases[row].ms += s->phases[j].ms;
+	}
+}
+
+/* One level's series into `into` (summed), its median into *median_ms,
+ * its phases into trees'. */
 static int time_level(const struct two_level_job *job, const bvhlab_plugin *plugin,
                       const bvhlab_options *opts, const bvhlab_build_input *input,
                       double *into, double *cold_ms, double *median_ms, bvhlab_tree *tree,
-                      bvhlab_error *err)
+                      struct two_level_trees *trees, bvhlab_error *err)
 {
 	double *samples = calloc(job->repeat, sizeof(*samples)), mn, mx, med;
 	struct build_series s = {.warmup = job->warmup, .repeat = job->repeat,
@@ -34,6 +51,7 @@ static int time_level(const struct two_level_job *job, const bvhlab_plugin *plug
 		*cold_ms += s.cold_ms;
 		util_summarise(samples, job->repeat, &med, &mn, &mx);
 		*median_ms += med;
+		add_phases(trees, &s);
 	}
 	*tree = s.tree;
 	free(samples);
@@ -71,7 +89,7 @@ static enum tree_verdict bottom_level(const struct two_level_job *job, double *s
 		int r = bvhlab_prims_init(&prims, mesh, err);
 		if (r == 0)
 			r = time_level(job, job->bottom, job->bottom_opts, &prims.input, samples, cold_ms,
-			               &lv->bottom.build_ms, &trees->bottom[m], err);
+			               &lv->bottom.build_ms, &trees->bottom[m], trees, err);
 		enum tree_verdict v = r < 0 ? TREE_FAILED
 			: harness_measure_tree(&trees->bottom[m], mesh, &prims.input, spatial,
 			                       job->validate_rays, &tm, err);
@@ -106,7 +124,7 @@ static enum tree_verdict top_level(const struct two_level_job *job, double *samp
 	int r = bvhlab_prims_init_boxes(&trees->top_prims, boxes, inst->instance_count, err);
 	if (r == 0)
 		r = time_level(job, job->top, job->top_opts, &trees->top_prims.input, samples, cold_ms,
-		               &lv->top.build_ms, &trees->top, err);
+		               &lv->top.build_ms, &trees->top, trees, err);
 	if (r == 0 && bvhlab_validate_tree(&trees->top, &trees->top_prims.input, false, err) != 0) {
 		error_prefix(err, "top tree: ");
 		free(boxes);
@@ -215,6 +233,8 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
 	                                               &rep->two_level, &trees, err);
 	rep->sample_count = v == TREE_OK ? cfg->repeat : 0;
 	rep->validated = v != TREE_FAILED;
+	rep->phase_count = trees.phase_count;
+	memcpy(rep->phases, trees.phases, sizeof(rep->phases));
 	harness_two_level_finish(&trees);
 	return v;
 }

@@ -30,6 +30,11 @@ struct two_level_trees {
 	uint32_t mesh_count;
 	bvhlab_tree top;
 	bvhlab_prims top_prims;
+	/* The plugins' phases (a peer's input and convert): per name, the sum
+	 * over the builds (each mesh's bottom, the top) of each one's median,
+	 * as the bottom's build_ms sums the meshes' medians. */
+	bvhlab_phase phases[BVHLAB_MAX_PHASES];
+	uint32_t phase_count;
 };
 
 /*

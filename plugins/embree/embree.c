@@ -11,6 +11,11 @@
  * least one reference per primitive (the tests check "low" and "medium"
  * reference each exactly once).
  *
+ * Over boxes (BVHLAB_PRIM_BOXES: a two-level scene's top, over the
+ * instances' world boxes) the same rtcBuildBVH builds from the boxes
+ * alone (the primitive id the instance); "high" is refused there, since
+ * its spatial splits clip triangles.
+ *
  * Embree's tasking (TBB on Debian) sizes its thread pool per device, and
  * creating one costs far more than a small build, so one device is kept
  * for the last thread count asked for and replaced when it changes. Only
@@ -267,6 +272,11 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 	}
 	if ((rc = PLUGIN_OPTIONS_GET(host, ctx, input, &s)) < 0)
 		return rc;
+	if (input->prim_kind == BVHLAB_PRIM_BOXES && s.quality == RTC_BUILD_QUALITY_HIGH) {
+		host->set_error(ctx, "quality 'high' splits triangles; a build over boxes (a "
+		                "two-level top) takes 'low' or 'medium'");
+		return -EINVAL;
+	}
 	pthread_mutex_lock(&cache.lock);
 	rc = build_locked(host, ctx, input, &s, output);
 	pthread_mutex_unlock(&cache.lock);
@@ -274,8 +284,9 @@ static int build(const bvhlab_host *host, bvhlab_build_ctx *ctx,
 }
 
 PLUGIN_WITH_OPTIONS(options, .name = "embree",
-	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_SPATIAL_SPLITS,
+	.flags = BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_SPATIAL_SPLITS |
+	         BVHLAB_BUILDER_BOXES,
 	.summary = "Intel Embree 3 rtcBuildBVH: low (Morton), "
-	           "medium (binned SAH), high (spatial splits)",
+	           "medium (binned SAH), high (spatial splits); low and medium over boxes",
 	.build = build,
 	.peak_bytes_per_prim = 256 /* measured 129-199 (low the most) */)

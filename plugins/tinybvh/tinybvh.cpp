@@ -25,6 +25,11 @@
 // build_ms, as everything in the call is for every plugin; comparisons of
 // the library's own time take both out. One BVH object serves every build
 // of a run (Kept, below).
+//
+// Over boxes (BVHLAB_PRIM_BOXES: a two-level scene's top, over the
+// instances' world boxes) the build is tinybvh's TLAS build,
+// Build(BLASInstance*, ...), over one BLASInstance per box: its binned SAH
+// (builder binned; the others need triangles), width 2, no Optimize.
 #define TINYBVH_IMPLEMENTATION
 #include <tiny_bvh.h>
 
@@ -127,6 +132,11 @@ struct Kept {
 	uint32_t prims = 0;
 	bool optimized = false;
 	std::vector<bvhvec4> soup;
+	// a two-level top's: its own object (a TLAS is a BVH over no
+	// vertices) and its instance records, reused as a TLAS rebuilt per
+	// frame reuses them
+	std::unique_ptr<BVH> tlas;
+	std::vector<tinybvh::BLASInstance> instances;
 };
 Kept kept;
 
@@ -169,6 +179,16 @@ template <typename Tag, typename Tag::type M> struct Reach {
 };
 template struct Reach<CounterTag, &BVH::atomicNewNodePtr>;
 
+// The node counter a one-thread build left (see CounterTag).
+void free_counter(BVH &bvh)
+{
+	if (!bvh.threadedBuild) {
+		std::atomic<uint32_t> *&counter = bvh.*counter_member(CounterTag{});
+		delete counter;
+		counter = nullptr;
+	}
+}
+
 // The library's call for `s`, on the calling thread (which may spawn more).
 void run_builder(BVH &bvh, const Settings &s, const bvhvec4 *v, uint32_t n)
 {
@@ -179,11 +199,7 @@ void run_builder(BVH &bvh, const Settings &s, const bvhvec4 *v, uint32_t n)
 	case sweep: bvh.useFullSweep = true; bvh.Build(v, n); break;
 	case hq: bvh.BuildHQ(v, n); break;
 	}
-	if (!bvh.threadedBuild) {
-		std::atomic<uint32_t> *&counter = bvh.*counter_member(CounterTag{});
-		delete counter;
-		counter = nullptr;
-	}
+	free_counter(bvh);
 }
 
 // BVH::Optimize does exactly this, but with a BVH_Verbose it never frees
@@ -272,22 +288,66 @@ void configure(BVH &bvh, const Settings &s, uint32_t threads)
 	bvh.useFullSweep = false;
 }
 
+// The calling thread's CPUs narrowed to `threads` for the call (see
+// tinybvh_cpus.h); none at 1 thread, where no thread is started.
+int narrow(const bvhlab_host *host, bvhlab_build_ctx *ctx, tbvh::CpuLimit &cpus,
+           uint32_t threads)
+{
+	int rc = threads > 1 ? cpus.limit(threads) : 0;
+	if (rc < 0)
+		host->set_error(ctx, "cannot narrow the CPU affinity to %u CPUs (%s)", threads,
+		                std::strerror(-rc));
+	return rc;
+}
+
+// A two-level top: the boxes as BLASInstance records whose world boxes
+// are already set (Build's null BLAS list: "updated elsewhere", the
+// library's own path for a TLAS over boxes it did not compute), built by
+// the TLAS build. The caller holds the lock and has narrowed the CPUs.
+int build_top(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
+              const Settings &s, bvhlab_build_output *out)
+{
+	if (s.method != binned || s.width != 2 || s.optimize > 0) {
+		host->set_error(ctx, "over boxes (a two-level top) tinybvh builds its TLAS, "
+		                "Build(BLASInstance*), a binned SAH: set builder 'binned' and "
+		                "leave width (2) and optimize (0)");
+		return -EINVAL;
+	}
+	auto t0 = clk::now();
+	kept.instances.resize(in->prim_count);
+	for (uint32_t i = 0; i < in->prim_count; i++) {
+		const bvhlab_aabb &b = in->prim_bounds[i];
+		kept.instances[i].aabbMin = tinybvh::bvhvec3(b.lo[0], b.lo[1], b.lo[2]);
+		kept.instances[i].aabbMax = tinybvh::bvhvec3(b.hi[0], b.hi[1], b.hi[2]);
+	}
+	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
+	if (!kept.tlas)
+		kept.tlas = std::make_unique<BVH>();
+	BVH &tlas = *kept.tlas;
+	configure(tlas, s, in->threads);
+	tlas.Build(kept.instances.data(), in->prim_count, nullptr, 0);
+	free_counter(tlas);
+	return peer::convert(host, ctx, View{tlas}, out);
+}
+
 int build_tree(const bvhlab_host *host, bvhlab_build_ctx *ctx, const bvhlab_build_input *in,
                const Settings &s, bvhlab_build_output *out)
 {
 	std::lock_guard<std::mutex> hold(kept.lock);
+	if (in->prim_kind == BVHLAB_PRIM_BOXES) {
+		tbvh::CpuLimit cpus;
+		int rc = narrow(host, ctx, cpus, in->threads);
+		return rc < 0 ? rc : build_top(host, ctx, in, s, out);
+	}
 	auto t0 = clk::now();
 	soup(in, kept.soup);
 	peer::report_phase(host, ctx, "input", peer::ms_since(t0));
 	BVH *bvh = nullptr;
 	{
 		tbvh::CpuLimit cpus;
-		int rc = in->threads > 1 ? cpus.limit(in->threads) : 0;
-		if (rc < 0) {
-			host->set_error(ctx, "cannot narrow the CPU affinity to %u CPUs (%s)",
-			                in->threads, std::strerror(-rc));
+		int rc = narrow(host, ctx, cpus, in->threads);
+		if (rc < 0)
 			return rc;
-		}
 		if (s.width != 2)
 			return s.width == 4 ? build_wide<tinybvh::BVH4_CPU, 4>(host, ctx, in, out)
 			                    : build_wide<tinybvh::BVH8_CPU, 8>(host, ctx, in, out);
@@ -308,10 +368,10 @@ PEER_BUILD_FN(UINT32_MAX / 8)
 const bvhlab_builder descriptor = bvhlab::with_peak_bytes(bvhlab::with_fill_options(
 	bvhlab::make_builder("tinybvh",
 	                     "jbikker/tinybvh 1.6.7: quick, binned, avx, sweep, hq (spatial "
-	                     "splits), optional Optimize; thread count held by CPU affinity (see "
-	                     "the builder option)",
+	                     "splits), optional Optimize; over boxes its TLAS build (binned); "
+	                     "thread count held by CPU affinity (see the builder option)",
 	                     BVHLAB_BUILDER_PARALLEL | BVHLAB_BUILDER_DETERMINISTIC |
-	                             BVHLAB_BUILDER_SPATIAL_SPLITS,
+	                             BVHLAB_BUILDER_SPATIAL_SPLITS | BVHLAB_BUILDER_BOXES,
 	                     plugin_decls, bvhlab::guarded_build<build>),
 	plugin_fill_options, sizeof(Settings)), 288);
 
