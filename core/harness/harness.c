@@ -228,8 +228,9 @@ static void series_work(void *arg, void *report, size_t size)
 	(void)size;
 	rep->status = SERIES_OK;
 	if (job->hb->top.plugin) { /* two-level (harness_two_level.c): status in the same order */
-		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst, job->run->key.threads,
-		                                    rep, &err);
+		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst,
+		                                    cfg->scenes[job->run->scene].name,
+		                                    job->run->key.threads, rep, &err);
 		goto out;
 	}
 	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);
