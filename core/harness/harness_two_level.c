@@ -202,11 +202,12 @@ void harness_two_level_finish(struct two_level_trees *trees)
 }
 
 /* The run's primary rays through its trees, with the config's CPU
- * traversals and camera (auto-framed on the flattened scene's bounds, so
- * its one-level runs trace the same rays). */
+ * traversals and camera (auto-framed on `flat`, the flattened scene's
+ * bounds, so its one-level runs trace the same rays; NULL: on the top
+ * tree's root box). */
 static void trace_rays(const struct config *cfg, const struct scene_instanced *inst,
-                       const char *scene, const struct two_level_trees *trees,
-                       struct ray_metrics *m)
+                       const char *scene, const bvhlab_aabb *flat,
+                       const struct two_level_trees *trees, struct ray_metrics *m)
 {
 	struct trace_two_level tl = {.inst = inst, .top = &trees->top, .bottom = trees->bottom};
 	struct ray_settings rs;
@@ -219,16 +220,17 @@ static void trace_rays(const struct config *cfg, const struct scene_instanced *i
 		rs.main = BVHLAB_TRAVERSAL_STACK; /* the device ones are said left out */
 		rs.traversals |= 1u << BVHLAB_TRAVERSAL_STACK;
 	}
-	scene_instanced_bounds(inst, &bounds);
-	harness_camera_of(cfg, scene, &bounds, &cam);
+	memcpy(bounds.lo, trees->top.nodes[0].lo, sizeof(bounds.lo));
+	memcpy(bounds.hi, trees->top.nodes[0].hi, sizeof(bounds.hi));
+	harness_camera_of(cfg, scene, flat ? flat : &bounds, &cam);
 	harness_trace_rays_two_level(&tl, &cam, &rs, m);
 }
 
 enum tree_verdict harness_two_level_run(const struct config *cfg,
                                         const struct harness_builder *hb,
                                         const struct scene_instanced *inst, const char *scene,
-                                        uint32_t threads, struct series_report *rep,
-                                        bvhlab_error *err)
+                                        const bvhlab_aabb *flat, uint32_t threads,
+                                        struct series_report *rep, bvhlab_error *err)
 {
 	struct two_level_job job = {.inst = inst, .bottom = hb->plugin, .top = hb->top.plugin,
 	                            .bottom_opts = &hb->opts, .top_opts = &hb->top.opts,
@@ -241,7 +243,7 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
 	rep->sample_count = v == TREE_OK ? cfg->repeat : 0;
 	rep->validated = v != TREE_FAILED;
 	if (v == TREE_OK)
-		trace_rays(cfg, inst, scene, &trees, &rep->rays);
+		trace_rays(cfg, inst, scene, flat, &trees, &rep->rays);
 	harness_two_level_finish(&trees);
 	return v;
 }

@@ -165,24 +165,6 @@ static void place(const struct scene_instanced *s, uint32_t i, float *dst)
 		place_vertex(&s->instances[i], m->vertices + 3 * (size_t)v, dst + 3 * (size_t)v);
 }
 
-void scene_instanced_bounds(const struct scene_instanced *s, bvhlab_aabb *out)
-{
-	float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-	for (uint32_t i = 0; i < s->instance_count; i++) {
-		const bvhlab_scene *m = s->meshes[s->instances[i].mesh];
-		for (uint32_t v = 0; v < m->vertex_count; v++) {
-			float q[3];
-			place_vertex(&s->instances[i], m->vertices + 3 * (size_t)v, q);
-			for (int k = 0; k < 3; k++) {
-				lo[k] = fminf(lo[k], q[k]);
-				hi[k] = fmaxf(hi[k], q[k]);
-			}
-		}
-	}
-	memcpy(out->lo, lo, sizeof(lo));
-	memcpy(out->hi, hi, sizeof(hi));
-}
-
 int scene_instanced_flatten(const struct scene_instanced *s, const char *name,
                             bvhlab_scene **out, bvhlab_error *err)
 {

@@ -58,9 +58,6 @@ void scene_instanced_box(const struct scene_instanced *s, uint32_t i, bvhlab_aab
 /* Triangles of the meshes once each, and of every instance. */
 uint64_t scene_instanced_unique_triangles(const struct scene_instanced *s);
 uint64_t scene_instanced_triangles(const struct scene_instanced *s);
-/* The box of every instance's vertices in world space, rounded to floats
- * as the flattened scene's are: its bounds, bit for bit, without it. */
-void scene_instanced_bounds(const struct scene_instanced *s, bvhlab_aabb *out);
 /* Every instance's triangles in world space, in instance order, as one
  * mesh named `name`: -EOVERFLOW past UINT32_MAX vertices or triangles. */
 int scene_instanced_flatten(const struct scene_instanced *s, const char *name,

@@ -104,9 +104,41 @@ static void refused(void)
 	CHECK(!cli_exists(cli_path_in("out-bad")));
 }
 
+/* A scene no flat tree can hold (100,820-triangle spheres placed 50,000
+ * times: 5,041,000,000 triangles): the one-level run fails naming the
+ * scene and its triangles, the two-level one runs without the flat scene. */
+static void unflattenable(void)
+{
+	const char *text =
+		"{ \"output\": \"out-big\", \"repeat\": 1, \"warmup\": 0, \"threads\": [2],\n"
+		"  \"validate_rays\": 8, \"rays\": { \"width\": 4, \"height\": 4, \"min_ms\": 1 },\n"
+		"  \"scenes\": [ { \"name\": \"big\",\n"
+		"    \"meshes\": [ { \"name\": \"ball\", \"generator\": \"icosphere\",\n"
+		"                    \"frequency\": 71 } ],\n"
+		"    \"instances\": [ { \"scatter\": { \"mesh\": \"ball\", \"count\": 50000,\n"
+		"      \"bounds\": [[-2000, 0, -2000], [2000, 0, 2000]] } } ] } ],\n"
+		"  \"builders\": [ { \"plugin\": \"lbvh\" }, { \"bottom\": \"lbvh\", \"top\": \"lbvh\" } ] }\n";
+	CHECK_INT(run_in(tmpdir, ARGS("run", "--quiet", write_config("big.json", text))), 1);
+	cJSON *doc = load_results(cli_path_in("out-big"));
+	const cJSON *scene = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "scenes"), 0);
+	CHECK(num_at(scene, "instances", "instanced_triangles", NULL) == 5041000000.0);
+	CHECK(scene && !strcmp(run_str(scene, "source"), "two-level scene"));
+	const cJSON *flat = find_run(doc, "big", "lbvh", 2);
+	const cJSON *two = find_run(doc, "big", "two-level[top=lbvh,bottom=lbvh]", 2);
+	CHECK(flat && !strcmp(run_str(flat, "status"), "failed"));
+	CHECK(flat && strstr(run_str(flat, "error"), "big") &&
+	      strstr(run_str(flat, "error"), "flattened") &&
+	      strstr(run_str(flat, "error"), "5041000000"));
+	CHECK(two && !strcmp(run_str(two, "status"), "ok"));
+	CHECK(num_at(two, "validation", "mismatches", NULL) == 0);
+	CHECK(num_at(cJSON_GetObjectItem(two, "rays"), "primary", "rays", NULL) == 16);
+	cJSON_Delete(doc);
+}
+
 static void all(void)
 {
 	sweep();
+	unflattenable();
 	refused();
 }
 
