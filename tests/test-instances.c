@@ -264,6 +264,73 @@ static double two_level_sah(const struct scene_instanced *s, const struct two_le
 	return sah;
 }
 
+/* Every CPU traversal through both levels (trace_two_level_prepare): no
+ * disagreement with brute force over the instanced triangles or over the
+ * flattened scene, and for every ray the stack traversal's very hit. */
+static void check_traversals(const struct scene_instanced *inst, struct two_level_trees *trees,
+                             const bvhlab_scene *flat, const char *what)
+{
+	static const int kinds[] = {BVHLAB_TRAVERSAL_STACK, BVHLAB_TRAVERSAL_STACKLESS,
+	                            BVHLAB_TRAVERSAL_WIDE, BVHLAB_TRAVERSAL_WIDE4,
+	                            BVHLAB_TRAVERSAL_WIDE8};
+	struct trace_two_level ref = {.inst = inst, .top = &trees->top, .bottom = trees->bottom};
+	bvhlab_aabb b;
+	memcpy(b.lo, trees->top.nodes[0].lo, sizeof(b.lo));
+	memcpy(b.hi, trees->top.nodes[0].hi, sizeof(b.hi));
+	for (size_t k = 0; k < sizeof(kinds) / sizeof(kinds[0]); k++) {
+		struct trace_two_level tl = ref;
+		uint64_t mismatches = 1, flat_mismatches = 1, differ = 0;
+		CHECK_INT(trace_two_level_prepare(&tl, kinds[k]), 0);
+		trace_two_level_check(&tl, flat, 500, 11, &mismatches, &flat_mismatches);
+		for (uint32_t i = 0; i < 500; i++) {
+			bvhlab_ray ray;
+			struct trace_inst_hit a, h;
+			trace_two_level_ray(inst, &b, 11, i, &ray);
+			trace_two_level_closest(&ref, &ray, &a, NULL);
+			trace_two_level_closest(&tl, &ray, &h, NULL);
+			differ += a.instance != h.instance || a.hit.prim != h.hit.prim ||
+			          memcmp(&a.hit.t, &h.hit.t, sizeof(a.hit.t)) != 0;
+		}
+		if (mismatches || flat_mismatches || differ)
+			fprintf(stderr, "%s, %s: %llu against brute force, %llu against the flat "
+			        "scene, %llu against the stack traversal\n", what,
+			        bvhlab_traversal_name(kinds[k]), (unsigned long long)mismatches,
+			        (unsigned long long)flat_mismatches, (unsigned long long)differ);
+		CHECK(mismatches == 0 && flat_mismatches == 0 && differ == 0);
+		trace_two_level_release(&tl);
+		CHECK(tl.views == NULL && tl.top_parents == NULL);
+	}
+	struct trace_two_level tl = ref;
+	CHECK_INT(trace_two_level_prepare(&tl, BVHLAB_TRAVERSAL_DEVICE_STACK), -EINVAL);
+}
+
+/* The bottom trees collapsed to 8 wide (wide_collapse), so wide8 walks
+ * 8-lane nodes as built, and the top to 4: every traversal again. */
+static void check_wide_bottoms(const struct scene_instanced *inst, struct two_level_trees *trees,
+                               const bvhlab_scene *flat)
+{
+	bvhlab_plugin *collapser = NULL;
+	bvhlab_error err = { "" };
+	if (!plugin_loads("collapse", &collapser))
+		return;
+	for (uint32_t m = 0; m <= inst->mesh_count; m++) {
+		bvhlab_prims prims = {0};
+		bvhlab_options o;
+		bool top = m == inst->mesh_count;
+		CHECK_INT(bvhlab_options_init(&o, bvhlab_plugin_builder(collapser)), 0);
+		CHECK_INT(bvhlab_options_parse(&o, top ? "width=4" : "width=8", &err), 0);
+		if (!top)
+			CHECK_INT(bvhlab_prims_init(&prims, inst->meshes[m], &err), 0);
+		CHECK_INT(bvhlab_refine(collapser, &o, top ? &trees->top_prims.input : &prims.input, 1,
+		                        top ? &trees->top : &trees->bottom[m], &err), 0);
+		bvhlab_prims_finish(&prims);
+		bvhlab_options_finish(&o);
+	}
+	CHECK(trees->bottom[0].width == 8 && trees->top.width == 4);
+	check_traversals(inst, trees, flat, "8-wide bottoms, 4-wide top");
+	bvhlab_plugin_close(collapser);
+}
+
 /* Rays through both levels: the brute force over every instanced triangle
  * gives the same (instance, primitive, t), and the flattened scene the
  * same hits; a top tree whose leaves name the wrong instances is caught. */
@@ -288,6 +355,7 @@ static void check_trace(const struct scene_instanced *inst, struct two_level_tre
 		CHECK(h.hit.prim == BVHLAB_NO_HIT || h.instance < inst->instance_count);
 	}
 	CHECK(hits > 300);
+	check_traversals(inst, trees, flat, "binary trees");
 	uint32_t *ix = trees->top.prim_index, keep = ix[0];
 	ix[0] = ix[trees->top.index_count - 1];
 	ix[trees->top.index_count - 1] = keep;
@@ -295,6 +363,7 @@ static void check_trace(const struct scene_instanced *inst, struct two_level_tre
 	CHECK(mismatches > 0);
 	ix[trees->top.index_count - 1] = ix[0];
 	ix[0] = keep;
+	check_wide_bottoms(inst, trees, flat);
 	bvhlab_scene_destroy(flat);
 }
 

@@ -228,8 +228,10 @@ static void series_work(void *arg, void *report, size_t size)
 	(void)size;
 	rep->status = SERIES_OK;
 	if (job->hb->top.plugin) { /* two-level (harness_two_level.c): status in the same order */
-		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst, job->run->key.threads,
-		                                    rep, &err);
+		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst,
+		                                    cfg->scenes[job->run->scene].name,
+		                                    job->scene ? &job->scene->bounds : NULL,
+		                                    job->run->key.threads, rep, &err);
 		goto out;
 	}
 	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);
@@ -338,6 +340,14 @@ static void queue_tree(struct harness *h, const struct series_job *job,
 		unlink(job->tree_path);
 }
 
+/* The scene's triangles: the flattened scene's, or a two-level one's
+ * instanced triangles (past 2^32 - 1, its "instances" entry has them). */
+static uint32_t scene_triangles(const struct harness *h, const bvhlab_scene *scene)
+{
+	uint64_t t = scene ? scene->triangle_count : scene_instanced_triangles(&h->inst);
+	return t > UINT32_MAX ? UINT32_MAX : (uint32_t)t;
+}
+
 static void run_one(struct harness *h, struct series_job *job)
 {
 	const struct plan_run *pr = job->run;
@@ -345,15 +355,17 @@ static void run_one(struct harness *h, struct series_job *job)
 	struct run_record run = run_record_of(pr, job->hb);
 	char paths[2][4096], tree_path[4096];
 	run.plugin = bvhlab_plugin_builder(job->hb->plugin)->name;
+	const char *scene = h->cfg->scenes[pr->scene].name;
 	run.status = "failed";
-	run.triangles = job->scene->triangle_count;
+	run.triangles = scene_triangles(h, job->scene);
 	if (skip_run(h, pr))
 		return;
 	struct memory_estimate est;
 	char refused[512];
-	run.estimate = &est;
-	if (harness_estimate_run(h->cfg, job->hb, job->scene->name, &job->prims->input, &est,
-	                         refused, sizeof(refused)) < 0) {
+	/* The estimates are of one-level builds: a two-level one has none yet. */
+	run.estimate = job->hb->top.plugin ? NULL : &est;
+	if (run.estimate && harness_estimate_run(h->cfg, job->hb, scene, &job->prims->input, &est,
+	                                         refused, sizeof(refused)) < 0) {
 		run.error = refused; /* nothing built: the sweep goes on */
 		record(h, &run);
 		return;
@@ -374,7 +386,7 @@ static void run_one(struct harness *h, struct series_job *job)
 		job->tree_path = tree_path;
 	progress_start(&h->progress, &run);
 	run_series(h, job, &run, rep, size);
-	images_lost(h, harness_image_lost(job->scene->name, job->hb->cb->name, job->heat_path,
+	images_lost(h, harness_image_lost(scene, job->hb->cb->name, job->heat_path,
 	                                  rep->heat_error, h->progress.tty));
 	if (job->shade_path && rep->shade_error < 0)
 		h->shade_error = rep->shade_error; /* a later run may still leave it */
@@ -383,9 +395,10 @@ static void run_one(struct harness *h, struct series_job *job)
 	munmap(rep, size);
 }
 
-/* The scene's runs of the list, on the loaded scene. */
+/* The scene's runs of the list, on the loaded scene (NULL: a two-level
+ * scene not flattened, its one-level runs failed with no_flat). */
 static void run_list_scene(struct harness *h, const bvhlab_scene *scene,
-                           const bvhlab_prims *prims, size_t s)
+                           const bvhlab_prims *prims, size_t s, const char *no_flat)
 {
 	for (size_t k = h->list.scene_first[s]; k < h->list.scene_first[s + 1]; k++) {
 		const struct plan_run *run = &h->list.runs[k];
@@ -394,6 +407,8 @@ static void run_list_scene(struct harness *h, const bvhlab_scene *scene,
 		                         .run = run};
 		if (!hb->plugin || !hb->opts_ok)
 			record_failed(h, run, hb->status, hb->error.message);
+		else if (!scene && !hb->top.plugin)
+			record_failed(h, run, "failed", no_flat);
 		else
 			run_one(h, &job);
 	}
@@ -410,18 +425,40 @@ static void scene_images(struct harness *h, const bvhlab_scene *scene, size_t s)
 	images_lost(h, harness_scene_images(&h->res, h->cfg, &h->list, scene, s, h->progress.tty));
 }
 
+/* Whether scene s has a run of a one-level builder: a two-level scene is
+ * flattened for those alone. */
+static bool wants_flat(const struct harness *h, size_t s)
+{
+	for (size_t k = h->list.scene_first[s]; k < h->list.scene_first[s + 1]; k++)
+		if (!h->builders[h->list.runs[k].builder].top.plugin)
+			return true;
+	return false;
+}
+
+/* A two-level scene's meshes and instances, and its flattened form when a
+ * one-level builder needs it; one that cannot be made fails those runs
+ * alone (flat_err says why), the two-level ones run without it. */
+static int load_instanced(struct harness *h, const struct config_scene *cs, size_t s,
+                          bvhlab_scene **scene, bvhlab_error *flat_err, bvhlab_error *err)
+{
+	int r = harness_load_instanced(cs, &h->inst, err);
+	if (r == 0 && wants_flat(h, s) && harness_flatten(cs, &h->inst, scene, flat_err) < 0)
+		fprintf(stderr, "%s%s\n", h->progress.tty ? "\n" : "", flat_err->message);
+	return r;
+}
+
 static void run_scene(struct harness *h, const struct config_scene *cs, size_t s)
 {
 	bvhlab_scene *scene = NULL;
 	bvhlab_prims prims = {0};
-	bvhlab_error err = {{0}};
+	bvhlab_error err = {{0}}, flat_err = {{0}};
 	if (scene_done(h, s))
 		return;
 	int r = h->cfg->isolate ? harness_probe_scene(h->cfg, cs, &err) : 0;
-	if (r == 0) /* two-level: meshes once, flattened; animated: frame 0 (harness_anim.c) */
-		r = cs->meshes ? harness_scene_instanced(cs, &h->inst, &scene, &err)
+	if (r == 0) /* two-level: meshes once, flattened if need be; animated: frame 0 */
+		r = cs->meshes ? load_instanced(h, cs, s, &scene, &flat_err, &err)
 		               : harness_anim_load(cs, &h->anim, &scene, &err);
-	if (r == 0)
+	if (r == 0 && scene)
 		r = bvhlab_prims_init(&prims, scene, &err);
 	if (r < 0) {
 		results_add_scene(&h->res, cs->name, cs->path ? cs->path : cs->generator, 0,
@@ -431,17 +468,18 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 		goto out;
 	}
 	char *shown = cs->path ? util_path_shown(h->cfg->dir, cs->path) : NULL;
-	results_add_scene(&h->res, scene->name, shown ? shown : scene->source,
-	                  scene->triangle_count, NULL);
+	const char *source = shown ? shown : scene ? scene->source : "two-level scene";
+	results_add_scene(&h->res, cs->name, source, scene_triangles(h, scene), NULL);
 	free(shown);
-	harness_record_instances(&h->res, scene->name, &h->inst);
+	harness_record_instances(&h->res, cs->name, &h->inst);
 	h->shade_done = false;
 	h->shade_error = 0;
-	h->rounds_on = harness_rounds_start(h->cfg, scene, h->progress.tty);
-	run_list_scene(h, scene, &prims, s);
-	harness_rounds_end(&h->rounds, &h->res, h->cfg, scene, &prims, h->progress.tty);
+	h->rounds_on = scene && harness_rounds_start(h->cfg, scene, h->progress.tty);
+	run_list_scene(h, scene, &prims, s, flat_err.message);
+	if (scene)
+		harness_rounds_end(&h->rounds, &h->res, h->cfg, scene, &prims, h->progress.tty);
 	h->rounds_on = false;
-	if (h->images)
+	if (h->images && scene)
 		scene_images(h, scene, s);
 out:
 	harness_anim_close(&h->anim);

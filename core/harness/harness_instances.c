@@ -9,6 +9,7 @@
 
 #include "harness/harness_instances.h"
 #include "harness/harness_scene.h"
+#include "machine/machine.h"
 #include "util/util.h"
 
 /* Prefixes err's message with the scene and what in it failed. */
@@ -87,13 +88,30 @@ int harness_load_flattened(const struct config_scene *cs, bvhlab_scene **out,
 	return r;
 }
 
-int harness_scene_instanced(const struct config_scene *cs, struct scene_instanced *inst,
-                            bvhlab_scene **flat, bvhlab_error *err)
+/* What the flattened scene and its primitives take: vertices, indices,
+ * and per triangle a box and a centroid (bvhlab_prims). */
+static uint64_t flat_bytes(const struct scene_instanced *inst)
 {
-	int r = harness_load_instanced(cs, inst, err);
-	if (r == 0)
-		r = scene_instanced_flatten(inst, cs->name, flat, err);
-	return r;
+	uint64_t v = 0;
+	for (uint32_t i = 0; i < inst->instance_count; i++)
+		v += inst->meshes[inst->instances[i].mesh]->vertex_count;
+	return 12 * v + (12 + 24 + 12) * scene_instanced_triangles(inst);
+}
+
+int harness_flatten(const struct config_scene *cs, const struct scene_instanced *inst,
+                    bvhlab_scene **flat, bvhlab_error *err)
+{
+	uint64_t bytes = flat_bytes(inst), available = machine_memory_available();
+	*flat = NULL;
+	if (available && bytes > available) {
+		error_set(err, "scene '%s': flattened, its %llu instanced triangles would take "
+		          "%.1f GiB with their primitive boxes, more than the %.1f GiB available; "
+		          "one-level builders cannot run on it (two-level builders need no flat "
+		          "scene)", cs->name, (unsigned long long)scene_instanced_triangles(inst),
+		          (double)bytes / (1u << 30), (double)available / (1u << 30));
+		return -E2BIG;
+	}
+	return scene_instanced_flatten(inst, cs->name, flat, err);
 }
 
 void harness_record_instances(struct results *res, const char *scene,

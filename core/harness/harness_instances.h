@@ -19,10 +19,13 @@ int harness_load_instanced(const struct config_scene *cs, struct scene_instanced
 int harness_load_flattened(const struct config_scene *cs, bvhlab_scene **out,
                            bvhlab_error *err);
 
-/* For a sweep: the two-level form into inst and the flattened scene (the
- * one-level builders' input) into *flat, both from one loading. */
-int harness_scene_instanced(const struct config_scene *cs, struct scene_instanced *inst,
-                            bvhlab_scene **flat, bvhlab_error *err);
+/* For a sweep that has one-level builders on the two-level scene inst:
+ * the scene flattened into *flat, refused (-E2BIG, err naming the scene
+ * and its instanced triangles) when it and its primitive boxes would not
+ * fit in the memory available, or past the one-level limit (-EOVERFLOW);
+ * *flat NULL on failure. */
+int harness_flatten(const struct config_scene *cs, const struct scene_instanced *inst,
+                    bvhlab_scene **flat, bvhlab_error *err);
 
 /* The scene's meshes, instances and triangle counts into its results
  * entry; nothing for a one-level scene (inst zeroed). */

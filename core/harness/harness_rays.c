@@ -14,22 +14,29 @@
 #include "harness/harness_rays.h"
 #include "output/image.h"
 #include "output/results.h"
+#include "trace/trace_instances.h"
 #include "trace/trace_series.h"
 #include "util/util.h"
 
-void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam)
+void harness_camera_of(const struct config *cfg, const char *name, const bvhlab_aabb *bounds,
+                       bvhlab_camera *cam)
 {
 	/* Scene names are unique in a config, and the harness names each
 	 * loaded scene after its config entry. */
-	for (size_t i = 0; cfg && scene->name && i < cfg->scene_count; i++)
-		if (cfg->scenes[i].has_camera && strcmp(cfg->scenes[i].name, scene->name) == 0) {
+	for (size_t i = 0; cfg && name && i < cfg->scene_count; i++)
+		if (cfg->scenes[i].has_camera && strcmp(cfg->scenes[i].name, name) == 0) {
 			*cam = cfg->scenes[i].camera;
 			return;
 		}
 	if (cfg && cfg->has_camera)
 		*cam = cfg->camera;
 	else
-		bvhlab_camera_frame(&scene->bounds, cam);
+		bvhlab_camera_frame(bounds, cam);
+}
+
+void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam)
+{
+	harness_camera_of(cfg, scene->name, &scene->bounds, cam);
 }
 
 void harness_ray_settings(const struct config *cfg, struct ray_settings *rs)
@@ -215,6 +222,60 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
 	if (r < 0 && !m->error[0])
 		snprintf(m->error, sizeof(m->error), "%s", strerror(-r));
 out:
+	free(hits);
+	free(rays);
+	return r;
+}
+
+/* One CPU traversal of a two-level batch, as measure() one of a tree. */
+static int measure_two_level(const struct trace_two_level *tl, const bvhlab_ray *rays, size_t n,
+                             const bvhlab_trace_options *o, bvhlab_hit *hits,
+                             bvhlab_trace_timing *out, struct ray_metrics *m)
+{
+	bvhlab_error err = {{0}};
+	int r = trace_measure_two_level(tl, rays, n, o, hits, out, &err);
+	if (r < 0) {
+		error_prefix(&err, "%s", bvhlab_traversal_name(o->traversal));
+		add_error(m, err.message);
+	}
+	return r;
+}
+
+int harness_trace_rays_two_level(const struct trace_two_level *tl, const bvhlab_camera *cam,
+                                 const struct ray_settings *rs, struct ray_metrics *m)
+{
+	bvhlab_ray *rays = NULL;
+	size_t n = (size_t)rs->width * rs->height;
+	memset(m, 0, sizeof(*m));
+	m->traversals = rs->traversals;
+	m->main = rs->main;
+	m->kinds = 1u << RAY_PRIMARY;
+	m->rounds = 1;
+	int r = bvhlab_rays_primary(cam, rs->width, rs->height, &rays);
+	bvhlab_hit *hits = r == 0 ? malloc(n * sizeof(*hits)) : NULL, *other = NULL;
+	other = hits ? malloc(n * sizeof(*other)) : NULL;
+	r = r < 0 ? r : other ? 0 : -ENOMEM;
+	bvhlab_trace_options o = {.traversal = rs->main, .threads = rs->threads,
+	                          .min_ms = rs->min_ms, .min_repeats = rs->min_repeats};
+	if (r == 0)
+		r = measure_two_level(tl, rays, n, &o, hits, &m->primary[rs->main], m);
+	m->threads = m->primary[rs->main].threads;
+	for (int k = 0; r == 0 && k < BVHLAB_TRAVERSAL_COUNT; k++) {
+		if (k == rs->main || !(m->traversals & (1u << k)))
+			continue;
+		o.traversal = k;
+		if (measure_two_level(tl, rays, n, &o, other, &m->primary[k], m) == 0) {
+			for (size_t i = 0; i < n; i++)
+				m->disagreements += !same_hit(&hits[i], &other[i], false);
+		} else { /* a device traversal: the CPU ones go on */
+			m->traversals &= ~(1u << k);
+			m->primary[k] = (bvhlab_trace_timing){0};
+		}
+	}
+	m->measured = r == 0;
+	if (r < 0 && !m->error[0])
+		snprintf(m->error, sizeof(m->error), "%s", strerror(-r));
+	free(other);
 	free(hits);
 	free(rays);
 	return r;

@@ -40,6 +40,9 @@ void harness_ray_settings(const struct config *cfg, struct ray_settings *rs);
 
 /* The config's camera, or the automatic framing of the scene. */
 void harness_camera(const struct config *cfg, const bvhlab_scene *scene, bvhlab_camera *cam);
+/* The same for the scene named `name` whose bounds are `bounds`. */
+void harness_camera_of(const struct config *cfg, const char *name, const bvhlab_aabb *bounds,
+                       bvhlab_camera *cam);
 
 /*
  * The rays of a secondary kind (diffuse, shadow, ao) from the primary
@@ -64,6 +67,18 @@ int harness_secondary_rays(int kind, const bvhlab_scene *scene, const struct ray
 int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
                        const bvhlab_camera *cam, const struct ray_settings *rs,
                        struct ray_metrics *m, uint32_t *nodes, uint8_t *shade);
+
+/*
+ * A two-level scene's primary rays (width x height from cam) timed with
+ * each CPU traversal of rs at both levels (trace_measure_two_level), into
+ * m->primary; another traversal's hits are compared with the main one's
+ * into m->disagreements, a device one is left out with its reason in
+ * m->error. No secondary kinds (they need the flattened scene's normals).
+ * 0 or a negative errno (the main traversal failing).
+ */
+struct trace_two_level;
+int harness_trace_rays_two_level(const struct trace_two_level *tl, const bvhlab_camera *cam,
+                                 const struct ray_settings *rs, struct ray_metrics *m);
 
 /* Why no ray was traced (r a negative errno) into buf; out of memory with
  * the limit it ran under (memory_limit bytes, 0 none; only when isolated,

@@ -80,10 +80,16 @@ static void probe_work(void *arg, void *report, size_t size)
 	bvhlab_scene *scene = NULL;
 	bvhlab_prims prims = {0};
 	bvhlab_error err = {{0}};
+	struct scene_instanced inst = {0};
+	const struct config_scene *cs = arg;
 	(void)size;
-	int r = harness_load_scene(arg, &scene, &err);
-	if (r == 0)
+	/* A two-level scene's meshes and instances; the parent flattens it,
+	 * checked against the memory available, only where a run needs it. */
+	int r = cs->meshes ? harness_load_instanced(cs, &inst, &err)
+	                   : harness_load_scene(cs, &scene, &err);
+	if (r == 0 && scene)
 		r = bvhlab_prims_init(&prims, scene, &err);
+	scene_instanced_finish(&inst);
 	rep->ok = r == 0;
 	snprintf(rep->error, sizeof(rep->error), "%s", err.message);
 }

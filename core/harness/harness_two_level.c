@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "harness/harness_rays.h"
 #include "harness/harness_report.h"
 #include "harness/harness_series.h"
 #include "harness/harness_two_level.h"
@@ -95,7 +96,7 @@ static enum tree_verdict bottom_level(const struct two_level_job *job, double *s
 			                       job->validate_rays, &tm, err);
 		bvhlab_prims_finish(&prims);
 		if (v != TREE_OK) {
-			error_prefix(err, "bottom tree of mesh '%s': ", mesh->name);
+			error_prefix(err, "bottom tree of mesh '%s'", mesh->name);
 			return v;
 		}
 		whole->rays_checked += tm.rays_checked;
@@ -126,7 +127,7 @@ static enum tree_verdict top_level(const struct two_level_job *job, double *samp
 		r = time_level(job, job->top, job->top_opts, &trees->top_prims.input, samples, cold_ms,
 		               &lv->top.build_ms, &trees->top, trees, err);
 	if (r == 0 && bvhlab_validate_tree(&trees->top, &trees->top_prims.input, false, err) != 0) {
-		error_prefix(err, "top tree: ");
+		error_prefix(err, "top tree");
 		free(boxes);
 		return TREE_INVALID;
 	}
@@ -218,9 +219,35 @@ void harness_two_level_finish(struct two_level_trees *trees)
 	memset(trees, 0, sizeof(*trees));
 }
 
+/* The run's primary rays through its trees, with the config's CPU
+ * traversals and camera (auto-framed on `flat`, the flattened scene's
+ * bounds, so its one-level runs trace the same rays; NULL: on the top
+ * tree's root box). */
+static void trace_rays(const struct config *cfg, const struct scene_instanced *inst,
+                       const char *scene, const bvhlab_aabb *flat,
+                       const struct two_level_trees *trees, struct ray_metrics *m)
+{
+	struct trace_two_level tl = {.inst = inst, .top = &trees->top, .bottom = trees->bottom};
+	struct ray_settings rs;
+	bvhlab_camera cam;
+	bvhlab_aabb bounds;
+	harness_ray_settings(cfg, &rs);
+	if ((size_t)rs.width * rs.height == 0)
+		return;
+	if (rs.main == BVHLAB_TRAVERSAL_DEVICE_STACK || rs.main == BVHLAB_TRAVERSAL_DEVICE_STACKLESS) {
+		rs.main = BVHLAB_TRAVERSAL_STACK; /* the device ones are said left out */
+		rs.traversals |= 1u << BVHLAB_TRAVERSAL_STACK;
+	}
+	memcpy(bounds.lo, trees->top.nodes[0].lo, sizeof(bounds.lo));
+	memcpy(bounds.hi, trees->top.nodes[0].hi, sizeof(bounds.hi));
+	harness_camera_of(cfg, scene, flat ? flat : &bounds, &cam);
+	harness_trace_rays_two_level(&tl, &cam, &rs, m);
+}
+
 enum tree_verdict harness_two_level_run(const struct config *cfg,
                                         const struct harness_builder *hb,
-                                        const struct scene_instanced *inst, uint32_t threads,
+                                        const struct scene_instanced *inst, const char *scene,
+                                        const bvhlab_aabb *flat, uint32_t threads,
                                         struct series_report *rep, bvhlab_error *err)
 {
 	struct two_level_job job = {.inst = inst, .bottom = hb->plugin, .top = hb->top.plugin,
@@ -235,6 +262,8 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
 	rep->validated = v != TREE_FAILED;
 	rep->phase_count = trees.phase_count;
 	memcpy(rep->phases, trees.phases, sizeof(rep->phases));
+	if (v == TREE_OK)
+		trace_rays(cfg, inst, scene, flat, &trees, &rep->rays);
 	harness_two_level_finish(&trees);
 	return v;
 }

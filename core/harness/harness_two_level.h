@@ -64,12 +64,17 @@ struct series_report; /* harness_report.h */
  * validation, at `threads`. Fills rep's samples, cold_ms, tree (the
  * two-level tree's statistics) and two_level (the levels apart) as
  * harness_two_level_series gives them, sample_count (the repeats timed) and
- * validated (whether the trees were judged: TREE_OK or TREE_INVALID); returns
+ * validated (whether the trees were judged: TREE_OK or TREE_INVALID), and on
+ * valid trees rays (the primary rays of the config's camera for scene
+ * `scene`, or of one framing `flat`, the flattened scene's bounds, or when
+ * NULL the top tree's root box; each CPU traversal at both levels,
+ * harness_trace_rays_two_level); returns
  * the verdict (TREE_OK, _INVALID, _FAILED: the run's status, in the same order).
  */
 enum tree_verdict harness_two_level_run(const struct config *cfg,
                                         const struct harness_builder *hb,
-                                        const struct scene_instanced *inst, uint32_t threads,
+                                        const struct scene_instanced *inst, const char *scene,
+                                        const bvhlab_aabb *flat, uint32_t threads,
                                         struct series_report *rep, bvhlab_error *err);
 
 /* levels as a run's child sent them, its strings ended, for the record;

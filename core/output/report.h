@@ -63,8 +63,10 @@ void report_machines_html(struct strbuf *sb, const cJSON *doc);
  * up, the cheapest strategy, and in HTML SAH and cumulative cost over the
  * frames as charts; nothing for a scene without frames. */
 void report_frames_md(struct strbuf *sb, const struct report_index *ix, const cJSON *scene);
-/* The scene's two-level runs' levels apart (report_two_level.c), if any. */
+/* The scene's two-level runs' levels apart, and each against the flat run
+ * of its bottom's plugin (report_two_level.c); nothing without such runs. */
 void report_two_level_md(struct strbuf *sb, const cJSON *const *runs, size_t n);
+void report_two_level_html(struct strbuf *sb, const cJSON *const *runs, size_t n);
 void report_frames_html(struct strbuf *sb, const struct report_index *ix, const cJSON *scene);
 
 /* A scene's memory per triangle (report_memory.c): the builds' peak, with

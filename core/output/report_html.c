@@ -469,6 +469,7 @@ static void scene_section(struct strbuf *sb, const struct report_index *ix, cons
 	size_t n;
 	const cJSON *const *runs = report_scene_runs(ix, name, &n);
 	report_kinds(sb, runs, n, true);
+	report_two_level_html(sb, runs, n);
 	report_memory_html(sb, runs, n);
 	report_front_html(sb, ix, runs, n);
 	report_budget_html(sb, ix, name);

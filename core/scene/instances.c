@@ -148,17 +148,21 @@ uint64_t scene_instanced_triangles(const struct scene_instanced *s)
 	return t;
 }
 
+/* A mesh vertex p placed by instance in, rounded to floats. */
+static void place_vertex(const struct scene_instance *in, const float *p, float out[3])
+{
+	double q[3] = { p[0], p[1], p[2] }, r[3];
+	scene_matrix_apply(in->xf, q, 1.0, r);
+	for (int k = 0; k < 3; k++)
+		out[k] = (float)r[k];
+}
+
 /* Instance i's vertices, placed, at dst. */
 static void place(const struct scene_instanced *s, uint32_t i, float *dst)
 {
 	const bvhlab_scene *m = s->meshes[s->instances[i].mesh];
-	for (uint32_t v = 0; v < m->vertex_count; v++) {
-		const float *p = m->vertices + 3 * (size_t)v;
-		double q[3] = { p[0], p[1], p[2] }, r[3];
-		scene_matrix_apply(s->instances[i].xf, q, 1.0, r);
-		for (int k = 0; k < 3; k++)
-			dst[3 * (size_t)v + k] = (float)r[k];
-	}
+	for (uint32_t v = 0; v < m->vertex_count; v++)
+		place_vertex(&s->instances[i], m->vertices + 3 * (size_t)v, dst + 3 * (size_t)v);
 }
 
 int scene_instanced_flatten(const struct scene_instanced *s, const char *name,

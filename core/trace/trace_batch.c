@@ -17,22 +17,34 @@
 #include "util/util.h"
 
 #include "trace/trace_batch.h"
+#include "trace/trace_instances.h"
 #include "trace/trace_kernel.h"
 #include "trace/trace_wide8.h"
+
+void trace_ray_view(int traversal, const bvhlab_tree *tree, const bvhlab_scene *scene,
+                    const struct trace_view *view, const bvhlab_ray *ray, bool any,
+                    bvhlab_hit *hit, bvhlab_trace_stats *st)
+{
+	if (traversal == BVHLAB_TRAVERSAL_WIDE8 && view->wide8)
+		trace_ray_wide8(tree, scene, view, ray, any, hit, st);
+	else if (trace_is_wide(traversal))
+		trace_ray_wide(tree, scene, view, ray, any, hit, st);
+	else if (traversal == BVHLAB_TRAVERSAL_STACKLESS)
+		trace_ray_stackless(tree, scene, view, ray, any, hit, st);
+	else
+		trace_ray_stack(tree, scene, view, ray, any, hit, st);
+}
 
 static void trace_tile(struct batch *b, size_t begin, size_t end, bvhlab_trace_stats *st)
 {
 	for (size_t i = begin; i < end; i++) {
 		bvhlab_hit hit;
 		uint64_t before = st->nodes_visited;
-		if (b->traversal == BVHLAB_TRAVERSAL_WIDE8 && b->view.wide8)
-			trace_ray_wide8(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
-		else if (trace_is_wide(b->traversal))
-			trace_ray_wide(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
-		else if (b->traversal == BVHLAB_TRAVERSAL_STACKLESS)
-			trace_ray_stackless(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
+		if (b->two_level)
+			trace_two_level_hit(b->two_level, &b->rays[i], &hit, st);
 		else
-			trace_ray_stack(b->tree, b->scene, &b->view, &b->rays[i], b->any, &hit, st);
+			trace_ray_view(b->traversal, b->tree, b->scene, &b->view, &b->rays[i], b->any,
+			               &hit, st);
 		if (b->hits)
 			b->hits[i] = hit;
 		if (b->nodes)

@@ -15,6 +15,8 @@
 
 #include "trace/trace_kernel.h"
 
+struct trace_two_level; /* trace_instances.h */
+
 /* Rays per tile: large enough that the counter is rarely touched, small
  * enough to balance 2 to 64 threads over 64k rays. */
 #define TILE 256
@@ -26,6 +28,9 @@ struct batch {
 	size_t count;
 	bool any;
 	int traversal;          /* enum bvhlab_traversal */
+	const struct trace_two_level *two_level; /* a two-level scene's trees, traced with
+	                                         * their own traversal (trace_instances.h)
+	                                         * instead of tree and scene; or NULL */
 	struct trace_view view; /* what the traversal reads */
 	double *tile_cpu;       /* [tiles] CPU seconds of each tile of a pass, or NULL */
 	bvhlab_hit *hits;
@@ -44,6 +49,13 @@ static inline size_t trace_tiles(size_t count)
 {
 	return (count + TILE - 1) / TILE;
 }
+
+/* One ray through a view with a CPU traversal (enum bvhlab_traversal:
+ * stack, stackless, wide, wide4, wide8; wide8 falls back to the 4-lane
+ * kernel on a view without 8-lane nodes), as the batch tracer does. */
+void trace_ray_view(int traversal, const bvhlab_tree *tree, const bvhlab_scene *scene,
+                    const struct trace_view *view, const bvhlab_ray *ray, bool any,
+                    bvhlab_hit *hit, bvhlab_trace_stats *st);
 
 /* Threads a batch of `count` rays gets: 0 means all hardware threads, and
  * never more than there are tiles. */

@@ -1,12 +1,18 @@
 /*
  * Two-level traversal (trace_instances.h): the top tree walked with a
- * stack, nearest child box first; at a leaf each instance's bottom tree is
- * traced by the one-level stack traversal (bvhlab_trace_closest) with the
- * ray in the instance's space and the best t so far as its tmax.
+ * stack, nearest child box first, or without one through its parent links
+ * (the stackless traversal); at a leaf each instance's bottom tree is
+ * traced by the one-level traversal (trace_ray_view: stack, stackless or
+ * wide) with the ray in the instance's space and the best t so far as its
+ * tmax. Carrying the ray into an instance and keeping the best hit are
+ * this file's alone, whichever traversal walks either level.
  */
+#include <errno.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "trace/trace_batch.h"
 #include "trace/trace_instances.h"
 #include "trace/trace_kernel.h"
 #include "tree/tree_view.h"
@@ -59,11 +65,34 @@ static void enter_instance(const struct trace_two_level *tl, uint32_t i, const b
                            struct trace_inst_hit *best, bvhlab_trace_stats *stats)
 {
 	const struct scene_instance *in = &tl->inst->instances[i];
+	const bvhlab_tree *tree = &tl->bottom[in->mesh];
+	struct trace_view plain = trace_view_plain(tree);
+	bvhlab_trace_stats st = {0};
 	bvhlab_ray r;
 	bvhlab_hit h;
+	if (tree->node_count == 0)
+		return;
 	local_ray(in, ray, best->hit.t, &r);
-	bvhlab_trace_closest(&tl->bottom[in->mesh], tl->inst->meshes[in->mesh], &r, &h, stats);
+	trace_ray_view(tl->views ? tl->traversal : BVHLAB_TRAVERSAL_STACK, tree,
+	               tl->inst->meshes[in->mesh], tl->views ? &tl->views[in->mesh] : &plain, &r,
+	               false, &h, &st);
 	offer(best, &h, i);
+	if (stats) { /* one two-level ray, however many instances it enters */
+		stats->nodes_visited += st.nodes_visited;
+		stats->tris_tested += st.tris_tested;
+	}
+}
+
+/* A top leaf's instances, each traced. */
+static void enter_leaf(const struct trace_two_level *tl, const bvhlab_node *n,
+                       const bvhlab_ray *ray, struct trace_inst_hit *best,
+                       bvhlab_trace_stats *stats)
+{
+	const bvhlab_tree *top = tl->top;
+	uint32_t first = tree_leaf_first(n), end = first + tree_leaf_count(n);
+	for (uint32_t s = first; s < end && s < top->index_count; s++)
+		if (top->prim_index[s] < tl->inst->instance_count)
+			enter_instance(tl, top->prim_index[s], ray, best, stats);
 }
 
 /* An inner node's children the ray enters, pushed farthest first. */
@@ -90,15 +119,13 @@ static uint32_t push_children(const ray_prep *p, const bvhlab_tree *top, const b
 	return sp;
 }
 
-void trace_two_level_closest(const struct trace_two_level *tl, const bvhlab_ray *ray,
-                             struct trace_inst_hit *out, bvhlab_trace_stats *stats)
+static void walk_stack(const struct trace_two_level *tl, const bvhlab_ray *ray,
+                       struct trace_inst_hit *out, bvhlab_trace_stats *stats)
 {
 	const bvhlab_tree *top = tl->top;
 	uint32_t stack[TOP_STACK], sp = 0;
 	ray_prep p;
-	inst_hit_init(ray, out);
-	if (top->node_count == 0 || !prep_box(ray, &p) ||
-	    box_enter(&p, &top->nodes[0], out->hit.t) == INFINITY)
+	if (!prep_box(ray, &p) || box_enter(&p, &top->nodes[0], out->hit.t) == INFINITY)
 		return;
 	stack[sp++] = 0;
 	while (sp > 0) {
@@ -107,15 +134,100 @@ void trace_two_level_closest(const struct trace_two_level *tl, const bvhlab_ray 
 			stats->nodes_visited++;
 		if (box_enter(&p, n, out->hit.t) == INFINITY)
 			continue; /* a nearer hit came since it was pushed */
-		if (!tree_is_leaf(n)) {
+		if (!tree_is_leaf(n))
 			sp = push_children(&p, top, n, out->hit.t, stack, sp);
-			continue;
-		}
-		for (uint32_t s = tree_leaf_first(n); s < tree_leaf_first(n) + tree_leaf_count(n) &&
-		                                      s < top->index_count; s++)
-			if (top->prim_index[s] < tl->inst->instance_count)
-				enter_instance(tl, top->prim_index[s], ray, out, stats);
+		else
+			enter_leaf(tl, n, ray, out, stats);
 	}
+}
+
+/* The stackless walk's leaf: what it needs to trace the leaf's instances. */
+struct top_leaf {
+	const struct trace_two_level *tl;
+	const bvhlab_ray *ray;
+	struct trace_inst_hit *best;
+	bvhlab_trace_stats *stats;
+};
+
+static bool stackless_leaf(void *ctx, const bvhlab_node *n)
+{
+	struct top_leaf *c = ctx;
+	enter_leaf(c->tl, n, c->ray, c->best, c->stats);
+	return false;
+}
+
+void trace_two_level_closest(const struct trace_two_level *tl, const bvhlab_ray *ray,
+                             struct trace_inst_hit *out, bvhlab_trace_stats *stats)
+{
+	inst_hit_init(ray, out);
+	if (tl->top->node_count == 0)
+		return;
+	if (tl->views && tl->traversal == BVHLAB_TRAVERSAL_STACKLESS) {
+		struct top_leaf c = {tl, ray, out, stats};
+		trace_walk_stackless(tl->top, tl->top_parents, ray, &out->hit, stackless_leaf, &c,
+		                     stats);
+	} else {
+		walk_stack(tl, ray, out, stats);
+	}
+}
+
+void trace_two_level_hit(const struct trace_two_level *tl, const bvhlab_ray *ray,
+                         bvhlab_hit *hit, bvhlab_trace_stats *stats)
+{
+	struct trace_inst_hit h;
+	trace_two_level_closest(tl, ray, &h, stats);
+	*hit = h.hit;
+	if (stats)
+		stats->rays++;
+}
+
+/* Mesh m's copies for the traversal. */
+static int prepare_mesh(struct trace_two_level *tl, uint32_t m)
+{
+	const bvhlab_tree *tree = &tl->bottom[m];
+	const bvhlab_scene *mesh = tl->inst->meshes[m];
+	int r = trace_view_copy(tree, mesh, &tl->views[m]);
+	if (r == 0 && tl->traversal == BVHLAB_TRAVERSAL_STACKLESS) {
+		r = bvhlab_tree_parents(tree, &tl->parents[m]);
+		tl->views[m].parents = tl->parents[m];
+	}
+	if (r == 0 && trace_is_wide(tl->traversal) && tree->node_count)
+		r = trace_view_wide(tree, mesh, tl->traversal, &tl->views[m]);
+	return r;
+}
+
+int trace_two_level_prepare(struct trace_two_level *tl, int traversal)
+{
+	uint32_t meshes = tl->inst->mesh_count;
+	if (traversal != BVHLAB_TRAVERSAL_STACK && traversal != BVHLAB_TRAVERSAL_STACKLESS &&
+	    !trace_is_wide(traversal))
+		return -EINVAL;
+	tl->traversal = traversal;
+	tl->views = calloc(meshes ? meshes : 1, sizeof(*tl->views));
+	tl->parents = calloc(meshes ? meshes : 1, sizeof(*tl->parents));
+	int r = tl->views && tl->parents ? 0 : -ENOMEM;
+	if (r == 0 && traversal == BVHLAB_TRAVERSAL_STACKLESS)
+		r = bvhlab_tree_parents(tl->top, &tl->top_parents);
+	for (uint32_t m = 0; r == 0 && m < meshes; m++)
+		r = prepare_mesh(tl, m);
+	if (r < 0)
+		trace_two_level_release(tl);
+	return r;
+}
+
+void trace_two_level_release(struct trace_two_level *tl)
+{
+	for (uint32_t m = 0; tl->views && m < tl->inst->mesh_count; m++)
+		trace_view_free(&tl->views[m]);
+	for (uint32_t m = 0; tl->parents && m < tl->inst->mesh_count; m++)
+		free(tl->parents[m]);
+	free(tl->views);
+	free(tl->parents);
+	free(tl->top_parents);
+	tl->views = NULL;
+	tl->parents = NULL;
+	tl->top_parents = NULL;
+	tl->traversal = BVHLAB_TRAVERSAL_STACK;
 }
 
 void trace_two_level_brute(const struct scene_instanced *inst, const bvhlab_ray *ray,

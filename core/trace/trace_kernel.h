@@ -270,4 +270,15 @@ void trace_ray_stackless(const bvhlab_tree *tree, const bvhlab_scene *scene,
                          const struct trace_view *view, const bvhlab_ray *ray, bool any,
                          bvhlab_hit *hit, bvhlab_trace_stats *stats);
 
+/* The stackless walk of a tree whose leaves hold something other than
+ * triangles (a two-level top's instances): on_leaf(ctx, leaf) for each
+ * leaf the ray enters, in the walk's order, with hit->t the walk's tmax,
+ * which on_leaf may lower; true from it ends the walk. hit is the
+ * caller's, not initialised here; stats (may be NULL) gains the nodes
+ * entered. (trace_stackless.c) */
+void trace_walk_stackless(const bvhlab_tree *tree, const uint32_t *parents,
+                          const bvhlab_ray *ray, bvhlab_hit *hit,
+                          bool (*on_leaf)(void *ctx, const bvhlab_node *n), void *ctx,
+                          bvhlab_trace_stats *stats);
+
 #endif /* BVHLAB_CORE_TRACE_KERNEL_H */

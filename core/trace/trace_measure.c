@@ -20,6 +20,7 @@
 
 #include "trace/trace_batch.h"
 #include "trace/trace_cl.h"
+#include "trace/trace_instances.h"
 #include "trace/trace_kernel.h"
 #include "trace/trace_series.h"
 #include "util/util.h"
@@ -434,6 +435,35 @@ int trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhl
 	if (device && device_size && trace_series_device(s))
 		snprintf(device, device_size, "%s", trace_series_device(s));
 	trace_series_destroy(s);
+	return r;
+}
+
+int trace_measure_two_level(const struct trace_two_level *tl, const bvhlab_ray *rays,
+                            size_t count, const bvhlab_trace_options *opts, bvhlab_hit *hits,
+                            bvhlab_trace_timing *timing, bvhlab_error *err)
+{
+	struct trace_two_level prepared = *tl;
+	*timing = (bvhlab_trace_timing){0};
+	int r = trace_two_level_prepare(&prepared, opts->traversal);
+	if (r < 0) {
+		error_set(err, "%s", r == -EINVAL ? "a two-level scene is traced on the CPU only"
+		                                  : "out of memory");
+		return r;
+	}
+	/* The batch's own traversal stays the stack's, so its first pass keeps
+	 * the counters (the two levels' nodes, whichever kernel walks them). */
+	struct batch b = {.two_level = &prepared, .rays = rays, .count = count,
+	                  .traversal = BVHLAB_TRAVERSAL_STACK, .hits = hits};
+	struct trace_series *s = count ? series_alloc(&b, opts->threads, opts->max_repeats) : NULL;
+	r = count && !s ? -ENOMEM : 0;
+	if (s)
+		r = trace_series_slice(s, opts);
+	if (s && r == 0)
+		trace_series_timing(s, timing);
+	if (r < 0)
+		error_set(err, "%s", s && s->err.message[0] ? s->err.message : strerror(-r));
+	trace_series_destroy(s);
+	trace_two_level_release(&prepared);
 	return r;
 }
 

@@ -72,4 +72,16 @@ int trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhl
                   uint32_t *nodes, bvhlab_trace_timing *timing, char *device, size_t device_size,
                   bvhlab_error *err);
 
+/*
+ * The same for a two-level scene (trace_instances.h) with opts->traversal,
+ * a CPU one, at both levels (trace_two_level_prepare): hits (may be NULL)
+ * as trace_two_level_hit gives them, the counters the nodes and triangles
+ * of both levels. 0, or a negative errno with err saying why (-EINVAL: a
+ * device traversal).
+ */
+struct trace_two_level;
+int trace_measure_two_level(const struct trace_two_level *tl, const bvhlab_ray *rays,
+                            size_t count, const bvhlab_trace_options *opts, bvhlab_hit *hits,
+                            bvhlab_trace_timing *timing, bvhlab_error *err);
+
 #endif

@@ -104,6 +104,10 @@ struct walk {
 	bvhlab_hit *hit;
 	uint64_t nodes, tests;
 	bool any;
+	/* A leaf of something else than triangles (a two-level top's
+	 * instances), or NULL: see trace_walk_stackless. */
+	bool (*on_leaf)(void *ctx, const bvhlab_node *n);
+	void *ctx;
 };
 
 /* Tests a leaf's triangles; true when an any-hit walk may stop. */
@@ -183,7 +187,7 @@ static void walk(struct walk *w)
 		if (!tree_is_leaf(n)) {
 			if (enter_next(w, n, NONE, &node))
 				continue;
-		} else if (leaf(w, n)) {
+		} else if (w->on_leaf ? w->on_leaf(w->ctx, n) : leaf(w, n)) {
 			return;
 		}
 		if (!climb(w, &node))
@@ -197,7 +201,7 @@ void trace_ray_stackless(const bvhlab_tree *tree, const bvhlab_scene *scene,
 {
 	ray_prep p;
 	struct walk w = {tree, view->nodes, view->parents, scene, view->tris, &p, hit, 0, 0,
-	                 any_hit};
+	                 any_hit, NULL, NULL};
 	hit->t = ray->tmax;
 	hit->u = hit->v = 0.0f;
 	hit->prim = BVHLAB_NO_HIT;
@@ -208,6 +212,20 @@ void trace_ray_stackless(const bvhlab_tree *tree, const bvhlab_scene *scene,
 		stats->nodes_visited += w.nodes;
 		stats->tris_tested += w.tests;
 	}
+}
+
+void trace_walk_stackless(const bvhlab_tree *tree, const uint32_t *parents,
+                          const bvhlab_ray *ray, bvhlab_hit *hit,
+                          bool (*on_leaf)(void *ctx, const bvhlab_node *n), void *ctx,
+                          bvhlab_trace_stats *stats)
+{
+	ray_prep p;
+	struct walk w = {tree, tree->nodes, parents, NULL, NULL, &p, hit, 0, 0, false, on_leaf,
+	                 ctx};
+	if (prep_box(ray, &p) && tree->node_count > 0)
+		walk(&w);
+	if (stats)
+		stats->nodes_visited += w.nodes;
 }
 
 bool bvhlab_trace_stackless(const bvhlab_tree *tree, const uint32_t *parents,
