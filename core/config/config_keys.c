@@ -138,6 +138,7 @@ const struct config_key config_instance_keys[] = {
 	CUSTOM("rotate"),
 	CUSTOM("translate"),
 	CUSTOM("scatter"),
+	CUSTOM("animate"),
 	END,
 };
 
@@ -150,6 +151,7 @@ const struct config_key config_scatter_keys[] = {
 	CUSTOM("bounds"),
 	CUSTOM("scale"),
 	CUSTOM("rotate"),
+	CUSTOM("animate"),
 	END,
 };
 

@@ -228,8 +228,8 @@ static void series_work(void *arg, void *report, size_t size)
 	(void)size;
 	rep->status = SERIES_OK;
 	if (job->hb->top.plugin) { /* two-level (harness_two_level.c): status in the same order */
-		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst, job->run->key.threads,
-		                                    rep, &err);
+		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst, &job->h->anim,
+		                                    job->run->key.threads, rep, &err);
 		goto out;
 	}
 	rep->has_device = harness_memory_device(job->hb->plugin, &job->hb->opts, &rep->device);
@@ -421,6 +421,8 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (r == 0) /* two-level: meshes once, flattened; animated: frame 0 (harness_anim.c) */
 		r = cs->meshes ? harness_scene_instanced(cs, &h->inst, &scene, &err)
 		               : harness_anim_load(cs, &h->anim, &scene, &err);
+	if (r == 0 && cs->meshes) /* its instances move (harness_anim_inst.c) */
+		harness_anim_instanced(cs, &h->inst, &h->anim);
 	if (r == 0)
 		r = bvhlab_prims_init(&prims, scene, &err);
 	if (r < 0) {

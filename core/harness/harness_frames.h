@@ -33,6 +33,30 @@ struct frames_job {
 	double first_ms;                 /* frame 0's build (the series' median) */
 };
 
+/* The update plugin and its stages, opened in the run's child. */
+struct frames_updater {
+	bvhlab_plugin *plugin;
+	bvhlab_options opts;
+	bvhlab_plugin *stage_plugins[CONFIG_MAX_REFINE];
+	bvhlab_options stage_opts[CONFIG_MAX_REFINE];
+	uint32_t stage_count;
+};
+
+/* job->cb's animation's update plugin and stages into u (zeroed first by
+ * the caller); close frees what open got, whether it failed or not. */
+int harness_frames_updater_open(const struct frames_job *job, struct frames_updater *u,
+                                bvhlab_error *err);
+void harness_frames_updater_close(struct frames_updater *u);
+
+/* Frame f is rebuilt: always without "animation", else every K frames. */
+bool harness_frames_rebuilds(const struct frames_job *job, uint32_t f);
+
+/* The rebuild (job's plugin and stages) or update (u's) of frame f over
+ * `in`, timed together into *ms. 0 or a negative errno (err says why). */
+int harness_frames_advance(const struct frames_job *job, const struct frames_updater *u,
+                           uint32_t f, const bvhlab_build_input *in, bvhlab_tree *tree,
+                           double *ms, bvhlab_error *err);
+
 /* Room a run's report needs for the frames of scene a (0 for none). */
 static inline size_t harness_frames_size(const struct harness_anim *a)
 {

@@ -51,7 +51,13 @@ enum tree_verdict harness_two_level_series(const struct two_level_job *job,
                                            struct two_level_trees *trees, bvhlab_error *err);
 void harness_two_level_finish(struct two_level_trees *trees);
 
+/* The two-level SAH (docs/instances.md) of top (over inst's world boxes,
+ * its own SAH top_sah), mesh m's bottom tree's SAH mesh_sah[m]. */
+double harness_two_level_sah(const struct scene_instanced *inst, const bvhlab_tree *top,
+                             const bvhlab_aabb *boxes, double top_sah, const double *mesh_sah);
+
 struct series_report; /* harness_report.h */
+struct harness_anim;  /* harness_anim.h */
 
 /*
  * A sweep's two-level run, in its child: builder hb's bottom plugin and
@@ -59,12 +65,15 @@ struct series_report; /* harness_report.h */
  * validation, at `threads`. Fills rep's samples, cold_ms, tree (the
  * two-level tree's statistics) and two_level (the levels apart) as
  * harness_two_level_series gives them, sample_count (the repeats timed) and
- * validated (whether the trees were judged: TREE_OK or TREE_INVALID); returns
- * the verdict (TREE_OK, _INVALID, _FAILED: the run's status, in the same order).
+ * validated (whether the trees were judged: TREE_OK or TREE_INVALID); on an
+ * animated scene (anim's frames; NULL or 0: none) then the frames, the top
+ * rebuilt or updated on each (harness_anim_top.c). Returns the verdict
+ * (TREE_OK, _INVALID, _FAILED: the run's status, in the same order).
  */
 enum tree_verdict harness_two_level_run(const struct config *cfg,
                                         const struct harness_builder *hb,
-                                        const struct scene_instanced *inst, uint32_t threads,
+                                        const struct scene_instanced *inst,
+                                        const struct harness_anim *anim, uint32_t threads,
                                         struct series_report *rep, bvhlab_error *err);
 
 /* levels as a run's child sent them, its strings ended, for the record;
