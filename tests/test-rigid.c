@@ -148,6 +148,49 @@ static void test_harness(const struct config *cfg, const struct harness_anim *a,
 	free(rep);
 }
 
+/* What an animated two-level config cannot say, each named at its key. */
+static void test_errors(void)
+{
+	static const char *const bad[][2] = {
+		{"\"meshes\": [ { \"name\": \"b\", \"generator\": \"soup\" } ], \"instances\": "
+		 "[ { \"mesh\": \"b\", \"animate\": { \"translate\": [1, 0, 0] } } ]",
+		 "'scenes[0].instances[0].animate': the scene has no 'frames'"},
+		{"\"frames\": 3, \"meshes\": [ { \"name\": \"b\", \"generator\": \"soup\" } ], "
+		 "\"instances\": [ { \"scatter\": { \"mesh\": \"b\", \"count\": 2, \"bounds\": "
+		 "[[0, 0, 0], [1, 1, 1]], \"animate\": { \"spin\": 1 } } } ]",
+		 "unknown key 'spin' in scenes[0].instances[0].scatter.animate"},
+		{"\"frames\": 3, \"meshes\": [ { \"name\": \"b\", \"generator\": \"soup\" } ], "
+		 "\"instances\": [ { \"mesh\": \"b\", \"animate\": { \"scale\": 0 } } ]",
+		 "'scenes[0].instances[0].animate.scale'"},
+		{"\"frames\": 3, \"animate\": { \"translate\": [1, 0, 0] }, \"meshes\": [ { "
+		 "\"name\": \"b\", \"generator\": \"soup\" } ], \"instances\": [ { \"mesh\": "
+		 "\"b\" } ]",
+		 "'scenes[0].animate' does not apply to a scene with 'instances': give 'animate' to "
+		 "the instances that move"},
+		{"\"frames\": 3, \"meshes\": [ { \"name\": \"b\", \"generator\": \"soup\" } ], "
+		 "\"instances\": [ { \"mesh\": \"b\", \"deform\": \"wave\" } ]",
+		 "unknown key 'deform' in scenes[0].instances[0]"},
+	};
+	char text[4096];
+	struct config cfg;
+	bvhlab_error err = { "" };
+	for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
+		snprintf(text, sizeof(text), "{ \"scenes\": [ { %s } ], \"builders\": [ { "
+		         "\"plugin\": \"lbvh\" } ] }", bad[k][0]);
+		CHECK_INT(config_parse(&cfg, "/cfg/c.json", text, &err), -EINVAL);
+		CHECK_CONTAINS(err.message, "/cfg/c.json:1:");
+		CHECK_CONTAINS(err.message, bad[k][1]);
+		config_finish(&cfg);
+	}
+	/* A two-level builder's animation takes no refinement stages. */
+	snprintf(text, sizeof(text), "%.*s\"animation\": { \"update\": \"refit\", \"refine\": [ "
+	         "{ \"plugin\": \"reinsert\" } ] } } ] }", (int)(strstr(config_text,
+	         "\"animation\"") - config_text), config_text);
+	CHECK_INT(config_parse(&cfg, "/cfg/c.json", text, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "'builders[0].animation.refine': a two-level builder's top");
+	config_finish(&cfg);
+}
+
 int main(void)
 {
 	struct config cfg;
@@ -163,6 +206,7 @@ int main(void)
 	harness_anim_instanced(&cfg.scenes[0], &inst, &a);
 	CHECK(a.frames == FRAMES && a.inst == &inst);
 	test_pose(&a);
+	test_errors();
 	if (plugin_loads("sah_seq", &bottom) && plugin_loads("lbvh", &top) &&
 	    plugin_loads("refit", &refit)) {
 		CHECK_INT(bvhlab_options_init(&bo, bvhlab_plugin_builder(bottom)), 0);
