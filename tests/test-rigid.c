@@ -148,6 +148,17 @@ static void test_harness(const struct config *cfg, const struct harness_anim *a,
 	free(rep);
 }
 
+/* Config `text` is refused, the message placing it and containing needle. */
+static void refused(const char *text, const char *needle)
+{
+	struct config cfg;
+	bvhlab_error err = { "" };
+	CHECK_INT(config_parse(&cfg, "/cfg/c.json", text, &err), -EINVAL);
+	CHECK_CONTAINS(err.message, "/cfg/c.json:1:");
+	CHECK_CONTAINS(err.message, needle);
+	config_finish(&cfg);
+}
+
 /* What an animated two-level config cannot say, each named at its key. */
 static void test_errors(void)
 {
@@ -172,23 +183,16 @@ static void test_errors(void)
 		 "unknown key 'deform' in scenes[0].instances[0]"},
 	};
 	char text[4096];
-	struct config cfg;
-	bvhlab_error err = { "" };
 	for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
 		snprintf(text, sizeof(text), "{ \"scenes\": [ { %s } ], \"builders\": [ { "
 		         "\"plugin\": \"lbvh\" } ] }", bad[k][0]);
-		CHECK_INT(config_parse(&cfg, "/cfg/c.json", text, &err), -EINVAL);
-		CHECK_CONTAINS(err.message, "/cfg/c.json:1:");
-		CHECK_CONTAINS(err.message, bad[k][1]);
-		config_finish(&cfg);
+		refused(text, bad[k][1]);
 	}
 	/* A two-level builder's animation takes no refinement stages. */
 	snprintf(text, sizeof(text), "%.*s\"animation\": { \"update\": \"refit\", \"refine\": [ "
 	         "{ \"plugin\": \"reinsert\" } ] } } ] }", (int)(strstr(config_text,
 	         "\"animation\"") - config_text), config_text);
-	CHECK_INT(config_parse(&cfg, "/cfg/c.json", text, &err), -EINVAL);
-	CHECK_CONTAINS(err.message, "'builders[0].animation.refine': a two-level builder's top");
-	config_finish(&cfg);
+	refused(text, "'builders[0].animation.refine': a two-level builder's top");
 }
 
 int main(void)
