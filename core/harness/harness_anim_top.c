@@ -57,8 +57,8 @@ static void check(const struct top_frames *tf, const struct scene_instanced *pos
 	fm->valid = bvhlab_validate_tree(&tf->trees->top, &tf->trees->top_prims.input, false,
 	                                 err) == 0;
 	if (!fm->valid)
-		error_prefix(err, "top tree: ");
-	if (!fm->valid || !tf->cfg->validate || (f != 0 && f != (n - 1) / 2 && f != n - 1))
+		error_prefix(err, "top tree");
+	if (!fm->valid || !tf->cfg->validate || !harness_frames_rays_frame(n, f))
 		return;
 	fm->rays_checked = true;
 	trace_two_level_check(&tl, NULL, rays, HARNESS_RAY_SEED, &mismatches, NULL);

@@ -102,7 +102,7 @@ static int check(const struct frames_job *job, const bvhlab_scene *scene,
 	uint32_t n = job->anim->frames, f = fm->frame;
 	uint64_t mismatches = 0;
 	fm->valid = bvhlab_validate_tree(tree, in, job->spatial_splits, err) == 0;
-	if (!fm->valid || !job->cfg->validate || (f != 0 && f != (n - 1) / 2 && f != n - 1))
+	if (!fm->valid || !job->cfg->validate || !harness_frames_rays_frame(n, f))
 		return 0;
 	fm->rays_checked = true;
 	int r = bvhlab_validate_rays(tree, scene, job->cfg->validate_rays, FRAME_RAY_SEED,

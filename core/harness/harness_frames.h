@@ -24,7 +24,7 @@ struct frames_job {
 	const struct config_builder *cb; /* its "animation", or none: rebuild */
 	const struct harness_anim *anim;
 	const bvhlab_scene *first;       /* frame 0, the run's scene */
-	const bvhlab_plugin *plugin;     /* the builder, for rebuilds */
+	const bvhlab_plugin *plugin;     /* the builder (a two-level run's top), for rebuilds */
 	const bvhlab_options *opts;
 	const struct refine_stage *stages; /* the builder's own, after each rebuild */
 	uint32_t stage_count;
@@ -56,6 +56,13 @@ bool harness_frames_rebuilds(const struct frames_job *job, uint32_t f);
 int harness_frames_advance(const struct frames_job *job, const struct frames_updater *u,
                            uint32_t f, const bvhlab_build_input *in, bvhlab_tree *tree,
                            double *ms, bvhlab_error *err);
+
+/* Frame f of `frames` has its brute-force rays checked: the first, the
+ * middle and the last. */
+static inline bool harness_frames_rays_frame(uint32_t frames, uint32_t f)
+{
+	return f == 0 || f == (frames - 1) / 2 || f == frames - 1;
+}
 
 /* Room a run's report needs for the frames of scene a (0 for none). */
 static inline size_t harness_frames_size(const struct harness_anim *a)
