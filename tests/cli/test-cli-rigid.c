@@ -64,6 +64,12 @@ static void all(void)
 	check_frames(doc, "lbvh+refit", true);
 	check_frames(doc, two, false);
 	check_frames(doc, two_refit, true);
+	/* Frame 0 is the series' tree: the same two-level SAH. */
+	const cJSON *run = find_run(doc, "grove", two_refit, 2);
+	const cJSON *sah = cJSON_GetObjectItem(cJSON_GetObjectItem(run, "two_level"), "sah_cost");
+	const cJSON *first = cJSON_GetArrayItem(cJSON_GetObjectItem(run, "frames"), 0);
+	CHECK(cJSON_IsNumber(sah) && sah->valuedouble ==
+	      cJSON_GetObjectItem(first, "sah")->valuedouble);
 	cJSON_Delete(doc);
 	char *csv = read_file(cli_path_in("out"), "frames.csv");
 	CHECK(csv && strstr(csv, "grove,\"two-level[top=lbvh,bottom=sah_seq]+refit\",sah_seq,2,2,"
