@@ -115,8 +115,9 @@ static void test_errors(void)
 	             "mesh 'a' is also scenes[0].meshes[0]'s name");
 	expect_error("\"generator\": \"soup\", " MESHES ", \"instances\": [ { \"mesh\": \"a\" } ]",
 	             "'scenes[0].generator' does not apply to a scene with 'meshes'");
-	expect_error("\"frames\": 4, " MESHES ", \"instances\": [ { \"mesh\": \"ball\" } ]",
-	             "'scenes[0].frames' does not apply to a scene with 'instances'");
+	expect_error("\"frames\": { \"pattern\": \"f%d.ply\", \"count\": 2 }, " MESHES
+	             ", \"instances\": [ { \"mesh\": \"ball\" } ]",
+	             "'scenes[0].frames' of a scene with 'instances' is a number of frames");
 }
 
 /* Two-level builders: "bottom" and "top" together, on two-level scenes only. */

@@ -94,6 +94,9 @@ struct config_instance {
 	double lo[3], hi[3]; /* "bounds": [[x, y, z], [x, y, z]] the positions are drawn in */
 	double scale[2];     /* "scale": [a, b], 0 < a <= b, drawn uniformly; default [1, 1] */
 	int rotate;          /* "rotate": enum config_scatter_rotate, default none */
+	struct config_motion motion; /* "animate" (config_anim.c): a rigid motion over
+	                      * the scene's frames, turning about the instance's own
+	                      * origin (each of a scatter's); docs/instances.md */
 };
 
 /* Most instances a scene may hold, all entries and scatters together: the

@@ -187,6 +187,11 @@ int config_check_scene_anim(struct config *cfg, const cJSON *obj, const char *pr
 		                    "'deform' to the parts that move", (int)strlen(prefix) - 1, prefix);
 	for (size_t i = 0; i < sc->part_count; i++)
 		any = any || moves(&sc->parts[i].motion);
+	for (size_t i = 0; !sc->frames && i < sc->instance_count; i++)
+		if (sc->instances[i].motion.animate)
+			return config_error(cfg, obj, false, err, "'%sinstances[%zu]%s.animate': the "
+			                    "scene has no 'frames' for its instances to move in", prefix,
+			                    i, sc->instances[i].scatter ? ".scatter" : "");
 	if (any && !sc->frames)
 		return config_error(cfg, obj, false, err, "'%.*s' moves ('animate' or 'deform') but "
 		                    "has no 'frames'", (int)strlen(prefix) - 1, prefix);
@@ -290,6 +295,10 @@ int config_parse_animation(struct config *cfg, const cJSON *obj, size_t index,
 	cfg->animations = a;
 	b->animation = a;
 	int rc = anim_body(cfg, item, index, a, &stage_names, err);
+	if (!rc && b->top && a->refine_count)
+		rc = config_error(cfg, config_member(item, "refine"), true, err,
+		                  "'builders[%zu].animation.refine': a two-level builder's top is "
+		                  "rebuilt or updated without refinement stages (not yet)", index);
 	if (!rc)
 		rc = static_scenes(cfg, item, index, a, err);
 	if (!rc && !config_member(obj, "name") && anim_name(b, a, stage_names) < 0)

@@ -258,7 +258,8 @@ static int builder_plugin(struct config *cfg, const cJSON *obj, const char *pref
 
 /* "bottom" and "top" come together; "bottom" is the builder's plugin (its
  * "options" are the bottom's), default name "two-level[top=T,bottom=B]".
- * Refinement and animation of two-level trees are not there yet. */
+ * Refinement of two-level trees is not there yet; an "animation" updates
+ * the top (config_anim.c). */
 static int two_level(struct config *cfg, const cJSON *obj, const char *prefix,
                      struct config_builder *b, bvhlab_error *err)
 {
@@ -282,8 +283,8 @@ static int two_level(struct config *cfg, const cJSON *obj, const char *prefix,
 	if (!cJSON_IsString(bottom) || !bottom->valuestring[0])
 		return config_error(cfg, bottom, false, err, "'%sbottom' must be a plugin name, "
 		                    "not %s", prefix, config_describe(cfg, bottom, got, sizeof(got)));
-	static const char *const not_with[] = {"plugin", "refine", "animation"};
-	for (size_t k = 0; k < 3; k++)
+	static const char *const not_with[] = {"plugin", "refine"};
+	for (size_t k = 0; k < 2; k++)
 		if ((other = config_member(obj, not_with[k])))
 			return config_error(cfg, other, true, err, "'%s%s' does not apply to a "
 			                    "two-level builder ('bottom' and 'top')%s", prefix,

@@ -239,7 +239,9 @@ static int parse_scatter(struct config *cfg, const cJSON *obj, const char *prefi
 		rc = mesh_of(cfg, obj, prefix, sc, &in->mesh, err);
 	if (!rc)
 		rc = parse_bounds(cfg, obj, prefix, in, err);
-	return rc ? rc : parse_spread(cfg, obj, prefix, in, err);
+	if (!rc)
+		rc = parse_spread(cfg, obj, prefix, in, err);
+	return rc ? rc : config_parse_motion(cfg, obj, prefix, &in->motion, err);
 }
 
 static int parse_instance(struct config *cfg, const cJSON *obj, const char *prefix,
@@ -264,7 +266,9 @@ static int parse_instance(struct config *cfg, const cJSON *obj, const char *pref
 	}
 	in->count = 1;
 	rc = mesh_of(cfg, obj, prefix, sc, &in->mesh, err);
-	return rc ? rc : parse_placed(cfg, obj, prefix, in, err);
+	if (!rc)
+		rc = parse_placed(cfg, obj, prefix, in, err);
+	return rc ? rc : config_parse_motion(cfg, obj, prefix, &in->motion, err);
 }
 
 static int parse_instances(struct config *cfg, const cJSON *obj, const char *prefix,
@@ -293,20 +297,26 @@ static int parse_instances(struct config *cfg, const cJSON *obj, const char *pre
 	return rc;
 }
 
-/* What a two-level scene cannot have (yet): its own source, subdivision of
- * the whole, parts, an animation. */
+/* What a two-level scene cannot have: its own source, subdivision of the
+ * whole, parts, a motion of the whole (its instances move: "animate" on
+ * them), frame files. */
 static int refuse_others(struct config *cfg, const cJSON *obj, const char *prefix,
                          bvhlab_error *err)
 {
-	static const char *const keys[] = {"parts", "subdivide", "frames", "animate", "deform",
-	                                   "amplitude"};
+	static const char *const keys[] = {"parts", "subdivide", "animate", "deform", "amplitude"};
+	const cJSON *frames = config_member(obj, "frames");
 	int rc = config_no_own_source(cfg, obj, prefix, "meshes", "a mesh", err);
 	for (size_t k = 0; !rc && k < sizeof(keys) / sizeof(keys[0]); k++)
 		if (config_member(obj, keys[k]))
 			rc = config_error(cfg, config_member(obj, keys[k]), true, err,
 			                  "'%s%s' does not apply to a scene with 'instances'%s", prefix,
 			                  keys[k], k < 2 ? ": give it to a mesh"
-			                           : " (animated instances are not supported yet)");
+			                           : ": give 'animate' to the instances that move (they "
+			                             "move rigidly; a mesh does not deform)");
+	if (!rc && cJSON_IsObject(frames))
+		rc = config_error(cfg, frames, true, err, "'%sframes' of a scene with 'instances' "
+		                  "is a number of frames: its instances move by their 'animate', "
+		                  "not from frame files", prefix);
 	return rc;
 }
 

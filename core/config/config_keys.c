@@ -141,6 +141,7 @@ const struct config_key config_instance_keys[] = {
 	CUSTOM("translate"),
 	CUSTOM("matrix"),
 	CUSTOM("scatter"),
+	CUSTOM("animate"),
 	END,
 };
 
@@ -151,6 +152,7 @@ const struct config_key config_scatter_keys[] = {
 	SCATTER("count", CONFIG_U32, count, 1, CONFIG_MAX_INSTANCES),
 	SCATTER("seed", CONFIG_U64, seed, 0, UINT64_MAX),
 	CUSTOM("bounds"),
+	CUSTOM("animate"),
 	END,
 };
 

@@ -228,7 +228,7 @@ static void series_work(void *arg, void *report, size_t size)
 	(void)size;
 	rep->status = SERIES_OK;
 	if (job->hb->top.plugin) { /* two-level (harness_two_level.c): status in the same order */
-		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst,
+		rep->status = harness_two_level_run(cfg, job->hb, &job->h->inst, &job->h->anim,
 		                                    cfg->scenes[job->run->scene].name,
 		                                    job->scene ? &job->scene->bounds : NULL,
 		                                    job->run->key.threads, rep, &err);
@@ -458,6 +458,8 @@ static void run_scene(struct harness *h, const struct config_scene *cs, size_t s
 	if (r == 0) /* two-level: meshes once, flattened if need be; animated: frame 0 */
 		r = cs->meshes ? load_instanced(h, cs, s, &scene, &flat_err, &err)
 		               : harness_anim_load(cs, &h->anim, &scene, &err);
+	if (r == 0 && cs->meshes) /* its instances move (harness_anim_inst.c) */
+		harness_anim_instanced(cs, &h->inst, &h->anim);
 	if (r == 0 && scene)
 		r = bvhlab_prims_init(&prims, scene, &err);
 	if (r < 0) {

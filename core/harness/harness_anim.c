@@ -155,6 +155,8 @@ int harness_anim_frame(const struct harness_anim *a, uint32_t f, bvhlab_scene **
                        bvhlab_error *err)
 {
 	*out = NULL;
+	if (a->inst)
+		return harness_anim_flat_frame(a, f, out, err);
 	int r = a->cs->frame_pattern ? frame_file(a, f, out, err) : posed(a, f, out, err);
 	if (r < 0 && *out) {
 		bvhlab_scene_destroy(*out);

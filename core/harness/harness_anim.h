@@ -11,6 +11,7 @@
 #include <bvhlab/bvhlab.h>
 
 #include "config/config.h"
+#include "scene/instances.h"
 #include "scene/scene_anim.h"
 
 struct harness_anim {
@@ -20,6 +21,10 @@ struct harness_anim {
 	struct scene_motion *motions; /* [mesh_count] */
 	uint32_t mesh_count;          /* parts, or 1; 0 for frame files */
 	const bvhlab_scene *first;    /* frame 0, which frame files must match */
+	/* An animated two-level scene (harness_anim_inst.c): its instances at
+	 * rest (not owned); its frames are those instances posed, and, for the
+	 * builders of one-level trees, flattened. NULL otherwise. */
+	const struct scene_instanced *inst;
 };
 
 /* Whether the config scene is animated ("frames"). */
@@ -47,5 +52,27 @@ int harness_anim_load(const struct config_scene *cs, struct harness_anim *a,
  */
 int harness_anim_frame(const struct harness_anim *a, uint32_t f, bvhlab_scene **out,
                        bvhlab_error *err);
+
+/* ---- animated two-level scenes (harness_anim_inst.c) ---- */
+
+/* a for the two-level scene cs, whose instances at rest are inst (kept by
+ * the caller for as long as a): frames 0 for a static scene. */
+void harness_anim_instanced(const struct config_scene *cs, const struct scene_instanced *inst,
+                            struct harness_anim *a);
+
+/*
+ * Frame f's instances (a->inst set) into *out: the rest's meshes, shared,
+ * and instances of its own, each that moves posed at f (its inverse with
+ * it). 0, -ENOMEM or -EINVAL (err says why); free it with
+ * harness_anim_posed_finish, never scene_instanced_finish.
+ */
+int harness_anim_pose_instances(const struct harness_anim *a, uint32_t f,
+                                struct scene_instanced *out, bvhlab_error *err);
+void harness_anim_posed_finish(struct scene_instanced *posed);
+
+/* Frame f posed and flattened, named as the scene (harness_anim_frame's
+ * for a two-level scene). */
+int harness_anim_flat_frame(const struct harness_anim *a, uint32_t f, bvhlab_scene **out,
+                            bvhlab_error *err);
 
 #endif

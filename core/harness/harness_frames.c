@@ -17,16 +17,7 @@
 /* The brute-force check's rays: the same seed as a static run's. */
 #define FRAME_RAY_SEED 0x5eedULL
 
-/* The update plugin and its stages, opened in the run's child. */
-struct updater {
-	bvhlab_plugin *plugin;
-	bvhlab_options opts;
-	bvhlab_plugin *stage_plugins[CONFIG_MAX_REFINE];
-	bvhlab_options stage_opts[CONFIG_MAX_REFINE];
-	uint32_t stage_count;
-};
-
-static void updater_close(struct updater *u)
+void harness_frames_updater_close(struct frames_updater *u)
 {
 	for (uint32_t k = 0; k < u->stage_count; k++) {
 		bvhlab_options_finish(&u->stage_opts[k]);
@@ -37,7 +28,7 @@ static void updater_close(struct updater *u)
 	bvhlab_plugin_close(u->plugin);
 }
 
-static int open_stage(const struct frames_job *job, struct updater *u, size_t k,
+static int open_stage(const struct frames_job *job, struct frames_updater *u, size_t k,
                       bvhlab_error *err)
 {
 	const struct config_animation *a = job->cb->animation;
@@ -58,7 +49,8 @@ static int open_stage(const struct frames_job *job, struct updater *u, size_t k,
 	return config_apply_anim_refine_options(job->cfg, job->cb, k, &u->stage_opts[k], err);
 }
 
-static int updater_open(const struct frames_job *job, struct updater *u, bvhlab_error *err)
+int harness_frames_updater_open(const struct frames_job *job, struct frames_updater *u,
+                                bvhlab_error *err)
 {
 	const struct config_animation *a = job->cb->animation;
 	int r = bvhlab_plugin_open(a->update, &u->plugin, err);
@@ -78,19 +70,17 @@ static int updater_open(const struct frames_job *job, struct updater *u, bvhlab_
 	return r;
 }
 
-/* Frame f is rebuilt: always without "animation", else every K frames. */
-static bool rebuilds(const struct frames_job *job, uint32_t f)
+bool harness_frames_rebuilds(const struct frames_job *job, uint32_t f)
 {
 	const struct config_animation *a = job->cb->animation;
 	return !a || (a->rebuild_every && f % a->rebuild_every == 0);
 }
 
-/* The rebuild or update of frame f and its stages, timed together. */
-static int advance(const struct frames_job *job, const struct updater *u, uint32_t f,
-                   const bvhlab_build_input *in, bvhlab_tree *tree, double *ms,
-                   bvhlab_error *err)
+int harness_frames_advance(const struct frames_job *job, const struct frames_updater *u,
+                           uint32_t f, const bvhlab_build_input *in, bvhlab_tree *tree,
+                           double *ms, bvhlab_error *err)
 {
-	bool rebuild = rebuilds(job, f);
+	bool rebuild = harness_frames_rebuilds(job, f);
 	double t0 = util_now();
 	int r = rebuild ? bvhlab_build(job->plugin, job->opts, in, job->threads, tree, err)
 	                : bvhlab_update(u->plugin, &u->opts, in, job->threads, tree, err);
@@ -112,7 +102,7 @@ static int check(const struct frames_job *job, const bvhlab_scene *scene,
 	uint32_t n = job->anim->frames, f = fm->frame;
 	uint64_t mismatches = 0;
 	fm->valid = bvhlab_validate_tree(tree, in, job->spatial_splits, err) == 0;
-	if (!fm->valid || !job->cfg->validate || (f != 0 && f != (n - 1) / 2 && f != n - 1))
+	if (!fm->valid || !job->cfg->validate || !harness_frames_rays_frame(n, f))
 		return 0;
 	fm->rays_checked = true;
 	int r = bvhlab_validate_rays(tree, scene, job->cfg->validate_rays, FRAME_RAY_SEED,
@@ -168,16 +158,16 @@ static int make_frame(const struct frames_job *job, const struct harness_anim *a
 }
 
 static int one_frame(const struct frames_job *job, const struct harness_anim *a,
-                     const struct updater *u, uint32_t f, const bvhlab_camera *cam,
+                     const struct frames_updater *u, uint32_t f, const bvhlab_camera *cam,
                      bvhlab_tree *tree, struct frame_metrics *fm, bvhlab_error *err)
 {
 	bvhlab_scene *scene = NULL;
 	bvhlab_prims prims = {0};
-	*fm = (struct frame_metrics){.frame = f, .rebuilt = f == 0 || rebuilds(job, f),
-	                             .update_ms = job->first_ms};
+	bool rebuilt = f == 0 || harness_frames_rebuilds(job, f);
+	*fm = (struct frame_metrics){.frame = f, .rebuilt = rebuilt, .update_ms = job->first_ms};
 	int r = make_frame(job, a, f, &scene, &prims, err);
 	if (r == 0 && f > 0)
-		r = advance(job, u, f, &prims.input, tree, &fm->update_ms, err);
+		r = harness_frames_advance(job, u, f, &prims.input, tree, &fm->update_ms, err);
 	if (r == 0)
 		r = check(job, scene ? scene : job->first, &prims.input, tree, fm, err);
 	if (r == 0 && fm->valid)
@@ -192,10 +182,10 @@ static int one_frame(const struct frames_job *job, const struct harness_anim *a,
 int harness_frames_run(const struct frames_job *job, bvhlab_tree *tree,
                        struct frame_metrics *out, uint32_t *count, bvhlab_error *err)
 {
-	struct updater u = {0};
+	struct frames_updater u = {0};
 	struct harness_anim a = *job->anim;
 	bvhlab_camera cam;
-	int r = job->cb->animation ? updater_open(job, &u, err) : 0;
+	int r = job->cb->animation ? harness_frames_updater_open(job, &u, err) : 0;
 	a.first = job->first; /* frame files are checked against it */
 	harness_camera(job->cfg, job->first, &cam);
 	*count = 0;
@@ -204,7 +194,7 @@ int harness_frames_run(const struct frames_job *job, bvhlab_tree *tree,
 		if (r >= 0)
 			*count = f + 1;
 	}
-	updater_close(&u);
+	harness_frames_updater_close(&u);
 	return r;
 }
 
@@ -235,5 +225,6 @@ void harness_frames_death(const struct config_builder *cb, uint32_t f, char *why
 		snprintf(why, size, "frame %u, updated by '%s'%s: %s", f, a->update,
 		         a->refine_count ? " and its refine stages" : "", was);
 	else
-		snprintf(why, size, "frame %u, rebuilt by '%s': %s", f, cb->plugin, was);
+		snprintf(why, size, "frame %u, rebuilt by '%s'%s: %s", f, cb->top ? cb->top : cb->plugin,
+		         cb->top ? " (the top)" : "", was);
 }

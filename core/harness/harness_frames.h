@@ -24,7 +24,7 @@ struct frames_job {
 	const struct config_builder *cb; /* its "animation", or none: rebuild */
 	const struct harness_anim *anim;
 	const bvhlab_scene *first;       /* frame 0, the run's scene */
-	const bvhlab_plugin *plugin;     /* the builder, for rebuilds */
+	const bvhlab_plugin *plugin;     /* the builder (a two-level run's top), for rebuilds */
 	const bvhlab_options *opts;
 	const struct refine_stage *stages; /* the builder's own, after each rebuild */
 	uint32_t stage_count;
@@ -32,6 +32,37 @@ struct frames_job {
 	bool spatial_splits;
 	double first_ms;                 /* frame 0's build (the series' median) */
 };
+
+/* The update plugin and its stages, opened in the run's child. */
+struct frames_updater {
+	bvhlab_plugin *plugin;
+	bvhlab_options opts;
+	bvhlab_plugin *stage_plugins[CONFIG_MAX_REFINE];
+	bvhlab_options stage_opts[CONFIG_MAX_REFINE];
+	uint32_t stage_count;
+};
+
+/* job->cb's animation's update plugin and stages into u (zeroed first by
+ * the caller); close frees what open got, whether it failed or not. */
+int harness_frames_updater_open(const struct frames_job *job, struct frames_updater *u,
+                                bvhlab_error *err);
+void harness_frames_updater_close(struct frames_updater *u);
+
+/* Frame f is rebuilt: always without "animation", else every K frames. */
+bool harness_frames_rebuilds(const struct frames_job *job, uint32_t f);
+
+/* The rebuild (job's plugin and stages) or update (u's) of frame f over
+ * `in`, timed together into *ms. 0 or a negative errno (err says why). */
+int harness_frames_advance(const struct frames_job *job, const struct frames_updater *u,
+                           uint32_t f, const bvhlab_build_input *in, bvhlab_tree *tree,
+                           double *ms, bvhlab_error *err);
+
+/* Frame f of `frames` has its brute-force rays checked: the first, the
+ * middle and the last. */
+static inline bool harness_frames_rays_frame(uint32_t frames, uint32_t f)
+{
+	return f == 0 || f == (frames - 1) / 2 || f == frames - 1;
+}
 
 /* Room a run's report needs for the frames of scene a (0 for none). */
 static inline size_t harness_frames_size(const struct harness_anim *a)

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "harness/harness_rays.h"
+#include "harness/harness_anim_top.h"
 #include "harness/harness_report.h"
 #include "harness/harness_series.h"
 #include "harness/harness_two_level.h"
@@ -109,6 +110,16 @@ static enum tree_verdict bottom_level(const struct two_level_job *job, double *s
 	return TREE_OK;
 }
 
+double harness_two_level_sah(const struct scene_instanced *inst, const bvhlab_tree *top,
+                             const bvhlab_aabb *boxes, double top_sah, const double *mesh_sah)
+{
+	double root = bvhlab_box_area(top->nodes[0].lo, top->nodes[0].hi), sah = top_sah;
+	for (uint32_t i = 0; root > 0 && i < inst->instance_count; i++)
+		sah += bvhlab_box_area(boxes[i].lo, boxes[i].hi) / root *
+		       mesh_sah[inst->instances[i].mesh];
+	return sah;
+}
+
 static enum tree_verdict top_level(const struct two_level_job *job, double *samples,
                                    double *cold_ms, struct tree_measure *whole,
                                    struct results_two_level *lv, const double *mesh_sah,
@@ -137,11 +148,7 @@ static enum tree_verdict top_level(const struct two_level_job *job, double *samp
 	}
 	bvhlab_tree_stats_compute(&trees->top, &st);
 	add_tree(&lv->top, &st, &whole->stats);
-	double root = bvhlab_box_area(trees->top.nodes[0].lo, trees->top.nodes[0].hi);
-	lv->sah = st.sah_cost;
-	for (uint32_t i = 0; root > 0 && i < inst->instance_count; i++)
-		lv->sah += bvhlab_box_area(boxes[i].lo, boxes[i].hi) / root *
-		           mesh_sah[inst->instances[i].mesh];
+	lv->sah = harness_two_level_sah(inst, &trees->top, boxes, st.sah_cost, mesh_sah);
 	whole->stats.max_depth += st.max_depth + 1; /* a top leaf, then an instance's root */
 	free(boxes);
 	return TREE_OK;
@@ -246,7 +253,8 @@ static void trace_rays(const struct config *cfg, const struct scene_instanced *i
 
 enum tree_verdict harness_two_level_run(const struct config *cfg,
                                         const struct harness_builder *hb,
-                                        const struct scene_instanced *inst, const char *scene,
+                                        const struct scene_instanced *inst,
+                                        const struct harness_anim *anim, const char *scene,
                                         const bvhlab_aabb *flat, uint32_t threads,
                                         struct series_report *rep, bvhlab_error *err)
 {
@@ -264,6 +272,9 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
 	memcpy(rep->phases, trees.phases, sizeof(rep->phases));
 	if (v == TREE_OK)
 		trace_rays(cfg, inst, scene, flat, &trees, &rep->rays);
+	/* An animated scene's frames, on these trees (harness_anim_top.c). */
+	int f = v != TREE_OK ? 0 : harness_anim_top_frames(cfg, hb, anim, &trees, threads, rep, err);
+	v = f > 0 ? TREE_INVALID : f < 0 ? TREE_FAILED : v;
 	harness_two_level_finish(&trees);
 	return v;
 }

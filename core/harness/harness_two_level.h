@@ -56,7 +56,13 @@ enum tree_verdict harness_two_level_series(const struct two_level_job *job,
                                            struct two_level_trees *trees, bvhlab_error *err);
 void harness_two_level_finish(struct two_level_trees *trees);
 
+/* The two-level SAH (docs/instances.md) of top (over inst's world boxes,
+ * its own SAH top_sah), mesh m's bottom tree's SAH mesh_sah[m]. */
+double harness_two_level_sah(const struct scene_instanced *inst, const bvhlab_tree *top,
+                             const bvhlab_aabb *boxes, double top_sah, const double *mesh_sah);
+
 struct series_report; /* harness_report.h */
+struct harness_anim;  /* harness_anim.h */
 
 /*
  * A sweep's two-level run, in its child: builder hb's bottom plugin and
@@ -68,12 +74,14 @@ struct series_report; /* harness_report.h */
  * valid trees rays (the primary rays of the config's camera for scene
  * `scene`, or of one framing `flat`, the flattened scene's bounds, or when
  * NULL the top tree's root box; each CPU traversal at both levels,
- * harness_trace_rays_two_level); returns
- * the verdict (TREE_OK, _INVALID, _FAILED: the run's status, in the same order).
+ * harness_trace_rays_two_level); on an animated scene (anim's frames; NULL or 0: none) then the frames, the top
+ * rebuilt or updated on each (harness_anim_top.c). Returns the verdict
+ * (TREE_OK, _INVALID, _FAILED: the run's status, in the same order).
  */
 enum tree_verdict harness_two_level_run(const struct config *cfg,
                                         const struct harness_builder *hb,
-                                        const struct scene_instanced *inst, const char *scene,
+                                        const struct scene_instanced *inst,
+                                        const struct harness_anim *anim, const char *scene,
                                         const bvhlab_aabb *flat, uint32_t threads,
                                         struct series_report *rep, bvhlab_error *err);
 

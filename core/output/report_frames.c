@@ -60,7 +60,8 @@ static void sum_up(const cJSON *run, struct strategy *s)
 }
 
 /* The run that rebuilds every frame with the same plugin and threads, on
- * the same machine (another machine's costs are its own). */
+ * the same machine (another machine's costs are its own); a two-level
+ * run's with the same top ("" for a one-level run: never each other's). */
 static const struct strategy *rebuild_of(const struct strategy *s, size_t n,
                                          const struct strategy *u)
 {
@@ -68,6 +69,8 @@ static const struct strategy *rebuild_of(const struct strategy *s, size_t n,
 		if (!s[k].updates && s[k].all_valid && s[k].count == u->count &&
 		    s[k].machine == u->machine &&
 		    strcmp(report_str(s[k].run, "plugin"), report_str(u->run, "plugin")) == 0 &&
+		    strcmp(report_str(s[k].run, "two_level.top.plugin"),
+		           report_str(u->run, "two_level.top.plugin")) == 0 &&
 		    report_num(s[k].run, "threads") == report_num(u->run, "threads"))
 			return &s[k];
 	return NULL;
