@@ -359,8 +359,8 @@ static void run_one(struct harness *h, struct series_job *job)
 	struct memory_estimate est;
 	char refused[512];
 	run.estimate = &est;
-	if (harness_estimate_run(h->cfg, job->hb, job->scene->name, &job->prims->input, &est,
-	                         refused, sizeof(refused)) < 0) {
+	if (harness_estimate_run(h->cfg, job->hb, job->scene->name, &job->prims->input,
+	                         h->anim.frames != 0, &est, refused, sizeof(refused)) < 0) {
 		run.error = refused; /* nothing built: the sweep goes on */
 		record(h, &run);
 		return;

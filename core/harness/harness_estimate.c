@@ -78,12 +78,14 @@ static uint64_t trace_per_prim(const struct config *cfg)
 	return most;
 }
 
-/* Bytes per primitive held after the builds, the tree included. */
+/* Bytes per primitive held after the builds, the tree included; with
+ * `spare_kept` (frames build again) the output keeps the builds' scratch. */
 static uint64_t after_per_prim(const struct config *cfg, const struct harness_builder *hb,
-                               uint64_t declared)
+                               uint64_t declared, bool spare_kept)
 {
 	bool spatial = bvhlab_plugin_builder(hb->plugin)->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
-	uint64_t tree = spatial || declared < TREE_PER_PRIM ? declared : TREE_PER_PRIM;
+	uint64_t tree = spatial || spare_kept || declared < TREE_PER_PRIM ? declared
+	                                                                    : TREE_PER_PRIM;
 	uint64_t trace = trace_per_prim(cfg);
 	return tree + (trace > CHECKS_PER_PRIM ? trace : CHECKS_PER_PRIM);
 }
@@ -110,13 +112,13 @@ static void describe(const struct memory_estimate *e, const char *scene,
 }
 
 int harness_estimate_run(const struct config *cfg, const struct harness_builder *hb,
-                         const char *scene, const bvhlab_build_input *in,
+                         const char *scene, const bvhlab_build_input *in, bool frames,
                          struct memory_estimate *e, char *why, size_t size)
 {
 	uint64_t mb = hb->cb->memory_limit_mb ? hb->cb->memory_limit_mb : cfg->memory_limit_mb;
 	*e = (struct memory_estimate){.scene_bytes = harness_memory_scene_bytes(in)};
 	e->bytes_per_prim = per_prim(hb, &e->declared);
-	e->after_bytes_per_prim = after_per_prim(cfg, hb, e->bytes_per_prim);
+	e->after_bytes_per_prim = after_per_prim(cfg, hb, e->bytes_per_prim, frames);
 	uint64_t most = e->bytes_per_prim > e->after_bytes_per_prim ? e->bytes_per_prim
 	                                                            : e->after_bytes_per_prim;
 	e->bytes = e->scene_bytes + most * in->prim_count;
