@@ -103,8 +103,9 @@ static void describe(const struct memory_estimate *e, const char *scene,
 	uint64_t most = e->bytes_per_prim > e->after_bytes_per_prim ? e->bytes_per_prim
 	                                                            : e->after_bytes_per_prim;
 	snprintf(why, size, "scene '%s', builder '%s': refused before building: estimated peak "
-	         "%.0f MiB (the scene's %.0f MiB + %u triangles x %llu bytes, the larger of the "
-	         "build's %llu per triangle (%s) and validation and tracing's %llu) exceeds %s",
+	         "%.0f MiB (the scene's %.0f MiB + %u triangles x %llu bytes, the larger of "
+	         "the build's %llu per triangle (%s) and validation and tracing's %llu) "
+	         "exceeds %s",
 	         scene, hb->cb->name, (double)e->bytes / MIB, (double)e->scene_bytes / MIB,
 	         prims, (unsigned long long)most, (unsigned long long)e->bytes_per_prim,
 	         e->declared ? "declared" : "assumed, not declared",

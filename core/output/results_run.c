@@ -59,7 +59,8 @@ static void per_triangle_json(cJSON *o, const struct build_memory *m, uint32_t t
 		results_add_numbers(o, per, RESULTS_NUMBERS(per));
 	cJSON_AddNumberToObject(o, "child_bytes_per_triangle", (double)m->peak_rss_bytes / n);
 	if (m->run_peak_rss_bytes)
-		cJSON_AddNumberToObject(o, "run_bytes_per_triangle", (double)m->run_peak_rss_bytes / n);
+		cJSON_AddNumberToObject(o, "run_bytes_per_triangle",
+		                        (double)m->run_peak_rss_bytes / n);
 	cJSON_AddNumberToObject(o, "scene_bytes_per_triangle", (double)m->scene_bytes / n);
 }
 

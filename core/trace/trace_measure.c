@@ -290,7 +290,7 @@ void trace_series_destroy(struct trace_series *s)
  * (trace_view_copy); a wide one reads its wide nodes, so its counting pass
  * walks the tree in place (the same nodes visited, the same triangles
  * tested) and the tree is not held three times at once: at 68.8M
- * triangles the binary copies alone are 6.9 GB (docs/benchmarks.md). */
+ * triangles the binary copies alone are up to 6.9 GB (docs/benchmarks.md). */
 static int series_views(struct trace_series *s, int traversal, bool counters)
 {
 	s->b.view = trace_view_plain(s->b.tree);
