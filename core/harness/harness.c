@@ -34,6 +34,7 @@
 #include "output/images.h"
 #include "output/safe_file.h"
 #include "plan/plan.h"
+#include "tree/tree_spare.h"
 #include "util/util.h"
 
 struct harness {
@@ -246,6 +247,11 @@ static void series_work(void *arg, void *report, size_t size)
 		rep->stage_count = s.stage_count;
 		rep->phase_count = s.phase_count;
 		memcpy(rep->phases, s.phases, sizeof(rep->phases));
+		/* The builders' scratch, kept for builds no longer coming, makes
+		 * room for validation and tracing (harness_estimate.c counts on
+		 * it); an animation's frames build again and keep it. */
+		if (!job->h->anim.frames)
+			tree_release_spare(&s.tree);
 		measure(job, &s.tree, rep, &err);
 		if (rep->status == SERIES_OK)
 			trace_rays(job, &s.tree, rep);
@@ -254,6 +260,7 @@ static void series_work(void *arg, void *report, size_t size)
 			&job->h->anim, job->scene, job->run->key.threads, rep->samples, s.repeat, &s.tree,
 			&rep->frame_count, &err); /* an animated scene's frames: harness_frames.c */
 		rep->status = f > 0 ? SERIES_INVALID : f < 0 ? SERIES_FAILED : rep->status;
+		harness_memory_run_end(&rep->memory);
 	}
 out:
 	if (rep->status != SERIES_OK)
@@ -364,8 +371,9 @@ static void run_one(struct harness *h, struct series_job *job)
 	char refused[512];
 	/* The estimates are of one-level builds: a two-level one has none yet. */
 	run.estimate = job->hb->top.plugin ? NULL : &est;
-	if (run.estimate && harness_estimate_run(h->cfg, job->hb, scene, &job->prims->input, &est,
-	                                         refused, sizeof(refused)) < 0) {
+	if (run.estimate && harness_estimate_run(h->cfg, job->hb, scene, &job->prims->input,
+	                                         h->anim.frames != 0, &est, refused,
+	                                         sizeof(refused)) < 0) {
 		run.error = refused; /* nothing built: the sweep goes on */
 		record(h, &run);
 		return;

@@ -3,9 +3,10 @@
  * child is forked, with the figures, instead of being killed by the
  * kernel (or by RLIMIT_AS) part-way through and taking the machine's
  * other work with it. The estimate is the data's, not the process's: the
- * scene's arrays as the builds read them and the bytes per primitive the
- * plugins declare (a builder and each refine stage, summed: a stage's
- * scratch comes on top of the tree it is given).
+ * scene's arrays as the builds read them, plus per primitive the larger
+ * of what the builds hold (the bytes the plugins declare: a builder and
+ * each refine stage, summed, since a stage's scratch comes on top of the
+ * tree it is given) and what validation and tracing hold after them.
  */
 #include <errno.h>
 #include <stdio.h>
@@ -33,6 +34,62 @@ static uint64_t per_prim(const struct harness_builder *hb, bool *all)
 	return bytes;
 }
 
+/*
+ * After the builds (docs/benchmarks.md, "What a run holds"): the tree they
+ * left, 2N - 1 nodes of 32 bytes and N indices (68; the host gives the
+ * builders' spare capacity back before validating, harness.c), or the
+ * build's whole declaration for a builder whose spatial splits add
+ * references; then the largest of validation's and EPO's arrays (slot and
+ * primitive owners, the coverage check's reference lists, parent links,
+ * area sums: 24 at most) and the tracing copies of the configured
+ * traversals (trace_per_prim).
+ */
+#define TREE_PER_PRIM 68
+#define CHECKS_PER_PRIM 24
+/* The binary copies (trace_view.c): the nodes and the vertices in slot order. */
+#define BINARY_COPY_PER_PRIM (2 * 32 + 36)
+/* The wide nodes and triangle groups (wide_bvh.c): groups of 4 triangles,
+ * 160 bytes each, a leaf lane's subtree of up to 8 taking one or two, and
+ * 4-child nodes of 128 bytes; what tracing added on igea subdivided twice
+ * was 62.5 (lbvh) and 60.6 (hlbvh), with a margin for other trees. */
+#define WIDE_COPY_PER_PRIM 72
+
+/* The largest tracing copy of the traversals the config times (the
+ * traversals of a batch run one after another, each freeing its copy). A
+ * device traversal counts the host's copy and the device's buffers, which
+ * a CPU device (PoCL) keeps in host memory too. */
+static uint64_t trace_per_prim(const struct config *cfg)
+{
+	static const uint64_t per[BVHLAB_TRAVERSAL_COUNT] = {
+		[BVHLAB_TRAVERSAL_STACK] = BINARY_COPY_PER_PRIM,
+		[BVHLAB_TRAVERSAL_STACKLESS] = BINARY_COPY_PER_PRIM + 8,
+		[BVHLAB_TRAVERSAL_WIDE] = WIDE_COPY_PER_PRIM,
+		[BVHLAB_TRAVERSAL_WIDE4] = WIDE_COPY_PER_PRIM,
+		[BVHLAB_TRAVERSAL_WIDE8] = WIDE_COPY_PER_PRIM,
+		[BVHLAB_TRAVERSAL_DEVICE_STACK] = 2 * BINARY_COPY_PER_PRIM,
+		[BVHLAB_TRAVERSAL_DEVICE_STACKLESS] = 2 * BINARY_COPY_PER_PRIM + 8,
+	};
+	uint64_t most = 0;
+	if ((uint64_t)cfg->ray_width * cfg->ray_height == 0)
+		return 0;
+	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++)
+		if (cfg->ray_traversals & (1u << k) && per[k] > most)
+			most = per[k];
+	return most;
+}
+
+/* Bytes per primitive held after the builds, the tree included; with
+ * `spare_kept` (frames build again) the output keeps the builds' scratch. */
+static uint64_t after_per_prim(const struct config *cfg, const struct harness_builder *hb,
+                               uint64_t declared, bool spare_kept)
+{
+	bool spatial = bvhlab_plugin_builder(hb->plugin)->flags & BVHLAB_BUILDER_SPATIAL_SPLITS;
+	uint64_t tree = spatial || spare_kept || declared < TREE_PER_PRIM ? declared
+	                                                                    : TREE_PER_PRIM;
+	uint64_t trace = trace_per_prim(cfg);
+	return tree + (trace > CHECKS_PER_PRIM ? trace : CHECKS_PER_PRIM);
+}
+
 static void describe(const struct memory_estimate *e, const char *scene,
                      const struct harness_builder *hb, uint32_t prims, char *why, size_t size)
 {
@@ -43,21 +100,29 @@ static void describe(const struct memory_estimate *e, const char *scene,
 	else
 		snprintf(limit, sizeof(limit), "the memory available (%.0f MiB, memory_limit_mb "
 		         "unset)", (double)e->limit_bytes / MIB);
+	uint64_t most = e->bytes_per_prim > e->after_bytes_per_prim ? e->bytes_per_prim
+	                                                            : e->after_bytes_per_prim;
 	snprintf(why, size, "scene '%s', builder '%s': refused before building: estimated peak "
-	         "%.0f MiB (the scene's %.0f MiB + %llu bytes per triangle %s x %u triangles) "
-	         "exceeds %s", scene, hb->cb->name, (double)e->bytes / MIB,
-	         (double)e->scene_bytes / MIB, (unsigned long long)e->bytes_per_prim,
-	         e->declared ? "declared" : "assumed, not declared", prims, limit);
+	         "%.0f MiB (the scene's %.0f MiB + %u triangles x %llu bytes, the larger of "
+	         "the build's %llu per triangle (%s) and validation and tracing's %llu) "
+	         "exceeds %s",
+	         scene, hb->cb->name, (double)e->bytes / MIB, (double)e->scene_bytes / MIB,
+	         prims, (unsigned long long)most, (unsigned long long)e->bytes_per_prim,
+	         e->declared ? "declared" : "assumed, not declared",
+	         (unsigned long long)e->after_bytes_per_prim, limit);
 }
 
 int harness_estimate_run(const struct config *cfg, const struct harness_builder *hb,
-                         const char *scene, const bvhlab_build_input *in,
+                         const char *scene, const bvhlab_build_input *in, bool frames,
                          struct memory_estimate *e, char *why, size_t size)
 {
 	uint64_t mb = hb->cb->memory_limit_mb ? hb->cb->memory_limit_mb : cfg->memory_limit_mb;
 	*e = (struct memory_estimate){.scene_bytes = harness_memory_scene_bytes(in)};
 	e->bytes_per_prim = per_prim(hb, &e->declared);
-	e->bytes = e->scene_bytes + e->bytes_per_prim * in->prim_count;
+	e->after_bytes_per_prim = after_per_prim(cfg, hb, e->bytes_per_prim, frames);
+	uint64_t most = e->bytes_per_prim > e->after_bytes_per_prim ? e->bytes_per_prim
+	                                                            : e->after_bytes_per_prim;
+	e->bytes = e->scene_bytes + most * in->prim_count;
 	e->limit_from_config = mb != 0;
 	if (mb) {
 		e->limit_bytes = mb << 20;

@@ -13,13 +13,17 @@
 /*
  * The run's peak from the scene's size and what its builder and refine
  * stages declare per primitive (bvhlab_builder.peak_bytes_per_prim, ABI
- * 1.7), against the builder's or the config's memory_limit_mb, or without
- * one the memory available now plus the scene's (resident already). 0 when
- * it fits or the limit is unknown; -E2BIG when it does not, `why` naming
- * scene, builder, the estimate and the limit. *e is filled either way.
+ * 1.7), or, when larger, what validation and tracing hold after the
+ * builds (the tree, the checks, the tracing copies of the config's
+ * traversals; `frames`: an animation's frames follow, so the builds'
+ * scratch stays), against the builder's or the config's memory_limit_mb,
+ * or without one the memory available now plus the scene's (resident
+ * already). 0 when it fits or the limit is unknown; -E2BIG when it does
+ * not, `why` naming scene, builder, the estimate and the limit. *e is
+ * filled either way.
  */
 int harness_estimate_run(const struct config *cfg, const struct harness_builder *hb,
-                         const char *scene, const bvhlab_build_input *in,
+                         const char *scene, const bvhlab_build_input *in, bool frames,
                          struct memory_estimate *e, char *why, size_t size);
 
 #endif

@@ -69,6 +69,12 @@ void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree)
 	m->measured = m->peak_rss_bytes > 0;
 }
 
+void harness_memory_run_end(struct build_memory *m)
+{
+	if (m->measured)
+		m->run_peak_rss_bytes = status_bytes("VmHWM");
+}
+
 /* The runtime's baseline: the resident memory machine_cl_open added the
  * first time in this process. */
 static int open_device(const char *spec, struct run_device *dev)

@@ -10,6 +10,8 @@ struct build_memory; /* output/results.h */
  * in is the run's input (its scene's share is recorded). */
 void harness_memory_begin(struct build_memory *m, const bvhlab_build_input *in);
 void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree);
+/* After validation and tracing: the run's peak over all of it. */
+void harness_memory_run_end(struct build_memory *m);
 
 /*
  * The scene's own bytes as the builds get it: vertices, indices and the

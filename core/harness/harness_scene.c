@@ -73,21 +73,34 @@ struct scene_probe {
 	char error[sizeof(((bvhlab_error *)0)->message)];
 };
 
-/* In the child: the scene and its primitives, as the sweep will make them. */
+/* What the probe loads: with a memory limit, the scene and its primitives
+ * as the sweep will make them (the subdivided arrays are what must fit
+ * it); without one, the files alone (parsing them is what can crash or
+ * hang; subdividing and the primitives are the host's own arithmetic,
+ * which the parent does anyway, and at 68.8M triangles they take
+ * minutes). */
+struct probe_job {
+	const struct config_scene *cs;
+	bool whole;
+};
+
+/* In the child: the scene as the job says. */
 static void probe_work(void *arg, void *report, size_t size)
 {
+	const struct probe_job *job = arg;
 	struct scene_probe *rep = report;
+	struct config_scene files = *job->cs;
 	bvhlab_scene *scene = NULL;
 	bvhlab_prims prims = {0};
 	bvhlab_error err = {{0}};
 	struct scene_instanced inst = {0};
-	const struct config_scene *cs = arg;
 	(void)size;
 	/* A two-level scene's meshes and instances; the parent flattens it,
 	 * checked against the memory available, only where a run needs it. */
-	int r = cs->meshes ? harness_load_instanced(cs, &inst, &err)
-	                   : harness_load_scene(cs, &scene, &err);
-	if (r == 0 && scene)
+	files.subdivide = job->whole ? files.subdivide : 0;
+	int r = files.meshes ? harness_load_instanced(&files, &inst, &err)
+	                     : harness_load_scene(&files, &scene, &err);
+	if (r == 0 && scene && job->whole)
 		r = bvhlab_prims_init(&prims, scene, &err);
 	scene_instanced_finish(&inst);
 	rep->ok = r == 0;
@@ -115,7 +128,8 @@ int harness_probe_scene(const struct config *cfg, const struct config_scene *cs,
 	char why[sizeof(rep.error)] = "", limit[64] = "";
 	uint64_t mb = largest_limit_mb(cfg);
 	struct isolate_limits limits = {.timeout_s = cfg->timeout_s, .memory_bytes = mb << 20};
-	int outcome = isolate_call(probe_work, (void *)cs, &rep, sizeof(rep), &limits, why,
+	struct probe_job job = {.cs = cs, .whole = mb != 0};
+	int outcome = isolate_call(probe_work, &job, &rep, sizeof(rep), &limits, why,
 	                           sizeof(why));
 	if (outcome == ISOLATE_REPORTED && rep.ok)
 		return 0;

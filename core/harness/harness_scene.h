@@ -16,7 +16,8 @@ int harness_load_scene(const struct config_scene *cs, bvhlab_scene **out, bvhlab
  * Loads the scene once in a forked child first, under timeout_s and the
  * largest memory limit of the config's builders (none if one has none):
  * a scene that hangs the loader, eats the machine's memory or crashes it
- * costs that scene only. 0 when it loaded there; else a negative errno
+ * costs that scene only. Without a limit the child reads the files only,
+ * not subdividing them. 0 when it loaded there; else a negative errno
  * and err saying why, naming the limit it ran into.
  */
 int harness_probe_scene(const struct config *cfg, const struct config_scene *cs,

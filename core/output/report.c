@@ -118,6 +118,7 @@ static const char *const csv_numbers[][2] = {
 	{"memory.with_scene_bytes_per_triangle", "%.2f"},
 	{"memory.child_bytes_per_triangle", "%.2f"},
 	{"memory.scene_bytes_per_triangle", "%.2f"},
+	{"memory.run_bytes_per_triangle", "%.2f"},
 };
 
 /* build_phases as one field, "upload=1.2345;device=3.4567": the phases vary

@@ -119,6 +119,8 @@ struct build_memory {
 	uint64_t output_bytes;    /* the output buffers the host allocated, capacity */
 	uint64_t scene_bytes;     /* the scene's own arrays (harness_memory_scene_bytes):
 	                           * resident before the builds, part of start_rss */
+	uint64_t run_peak_rss_bytes; /* the peak over the builds, validation and tracing
+	                              * (0: not read) */
 };
 
 /* A run's peak memory as estimated before it started
@@ -127,9 +129,12 @@ struct memory_estimate {
 	bool known;             /* a limit was known (the config's, or MemAvailable) */
 	bool declared;          /* the builder and its stages declared their bytes */
 	bool limit_from_config; /* memory_limit_mb, not the memory available */
-	uint64_t bytes;         /* scene_bytes + bytes_per_prim x primitives */
+	uint64_t bytes;         /* scene_bytes + the larger of bytes_per_prim and
+	                         * after_bytes_per_prim x primitives */
 	uint64_t scene_bytes;   /* the scene's arrays (harness_memory_scene_bytes) */
 	uint64_t bytes_per_prim; /* the builder's and its stages' declarations, summed */
+	uint64_t after_bytes_per_prim; /* the tree, validation and tracing after the builds
+	                                * (harness_estimate.c) */
 	uint64_t limit_bytes;   /* what it was held against */
 };
 

@@ -58,6 +58,9 @@ static void per_triangle_json(cJSON *o, const struct build_memory *m, uint32_t t
 	if (m->reset)
 		results_add_numbers(o, per, RESULTS_NUMBERS(per));
 	cJSON_AddNumberToObject(o, "child_bytes_per_triangle", (double)m->peak_rss_bytes / n);
+	if (m->run_peak_rss_bytes)
+		cJSON_AddNumberToObject(o, "run_bytes_per_triangle",
+		                        (double)m->run_peak_rss_bytes / n);
 	cJSON_AddNumberToObject(o, "scene_bytes_per_triangle", (double)m->scene_bytes / n);
 }
 
@@ -72,6 +75,8 @@ static cJSON *memory_json(const struct build_memory *m, uint32_t triangles)
 		{"scene_bytes", (double)m->scene_bytes},
 	};
 	results_add_numbers(o, bytes, RESULTS_NUMBERS(bytes));
+	if (m->run_peak_rss_bytes)
+		cJSON_AddNumberToObject(o, "run_peak_rss_bytes", (double)m->run_peak_rss_bytes);
 	if (triangles)
 		per_triangle_json(o, m, triangles);
 	return o;
@@ -84,6 +89,7 @@ static cJSON *estimate_json(const struct memory_estimate *e)
 		{"bytes", (double)e->bytes},
 		{"scene_bytes", (double)e->scene_bytes},
 		{"bytes_per_triangle", (double)e->bytes_per_prim},
+		{"after_bytes_per_triangle", (double)e->after_bytes_per_prim},
 	};
 	results_add_numbers(o, bytes, RESULTS_NUMBERS(bytes));
 	cJSON_AddBoolToObject(o, "declared", e->declared);

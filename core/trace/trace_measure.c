@@ -290,8 +290,19 @@ void trace_series_destroy(struct trace_series *s)
 	free(s);
 }
 
+/* The stack and stackless traversals read the binary copies
+ * (trace_view_copy); a wide one reads its wide nodes, so its counting pass
+ * walks the tree in place (the same nodes visited, the same triangles
+ * tested) and the tree is not held three times at once: at 68.8M
+ * triangles the binary copies alone are up to 6.9 GB (docs/benchmarks.md). */
 static int series_views(struct trace_series *s, int traversal, bool counters)
 {
+	s->b.view = trace_view_plain(s->b.tree);
+	if (trace_is_wide(traversal) && !s->b.count)
+		return 0;
+	if (trace_is_wide(traversal))
+		return counters ? count_binary(s)
+		                : trace_view_wide(s->b.tree, s->b.scene, traversal, &s->b.view);
 	if (traversal == BVHLAB_TRAVERSAL_STACKLESS) {
 		int r = bvhlab_tree_parents(s->b.tree, &s->parents);
 		if (r < 0)
@@ -299,9 +310,6 @@ static int series_views(struct trace_series *s, int traversal, bool counters)
 	}
 	int r = trace_view_copy(s->b.tree, s->b.scene, &s->b.view);
 	s->b.view.parents = s->parents;
-	if (r == 0 && trace_is_wide(traversal) && s->b.count)
-		r = counters ? count_binary(s)
-		             : trace_view_wide(s->b.tree, s->b.scene, traversal, &s->b.view);
 	return r;
 }
 

@@ -70,15 +70,30 @@ static int copy_tris(const bvhlab_tree *tree, const bvhlab_scene *scene, struct 
 	return 0;
 }
 
+/* The binary copies added to a view (which keeps its wide nodes). */
+static int add_copies(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v)
+{
+	int r = copy_nodes(tree, v);
+	return r == 0 ? copy_tris(tree, scene, v) : r;
+}
+
 int trace_view_copy(const bvhlab_tree *tree, const bvhlab_scene *scene, struct trace_view *v)
 {
 	*v = trace_view_plain(tree);
-	int r = copy_nodes(tree, v);
-	if (r == 0)
-		r = copy_tris(tree, scene, v);
+	int r = add_copies(tree, scene, v);
 	if (r < 0)
 		trace_view_free(v);
 	return r;
+}
+
+/* Whether every ray walks the wide nodes: a tree too deep for the wide
+ * stack falls back to the stack traversal (trace_wide_body.h), which
+ * then wants the binary copies. */
+static bool wide_covers(const struct trace_view *v)
+{
+	if (v->wide8)
+		return (uint64_t)v->wide8->depth * (WIDE8 - 1) + 1 <= WIDE8_STACK;
+	return v->wide && (uint64_t)v->wide->depth * (WIDE - 1) + 1 <= WIDE_STACK;
 }
 
 /* The 4-lane nodes: the tree as built when wide4/wide8 get one of width
@@ -124,10 +139,11 @@ static int view_wide8(const bvhlab_tree *tree, const bvhlab_scene *scene, struct
 int trace_view_wide(const bvhlab_tree *tree, const bvhlab_scene *scene, int traversal,
                     struct trace_view *v)
 {
-	if (traversal == BVHLAB_TRAVERSAL_WIDE8 && tree_width(tree) > 4)
-		return view_wide8(tree, scene, v);
-	return view_wide4(tree, scene, traversal != BVHLAB_TRAVERSAL_WIDE && tree_width(tree) > 2,
-	                  v);
+	int r = traversal == BVHLAB_TRAVERSAL_WIDE8 && tree_width(tree) > 4
+	        ? view_wide8(tree, scene, v)
+	        : view_wide4(tree, scene,
+	                     traversal != BVHLAB_TRAVERSAL_WIDE && tree_width(tree) > 2, v);
+	return r == 0 && !wide_covers(v) && !v->owned ? add_copies(tree, scene, v) : r;
 }
 
 void trace_view_free(struct trace_view *v)

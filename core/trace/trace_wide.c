@@ -16,8 +16,7 @@ _Static_assert(WIDE == TRI_LANES, "node and triangle lanes share one vector type
 #define WB_NODE struct wide_node
 #define WB_TRIS struct wide_tris
 #define WB_BVH struct wide_bvh
-/* At most 3 entries per wide level. */
-#define WB_STACK 256
+#define WB_STACK WIDE_STACK
 #define WB(name) wide_##name
 
 /* SSE's MAXPS/MINPS are exactly the generic selects and MOVMSKPS gathers

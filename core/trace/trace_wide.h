@@ -17,6 +17,7 @@
 
 #define WIDE 4      /* children per wide node */
 #define TRI_LANES 4 /* triangles per group */
+#define WIDE_STACK 256 /* a ray's stack entries (at most 3 per wide level) */
 
 /*
  * The layout at `lanes` lanes (4 here, 8 in trace_wide8.h), its types

@@ -22,8 +22,7 @@
 #define WB_NODE struct wide8_node
 #define WB_TRIS struct wide8_tris
 #define WB_BVH struct wide8_bvh
-/* At most 7 entries per wide level. */
-#define WB_STACK 512
+#define WB_STACK WIDE8_STACK
 
 #define WB(name) portable_##name
 #include "trace/trace_wide_body.h"

@@ -15,6 +15,7 @@
 #include "trace/trace_wide.h"
 
 #define WIDE8 8
+#define WIDE8_STACK 512 /* a ray's stack entries (at most 7 per wide level) */
 
 /* trace_wide.h's layout at 8 lanes: a node is 256 bytes, four cache lines. */
 WIDE_LAYOUT(wide8_node, wide8_tris, wide8_bvh, WIDE8);

@@ -8,12 +8,15 @@
  */
 /* mremap needs _GNU_SOURCE, which the build defines. */
 #include <errno.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
 #include <bvhlab/tree.h>
+
+#include "tree/tree_spare.h"
 
 /*
  * Arrays of at least BIG_ARRAY bytes are page mappings of their own, grown
@@ -127,4 +130,23 @@ void bvhlab_tree_finish(bvhlab_tree *tree)
 	free_array(tree->nodes, tree->node_capacity, sizeof(bvhlab_node));
 	free_array(tree->prim_index, tree->index_capacity, sizeof(uint32_t));
 	memset(tree, 0, sizeof(*tree));
+}
+
+/* The whole pages of one array past `used` elements, given back: inside
+ * the block, so a malloc'd array's neighbours are not touched. */
+static void release_tail(void *array, size_t used, size_t capacity, size_t elem)
+{
+	uintptr_t page = (uintptr_t)sysconf(_SC_PAGESIZE);
+	uintptr_t from = ((uintptr_t)array + used * elem + page - 1) / page * page;
+	uintptr_t end = ((uintptr_t)array + capacity * elem) / page * page;
+
+	if (array && end > from)
+		(void)madvise((void *)from, end - from, MADV_DONTNEED);
+}
+
+void tree_release_spare(bvhlab_tree *tree)
+{
+	release_tail(tree->nodes, tree->node_count, tree->node_capacity, sizeof(bvhlab_node));
+	release_tail(tree->prim_index, tree->index_count, tree->index_capacity,
+	             sizeof(uint32_t));
 }

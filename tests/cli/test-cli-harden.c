@@ -365,9 +365,15 @@ static void test_limits(void)
 	char dir[512];
 	cJSON *doc = run_config("mem.json",
 		"{ \"output\": \"out-mem\", \"repeat\": 1, \"memory_limit_mb\": 64,\n"
-		"  \"scenes\": [ { \"generator\": \"icosphere\", \"frequency\": 300 } ],\n"
+		"  \"scenes\": [ { \"generator\": \"icosphere\", \"frequency\": 300 },\n"
+		"    { \"name\": \"fine\", \"generator\": \"icosphere\", \"frequency\": 10,\n"
+		"      \"subdivide\": 7 } ],\n"
 		"  \"builders\": [ { \"plugin\": \"fake_good\" } ] }\n", 1, "out-mem", dir);
 	check_run(doc, "icosphere", "fake_good", 1, "failed", "memory_limit_mb = 64");
+	/* Under a limit the probe subdivides too (33M triangles), so the
+	 * parent never makes a scene the limit cannot hold. */
+	check_run(doc, "fine", "fake_good", 1, "failed", "subdivide: out of memory splitting ");
+	check_run(doc, "fine", "fake_good", 1, "failed", " (under memory_limit_mb = 64)");
 	cJSON_Delete(doc);
 #endif
 }
