@@ -58,6 +58,15 @@ struct wide_walk {
 	bool any;
 };
 
+/* The generic sign gather of n lanes. */
+static inline unsigned lane_bits(const int32_t *m, int n)
+{
+	unsigned bits = 0;
+	for (int i = 0; i < n; i++)
+		bits |= (unsigned)(m[i] & 1) << i;
+	return bits;
+}
+
 /* isect() and take_hit() on lane i of a group. */
 static bool isect_lane(const ray_prep *p, const WB_TRIS *g, uint32_t i, bvhlab_hit *hit)
 {
@@ -164,10 +173,7 @@ static inline unsigned WB(bits)(vi m)
 #ifdef WB_BITS
 	return WB_BITS(m);
 #else
-	unsigned bits = 0;
-	for (int i = 0; i < WB_LANES; i++)
-		bits |= (unsigned)(m[i] & 1) << i;
-	return bits;
+	return lane_bits((const int32_t *)&m, WB_LANES);
 #endif
 }
 
@@ -177,19 +183,8 @@ static inline unsigned WB(tbits)(vti m)
 #ifdef WB_TBITS
 	return WB_TBITS(m);
 #else
-	unsigned bits = 0;
-	for (int i = 0; i < WB_TRI_LANES; i++)
-		bits |= (unsigned)(m[i] & 1) << i;
-	return bits;
+	return lane_bits((const int32_t *)&m, WB_TRI_LANES);
 #endif
-}
-
-static inline vt WB(tsplat)(float x)
-{
-	vt v;
-	for (int i = 0; i < WB_TRI_LANES; i++)
-		v[i] = x;
-	return v;
 }
 
 static void WB(ray_init)(struct wide_ray *r, ray_prep *p)
@@ -210,10 +205,12 @@ static void WB(ray_init)(struct wide_ray *r, ray_prep *p)
 static void WB(ray_shear)(struct wide_ray *r)
 {
 	prep_shear(r->p);
-	for (int k = 0; k < 3; k++)
-		r->torg[k] = WB(tsplat)(r->p->org[k]);
-	r->sx = WB(tsplat)(r->p->sx);
-	r->sy = WB(tsplat)(r->p->sy);
+	for (int i = 0; i < WB_TRI_LANES; i++) {
+		for (int k = 0; k < 3; k++)
+			r->torg[k][i] = r->p->org[k];
+		r->sx[i] = r->p->sx;
+		r->sy[i] = r->p->sy;
+	}
 	r->sheared = true;
 }
 
@@ -241,7 +238,7 @@ static inline unsigned WB(enter)(const struct wide_ray *r, const WB_NODE *n, flo
 static inline unsigned WB(sign)(const struct wide_ray *r, const WB_TRIS *g)
 {
 	const ray_prep *p = r->p;
-	vt x[3], y[3], zero = WB(tsplat)(0.0f);
+	vt x[3], y[3], zero = {0};
 	for (int j = 0; j < 3; j++) {
 		vt z = *(const vt *)g->v[3 * j + p->kz] - r->torg[p->kz];
 		x[j] = (*(const vt *)g->v[3 * j + p->kx] - r->torg[p->kx]) - r->sx * z;
