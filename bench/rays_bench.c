@@ -227,10 +227,11 @@ static void print_kind(const struct rb_args *a, const struct rb_setup *s, int ki
 	printf("  %s: %.2f Mrays/s (%zu hits)\n", peer, t[0].mrays[clock], t[0].hits);
 	for (size_t k = 1; k < TRACERS; k++)
 		printf("  bvhlab %s%s%s tree (width %u), %s traversal: %.2f Mrays/s (%zu hits, %.2f "
-		       "nodes/ray, %.2f triangles/ray), ratio to %s %.2f\n", a->builder, a->refine ? " + " : "",
-		       a->refine ? a->refine : "", s->tree.width > 2 ? s->tree.width : 2,
-		       bvhlab_traversal_name(ours[k - 1]), t[k].mrays[clock], t[k].hits, t[k].nodes,
-		       t[k].tris, peer, t[0].mrays[clock] > 0 ? t[k].mrays[clock] / t[0].mrays[clock] : 0);
+		       "nodes/ray, %.2f triangles/ray), ratio to %s %.2f\n", a->builder,
+		       a->refine ? " + " : "", a->refine ? a->refine : "",
+		       s->tree.width > 2 ? s->tree.width : 2, bvhlab_traversal_name(ours[k - 1]),
+		       t[k].mrays[clock], t[k].hits, t[k].nodes, t[k].tris, peer,
+		       t[0].mrays[clock] > 0 ? t[k].mrays[clock] / t[0].mrays[clock] : 0);
 }
 
 /* The wide copy's size, printed once per traversal. */
@@ -249,7 +250,7 @@ static void print_view(const struct trace_view *v)
 }
 
 /* One untimed pass of core traversal k over its own tracing copies (the
- * batch tracer's, one thread), its counters into *st; hits counted. */
+ * batch tracer's, one thread): its hits and its own counters printed. */
 static void count_pass(const struct rb_args *a, const struct rb_setup *s, int kind, int k)
 {
 	struct batch b = {.tree = &s->tree, .scene = s->scene, .rays = s->rays[kind],
