@@ -5,7 +5,7 @@
  * per-thread traversal speed (issues 17 and 41).
  *
  *   build/bench/embree-rays SCENE [--subdivide K] [--size N] [--min-ms MS]
- *                           [--builder PLUGIN] [--refine PLUGIN[:KEY=VALUE,...]]
+ *                           [--builder PLUGIN] [--refine PLUGIN[:KEY=VALUE,...]] [--count]
  *
  * e.g. `--builder sah_tasks --refine collapse:width=8` times wide8 on the
  * collapsed 8-wide tree. Embree's BVH is its own (rtcCommitScene, default

@@ -16,6 +16,8 @@
 #include <time.h>
 
 #include "rays_bench.h"
+#include "trace/trace_batch.h"
+#include "trace/trace_wide8.h"
 #include "util/util.h"
 
 #define MAX_SAMPLES 4096
@@ -45,6 +47,8 @@ int rb_parse(int argc, char **argv, const char *prog, struct rb_args *a)
 			a->builder = argv[++i];
 		else if (strcmp(argv[i], "--refine") == 0 && v)
 			a->refine = argv[++i];
+		else if (strcmp(argv[i], "--count") == 0)
+			a->count = true;
 		else if (argv[i][0] != '-' && !a->scene)
 			a->scene = argv[i];
 		else
@@ -53,7 +57,7 @@ int rb_parse(int argc, char **argv, const char *prog, struct rb_args *a)
 	if (a->scene && a->size > 0)
 		return 0;
 	fprintf(stderr, "usage: %s SCENE [--subdivide K] [--size N] [--min-ms MS] "
-	                "[--builder PLUGIN] [--refine PLUGIN[:KEY=VALUE,...]]\n", prog);
+	                "[--builder PLUGIN] [--refine PLUGIN[:KEY=VALUE,...]] [--count]\n", prog);
 	return -EINVAL;
 }
 
@@ -170,7 +174,9 @@ struct tracer {
 	double cpu[MAX_SAMPLES], wall[MAX_SAMPLES];
 	double mrays[2]; /* medians over rounds: thread CPU time, wall clock */
 	size_t hits;
-	double nodes; /* per ray; the core's traversals only */
+	double nodes, tris; /* per ray, the core's traversals only: for the wide
+	                     * ones the stack traversal's (bvhlab_trace_measure);
+	                     * --count gives their own */
 };
 
 static double rate(size_t n, double seconds)
@@ -203,7 +209,9 @@ static bool ours_round(const struct rb_setup *s, int kind, int k, bvhlab_hit *h,
 		return false;
 	t->cpu[round] = tm.mrays_median;
 	t->wall[round] = tm.wall_mrays_median;
-	t->nodes = tm.stats.rays ? (double)tm.stats.nodes_visited / (double)tm.stats.rays : 0;
+	double rays = tm.stats.rays ? (double)tm.stats.rays : 1;
+	t->nodes = (double)tm.stats.nodes_visited / rays;
+	t->tris = (double)tm.stats.tris_tested / rays;
 	t->hits = 0;
 	for (size_t i = 0; i < n; i++)
 		t->hits += h[i].prim != BVHLAB_NO_HIT;
@@ -219,15 +227,82 @@ static void print_kind(const struct rb_args *a, const struct rb_setup *s, int ki
 	printf("  %s: %.2f Mrays/s (%zu hits)\n", peer, t[0].mrays[clock], t[0].hits);
 	for (size_t k = 1; k < TRACERS; k++)
 		printf("  bvhlab %s%s%s tree (width %u), %s traversal: %.2f Mrays/s (%zu hits, %.2f "
-		       "nodes/ray), ratio to %s %.2f\n", a->builder, a->refine ? " + " : "",
-		       a->refine ? a->refine : "", s->tree.width > 2 ? s->tree.width : 2,
-		       bvhlab_traversal_name(ours[k - 1]), t[k].mrays[clock], t[k].hits, t[k].nodes,
-		       peer, t[0].mrays[clock] > 0 ? t[k].mrays[clock] / t[0].mrays[clock] : 0);
+		       "nodes/ray, %.2f triangles/ray), ratio to %s %.2f\n", a->builder,
+		       a->refine ? " + " : "", a->refine ? a->refine : "",
+		       s->tree.width > 2 ? s->tree.width : 2, bvhlab_traversal_name(ours[k - 1]),
+		       t[k].mrays[clock], t[k].hits, t[k].nodes, t[k].tris, peer,
+		       t[0].mrays[clock] > 0 ? t[k].mrays[clock] / t[0].mrays[clock] : 0);
+}
+
+/* The wide copy's size, printed once per traversal. */
+static void print_view(const struct trace_view *v)
+{
+	if (v->wide8)
+		printf("    its copy: %u 8-lane nodes, %u triangle groups, depth %u, %.1f MB\n",
+		       v->wide8->node_count, v->wide8->tri_groups, v->wide8->depth,
+		       1e-6 * ((double)v->wide8->node_count * sizeof(struct wide8_node) +
+		               (double)v->wide8->tri_groups * sizeof(struct wide8_tris)));
+	else if (v->wide)
+		printf("    its copy: %u 4-lane nodes, %u triangle groups, depth %u, %.1f MB\n",
+		       v->wide->node_count, v->wide->tri_groups, v->wide->depth,
+		       1e-6 * ((double)v->wide->node_count * sizeof(struct wide_node) +
+		               (double)v->wide->tri_groups * sizeof(struct wide_tris)));
+}
+
+/* One untimed pass of core traversal k over its own tracing copies (the
+ * batch tracer's, one thread): its hits and its own counters printed. */
+static void count_pass(const struct rb_args *a, const struct rb_setup *s, int kind, int k)
+{
+	struct batch b = {.tree = &s->tree, .scene = s->scene, .rays = s->rays[kind],
+	                  .count = s->count[kind], .traversal = k};
+	struct worker w = {0};
+	bvhlab_hit *h = malloc(b.count * sizeof(*h));
+	uint32_t *parents = NULL;
+	size_t hits = 0;
+	atomic_init(&b.next, 0);
+	int r = h ? trace_view_copy(b.tree, b.scene, &b.view) : -ENOMEM;
+	if (r == 0 && k == BVHLAB_TRAVERSAL_STACKLESS)
+		r = bvhlab_tree_parents(b.tree, &parents);
+	b.view.parents = parents;
+	if (r == 0 && trace_is_wide(k))
+		r = trace_view_wide(b.tree, b.scene, k, &b.view);
+	b.hits = h;
+	if (r == 0)
+		trace_run_workers(&b, &w, 1);
+	for (size_t i = 0; r == 0 && i < b.count; i++)
+		hits += h[i].prim != BVHLAB_NO_HIT;
+	double rays = w.stats.rays ? (double)w.stats.rays : 1;
+	printf("  bvhlab %s%s%s, %s traversal: %zu hits, %.2f nodes/ray, %.2f triangles/ray (its "
+	       "own)\n", a->builder, a->refine ? " + " : "", a->refine ? a->refine : "",
+	       bvhlab_traversal_name(k), hits, (double)w.stats.nodes_visited / rays,
+	       (double)w.stats.tris_tested / rays);
+	if (r == 0 && kind == 0)
+		print_view(&b.view);
+	trace_view_free(&b.view);
+	free(parents);
+	free(h);
+}
+
+static void rb_count(const struct rb_args *a, const struct rb_setup *s, const char *peer_name,
+                     rb_pass_fn *pass, void *peer)
+{
+	for (int kind = 0; kind < RB_KINDS; kind++) {
+		size_t n = s->count[kind];
+		printf("scene %s (%u triangles), %zu %s rays, one untimed pass each\n",
+		       s->scene->name, s->scene->triangle_count, n, kind ? "diffuse" : "primary");
+		printf("  %s: %zu hits\n", peer_name, pass(peer, s->rays[kind], n));
+		for (size_t k = 0; k < OURS; k++)
+			count_pass(a, s, kind, ours[k]);
+	}
 }
 
 void rb_run(const struct rb_args *a, const struct rb_setup *s, const char *peer_name,
             rb_pass_fn *pass, void *peer)
 {
+	if (a->count) {
+		rb_count(a, s, peer_name, pass, peer);
+		return;
+	}
 	struct tracer(*t)[TRACERS] = calloc(RB_KINDS, sizeof(*t));
 	bvhlab_hit *h = malloc((s->count[0] > s->count[1] ? s->count[0] : s->count[1]) *
 	                       sizeof(*h));

@@ -7,7 +7,13 @@
  * embree_rays.c and tinybvh_rays.cpp.
  *
  *   BENCH SCENE [--subdivide K] [--size N] [--min-ms MS] [--builder PLUGIN]
- *               [--refine PLUGIN[:KEY=VALUE,...]]
+ *               [--refine PLUGIN[:KEY=VALUE,...]] [--count]
+ *
+ * --count replaces the timed rounds by one untimed pass of each tracer
+ * over each kind of rays, printing each core traversal's own counters
+ * (wide nodes and triangle lanes of the wide ones): the run to give
+ * `valgrind --tool=callgrind`, whose instructions per ray (a tracer's
+ * inclusive cost over its calls) do not depend on the machine's load.
  */
 #ifndef BVHLAB_BENCH_RAYS_BENCH_H
 #define BVHLAB_BENCH_RAYS_BENCH_H
@@ -30,6 +36,7 @@ struct rb_args {
 	unsigned subdivide;
 	uint32_t size;
 	double min_ms;
+	bool count; /* --count: one untimed pass each, own counters */
 };
 
 struct rb_setup {
@@ -54,6 +61,7 @@ void rb_setup_finish(struct rb_setup *s);
  * primary then diffuse rays, until a->min_ms has passed and at least 5
  * rounds ran; prints per kind and clock the medians over rounds, each
  * traversal's ratio to the peer and its hit count beside the peer's.
+ * With a->count, one untimed pass each instead (rays_bench.h's top).
  */
 void rb_run(const struct rb_args *a, const struct rb_setup *s, const char *peer_name,
             rb_pass_fn *pass, void *peer);

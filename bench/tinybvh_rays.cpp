@@ -5,7 +5,7 @@
 // ../shared/peers/tinybvh as the tinybvh plugin finds it; nothing copied.
 //
 //   build/bench/tinybvh-rays SCENE [--subdivide K] [--size N] [--min-ms MS]
-//                            [--builder PLUGIN] [--refine PLUGIN[:KEY=VALUE,...]]
+//                            [--builder PLUGIN] [--refine PLUGIN[:KEY=VALUE,...]] [--count]
 //
 // Rounds and clocks: rays_bench.c.
 #define TINYBVH_IMPLEMENTATION

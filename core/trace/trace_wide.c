@@ -13,6 +13,7 @@
 _Static_assert(WIDE == TRI_LANES, "node and triangle lanes share one vector type");
 
 #define WB_LANES WIDE
+#define WB_TRI_LANES TRI_LANES
 #define WB_NODE struct wide_node
 #define WB_TRIS struct wide_tris
 #define WB_BVH struct wide_bvh
@@ -25,6 +26,7 @@ _Static_assert(WIDE == TRI_LANES, "node and triangle lanes share one vector type
 #define WB_MAX(a, b) __builtin_ia32_maxps(a, b)
 #define WB_MIN(a, b) __builtin_ia32_minps(a, b)
 #define WB_BITS(m) ((unsigned)__builtin_ia32_movmskps((vf)(m)))
+#define WB_TBITS WB_BITS
 #endif
 
 #include "trace/trace_wide_body.h"

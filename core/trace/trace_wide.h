@@ -31,7 +31,8 @@
  * empty lane: its box is inverted, +inf to -inf, and the traversal masks
  * it out besides, since a ray with a NaN origin enters every box.
  *
- * tris: up to `lanes` triangles of a leaf, one lane each, so the sign test
+ * tris: up to `tri_lanes` triangles of a leaf, one lane each (TRI_LANES
+ * at either node width: see trace_wide8.h), so the sign test
  * of the triangle test runs on all at once: v[3 * j + k] is coordinate k
  * of vertex j. prim holds the primitive ids of the lanes. A leaf's
  * triangles take consecutive groups in slot order; lanes past the leaf's
@@ -42,23 +43,23 @@
  */
 #define WIDE_EMPTY UINT32_MAX
 
-#define WIDE_LAYOUT(node_name, tris_name, bvh_name, lanes) \
-	struct node_name {                                 \
-		float box[6][lanes];                       \
-		uint32_t child[lanes];                     \
-		uint32_t count[lanes];                     \
-	};                                                 \
-	struct tris_name {                                 \
-		float v[9][lanes];                         \
-		uint32_t prim[lanes];                      \
-	};                                                 \
+#define WIDE_LAYOUT(node_name, tris_name, bvh_name, lanes, tri_lanes) \
+	struct node_name {                                            \
+		float box[6][lanes];                                  \
+		uint32_t child[lanes];                                \
+		uint32_t count[lanes];                                \
+	};                                                            \
+	struct tris_name {                                            \
+		float v[9][tri_lanes];                                \
+		uint32_t prim[tri_lanes];                             \
+	};                                                            \
 	struct bvh_name {                                  \
 		struct node_name *nodes;                   \
 		struct tris_name *tris;                    \
 		uint32_t node_count, tri_groups, depth;    \
 	}
 
-WIDE_LAYOUT(wide_node, wide_tris, wide_bvh, WIDE);
+WIDE_LAYOUT(wide_node, wide_tris, wide_bvh, WIDE, TRI_LANES);
 
 /*
  * Collapses tree into *w: each wide node takes a binary inner node's two
@@ -71,8 +72,9 @@ void wide_bvh_finish(struct wide_bvh *w);
 
 /*
  * A tree of width 3 to `lanes` (4 or 8) as built, without re-collapse:
- * nodes and triangle groups of `lanes` lanes, struct wide_node and
- * wide_tris for 4 (so a struct wide_bvh over them), trace_wide8.h's for 8.
+ * nodes of `lanes` lanes and triangle groups of TRI_LANES, struct
+ * wide_node and wide_tris for 4 (so a struct wide_bvh over them),
+ * trace_wide8.h's for 8.
  * 0; -ERANGE when some node has more than `lanes` children; -EINVAL for
  * links that do not make a tree; -ENOMEM. (wide_built.c; the arrays are
  * freed with free())

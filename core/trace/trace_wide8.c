@@ -19,6 +19,7 @@
 #endif
 
 #define WB_LANES WIDE8
+#define WB_TRI_LANES TRI_LANES
 #define WB_NODE struct wide8_node
 #define WB_TRIS struct wide8_tris
 #define WB_BVH struct wide8_bvh
@@ -34,6 +35,7 @@
 #define WB_MAX(a, b) __builtin_ia32_maxps256(a, b)
 #define WB_MIN(a, b) __builtin_ia32_minps256(a, b)
 #define WB_BITS(m) ((unsigned)__builtin_ia32_movmskps256((vf)(m)))
+#define WB_TBITS(m) ((unsigned)__builtin_ia32_movmskps((vt)(m)))
 
 #pragma GCC push_options
 #pragma GCC target("avx2")

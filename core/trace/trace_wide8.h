@@ -17,8 +17,14 @@
 #define WIDE8 8
 #define WIDE8_STACK 512 /* a ray's stack entries (at most 7 per wide level) */
 
-/* trace_wide.h's layout at 8 lanes: a node is 256 bytes, four cache lines. */
-WIDE_LAYOUT(wide8_node, wide8_tris, wide8_bvh, WIDE8);
+/*
+ * trace_wide.h's layout at 8 lanes: a node is 256 bytes, four cache
+ * lines. Triangle groups keep trace_wide.h's 4 lanes (160 bytes): most
+ * leaves of a collapsed tree hold 1 to 4 triangles, and 8-lane groups
+ * (320 bytes, five lines) doubled the bytes a leaf visit reads
+ * (docs/wide.md, "Why wide8 was slower than wide").
+ */
+WIDE_LAYOUT(wide8_node, wide8_tris, wide8_bvh, WIDE8, TRI_LANES);
 
 /* The 8-lane traversal of view->wide8, as trace_ray_wide (trace_kernel.h). */
 void trace_ray_wide8(const bvhlab_tree *tree, const bvhlab_scene *scene,

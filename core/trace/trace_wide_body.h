@@ -11,14 +11,16 @@
  * Included by trace_wide.c (4 lanes, once) and trace_wide8.c (8 lanes,
  * once per instruction set under that set's target pragma), which define
  * first:
- *   WB_LANES         lanes per node and per triangle group
- *   WB_NODE, WB_TRIS the node and group types at that width, WB_BVH the
+ *   WB_LANES         lanes per node
+ *   WB_TRI_LANES     lanes per triangle group (TRI_LANES at both widths)
+ *   WB_NODE, WB_TRIS the node and group types at those widths, WB_BVH the
  *                    tree (trace_wide.h's layout)
  *   WB_STACK         a ray's stack entries; deeper trees go to the stack
  *                    traversal, so no ray allocates
  *   WB(name)         the names of this inclusion's functions
  *   WB_MAX, WB_MIN, WB_BITS (optional) the lane max, min and sign gather
- *                    in one instruction each; the generic selects below
+ *                    in one instruction each, WB_TBITS the sign gather at
+ *                    the group's width; the generic selects below
  *                    otherwise (GCC does not find MAXPS/MINPS/MOVMSKPS
  *                    from them).
  * The types and the scalar helpers come once per file, the vector
@@ -31,6 +33,9 @@
 
 typedef float vf __attribute__((vector_size(4 * WB_LANES)));
 typedef int32_t vi __attribute__((vector_size(4 * WB_LANES)));
+/* A triangle group's lanes. */
+typedef float vt __attribute__((vector_size(4 * WB_TRI_LANES)));
+typedef int32_t vti __attribute__((vector_size(4 * WB_TRI_LANES)));
 
 struct wide_entry {
 	uint32_t child, count; /* a lane: count 0 inner, else a leaf's triangles */
@@ -41,7 +46,7 @@ struct wide_ray {
 	ray_prep *p;
 	bool sheared; /* p's triangle constants and sx, sy are set */
 	vf org[3], inv[3];
-	vf sx, sy; /* the shear of ray_prep, for the triangle lanes */
+	vt torg[3], sx, sy; /* the origin and shear of ray_prep, for the triangle lanes */
 	int near[3], far[3]; /* rows of the node's box */
 };
 
@@ -52,6 +57,15 @@ struct wide_walk {
 	uint64_t nodes_visited, tris_tested;
 	bool any;
 };
+
+/* The generic sign gather of n lanes. */
+static inline unsigned lane_bits(const int32_t *m, int n)
+{
+	unsigned bits = 0;
+	for (int i = 0; i < n; i++)
+		bits |= (unsigned)(m[i] & 1) << i;
+	return bits;
+}
 
 /* isect() and take_hit() on lane i of a group. */
 static bool isect_lane(const ray_prep *p, const WB_TRIS *g, uint32_t i, bvhlab_hit *hit)
@@ -159,10 +173,17 @@ static inline unsigned WB(bits)(vi m)
 #ifdef WB_BITS
 	return WB_BITS(m);
 #else
-	unsigned bits = 0;
-	for (int i = 0; i < WB_LANES; i++)
-		bits |= (unsigned)(m[i] & 1) << i;
-	return bits;
+	return lane_bits((const int32_t *)&m, WB_LANES);
+#endif
+}
+
+/* The same at a group's width. */
+static inline unsigned WB(tbits)(vti m)
+{
+#ifdef WB_TBITS
+	return WB_TBITS(m);
+#else
+	return lane_bits((const int32_t *)&m, WB_TRI_LANES);
 #endif
 }
 
@@ -184,8 +205,12 @@ static void WB(ray_init)(struct wide_ray *r, ray_prep *p)
 static void WB(ray_shear)(struct wide_ray *r)
 {
 	prep_shear(r->p);
-	r->sx = WB(splat)(r->p->sx);
-	r->sy = WB(splat)(r->p->sy);
+	for (int i = 0; i < WB_TRI_LANES; i++) {
+		for (int k = 0; k < 3; k++)
+			r->torg[k][i] = r->p->org[k];
+		r->sx[i] = r->p->sx;
+		r->sy[i] = r->p->sy;
+	}
 	r->sheared = true;
 }
 
@@ -213,19 +238,19 @@ static inline unsigned WB(enter)(const struct wide_ray *r, const WB_NODE *n, flo
 static inline unsigned WB(sign)(const struct wide_ray *r, const WB_TRIS *g)
 {
 	const ray_prep *p = r->p;
-	vf x[3], y[3], zero = WB(splat)(0.0f);
+	vt x[3], y[3], zero = {0};
 	for (int j = 0; j < 3; j++) {
-		vf z = *(const vf *)g->v[3 * j + p->kz] - r->org[p->kz];
-		x[j] = (*(const vf *)g->v[3 * j + p->kx] - r->org[p->kx]) - r->sx * z;
-		y[j] = (*(const vf *)g->v[3 * j + p->ky] - r->org[p->ky]) - r->sy * z;
+		vt z = *(const vt *)g->v[3 * j + p->kz] - r->torg[p->kz];
+		x[j] = (*(const vt *)g->v[3 * j + p->kx] - r->torg[p->kx]) - r->sx * z;
+		y[j] = (*(const vt *)g->v[3 * j + p->ky] - r->torg[p->ky]) - r->sy * z;
 	}
-	vf e0 = x[2] * y[1] - y[2] * x[1];
-	vf e1 = x[0] * y[2] - y[0] * x[2];
-	vf e2 = x[1] * y[0] - y[1] * x[0];
-	vi on_edge = (e0 == zero) | (e1 == zero) | (e2 == zero);
-	vi neg = (e0 < zero) | (e1 < zero) | (e2 < zero);
-	vi pos = (e0 > zero) | (e1 > zero) | (e2 > zero);
-	return WB(bits)(on_edge | ~(neg & pos));
+	vt e0 = x[2] * y[1] - y[2] * x[1];
+	vt e1 = x[0] * y[2] - y[0] * x[2];
+	vt e2 = x[1] * y[0] - y[1] * x[0];
+	vti on_edge = (e0 == zero) | (e1 == zero) | (e2 == zero);
+	vti neg = (e0 < zero) | (e1 < zero) | (e2 < zero);
+	vti pos = (e0 > zero) | (e1 > zero) | (e2 > zero);
+	return WB(tbits)(on_edge | ~(neg & pos));
 }
 
 /* True when an any-hit ray is done. */
@@ -235,7 +260,7 @@ static bool WB(leaf)(struct wide_walk *w, struct wide_ray *r, const struct wide_
 	if (!r->sheared)
 		WB(ray_shear)(r);
 	for (uint32_t left = e->count; left > 0; g++) {
-		uint32_t lanes = left < WB_LANES ? left : WB_LANES;
+		uint32_t lanes = left < WB_TRI_LANES ? left : WB_TRI_LANES;
 		unsigned mask = WB(sign)(r, g) & ((1u << lanes) - 1);
 		w->tris_tested += lanes;
 		left -= lanes;

@@ -3,11 +3,11 @@
  * 3 to `lanes` becomes one wide node with a lane per child, in the
  * builder's (or the collapse stage's) order, so what is measured is that
  * tree and not a re-collapse of it. A leaf child becomes a leaf lane whose
- * triangles are copied in groups of `lanes`, NaN past the leaf's count.
+ * triangles are copied in groups of TRI_LANES, NaN past the leaf's count.
  * The layout is trace_wide.h's for 4 lanes (struct wide_node, wide_tris)
  * and trace_wide8.h's for 8; here both are walked as arrays of words:
  * a node is box[6][lanes], child[lanes], count[lanes]; a group
- * v[9][lanes], prim[lanes].
+ * v[9][TRI_LANES], prim[TRI_LANES].
  */
 #include <errno.h>
 #include <math.h>
@@ -48,29 +48,29 @@ static void group_lane(struct built *b, uint32_t *g, uint32_t lane, uint32_t slo
 	const bvhlab_scene *s = b->scene;
 	uint32_t prim = used ? b->tree->prim_index[slot] : BVHLAB_NO_HIT;
 	float *v = (float *)(void *)g;
-	g[9 * b->lanes + lane] = prim;
+	g[9 * TRI_LANES + lane] = prim;
 	for (int j = 0; j < 3; j++) {
 		const float *p = prim < s->triangle_count
 		                         ? s->vertices + 3 * (size_t)s->indices[3 * (size_t)prim + j]
 		                         : NULL;
 		for (int k = 0; k < 3; k++)
-			v[(3 * j + k) * b->lanes + lane] = p ? p[k] : NAN;
+			v[(3 * j + k) * TRI_LANES + lane] = p ? p[k] : NAN;
 	}
 }
 
 /* Lane `lane` of node w as the tree's leaf n, its triangles copied. */
 static int leaf_lane(struct built *b, uint32_t *w, uint32_t lane, const bvhlab_node *n)
 {
-	uint32_t first = tree_leaf_first(n), count = tree_leaf_count(n), L = b->lanes;
-	uint64_t need = ((uint64_t)count + L - 1) / L;
+	uint32_t first = tree_leaf_first(n), count = tree_leaf_count(n), L = b->lanes, G = TRI_LANES;
+	uint64_t need = ((uint64_t)count + G - 1) / G;
 	if (first > b->tree->index_count || count > b->tree->index_count - first ||
 	    need > b->group_cap - b->groups)
 		return -EINVAL;
 	w[6 * L + lane] = b->groups;
 	w[7 * L + lane] = count;
-	for (uint32_t k = 0; k < count; k += L) {
-		uint32_t *g = b->tris + (size_t)b->groups++ * 10 * L;
-		for (uint32_t i = 0; i < L; i++)
+	for (uint32_t k = 0; k < count; k += G) {
+		uint32_t *g = b->tris + (size_t)b->groups++ * 10 * G;
+		for (uint32_t i = 0; i < G; i++)
 			group_lane(b, g, i, first + k + i, k + i < count);
 	}
 	return 0;
@@ -115,12 +115,12 @@ static int fill(struct built *b, uint32_t id, uint32_t node, uint32_t level, uin
 }
 
 /* Inner nodes and triangle groups the copy needs (a leaf root: one node). */
-static void count_built(const bvhlab_tree *t, uint32_t lanes, uint32_t *inner, uint32_t *groups)
+static void count_built(const bvhlab_tree *t, uint32_t *inner, uint32_t *groups)
 {
 	uint64_t in = 0, g = 0;
 	for (uint32_t i = 0; i < t->node_count; i++) {
 		in += tree_child_count(&t->nodes[i]) > 0;
-		g += (tree_leaf_count(&t->nodes[i]) + (uint64_t)lanes - 1) / lanes;
+		g += (tree_leaf_count(&t->nodes[i]) + (uint64_t)TRI_LANES - 1) / TRI_LANES;
 	}
 	*inner = in ? (in < UINT32_MAX ? (uint32_t)in : UINT32_MAX) : 1;
 	*groups = g < UINT32_MAX ? (uint32_t)g : UINT32_MAX;
@@ -165,9 +165,9 @@ int wide_built_init(struct wide_built *out, const bvhlab_tree *tree, const bvhla
 	memset(out, 0, sizeof(*out));
 	if (tree->node_count == 0 || (lanes != 4 && lanes != 8))
 		return -EINVAL;
-	count_built(tree, lanes, &b.node_cap, &b.group_cap);
+	count_built(tree, &b.node_cap, &b.group_cap);
 	b.nodes = aligned(b.node_cap, 32 * (size_t)lanes);
-	b.tris = aligned(b.group_cap, 40 * (size_t)lanes);
+	b.tris = aligned(b.group_cap, sizeof(struct wide_tris));
 	b.seen = calloc(tree->node_count, 1);
 	uint32_t *todo = malloc(3 * sizeof(*todo) * (size_t)b.node_cap);
 	int r = b.nodes && b.tris && b.seen && todo ? walk(&b, todo) : -ENOMEM;
