@@ -92,8 +92,11 @@ static void check_fitted(const cJSON *doc)
 	CHECK(num_at(run, "memory", "scene_bytes_per_triangle") == SOUP_SCENE_BYTES);
 	CHECK(fabs(num_at(run, "memory", "with_scene_bytes_per_triangle") -
 	           (peak + scene) / TRIANGLES) < 1e-6);
-	CHECK(num_at(run, "memory", "child_bytes_per_triangle") * TRIANGLES ==
-	      num_at(run, "memory", "peak_rss_bytes"));
+	/* A quotient times its divisor is the dividend only to the last bit:
+	 * exact equality failed for some resident sizes (seen under load). */
+	double rss = num_at(run, "memory", "peak_rss_bytes");
+	CHECK(rss > 0 && fabs(num_at(run, "memory", "child_bytes_per_triangle") * TRIANGLES - rss) <=
+	                     1e-9 * rss);
 	CHECK_CONTAINS(run_str(cJSON_GetObjectItem(run, "memory_estimate"), "limit"), "available");
 }
 
