@@ -10,6 +10,7 @@
 
 #include "config/config_internal.h"
 #include "config/json_locate.h"
+#include "trace/trace_cl.h"
 
 #define DEFAULT_OUTPUT "results"
 #define READ_CHUNK 65536
@@ -94,18 +95,12 @@ static int resolve_output(struct config *cfg, bvhlab_error *err)
 	return rc ? out_of_memory(cfg->path, err) : 0;
 }
 
-static bool on_device(int k)
-{
-	return k == BVHLAB_TRAVERSAL_DEVICE_STACK || k == BVHLAB_TRAVERSAL_DEVICE_STACKLESS ||
-	       k == BVHLAB_TRAVERSAL_DEVICE_WIDE8;
-}
-
 /* enum bvhlab_traversal of a CPU traversal's name; -1 for none (a device
  * traversal is one of these with "device": true). */
 static int traversal_of(const char *name)
 {
 	for (int k = 0; k < BVHLAB_TRAVERSAL_COUNT; k++)
-		if (!on_device(k) && strcmp(name, bvhlab_traversal_name(k)) == 0)
+		if (!trace_cl_traversal(k) && strcmp(name, bvhlab_traversal_name(k)) == 0)
 			return k;
 	return -1;
 }
@@ -153,7 +148,7 @@ static int traversal_built(struct config *cfg, const cJSON *item, int k, bvhlab_
 	(void)cfg, (void)item, (void)k, (void)err;
 	return 0;
 #else
-	if (!on_device(k))
+	if (!trace_cl_traversal(k))
 		return 0;
 	return config_error(cfg, item, false, err,
 	                    "'rays.traversal' \"%s\" with \"device\": true runs on a device, and "

@@ -15,6 +15,7 @@
 #include "harness/harness_report.h"
 #include "harness/harness_series.h"
 #include "harness/harness_two_level.h"
+#include "trace/trace_cl.h"
 #include "trace/trace_instances.h"
 #include "util/util.h"
 
@@ -241,7 +242,7 @@ static void trace_rays(const struct config *cfg, const struct scene_instanced *i
 	harness_ray_settings(cfg, &rs);
 	if ((size_t)rs.width * rs.height == 0)
 		return;
-	if (rs.main == BVHLAB_TRAVERSAL_DEVICE_STACK || rs.main == BVHLAB_TRAVERSAL_DEVICE_STACKLESS) {
+	if (trace_cl_traversal(rs.main)) {
 		rs.main = BVHLAB_TRAVERSAL_STACK; /* the device ones are said left out */
 		rs.traversals |= 1u << BVHLAB_TRAVERSAL_STACK;
 	}

@@ -32,6 +32,15 @@ struct trace_cl_batch;
 /* Whether this build has the device traversals. */
 bool trace_cl_built(void);
 
+/* Whether traversal (enum bvhlab_traversal) is one of the device ones:
+ * the one list the config, the tracer and two-level runs ask. */
+static inline bool trace_cl_traversal(int traversal)
+{
+	return traversal == BVHLAB_TRAVERSAL_DEVICE_STACK ||
+	       traversal == BVHLAB_TRAVERSAL_DEVICE_STACKLESS ||
+	       traversal == BVHLAB_TRAVERSAL_DEVICE_WIDE8;
+}
+
 /* The traversal (BVHLAB_TRAVERSAL_DEVICE_STACK, _STACKLESS or _WIDE8) of
  * tree on the device `device` names (NULL: "auto"). 0, or a negative errno
  * with err saying why: -ENOTSUP OpenCL not built, -ENODEV no platform or

@@ -135,13 +135,6 @@ struct trace_series {
 	bvhlab_error err;       /* why a slice failed */
 };
 
-static bool on_device(int traversal)
-{
-	return traversal == BVHLAB_TRAVERSAL_DEVICE_STACK ||
-	       traversal == BVHLAB_TRAVERSAL_DEVICE_STACKLESS ||
-	       traversal == BVHLAB_TRAVERSAL_DEVICE_WIDE8;
-}
-
 static int grow(struct trace_series *s)
 {
 	uint32_t cap = s->cap ? 2 * s->cap : 64;
@@ -366,7 +359,7 @@ int trace_series_create(const bvhlab_tree *tree, const bvhlab_scene *scene,
 		error_set(err, "out of memory");
 		return -ENOMEM;
 	}
-	int r = on_device(opts->traversal) ? series_device(s, opts)
+	int r = trace_cl_traversal(opts->traversal) ? series_device(s, opts)
 	                                    : series_views(s, opts->traversal, counters);
 	if (r < 0) {
 		if (s->err.message[0])
