@@ -126,16 +126,6 @@ static void count_built(const bvhlab_tree *t, uint32_t *inner, uint32_t *groups)
 	*groups = g < UINT32_MAX ? (uint32_t)g : UINT32_MAX;
 }
 
-static void *aligned(size_t count, size_t size)
-{
-	void *mem = NULL;
-	if (count == 0)
-		count = 1;
-	if (count > SIZE_MAX / size || posix_memalign(&mem, LINE, count * size) != 0)
-		return NULL;
-	return mem;
-}
-
 /* The root as a wide node: its children, or itself as one leaf lane. */
 static int walk(struct built *b, uint32_t *todo)
 {
@@ -166,8 +156,8 @@ int wide_built_init(struct wide_built *out, const bvhlab_tree *tree, const bvhla
 	if (tree->node_count == 0 || (lanes != 4 && lanes != 8))
 		return -EINVAL;
 	count_built(tree, &b.node_cap, &b.group_cap);
-	b.nodes = aligned(b.node_cap, 32 * (size_t)lanes);
-	b.tris = aligned(b.group_cap, sizeof(struct wide_tris));
+	b.nodes = wide_alloc(b.node_cap, 32 * (size_t)lanes);
+	b.tris = wide_alloc(b.group_cap, sizeof(struct wide_tris));
 	b.seen = calloc(tree->node_count, 1);
 	uint32_t *todo = malloc(3 * sizeof(*todo) * (size_t)b.node_cap);
 	int r = b.nodes && b.tris && b.seen && todo ? walk(&b, todo) : -ENOMEM;
