@@ -3,7 +3,7 @@
 
 Usage (from the checkout): bench/peers-standalone/compare.py [--build DIR]
     [--scene PATH] [--subdivide K] [--threads 1,2] [--repeat N] [--warmup N]
-    [--only SUBSTRING] [--keep DIR]
+    [--pairs N] [--only SUBSTRING] [--keep DIR]
 
 For every peer builder (tinybvh quick, binned, avx, sweep; madmann91/bvh
 low, medium, high, sweep, binned; Embree low, medium, high) and thread
@@ -21,7 +21,10 @@ The in-harness time is the library's: results.json's own_ms, the median
 build_ms less the median `input` (the library's input made from
 bvhlab's scene) and `convert` (its tree written in bvhlab's layout)
 phases, as the report's fronts take it. The standalone
-time is the median of the build call alone. A run whose tree is invalid
+time is the median of the build call alone. With --pairs N every builder
+runs N such pairs and its ratio is the median of the N pairs' ratios (their
+range in a last column): on a VM whose runs of one program differ by 30 %,
+one pair's ratio is one draw. A run whose tree is invalid
 (tinybvh avx on igea subdivided once: the library's own boxes) keeps its
 time, its ratio marked "(note)" and the reason printed under the table. Prints a Markdown table with
 the CPU model, the ratio in-harness / standalone per builder.
@@ -61,6 +64,8 @@ def parse_args():
     p.add_argument("--threads", default="1,2")
     p.add_argument("--repeat", type=int, default=5)
     p.add_argument("--warmup", type=int, default=1)
+    p.add_argument("--pairs", type=int, default=1,
+                   help="harness/standalone pairs per builder (the ratio is their median)")
     p.add_argument("--only", default="", help="run the builders whose name holds this")
     p.add_argument("--keep", help="folder for the harness's outputs (default: a temporary one)")
     return p.parse_args()
@@ -131,6 +136,28 @@ def standalone(args, plugin, variant, threads, extra):
     return float(fields["wall_ms"]), float(fields["cpu_ms"])
 
 
+def median(values):
+    v = sorted(values)
+    return (v[(len(v) - 1) // 2] + v[len(v) // 2]) / 2
+
+
+def summarise(name, t, tries):
+    """One row from a builder's pairs: medians of each column, and the ratio
+    as the median of the pairs' own ratios (each pair ran in one stretch of
+    the machine's speed), with their range when there were several."""
+    alone = [a for _, (a, _) in tries]
+    alone_cpu = median([c for _, (_, c) in tries])
+    ok = [h for h, _ in tries if h[0] is not None]
+    note = next((h[4] for h, _ in tries if h[4]), "")
+    if len(ok) < len(tries):  # a harness run did not end ok: its note says why
+        return (name, t, tries[0][0][1], 0.0, 0.0, None, median(alone), alone_cpu, note, None)
+    ratios = [h[0] / a for h, (a, _) in tries]
+    return (name, t, median([h[1] for h in ok]),
+            median([h[2].get("input", 0.0) for h in ok]),
+            median([h[2].get("convert", 0.0) for h in ok]), median([h[0] for h in ok]),
+            median(alone), alone_cpu, note, (median(ratios), min(ratios), max(ratios)))
+
+
 def cpu_model(from_results):
     """results.json's CPU name (/proc/cpuinfo's when no run was made),
     with lscpu's family: "AMD EPYC" alone does not say which."""
@@ -152,32 +179,40 @@ def main():
     keep = os.path.abspath(args.keep or tempfile.mkdtemp(prefix="peers-compare-"))
     os.makedirs(keep, exist_ok=True)
     rows, cpu, start = [], "?", datetime.datetime.now(datetime.timezone.utc)
-    for k, (name, plugin, variant, t, extra) in enumerate(pairs(args)):
+    order = 0
+    for name, plugin, variant, t, extra in pairs(args):
         folder = os.path.join(keep, f"{name.split(' ')[0]}-{t}t{'-cb' if extra else ''}")
         steps = [lambda: harness(args, plugin, variant, t, folder),
                  lambda: standalone(args, plugin, variant, t, extra)]
-        got = [None, None]
-        for i in ([0, 1] if k % 2 == 0 else [1, 0]):
-            got[i] = steps[i]()
-        (own, whole, phases, cpu, note), (alone, alone_cpu) = got
-        rows.append((name, t, whole, phases.get("input", 0.0), phases.get("convert", 0.0),
-                     own, alone, alone_cpu, note))
-        print(f"{name} {t}T: harness {own if own is None else round(own, 1)} ms "
-              f"({whole}), alone {alone:.1f} ms", file=sys.stderr)
+        tries = []
+        for _ in range(args.pairs):
+            got = [None, None]
+            for i in ([0, 1] if order % 2 == 0 else [1, 0]):
+                got[i] = steps[i]()
+            order += 1
+            tries.append(got)
+            (own, whole, _, cpu, _), (alone, _) = got
+            print(f"{name} {t}T: harness {own if own is None else round(own, 1)} ms "
+                  f"({whole}), alone {alone:.1f} ms", file=sys.stderr)
+        rows.append(summarise(name, t, tries))
     end = datetime.datetime.now(datetime.timezone.utc)
     print(f"{os.path.basename(args.scene)} subdivided {args.subdivide}x, "
-          f"{args.repeat} repeats after {args.warmup} warm-up, {cpu_model(cpu)}, "
+          f"{args.repeat} repeats after {args.warmup} warm-up, {args.pairs} "
+          f"pair{'s' if args.pairs > 1 else ''} per builder, {cpu_model(cpu)}, "
           f"{start:%Y-%m-%d %H:%M} to {end:%H:%M} UTC\n")
+    spread = args.pairs > 1
     print("| builder | threads | harness build_ms | input | convert | harness, library "
-          "| standalone | standalone CPU | ratio |")
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
-    for name, t, whole, inp, conv, own, alone, alone_cpu, note in rows:
+          "| standalone | standalone CPU | ratio |" + (" pairs' ratios |" if spread else ""))
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|" if spread else ""))
+    for name, t, whole, inp, conv, own, alone, alone_cpu, note, ratio in rows:
         if own is None:  # the harness's run did not end ok: whole says why
-            print(f"| {name} | {t} | {whole} | | | | {alone:.1f} | {alone_cpu:.1f} | - |")
+            print(f"| {name} | {t} | {whole} | | | | {alone:.1f} | {alone_cpu:.1f} | - |"
+                  + (" |" if spread else ""))
             continue
         print(f"| {name} | {t} | {whole:.1f} | {inp:.1f} | {conv:.1f} | {own:.1f} "
-              f"| {alone:.1f} | {alone_cpu:.1f} | {own / alone:.2f}{' (note)' if note else ''} |")
-    for name, t, *_, note in rows:
+              f"| {alone:.1f} | {alone_cpu:.1f} | {ratio[0]:.2f}{' (note)' if note else ''} |"
+              + (f" {ratio[1]:.2f}-{ratio[2]:.2f} |" if spread else ""))
+    for name, t, *_, note, _ in rows:
         if note:
             print(f"\n{name} at {t} threads: {note}")
 
