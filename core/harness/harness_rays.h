@@ -73,7 +73,8 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
  * each traversal of rs at both levels (trace_measure_two_level), into
  * m->primary; another traversal's hits are compared with the main one's
  * into m->disagreements, one that cannot run (a device traversal with no
- * device) is left out with its reason in m->error. No secondary kinds (they need the flattened scene's normals).
+ * device) is left out with its reason in m->error. No secondary kinds
+ * (they need the flattened scene's normals).
  * 0 or a negative errno (the main traversal failing).
  */
 struct trace_two_level;

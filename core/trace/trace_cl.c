@@ -99,7 +99,7 @@ int trace_cl_fits(const bvhlab_cl *d, const size_t *want, unsigned count, bvhlab
 }
 
 int trace_cl_upload(const bvhlab_cl *d, const void *data, size_t bytes, cl_mem *out,
-                  const char *what, bvhlab_error *err)
+                    const char *what, bvhlab_error *err)
 {
 	char why[256];
 	cl_int rc;

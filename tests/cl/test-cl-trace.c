@@ -169,10 +169,26 @@ static void trace_mode(void)
 	            6, 5);
 }
 
+/* `bvhlab run` of this config, written as NAME.json, exiting want_rc; the
+ * document of its output folder NAME (NULL for exit 2). */
+static cJSON *run_config(const char *name, const char *config, int want_rc)
+{
+	char out[600];
+	snprintf(out, sizeof(out), "%s.json", name);
+	int rc = run(ARGS("run", write_config(out, config), "--quiet"));
+	if (rc != want_rc)
+		fprintf(stderr, "%s: %s", name, err_text);
+	CHECK_INT(rc, want_rc);
+	if (want_rc == 2)
+		return NULL;
+	snprintf(out, sizeof(out), "%s/%s", tmpdir, name);
+	return load_results(out);
+}
+
 /* A run of one scene with this "rays" object; the document. */
 static cJSON *run_rays(const char *name, const char *rays, int want_rc)
 {
-	char config[2048], out[600];
+	char config[2048];
 	/* Isolated (each run in a forked child) as a sweep runs, except under
 	 * TSan: it kills a child of bvhlab's (multi-threaded) process that
 	 * starts threads, as PoCL does ("starting new threads after
@@ -183,16 +199,7 @@ static cJSON *run_rays(const char *name, const char *rays, int want_rc)
 	         "  \"scenes\": [ { \"name\": \"ico\", \"generator\": \"icosphere\", \"frequency\": 4 } ],\n"
 	         "  \"builders\": [ { \"plugin\": \"sah_seq\" } ] }\n", name,
 	         UNDER_TSAN ? "false" : "true", rays);
-	snprintf(out, sizeof(out), "%s.json", name);
-	char *path = write_config(out, config);
-	int rc = run(ARGS("run", path, "--quiet"));
-	if (rc != want_rc)
-		fprintf(stderr, "%s: %s", name, err_text);
-	CHECK_INT(rc, want_rc);
-	if (want_rc == 2)
-		return NULL;
-	snprintf(out, sizeof(out), "%s/%s", tmpdir, name);
-	return load_results(out);
+	return run_config(name, config, want_rc);
 }
 
 static const cJSON *first_rays(const cJSON *doc)
@@ -239,7 +246,7 @@ static void errors_mode(void)
  * (its main traversal "stack", the others any); its run's rays. */
 static cJSON *run_two_level(const char *name, const char *traversals)
 {
-	char config[2048], out[600];
+	char config[2048];
 	snprintf(config, sizeof(config),
 	         "{ \"format_version\": 1, \"output\": \"%s\", \"repeat\": 1, \"threads\": [1],\n"
 	         "  \"isolate\": %s, \"rays\": { \"width\": 16, \"height\": 16, \"min_ms\": 1,\n"
@@ -251,13 +258,7 @@ static cJSON *run_two_level(const char *name, const char *traversals)
 	         "      \"rotate\": \"random-y\" } } ] } ],\n"
 	         "  \"builders\": [ { \"bottom\": \"sah_seq\", \"top\": \"lbvh\" } ] }\n", name,
 	         UNDER_TSAN ? "false" : "true", traversals);
-	snprintf(out, sizeof(out), "%s.json", name);
-	int rc = run(ARGS("run", write_config(out, config), "--quiet"));
-	if (rc != 0)
-		fprintf(stderr, "%s: %s", name, err_text);
-	CHECK_INT(rc, 0);
-	snprintf(out, sizeof(out), "%s/%s", tmpdir, name);
-	return load_results(out);
+	return run_config(name, config, 0);
 }
 
 /* Two-level runs trace with the device traversals too: the same hits as

@@ -31,6 +31,7 @@
 #define FIXTURE_SEED 0x4201ULL
 #include "../scene_fixture.h"
 #include "../testutil.h"
+#include "../two_level_fixture.h"
 
 #define SCATTERED 300
 #define AIMED 1200
@@ -42,21 +43,6 @@ static const int device_kinds[] = {BVHLAB_TRAVERSAL_DEVICE_STACK,
                                    BVHLAB_TRAVERSAL_DEVICE_WIDE8};
 /* The CPU traversal whose counters each one's must equal (-1: none). */
 static const int cpu_twins[] = {BVHLAB_TRAVERSAL_STACK, BVHLAB_TRAVERSAL_STACKLESS, -1};
-
-static bvhlab_scene *gen_mesh(const char *name, uint32_t frequency, uint32_t count,
-                              uint32_t size)
-{
-	bvhlab_gen_params p;
-	bvhlab_scene *s = NULL;
-	bvhlab_error err = {{0}};
-	bvhlab_gen_params_init(&p);
-	p.frequency = frequency;
-	p.count = count;
-	p.size = size;
-	p.seed = 5;
-	CHECK_INT(bvhlab_scene_generate(name, &p, &s, &err), 0);
-	return s;
-}
 
 /* A turn of `deg` degrees about axis a (0 x, 2 z), scaled by sc per
  * column, moved by tr; shear adds x's column into y's row. */
@@ -80,9 +66,9 @@ static void make_scene(struct scene_instanced *inst)
 {
 	bvhlab_scene **meshes = calloc(3, sizeof(*meshes));
 	bvhlab_error err = {{0}};
-	meshes[0] = gen_mesh("icosphere", 3, 0, 0);
-	meshes[1] = gen_mesh("soup", 0, 60, 0);
-	meshes[2] = gen_mesh("terrain", 0, 0, 6);
+	meshes[0] = generate("icosphere", 0, 3, 0);
+	meshes[1] = generate("soup", 60, 0, 0);
+	meshes[2] = generate("terrain", 0, 0, 6);
 	scene_instanced_init(inst, meshes, 3);
 	struct scene_scatter sc = {.mesh = 0, .count = SCATTERED / 2, .seed = 3,
 	                           .lo = {-40, -2, -40}, .hi = {40, 2, 40}, .scale = {0.5, 2.0},
@@ -215,29 +201,6 @@ static void check_all(const struct scene_instanced *inst, const struct two_level
 	free(ref);
 }
 
-/* The bottoms collapsed 8 wide and the top 4 wide (the collapse plugin). */
-static void collapse(const struct scene_instanced *inst, struct two_level_trees *trees)
-{
-	bvhlab_plugin *collapser = NULL;
-	bvhlab_error err = {{0}};
-	if (!plugin_loads("collapse", &collapser))
-		return;
-	for (uint32_t m = 0; m <= inst->mesh_count; m++) {
-		bvhlab_prims prims = {0};
-		bvhlab_options o;
-		bool top = m == inst->mesh_count;
-		CHECK_INT(bvhlab_options_init(&o, bvhlab_plugin_builder(collapser)), 0);
-		CHECK_INT(bvhlab_options_parse(&o, top ? "width=4" : "width=8", &err), 0);
-		if (!top)
-			CHECK_INT(bvhlab_prims_init(&prims, inst->meshes[m], &err), 0);
-		CHECK_INT(bvhlab_refine(collapser, &o, top ? &trees->top_prims.input : &prims.input, 1,
-		                        top ? &trees->top : &trees->bottom[m], &err), 0);
-		bvhlab_prims_finish(&prims);
-		bvhlab_options_finish(&o);
-	}
-	bvhlab_plugin_close(collapser);
-}
-
 int main(void)
 {
 	bvhlab_cl cl = {0};
@@ -265,9 +228,8 @@ int main(void)
 	CHECK_INT(harness_two_level_series(&job, samples, &cold, &whole, &lv, &trees, &err), TREE_OK);
 	CHECK(inst.instance_count == SCATTERED + 4 && trees.top.index_count == inst.instance_count);
 	check_all(&inst, &trees, "binary trees");
-	collapse(&inst, &trees);
-	CHECK(trees.bottom[0].width == 8 && trees.top.width == 4);
-	check_all(&inst, &trees, "8-wide bottoms, 4-wide top");
+	if (collapse_levels(&inst, &trees, 8, 4))
+		check_all(&inst, &trees, "8-wide bottoms, 4-wide top");
 	harness_two_level_finish(&trees);
 	bvhlab_options_finish(&bo);
 	bvhlab_options_finish(&to);
