@@ -16,6 +16,7 @@
 #define FIXTURE_SEED 0x42ULL
 #include "scene_fixture.h"
 #include "testutil.h"
+#include "two_level_fixture.h"
 
 #define BUILDERS "\"builders\": [ { \"plugin\": \"sah_seq\" } ]"
 #define MESHES "\"meshes\": [ { \"name\": \"ball\", \"generator\": \"icosphere\", " \
@@ -310,26 +311,8 @@ static void check_traversals(const struct scene_instanced *inst, struct two_leve
 static void check_wide_bottoms(const struct scene_instanced *inst, struct two_level_trees *trees,
                                const bvhlab_scene *flat)
 {
-	bvhlab_plugin *collapser = NULL;
-	bvhlab_error err = { "" };
-	if (!plugin_loads("collapse", &collapser))
-		return;
-	for (uint32_t m = 0; m <= inst->mesh_count; m++) {
-		bvhlab_prims prims = {0};
-		bvhlab_options o;
-		bool top = m == inst->mesh_count;
-		CHECK_INT(bvhlab_options_init(&o, bvhlab_plugin_builder(collapser)), 0);
-		CHECK_INT(bvhlab_options_parse(&o, top ? "width=4" : "width=8", &err), 0);
-		if (!top)
-			CHECK_INT(bvhlab_prims_init(&prims, inst->meshes[m], &err), 0);
-		CHECK_INT(bvhlab_refine(collapser, &o, top ? &trees->top_prims.input : &prims.input, 1,
-		                        top ? &trees->top : &trees->bottom[m], &err), 0);
-		bvhlab_prims_finish(&prims);
-		bvhlab_options_finish(&o);
-	}
-	CHECK(trees->bottom[0].width == 8 && trees->top.width == 4);
-	check_traversals(inst, trees, flat, "8-wide bottoms, 4-wide top");
-	bvhlab_plugin_close(collapser);
+	if (collapse_levels(inst, trees, 8, 4))
+		check_traversals(inst, trees, flat, "8-wide bottoms, 4-wide top");
 }
 
 /* Rays through both levels: the brute force over every instanced triangle

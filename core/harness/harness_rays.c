@@ -227,13 +227,16 @@ out:
 	return r;
 }
 
-/* One CPU traversal of a two-level batch, as measure() one of a tree. */
+/* One traversal of a two-level batch, as measure() one of a tree. */
 static int measure_two_level(const struct trace_two_level *tl, const bvhlab_ray *rays, size_t n,
                              const bvhlab_trace_options *o, bvhlab_hit *hits,
                              bvhlab_trace_timing *out, struct ray_metrics *m)
 {
 	bvhlab_error err = {{0}};
-	int r = trace_measure_two_level(tl, rays, n, o, hits, out, &err);
+	char device[sizeof(m->device)] = "";
+	int r = trace_measure_two_level(tl, rays, n, o, hits, out, device, sizeof(device), &err);
+	if (device[0])
+		memcpy(m->device, device, sizeof(device));
 	if (r < 0) {
 		error_prefix(&err, "%s", bvhlab_traversal_name(o->traversal));
 		add_error(m, err.message);
@@ -256,7 +259,8 @@ int harness_trace_rays_two_level(const struct trace_two_level *tl, const bvhlab_
 	other = hits ? malloc(n * sizeof(*other)) : NULL;
 	r = r < 0 ? r : other ? 0 : -ENOMEM;
 	bvhlab_trace_options o = {.traversal = rs->main, .threads = rs->threads,
-	                          .min_ms = rs->min_ms, .min_repeats = rs->min_repeats};
+	                          .min_ms = rs->min_ms, .min_repeats = rs->min_repeats,
+	                          .device = rs->device};
 	if (r == 0)
 		r = measure_two_level(tl, rays, n, &o, hits, &m->primary[rs->main], m);
 	m->threads = m->primary[rs->main].threads;
@@ -267,7 +271,7 @@ int harness_trace_rays_two_level(const struct trace_two_level *tl, const bvhlab_
 		if (measure_two_level(tl, rays, n, &o, other, &m->primary[k], m) == 0) {
 			for (size_t i = 0; i < n; i++)
 				m->disagreements += !same_hit(&hits[i], &other[i], false);
-		} else { /* a device traversal: the CPU ones go on */
+		} else { /* this traversal only (no device, say): the others go on */
 			m->traversals &= ~(1u << k);
 			m->primary[k] = (bvhlab_trace_timing){0};
 		}

@@ -70,10 +70,11 @@ int harness_trace_rays(const bvhlab_tree *tree, const bvhlab_scene *scene,
 
 /*
  * A two-level scene's primary rays (width x height from cam) timed with
- * each CPU traversal of rs at both levels (trace_measure_two_level), into
+ * each traversal of rs at both levels (trace_measure_two_level), into
  * m->primary; another traversal's hits are compared with the main one's
- * into m->disagreements, a device one is left out with its reason in
- * m->error. No secondary kinds (they need the flattened scene's normals).
+ * into m->disagreements, one that cannot run (a device traversal with no
+ * device) is left out with its reason in m->error. No secondary kinds
+ * (they need the flattened scene's normals).
  * 0 or a negative errno (the main traversal failing).
  */
 struct trace_two_level;

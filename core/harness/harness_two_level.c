@@ -227,7 +227,7 @@ void harness_two_level_finish(struct two_level_trees *trees)
 	memset(trees, 0, sizeof(*trees));
 }
 
-/* The run's primary rays through its trees, with the config's CPU
+/* The run's primary rays through its trees, with the config's
  * traversals and camera (auto-framed on `flat`, the flattened scene's
  * bounds, so its one-level runs trace the same rays; NULL: on the top
  * tree's root box). */
@@ -242,8 +242,11 @@ static void trace_rays(const struct config *cfg, const struct scene_instanced *i
 	harness_ray_settings(cfg, &rs);
 	if ((size_t)rs.width * rs.height == 0)
 		return;
+	/* The CPU stack traversal is the main one of a two-level run: a device
+	 * traversal is measured and compared beside it, and where there is no
+	 * device it alone is left out (its reason in rays.error). */
 	if (trace_cl_traversal(rs.main)) {
-		rs.main = BVHLAB_TRAVERSAL_STACK; /* the device ones are said left out */
+		rs.main = BVHLAB_TRAVERSAL_STACK;
 		rs.traversals |= 1u << BVHLAB_TRAVERSAL_STACK;
 	}
 	memcpy(bounds.lo, trees->top.nodes[0].lo, sizeof(bounds.lo));

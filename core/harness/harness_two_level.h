@@ -73,9 +73,10 @@ struct harness_anim;  /* harness_anim.h */
  * validated (whether the trees were judged: TREE_OK or TREE_INVALID), and on
  * valid trees rays (the primary rays of the config's camera for scene
  * `scene`, or of one framing `flat`, the flattened scene's bounds, or when
- * NULL the top tree's root box; each CPU traversal at both levels,
- * harness_trace_rays_two_level); on an animated scene (anim's frames; NULL or 0: none) then the frames, the top
- * rebuilt or updated on each (harness_anim_top.c). Returns the verdict
+ * NULL the top tree's root box; each traversal, CPU or device, at both
+ * levels, harness_trace_rays_two_level); on an animated scene (anim's
+ * frames; NULL or 0: none) then the frames, the top rebuilt or updated on
+ * each (harness_anim_top.c). Returns the verdict
  * (TREE_OK, _INVALID, _FAILED: the run's status, in the same order).
  */
 enum tree_verdict harness_two_level_run(const struct config *cfg,

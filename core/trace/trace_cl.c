@@ -14,6 +14,7 @@
 #include "device/device_run.h"
 #include "trace/cwbvh.h"
 #include "trace/trace_cl.h"
+#include "trace/trace_cl_host.h"
 #include "trace/trace_cl_source.h"
 #include "trace/trace_layout.h"
 #include "tree/tree_view.h"
@@ -28,17 +29,10 @@
  * say so). */
 #define BUILD_OPTIONS "-cl-std=CL1.2 -DSTACK_SIZE=%u"
 
-struct trace_cl_tree {
-	const bvhlab_cl *dev; /* the device layer's */
-	cl_kernel kernel;
-	cl_mem nodes, tris, prim_index;
-	cl_mem extra; /* parent links (stackless), leaf ranges (wide8) */
-	uint32_t node_count, index_count, tri_count;
-};
-
 struct trace_cl_batch {
 	struct trace_cl_tree *t;
 	cl_mem rays, hits, counts;
+	cl_mem inst; /* a two-level tree's: each ray's hit instance */
 	size_t count;
 	cl_uint any;
 };
@@ -93,9 +87,9 @@ static unsigned stack_size(unsigned need)
 	return s;
 }
 
-/* Whether buffers of want[] bytes fit the device: the layer's check, so a
- * tree or batch too big is refused with the figures, not by the driver. */
-static int fits(const bvhlab_cl *d, const size_t *want, unsigned count, bvhlab_error *err)
+/* The layer's check, so a tree or batch too big is refused with the
+ * figures, not by the driver. */
+int trace_cl_fits(const bvhlab_cl *d, const size_t *want, unsigned count, bvhlab_error *err)
 {
 	char why[512];
 	int r = cl_bufs_fit_on(d, want, count, why, sizeof(why));
@@ -104,9 +98,8 @@ static int fits(const bvhlab_cl *d, const size_t *want, unsigned count, bvhlab_e
 	return r;
 }
 
-/* A read-only buffer holding bytes (at least 4, so empty arrays upload). */
-static int upload(const bvhlab_cl *d, const void *data, size_t bytes, cl_mem *out,
-                  const char *what, bvhlab_error *err)
+int trace_cl_upload(const bvhlab_cl *d, const void *data, size_t bytes, cl_mem *out,
+                    const char *what, bvhlab_error *err)
 {
 	char why[256];
 	cl_int rc;
@@ -120,11 +113,11 @@ static int upload(const bvhlab_cl *d, const void *data, size_t bytes, cl_mem *ou
 	return r;
 }
 
-/* The triangles' vertices in leaf-slot order, as the CPU batch copy. */
-static float *slot_vertices(const bvhlab_tree *tree, const bvhlab_scene *scene)
+/* As the CPU batch copy. */
+void trace_cl_slot_vertices(const bvhlab_tree *tree, const bvhlab_scene *scene, float *v)
 {
-	float *v = calloc((size_t)tree->index_count * TRACE_SLOT_FLOATS + 1, sizeof(*v));
-	for (uint32_t i = 0; v && i < tree->index_count; i++) {
+	memset(v, 0, (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(*v));
+	for (uint32_t i = 0; i < tree->index_count; i++) {
 		uint32_t prim = tree->prim_index[i];
 		if (prim >= scene->triangle_count)
 			continue; /* zeros: the kernel skips such slots */
@@ -133,22 +126,10 @@ static float *slot_vertices(const bvhlab_tree *tree, const bvhlab_scene *scene)
 			       scene->vertices + 3 * (size_t)scene->indices[3 * (size_t)prim + k],
 			       3 * sizeof(float));
 	}
-	return v;
 }
 
-/* What goes up for a traversal: the tree's nodes and parent links, or
- * (wide8) its compressed nodes and leaf ranges; and the stack it needs. */
-struct tree_arrays {
-	const void *nodes, *extra; /* extra: parent links or leaf ranges */
-	size_t node_bytes, extra_bytes;
-	uint32_t node_count;
-	unsigned need;
-	uint32_t *parents;
-	struct cwbvh cw;
-};
-
-static int tree_arrays(const bvhlab_tree *tree, int traversal, struct tree_arrays *a,
-                       bvhlab_error *err)
+int trace_cl_arrays(const bvhlab_tree *tree, int traversal, struct tree_arrays *a,
+                    bvhlab_error *err)
 {
 	*a = (struct tree_arrays){.nodes = tree->nodes, .node_count = tree->node_count,
 	                          .node_bytes = (size_t)tree->node_count * sizeof(bvhlab_node)};
@@ -163,6 +144,7 @@ static int tree_arrays(const bvhlab_tree *tree, int traversal, struct tree_array
 		a->node_count = a->cw.node_count;
 		a->node_bytes = (size_t)a->cw.node_count * sizeof(cw_node);
 		a->extra = a->cw.leaves;
+		a->extra_count = a->cw.leaf_count;
 		a->extra_bytes = (size_t)a->cw.leaf_count * sizeof(*a->cw.leaves);
 		a->need = a->cw.depth;
 		return r;
@@ -173,7 +155,33 @@ static int tree_arrays(const bvhlab_tree *tree, int traversal, struct tree_array
 	else if (r < 0)
 		error_set(err, "cl: out of memory");
 	a->extra = a->parents;
+	a->extra_count = tree->node_count;
 	a->extra_bytes = (size_t)tree->node_count * sizeof(uint32_t);
+	return r;
+}
+
+void trace_cl_arrays_free(struct tree_arrays *a)
+{
+	free(a->parents);
+	cwbvh_free(&a->cw);
+	a->parents = NULL;
+}
+
+int trace_cl_upload_trees(struct trace_cl_tree *t, const struct tree_arrays *a,
+                          const float *verts, const uint32_t *prim_index, size_t slots,
+                          bvhlab_error *err)
+{
+	size_t want[] = {a->node_bytes, slots * TRACE_SLOT_FLOATS * sizeof(float),
+	                 slots * sizeof(uint32_t), a->extra_bytes};
+	int r = trace_cl_fits(t->dev, want, 4, err);
+	if (r == 0)
+		r = trace_cl_upload(t->dev, a->nodes, want[0], &t->nodes, "nodes", err);
+	if (r == 0)
+		r = trace_cl_upload(t->dev, verts, want[1], &t->tris, "triangles", err);
+	if (r == 0)
+		r = trace_cl_upload(t->dev, prim_index, want[2], &t->prim_index, "prim_index", err);
+	if (r == 0)
+		r = trace_cl_upload(t->dev, a->extra, want[3], &t->extra, "links", err);
 	return r;
 }
 
@@ -181,27 +189,18 @@ static int upload_tree(struct trace_cl_tree *t, const bvhlab_tree *tree,
                        const bvhlab_scene *scene, const struct tree_arrays *a,
                        bvhlab_error *err)
 {
-	float *verts = slot_vertices(tree, scene);
-	int r = verts ? 0 : -ENOMEM;
-	if (r < 0)
+	float *verts = malloc(((size_t)tree->index_count * TRACE_SLOT_FLOATS + 1) * sizeof(*verts));
+	if (!verts) {
 		error_set(err, "cl: out of memory");
-	size_t want[] = {a->node_bytes, (size_t)tree->index_count * TRACE_SLOT_FLOATS * sizeof(float),
-	                 (size_t)tree->index_count * sizeof(uint32_t), a->extra_bytes};
-	if (r == 0)
-		r = fits(t->dev, want, 4, err);
-	if (r == 0)
-		r = upload(t->dev, a->nodes, want[0], &t->nodes, "nodes", err);
-	if (r == 0)
-		r = upload(t->dev, verts, want[1], &t->tris, "triangles", err);
-	if (r == 0)
-		r = upload(t->dev, tree->prim_index, want[2], &t->prim_index, "prim_index", err);
-	if (r == 0)
-		r = upload(t->dev, a->extra, want[3], &t->extra, "links", err);
+		return -ENOMEM;
+	}
+	trace_cl_slot_vertices(tree, scene, verts);
+	int r = trace_cl_upload_trees(t, a, verts, tree->prim_index, tree->index_count, err);
 	free(verts);
 	return r;
 }
 
-static int set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
+int trace_cl_set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
 {
 	char why[256];
 	cl_int rc = clSetKernelArg(t->kernel, TRACE_ARG_NODES, sizeof(cl_mem), &t->nodes);
@@ -232,10 +231,9 @@ static const char *kernel_name(int traversal)
 	}
 }
 
-/* The device and the program for a stack of at least `need` entries, from
- * the process's device layer (core/device), and the traversal's kernel. */
-static int make_kernel(struct trace_cl_tree *t, const char *device, int traversal,
-                       unsigned need, bvhlab_error *err)
+/* From the process's device layer (core/device). */
+int trace_cl_make_kernel(struct trace_cl_tree *t, const char *device, const char *name,
+                         unsigned need, bvhlab_error *err)
 {
 	char why[BVHLAB_CL_ERROR_SIZE], options[64];
 	const void *dev;
@@ -245,7 +243,7 @@ static int make_kernel(struct trace_cl_tree *t, const char *device, int traversa
 	                       why, sizeof(why));
 	if (r == 0) {
 		t->dev = dev;
-		r = bvhlab_cl_kernel(prog, kernel_name(traversal), &t->kernel, why, sizeof(why));
+		r = bvhlab_cl_kernel(prog, name, &t->kernel, why, sizeof(why));
 	}
 	if (r < 0)
 		cl_error(err, why);
@@ -264,7 +262,7 @@ int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *t
 		error_set(err, "cl: not a device traversal (%d)", traversal);
 		return -EINVAL;
 	}
-	int r = tree_arrays(tree, traversal, &a, err);
+	int r = trace_cl_arrays(tree, traversal, &a, err);
 	struct trace_cl_tree *t = r == 0 ? calloc(1, sizeof(*t)) : NULL;
 	if (r == 0 && !t)
 		r = -ENOMEM;
@@ -272,14 +270,13 @@ int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *t
 		t->node_count = a.node_count;
 		t->index_count = tree->index_count;
 		t->tri_count = scene->triangle_count;
-		r = make_kernel(t, device, traversal, a.need, err);
+		r = trace_cl_make_kernel(t, device, kernel_name(traversal), a.need, err);
 	}
 	if (r == 0)
 		r = upload_tree(t, tree, scene, &a, err);
 	if (r == 0)
-		r = set_tree_args(t, err);
-	free(a.parents);
-	cwbvh_free(&a.cw);
+		r = trace_cl_set_tree_args(t, err);
+	trace_cl_arrays_free(&a);
 	if (r < 0) {
 		trace_cl_tree_destroy(t);
 		return r;
@@ -297,6 +294,12 @@ void trace_cl_tree_destroy(struct trace_cl_tree *t)
 	bvhlab_cl_release_mem(&t->tris);
 	bvhlab_cl_release_mem(&t->prim_index);
 	bvhlab_cl_release_mem(&t->extra);
+	bvhlab_cl_release_mem(&t->top);
+	bvhlab_cl_release_mem(&t->top_index);
+	bvhlab_cl_release_mem(&t->top_parents);
+	bvhlab_cl_release_mem(&t->meshes);
+	bvhlab_cl_release_mem(&t->inverse);
+	bvhlab_cl_release_mem(&t->inst_mesh);
 	free(t);
 }
 
@@ -324,6 +327,10 @@ int trace_cl_batch_create(struct trace_cl_tree *t, const bvhlab_ray *rays, size_
 		error_set(err, "cl: %zu rays in one batch: too many", count);
 		return -EINVAL;
 	}
+	if (any_hit && t->two_level) { /* as trace_instances.c: closest hits only */
+		error_set(err, "cl: a two-level scene is traced for closest hits only");
+		return -EINVAL;
+	}
 	struct trace_cl_batch *b = calloc(1, sizeof(*b));
 	if (!b)
 		return -ENOMEM;
@@ -331,14 +338,16 @@ int trace_cl_batch_create(struct trace_cl_tree *t, const bvhlab_ray *rays, size_
 	b->count = count;
 	b->any = any_hit;
 	size_t want[] = {count * sizeof(*rays), count * sizeof(bvhlab_hit),
-	                 count * 2 * sizeof(uint32_t)};
-	int r = fits(t->dev, want, 3, err);
+	                 count * 2 * sizeof(uint32_t), t->two_level ? count * sizeof(uint32_t) : 0};
+	int r = trace_cl_fits(t->dev, want, 4, err);
 	if (r == 0)
-		r = upload(t->dev, rays, want[0], &b->rays, "rays", err);
+		r = trace_cl_upload(t->dev, rays, want[0], &b->rays, "rays", err);
 	if (r == 0)
 		r = output_buffer(t, count * sizeof(bvhlab_hit), &b->hits, err);
 	if (r == 0)
 		r = output_buffer(t, count * 2 * sizeof(uint32_t), &b->counts, err);
+	if (r == 0 && t->two_level)
+		r = output_buffer(t, want[3], &b->inst, err);
 	if (r < 0) {
 		trace_cl_batch_destroy(b);
 		return r;
@@ -354,6 +363,7 @@ void trace_cl_batch_destroy(struct trace_cl_batch *b)
 	bvhlab_cl_release_mem(&b->rays);
 	bvhlab_cl_release_mem(&b->hits);
 	bvhlab_cl_release_mem(&b->counts);
+	bvhlab_cl_release_mem(&b->inst);
 	free(b);
 }
 
@@ -368,6 +378,8 @@ static cl_int set_batch_args(struct trace_cl_batch *b)
 	rc |= clSetKernelArg(k, TRACE_ARG_ANY, sizeof(cl_uint), &b->any);
 	rc |= clSetKernelArg(k, TRACE_ARG_HITS, sizeof(cl_mem), &b->hits);
 	rc |= clSetKernelArg(k, TRACE_ARG_COUNTS, sizeof(cl_mem), &b->counts);
+	if (b->t->two_level)
+		rc |= clSetKernelArg(k, TRACE_ARG_HIT_INSTANCE, sizeof(cl_mem), &b->inst);
 	return rc ? CL_INVALID_KERNEL_ARGS : CL_SUCCESS;
 }
 
@@ -442,5 +454,22 @@ int trace_cl_pass(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
 	*kernel_s = ms > 0 ? ms * 1e-3 : *wall_s; /* no profiling: the wall clock */
 	if (hits || nodes || stats)
 		r = read_back(b, hits, nodes, stats, err);
+	return r;
+}
+
+int trace_cl_instances(struct trace_cl_batch *b, uint32_t *instances, bvhlab_error *err)
+{
+	char why[256];
+	if (!b->t->two_level) {
+		error_set(err, "cl: a one-level tree's hits have no instance");
+		return -EINVAL;
+	}
+	if (b->count == 0)
+		return 0;
+	cl_int rc = clEnqueueReadBuffer(b->t->dev->queue, b->inst, CL_TRUE, 0,
+	                                b->count * sizeof(*instances), instances, 0, NULL, NULL);
+	int r = bvhlab_cl_check(rc, "clEnqueueReadBuffer", why, sizeof(why));
+	if (r < 0)
+		cl_error(err, why);
 	return r;
 }

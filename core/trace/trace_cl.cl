@@ -271,31 +271,29 @@ static uint children_hit(const prep *p, NODES, const __global tree_node *n, floa
 	return m;
 }
 
-/* trace.c's traverse(): nearest child next, the others on a stack with
- * their entry distance, popped only while it still beats the closest hit. */
-__kernel void trace_stack(TRACE_KERNEL_ARGS)
+/* trace.c's traverse() of one tree whose root box the ray enters: nearest
+ * child next, the others on a stack with their entry distance, popped only
+ * while it still beats the closest hit. *visited counts the nodes entered
+ * (ending the walk past node_total: a cycle), *tests the triangles; false
+ * when the stack overflowed (deeper than the host said). */
+static bool walk_stack(const prep *p, NODES, __global const float *tris,
+                       __global const uint *prim_index, uint node_total, uint index_count,
+                       uint tri_count, bool any, hit *h, uint *visited, uint *tests)
 {
-	uint i = get_global_id(0), visited = 0, tests = 0, sp = 0, node = 0;
+	uint sp = 0, node = 0;
 	uint st_node[STACK_SIZE];
 	float st_t[STACK_SIZE];
 	entry e[TREE_MAX_WIDTH];
-	hit h;
-	prep p;
-	(void)parents;
-	if (!ray_begin(nodes, node_total, rays, ray_count, i, hits, counts, &p, &h))
-		return;
-	while (enter_node(node_total, &visited)) {
+	while (enter_node(node_total, visited)) {
 		const __global tree_node *n = &nodes[node];
 		if (tree_is_leaf(n)) {
-			if (leaf(&p, tris, prim_index, n, index_count, tri_count, any, &h, &tests))
-				break;
+			if (leaf(p, tris, prim_index, n, index_count, tri_count, any, h, tests))
+				return true;
 		} else if (children_inside(n, node_total)) {
-			uint m = children_hit(&p, nodes, n, h.t, e);
+			uint m = children_hit(p, nodes, n, h->t, e);
 			if (m > 0) {
-				if (sp + m - 1 > STACK_SIZE) { /* deeper than the host said: flag it */
-					visited = TRACE_OVERFLOW;
-					break;
-				}
+				if (sp + m - 1 > STACK_SIZE)
+					return false;
 				for (uint k = 0; k + 1 < m; k++) {
 					st_node[sp] = e[k].node;
 					st_t[sp++] = e[k].t;
@@ -307,15 +305,29 @@ __kernel void trace_stack(TRACE_KERNEL_ARGS)
 		bool popped = false;
 		while (sp) {
 			--sp;
-			if (st_t[sp] <= h.t * FAR_SCALE) {
+			if (st_t[sp] <= h->t * FAR_SCALE) {
 				node = st_node[sp];
 				popped = true;
 				break;
 			}
 		}
 		if (!popped)
-			break;
+			return true;
 	}
+	return true;
+}
+
+__kernel void trace_stack(TRACE_KERNEL_ARGS)
+{
+	uint i = get_global_id(0), visited = 0, tests = 0;
+	hit h;
+	prep p;
+	(void)parents;
+	if (!ray_begin(nodes, node_total, rays, ray_count, i, hits, counts, &p, &h))
+		return;
+	if (!walk_stack(&p, nodes, tris, prim_index, node_total, index_count, tri_count, any, &h,
+	                &visited, &tests))
+		visited = TRACE_OVERFLOW;
 	store(hits, counts, i, &h, visited, tests);
 }
 
@@ -388,34 +400,50 @@ static bool enter_next(const prep *p, NODES, const __global tree_node *n, uint a
 	return false;
 }
 
-/* trace_stackless.c's walk(): down into the near child, up through the
- * parent links (Hapala et al. 2011), a wide node's children in the ray
- * order. */
+/* trace_stackless.c's climb(): from a node whose subtree is done, up to
+ * the next sibling to enter, into *node; false back at the root. */
+static bool climb(const prep *p, NODES, __global const uint *parents, float tmax, uint *node)
+{
+	uint at = *node;
+	while (at != 0) {
+		uint parent = parents[at];
+		if (enter_next(p, nodes, &nodes[parent], at, tmax, node))
+			return true;
+		at = parent;
+	}
+	return false;
+}
+
+/* trace_stackless.c's walk() of one tree whose root box the ray enters:
+ * down into the near child, up through the parent links (Hapala et al.
+ * 2011), a wide node's children in the ray order; counted as walk_stack. */
+static void walk_stackless(const prep *p, NODES, __global const uint *parents,
+                           __global const float *tris, __global const uint *prim_index,
+                           uint node_total, uint index_count, uint tri_count, bool any, hit *h,
+                           uint *visited, uint *tests)
+{
+	uint node = 0;
+	while (enter_node(node_total, visited)) {
+		const __global tree_node *n = &nodes[node];
+		if (!tree_is_leaf(n)) {
+			if (enter_next(p, nodes, n, NO_HIT, h->t, &node))
+				continue;
+		} else if (leaf(p, tris, prim_index, n, index_count, tri_count, any, h, tests)) {
+			return;
+		}
+		if (!climb(p, nodes, parents, h->t, &node))
+			return;
+	}
+}
+
 __kernel void trace_stackless(TRACE_KERNEL_ARGS)
 {
-	uint i = get_global_id(0), visited = 0, tests = 0, node = 0;
+	uint i = get_global_id(0), visited = 0, tests = 0;
 	hit h;
 	prep p;
 	if (!ray_begin(nodes, node_total, rays, ray_count, i, hits, counts, &p, &h))
 		return;
-	while (enter_node(node_total, &visited)) {
-		const __global tree_node *n = &nodes[node];
-		if (!tree_is_leaf(n)) {
-			if (enter_next(&p, nodes, n, NO_HIT, h.t, &node))
-				continue;
-		} else if (leaf(&p, tris, prim_index, n, index_count, tri_count, any, &h, &tests)) {
-			break;
-		}
-		/* climb(): up to the next sibling to enter, or out at the root */
-		uint at = node;
-		bool found = false;
-		while (at != 0 && !found) {
-			uint parent = parents[at];
-			found = enter_next(&p, nodes, &nodes[parent], at, h.t, &node);
-			at = parent;
-		}
-		if (!found)
-			break;
-	}
+	walk_stackless(&p, nodes, parents, tris, prim_index, node_total, index_count, tri_count, any,
+	               &h, &visited, &tests);
 	store(hits, counts, i, &h, visited, tests);
 }

@@ -51,6 +51,23 @@ int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *t
                          bvhlab_error *err);
 void trace_cl_tree_destroy(struct trace_cl_tree *t);
 
+struct trace_two_level; /* trace_instances.h */
+
+/*
+ * A two-level scene on the device (trace_cl_two_level.c): tl's top tree,
+ * every mesh's bottom tree once (for wide8 each compressed), and the
+ * instances' world-to-object matrices, traced as trace_instances.c traces
+ * them with traversal at both levels (device_wide8: its bottoms, the top
+ * with the stack walk, as the CPU's wide traversals). Its batches are
+ * closest-hit ones; trace_cl_instances gives each ray's instance. Errors
+ * as trace_cl_tree_create's, and -ENOTSUP on a device without doubles
+ * (cl_khr_fp64), which the ray's carrying into an instance needs to round
+ * as the CPU's does.
+ */
+int trace_cl_two_level_create(const char *device, int traversal,
+                              const struct trace_two_level *tl, struct trace_cl_tree **out,
+                              bvhlab_error *err);
+
 /* The device's name (CL_DEVICE_NAME). */
 const char *trace_cl_device_name(const struct trace_cl_tree *t);
 
@@ -68,5 +85,10 @@ void trace_cl_batch_destroy(struct trace_cl_batch *b);
 int trace_cl_pass(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
                   bvhlab_trace_stats *stats, double *kernel_s, double *wall_s,
                   bvhlab_error *err);
+
+/* After a pass over a two-level tree's batch: each ray's hit instance
+ * (BVHLAB_NO_HIT for a miss) into instances[count]. 0, -EINVAL (a
+ * one-level tree's batch) or -EIO. */
+int trace_cl_instances(struct trace_cl_batch *b, uint32_t *instances, bvhlab_error *err);
 
 #endif

@@ -25,6 +25,14 @@ int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *t
 	return -ENOTSUP;
 }
 
+int trace_cl_two_level_create(const char *device, int traversal,
+                              const struct trace_two_level *tl, struct trace_cl_tree **out,
+                              bvhlab_error *err)
+{
+	(void)tl;
+	return trace_cl_tree_create(device, traversal, NULL, NULL, out, err);
+}
+
 void trace_cl_tree_destroy(struct trace_cl_tree *t)
 {
 	(void)t;
@@ -56,6 +64,13 @@ int trace_cl_pass(struct trace_cl_batch *b, bvhlab_hit *hits, uint32_t *nodes,
 {
 	(void)b, (void)hits, (void)nodes, (void)stats;
 	*kernel_s = *wall_s = 0;
+	error_set(err, "OpenCL was not built");
+	return -ENOTSUP;
+}
+
+int trace_cl_instances(struct trace_cl_batch *b, uint32_t *instances, bvhlab_error *err)
+{
+	(void)b, (void)instances;
 	error_set(err, "OpenCL was not built");
 	return -ENOTSUP;
 }

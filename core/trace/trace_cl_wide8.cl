@@ -73,32 +73,24 @@ static uint cw_octant_flip(const prep *p)
 	return 7u ^ from;
 }
 
-/* The arguments in enum trace_arg's order: nodes the compressed nodes
- * (node_total of them), and in the parents' place the leaf ranges. */
-__kernel void trace_wide8(__global const cw_node *cw, __global const float *tris,
-                          __global const uint *prim_index, __global const uint2 *ranges,
-                          uint node_total, uint index_count, uint tri_count,
-                          __global const float4 *rays, uint ray_count, uint any,
-                          __global uint4 *hits, __global uint2 *counts)
+/* The walk of one compressed tree (node_total nodes, its leaf ranges)
+ * from its root; counted as walk_stack; false when the stack overflowed
+ * (deeper than the host said). */
+static bool walk_cw(const prep *p, __global const cw_node *cw, __global const uint2 *ranges,
+                    __global const float *tris, __global const uint *prim_index,
+                    uint node_total, uint index_count, uint tri_count, bool any, hit *h,
+                    uint *visited, uint *tests)
 {
-	uint i = get_global_id(0), visited = 0, tests = 0, sp = 0;
+	uint sp = 0;
 	uint2 stack[STACK_SIZE];
-	hit h;
-	prep p;
-	if (i >= ray_count)
-		return;
-	if (!ray_load(rays, i, &p, &h) || node_total == 0) {
-		store(hits, counts, i, &h, 0, 0);
-		return;
-	}
-	uint oinv = cw_octant_flip(&p);
+	uint oinv = cw_octant_flip(p);
 	/* the root as the one inner child (slot 0) of a group with node 0 first */
 	uint2 group = (uint2)(0, 1u << (CW_META_INNER_BASE + oinv) | 1u);
 	for (;;) {
 		uint inner = group.y & 0xff000000u;
 		if (!inner) {
 			if (sp == 0)
-				break;
+				return true;
 			group = stack[--sp];
 			continue;
 		}
@@ -107,19 +99,36 @@ __kernel void trace_wide8(__global const cw_node *cw, __global const float *tris
 		uint slot = (bit - CW_META_INNER_BASE) ^ oinv;
 		uint node = group.x + popcount(group.y & 0xffu & ((1u << slot) - 1u));
 		if (group.y & 0xff000000u) {
-			if (sp == STACK_SIZE) { /* deeper than the host said: flag it */
-				visited = TRACE_OVERFLOW;
-				break;
-			}
+			if (sp == STACK_SIZE)
+				return false;
 			stack[sp++] = group;
 		}
-		if (node >= node_total || !enter_node(node_total, &visited))
-			break;
+		if (node >= node_total || !enter_node(node_total, visited))
+			return true;
 		uint leaf_bits;
-		group = cw_visit(&p, &cw[node], h.t, oinv, &leaf_bits);
-		if (cw_leaves(&p, tris, prim_index, ranges, cw[node].leaf_base, leaf_bits, index_count,
-		              tri_count, any, &h, &tests))
-			break;
+		group = cw_visit(p, &cw[node], h->t, oinv, &leaf_bits);
+		if (cw_leaves(p, tris, prim_index, ranges, cw[node].leaf_base, leaf_bits, index_count,
+		              tri_count, any, h, tests))
+			return true;
 	}
+}
+
+/* The arguments in enum trace_arg's order: nodes the compressed nodes
+ * (node_total of them), and in the parents' place the leaf ranges. */
+__kernel void trace_wide8(__global const cw_node *cw, __global const float *tris,
+                          __global const uint *prim_index, __global const uint2 *ranges,
+                          uint node_total, uint index_count, uint tri_count,
+                          __global const float4 *rays, uint ray_count, uint any,
+                          __global uint4 *hits, __global uint2 *counts)
+{
+	uint i = get_global_id(0), visited = 0, tests = 0;
+	hit h;
+	prep p;
+	if (i >= ray_count)
+		return;
+	if (ray_load(rays, i, &p, &h) && node_total != 0 &&
+	    !walk_cw(&p, cw, ranges, tris, prim_index, node_total, index_count, tri_count, any, &h,
+	             &visited, &tests))
+		visited = TRACE_OVERFLOW;
 	store(hits, counts, i, &h, visited, tests);
 }

@@ -49,4 +49,35 @@ enum trace_arg {
 	TRACE_ARGS
 };
 
+/* A two-level scene's kernels (trace_cl_two_level.cl) take the arguments
+ * above, with the bottom trees (every mesh's, one after another) as the
+ * tree and node_total, index_count and tri_count unused, then these. */
+enum trace_arg_two_level {
+	TRACE_ARG_TOP = TRACE_ARGS, /* the top tree's nodes */
+	TRACE_ARG_TOP_INDEX,        /* its prim_index: instance ids */
+	TRACE_ARG_TOP_PARENTS,      /* its parent links (stackless) */
+	TRACE_ARG_TOP_COUNT,        /* its node count */
+	TRACE_ARG_TOP_INDEX_COUNT,  /* its prim_index's length */
+	TRACE_ARG_MESHES,           /* TRACE_MESH_FIELDS uints per mesh */
+	TRACE_ARG_INVERSE,          /* 12 doubles per instance: world to object, row-major 3x4 */
+	TRACE_ARG_INSTANCE_MESH,    /* a uint per instance: its mesh */
+	TRACE_ARG_INSTANCE_COUNT,
+	TRACE_ARG_HIT_INSTANCE,     /* out: a uint per ray, the hit's instance */
+	TRACE_ARGS_TWO_LEVEL
+};
+
+/* One mesh's place in the concatenated bottom trees: its first node (a
+ * tree_node, or a cw_node for wide8), node count, first leaf slot (into
+ * the vertices and prim_index), slot count, triangle count, and first
+ * link (parent links: its first node's; wide8: its first leaf range). */
+enum trace_mesh_field {
+	TRACE_MESH_NODE_BASE,
+	TRACE_MESH_NODES,
+	TRACE_MESH_SLOT_BASE,
+	TRACE_MESH_SLOTS,
+	TRACE_MESH_TRIS,
+	TRACE_MESH_LINK_BASE,
+	TRACE_MESH_FIELDS
+};
+
 #endif /* BVHLAB_TRACE_LAYOUT_H */

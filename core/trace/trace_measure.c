@@ -439,15 +439,52 @@ int trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhl
 	return r;
 }
 
+/* A two-level series on the device: tl's trees and the rays uploaded. */
+static int two_level_device(struct trace_series *s, const struct trace_two_level *tl,
+                            const bvhlab_trace_options *o)
+{
+	int r = trace_cl_two_level_create(o->device, o->traversal, tl, &s->cl_tree, &s->err);
+	if (r == 0)
+		r = trace_cl_batch_create(s->cl_tree, s->b.rays, s->b.count, false, &s->cl_batch,
+		                          &s->err);
+	return r;
+}
+
+/* The timed slice of a two-level batch b (its hits into b->hits), on the
+ * CPU (b->two_level prepared) or on the device (tl's trees uploaded). */
+static int two_level_slice(const struct batch *b, const struct trace_two_level *tl,
+                           const bvhlab_trace_options *opts, bvhlab_trace_timing *timing,
+                           char *device, size_t device_size, bvhlab_error *err)
+{
+	struct trace_series *s = series_alloc(b, opts->threads, opts->max_repeats);
+	if (!s) {
+		error_set(err, "out of memory");
+		return -ENOMEM;
+	}
+	int r = trace_cl_traversal(opts->traversal) ? two_level_device(s, tl, opts) : 0;
+	if (r == 0)
+		r = trace_series_slice(s, opts);
+	if (r == 0)
+		trace_series_timing(s, timing);
+	if (r < 0)
+		error_set(err, "%s", s->err.message[0] ? s->err.message : strerror(-r));
+	if (device && device_size && trace_series_device(s))
+		snprintf(device, device_size, "%s", trace_series_device(s));
+	trace_series_destroy(s);
+	return r;
+}
+
 int trace_measure_two_level(const struct trace_two_level *tl, const bvhlab_ray *rays,
                             size_t count, const bvhlab_trace_options *opts, bvhlab_hit *hits,
-                            bvhlab_trace_timing *timing, bvhlab_error *err)
+                            bvhlab_trace_timing *timing, char *device, size_t device_size,
+                            bvhlab_error *err)
 {
 	struct trace_two_level prepared = *tl;
+	bool on_device = trace_cl_traversal(opts->traversal);
 	*timing = (bvhlab_trace_timing){0};
-	int r = trace_two_level_prepare(&prepared, opts->traversal);
+	int r = on_device ? 0 : trace_two_level_prepare(&prepared, opts->traversal);
 	if (r < 0) {
-		error_set(err, "%s", r == -EINVAL ? "a two-level scene is traced on the CPU only"
+		error_set(err, "%s", r == -EINVAL ? "not a traversal of two-level scenes"
 		                                  : "out of memory");
 		return r;
 	}
@@ -455,16 +492,10 @@ int trace_measure_two_level(const struct trace_two_level *tl, const bvhlab_ray *
 	 * the counters (the two levels' nodes, whichever kernel walks them). */
 	struct batch b = {.two_level = &prepared, .rays = rays, .count = count,
 	                  .traversal = BVHLAB_TRAVERSAL_STACK, .hits = hits};
-	struct trace_series *s = count ? series_alloc(&b, opts->threads, opts->max_repeats) : NULL;
-	r = count && !s ? -ENOMEM : 0;
-	if (s)
-		r = trace_series_slice(s, opts);
-	if (s && r == 0)
-		trace_series_timing(s, timing);
-	if (r < 0)
-		error_set(err, "%s", s && s->err.message[0] ? s->err.message : strerror(-r));
-	trace_series_destroy(s);
-	trace_two_level_release(&prepared);
+	if (count)
+		r = two_level_slice(&b, tl, opts, timing, device, device_size, err);
+	if (!on_device)
+		trace_two_level_release(&prepared);
 	return r;
 }
 

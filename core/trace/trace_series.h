@@ -73,15 +73,19 @@ int trace_measure(const bvhlab_tree *tree, const bvhlab_scene *scene, const bvhl
                   bvhlab_error *err);
 
 /*
- * The same for a two-level scene (trace_instances.h) with opts->traversal,
- * a CPU one, at both levels (trace_two_level_prepare): hits (may be NULL)
- * as trace_two_level_hit gives them, the counters the nodes and triangles
- * of both levels. 0, or a negative errno with err saying why (-EINVAL: a
- * device traversal).
+ * The same for a two-level scene (trace_instances.h) with opts->traversal
+ * at both levels: a CPU one (trace_two_level_prepare), or a device one
+ * (trace_cl_two_level_create: the trees and rays uploaded to
+ * opts->device, the device's name into device when not NULL). hits (may
+ * be NULL) as trace_two_level_hit gives them, the counters the nodes and
+ * triangles of both levels. 0, or a negative errno with err saying why
+ * (-EINVAL: not a traversal of two-level scenes; for the device, as
+ * trace_series_create's).
  */
 struct trace_two_level;
 int trace_measure_two_level(const struct trace_two_level *tl, const bvhlab_ray *rays,
                             size_t count, const bvhlab_trace_options *opts, bvhlab_hit *hits,
-                            bvhlab_trace_timing *timing, bvhlab_error *err);
+                            bvhlab_trace_timing *timing, char *device, size_t device_size,
+                            bvhlab_error *err);
 
 #endif

@@ -14,8 +14,10 @@
  *           in rounds;
  *   errors  a bad rays.device is a config error naming the key; a device
  *           that does not exist, or no OpenCL platform at all, leaves the
- *           runs ok with rays.error saying why; info --machine lists the
- *           device.
+ *           runs ok with rays.error saying why; a two-level run (20
+ *           instances) traces its primary rays with the device traversals
+ *           too, as above, and with no platform is ok, saying why;
+ *           info --machine lists the device.
  * Skips (77) when this machine has no OpenCL device. PoCL runs under ASan
  * and TSan (checked; under TSan not in a forked child, see run_rays);
  * sanitizer builds leave out the bunny (CL_TRACE_NO_MESH), which the
@@ -61,7 +63,9 @@ static double num(const cJSON *run, const char *a, const char *b, const char *c)
 	return cJSON_IsNumber(v) ? v->valuedouble : NAN;
 }
 
-static void check_run(const cJSON *run)
+/* A run's device traversals against its CPU ones over its first `kinds`
+ * ray kinds (primary, diffuse, shadow, ao). */
+static void check_run_kinds(const cJSON *run, int kinds_traced)
 {
 	const cJSON *rays = cJSON_GetObjectItem(run, "rays");
 	const char *what = run_str(run, "scene");
@@ -73,7 +77,7 @@ static void check_run(const cJSON *run)
 	CHECK(strlen(run_str(rays, "device")) > 0);
 	CHECK(num(run, "traversal_disagreements", NULL, NULL) == 0);
 	static const char *const kinds[] = {"primary", "diffuse", "shadow", "ao"};
-	for (int k = 0; k < 4; k++) {
+	for (int k = 0; k < kinds_traced; k++) {
 		double n = num(run, kinds[k], "rays", NULL);
 		CHECK(num(run, "device_stack", kinds[k], "rays") == n);
 		CHECK(num(run, "device_stackless", kinds[k], "rays") == n);
@@ -95,6 +99,11 @@ static void check_run(const cJSON *run)
 			CHECK(num(run, "device_wide8", kinds[k], "nodes_per_ray") > 0);
 		}
 	}
+}
+
+static void check_run(const cJSON *run)
+{
+	check_run_kinds(run, 4);
 }
 
 /* lbvh's tree collapsed into 4- and 8-wide ones (tests/fake/wide_collapse). */
@@ -160,10 +169,26 @@ static void trace_mode(void)
 	            6, 5);
 }
 
+/* `bvhlab run` of this config, written as NAME.json, exiting want_rc; the
+ * document of its output folder NAME (NULL for exit 2). */
+static cJSON *run_config(const char *name, const char *config, int want_rc)
+{
+	char out[600];
+	snprintf(out, sizeof(out), "%s.json", name);
+	int rc = run(ARGS("run", write_config(out, config), "--quiet"));
+	if (rc != want_rc)
+		fprintf(stderr, "%s: %s", name, err_text);
+	CHECK_INT(rc, want_rc);
+	if (want_rc == 2)
+		return NULL;
+	snprintf(out, sizeof(out), "%s/%s", tmpdir, name);
+	return load_results(out);
+}
+
 /* A run of one scene with this "rays" object; the document. */
 static cJSON *run_rays(const char *name, const char *rays, int want_rc)
 {
-	char config[2048], out[600];
+	char config[2048];
 	/* Isolated (each run in a forked child) as a sweep runs, except under
 	 * TSan: it kills a child of bvhlab's (multi-threaded) process that
 	 * starts threads, as PoCL does ("starting new threads after
@@ -174,16 +199,7 @@ static cJSON *run_rays(const char *name, const char *rays, int want_rc)
 	         "  \"scenes\": [ { \"name\": \"ico\", \"generator\": \"icosphere\", \"frequency\": 4 } ],\n"
 	         "  \"builders\": [ { \"plugin\": \"sah_seq\" } ] }\n", name,
 	         UNDER_TSAN ? "false" : "true", rays);
-	snprintf(out, sizeof(out), "%s.json", name);
-	char *path = write_config(out, config);
-	int rc = run(ARGS("run", path, "--quiet"));
-	if (rc != want_rc)
-		fprintf(stderr, "%s: %s", name, err_text);
-	CHECK_INT(rc, want_rc);
-	if (want_rc == 2)
-		return NULL;
-	snprintf(out, sizeof(out), "%s/%s", tmpdir, name);
-	return load_results(out);
+	return run_config(name, config, want_rc);
 }
 
 static const cJSON *first_rays(const cJSON *doc)
@@ -226,6 +242,48 @@ static void errors_mode(void)
 	unsetenv("OCL_ICD_VENDORS");
 }
 
+/* A two-level scene (20 instances of one sphere) with this "rays" object
+ * (its main traversal "stack", the others any); its run's rays. */
+static cJSON *run_two_level(const char *name, const char *traversals)
+{
+	char config[2048];
+	snprintf(config, sizeof(config),
+	         "{ \"format_version\": 1, \"output\": \"%s\", \"repeat\": 1, \"threads\": [1],\n"
+	         "  \"isolate\": %s, \"rays\": { \"width\": 16, \"height\": 16, \"min_ms\": 1,\n"
+	         "    \"traversal\": [\"stack\", %s] },\n"
+	         "  \"scenes\": [ { \"name\": \"grove\", \"meshes\": [ { \"name\": \"ball\",\n"
+	         "    \"generator\": \"icosphere\", \"frequency\": 2 } ], \"instances\": [\n"
+	         "    { \"scatter\": { \"mesh\": \"ball\", \"count\": 20, \"seed\": 3,\n"
+	         "      \"bounds\": [[-5, 0, -5], [5, 1, 5]], \"scale\": [0.5, 1.5],\n"
+	         "      \"rotate\": \"random-y\" } } ] } ],\n"
+	         "  \"builders\": [ { \"bottom\": \"sah_seq\", \"top\": \"lbvh\" } ] }\n", name,
+	         UNDER_TSAN ? "false" : "true", traversals);
+	return run_config(name, config, 0);
+}
+
+/* Two-level runs trace with the device traversals too: the same hits as
+ * the CPU's, the same nodes entered as the CPU stack and stackless
+ * traversals'; with no OpenCL platform the run is ok and says why. */
+static void two_level_mode(void)
+{
+	cJSON *doc = run_two_level("inst", "\"stackless\", {\"name\": \"stack\", \"device\": true}, "
+	                           "{\"name\": \"stackless\", \"device\": true}, "
+	                           "{\"name\": \"wide8\", \"device\": true}");
+	const cJSON *run = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
+	check_run_kinds(run, 1);
+	CHECK(num(run, "primary", "rays", NULL) == 256);
+	cJSON_Delete(doc);
+	setenv("OCL_ICD_VENDORS", "/nonexistent-bvhlab-vendors", 1);
+	doc = run_two_level("inst-noplat", "{\"name\": \"stack\", \"device\": true}");
+	run = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "runs"), 0);
+	const cJSON *rays = first_rays(doc);
+	CHECK(cJSON_GetObjectItem(rays, "device_stack") == NULL);
+	CHECK(num(run, "primary", "rays", NULL) == 256);
+	CHECK_CONTAINS(run_str(rays, "error"), "device_stack: cl: no OpenCL platform found");
+	cJSON_Delete(doc);
+	unsetenv("OCL_ICD_VENDORS");
+}
+
 /* info --machine names the device the layer picks for "auto". */
 static void info_mode(const char *device)
 {
@@ -257,6 +315,7 @@ int main(int argc, char **argv)
 		trace_mode();
 	} else if (strcmp(argv[2], "errors") == 0) {
 		errors_mode();
+		two_level_mode();
 		info_mode(device);
 	} else {
 		return 99;
