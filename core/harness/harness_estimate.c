@@ -93,16 +93,39 @@ static uint64_t after_per_prim(const struct config *cfg, const struct harness_bu
 	return tree + (trace > CHECKS_PER_PRIM ? trace : CHECKS_PER_PRIM);
 }
 
+/* e's limit (the builder's or the config's memory_limit_mb, else the memory
+ * available plus the scene's arrays, resident already: taken out of what is
+ * available); whether e->bytes exceeds a known one. */
+static bool over_limit(const struct config *cfg, const struct harness_builder *hb,
+                       struct memory_estimate *e)
+{
+	uint64_t mb = hb->cb->memory_limit_mb ? hb->cb->memory_limit_mb : cfg->memory_limit_mb;
+	e->limit_from_config = mb != 0;
+	if (mb) {
+		e->limit_bytes = mb << 20;
+	} else {
+		uint64_t available = machine_memory_available();
+		e->limit_bytes = available ? available + e->scene_bytes : 0;
+	}
+	e->known = e->limit_bytes != 0;
+	return e->known && e->bytes > e->limit_bytes;
+}
+
+/* What a refused run was held against, for its message. */
+static void limit_text(const struct memory_estimate *e, char *buf, size_t size)
+{
+	if (e->limit_from_config)
+		snprintf(buf, size, "memory_limit_mb = %llu", (unsigned long long)(e->limit_bytes >> 20));
+	else
+		snprintf(buf, size, "the memory available (%.0f MiB, memory_limit_mb unset)",
+		         (double)e->limit_bytes / MIB);
+}
+
 static void describe(const struct memory_estimate *e, const char *scene,
                      const struct harness_builder *hb, uint32_t prims, char *why, size_t size)
 {
 	char limit[96];
-	if (e->limit_from_config)
-		snprintf(limit, sizeof(limit), "memory_limit_mb = %llu",
-		         (unsigned long long)(e->limit_bytes >> 20));
-	else
-		snprintf(limit, sizeof(limit), "the memory available (%.0f MiB, memory_limit_mb "
-		         "unset)", (double)e->limit_bytes / MIB);
+	limit_text(e, limit, sizeof(limit));
 	uint64_t most = e->bytes_per_prim > e->after_bytes_per_prim ? e->bytes_per_prim
 	                                                            : e->after_bytes_per_prim;
 	snprintf(why, size, "scene '%s', builder '%s': refused before building: estimated peak "
@@ -119,23 +142,13 @@ int harness_estimate_run(const struct config *cfg, const struct harness_builder 
                          const char *scene, const bvhlab_build_input *in, bool frames,
                          struct memory_estimate *e, char *why, size_t size)
 {
-	uint64_t mb = hb->cb->memory_limit_mb ? hb->cb->memory_limit_mb : cfg->memory_limit_mb;
 	*e = (struct memory_estimate){.scene_bytes = harness_memory_scene_bytes(in)};
 	e->bytes_per_prim = per_prim(hb, &e->declared);
 	e->after_bytes_per_prim = after_per_prim(cfg, hb, e->bytes_per_prim, frames);
 	uint64_t most = e->bytes_per_prim > e->after_bytes_per_prim ? e->bytes_per_prim
 	                                                            : e->after_bytes_per_prim;
 	e->bytes = e->scene_bytes + most * in->prim_count;
-	e->limit_from_config = mb != 0;
-	if (mb) {
-		e->limit_bytes = mb << 20;
-	} else {
-		uint64_t available = machine_memory_available();
-		/* The scene is resident already: it was taken out of what is available. */
-		e->limit_bytes = available ? available + e->scene_bytes : 0;
-	}
-	e->known = e->limit_bytes != 0;
-	if (!e->known || e->bytes <= e->limit_bytes)
+	if (!over_limit(cfg, hb, e))
 		return 0;
 	describe(e, scene, hb, in->prim_count, why, size);
 	return -E2BIG;
@@ -171,12 +184,7 @@ static void describe_two_level(const struct memory_estimate *e, const char *scen
                                uint64_t top_declared, char *why, size_t size)
 {
 	char limit[96];
-	if (e->limit_from_config)
-		snprintf(limit, sizeof(limit), "memory_limit_mb = %llu",
-		         (unsigned long long)(e->limit_bytes >> 20));
-	else
-		snprintf(limit, sizeof(limit), "the memory available (%.0f MiB, memory_limit_mb "
-		         "unset)", (double)e->limit_bytes / MIB);
+	limit_text(e, limit, sizeof(limit));
 	snprintf(why, size, "scene '%s', builder '%s': refused before building: estimated peak "
 	         "%.0f MiB (the meshes' and instances' %.0f MiB + %llu unique triangles x %llu "
 	         "bytes, the bottom builds' %llu (%s) and validation and tracing's %llu, + %llu "
@@ -195,7 +203,6 @@ int harness_estimate_two_level(const struct config *cfg, const struct harness_bu
                                const char *scene, const struct scene_instanced *inst,
                                struct memory_estimate *e, char *why, size_t size)
 {
-	uint64_t mb = hb->cb->memory_limit_mb ? hb->cb->memory_limit_mb : cfg->memory_limit_mb;
 	uint64_t unique = scene_instanced_unique_triangles(inst), trace;
 	bool top_declared;
 	uint64_t top = bvhlab_builder_peak_bytes_per_prim(bvhlab_plugin_builder(hb->top.plugin),
@@ -209,16 +216,7 @@ int harness_estimate_two_level(const struct config *cfg, const struct harness_bu
 	e->top_bytes_per_instance = top + TOP_INPUT_PER_INSTANCE + TOP_TRACE_PER_INSTANCE;
 	e->bytes = e->scene_bytes + (e->bytes_per_prim + e->after_bytes_per_prim) * unique +
 	           e->top_bytes_per_instance * e->instances;
-	e->limit_from_config = mb != 0;
-	if (mb) {
-		e->limit_bytes = mb << 20;
-	} else {
-		uint64_t available = machine_memory_available();
-		/* The meshes and instances are resident already. */
-		e->limit_bytes = available ? available + e->scene_bytes : 0;
-	}
-	e->known = e->limit_bytes != 0;
-	if (!e->known || e->bytes <= e->limit_bytes)
+	if (!over_limit(cfg, hb, e))
 		return 0;
 	describe_two_level(e, scene, hb, unique, top, why, size);
 	return -E2BIG;
