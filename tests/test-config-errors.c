@@ -68,7 +68,7 @@ static void test_unknown_keys(void)
 	             3, 22,
 	             "unknown key 'threds' in builders[1] (known: plugin, name, threads, "
 	             "timeout_s, memory_limit_mb, options, optional, refine, animation, bottom, "
-	             "top, top_options); did you mean 'threads'?");
+	             "top, top_options, scenes); did you mean 'threads'?");
 	t = "{ " SCENES ", " BUILDERS ", \"rays\": { \"widht\": 8 } }";
 	EXPECT_ERROR_AT(t, "\"widht\"", 0, "unknown key 'widht' in rays (known: width, height, "
 	                "diffuse, camera, threads, min_ms, rounds, traversal, device, kinds, light, "

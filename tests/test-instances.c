@@ -160,6 +160,31 @@ static void test_builder_errors(void)
 	config_finish(&cfg);
 }
 
+/* Beside a one-level scene, a two-level builder whose "scenes" leaves it
+ * out is fine, and so is an animation beside a static scene it does not
+ * run on; config_builder_runs_on answers for each pair, grids alike. */
+static void test_builder_scenes(void)
+{
+	char text[4096];
+	struct config cfg;
+	bvhlab_error err = { "" };
+	snprintf(text, sizeof(text), "{ \"scenes\": [ { \"name\": \"g\", %s }, { \"generator\": "
+	         "\"soup\" }, { \"name\": \"moving\", \"generator\": \"soup\", \"frames\": 3 } ], "
+	         "\"builders\": [ { \"top\": \"lbvh\", \"bottom\": \"ploc\", \"scenes\": [\"g\"] },"
+	         " { \"plugin\": \"lbvh\", \"scenes\": [\"soup\", \"moving\"],"
+	         "   \"options\": { \"max_leaf\": { \"grid\": [2, 4] } } },"
+	         " { \"plugin\": \"lbvh\", \"name\": \"refitted\", \"scenes\": [\"moving\"],"
+	         "   \"animation\": { \"update\": \"refit\" } } ] }", ok_scene);
+	CHECK_INT(config_parse(&cfg, "/cfg/c.json", text, &err), 0);
+	static const bool runs[4][3] = {{true, false, false}, {false, true, true},
+	                                {false, true, true}, {false, false, true}};
+	CHECK_INT(cfg.builder_count, 4);
+	for (size_t b = 0; b < 4 && b < cfg.builder_count; b++)
+		for (size_t s = 0; s < 3; s++)
+			CHECK(config_builder_runs_on(&cfg.builders[b], &cfg.scenes[s]) == runs[b][s]);
+	config_finish(&cfg);
+}
+
 static double xf_of(const struct scene_instanced *s, uint32_t i, int k)
 {
 	return s->instances[i].xf[k];
@@ -405,6 +430,7 @@ int main(void)
 	test_parse();
 	test_errors();
 	test_builder_errors();
+	test_builder_scenes();
 	test_scene();
 	test_inverse();
 	test_load_error();

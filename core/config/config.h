@@ -154,6 +154,9 @@ struct config_builder {
 	/* An option grid's builder (config_grid.c): the value it takes of each grid. */
 	struct config_grid_pick *picks;
 	size_t pick_count;
+	/* "scenes" (config_filter.c): the names of the scenes it runs on, each
+	 * one of the config's, an array owned by root; NULL: every scene. */
+	const struct cJSON *scenes;
 };
 
 /* One option of a grid builder: {"grid": [...]} under member, value the chosen element. */
@@ -277,6 +280,11 @@ int config_apply_anim_refine_options(const struct config *cfg, const struct conf
  */
 void config_locate_builder_error(const struct config *cfg, const struct config_builder *b,
                                  size_t stage, bvhlab_error *err);
+
+/* Whether builder b runs on scene sc: its "scenes" names it, or it has
+ * none (config_filter.c). The run list (plan_runs.c) asks, and nothing
+ * else decides it. */
+bool config_builder_runs_on(const struct config_builder *b, const struct config_scene *sc);
 
 /* Replaces the thread list (command line --threads). */
 int config_set_threads(struct config *cfg, const uint32_t *threads, size_t count);

@@ -262,18 +262,19 @@ static int anim_body(struct config *cfg, const cJSON *item, size_t index,
 	return rc == -ENOMEM ? out_of_memory(cfg, err) : rc;
 }
 
-/* An animation meets every scene of the config: on a static one it would
- * be ignored, silently, unless the config says that is meant. */
-static int static_scenes(struct config *cfg, const cJSON *item, size_t index,
-                         const struct config_animation *a, bvhlab_error *err)
+int config_check_static_scenes(struct config *cfg, const cJSON *obj, size_t index,
+                               const struct config_builder *b, bvhlab_error *err)
 {
-	for (size_t s = 0; !a->allow_static && s < cfg->scene_count; s++)
-		if (!cfg->scenes[s].frames)
+	const struct config_animation *a = b->animation;
+	const cJSON *item = config_member(obj, "animation");
+	for (size_t s = 0; a && !a->allow_static && s < cfg->scene_count; s++)
+		if (!cfg->scenes[s].frames && config_builder_runs_on(b, &cfg->scenes[s]))
 			return config_error(cfg, item, false, err, "'builders[%zu].animation': scene "
 			                    "'%s' (scenes[%zu]) is static (no 'frames'), where the "
-			                    "animation would be ignored: give the scene 'frames', or set "
-			                    "\"allow_static\": true to run this builder on static scenes "
-			                    "as a plain build", index, cfg->scenes[s].name, s);
+			                    "animation would be ignored: give the scene 'frames', leave "
+			                    "it out of the builder's \"scenes\", or set \"allow_static\": "
+			                    "true to run this builder on static scenes as a plain build",
+			                    index, cfg->scenes[s].name, s);
 	return 0;
 }
 
@@ -299,8 +300,6 @@ int config_parse_animation(struct config *cfg, const cJSON *obj, size_t index,
 		rc = config_error(cfg, config_member(item, "refine"), true, err,
 		                  "'builders[%zu].animation.refine': a two-level builder's top is "
 		                  "rebuilt or updated without refinement stages (not yet)", index);
-	if (!rc)
-		rc = static_scenes(cfg, item, index, a, err);
 	if (!rc && !config_member(obj, "name") && anim_name(b, a, stage_names) < 0)
 		rc = out_of_memory(cfg, err);
 	free(stage_names);

@@ -289,11 +289,6 @@ static int two_level(struct config *cfg, const cJSON *obj, const char *prefix,
 			return config_error(cfg, other, true, err, "'%s%s' does not apply to a "
 			                    "two-level builder ('bottom' and 'top')%s", prefix,
 			                    not_with[k], k ? " yet" : ": 'bottom' is its plugin");
-	for (size_t k = 0; k < cfg->scene_count; k++)
-		if (!cfg->scenes[k].meshes)
-			return config_error(cfg, bottom, true, err, "'%sbottom': a two-level builder "
-			                    "runs on two-level scenes only, and scene '%s' has no "
-			                    "'instances'", prefix, cfg->scenes[k].name);
 	if (!(b->plugin = strdup(bottom->valuestring)))
 		return out_of_memory(cfg, err);
 	if (!b->name) {
@@ -345,6 +340,10 @@ static int parse_builder(struct config *cfg, const cJSON *obj, size_t index,
 		rc = config_parse_refine(cfg, obj, index, b, err);
 	if (!rc)
 		rc = config_parse_animation(cfg, obj, index, b, err);
+	if (!rc) /* its name final: config_filter.c */
+		rc = config_parse_builder_scenes(cfg, obj, index, b, err);
+	if (!rc)
+		rc = config_check_static_scenes(cfg, obj, index, b, err);
 	return rc;
 }
 

@@ -182,5 +182,16 @@ int config_apply_stage_options(const struct config *cfg, const struct config_bui
 int config_parse_animation(struct config *cfg, const cJSON *obj, size_t index,
                            struct config_builder *b, bvhlab_error *err);
 void config_anim_finish(struct config *cfg);
+/* An animation on a static scene the builder runs on would be ignored,
+ * silently: an error unless its "allow_static" says that is meant. After
+ * the builder's "scenes" (config_parse_builder_scenes). */
+int config_check_static_scenes(struct config *cfg, const cJSON *obj, size_t index,
+                               const struct config_builder *b, bvhlab_error *err);
+/* builders[index]'s "scenes" (config_filter.c): a non-empty array of the
+ * config's scene names, none twice, into b->scenes; then a two-level
+ * builder's scenes must all be two-level. After the builder's name is
+ * final, which its messages use. */
+int config_parse_builder_scenes(struct config *cfg, const cJSON *obj, size_t index,
+                                struct config_builder *b, bvhlab_error *err);
 
 #endif /* BVHLAB_CORE_CONFIG_INTERNAL_H */

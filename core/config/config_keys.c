@@ -171,6 +171,7 @@ const struct config_key config_builder_keys[] = {
 	CUSTOM("bottom"), /* a two-level builder: config_entries.c */
 	BUILDER("top", CONFIG_STRING, top, 0, 0),
 	CUSTOM("top_options"),
+	CUSTOM("scenes"), /* the scenes it runs on: config_filter.c */
 	END,
 };
 

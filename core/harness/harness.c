@@ -368,12 +368,13 @@ static void run_one(struct harness *h, struct series_job *job)
 	if (skip_run(h, pr))
 		return;
 	struct memory_estimate est;
-	char refused[512];
-	/* The estimates are of one-level builds: a two-level one has none yet. */
-	run.estimate = job->hb->top.plugin ? NULL : &est;
-	if (run.estimate && harness_estimate_run(h->cfg, job->hb, scene, &job->prims->input,
-	                                         h->anim.frames != 0, &est, refused,
-	                                         sizeof(refused)) < 0) {
+	char refused[640];
+	run.estimate = &est;
+	if ((job->hb->top.plugin
+	     ? harness_estimate_two_level(h->cfg, job->hb, scene, &h->inst, &est, refused,
+	                                  sizeof(refused))
+	     : harness_estimate_run(h->cfg, job->hb, scene, &job->prims->input,
+	                            h->anim.frames != 0, &est, refused, sizeof(refused))) < 0) {
 		run.error = refused; /* nothing built: the sweep goes on */
 		record(h, &run);
 		return;

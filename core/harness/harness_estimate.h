@@ -26,4 +26,19 @@ int harness_estimate_run(const struct config *cfg, const struct harness_builder 
                          const char *scene, const bvhlab_build_input *in, bool frames,
                          struct memory_estimate *e, char *why, size_t size);
 
+struct scene_instanced; /* scene/instances.h */
+/*
+ * The same for a two-level run of builder hb over inst: the meshes' and
+ * instances' arrays, per unique triangle the bottom build's declaration
+ * (every bottom tree is held as built) plus validation's or tracing's
+ * copies, per instance the top build's declaration plus its input and
+ * tracing's (harness_estimate.c). *e's bytes_per_prim and
+ * after_bytes_per_prim are per unique triangle; instances and
+ * top_bytes_per_instance are set. 0, or -E2BIG with `why` naming scene,
+ * builder, the estimate's parts and the limit.
+ */
+int harness_estimate_two_level(const struct config *cfg, const struct harness_builder *hb,
+                               const char *scene, const struct scene_instanced *inst,
+                               struct memory_estimate *e, char *why, size_t size);
+
 #endif

@@ -47,8 +47,10 @@ size_t harness_scene_images(struct results *res, const struct config *cfg,
 	size_t lost = 0;
 	if (!heat_runs)
 		return fprintf(stderr, "bvhlab: images of scene '%s': out of memory\n", scene->name), 1;
-	for (size_t b = 0; b < nb; b++)
-		heat_runs[b] = &plan_list_first(list, s, b)->key;
+	for (size_t b = 0; b < nb; b++) { /* NULL: the builder does not run on the scene */
+		const struct plan_run *run = plan_list_first(list, s, b);
+		heat_runs[b] = run ? &run->key : NULL;
+	}
 	struct scene_images si = {.dir = cfg->output, .scene_index = s, .scene = scene->name,
 	                          .width = cfg->ray_width, .height = cfg->ray_height,
 	                          .heat_runs = heat_runs, .builder_count = nb};

@@ -17,6 +17,7 @@
 #include "harness/harness_memory.h"
 #include "machine/machine.h"
 #include "output/results.h"
+#include "scene/instances.h"
 
 /* A "Name:   123 kB" line of /proc/self/status, in bytes; 0 if absent. */
 static uint64_t status_bytes(const char *name)
@@ -46,11 +47,29 @@ uint64_t harness_memory_scene_bytes(const bvhlab_build_input *in)
 	return (uint64_t)in->vertex_count * 3 * sizeof(float) + per_prim * in->prim_count;
 }
 
+uint64_t harness_memory_instanced_bytes(const struct scene_instanced *inst)
+{
+	uint64_t bytes = (uint64_t)inst->instance_count * sizeof(struct scene_instance);
+	for (uint32_t m = 0; m < inst->mesh_count; m++) {
+		const bvhlab_scene *mesh = inst->meshes[m];
+		bvhlab_build_input in = {.vertex_count = mesh->vertex_count,
+		                         .prim_count = mesh->triangle_count,
+		                         .indices = mesh->indices};
+		bytes += harness_memory_scene_bytes(&in);
+	}
+	return bytes;
+}
+
 void harness_memory_begin(struct build_memory *m, const bvhlab_build_input *in)
+{
+	harness_memory_begin_bytes(m, harness_memory_scene_bytes(in));
+}
+
+void harness_memory_begin_bytes(struct build_memory *m, uint64_t scene_bytes)
 {
 	FILE *f = fopen("/proc/self/clear_refs", "w");
 	memset(m, 0, sizeof(*m));
-	m->scene_bytes = harness_memory_scene_bytes(in);
+	m->scene_bytes = scene_bytes;
 	/* Without the reset the peak may predate the builds; then the growth
 	 * is not known and is left at 0 (peak_rss still tells the peak). */
 	m->reset = f && fputs("5", f) >= 0;
@@ -62,11 +81,16 @@ void harness_memory_begin(struct build_memory *m, const bvhlab_build_input *in)
 void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree)
 {
 	m->peak_rss_bytes = status_bytes("VmHWM");
-	m->output_bytes = (uint64_t)tree->node_capacity * sizeof(bvhlab_node) +
-	                  (uint64_t)tree->index_capacity * sizeof(uint32_t);
+	m->output_bytes = harness_memory_tree_bytes(tree);
 	if (m->reset && m->peak_rss_bytes > m->start_rss_bytes)
 		m->peak_bytes = m->peak_rss_bytes - m->start_rss_bytes;
 	m->measured = m->peak_rss_bytes > 0;
+}
+
+uint64_t harness_memory_tree_bytes(const bvhlab_tree *tree)
+{
+	return (uint64_t)tree->node_capacity * sizeof(bvhlab_node) +
+	       (uint64_t)tree->index_capacity * sizeof(uint32_t);
 }
 
 void harness_memory_run_end(struct build_memory *m)

@@ -9,7 +9,11 @@ struct build_memory; /* output/results.h */
 /* Before the first build (warm-up included), and after the last one;
  * in is the run's input (its scene's share is recorded). */
 void harness_memory_begin(struct build_memory *m, const bvhlab_build_input *in);
+/* The same with the scene's share given (a two-level scene's, below). */
+void harness_memory_begin_bytes(struct build_memory *m, uint64_t scene_bytes);
 void harness_memory_end(struct build_memory *m, const bvhlab_tree *tree);
+/* The output buffers the host allocated for a tree, capacity. */
+uint64_t harness_memory_tree_bytes(const bvhlab_tree *tree);
 /* After validation and tracing: the run's peak over all of it. */
 void harness_memory_run_end(struct build_memory *m);
 
@@ -19,6 +23,10 @@ void harness_memory_run_end(struct build_memory *m);
  * scene holds whatever the builder, so per-triangle figures can state it.
  */
 uint64_t harness_memory_scene_bytes(const bvhlab_build_input *in);
+struct scene_instanced; /* scene/instances.h */
+/* A two-level scene's: each mesh's as above, and the instances' records
+ * (placement and inverse). */
+uint64_t harness_memory_instanced_bytes(const struct scene_instanced *inst);
 
 struct run_device; /* output/results.h */
 

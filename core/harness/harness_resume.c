@@ -95,8 +95,8 @@ int harness_resume(struct results *res, const struct run_list *list, bool quiet,
 		        kept - gone - changed, plural(kept - gone - changed));
 	if (!quiet && gone)
 		fprintf(stderr, "bvhlab: %zu run%s dropped: made at a thread count its builder no "
-		        "longer runs at (its threads changed, or its plugin was not known then)\n",
-		        gone, plural(gone));
+		        "longer runs at, or on a scene it no longer runs on (its threads or "
+		        "\"scenes\" changed, or its plugin was not known then)\n", gone, plural(gone));
 	if (!quiet && changed)
 		say_changes(&why, changed);
 	return 0;

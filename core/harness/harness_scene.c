@@ -107,11 +107,14 @@ static void probe_work(void *arg, void *report, size_t size)
 	snprintf(rep->error, sizeof(rep->error), "%s", err.message);
 }
 
-/* The largest memory limit any builder runs under; 0 when one has none. */
-static uint64_t largest_limit_mb(const struct config *cfg)
+/* The largest memory limit any builder of the scene runs under; 0 when
+ * one has none. */
+static uint64_t largest_limit_mb(const struct config *cfg, const struct config_scene *cs)
 {
 	uint64_t most = 0;
 	for (size_t b = 0; b < cfg->builder_count; b++) {
+		if (!config_builder_runs_on(&cfg->builders[b], cs))
+			continue;
 		uint64_t mb = cfg->builders[b].memory_limit_mb ? cfg->builders[b].memory_limit_mb
 		                                                : cfg->memory_limit_mb;
 		if (mb == 0)
@@ -126,7 +129,7 @@ int harness_probe_scene(const struct config *cfg, const struct config_scene *cs,
 {
 	struct scene_probe rep = {0};
 	char why[sizeof(rep.error)] = "", limit[64] = "";
-	uint64_t mb = largest_limit_mb(cfg);
+	uint64_t mb = largest_limit_mb(cfg, cs);
 	struct isolate_limits limits = {.timeout_s = cfg->timeout_s, .memory_bytes = mb << 20};
 	struct probe_job job = {.cs = cs, .whole = mb != 0};
 	int outcome = isolate_call(probe_work, &job, &rep, sizeof(rep), &limits, why,

@@ -12,6 +12,7 @@
 
 #include "harness/harness_rays.h"
 #include "harness/harness_anim_top.h"
+#include "harness/harness_memory.h"
 #include "harness/harness_report.h"
 #include "harness/harness_series.h"
 #include "harness/harness_two_level.h"
@@ -268,8 +269,15 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
 	                            .threads = threads,
 	                            .validate_rays = cfg->validate ? cfg->validate_rays : 0};
 	struct two_level_trees trees;
+	/* Its memory: the builds and their validation (interleaved, mesh by
+	 * mesh), then tracing and frames; the meshes and instances are the
+	 * scene's share. */
+	harness_memory_begin_bytes(&rep->memory, harness_memory_instanced_bytes(inst));
 	enum tree_verdict v = harness_two_level_series(&job, rep->samples, &rep->cold_ms, &rep->tree,
 	                                               &rep->two_level, &trees, err);
+	harness_memory_end(&rep->memory, &trees.top);
+	for (uint32_t m = 0; m < trees.mesh_count; m++)
+		rep->memory.output_bytes += harness_memory_tree_bytes(&trees.bottom[m]);
 	rep->sample_count = v == TREE_OK ? cfg->repeat : 0;
 	rep->validated = v != TREE_FAILED;
 	rep->phase_count = trees.phase_count;
@@ -279,6 +287,7 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
 	/* An animated scene's frames, on these trees (harness_anim_top.c). */
 	int f = v != TREE_OK ? 0 : harness_anim_top_frames(cfg, hb, anim, &trees, threads, rep, err);
 	v = f > 0 ? TREE_INVALID : f < 0 ? TREE_FAILED : v;
+	harness_memory_run_end(&rep->memory);
 	harness_two_level_finish(&trees);
 	return v;
 }

@@ -176,7 +176,8 @@ static int load_heat(const struct scene_images *si, uint32_t **heat, uint32_t *l
 	for (size_t b = 0; b < si->builder_count; b++) {
 		bvhlab_error e = {{0}};
 		heat[b] = NULL;
-		if (images_temp_path(path, sizeof(path), si->dir, "heat", si->scene_index, b) < 0)
+		if (!si->heat_runs[b] || /* the builder does not run on the scene */
+		    images_temp_path(path, sizeof(path), si->dir, "heat", si->scene_index, b) < 0)
 			continue;
 		uint32_t *counts = malloc(n * sizeof(*counts));
 		int k = counts ? load_raw(path, counts, n * sizeof(*counts), &e)

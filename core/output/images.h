@@ -29,7 +29,8 @@ struct scene_images {
 	const char *scene;
 	uint32_t width, height;
 	/* [builder_count], by config index: the run that drew each heat map
-	 * (each builder's first of the scene, from the run list) */
+	 * (each builder's first of the scene, from the run list; NULL for a
+	 * builder that does not run on the scene) */
 	const struct run_identity *const *heat_runs;
 	size_t builder_count;
 };

@@ -24,10 +24,11 @@ static const char *const columns[][2] = {
 static const char levels_intro[] =
 	"Two-level builds (docs/instances.md): bottom build ms summed over the meshes (each "
 	"mesh's median), top over the instances' boxes; SAH: the bottom trees' mean, the "
-	"top's, and the two-level SAH of the whole.";
+	"top's, and the two-level SAH of the whole; peak MiB: the run's child's peak resident "
+	"set (builds, validation, tracing; memory.run_peak_rss_bytes).";
 static const char *const levels_heads[] = {
 	"builder", "threads", "bottom", "top", "bottom ms", "top ms", "sum ms", "meshes",
-	"bottom nodes", "top nodes", "bottom SAH", "top SAH", "two-level SAH"};
+	"bottom nodes", "top nodes", "bottom SAH", "top SAH", "two-level SAH", "peak MiB"};
 
 static const char flat_intro[] =
 	"Two-level against flat: each two-level run beside the flattened scene's run of its "
@@ -66,6 +67,7 @@ static void levels_row(const struct table_format *f, struct strbuf *sb, const cJ
 	f->cell(sb, report_str(t, "top.plugin"));
 	for (size_t k = 0; k < COLUMNS; k++)
 		cell_num(f, sb, columns[k][1], report_num(t, columns[k][0]));
+	cell_num(f, sb, "%.1f", report_num(run, "memory.run_peak_rss_bytes") / 1048576.0);
 	f->row_end(sb);
 }
 

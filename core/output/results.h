@@ -136,6 +136,11 @@ struct memory_estimate {
 	uint64_t after_bytes_per_prim; /* the tree, validation and tracing after the builds
 	                                * (harness_estimate.c) */
 	uint64_t limit_bytes;   /* what it was held against */
+	/* A two-level run's (harness_estimate_two_level): its instances and the
+	 * bytes each adds (top build, input, tracing); bytes_per_prim and
+	 * after_bytes_per_prim are then per unique triangle. 0: one-level. */
+	uint64_t instances;
+	uint64_t top_bytes_per_instance;
 };
 
 /* The device a device builder's run built on (BVHLAB_BUILDER_DEVICE) and

@@ -44,16 +44,19 @@ static const char *string_of(const cJSON *run, const char *key)
 	return cJSON_IsString(v) ? v->valuestring : NULL;
 }
 
-/* A run of a scene and builder the sweep has, at a thread count it no
- * longer makes: the config's threads changed, or the builder's plugin
- * could not be probed then (every thread count) and is serial now. */
+/* A run of a scene and a builder the sweep has, in a slot it no longer
+ * makes: the config's threads changed, the builder's plugin could not be
+ * probed then (every thread count) and is serial now, or its "scenes" no
+ * longer names the scene. */
 static bool slot_gone(const struct run_identity *keys, size_t count, const cJSON *run)
 {
 	const char *scene = string_of(run, "scene"), *builder = string_of(run, "builder");
-	for (size_t k = 0; scene && builder && k < count; k++)
-		if (!strcmp(keys[k].scene, scene) && !strcmp(keys[k].builder, builder))
-			return true;
-	return false;
+	bool scene_known = false, builder_known = false;
+	for (size_t k = 0; scene && builder && k < count; k++) {
+		scene_known = scene_known || !strcmp(keys[k].scene, scene);
+		builder_known = builder_known || !strcmp(keys[k].builder, builder);
+	}
+	return scene_known && builder_known;
 }
 
 static bool is_count(const cJSON *v, double max)

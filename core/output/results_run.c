@@ -93,6 +93,10 @@ static cJSON *estimate_json(const struct memory_estimate *e)
 	};
 	results_add_numbers(o, bytes, RESULTS_NUMBERS(bytes));
 	cJSON_AddBoolToObject(o, "declared", e->declared);
+	if (e->instances) { /* a two-level run's: per unique triangle above */
+		cJSON_AddNumberToObject(o, "instances", (double)e->instances);
+		cJSON_AddNumberToObject(o, "top_bytes_per_instance", (double)e->top_bytes_per_instance);
+	}
 	if (e->known)
 		cJSON_AddNumberToObject(o, "limit_bytes", (double)e->limit_bytes);
 	cJSON_AddStringToObject(o, "limit", !e->known ? "unknown"
@@ -220,7 +224,10 @@ cJSON *results_run_json(const struct run_record *run)
 	if (run->stats && run->epo)
 		cJSON_AddNumberToObject(cJSON_GetObjectItem(o, "tree"), "epo", *run->epo);
 	if (run->memory)
-		cJSON_AddItemToObject(o, "memory", memory_json(run->memory, run->triangles));
+		/* A two-level run's triangles are instanced (clipped past 2^32 - 1):
+		 * its memory has totals only. */
+		cJSON_AddItemToObject(o, "memory", memory_json(run->memory,
+		                                                run->two_level ? 0 : run->triangles));
 	if (run->estimate)
 		cJSON_AddItemToObject(o, "memory_estimate", estimate_json(run->estimate));
 	if (run->device) /* after "memory", which it adds to */

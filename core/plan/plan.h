@@ -4,7 +4,8 @@
  * results folders of a plan's parts into one.
  *
  * A run's id is its position in the run list, the order `bvhlab run`
- * takes the runs: scenes outermost, then builders (grids expanded), then
+ * takes the runs: scenes outermost, then the builders that run on the
+ * scene (grids expanded; a builder's "scenes" may leave it out), then
  * the builder's thread counts as configured, one for a serial builder. Ids
  * depend on the config and the builders' PARALLEL flags, never on the
  * machine's thread count.
@@ -79,8 +80,9 @@ const uint32_t *plan_builder_threads(const struct config *cfg, const struct conf
  */
 int plan_check_threads(const struct config *cfg, bvhlab_error *err);
 /*
- * The config's runs, made once: scenes outermost, then builders (grids
- * expanded), then the builder's thread counts as configured, ids from 0 in
+ * The config's runs, made once: scenes outermost, then the builders that
+ * run on the scene (config_builder_runs_on; grids expanded), then the
+ * builder's thread counts as configured, ids from 0 in
  * that order. Thread counts are resolved here and nowhere else (0 becomes
  * this machine's hardware threads; plan_check_threads first). A builder
  * with `serial` runs once per scene, at the first of its counts that
@@ -99,7 +101,7 @@ void plan_identity_finish(struct run_list *list);
 /* The run of scene x builder at its configured thread index, or NULL. */
 const struct plan_run *plan_list_find(const struct run_list *list, size_t scene,
                                       size_t builder, size_t thread_index);
-/* A builder's first run in scene s, or NULL. */
+/* A builder's first run in scene s, or NULL (it does not run on s). */
 const struct plan_run *plan_list_first(const struct run_list *list, size_t scene,
                                        size_t builder);
 

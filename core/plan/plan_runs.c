@@ -73,7 +73,8 @@ static bool listed(const struct plan_threads *t, size_t k)
 	return !t->serial || k == t->first;
 }
 
-/* Every builder's runs of scene s, appended to the list. */
+/* The runs of scene s of every builder that runs on it ("scenes"),
+ * appended to the list. */
 static void add_scene(struct run_list *list, size_t s, const struct plan_builder *builders)
 {
 	const struct config *cfg = list->cfg;
@@ -81,7 +82,7 @@ static void add_scene(struct run_list *list, size_t s, const struct plan_builder
 	for (size_t b = 0; b < cfg->builder_count; b++) {
 		const struct plan_threads *t = &list->threads[b];
 		for (size_t k = 0; k < t->count; k++) {
-			if (!listed(t, k))
+			if (!listed(t, k) || !config_builder_runs_on(&cfg->builders[b], &cfg->scenes[s]))
 				continue;
 			struct plan_run *run = &list->runs[list->count];
 			*run = (struct plan_run){.scene = s, .builder = b, .threads = t->configured[k]};
