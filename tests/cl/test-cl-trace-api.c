@@ -21,6 +21,7 @@
 #include <bvhlab/trace.h>
 
 #include "../testutil.h"
+#include "cl_device.h"
 #include "trace/trace_series.h"
 
 #define CHAIN 300
@@ -176,13 +177,8 @@ static void errors(void)
 
 int main(void)
 {
-	bvhlab_cl cl = {0};
-	char why[BVHLAB_CL_ERROR_SIZE];
-	if (bvhlab_cl_init(&cl, "auto", why, sizeof(why)) < 0) {
-		printf("skipped: no OpenCL device on this machine (%s)\n", why);
+	if (!cl_device_present(NULL, 0))
 		return TEST_SKIP;
-	}
-	bvhlab_cl_finish(&cl);
 	ties();
 	deep();
 	errors();

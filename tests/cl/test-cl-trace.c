@@ -30,6 +30,7 @@
 #include <bvhlab/opencl.h>
 
 #include "../cli/cliutil.h"
+#include "cl_device.h"
 
 static const char rays_keys[] =
 	"\"rays\": { \"width\": 40, \"height\": 30, \"diffuse\": 2, \"min_ms\": 1, \"rounds\": 2,\n"
@@ -300,17 +301,11 @@ static void info_mode(const char *device)
 
 int main(int argc, char **argv)
 {
-	bvhlab_cl cl = {0};
-	char why[BVHLAB_CL_ERROR_SIZE];
+	char device[sizeof(((bvhlab_cl *)0)->name)];
 	if (!cli_begin(argc, argv))
 		return 99;
-	if (bvhlab_cl_init(&cl, "auto", why, sizeof(why)) < 0) {
-		printf("skipped: no OpenCL device on this machine (%s)\n", why);
+	if (!cl_device_present(device, sizeof(device)))
 		return TEST_SKIP;
-	}
-	char device[sizeof(cl.name)];
-	memcpy(device, cl.name, sizeof(device));
-	bvhlab_cl_finish(&cl);
 	if (strcmp(argv[2], "trace") == 0) {
 		trace_mode();
 	} else if (strcmp(argv[2], "errors") == 0) {

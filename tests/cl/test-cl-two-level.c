@@ -31,6 +31,7 @@
 #define FIXTURE_SEED 0x4201ULL
 #include "../scene_fixture.h"
 #include "../testutil.h"
+#include "cl_device.h"
 #include "../two_level_fixture.h"
 
 #define SCATTERED 300
@@ -203,13 +204,8 @@ static void check_all(const struct scene_instanced *inst, const struct two_level
 
 int main(void)
 {
-	bvhlab_cl cl = {0};
-	char why[BVHLAB_CL_ERROR_SIZE];
-	if (bvhlab_cl_init(&cl, "auto", why, sizeof(why)) < 0) {
-		printf("skipped: no OpenCL device on this machine (%s)\n", why);
+	if (!cl_device_present(NULL, 0))
 		return TEST_SKIP;
-	}
-	bvhlab_cl_finish(&cl);
 	struct scene_instanced inst;
 	bvhlab_plugin *bottom = NULL, *top = NULL;
 	bvhlab_options bo, to;
