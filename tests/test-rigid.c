@@ -18,6 +18,7 @@
 #include "harness/harness_anim.h"
 #include "harness/harness_anim_top.h"
 #include "harness/harness_instances.h"
+#include "harness/harness_rays.h"
 #include "harness/harness_report.h"
 #include "trace/trace_instances.h"
 #define FIXTURE_SEED 0x42ULL
@@ -127,10 +128,17 @@ static void build_series(const struct scene_instanced *inst, const bvhlab_plugin
 }
 
 /* The harness's frames of the config's builder: every frame valid, rays
- * checked on the first, middle and last, the later frames refitted. */
+ * checked on the first, middle and last, the later frames refitted; with
+ * a camera each frame's primary rays timed and its cost known, without
+ * one neither. */
 static void test_harness(const struct config *cfg, const struct harness_anim *a,
-                         struct two_level_trees *trees, const bvhlab_plugin *top)
+                         struct two_level_trees *trees, const bvhlab_plugin *top, bool camera)
 {
+	bvhlab_camera cam;
+	bvhlab_aabb root;
+	memcpy(root.lo, trees->top.nodes[0].lo, sizeof(root.lo));
+	memcpy(root.hi, trees->top.nodes[0].hi, sizeof(root.hi));
+	harness_camera_of(cfg, cfg->scenes[0].name, &root, &cam);
 	struct harness_builder hb = {.cb = &cfg->builders[0]};
 	size_t size = sizeof(struct series_report) + sizeof(double) +
 	              FRAMES * sizeof(struct frame_metrics);
@@ -141,14 +149,18 @@ static void test_harness(const struct config *cfg, const struct harness_anim *a,
 	rep->samples[0] = 1.0;
 	struct config one = *cfg;
 	one.repeat = 1;
-	CHECK_INT(harness_anim_top_frames(&one, &hb, a, trees, 2, rep, &err), 0);
+	CHECK_INT(harness_anim_top_frames(&one, &hb, a, trees, 2, camera ? &cam : NULL, rep, &err),
+	          0);
 	CHECK(rep->in_frames && rep->frame_count == FRAMES);
 	const struct frame_metrics *fm = (const struct frame_metrics *)(rep->samples + 1);
 	for (uint32_t f = 0; f < FRAMES; f++) {
 		CHECK(fm[f].frame == f && fm[f].valid && isfinite(fm[f].sah) && fm[f].sah > 0);
 		CHECK(fm[f].rebuilt == (f == 0));
 		CHECK(fm[f].rays_checked == (f == 0 || f == 2 || f == 4));
-		CHECK(!fm[f].traced && !fm[f].costed);
+		CHECK(fm[f].traced == camera && fm[f].costed == camera);
+		if (camera)
+			CHECK(fm[f].nodes_per_ray > 0 && fm[f].mrays_per_s > 0 &&
+			      fm[f].cost_ms > fm[f].update_ms);
 	}
 	CHECK(fm[0].update_ms == 1.0);
 	bvhlab_options_finish(&hb.top.opts);
@@ -223,13 +235,13 @@ int main(void)
 		CHECK_INT(bvhlab_options_init(&bo, bvhlab_plugin_builder(bottom)), 0);
 		CHECK_INT(bvhlab_options_init(&to, bvhlab_plugin_builder(top)), 0);
 		CHECK_INT(bvhlab_options_init(&ro, bvhlab_plugin_builder(refit)), 0);
-		for (int strategy = 0; strategy < 3; strategy++) {
+		for (int strategy = 0; strategy < 4; strategy++) {
 			struct two_level_trees trees;
 			build_series(&inst, bottom, &bo, top, &to, &trees);
 			if (strategy < 2)
 				run_frames(&a, &trees, top, &to, strategy ? refit : NULL, &ro);
 			else
-				test_harness(&cfg, &a, &trees, top);
+				test_harness(&cfg, &a, &trees, top, strategy == 3);
 			harness_two_level_finish(&trees);
 		}
 		bvhlab_options_finish(&bo);

@@ -23,6 +23,7 @@ struct top_frames {
 	struct frames_job job; /* the top's plugin, options and the animation */
 	struct frames_updater u;
 	struct two_level_trees *trees;
+	const bvhlab_camera *cam; /* frame 0's; NULL: no rays timed */
 	double *mesh_sah;      /* [mesh_count] each bottom tree's SAH */
 };
 
@@ -69,17 +70,23 @@ static void check(const struct top_frames *tf, const struct scene_instanced *pos
 	}
 }
 
-/* The two-level SAH. No rays are timed: a two-level run has no ray
- * figures yet, so a frame's cost is known only without rays per frame. */
+/* The two-level SAH, and the primary rays of frame 0's camera through
+ * both levels, in one short stretch, as a one-level frame's. */
 static void measure(const struct top_frames *tf, const struct scene_instanced *posed,
                     struct frame_metrics *fm)
 {
 	bvhlab_tree_stats st;
+	struct trace_two_level tl = {.inst = posed, .top = &tf->trees->top,
+	                             .bottom = tf->trees->bottom};
 	bvhlab_tree_stats_compute(&tf->trees->top, &st);
 	const bvhlab_aabb *boxes = tf->trees->top_prims.input.prim_bounds;
 	fm->sah = harness_two_level_sah(posed, &tf->trees->top, boxes, st.sah_cost, tf->mesh_sah);
+	harness_two_level_frame_rays(tf->cfg, &tl, tf->cam, fm);
+	/* Untraced rays are not free: such a frame's cost stays unknown. */
+	fm->costed = fm->traced || tf->cfg->rays_per_frame == 0;
 	fm->cost_ms = fm->update_ms;
-	fm->costed = tf->cfg->rays_per_frame == 0;
+	if (fm->traced)
+		fm->cost_ms += (double)tf->cfg->rays_per_frame / (fm->mrays_per_s * 1e3);
 }
 
 static int one_frame(struct top_frames *tf, uint32_t f, struct frame_metrics *fm,
@@ -122,14 +129,15 @@ static int mesh_sahs(struct top_frames *tf, bvhlab_error *err)
 
 int harness_anim_top_frames(const struct config *cfg, const struct harness_builder *hb,
                             const struct harness_anim *a, struct two_level_trees *trees,
-                            uint32_t threads, struct series_report *rep, bvhlab_error *err)
+                            uint32_t threads, const bvhlab_camera *cam,
+                            struct series_report *rep, bvhlab_error *err)
 {
 	double median, mn, mx;
 	struct frame_metrics *out = (struct frame_metrics *)(rep->samples + cfg->repeat);
 	if (!a || !a->frames)
 		return 0;
 	util_summarise(rep->samples, cfg->repeat, &median, &mn, &mx);
-	struct top_frames tf = {.cfg = cfg, .a = a, .trees = trees,
+	struct top_frames tf = {.cfg = cfg, .a = a, .trees = trees, .cam = cam,
 	                        .job = {.cfg = cfg, .cb = hb->cb, .anim = a,
 	                                .plugin = hb->top.plugin, .opts = &hb->top.opts,
 	                                .threads = threads, .first_ms = median}};

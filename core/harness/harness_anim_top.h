@@ -25,6 +25,7 @@ struct series_report; /* harness_report.h */
  */
 int harness_anim_top_frames(const struct config *cfg, const struct harness_builder *hb,
                             const struct harness_anim *a, struct two_level_trees *trees,
-                            uint32_t threads, struct series_report *rep, bvhlab_error *err);
+                            uint32_t threads, const bvhlab_camera *cam,
+                            struct series_report *rep, bvhlab_error *err);
 
 #endif

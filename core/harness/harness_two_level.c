@@ -228,32 +228,62 @@ void harness_two_level_finish(struct two_level_trees *trees)
 	memset(trees, 0, sizeof(*trees));
 }
 
-/* The run's primary rays through its trees, with the config's
- * traversals and camera (auto-framed on `flat`, the flattened scene's
- * bounds, so its one-level runs trace the same rays; NULL: on the top
- * tree's root box). */
+/* The rays' settings of a two-level run: the CPU stack traversal is the
+ * main one, a device traversal is measured and compared beside it, and
+ * where there is no device it alone is left out (its reason in
+ * rays.error). */
+static void two_level_ray_settings(const struct config *cfg, struct ray_settings *rs)
+{
+	harness_ray_settings(cfg, rs);
+	if (trace_cl_traversal(rs->main)) {
+		rs->main = BVHLAB_TRAVERSAL_STACK;
+		rs->traversals |= 1u << BVHLAB_TRAVERSAL_STACK;
+	}
+}
+
+/* The run's camera: the config's, auto-framed on `flat`, the flattened
+ * scene's bounds, so its one-level runs trace the same rays (NULL: on
+ * the top tree's root box). Its frames keep frame 0's, as one-level
+ * frames do. */
+static void two_level_camera(const struct config *cfg, const char *scene,
+                             const bvhlab_aabb *flat, const struct two_level_trees *trees,
+                             bvhlab_camera *cam)
+{
+	bvhlab_aabb bounds;
+	memcpy(bounds.lo, trees->top.nodes[0].lo, sizeof(bounds.lo));
+	memcpy(bounds.hi, trees->top.nodes[0].hi, sizeof(bounds.hi));
+	harness_camera_of(cfg, scene, flat ? flat : &bounds, cam);
+}
+
+/* The run's primary rays through its trees, with the config's traversals. */
 static void trace_rays(const struct config *cfg, const struct scene_instanced *inst,
-                       const char *scene, const bvhlab_aabb *flat,
-                       const struct two_level_trees *trees, struct ray_metrics *m)
+                       const bvhlab_camera *cam, const struct two_level_trees *trees,
+                       struct ray_metrics *m)
 {
 	struct trace_two_level tl = {.inst = inst, .top = &trees->top, .bottom = trees->bottom};
 	struct ray_settings rs;
-	bvhlab_camera cam;
-	bvhlab_aabb bounds;
-	harness_ray_settings(cfg, &rs);
+	two_level_ray_settings(cfg, &rs);
 	if ((size_t)rs.width * rs.height == 0)
 		return;
-	/* The CPU stack traversal is the main one of a two-level run: a device
-	 * traversal is measured and compared beside it, and where there is no
-	 * device it alone is left out (its reason in rays.error). */
-	if (trace_cl_traversal(rs.main)) {
-		rs.main = BVHLAB_TRAVERSAL_STACK;
-		rs.traversals |= 1u << BVHLAB_TRAVERSAL_STACK;
-	}
-	memcpy(bounds.lo, trees->top.nodes[0].lo, sizeof(bounds.lo));
-	memcpy(bounds.hi, trees->top.nodes[0].hi, sizeof(bounds.hi));
-	harness_camera_of(cfg, scene, flat ? flat : &bounds, &cam);
-	harness_trace_rays_two_level(&tl, &cam, &rs, m);
+	harness_trace_rays_two_level(&tl, cam, &rs, m);
+}
+
+void harness_two_level_frame_rays(const struct config *cfg, const struct trace_two_level *tl,
+                                  const bvhlab_camera *cam, struct frame_metrics *fm)
+{
+	struct ray_settings rs;
+	struct ray_metrics m;
+	two_level_ray_settings(cfg, &rs);
+	rs.traversals = 1u << rs.main; /* a frame reports its main traversal's primary rays */
+	rs.min_ms /= rs.rounds;
+	rs.min_repeats = 1;
+	if (!cam || (size_t)rs.width * rs.height == 0 ||
+	    harness_trace_rays_two_level(tl, cam, &rs, &m) < 0)
+		return;
+	const bvhlab_trace_timing *t = &m.primary[rs.main];
+	fm->nodes_per_ray = t->stats.rays ? (double)t->stats.nodes_visited / t->stats.rays : 0;
+	fm->mrays_per_s = t->mrays_best;
+	fm->traced = t->stats.rays > 0 && t->mrays_best > 0;
 }
 
 enum tree_verdict harness_two_level_run(const struct config *cfg,
@@ -282,10 +312,14 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
 	rep->validated = v != TREE_FAILED;
 	rep->phase_count = trees.phase_count;
 	memcpy(rep->phases, trees.phases, sizeof(rep->phases));
-	if (v == TREE_OK)
-		trace_rays(cfg, inst, scene, flat, &trees, &rep->rays);
+	bvhlab_camera cam;
+	if (v == TREE_OK) {
+		two_level_camera(cfg, scene, flat, &trees, &cam);
+		trace_rays(cfg, inst, &cam, &trees, &rep->rays);
+	}
 	/* An animated scene's frames, on these trees (harness_anim_top.c). */
-	int f = v != TREE_OK ? 0 : harness_anim_top_frames(cfg, hb, anim, &trees, threads, rep, err);
+	int f = v != TREE_OK ? 0
+	                     : harness_anim_top_frames(cfg, hb, anim, &trees, threads, &cam, rep, err);
 	v = f > 0 ? TREE_INVALID : f < 0 ? TREE_FAILED : v;
 	harness_memory_run_end(&rep->memory);
 	harness_two_level_finish(&trees);

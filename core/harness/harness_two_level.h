@@ -14,6 +14,7 @@
 #include "harness/harness_measure.h"
 #include "output/results.h"
 #include "scene/instances.h"
+#include "trace/trace_instances.h"
 
 struct two_level_job {
 	const struct scene_instanced *inst;
@@ -85,6 +86,15 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
                                         const struct harness_anim *anim, const char *scene,
                                         const bvhlab_aabb *flat, uint32_t threads,
                                         struct series_report *rep, bvhlab_error *err);
+
+/*
+ * A frame's primary rays (cam's, frame 0's camera; NULL or no rays
+ * configured: none) through tl's posed instances and trees, with the run's
+ * main traversal: fm's nodes_per_ray, mrays_per_s and traced, as a
+ * one-level frame's (harness_frames.c). Untraced when tracing fails.
+ */
+void harness_two_level_frame_rays(const struct config *cfg, const struct trace_two_level *tl,
+                                  const bvhlab_camera *cam, struct frame_metrics *fm);
 
 /* levels as a run's child sent them, its strings ended, for the record;
  * NULL when it holds no levels (a one-level run's zeroed report). */
