@@ -3,7 +3,7 @@
 
 Usage (from the checkout): bench/peers-standalone/compare.py [--build DIR]
     [--scene PATH] [--subdivide K] [--threads 1,2] [--repeat N] [--warmup N]
-    [--pairs N] [--only SUBSTRING] [--keep DIR]
+    [--pairs N] [--only SUBSTRING[,...]] [--keep DIR]
 
 For every peer builder (tinybvh quick, binned, avx, sweep; madmann91/bvh
 low, medium, high, sweep, binned; Embree low, medium, high) and thread
@@ -66,7 +66,7 @@ def parse_args():
     p.add_argument("--warmup", type=int, default=1)
     p.add_argument("--pairs", type=int, default=1,
                    help="harness/standalone pairs per builder (the ratio is their median)")
-    p.add_argument("--only", default="", help="run the builders whose name holds this")
+    p.add_argument("--only", default="", help="run the builders whose name holds this (or one of these, comma-separated)")
     p.add_argument("--keep", help="folder for the harness's outputs (default: a temporary one)")
     return p.parse_args()
 
@@ -85,7 +85,7 @@ def pairs(args):
     for t in [int(x) for x in args.threads.split(",")]:
         for plugin, variant, serial in BUILDERS:
             name = f"{plugin}_{variant}"
-            if (serial and t > 1) or args.only not in name:
+            if (serial and t > 1) or not any(o in name for o in args.only.split(",")):
                 continue
             if not os.access(program(args, plugin), os.X_OK):
                 continue
