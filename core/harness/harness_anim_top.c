@@ -82,11 +82,6 @@ static void measure(const struct top_frames *tf, const struct scene_instanced *p
 	const bvhlab_aabb *boxes = tf->trees->top_prims.input.prim_bounds;
 	fm->sah = harness_two_level_sah(posed, &tf->trees->top, boxes, st.sah_cost, tf->mesh_sah);
 	harness_two_level_frame_rays(tf->cfg, &tl, tf->cam, fm);
-	/* Untraced rays are not free: such a frame's cost stays unknown. */
-	fm->costed = fm->traced || tf->cfg->rays_per_frame == 0;
-	fm->cost_ms = fm->update_ms;
-	if (fm->traced)
-		fm->cost_ms += (double)tf->cfg->rays_per_frame / (fm->mrays_per_s * 1e3);
 }
 
 static int one_frame(struct top_frames *tf, uint32_t f, struct frame_metrics *fm,

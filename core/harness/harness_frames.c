@@ -115,6 +115,30 @@ static int check(const struct frames_job *job, const bvhlab_scene *scene,
 	return r;
 }
 
+void harness_frames_ray_settings(const struct config *cfg, struct ray_settings *rs)
+{
+	harness_ray_settings(cfg, rs);
+	rs->diffuse = 0;
+	rs->kinds = 1u << RAY_PRIMARY; /* a frame reports its primary rays only */
+	rs->min_ms /= rs->rounds;
+	rs->min_repeats = 1;
+}
+
+void harness_frames_cost(const struct config *cfg, const bvhlab_trace_timing *t,
+                         struct frame_metrics *fm)
+{
+	if (t) {
+		fm->nodes_per_ray = t->stats.rays ? (double)t->stats.nodes_visited / t->stats.rays : 0;
+		fm->mrays_per_s = t->mrays_best;
+		fm->traced = t->stats.rays > 0 && t->mrays_best > 0;
+	}
+	/* Untraced rays are not free: such a frame's cost stays unknown. */
+	fm->costed = fm->traced || cfg->rays_per_frame == 0;
+	fm->cost_ms = fm->update_ms;
+	if (fm->traced)
+		fm->cost_ms += (double)cfg->rays_per_frame / (fm->mrays_per_s * 1e3);
+}
+
 /* SAH, and the primary rays of frame 0's camera, in one short stretch. */
 static void measure(const struct frames_job *job, const bvhlab_scene *scene,
                     const bvhlab_tree *tree, const bvhlab_camera *cam,
@@ -125,22 +149,10 @@ static void measure(const struct frames_job *job, const bvhlab_scene *scene,
 	struct ray_metrics m = {0};
 	bvhlab_tree_stats_compute(tree, &st);
 	fm->sah = st.sah_cost;
-	harness_ray_settings(job->cfg, &rs);
-	rs.diffuse = 0;
-	rs.kinds = 1u << RAY_PRIMARY; /* a frame reports its primary rays only */
-	rs.min_ms /= rs.rounds;
-	rs.min_repeats = 1;
-	if (rs.width && rs.height && harness_trace_rays(tree, scene, cam, &rs, &m, NULL, NULL) == 0) {
-		const bvhlab_trace_timing *t = &m.primary[rs.main];
-		fm->nodes_per_ray = t->stats.rays ? (double)t->stats.nodes_visited / t->stats.rays : 0;
-		fm->mrays_per_s = t->mrays_best;
-		fm->traced = t->stats.rays > 0 && t->mrays_best > 0;
-	}
-	/* Untraced rays are not free: such a frame's cost stays unknown. */
-	fm->costed = fm->traced || job->cfg->rays_per_frame == 0;
-	fm->cost_ms = fm->update_ms;
-	if (fm->traced)
-		fm->cost_ms += (double)job->cfg->rays_per_frame / (fm->mrays_per_s * 1e3);
+	harness_frames_ray_settings(job->cfg, &rs);
+	bool traced = rs.width && rs.height &&
+	              harness_trace_rays(tree, scene, cam, &rs, &m, NULL, NULL) == 0;
+	harness_frames_cost(job->cfg, traced ? &m.primary[rs.main] : NULL, fm);
 }
 
 /* Frame f's scene and primitives, with the triangles of frame 0. */

@@ -16,6 +16,7 @@
 #include "config/config.h"
 #include "harness/harness_anim.h"
 #include "harness/harness_builders.h"
+#include "harness/harness_rays.h"
 #include "harness/refine_stage.h"
 #include "output/results.h"
 
@@ -56,6 +57,17 @@ bool harness_frames_rebuilds(const struct frames_job *job, uint32_t f);
 int harness_frames_advance(const struct frames_job *job, const struct frames_updater *u,
                            uint32_t f, const bvhlab_build_input *in, bvhlab_tree *tree,
                            double *ms, bvhlab_error *err);
+
+/* The rays a frame traces: the config's, primary only, in one short
+ * stretch (the config's min_ms spread over its rounds, one repeat). */
+void harness_frames_ray_settings(const struct config *cfg, struct ray_settings *rs);
+
+/* A frame's ray figures from the timing t of its main traversal (NULL:
+ * not traced), and its modelled cost: the update plus rays_per_frame rays
+ * at t's speed, unknown (costed false) when rays were asked for and none
+ * was traced. */
+void harness_frames_cost(const struct config *cfg, const bvhlab_trace_timing *t,
+                         struct frame_metrics *fm);
 
 /* Frame f of `frames` has its brute-force rays checked: the first, the
  * middle and the last. */

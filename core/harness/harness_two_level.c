@@ -12,6 +12,7 @@
 
 #include "harness/harness_rays.h"
 #include "harness/harness_anim_top.h"
+#include "harness/harness_frames.h"
 #include "harness/harness_memory.h"
 #include "harness/harness_report.h"
 #include "harness/harness_series.h"
@@ -228,13 +229,12 @@ void harness_two_level_finish(struct two_level_trees *trees)
 	memset(trees, 0, sizeof(*trees));
 }
 
-/* The rays' settings of a two-level run: the CPU stack traversal is the
- * main one, a device traversal is measured and compared beside it, and
- * where there is no device it alone is left out (its reason in
+/* A two-level run's main traversal: the CPU stack one, where the config's
+ * is a device traversal, which is measured and compared beside it (and
+ * where there is no device it alone is left out, its reason in
  * rays.error). */
-static void two_level_ray_settings(const struct config *cfg, struct ray_settings *rs)
+static void two_level_main(struct ray_settings *rs)
 {
-	harness_ray_settings(cfg, rs);
 	if (trace_cl_traversal(rs->main)) {
 		rs->main = BVHLAB_TRAVERSAL_STACK;
 		rs->traversals |= 1u << BVHLAB_TRAVERSAL_STACK;
@@ -262,7 +262,8 @@ static void trace_rays(const struct config *cfg, const struct scene_instanced *i
 {
 	struct trace_two_level tl = {.inst = inst, .top = &trees->top, .bottom = trees->bottom};
 	struct ray_settings rs;
-	two_level_ray_settings(cfg, &rs);
+	harness_ray_settings(cfg, &rs);
+	two_level_main(&rs);
 	if ((size_t)rs.width * rs.height == 0)
 		return;
 	harness_trace_rays_two_level(&tl, cam, &rs, m);
@@ -273,17 +274,12 @@ void harness_two_level_frame_rays(const struct config *cfg, const struct trace_t
 {
 	struct ray_settings rs;
 	struct ray_metrics m;
-	two_level_ray_settings(cfg, &rs);
-	rs.traversals = 1u << rs.main; /* a frame reports its main traversal's primary rays */
-	rs.min_ms /= rs.rounds;
-	rs.min_repeats = 1;
-	if (!cam || (size_t)rs.width * rs.height == 0 ||
-	    harness_trace_rays_two_level(tl, cam, &rs, &m) < 0)
-		return;
-	const bvhlab_trace_timing *t = &m.primary[rs.main];
-	fm->nodes_per_ray = t->stats.rays ? (double)t->stats.nodes_visited / t->stats.rays : 0;
-	fm->mrays_per_s = t->mrays_best;
-	fm->traced = t->stats.rays > 0 && t->mrays_best > 0;
+	harness_frames_ray_settings(cfg, &rs);
+	two_level_main(&rs);
+	rs.traversals = 1u << rs.main; /* a frame reports its main traversal's rays */
+	bool traced = cam && rs.width && rs.height &&
+	              harness_trace_rays_two_level(tl, cam, &rs, &m) == 0;
+	harness_frames_cost(cfg, traced ? &m.primary[rs.main] : NULL, fm);
 }
 
 enum tree_verdict harness_two_level_run(const struct config *cfg,

@@ -90,8 +90,8 @@ enum tree_verdict harness_two_level_run(const struct config *cfg,
 /*
  * A frame's primary rays (cam's, frame 0's camera; NULL or no rays
  * configured: none) through tl's posed instances and trees, with the run's
- * main traversal: fm's nodes_per_ray, mrays_per_s and traced, as a
- * one-level frame's (harness_frames.c). Untraced when tracing fails.
+ * main traversal, and the frame's cost from them (harness_frames_cost, as
+ * a one-level frame's). Untraced when tracing fails.
  */
 void harness_two_level_frame_rays(const struct config *cfg, const struct trace_two_level *tl,
                                   const bvhlab_camera *cam, struct frame_metrics *fm);

@@ -217,15 +217,15 @@ int trace_cl_set_tree_args(struct trace_cl_tree *t, bvhlab_error *err)
 	return r;
 }
 
-static const char *kernel_name(int traversal)
+const char *trace_cl_kernel_name(int traversal, bool two_level)
 {
 	switch (traversal) {
 	case BVHLAB_TRAVERSAL_DEVICE_STACK:
-		return "trace_stack";
+		return two_level ? "trace_two_level_stack" : "trace_stack";
 	case BVHLAB_TRAVERSAL_DEVICE_STACKLESS:
-		return "trace_stackless";
+		return two_level ? "trace_two_level_stackless" : "trace_stackless";
 	case BVHLAB_TRAVERSAL_DEVICE_WIDE8:
-		return "trace_wide8";
+		return two_level ? "trace_two_level_wide8" : "trace_wide8";
 	default:
 		return NULL;
 	}
@@ -258,7 +258,7 @@ int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *t
 {
 	struct tree_arrays a;
 	*out = NULL;
-	if (!kernel_name(traversal)) {
+	if (!trace_cl_kernel_name(traversal, false)) {
 		error_set(err, "cl: not a device traversal (%d)", traversal);
 		return -EINVAL;
 	}
@@ -270,7 +270,8 @@ int trace_cl_tree_create(const char *device, int traversal, const bvhlab_tree *t
 		t->node_count = a.node_count;
 		t->index_count = tree->index_count;
 		t->tri_count = scene->triangle_count;
-		r = trace_cl_make_kernel(t, device, kernel_name(traversal), a.need, err);
+		r = trace_cl_make_kernel(t, device, trace_cl_kernel_name(traversal, false), a.need,
+		                         err);
 	}
 	if (r == 0)
 		r = upload_tree(t, tree, scene, &a, err);

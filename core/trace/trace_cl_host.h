@@ -59,6 +59,10 @@ int trace_cl_upload_trees(struct trace_cl_tree *t, const struct tree_arrays *a,
  * at dst (tree->index_count slots); zeros for a slot naming no triangle. */
 void trace_cl_slot_vertices(const bvhlab_tree *tree, const bvhlab_scene *scene, float *dst);
 
+/* The kernel of a device traversal, for one tree or a two-level scene
+ * (trace_cl.cl, trace_cl_two_level.cl); NULL when traversal is not one. */
+const char *trace_cl_kernel_name(int traversal, bool two_level);
+
 /* The device, the program with a stack of at least `need` entries and its
  * kernel `name` into t (t->dev, t->kernel). */
 int trace_cl_make_kernel(struct trace_cl_tree *t, const char *device, const char *name,

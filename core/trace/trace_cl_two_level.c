@@ -25,20 +25,6 @@ struct bottoms {
 	size_t slots;
 };
 
-static const char *kernel_name(int traversal)
-{
-	switch (traversal) {
-	case BVHLAB_TRAVERSAL_DEVICE_STACK:
-		return "trace_two_level_stack";
-	case BVHLAB_TRAVERSAL_DEVICE_STACKLESS:
-		return "trace_two_level_stackless";
-	case BVHLAB_TRAVERSAL_DEVICE_WIDE8:
-		return "trace_two_level_wide8";
-	default:
-		return NULL;
-	}
-}
-
 /* Mesh m's place in the concatenation: its row of the table, and the
  * running totals (nodes, links, slots) moved past it. */
 static int place_mesh(struct bottoms *b, uint32_t m, const struct tree_arrays *a,
@@ -218,7 +204,7 @@ static bool has_doubles(const bvhlab_cl *d)
 static int make_kernel(struct trace_cl_tree *t, const char *device, int traversal,
                        unsigned need, bvhlab_error *err)
 {
-	int r = trace_cl_make_kernel(t, device, kernel_name(traversal), need, err);
+	int r = trace_cl_make_kernel(t, device, trace_cl_kernel_name(traversal, true), need, err);
 	if (r < 0 && t->dev && !has_doubles(t->dev)) {
 		error_set(err, "cl: %s has no doubles (cl_khr_fp64), which a two-level scene's "
 		          "traversal needs to carry rays into instances as the CPU does",
@@ -261,7 +247,7 @@ int trace_cl_two_level_create(const char *device, int traversal,
                               bvhlab_error *err)
 {
 	*out = NULL;
-	if (!kernel_name(traversal)) {
+	if (!trace_cl_kernel_name(traversal, true)) {
 		error_set(err, "cl: not a device traversal (%d)", traversal);
 		return -EINVAL;
 	}
