@@ -9,6 +9,7 @@
 #include <bvhlab/aabb.h>
 
 #include "scene/scene_private.h"
+#include "util/util.h"
 
 /* The centroids and the two overall boxes, from the per-primitive boxes. */
 static void compute_centres(bvhlab_prims *prims, size_t count)
@@ -46,8 +47,10 @@ static void compute_prims(bvhlab_prims *prims, const bvhlab_scene *scene)
 
 static int alloc_prims(bvhlab_prims *prims, size_t count, bvhlab_error *err)
 {
-	prims->bounds_storage = malloc(count * sizeof(bvhlab_aabb));
-	prims->centroid_storage = malloc(count * 3 * sizeof(float));
+	/* Huge pages: Morton builders read the boxes in sorted order, which is
+	 * no order in memory (util_big_alloc). */
+	prims->bounds_storage = util_big_alloc(count, sizeof(bvhlab_aabb));
+	prims->centroid_storage = util_big_alloc(count, 3 * sizeof(float));
 	if (!prims->bounds_storage || !prims->centroid_storage) {
 		bvhlab_prims_finish(prims);
 		scene_error(err, "out of memory for the boxes of %zu primitives", count);

@@ -68,9 +68,6 @@ WIDE_LAYOUT(wide_node, wide_tris, wide_bvh, WIDE, TRI_LANES);
  * node twice (validate first); -ENOMEM. (wide_bvh.c)
  */
 int wide_bvh_init(struct wide_bvh *w, const bvhlab_tree *tree, const bvhlab_scene *scene);
-/* count x size bytes aligned for the traversals' loads, NULL when out of
- * memory; freed with free(). (wide_bvh.c) */
-void *wide_alloc(size_t count, size_t size);
 void wide_bvh_finish(struct wide_bvh *w);
 
 /*

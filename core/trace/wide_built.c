@@ -16,8 +16,8 @@
 
 #include "trace/trace_wide.h"
 #include "tree/tree_view.h"
+#include "util/util.h"
 
-#define LINE 64
 
 struct built {
 	const bvhlab_tree *tree;
@@ -156,8 +156,8 @@ int wide_built_init(struct wide_built *out, const bvhlab_tree *tree, const bvhla
 	if (tree->node_count == 0 || (lanes != 4 && lanes != 8))
 		return -EINVAL;
 	count_built(tree, &b.node_cap, &b.group_cap);
-	b.nodes = wide_alloc(b.node_cap, 32 * (size_t)lanes);
-	b.tris = wide_alloc(b.group_cap, sizeof(struct wide_tris));
+	b.nodes = util_big_alloc(b.node_cap, 32 * (size_t)lanes);
+	b.tris = util_big_alloc(b.group_cap, sizeof(struct wide_tris));
 	b.seen = calloc(tree->node_count, 1);
 	uint32_t *todo = malloc(3 * sizeof(*todo) * (size_t)b.node_cap);
 	int r = b.nodes && b.tris && b.seen && todo ? walk(&b, todo) : -ENOMEM;

@@ -13,14 +13,13 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 
 #include <bvhlab/aabb.h>
 
 #include "trace/trace_wide.h"
 #include "tree/tree_view.h"
+#include "util/util.h"
 
-#define LINE 64
 /* Subtrees of at most this many triangles become one leaf lane (two
  * groups): on igea subdivided once, 4 gave 0.65 of Embree's speed, 8 gave
  * 0.74; 16 and 32 gave more (0.79, 0.83) but flatten so much of the
@@ -303,29 +302,6 @@ static void count_nodes(const bvhlab_tree *tree, uint32_t *pieces, uint32_t *gro
 	*groups = g < UINT32_MAX ? (uint32_t)g : UINT32_MAX;
 }
 
-/*
- * A copy of 2 MiB or more is aligned to 2 MiB and asked for huge pages:
- * rays reach its nodes in no order, and on 4 KiB pages a copy of tens of
- * MiB misses the TLB at most node visits, where the builders' trees
- * (tree.c) are already on huge pages.
- */
-void *wide_alloc(size_t count, size_t size)
-{
-	const size_t huge = (size_t)2 << 20;
-	void *mem = NULL;
-	if (count == 0)
-		count = 1;
-	if (count > SIZE_MAX / size)
-		return NULL;
-	size_t bytes = count * size;
-	if (bytes < huge)
-		return posix_memalign(&mem, LINE, bytes) == 0 ? mem : NULL;
-	if (bytes > SIZE_MAX - huge || posix_memalign(&mem, huge, (bytes + huge - 1) / huge * huge) != 0)
-		return NULL;
-	(void)madvise(mem, (bytes + huge - 1) / huge * huge, MADV_HUGEPAGE);
-	return mem;
-}
-
 int wide_bvh_init(struct wide_bvh *w, const bvhlab_tree *tree, const bvhlab_scene *scene)
 {
 	struct collapse c = {.tree = tree, .scene = scene, .w = w};
@@ -336,8 +312,8 @@ int wide_bvh_init(struct wide_bvh *w, const bvhlab_tree *tree, const bvhlab_scen
 	c.cap++; /* a leaf root still needs one wide node */
 	c.seen = calloc(tree->node_count, 1);
 	c.todo = malloc(c.cap * sizeof(*c.todo));
-	w->nodes = wide_alloc(c.cap, sizeof(*w->nodes));
-	w->tris = wide_alloc(c.group_cap ? c.group_cap : 1, sizeof(*w->tris));
+	w->nodes = util_big_alloc(c.cap, sizeof(*w->nodes));
+	w->tris = util_big_alloc(c.group_cap ? c.group_cap : 1, sizeof(*w->tris));
 	int r = c.seen && c.todo && w->nodes && w->tris ? 0 : -ENOMEM;
 	if (r == 0) {
 		w->node_count = 1;

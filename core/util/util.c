@@ -5,6 +5,8 @@
 #include <string.h>
 #include <time.h>
 
+#include <sys/mman.h>
+
 #include "util/util.h"
 
 void error_setv(bvhlab_error *err, const char *fmt, va_list ap)
@@ -191,4 +193,24 @@ char *util_path_shown(const char *dir, const char *path)
 	if (path[0] != '/' && strncmp(path, dir, n) == 0 && path[n] == '/')
 		path += n + 1;
 	return util_path_normalise(path);
+}
+
+void *util_big_alloc(size_t count, size_t size)
+{
+	const size_t line = 64, huge = (size_t)2 << 20;
+	void *mem = NULL;
+	if (count == 0)
+		count = 1;
+	if (size == 0 || count > SIZE_MAX / size)
+		return NULL;
+	size_t bytes = count * size;
+	if (bytes < huge)
+		return posix_memalign(&mem, line, bytes) == 0 ? mem : NULL;
+	if (bytes > SIZE_MAX - huge)
+		return NULL;
+	bytes = (bytes + huge - 1) / huge * huge;
+	if (posix_memalign(&mem, huge, bytes) != 0)
+		return NULL;
+	(void)madvise(mem, bytes, MADV_HUGEPAGE);
+	return mem;
 }

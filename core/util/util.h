@@ -68,6 +68,16 @@ static inline double util_now_ms(void)
 	return util_now() * 1e3;
 }
 
+/*
+ * count x size bytes, freed with free(); NULL when out of memory or when
+ * the product overflows. Under 2 MiB aligned to a cache line; from 2 MiB
+ * aligned to 2 MiB and asked for transparent huge pages (a hint), for
+ * arrays read in no order: the traversals' wide copies, and the primitive
+ * boxes that Morton builders gather in sorted order. On 4 KiB pages an
+ * array of hundreds of MiB misses the TLB at almost every such read.
+ */
+void *util_big_alloc(size_t count, size_t size);
+
 /* Median, min and max of n samples (sorts a copy); all 0 when n is 0. */
 void util_summarise(const double *samples, uint32_t n, double *median, double *min,
                     double *max);
