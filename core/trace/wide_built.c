@@ -18,7 +18,6 @@
 #include "tree/tree_view.h"
 #include "util/util.h"
 
-
 struct built {
 	const bvhlab_tree *tree;
 	const bvhlab_scene *scene;
