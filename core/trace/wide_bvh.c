@@ -6,7 +6,6 @@
  * whose children do not fit in the lanes left is opened in halves first
  * (a piece: children lo .. hi - 1 of one node, its box their union).
  */
-#define _DEFAULT_SOURCE /* madvise */
 #include <errno.h>
 #include <math.h>
 #include <stdbool.h>
@@ -313,7 +312,7 @@ int wide_bvh_init(struct wide_bvh *w, const bvhlab_tree *tree, const bvhlab_scen
 	c.seen = calloc(tree->node_count, 1);
 	c.todo = malloc(c.cap * sizeof(*c.todo));
 	w->nodes = util_big_alloc(c.cap, sizeof(*w->nodes));
-	w->tris = util_big_alloc(c.group_cap ? c.group_cap : 1, sizeof(*w->tris));
+	w->tris = util_big_alloc(c.group_cap, sizeof(*w->tris));
 	int r = c.seen && c.todo && w->nodes && w->tris ? 0 : -ENOMEM;
 	if (r == 0) {
 		w->node_count = 1;

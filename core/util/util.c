@@ -1,4 +1,7 @@
-/* Error text, strings, the clock and sample statistics shared by the core's modules. */
+/*
+ * Error text, strings, the clock, sample statistics and large arrays shared
+ * by the core's modules.
+ */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
